@@ -1,0 +1,61 @@
+//! The command-line tool: subcommands on top of the library.
+
+mod basic;
+mod bench;
+mod fair;
+mod hierarchy;
+
+use clap::{Parser, Subcommand};
+use std::path::PathBuf;
+
+#[derive(Parser, Debug)]
+#[command(
+    name = "fairmesh",
+    version,
+    about = "Remove noise and unwanted detail from triangle meshes without shrinking them.",
+    long_about = "Remove noise and unwanted detail from triangle meshes without shrinking them \
+(constrained fairing, after Liu, Bao, Heng, Wong and Peng).\n\nWith no subcommand, opens the editor on \
+the bundled Stanford bunny. Formats are chosen by file extension: .obj .gltf .glb .ply .stl .off to read; \
+.obj .gltf .glb .ply to write."
+)]
+pub struct Cli {
+    #[command(subcommand)]
+    pub command: Option<Command>,
+}
+
+#[derive(Subcommand, Debug)]
+pub enum Command {
+    /// Open the editor on FILE (or on the bundled bunny).
+    Edit { file: Option<PathBuf> },
+    /// Print counts, topology and measures of a mesh.
+    Info(basic::InfoArgs),
+    /// Add seeded Gaussian noise to a mesh.
+    Noise(basic::NoiseArgs),
+    /// Convert between formats (chosen by extension).
+    Convert(basic::ConvertArgs),
+    /// Compare OTHER against REFERENCE: surface distance, volume change, per-vertex errors.
+    Compare(basic::CompareArgs),
+    /// Smooth a mesh: constrained fairing or one of the baselines.
+    Fair(fair::FairArgs),
+    /// Build the decimation hierarchy and print its levels.
+    Hierarchy(hierarchy::HierarchyArgs),
+    /// Multiresolution fairing from a chosen start level.
+    Multires(hierarchy::MultiresArgs),
+    /// Time the operations that matter on a mesh.
+    Bench(bench::BenchArgs),
+}
+
+/// Runs a non-editor subcommand.
+pub fn run(command: Command) -> anyhow::Result<()> {
+    match command {
+        Command::Edit { .. } => unreachable!("the editor is started by main"),
+        Command::Info(args) => basic::info(args),
+        Command::Noise(args) => basic::noise(args),
+        Command::Convert(args) => basic::convert(args),
+        Command::Compare(args) => basic::compare(args),
+        Command::Fair(args) => fair::run(args),
+        Command::Hierarchy(args) => hierarchy::run_hierarchy(args),
+        Command::Multires(args) => hierarchy::run_multires(args),
+        Command::Bench(args) => bench::run(args),
+    }
+}
