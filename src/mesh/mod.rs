@@ -8,9 +8,11 @@
 //!   output files keep the input's vertex order.
 
 mod clean;
+mod subdivide;
 mod topology;
 
 pub use clean::{clean, weld, CleanReport, WeldReport};
+pub use subdivide::subdivide_loop;
 pub use topology::{ComponentInfo, Topology};
 
 /// An indexed triangle mesh. Positions are stored in f32 (what every supported file format
