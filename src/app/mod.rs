@@ -1,6 +1,1042 @@
-//! The editor (feature `gui`). STUB: to be filled by the editor work.
+//! The editor (feature `gui`): an eframe app that loads a mesh, builds its decimation hierarchy in
+//! the background, fairs it from the level picked with a slider, shows the result in a wgpu
+//! viewport and exports it.
+//!
+//! Layout:
+//! - [`state`]: persisted [`state::Settings`] and the [`state::Document`] (mesh and results);
+//! - [`jobs`]: worker threads, generation numbers, job results;
+//! - [`panels`]: the widgets; they only read state and emit [`Command`]s;
+//! - [`camera`]: the orbit camera;
+//! - this file: [`App`], which applies commands after the frame, dispatches jobs, applies their
+//!   results, and keeps the viewport's GPU buffers in step with what should be shown.
+//!
+//! Two named worker threads: `fairmesh-io` (load, export) and `fairmesh-compute` (hierarchy,
+//! fairing, level meshes), so an export or the next file's loading never waits for a long
+//! hierarchy build. Loading another file cancels the hierarchy build and fairing of the previous
+//! one through their generation numbers.
+
+pub mod camera;
+pub mod jobs;
+pub mod panels;
+pub mod state;
+
+use std::collections::VecDeque;
+use std::path::{Path, PathBuf};
+use std::sync::mpsc::{self, Receiver, Sender};
+use std::sync::{Arc, Mutex, PoisonError};
+use std::time::{Duration, Instant};
+
+use crate::hierarchy::{self, HierarchyError, HierarchyOptions};
+use crate::multires::{self, MultiresWorkspace};
+use crate::{metrics, TriMesh};
+
+use camera::OrbitCamera;
+use jobs::{
+    DialogPurpose, Faired, Generation, JobCounter, JobResult, JobTicket, SharedProgress, Worker,
+};
+use state::{Document, FairedResult, HierarchyState, Settings, ViewMode};
+
+use crate::render::{DrawParams, Viewport3d};
 
 /// Opens the editor window on `file`, or on the bundled bunny.
-pub fn run(_file: Option<std::path::PathBuf>) -> anyhow::Result<()> {
-    anyhow::bail!("the editor is not implemented yet")
+pub fn run(file: Option<PathBuf>) -> anyhow::Result<()> {
+    let options = eframe::NativeOptions {
+        viewport: egui::ViewportBuilder::default()
+            .with_title("fairmesh")
+            .with_inner_size([1280.0, 800.0])
+            .with_min_inner_size([640.0, 400.0])
+            .with_drag_and_drop(true),
+        renderer: eframe::Renderer::Wgpu,
+        ..Default::default()
+    };
+    eframe::run_native(
+        "fairmesh",
+        options,
+        Box::new(move |cc| {
+            Ok(Box::new(App::with_options(
+                cc,
+                AppOptions {
+                    file,
+                    persistence: true,
+                },
+            )))
+        }),
+    )
+    .map_err(|error| anyhow::anyhow!("the editor window failed: {error}"))
+}
+
+/// The bundled default mesh: `assets/bunny00.obj` beside the working directory or the source tree.
+pub fn bundled_mesh_path() -> PathBuf {
+    let relative = Path::new("assets").join("bunny00.obj");
+    if relative.is_file() {
+        return relative;
+    }
+    Path::new(env!("CARGO_MANIFEST_DIR")).join(relative)
+}
+
+/// How to start the app.
+#[derive(Clone, Debug, Default)]
+pub struct AppOptions {
+    /// The file to open; `None` opens the bundled bunny.
+    pub file: Option<PathBuf>,
+    /// Read and write settings through eframe's storage (off in tests).
+    pub persistence: bool,
+}
+
+/// Something the user asked for; applied after the frame's widgets are drawn.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Command {
+    Open(PathBuf),
+    OpenDialog,
+    Export(PathBuf),
+    ExportDialog,
+    FitView,
+    /// The start level changed.
+    SetLevel(usize),
+    /// A fairing option changed: run again.
+    Refair,
+    /// The view mode changed.
+    SetViewMode(ViewMode),
+    CancelHierarchy,
+    RebuildHierarchy,
+    DismissError,
+}
+
+/// What the viewport has uploaded, to know when to upload again.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+struct Shown {
+    document: u64,
+    what: ShownMesh,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum ShownMesh {
+    Original,
+    Faired { serial: u64 },
+    Level { level: usize },
+}
+
+impl ShownMesh {
+    /// Meshes with the same key share connectivity, so only positions need uploading.
+    fn connectivity(self, base_matches_original: bool) -> (u8, usize) {
+        match self {
+            ShownMesh::Original => (0, 0),
+            ShownMesh::Faired { .. } if base_matches_original => (0, 0),
+            ShownMesh::Faired { .. } => (1, 0),
+            ShownMesh::Level { level } => (2, level),
+        }
+    }
+}
+
+/// CPU time the UI thread spent per frame, for the performance readout.
+#[derive(Default)]
+pub struct FrameStats {
+    recent: VecDeque<Duration>,
+    /// Longest frame while a background job was running.
+    pub max_while_busy: Duration,
+    pub frames: u64,
+}
+
+impl FrameStats {
+    const WINDOW: usize = 240;
+
+    fn record(&mut self, elapsed: Duration, busy: bool) {
+        if self.recent.len() == Self::WINDOW {
+            self.recent.pop_front();
+        }
+        self.recent.push_back(elapsed);
+        if busy {
+            self.max_while_busy = self.max_while_busy.max(elapsed);
+        }
+        self.frames += 1;
+    }
+
+    pub fn last(&self) -> Duration {
+        self.recent.back().copied().unwrap_or_default()
+    }
+    pub fn mean(&self) -> Duration {
+        if self.recent.is_empty() {
+            return Duration::ZERO;
+        }
+        self.recent.iter().sum::<Duration>() / self.recent.len() as u32
+    }
+    pub fn max(&self) -> Duration {
+        self.recent.iter().max().copied().unwrap_or_default()
+    }
+    pub fn reset_busy_max(&mut self) {
+        self.max_while_busy = Duration::ZERO;
+    }
+}
+
+/// A summary of the app's state, for tests and the status line.
+#[derive(Clone, Debug, Default)]
+pub struct AppStatus {
+    pub document: Option<PathBuf>,
+    pub loading: bool,
+    pub hierarchy_ready: bool,
+    pub level_count: usize,
+    pub level: usize,
+    pub shown_vertices: usize,
+    pub shown_faces: usize,
+    /// Serial number of the faired result on record (changes with every new result).
+    pub faired_serial: Option<u64>,
+    pub volume_change: Option<f64>,
+    pub rms_displacement: Option<f64>,
+    pub error: Option<String>,
+    pub message: Option<String>,
+    pub images_drawn: u64,
+}
+
+pub struct App {
+    settings: Settings,
+    persistence: bool,
+    document: Option<Document>,
+    /// The file being loaded, while it loads.
+    loading: Option<PathBuf>,
+    load_generation: Generation,
+    document_generation: Generation,
+    hierarchy_generation: Generation,
+    view_generation: Generation,
+    /// View generation of the faired result on screen (newer results replace it, older don't).
+    applied_view: u64,
+    applied_level_view: u64,
+    hierarchy_progress: SharedProgress,
+    fair_progress: SharedProgress,
+    fair_in_flight: bool,
+    workspace: Arc<Mutex<MultiresWorkspace>>,
+    io: Worker,
+    compute: Worker,
+    jobs: JobCounter,
+    results_tx: Sender<(JobResult, JobTicket)>,
+    results_rx: Receiver<(JobResult, JobTicket)>,
+    dialog_open: bool,
+    ctx: egui::Context,
+    viewport: Option<Viewport3d>,
+    camera: OrbitCamera,
+    shown: Option<Shown>,
+    shown_counts: (usize, usize),
+    error: Option<String>,
+    message: Option<String>,
+    /// The typed path field for opening files.
+    open_path: String,
+    commands: Vec<Command>,
+    next_serial: u64,
+    frame_stats: FrameStats,
+    /// Where the viewport was drawn in the last frame (points).
+    viewport_rect: Option<egui::Rect>,
+}
+
+impl App {
+    /// The app as the window runs it: settings from eframe's storage when `persistence` is on.
+    pub fn with_options(cc: &eframe::CreationContext<'_>, options: AppOptions) -> Self {
+        let settings = if options.persistence {
+            cc.storage
+                .and_then(|storage| eframe::get_value::<Settings>(storage, Settings::STORAGE_KEY))
+                .unwrap_or_default()
+        } else {
+            Settings::default()
+        };
+        let (results_tx, results_rx) = mpsc::channel();
+        // Without threads the editor cannot work at all; failing to start one is fatal.
+        let io = Worker::spawn("fairmesh-io").expect("cannot start the fairmesh-io thread");
+        let compute =
+            Worker::spawn("fairmesh-compute").expect("cannot start the fairmesh-compute thread");
+        let file = options.file.unwrap_or_else(bundled_mesh_path);
+        let mut app = Self {
+            settings,
+            persistence: options.persistence,
+            document: None,
+            loading: None,
+            load_generation: Generation::default(),
+            document_generation: Generation::default(),
+            hierarchy_generation: Generation::default(),
+            view_generation: Generation::default(),
+            applied_view: 0,
+            applied_level_view: 0,
+            hierarchy_progress: SharedProgress::default(),
+            fair_progress: SharedProgress::default(),
+            fair_in_flight: false,
+            workspace: Arc::new(Mutex::new(MultiresWorkspace::default())),
+            io,
+            compute,
+            jobs: JobCounter::default(),
+            results_tx,
+            results_rx,
+            dialog_open: false,
+            ctx: cc.egui_ctx.clone(),
+            viewport: cc.wgpu_render_state.as_ref().map(Viewport3d::new),
+            camera: OrbitCamera::default(),
+            shown: None,
+            shown_counts: (0, 0),
+            error: None,
+            message: None,
+            open_path: file.display().to_string(),
+            commands: Vec::new(),
+            next_serial: 0,
+            frame_stats: FrameStats::default(),
+            viewport_rect: None,
+        };
+        app.open(file);
+        app
+    }
+
+    /// The app for tests: opens `file`, no persistence.
+    pub fn new_for_test(cc: &eframe::CreationContext<'_>, file: impl Into<PathBuf>) -> Self {
+        Self::with_options(
+            cc,
+            AppOptions {
+                file: Some(file.into()),
+                persistence: false,
+            },
+        )
+    }
+
+    /// Queues a command as if a widget had emitted it (applied at the end of the next frame).
+    pub fn push_command(&mut self, command: Command) {
+        self.commands.push(command);
+    }
+
+    /// No job running or waiting and every result applied.
+    pub fn is_settled(&self) -> bool {
+        self.jobs.in_flight() == 0 && self.commands.is_empty()
+    }
+
+    pub fn frame_stats(&self) -> &FrameStats {
+        &self.frame_stats
+    }
+
+    pub fn frame_stats_mut(&mut self) -> &mut FrameStats {
+        &mut self.frame_stats
+    }
+
+    pub fn settings(&self) -> &Settings {
+        &self.settings
+    }
+
+    /// Where the 3D view was drawn in the last frame, in points.
+    pub fn viewport_rect(&self) -> Option<egui::Rect> {
+        self.viewport_rect
+    }
+
+    pub fn camera(&self) -> &OrbitCamera {
+        &self.camera
+    }
+
+    pub fn status(&self) -> AppStatus {
+        let document = self.document.as_ref();
+        let faired = document.and_then(|d| d.faired.as_ref());
+        AppStatus {
+            document: document.map(|d| d.path.clone()),
+            loading: self.loading.is_some(),
+            hierarchy_ready: document.and_then(Document::level_count).is_some(),
+            level_count: document.and_then(Document::level_count).unwrap_or(0),
+            level: document.map(|d| d.level).unwrap_or(0),
+            shown_vertices: self.shown_counts.0,
+            shown_faces: self.shown_counts.1,
+            faired_serial: faired.map(|f| f.serial),
+            volume_change: faired.map(|f| f.volume_change),
+            rms_displacement: faired.map(|f| f.rms_displacement),
+            error: self.error.clone(),
+            message: self.message.clone(),
+            images_drawn: self.viewport.as_ref().map_or(0, Viewport3d::images_drawn),
+        }
+    }
+
+    fn busy(&self) -> bool {
+        self.jobs.in_flight() > 0
+    }
+
+    fn send_result(
+        tx: &Sender<(JobResult, JobTicket)>,
+        ctx: &egui::Context,
+        result: JobResult,
+        ticket: JobTicket,
+    ) {
+        // The receiver is gone only when the app closed; nothing left to tell.
+        let _ = tx.send((result, ticket));
+        ctx.request_repaint();
+    }
+
+    // ---- commands -------------------------------------------------------------------------
+
+    fn apply(&mut self, command: Command) {
+        match command {
+            Command::Open(path) => self.open(path),
+            Command::OpenDialog => self.open_dialog(DialogPurpose::Open),
+            Command::Export(path) => self.export(path),
+            Command::ExportDialog => self.open_dialog(DialogPurpose::Export),
+            Command::FitView => self.fit_view(),
+            Command::SetLevel(level) => {
+                if let Some(document) = &mut self.document {
+                    let top = document.level_count().unwrap_or(1).saturating_sub(1);
+                    document.level = level.min(top);
+                }
+                self.refresh_view();
+            }
+            Command::Refair => self.refresh_view(),
+            Command::SetViewMode(mode) => {
+                self.settings.view_mode = mode;
+                self.refresh_view();
+            }
+            Command::CancelHierarchy => {
+                self.hierarchy_generation.bump();
+                if let Some(document) = &mut self.document {
+                    if matches!(document.hierarchy, HierarchyState::Building) {
+                        document.hierarchy = HierarchyState::Failed("cancelled".into());
+                    }
+                }
+            }
+            Command::RebuildHierarchy => self.start_hierarchy(),
+            Command::DismissError => self.error = None,
+        }
+    }
+
+    /// Starts loading `path` on the io worker; the current mesh stays until it arrives.
+    fn open(&mut self, path: PathBuf) {
+        let generation = self.load_generation.bump();
+        self.loading = Some(path.clone());
+        self.open_path = path.display().to_string();
+        let (tx, ctx, ticket) = (self.results_tx.clone(), self.ctx.clone(), self.jobs.start());
+        self.io.submit(move || {
+            let started = Instant::now();
+            let result = crate::io::load(&path)
+                .map(Box::new)
+                .map_err(|error| error.to_string());
+            let result = result.and_then(|loaded| {
+                if loaded.mesh.triangles.is_empty() {
+                    Err(format!("{}: the file holds no triangles", path.display()))
+                } else {
+                    Ok(loaded)
+                }
+            });
+            let message = JobResult::Loaded {
+                load_generation: generation,
+                path,
+                result,
+                elapsed: started.elapsed(),
+            };
+            Self::send_result(&tx, &ctx, message, ticket);
+        });
+    }
+
+    fn start_hierarchy(&mut self) {
+        let Some(document) = &mut self.document else {
+            return;
+        };
+        let generation = self.hierarchy_generation.bump();
+        document.hierarchy = HierarchyState::Building;
+        self.hierarchy_progress.set(0.0);
+        let mesh = document.original.clone();
+        let document_generation = document.generation;
+        let hierarchy_generation = self.hierarchy_generation.clone();
+        let progress_out = self.hierarchy_progress.clone();
+        let (tx, ctx, ticket) = (self.results_tx.clone(), self.ctx.clone(), self.jobs.start());
+        self.compute.submit(move || {
+            if !hierarchy_generation.is_current(generation) {
+                return;
+            }
+            let started = Instant::now();
+            let mut progress = |fraction: f32| {
+                progress_out.set(fraction);
+                hierarchy_generation.is_current(generation)
+            };
+            let result =
+                hierarchy::build_hierarchy(&mesh, &HierarchyOptions::default(), &mut progress)
+                    .map(Arc::new);
+            let message = JobResult::Hierarchy {
+                document: document_generation,
+                hierarchy: generation,
+                result,
+                elapsed: started.elapsed(),
+            };
+            Self::send_result(&tx, &ctx, message, ticket);
+        });
+    }
+
+    /// Asks for what the current view mode needs at the current level and options.
+    fn refresh_view(&mut self) {
+        let Some(document) = &self.document else {
+            return;
+        };
+        let HierarchyState::Ready { hierarchy, .. } = &document.hierarchy else {
+            return;
+        };
+        let hierarchy = hierarchy.clone();
+        let level = document.level;
+        let document_generation = document.generation;
+        let view = self.view_generation.bump();
+        match self.settings.view_mode {
+            ViewMode::Level => self.request_level_mesh(hierarchy, document_generation, level, view),
+            ViewMode::Faired | ViewMode::Original => {
+                self.request_fairing(hierarchy, document_generation, level, view)
+            }
+        }
+    }
+
+    fn request_fairing(
+        &mut self,
+        hierarchy: Arc<hierarchy::Hierarchy>,
+        document: u64,
+        level: usize,
+        view: u64,
+    ) {
+        let options = self.settings.multires_options(level);
+        let document_generation = self.document_generation.clone();
+        let progress_out = self.fair_progress.clone();
+        let workspace = self.workspace.clone();
+        let (tx, ctx, ticket) = (self.results_tx.clone(), self.ctx.clone(), self.jobs.start());
+        self.fair_in_flight = true;
+        self.fair_progress.set(0.0);
+        self.compute.submit_latest("fair", move || {
+            if !document_generation.is_current(document) {
+                return;
+            }
+            let started = Instant::now();
+            // A newer slider value does not cancel this run: while dragging, finished runs are
+            // what keeps the view moving. Only a new document makes it pointless.
+            let mut progress = |fraction: f32| {
+                progress_out.set(fraction);
+                document_generation.is_current(document)
+            };
+            let mut workspace = workspace.lock().unwrap_or_else(PoisonError::into_inner);
+            let positions =
+                multires::fair_multires(&hierarchy, &options, &mut workspace, &mut progress);
+            drop(workspace);
+            let result = positions.map(|positions| {
+                let base = hierarchy.base_mesh();
+                let (volume_change, rms_displacement) = compare_to_base(base, &positions);
+                Faired {
+                    positions,
+                    volume_change,
+                    rms_displacement,
+                    elapsed: started.elapsed(),
+                }
+            });
+            let message = JobResult::Faired {
+                document,
+                view,
+                level,
+                result,
+            };
+            Self::send_result(&tx, &ctx, message, ticket);
+        });
+    }
+
+    fn request_level_mesh(
+        &mut self,
+        hierarchy: Arc<hierarchy::Hierarchy>,
+        document: u64,
+        level: usize,
+        view: u64,
+    ) {
+        let document_generation = self.document_generation.clone();
+        let (tx, ctx, ticket) = (self.results_tx.clone(), self.ctx.clone(), self.jobs.start());
+        self.compute.submit_latest("level", move || {
+            if !document_generation.is_current(document) {
+                return;
+            }
+            let mesh = Arc::new(hierarchy.level_mesh(level));
+            let message = JobResult::LevelMesh {
+                document,
+                view,
+                level,
+                mesh,
+            };
+            Self::send_result(&tx, &ctx, message, ticket);
+        });
+    }
+
+    fn export(&mut self, path: PathBuf) {
+        let Some(document) = &self.document else {
+            self.error = Some("Nothing to export: no mesh is loaded".into());
+            return;
+        };
+        if path.as_os_str().is_empty() {
+            self.error = Some("Export: type a file path first".into());
+            return;
+        }
+        // The faired positions go with M0's triangles (the hierarchy's base mesh).
+        let (positions, triangles_source) = match (&document.faired, &document.hierarchy) {
+            (Some(faired), HierarchyState::Ready { hierarchy, .. }) => (
+                Some(faired.positions.clone()),
+                ExportTriangles::Base(hierarchy.clone()),
+            ),
+            _ => (None, ExportTriangles::Original(document.original.clone())),
+        };
+        let (tx, ctx, ticket) = (self.results_tx.clone(), self.ctx.clone(), self.jobs.start());
+        self.message = Some(format!("Exporting to {} …", path.display()));
+        self.io.submit(move || {
+            let started = Instant::now();
+            let source = match &triangles_source {
+                ExportTriangles::Base(hierarchy) => hierarchy.base_mesh(),
+                ExportTriangles::Original(mesh) => mesh.as_ref(),
+            };
+            let mesh = match positions {
+                Some(positions) if positions.len() == source.positions.len() => TriMesh {
+                    positions: positions.as_ref().clone(),
+                    triangles: source.triangles.clone(),
+                },
+                _ => source.clone(),
+            };
+            let result = crate::io::save(&path, &mesh).map_err(|error| error.to_string());
+            let message = JobResult::Exported {
+                path,
+                result,
+                elapsed: started.elapsed(),
+            };
+            Self::send_result(&tx, &ctx, message, ticket);
+        });
+    }
+
+    fn open_dialog(&mut self, purpose: DialogPurpose) {
+        if self.dialog_open {
+            return;
+        }
+        let start_dir = self.settings.last_dir.clone().or_else(|| {
+            self.document
+                .as_ref()
+                .and_then(|d| d.path.parent().map(Path::to_path_buf))
+        });
+        let default_name = self.document.as_ref().and_then(|d| {
+            PathBuf::from(&d.export_path)
+                .file_name()
+                .map(|n| n.to_string_lossy().into_owned())
+        });
+        let (tx, ctx) = (self.results_tx.clone(), self.ctx.clone());
+        let ticket = self.jobs.start();
+        let spawned = std::thread::Builder::new()
+            .name("fairmesh-dialog".into())
+            .spawn(move || {
+                let mut dialog = rfd::FileDialog::new();
+                if let Some(dir) = start_dir {
+                    dialog = dialog.set_directory(dir);
+                }
+                let path = match purpose {
+                    DialogPurpose::Open => dialog
+                        .add_filter("Meshes", &["obj", "glb", "gltf", "ply", "stl", "off"])
+                        .add_filter("All files", &["*"])
+                        .pick_file(),
+                    DialogPurpose::Export => {
+                        if let Some(name) = default_name {
+                            dialog = dialog.set_file_name(name);
+                        }
+                        dialog
+                            .add_filter("glTF binary", &["glb"])
+                            .add_filter("glTF", &["gltf"])
+                            .add_filter("Wavefront OBJ", &["obj"])
+                            .add_filter("PLY", &["ply"])
+                            .save_file()
+                    }
+                };
+                Self::send_result(&tx, &ctx, JobResult::DialogPicked { purpose, path }, ticket);
+            });
+        match spawned {
+            Ok(_) => self.dialog_open = true,
+            Err(error) => self.error = Some(format!("Cannot open a file dialog: {error}")),
+        }
+    }
+
+    fn fit_view(&mut self) {
+        let Some(document) = &self.document else {
+            return;
+        };
+        let (lo, hi) = match (self.settings.view_mode, &document.level_mesh) {
+            (ViewMode::Level, Some((_, mesh))) => state::bounds_of(&mesh.positions),
+            _ => document.bounds,
+        };
+        self.camera
+            .fit(glam::Vec3::from_array(lo), glam::Vec3::from_array(hi));
+    }
+
+    // ---- results --------------------------------------------------------------------------
+
+    fn poll_results(&mut self) {
+        while let Ok((result, ticket)) = self.results_rx.try_recv() {
+            self.apply_result(result);
+            // The job counts as finished only once its result is applied.
+            drop(ticket);
+        }
+    }
+
+    fn apply_result(&mut self, result: JobResult) {
+        match result {
+            JobResult::Loaded {
+                load_generation,
+                path,
+                result,
+                elapsed,
+            } => {
+                if !self.load_generation.is_current(load_generation) {
+                    return;
+                }
+                self.loading = None;
+                match result {
+                    Ok(loaded) => {
+                        let generation = self.document_generation.bump();
+                        if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
+                            self.settings.last_dir = Some(dir.to_path_buf());
+                        }
+                        let loaded = *loaded;
+                        self.document = Some(Document::new(
+                            path,
+                            generation,
+                            loaded.mesh,
+                            loaded.report,
+                            elapsed,
+                        ));
+                        self.applied_view = 0;
+                        self.applied_level_view = 0;
+                        self.fair_in_flight = false;
+                        self.error = None;
+                        self.fit_view();
+                        self.start_hierarchy();
+                    }
+                    Err(error) => {
+                        self.error = Some(format!("Could not open the file: {error}"));
+                    }
+                }
+            }
+            JobResult::Hierarchy {
+                document,
+                hierarchy,
+                result,
+                elapsed,
+            } => {
+                if !self.hierarchy_generation.is_current(hierarchy) {
+                    return;
+                }
+                let Some(current) = self.document.as_mut().filter(|d| d.generation == document)
+                else {
+                    return;
+                };
+                match result {
+                    Ok(hierarchy) => {
+                        let levels = (0..hierarchy.level_count())
+                            .map(|l| hierarchy.level_info(l))
+                            .collect::<Vec<_>>();
+                        current.level = current.level.min(levels.len().saturating_sub(1));
+                        current.hierarchy = HierarchyState::Ready {
+                            base_matches_original: hierarchy.base_mesh().triangles
+                                == current.original.triangles,
+                            hierarchy,
+                            levels,
+                            build_time: elapsed,
+                        };
+                        self.refresh_view();
+                    }
+                    Err(HierarchyError::Cancelled) => {
+                        current.hierarchy = HierarchyState::Failed("cancelled".into());
+                    }
+                    Err(error) => {
+                        let text = error.to_string();
+                        current.hierarchy = HierarchyState::Failed(text.clone());
+                        self.error = Some(text);
+                    }
+                }
+            }
+            JobResult::Faired {
+                document,
+                view,
+                level,
+                result,
+            } => {
+                if self.view_generation.is_current(view) {
+                    self.fair_in_flight = false;
+                }
+                let Some(current) = self.document.as_mut().filter(|d| d.generation == document)
+                else {
+                    return;
+                };
+                // Older than what is on screen: stale.
+                if view <= self.applied_view {
+                    return;
+                }
+                if let Some(faired) = result {
+                    self.applied_view = view;
+                    self.next_serial += 1;
+                    current.faired = Some(FairedResult {
+                        positions: Arc::new(faired.positions),
+                        level,
+                        volume_change: faired.volume_change,
+                        rms_displacement: faired.rms_displacement,
+                        elapsed: faired.elapsed,
+                        serial: self.next_serial,
+                    });
+                }
+            }
+            JobResult::LevelMesh {
+                document,
+                view,
+                level,
+                mesh,
+            } => {
+                let Some(current) = self.document.as_mut().filter(|d| d.generation == document)
+                else {
+                    return;
+                };
+                if view <= self.applied_level_view {
+                    return;
+                }
+                self.applied_level_view = view;
+                current.level_mesh = Some((level, mesh));
+            }
+            JobResult::Exported {
+                path,
+                result,
+                elapsed,
+            } => match result {
+                Ok(()) => {
+                    if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
+                        self.settings.last_dir = Some(dir.to_path_buf());
+                    }
+                    self.message = Some(format!(
+                        "Exported to {} ({:.2} s)",
+                        path.display(),
+                        elapsed.as_secs_f64()
+                    ));
+                }
+                Err(error) => {
+                    self.message = None;
+                    self.error = Some(format!("Export failed: {error}"));
+                }
+            },
+            JobResult::DialogPicked { purpose, path } => {
+                self.dialog_open = false;
+                match (purpose, path) {
+                    (DialogPurpose::Open, Some(path)) => self.open(path),
+                    (DialogPurpose::Export, Some(path)) => {
+                        if let Some(document) = &mut self.document {
+                            document.export_path = path.display().to_string();
+                        }
+                        self.export(path);
+                    }
+                    (_, None) => {
+                        self.message = Some(
+                            "No file chosen (if no dialog appeared, type a path instead)".into(),
+                        );
+                    }
+                }
+            }
+        }
+    }
+
+    // ---- viewport -------------------------------------------------------------------------
+
+    /// What the viewport should show now: the view mode's mesh when it exists, otherwise the
+    /// last good mesh of this document, otherwise the loaded mesh.
+    fn wanted_mesh(&self) -> Option<Shown> {
+        let document = self.document.as_ref()?;
+        let previous = self
+            .shown
+            .filter(|s| s.document == document.generation)
+            .map(|s| s.what);
+        let what = match self.settings.view_mode {
+            ViewMode::Original => ShownMesh::Original,
+            ViewMode::Faired => match &document.faired {
+                Some(faired) => ShownMesh::Faired {
+                    serial: faired.serial,
+                },
+                None => ShownMesh::Original,
+            },
+            ViewMode::Level => match &document.level_mesh {
+                Some((level, _)) => ShownMesh::Level { level: *level },
+                None => previous.unwrap_or(ShownMesh::Original),
+            },
+        };
+        Some(Shown {
+            document: document.generation,
+            what,
+        })
+    }
+
+    /// Uploads the wanted mesh when it differs from the one on the GPU.
+    fn sync_viewport(&mut self) {
+        let Some(wanted) = self.wanted_mesh() else {
+            return;
+        };
+        if self.shown == Some(wanted) {
+            return;
+        }
+        let Some(document) = &self.document else {
+            return;
+        };
+        let base = match &document.hierarchy {
+            HierarchyState::Ready {
+                hierarchy,
+                base_matches_original,
+                ..
+            } => Some((hierarchy.clone(), *base_matches_original)),
+            _ => None,
+        };
+        let matches = base.as_ref().is_none_or(|b| b.1);
+        let same_connectivity = self.shown.is_some_and(|shown| {
+            shown.document == wanted.document
+                && shown.what.connectivity(matches) == wanted.what.connectivity(matches)
+        });
+        let (positions, triangles): (&[[f32; 3]], &[[u32; 3]]) = match wanted.what {
+            ShownMesh::Original => (&document.original.positions, &document.original.triangles),
+            ShownMesh::Faired { .. } => {
+                let Some(faired) = &document.faired else {
+                    return;
+                };
+                let triangles = match &base {
+                    Some((hierarchy, false)) => &hierarchy.base_mesh().triangles,
+                    _ => &document.original.triangles,
+                };
+                (&faired.positions, triangles)
+            }
+            ShownMesh::Level { .. } => {
+                let Some((_, mesh)) = &document.level_mesh else {
+                    return;
+                };
+                (&mesh.positions, &mesh.triangles)
+            }
+        };
+        if let Some(viewport) = &self.viewport {
+            if !(same_connectivity && viewport.set_positions(positions)) {
+                viewport.set_mesh(positions, triangles, None);
+            }
+        }
+        self.shown_counts = (positions.len(), triangles.len());
+        self.shown = Some(wanted);
+    }
+
+    fn draw_params(&self, rect: egui::Rect) -> DrawParams {
+        let aspect = rect.width() / rect.height().max(1.0);
+        DrawParams {
+            view_proj: self.camera.view_proj(aspect).to_cols_array_2d(),
+            eye: self.camera.eye().to_array(),
+            light_dir: self.camera.light_dir().to_array(),
+            wireframe: self.settings.wireframe,
+            scalar_range: None,
+            size: [0, 0],
+        }
+    }
+
+    fn handle_global_input(&mut self, ctx: &egui::Context) {
+        let dropped: Vec<PathBuf> = ctx.input(|i| {
+            i.raw
+                .dropped_files
+                .iter()
+                .filter_map(|f| f.path.clone())
+                .collect()
+        });
+        if let Some(path) = dropped.into_iter().next() {
+            self.commands.push(Command::Open(path));
+        }
+        if ctx.egui_wants_keyboard_input() {
+            return;
+        }
+        let (fit, wire) = ctx.input(|i| {
+            (
+                i.key_pressed(egui::Key::F) && i.modifiers.is_none(),
+                i.key_pressed(egui::Key::W) && i.modifiers.is_none(),
+            )
+        });
+        if fit {
+            self.commands.push(Command::FitView);
+        }
+        if wire {
+            self.settings.wireframe = !self.settings.wireframe;
+        }
+    }
+}
+
+enum ExportTriangles {
+    Base(Arc<hierarchy::Hierarchy>),
+    Original(Arc<TriMesh>),
+}
+
+/// Relative volume change and RMS vertex displacement of `positions` against `base`.
+fn compare_to_base(base: &TriMesh, positions: &[[f32; 3]]) -> (f64, f64) {
+    if positions.len() != base.positions.len() || positions.is_empty() {
+        return (f64::NAN, f64::NAN);
+    }
+    let before = metrics::signed_volume(base);
+    let after_mesh = TriMesh {
+        positions: positions.to_vec(),
+        triangles: base.triangles.clone(),
+    };
+    let after = metrics::signed_volume(&after_mesh);
+    let volume_change = if before.abs() > 0.0 {
+        (after - before) / before.abs()
+    } else {
+        f64::NAN
+    };
+    let sum_squared: f64 = positions
+        .iter()
+        .zip(&base.positions)
+        .map(|(p, q)| {
+            (0..3)
+                .map(|k| (p[k] as f64 - q[k] as f64).powi(2))
+                .sum::<f64>()
+        })
+        .sum();
+    (volume_change, (sum_squared / positions.len() as f64).sqrt())
+}
+
+impl eframe::App for App {
+    fn ui(&mut self, ui: &mut egui::Ui, _frame: &mut eframe::Frame) {
+        let started = Instant::now();
+        let ctx = ui.ctx().clone();
+        self.poll_results();
+        self.handle_global_input(&ctx);
+        // Upload before drawing, so the viewport draws what the panels describe.
+        self.sync_viewport();
+        panels::show(self, ui);
+        for command in std::mem::take(&mut self.commands) {
+            self.apply(command);
+        }
+        self.sync_viewport();
+        let busy = self.busy();
+        if busy {
+            // Progress bars move without input events.
+            ctx.request_repaint_after(Duration::from_millis(50));
+        }
+        self.frame_stats.record(started.elapsed(), busy);
+    }
+
+    fn save(&mut self, storage: &mut dyn eframe::Storage) {
+        if self.persistence {
+            eframe::set_value(storage, Settings::STORAGE_KEY, &self.settings);
+        }
+    }
+}
+
+impl Drop for App {
+    fn drop(&mut self) {
+        // Cancel whatever still runs for this app.
+        self.document_generation.bump();
+        self.hierarchy_generation.bump();
+        self.load_generation.bump();
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn displacement_and_volume_of_identical_meshes_are_zero() {
+        let mesh = TriMesh::new(
+            vec![
+                [0.0, 0.0, 0.0],
+                [1.0, 0.0, 0.0],
+                [0.0, 1.0, 0.0],
+                [0.0, 0.0, 1.0],
+            ],
+            vec![[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]],
+        );
+        let (dv, rms) = compare_to_base(&mesh, &mesh.positions);
+        assert_eq!(dv, 0.0);
+        assert_eq!(rms, 0.0);
+        let moved: Vec<_> = mesh
+            .positions
+            .iter()
+            .map(|p| [p[0] + 0.5, p[1], p[2]])
+            .collect();
+        let (dv, rms) = compare_to_base(&mesh, &moved);
+        assert!(dv.abs() < 1e-12, "translation keeps the volume");
+        assert!((rms - 0.5).abs() < 1e-12);
+    }
 }

@@ -1,1 +1,168 @@
-//! The wgpu viewport renderer (feature `gui`). STUB: to be filled by the editor work.
+//! The 3D viewport renderer (feature `gui`): our own wgpu pipeline ([`pipeline::MeshRenderer`],
+//! `shaders/mesh.wgsl`) behind an `egui_wgpu` paint callback.
+//!
+//! The mesh is drawn into the renderer's own colour + depth texture (multisampled, resolved) in
+//! the callback's `prepare` step, and that texture is shown as an ordinary egui image. So the
+//! mesh gets a depth buffer whatever egui's own render pass has (eframe without `depth_buffer`,
+//! or egui_kittest's single-sample pass with none), and the same code runs in the window and in
+//! headless tests. The renderer takes positions, triangles and optional per-vertex scalars and
+//! knows nothing of fairing.
+
+pub mod pipeline;
+
+pub use pipeline::{DrawParams, MeshRenderer};
+
+use egui_wgpu::wgpu;
+
+/// The app's handle on the renderer, which lives in egui_wgpu's callback resources so that the
+/// paint callback can reach it.
+pub struct Viewport3d {
+    state: egui_wgpu::RenderState,
+    texture: Option<egui::TextureId>,
+}
+
+impl Viewport3d {
+    /// Creates the pipelines on the render state's device.
+    pub fn new(state: &egui_wgpu::RenderState) -> Self {
+        let renderer = MeshRenderer::new(&state.device);
+        state.renderer.write().callback_resources.insert(renderer);
+        Self {
+            state: state.clone(),
+            texture: None,
+        }
+    }
+
+    fn with_renderer<R>(&self, f: impl FnOnce(&mut MeshRenderer) -> R) -> Option<R> {
+        let mut egui_renderer = self.state.renderer.write();
+        egui_renderer
+            .callback_resources
+            .get_mut::<MeshRenderer>()
+            .map(f)
+    }
+
+    /// Uploads a mesh with new connectivity (slow for big meshes: call only when it changed).
+    pub fn set_mesh(
+        &self,
+        positions: &[[f32; 3]],
+        triangles: &[[u32; 3]],
+        scalars: Option<&[f32]>,
+    ) {
+        let device = &self.state.device;
+        self.with_renderer(|r| r.set_mesh(device, positions, triangles, scalars));
+    }
+
+    /// Moves the current mesh's vertices; `false` when the vertex count differs.
+    pub fn set_positions(&self, positions: &[[f32; 3]]) -> bool {
+        let queue = &self.state.queue;
+        self.with_renderer(|r| r.set_positions(queue, positions))
+            .unwrap_or(false)
+    }
+
+    /// Replaces the per-vertex scalars; `false` when the count differs.
+    pub fn set_scalars(&self, scalars: &[f32]) -> bool {
+        let queue = &self.state.queue;
+        self.with_renderer(|r| r.set_scalars(queue, scalars))
+            .unwrap_or(false)
+    }
+
+    /// Offscreen images drawn so far.
+    pub fn images_drawn(&self) -> u64 {
+        self.with_renderer(|r| r.images_drawn).unwrap_or(0)
+    }
+
+    /// Adapter name and backend, for the performance readout.
+    pub fn adapter_description(&self) -> String {
+        let info = self.state.adapter.get_info();
+        format!("{} ({:?})", info.name, info.backend)
+    }
+
+    /// Paints the viewport into `rect`: sizes the offscreen target to the rect's pixels, adds the
+    /// paint callback that draws the mesh into it, and the image that shows it.
+    pub fn paint(&mut self, painter: &egui::Painter, rect: egui::Rect, mut params: DrawParams) {
+        let pixels_per_point = painter.ctx().pixels_per_point();
+        let size = [
+            ((rect.width() * pixels_per_point).round() as u32).max(1),
+            ((rect.height() * pixels_per_point).round() as u32).max(1),
+        ];
+        params.size = size;
+        {
+            let device = &self.state.device;
+            let mut egui_renderer = self.state.renderer.write();
+            let Some(renderer) = egui_renderer.callback_resources.get_mut::<MeshRenderer>() else {
+                return;
+            };
+            let recreated = renderer.ensure_target(device, size);
+            let view = renderer.color_view().cloned();
+            if let Some(view) = view {
+                match self.texture {
+                    None => {
+                        self.texture = Some(egui_renderer.register_native_texture(
+                            device,
+                            &view,
+                            wgpu::FilterMode::Linear,
+                        ));
+                    }
+                    Some(id) if recreated => egui_renderer.update_egui_texture_from_wgpu_texture(
+                        device,
+                        &view,
+                        wgpu::FilterMode::Linear,
+                        id,
+                    ),
+                    Some(_) => {}
+                }
+            }
+        }
+        let Some(texture) = self.texture else {
+            return;
+        };
+        painter.add(egui_wgpu::Callback::new_paint_callback(
+            rect,
+            ViewportCallback { params },
+        ));
+        painter.image(
+            texture,
+            rect,
+            egui::Rect::from_min_max(egui::pos2(0.0, 0.0), egui::pos2(1.0, 1.0)),
+            egui::Color32::WHITE,
+        );
+    }
+}
+
+impl Drop for Viewport3d {
+    fn drop(&mut self) {
+        if let Some(id) = self.texture.take() {
+            self.state.renderer.write().free_texture(&id);
+        }
+    }
+}
+
+/// The paint callback: draws the mesh into the offscreen target before egui's render pass
+/// begins; the image shape that follows it shows the result.
+struct ViewportCallback {
+    params: DrawParams,
+}
+
+impl egui_wgpu::CallbackTrait for ViewportCallback {
+    fn prepare(
+        &self,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        _screen_descriptor: &egui_wgpu::ScreenDescriptor,
+        egui_encoder: &mut wgpu::CommandEncoder,
+        callback_resources: &mut egui_wgpu::CallbackResources,
+    ) -> Vec<wgpu::CommandBuffer> {
+        if let Some(renderer) = callback_resources.get_mut::<MeshRenderer>() {
+            renderer.render(device, queue, egui_encoder, &self.params);
+        }
+        Vec::new()
+    }
+
+    fn paint(
+        &self,
+        _info: egui::PaintCallbackInfo,
+        _render_pass: &mut wgpu::RenderPass<'static>,
+        _callback_resources: &egui_wgpu::CallbackResources,
+    ) {
+        // Nothing: the image shape drawn after this callback shows the offscreen target.
+    }
+}

@@ -1,0 +1,293 @@
+//! Background work for the editor: named worker threads with a job queue, and the generation
+//! numbers that let the UI drop stale results and cancel work nobody needs any more.
+//!
+//! - [`Worker`] runs boxed jobs one after another on its own named thread. A job submitted with
+//!   [`Worker::submit_latest`] replaces any job of the same slot still waiting, so a slider being
+//!   dragged queues at most one fairing run behind the one in flight.
+//! - [`Generation`] is a shared counter. A job remembers the value it was started under; when the
+//!   UI bumps the counter (a new file, a newer slider value) the job's progress hook sees the
+//!   change and cancels, and the UI ignores a result whose generation is not the current one.
+//! - Jobs send a [`JobResult`] over a channel and call `request_repaint`, so the UI wakes up even
+//!   when nothing else moves.
+
+use std::collections::VecDeque;
+use std::path::PathBuf;
+use std::sync::atomic::{AtomicU32, AtomicU64, AtomicUsize, Ordering};
+use std::sync::{Arc, Condvar, Mutex, PoisonError};
+use std::time::Duration;
+
+use crate::hierarchy::{Hierarchy, HierarchyError};
+use crate::io::Loaded;
+use crate::TriMesh;
+
+type Job = Box<dyn FnOnce() + Send + 'static>;
+
+struct Queued {
+    slot: Option<&'static str>,
+    job: Job,
+}
+
+#[derive(Default)]
+struct Queue {
+    jobs: VecDeque<Queued>,
+    running: usize,
+    shutdown: bool,
+}
+
+struct Shared {
+    queue: Mutex<Queue>,
+    wake: Condvar,
+}
+
+/// One named background thread and its queue.
+pub struct Worker {
+    shared: Arc<Shared>,
+}
+
+impl Worker {
+    pub fn spawn(name: &str) -> std::io::Result<Self> {
+        let shared = Arc::new(Shared {
+            queue: Mutex::new(Queue::default()),
+            wake: Condvar::new(),
+        });
+        let thread_shared = shared.clone();
+        std::thread::Builder::new()
+            .name(name.to_owned())
+            .spawn(move || worker_loop(&thread_shared))?;
+        Ok(Self { shared })
+    }
+
+    fn lock(&self) -> std::sync::MutexGuard<'_, Queue> {
+        self.shared
+            .queue
+            .lock()
+            .unwrap_or_else(PoisonError::into_inner)
+    }
+
+    /// Queues `job` behind the others.
+    pub fn submit(&self, job: impl FnOnce() + Send + 'static) {
+        self.lock().jobs.push_back(Queued {
+            slot: None,
+            job: Box::new(job),
+        });
+        self.shared.wake.notify_one();
+    }
+
+    /// Queues `job`, dropping any job of the same `slot` that has not started yet.
+    pub fn submit_latest(&self, slot: &'static str, job: impl FnOnce() + Send + 'static) {
+        let mut queue = self.lock();
+        queue.jobs.retain(|queued| queued.slot != Some(slot));
+        queue.jobs.push_back(Queued {
+            slot: Some(slot),
+            job: Box::new(job),
+        });
+        drop(queue);
+        self.shared.wake.notify_one();
+    }
+
+    /// Whether a job is running or waiting.
+    pub fn is_busy(&self) -> bool {
+        let queue = self.lock();
+        queue.running > 0 || !queue.jobs.is_empty()
+    }
+}
+
+impl Drop for Worker {
+    fn drop(&mut self) {
+        // The thread finishes the job in hand (cancelled through its generation by the owner)
+        // and exits; nobody waits for it.
+        let mut queue = self.lock();
+        queue.shutdown = true;
+        queue.jobs.clear();
+        drop(queue);
+        self.shared.wake.notify_all();
+    }
+}
+
+fn worker_loop(shared: &Shared) {
+    loop {
+        let job = {
+            let mut queue = shared.queue.lock().unwrap_or_else(PoisonError::into_inner);
+            loop {
+                if queue.shutdown {
+                    return;
+                }
+                if let Some(queued) = queue.jobs.pop_front() {
+                    queue.running += 1;
+                    break queued.job;
+                }
+                queue = shared
+                    .wake
+                    .wait(queue)
+                    .unwrap_or_else(PoisonError::into_inner);
+            }
+        };
+        // A panicking job must not take the worker down with it; its result is simply missing.
+        let _ = std::panic::catch_unwind(std::panic::AssertUnwindSafe(job));
+        shared
+            .queue
+            .lock()
+            .unwrap_or_else(PoisonError::into_inner)
+            .running -= 1;
+    }
+}
+
+/// A generation counter shared between the UI and the jobs.
+#[derive(Clone, Default)]
+pub struct Generation(Arc<AtomicU64>);
+
+impl Generation {
+    /// Starts a new generation and returns its number.
+    pub fn bump(&self) -> u64 {
+        self.0.fetch_add(1, Ordering::SeqCst) + 1
+    }
+    pub fn current(&self) -> u64 {
+        self.0.load(Ordering::SeqCst)
+    }
+    pub fn is_current(&self, generation: u64) -> bool {
+        self.current() == generation
+    }
+}
+
+/// A fraction in 0..=1 written by a job and read by the UI.
+#[derive(Clone, Default)]
+pub struct SharedProgress(Arc<AtomicU32>);
+
+impl SharedProgress {
+    pub fn set(&self, fraction: f32) {
+        self.0
+            .store(fraction.clamp(0.0, 1.0).to_bits(), Ordering::Relaxed);
+    }
+    pub fn get(&self) -> f32 {
+        f32::from_bits(self.0.load(Ordering::Relaxed))
+    }
+}
+
+/// Counts jobs started and finished, so tests and the UI can tell when everything settled.
+#[derive(Clone, Default)]
+pub struct JobCounter(Arc<AtomicUsize>);
+
+impl JobCounter {
+    pub fn start(&self) -> JobTicket {
+        self.0.fetch_add(1, Ordering::SeqCst);
+        JobTicket(self.0.clone())
+    }
+    pub fn in_flight(&self) -> usize {
+        self.0.load(Ordering::SeqCst)
+    }
+}
+
+/// Held by a submitted job; dropping it (when the job ends, however it ends) counts it finished.
+pub struct JobTicket(Arc<AtomicUsize>);
+
+impl Drop for JobTicket {
+    fn drop(&mut self) {
+        self.0.fetch_sub(1, Ordering::SeqCst);
+    }
+}
+
+/// What the fairing job computed for one slider position and set of options.
+pub struct Faired {
+    pub positions: Vec<[f32; 3]>,
+    /// Relative change of the enclosed volume against the loaded mesh.
+    pub volume_change: f64,
+    /// Root mean square of the vertex displacements against the loaded mesh (model units).
+    pub rms_displacement: f64,
+    pub elapsed: Duration,
+}
+
+/// A job's answer to the UI. Each carries the generation it was started under.
+pub enum JobResult {
+    Loaded {
+        load_generation: u64,
+        path: PathBuf,
+        result: Result<Box<Loaded>, String>,
+        elapsed: Duration,
+    },
+    Hierarchy {
+        document: u64,
+        hierarchy: u64,
+        result: Result<Arc<Hierarchy>, HierarchyError>,
+        elapsed: Duration,
+    },
+    Faired {
+        document: u64,
+        view: u64,
+        level: usize,
+        /// `None`: cancelled or failed.
+        result: Option<Faired>,
+    },
+    LevelMesh {
+        document: u64,
+        view: u64,
+        level: usize,
+        mesh: Arc<TriMesh>,
+    },
+    Exported {
+        path: PathBuf,
+        result: Result<(), String>,
+        elapsed: Duration,
+    },
+    /// A file dialog closed; `None` when it was cancelled or no dialog could be shown.
+    DialogPicked {
+        purpose: DialogPurpose,
+        path: Option<PathBuf>,
+    },
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum DialogPurpose {
+    Open,
+    Export,
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::sync::mpsc;
+
+    #[test]
+    fn worker_runs_jobs_in_order_on_a_named_thread() {
+        let worker = Worker::spawn("fairmesh-test-worker").unwrap();
+        let (tx, rx) = mpsc::channel();
+        for i in 0..3 {
+            let tx = tx.clone();
+            worker.submit(move || {
+                let name = std::thread::current().name().map(str::to_owned);
+                tx.send((i, name)).unwrap();
+            });
+        }
+        let got: Vec<_> = (0..3)
+            .map(|_| rx.recv_timeout(Duration::from_secs(5)).unwrap())
+            .collect();
+        assert_eq!(got.iter().map(|g| g.0).collect::<Vec<_>>(), vec![0, 1, 2]);
+        assert_eq!(got[0].1.as_deref(), Some("fairmesh-test-worker"));
+    }
+
+    #[test]
+    fn latest_slot_keeps_only_the_newest_waiting_job() {
+        let worker = Worker::spawn("fairmesh-test-coalesce").unwrap();
+        let (tx, rx) = mpsc::channel();
+        let (release_tx, release_rx) = mpsc::channel::<()>();
+        // Block the worker so the next jobs wait in the queue.
+        worker.submit(move || {
+            release_rx.recv_timeout(Duration::from_secs(5)).ok();
+        });
+        for i in 0..5 {
+            let tx = tx.clone();
+            worker.submit_latest("fair", move || tx.send(i).unwrap());
+        }
+        release_tx.send(()).unwrap();
+        assert_eq!(rx.recv_timeout(Duration::from_secs(5)).unwrap(), 4);
+        assert!(rx.recv_timeout(Duration::from_millis(200)).is_err());
+    }
+
+    #[test]
+    fn generations_mark_old_work_stale() {
+        let generation = Generation::default();
+        let first = generation.bump();
+        assert!(generation.is_current(first));
+        let second = generation.bump();
+        assert!(!generation.is_current(first) && generation.is_current(second));
+    }
+}

@@ -1,0 +1,406 @@
+//! Headless tests of the editor: the real app driven through egui_kittest on a software wgpu
+//! adapter (lavapipe or llvmpipe; no GPU and no display needed). They load the bundled bunny,
+//! wait for the background hierarchy and fairing, move the level slider with the keyboard,
+//! export and re-load, check that a broken file leaves the mesh in place, drive the camera, and
+//! compare viewport images with reference snapshots (`UPDATE_SNAPSHOTS=1` rewrites them).
+#![cfg(feature = "gui")]
+
+use std::path::{Path, PathBuf};
+use std::time::{Duration, Instant};
+
+use egui::accesskit::Role;
+use egui_kittest::kittest::Queryable;
+use egui_kittest::{Harness, SnapshotOptions};
+use fairmesh::app::App;
+
+fn bunny() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/bunny00.obj")
+}
+
+fn harness_for(path: PathBuf) -> Harness<'static, App> {
+    Harness::builder()
+        .with_size(egui::vec2(1200.0, 800.0))
+        .wgpu()
+        .build_eframe(move |cc| App::new_for_test(cc, path))
+}
+
+/// Steps frames until every background job finished and its result was applied. The bound is
+/// generous (the real hierarchy of a 75k-face mesh in a debug build on a busy machine).
+fn settle(harness: &mut Harness<'_, App>) {
+    let deadline = Instant::now() + Duration::from_secs(300);
+    for _ in 0..200_000 {
+        harness.step();
+        if harness.state().is_settled() {
+            // One more frame: the results applied in the last one reach the viewport and labels.
+            harness.step();
+            return;
+        }
+        if Instant::now() > deadline {
+            break;
+        }
+        std::thread::sleep(Duration::from_millis(5));
+    }
+    panic!("the editor did not settle: {:?}", harness.state().status());
+}
+
+/// The viewport's pixels out of a full-window render.
+fn viewport_image(harness: &mut Harness<'_, App>) -> image::RgbaImage {
+    let full = harness.render().expect("the wgpu test renderer renders");
+    let rect = harness
+        .state()
+        .viewport_rect()
+        .expect("the viewport was drawn");
+    let scale = full.width() as f32 / 1200.0;
+    let (x, y) = (
+        (rect.min.x * scale).round() as u32,
+        (rect.min.y * scale).round() as u32,
+    );
+    let (w, h) = (
+        (rect.width() * scale).round() as u32,
+        (rect.height() * scale).round() as u32,
+    );
+    image::imageops::crop_imm(
+        &full,
+        x,
+        y,
+        w.min(full.width() - x),
+        h.min(full.height() - y),
+    )
+    .to_image()
+}
+
+fn snapshot_options() -> SnapshotOptions {
+    // Software rasterisers differ a little between versions: compare with a tolerance.
+    SnapshotOptions::new()
+        .threshold(2.0)
+        .max_failed_pixels(2500)
+}
+
+/// Replaces the text of the text field whose current value satisfies `which`.
+fn retype(harness: &mut Harness<'_, App>, which: impl Fn(&str) -> bool, text: &str) {
+    let field = harness
+        .get_all_by_role(Role::TextInput)
+        .find(|node| node.value().is_some_and(|v| which(&v)))
+        .expect("text field");
+    field.focus();
+    harness.step();
+    harness.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::A);
+    harness.step();
+    harness
+        .get_all_by_role(Role::TextInput)
+        .find(|node| node.is_focused())
+        .expect("focused text field")
+        .type_text(text);
+    harness.step();
+}
+
+#[test]
+fn loads_the_bunny_builds_the_hierarchy_and_fairs() {
+    let mut harness = harness_for(bunny());
+    settle(&mut harness);
+    let status = harness.state().status();
+    assert_eq!(status.document.as_deref(), Some(bunny().as_path()));
+    assert!(status.error.is_none(), "{:?}", status.error);
+    assert!(status.hierarchy_ready);
+    assert!(status.level_count >= 1);
+    assert!(status.faired_serial.is_some(), "a first fairing ran");
+    assert!(status.shown_vertices > 30_000 && status.shown_faces > 70_000);
+    // Per-level counts and the numbers are on screen.
+    harness.get_by_label("Level sizes");
+    assert!(harness.query_all_by_label("M0").next().is_some());
+    harness.get_by_label("Volume change");
+    harness.get_by_label("RMS displacement");
+    harness.get_by_label("Hierarchy build");
+}
+
+#[test]
+fn level_slider_refairs_and_updates_the_numbers() {
+    let mut harness = harness_for(bunny());
+    settle(&mut harness);
+    let before = harness.state().status();
+    let top = before.level_count - 1;
+
+    harness
+        .get_by_role_and_label(Role::Slider, "Start level")
+        .focus();
+    harness.step();
+    harness.key_press(egui::Key::ArrowRight);
+    settle(&mut harness);
+    let after = harness.state().status();
+    let expected = 1.min(top);
+    assert_eq!(after.level, expected);
+    if top >= 1 {
+        // Starting from a coarser level smooths more: a new result with other numbers.
+        assert_ne!(after.faired_serial, before.faired_serial);
+        assert_ne!(after.rms_displacement, before.rms_displacement);
+        assert!(after.rms_displacement.is_some_and(|r| r > 0.0));
+        assert!(harness
+            .query_all_by_label(&format!("M{expected}"))
+            .next()
+            .is_some());
+        // The slider keeps working while results stream in: several steps, one settle.
+        for _ in 0..3 {
+            harness.key_press(egui::Key::ArrowRight);
+            harness.step();
+        }
+        settle(&mut harness);
+        let last = harness.state().status();
+        assert_eq!(last.level, 4.min(top));
+        assert!(last.faired_serial > after.faired_serial);
+    }
+    // Fair M0 too: another run, the same level.
+    harness.get_by_label("Fair M0 too").click();
+    settle(&mut harness);
+    let refaired = harness.state().status();
+    assert!(refaired.faired_serial > after.faired_serial);
+    assert_eq!(refaired.level, expected);
+}
+
+#[test]
+fn exports_and_reloads_the_result() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut harness = harness_for(bunny());
+    settle(&mut harness);
+    let loaded = harness.state().status();
+
+    // The default export name sits next to the input.
+    let default_export = bunny().with_file_name("bunny00_faired.glb");
+    harness.get_by_value(&default_export.display().to_string());
+
+    let target = dir.path().join("bunny_faired.glb");
+    retype(
+        &mut harness,
+        |v| v.ends_with("_faired.glb"),
+        &target.display().to_string(),
+    );
+    harness
+        .get_by_role_and_label(Role::Button, "Export")
+        .click();
+    settle(&mut harness);
+    let exported = harness.state().status();
+    assert!(exported.error.is_none(), "{:?}", exported.error);
+    assert!(
+        exported
+            .message
+            .as_deref()
+            .is_some_and(|m| m.starts_with("Exported to") && m.contains("bunny_faired.glb")),
+        "{:?}",
+        exported.message
+    );
+    assert!(target.is_file());
+
+    retype(
+        &mut harness,
+        |v| v.ends_with("bunny00.obj"),
+        &target.display().to_string(),
+    );
+    harness.get_by_role_and_label(Role::Button, "Load").click();
+    settle(&mut harness);
+    let reloaded = harness.state().status();
+    assert_eq!(reloaded.document.as_deref(), Some(target.as_path()));
+    assert!(reloaded.error.is_none(), "{:?}", reloaded.error);
+    assert_eq!(reloaded.shown_faces, loaded.shown_faces);
+    assert_eq!(reloaded.shown_vertices, loaded.shown_vertices);
+}
+
+#[test]
+fn a_broken_file_shows_an_error_and_keeps_the_mesh() {
+    let dir = tempfile::tempdir().unwrap();
+    let broken = dir.path().join("broken.obj");
+    std::fs::write(&broken, "v 0 0 0\nv one two three\nf 1 2 3\n").unwrap();
+    let mut harness = harness_for(bunny());
+    settle(&mut harness);
+    let before = harness.state().status();
+
+    for path in [broken.clone(), dir.path().join("missing.obj")] {
+        harness
+            .state_mut()
+            .push_command(fairmesh::app::Command::Open(path.clone()));
+        settle(&mut harness);
+        let after = harness.state().status();
+        let error = after.error.clone().expect("an error is shown");
+        assert!(
+            error.contains(path.file_name().unwrap().to_str().unwrap()),
+            "{error}"
+        );
+        harness.get_by_label_contains("Could not open the file");
+        assert_eq!(after.document, before.document, "the old mesh stays");
+        assert_eq!(after.shown_faces, before.shown_faces);
+        harness
+            .get_by_role_and_label(Role::Button, "Dismiss")
+            .click();
+        harness.step();
+        harness.step();
+        assert!(harness.state().status().error.is_none());
+    }
+}
+
+#[test]
+fn camera_orbits_pans_zooms_and_fits() {
+    let mut harness = harness_for(bunny());
+    settle(&mut harness);
+    let rect = harness.state().viewport_rect().unwrap();
+    let fitted = *harness.state().camera();
+
+    let centre = rect.center();
+    harness.hover_at(centre);
+    harness.step();
+    harness.drag_at(centre);
+    harness.step();
+    for i in 1..=5 {
+        harness.hover_at(centre + egui::vec2(20.0 * i as f32, 5.0 * i as f32));
+        harness.step();
+    }
+    harness.drop_at(centre + egui::vec2(100.0, 25.0));
+    harness.step();
+    let orbited = *harness.state().camera();
+    assert!(orbited.yaw != fitted.yaw && orbited.pitch != fitted.pitch);
+    assert_eq!(orbited.target, fitted.target);
+
+    harness.hover_at(centre);
+    harness.event(egui::Event::MouseWheel {
+        unit: egui::MouseWheelUnit::Point,
+        delta: egui::vec2(0.0, 120.0),
+        phase: egui::TouchPhase::Move,
+        source: egui::MouseWheelSource::Unknown,
+        modifiers: egui::Modifiers::NONE,
+    });
+    for _ in 0..30 {
+        harness.step();
+    }
+    assert!(harness.state().camera().distance < orbited.distance);
+
+    harness.key_press(egui::Key::F);
+    harness.step();
+    let refitted = *harness.state().camera();
+    assert!((refitted.distance - fitted.distance).abs() < 1e-4 * fitted.distance);
+    assert_eq!(refitted.target, fitted.target);
+
+    assert!(!harness.state().settings().wireframe);
+    harness.key_press(egui::Key::W);
+    harness.step();
+    assert!(harness.state().settings().wireframe);
+}
+
+#[test]
+fn viewport_snapshots() {
+    let mut harness = harness_for(bunny());
+    settle(&mut harness);
+    // The loaded mesh, so the image does not depend on the fairing algorithm's details.
+    harness.get_by_label("Original").click();
+    settle(&mut harness);
+
+    let shaded = viewport_image(&mut harness);
+    assert!(harness.state().status().images_drawn >= 1);
+    // The mesh covers the middle of the view, in many shades (one per facet orientation).
+    let (w, h) = shaded.dimensions();
+    let background = *shaded.get_pixel(3, 3);
+    let middle = *shaded.get_pixel(w / 2, h / 2);
+    assert_ne!(
+        middle, background,
+        "the mesh is drawn in the middle of the view"
+    );
+    let mut shades = std::collections::HashSet::new();
+    for y in (0..h).step_by(3) {
+        for x in (0..w).step_by(3) {
+            shades.insert(shaded.get_pixel(x, y).0);
+        }
+    }
+    assert!(
+        shades.len() > 100,
+        "flat shading gives many shades: {}",
+        shades.len()
+    );
+    egui_kittest::image_snapshot_options(&shaded, "viewport_bunny", &snapshot_options());
+
+    harness.key_press(egui::Key::W);
+    harness.step();
+    let wire = viewport_image(&mut harness);
+    let differing = shaded
+        .pixels()
+        .zip(wire.pixels())
+        .filter(|(a, b)| a != b)
+        .count();
+    assert!(
+        differing > 5_000,
+        "the wireframe changes the image ({differing} pixels)"
+    );
+    egui_kittest::image_snapshot_options(&wire, "viewport_bunny_wireframe", &snapshot_options());
+}
+
+/// Writes `mesh` as a minimal OBJ (the test needs a big file before `io::save` can be relied on).
+fn write_obj(mesh: &fairmesh::TriMesh, path: &Path) {
+    use std::io::Write;
+    let mut out = std::io::BufWriter::new(std::fs::File::create(path).unwrap());
+    for p in &mesh.positions {
+        writeln!(out, "v {} {} {}", p[0], p[1], p[2]).unwrap();
+    }
+    for t in &mesh.triangles {
+        writeln!(out, "f {} {} {}", t[0] + 1, t[1] + 1, t[2] + 1).unwrap();
+    }
+}
+
+/// Responsiveness figures (not a pass/fail timing test): UI-thread CPU time per frame while the
+/// hierarchy of a 1.2M-face mesh builds, and frames from a slider step to the new result on the
+/// bunny. Run with `cargo test --release --test editor -- --ignored --nocapture responsiveness`.
+#[test]
+#[ignore]
+fn responsiveness() {
+    let dir = tempfile::tempdir().unwrap();
+    let large = dir.path().join("bunny_x16.obj");
+    let base = fairmesh::io::load(&bunny()).unwrap().mesh;
+    let big = fairmesh::mesh::subdivide_loop(&fairmesh::mesh::subdivide_loop(&base));
+    write_obj(&big, &large);
+    println!("large mesh: {} faces", big.face_count());
+
+    let mut harness = harness_for(large);
+    // Until the document is in and the hierarchy build runs.
+    while harness.state().status().document.is_none() {
+        harness.step();
+        std::thread::sleep(Duration::from_millis(5));
+    }
+    harness.state_mut().frame_stats_mut().reset_busy_max();
+    let started = Instant::now();
+    let mut frames = 0;
+    let mut max_frame = Duration::ZERO;
+    while !harness.state().status().hierarchy_ready {
+        harness.step();
+        frames += 1;
+        max_frame = max_frame.max(harness.state().frame_stats().last());
+        std::thread::sleep(Duration::from_millis(16));
+        assert!(started.elapsed() < Duration::from_secs(900));
+    }
+    println!(
+        "hierarchy of 1.2M faces: {:.1} s, {frames} frames, UI frame max {:.2} ms, mean {:.2} ms",
+        started.elapsed().as_secs_f64(),
+        max_frame.as_secs_f64() * 1e3,
+        harness.state().frame_stats().mean().as_secs_f64() * 1e3
+    );
+    drop(harness);
+
+    let mut harness = harness_for(bunny());
+    settle(&mut harness);
+    let top = harness.state().status().level_count - 1;
+    harness
+        .get_by_role_and_label(Role::Slider, "Start level")
+        .focus();
+    harness.step();
+    for step in 1..=top.min(6) {
+        let before = harness.state().status().faired_serial;
+        let started = Instant::now();
+        harness.key_press(egui::Key::ArrowRight);
+        let mut frames = 0;
+        loop {
+            harness.step();
+            frames += 1;
+            if harness.state().status().faired_serial != before {
+                break;
+            }
+            std::thread::sleep(Duration::from_millis(16));
+        }
+        println!(
+            "slider to level {step}: new result after {frames} frames ({:.0} ms)",
+            started.elapsed().as_secs_f64() * 1e3
+        );
+    }
+}
