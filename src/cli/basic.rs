@@ -139,7 +139,8 @@ pub fn info(args: InfoArgs) -> anyhow::Result<()> {
         topology.boundary_loops.len()
     )?;
     writeln!(out, "  closed              {closed}")?;
-    writeln!(out, 
+    writeln!(
+        out,
         "  manifold            {} ({} non-manifold edges, {} non-manifold vertices, {} inconsistently oriented edges)",
         topology.is_manifold(),
         topology.non_manifold_edges.len(),
