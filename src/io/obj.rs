@@ -13,6 +13,7 @@
 use super::text::{lines, non_finite_kind, quote, tokens};
 use super::{IoError, Parsed};
 use crate::mesh::TriMesh;
+use std::borrow::Cow;
 use std::io::Write;
 use std::path::Path;
 
@@ -24,7 +25,9 @@ pub(crate) fn parse(bytes: &[u8], path: &Path) -> Result<Parsed, IoError> {
         ignore_lines: true,
         ..Default::default()
     };
-    let mut reader = bytes;
+    // tobj reads `l` lines with 3 or more vertices as polygons; they are polylines, not faces.
+    let (filtered, polylines) = comment_out_polylines(bytes);
+    let mut reader: &[u8] = &filtered;
     let (models, _materials) = tobj::load_obj_buf(&mut reader, &options, |_| {
         Err(tobj::LoadError::OpenFileFailed)
     })
@@ -83,7 +86,39 @@ pub(crate) fn parse(bytes: &[u8], path: &Path) -> Result<Parsed, IoError> {
             ),
         ));
     }
-    Ok(Parsed::new(mesh))
+    let mut parsed = Parsed::new(mesh);
+    if polylines > 0 {
+        parsed
+            .warnings
+            .push(format!("{polylines} polylines (l) were skipped"));
+    }
+    Ok(parsed)
+}
+
+/// The file with every `l` line turned into a comment (same length, so line numbers and offsets
+/// stay), and how many there were. Borrowed when there are none, which is the common case.
+fn comment_out_polylines(bytes: &[u8]) -> (Cow<'_, [u8]>, usize) {
+    let mut copy: Option<Vec<u8>> = None;
+    let mut count = 0;
+    let mut line_start = true;
+    for (i, &b) in bytes.iter().enumerate() {
+        if b == b'\n' {
+            line_start = true;
+        } else if line_start && b != b' ' && b != b'\t' {
+            line_start = false;
+            let next = bytes.get(i + 1).copied();
+            if b == b'l' && next.is_none_or(|n| n.is_ascii_whitespace()) {
+                count += 1;
+                if let Some(slot) = copy.get_or_insert_with(|| bytes.to_vec()).get_mut(i) {
+                    *slot = b'#';
+                }
+            }
+        }
+    }
+    match copy {
+        Some(copy) => (Cow::Owned(copy), count),
+        None => (Cow::Borrowed(bytes), 0),
+    }
 }
 
 /// Find the first line that tobj would reject or that gives a bad vertex, and say why. Checks
@@ -175,10 +210,15 @@ fn locate(bytes: &[u8], path: &Path) -> Option<IoError> {
                         if part.is_empty() {
                             continue;
                         }
-                        let (kind, total, seen) = match slot {
-                            0 => ("vertex", total_v, seen_v),
-                            1 => ("texture coordinate", total_vt, seen_vt),
-                            2 => ("normal", total_vn, seen_vn),
+                        let (kind, kinds, total, seen) = match slot {
+                            0 => ("vertex", "vertices", total_v, seen_v),
+                            1 => (
+                                "texture coordinate",
+                                "texture coordinates",
+                                total_vt,
+                                seen_vt,
+                            ),
+                            2 => ("normal", "normals", total_vn, seen_vn),
                             _ => {
                                 return at(format!(
                                     "face {face_number}: corner {} has more than 3 indices",
@@ -199,7 +239,7 @@ fn locate(bytes: &[u8], path: &Path) -> Option<IoError> {
                         };
                         if index == 0 || resolved < 1 || resolved > total {
                             return at(format!(
-                                "face {face_number}: {kind} index {index} is out of range (the file has {total} {kind}s{})",
+                                "face {face_number}: {kind} index {index} is out of range (the file has {total} {kinds}{})",
                                 if index == 0 { "; OBJ indices start at 1" } else { "" }
                             ));
                         }
