@@ -165,7 +165,9 @@ fn exports_and_reloads_the_result() {
 
     // The default export name sits next to the input.
     let default_export = bunny().with_file_name("bunny00_faired.glb");
-    harness.get_by_value(&default_export.display().to_string());
+    assert!(harness
+        .get_all_by_role(Role::TextInput)
+        .any(|node| node.value() == Some(default_export.display().to_string())));
 
     let target = dir.path().join("bunny_faired.glb");
     retype(

@@ -2,7 +2,7 @@
 //! plane (right or middle drag), zooms by changing the distance (scroll), and fits a bounding box.
 //! Y is up, as in the bundled bunny and most scan formats.
 
-use glam::{Mat4, Vec3};
+use glam::{Mat4, Vec3, Vec4};
 
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct OrbitCamera {
@@ -89,10 +89,10 @@ impl OrbitCamera {
     pub fn view_proj(&self, aspect: f32) -> Mat4 {
         let eye = self.eye();
         let (_, up) = self.basis();
-        let view = Mat4::look_at_rh(eye, self.target, up);
+        let view = look_at(eye, self.target, up);
         let far = self.distance + self.scene_radius * 2.0;
         let near = (self.distance - self.scene_radius * 2.0).max(far * 1e-4);
-        Mat4::perspective_rh(self.fov_y, aspect.max(1e-3), near, far) * view
+        perspective(self.fov_y, aspect.max(1e-3), near, far) * view
     }
 
     /// Key light direction (towards the light): above and to the left of the viewer.
@@ -100,6 +100,31 @@ impl OrbitCamera {
         let (right, up) = self.basis();
         (self.backward() + up * 0.6 - right * 0.4).normalize()
     }
+}
+
+/// Right-handed view matrix: the camera at `eye` looks at `target`, `up` roughly up.
+fn look_at(eye: Vec3, target: Vec3, up: Vec3) -> Mat4 {
+    let forward = (target - eye).normalize_or(Vec3::NEG_Z);
+    let side = forward.cross(up).normalize_or(Vec3::X);
+    let up = side.cross(forward);
+    Mat4::from_cols(
+        Vec4::new(side.x, up.x, -forward.x, 0.0),
+        Vec4::new(side.y, up.y, -forward.y, 0.0),
+        Vec4::new(side.z, up.z, -forward.z, 0.0),
+        Vec4::new(-side.dot(eye), -up.dot(eye), forward.dot(eye), 1.0),
+    )
+}
+
+/// Right-handed perspective projection onto wgpu's clip space (depth 0 at `near`, 1 at `far`).
+fn perspective(fov_y: f32, aspect: f32, near: f32, far: f32) -> Mat4 {
+    let h = 1.0 / (fov_y * 0.5).tan();
+    let depth = far / (near - far);
+    Mat4::from_cols(
+        Vec4::new(h / aspect, 0.0, 0.0, 0.0),
+        Vec4::new(0.0, h, 0.0, 0.0),
+        Vec4::new(0.0, 0.0, depth, -1.0),
+        Vec4::new(0.0, 0.0, depth * near, 0.0),
+    )
 }
 
 #[cfg(test)]

@@ -73,7 +73,7 @@ fn toolbar(app: &mut App, ui: &mut egui::Ui) {
             .corner_radius(4.0)
             .show(ui, |ui| {
                 ui.horizontal(|ui| {
-                    ui.colored_label(egui::Color32::WHITE, format!("⚠ {error}"));
+                    ui.colored_label(egui::Color32::WHITE, format!("Error: {error}"));
                     if ui.button("Dismiss").clicked() {
                         app.commands.push(Command::DismissError);
                     }
@@ -121,7 +121,7 @@ fn controls(app: &mut App, ui: &mut egui::Ui) {
         ));
     }
     for warning in &report.warnings {
-        ui.small(format!("⚠ {warning}"));
+        ui.small(format!("Warning: {warning}"));
     }
 
     ui.separator();
