@@ -38,6 +38,7 @@ use std::io::Write;
 use std::path::Path;
 
 pub(crate) fn parse(bytes: &[u8], path: &Path, base_dir: Option<&Path>) -> Result<Parsed, IoError> {
+    check_glb_header(bytes, path)?;
     let document = ::gltf::Gltf::from_slice(bytes).map_err(|e| describe(e, path))?;
     let buffers = load_buffers(&document, path, base_dir)?;
     let mut reader = SceneReader {
@@ -86,6 +87,46 @@ pub(crate) fn parse(bytes: &[u8], path: &Path, base_dir: Option<&Path>) -> Resul
         mesh: reader.mesh,
         warnings: reader.warnings,
     })
+}
+
+/// The GLB header's length, checked before the `gltf` crate sees it: gltf 1.4 subtracts the
+/// header size from it unchecked (an overflow panic in debug builds, found by fuzzing).
+fn check_glb_header(bytes: &[u8], path: &Path) -> Result<(), IoError> {
+    if !bytes.starts_with(b"glTF") {
+        return Ok(());
+    }
+    let Some(declared) = bytes
+        .get(8..12)
+        .and_then(|b| b.try_into().ok())
+        .map(u32::from_le_bytes)
+    else {
+        return Err(IoError::at_byte(
+            path,
+            0,
+            format!(
+                "GLB container: the file is truncated: the 12-byte header is cut off at {} bytes",
+                bytes.len()
+            ),
+        ));
+    };
+    if declared < 12 {
+        return Err(IoError::at_byte(
+            path,
+            8,
+            format!("GLB container: the header declares a total length of {declared} bytes, less than the header itself"),
+        ));
+    }
+    if declared as usize > bytes.len() {
+        return Err(IoError::at_byte(
+            path,
+            8,
+            format!(
+                "GLB container: the file is truncated: the header declares {declared} bytes but the file has {}",
+                bytes.len()
+            ),
+        ));
+    }
+    Ok(())
 }
 
 fn describe(error: ::gltf::Error, path: &Path) -> IoError {
@@ -419,7 +460,7 @@ impl SceneReader<'_> {
                     for c in corners.chunks_exact(3) {
                         push([c[0], c[1], c[2]]);
                     }
-                    if corners.len() % 3 != 0 {
+                    if !corners.len().is_multiple_of(3) {
                         self.warnings.push(format!(
                             "{label}: {} indices is not a multiple of 3; the last {} were ignored",
                             corners.len(),
