@@ -545,6 +545,15 @@ fn broken_gltf_and_glb_files() {
     );
     expect_error(
         d,
+        "no_accessors.glb",
+        &edit(&|j| j["accessors"] = serde_json::json!([])),
+        &[
+            "meshes[0].primitives[0].attributes.POSITION",
+            "accessor 0 does not exist",
+        ],
+    );
+    expect_error(
+        d,
         "sparse.glb",
         &edit(&|j| {
             j["accessors"][0]["sparse"] = serde_json::json!({

@@ -39,7 +39,9 @@ use std::path::Path;
 
 pub(crate) fn parse(bytes: &[u8], path: &Path, base_dir: Option<&Path>) -> Result<Parsed, IoError> {
     check_glb_header(bytes, path)?;
-    let document = ::gltf::Gltf::from_slice(bytes).map_err(|e| describe(e, path))?;
+    let document =
+        ::gltf::Gltf::from_slice_without_validation(bytes).map_err(|e| describe(e, path))?;
+    validate(document.as_json(), path)?;
     let buffers = load_buffers(&document, path, base_dir)?;
     let mut reader = SceneReader {
         path,
@@ -127,6 +129,40 @@ fn check_glb_header(bytes: &[u8], path: &Path) -> Result<(), IoError> {
         ));
     }
     Ok(())
+}
+
+/// What `gltf::Gltf::from_slice` validates, after a check that its validation needs: gltf-json
+/// 1.4 looks up every primitive's POSITION accessor by index without a bounds check (a panic,
+/// found by fuzzing).
+fn validate(root: &json::Root, path: &Path) -> Result<(), IoError> {
+    use json::validation::{Checked, Validate};
+    for (m, mesh) in root.meshes.iter().enumerate() {
+        for (p, primitive) in mesh.primitives.iter().enumerate() {
+            let position = primitive
+                .attributes
+                .get(&Checked::Valid(json::mesh::Semantic::Positions));
+            if let Some(index) = position.filter(|i| i.value() >= root.accessors.len()) {
+                return Err(IoError::at_element(
+                    path,
+                    format!("meshes[{m}].primitives[{p}].attributes.POSITION"),
+                    format!(
+                        "invalid glTF: accessor {} does not exist (the file has {})",
+                        index.value(),
+                        root.accessors.len()
+                    ),
+                ));
+            }
+        }
+    }
+    let mut errors = Vec::new();
+    root.validate(root, json::Path::new, &mut |where_, what| {
+        errors.push((where_(), what))
+    });
+    if errors.is_empty() {
+        Ok(())
+    } else {
+        Err(describe(::gltf::Error::Validation(errors), path))
+    }
 }
 
 fn describe(error: ::gltf::Error, path: &Path) -> IoError {
