@@ -284,11 +284,11 @@ fn embedded_gltf(mut root: json::Root, bin: &[u8]) -> Vec<u8> {
 
 fn glb(root: &json::Root, bin: &[u8]) -> Vec<u8> {
     let mut json_bytes = json::serialize::to_vec(root).unwrap();
-    while json_bytes.len() % 4 != 0 {
+    while !json_bytes.len().is_multiple_of(4) {
         json_bytes.push(b' ');
     }
     let mut bin = bin.to_vec();
-    while bin.len() % 4 != 0 {
+    while !bin.len().is_multiple_of(4) {
         bin.push(0);
     }
     let mut out = b"glTF".to_vec();

@@ -23,7 +23,6 @@ pub(crate) fn parse(bytes: &[u8], path: &Path) -> Result<Parsed, IoError> {
         triangulate: true,
         ignore_points: true,
         ignore_lines: true,
-        ..Default::default()
     };
     // tobj reads `l` lines with 3 or more vertices as polygons; they are polylines, not faces.
     let (filtered, polylines) = comment_out_polylines(bytes);
