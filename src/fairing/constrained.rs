@@ -158,7 +158,6 @@ struct Workspace {
     anchors: Vec<[f32; 3]>,
     anchor_terms: Vec<[f32; 3]>,
     means: Vec<[f32; 3]>,
-    normals: Vec<[f32; 3]>,
     next: Vec<[f32; 3]>,
     curve_accumulator: Vec<([f64; 3], u32)>,
 }
@@ -318,10 +317,6 @@ impl ConstrainedFairing {
             anchors: vec![[0.0; 3]; vertex_count],
             anchor_terms: vec![[0.0; 3]; vertex_count],
             means: vec![[0.0; 3]; vertex_count],
-            normals: match variant {
-                FairVariant::NormalProjected => vec![[0.0; 3]; vertex_count],
-                FairVariant::Paper => Vec::new(),
-            },
             next: vec![[0.0; 3]; vertex_count],
             curve_accumulator: Vec::new(),
         };
@@ -432,45 +427,23 @@ impl ConstrainedFairing {
         let ring = &self.ring;
         let x: &[[f32; 3]] = positions;
 
-        // Pass 1: umbrella means (and normals) of the previous iterate.
+        // Pass 1: umbrella means of the previous iterate.
         let inverse_valence = &self.inverse_valence;
         let closed_fan = &self.closed_fan;
-        if project {
-            ws.means
-                .par_chunks_mut(CHUNK)
-                .zip(ws.normals.par_chunks_mut(CHUNK))
-                .enumerate()
-                .for_each(|(chunk, (means, normals))| {
-                    let start = chunk * CHUNK;
-                    for (i, (mean, normal)) in means.iter_mut().zip(normals.iter_mut()).enumerate()
-                    {
-                        let v = start + i;
-                        let ring_v = &ring[offsets[v] as usize..offsets[v + 1] as usize];
-                        *mean = umbrella_mean(x, ring_v, inverse_valence[v]);
-                        *normal = if closed_fan[v] {
-                            fan_normal(x, v, ring_v)
-                        } else {
-                            [0.0; 3]
-                        };
-                    }
-                });
-        } else {
-            ws.means
-                .par_chunks_mut(CHUNK)
-                .enumerate()
-                .for_each(|(chunk, means)| {
-                    let start = chunk * CHUNK;
-                    for (i, mean) in means.iter_mut().enumerate() {
-                        let v = start + i;
-                        let ring_v = &ring[offsets[v] as usize..offsets[v + 1] as usize];
-                        *mean = umbrella_mean(x, ring_v, inverse_valence[v]);
-                    }
-                });
-        }
+        ws.means
+            .par_chunks_mut(CHUNK)
+            .enumerate()
+            .for_each(|(chunk, means)| {
+                let start = chunk * CHUNK;
+                for (i, mean) in means.iter_mut().enumerate() {
+                    let v = start + i;
+                    let ring_v = &ring[offsets[v] as usize..offsets[v + 1] as usize];
+                    *mean = umbrella_mean(x, ring_v, inverse_valence[v]);
+                }
+            });
 
-        // Pass 2: the averaged local solutions.
+        // Pass 2: the averaged local solutions (the paper's update).
         let means = &ws.means;
-        let normals = &ws.normals;
         let anchor_terms = &ws.anchor_terms;
         let ring_weights = &self.ring_weights;
         let self_weights = &self.self_weights;
@@ -494,15 +467,9 @@ impl ConstrainedFairing {
                             sum[k] += wm * mu[k] + wx * xu[k];
                         }
                     }
-                    let mut step: [f32; 3] = std::array::from_fn(|k| sum[k] - p[k]);
-                    if project && closed_fan[v] {
-                        let n = normals[v];
-                        let along = n[0] * step[0] + n[1] * step[1] + n[2] * step[2];
-                        step = n.map(|c| c * along);
-                    }
-                    max_squared =
-                        max_squared.max(step[0] * step[0] + step[1] * step[1] + step[2] * step[2]);
-                    *new_position = std::array::from_fn(|k| p[k] + step[k]);
+                    let step: [f32; 3] = std::array::from_fn(|k| sum[k] - p[k]);
+                    max_squared = max_squared.max(dot(step, step));
+                    *new_position = sum;
                 }
                 max_squared
             })
@@ -520,8 +487,39 @@ impl ConstrainedFairing {
             );
             max_move = max_move.max(curve_move);
         }
-        std::mem::swap(positions, &mut ws.next);
-        max_move
+        if !project {
+            std::mem::swap(positions, &mut ws.next);
+            return max_move;
+        }
+
+        // Pass 3 (normal-projected variant): keep the component of each move along the normal of
+        // the updated fan. The means buffer is free now and receives the result.
+        let updated = &ws.next;
+        let max_move_squared = ws
+            .means
+            .par_chunks_mut(CHUNK)
+            .enumerate()
+            .map(|(chunk, out)| {
+                let start = chunk * CHUNK;
+                let mut max_squared = 0.0f32;
+                for (i, new_position) in out.iter_mut().enumerate() {
+                    let v = start + i;
+                    let p = x[v];
+                    let mut step: [f32; 3] = std::array::from_fn(|k| updated[v][k] - p[k]);
+                    if closed_fan[v] {
+                        let ring_v = &ring[offsets[v] as usize..offsets[v + 1] as usize];
+                        let n = fan_normal(updated, v, ring_v);
+                        let along = dot(n, step);
+                        step = n.map(|c| c * along);
+                    }
+                    max_squared = max_squared.max(dot(step, step));
+                    *new_position = std::array::from_fn(|k| p[k] + step[k]);
+                }
+                max_squared
+            })
+            .reduce(|| 0.0f32, f32::max);
+        std::mem::swap(positions, &mut ws.means);
+        (max_move_squared as f64).sqrt()
     }
 }
 
@@ -537,24 +535,36 @@ fn umbrella_mean(x: &[[f32; 3]], ring: &[u32], inverse_valence: f32) -> [f32; 3]
     sum.map(|s| s * inverse_valence)
 }
 
+#[inline]
+fn cross(a: [f32; 3], b: [f32; 3]) -> [f32; 3] {
+    [
+        a[1] * b[2] - a[2] * b[1],
+        a[2] * b[0] - a[0] * b[2],
+        a[0] * b[1] - a[1] * b[0],
+    ]
+}
+
+#[inline]
+fn dot(a: [f32; 3], b: [f32; 3]) -> f32 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+
 /// Unit area-weighted normal of the closed fan (v, ring[k], ring[k+1]); zero when degenerate.
 #[inline]
 fn fan_normal(x: &[[f32; 3]], v: usize, ring: &[u32]) -> [f32; 3] {
     let centre = x[v];
-    let relative = |u: u32| {
-        let p = x[u as usize];
-        [p[0] - centre[0], p[1] - centre[1], p[2] - centre[2]]
-    };
+    let relative = |u: u32| -> [f32; 3] { std::array::from_fn(|k| x[u as usize][k] - centre[k]) };
     let mut normal = [0.0f32; 3];
     let mut previous = relative(ring[ring.len() - 1]);
     for &u in ring {
         let current = relative(u);
-        normal[0] += previous[1] * current[2] - previous[2] * current[1];
-        normal[1] += previous[2] * current[0] - previous[0] * current[2];
-        normal[2] += previous[0] * current[1] - previous[1] * current[0];
+        let c = cross(previous, current);
+        for k in 0..3 {
+            normal[k] += c[k];
+        }
         previous = current;
     }
-    let length = (normal[0] * normal[0] + normal[1] * normal[1] + normal[2] * normal[2]).sqrt();
+    let length = dot(normal, normal).sqrt();
     if length > 0.0 && length.is_finite() {
         normal.map(|c| c / length)
     } else {
