@@ -1,5 +1,5 @@
 //! The fairing quality table: for each mesh, add noise of 0.3 mean edge lengths along the normals
-//! (seed 1), then compare constrained fairing (1, 2, 3, 5, 10, 20 rounds of 10 iterations, both
+//! (seed 1), then compare constrained fairing (1, 2, 3, 5, 10, 20, 30, 40, 60 rounds of 10 iterations, both
 //! variants) with each baseline at its best iteration count (scanned), against the clean mesh.
 //! Also measures how far each variant moves the vertices of the noise-free mesh.
 //!
@@ -229,7 +229,7 @@ fn main() {
             &quality(&clean, &noisy, &noisy, &faces, edge),
         );
         for variant in [FairVariant::Paper, FairVariant::NormalProjected] {
-            for rounds in [1, 2, 3, 5, 10, 20] {
+            for rounds in [1, 2, 3, 5, 10, 20, 30, 40, 60] {
                 let mut faired = noisy.clone();
                 fair(
                     &mut faired,
@@ -265,7 +265,7 @@ fn main() {
                     iterations: 1,
                     ..Default::default()
                 }),
-                150,
+                200,
             ),
             (
                 "hc β=0.5",
@@ -273,7 +273,7 @@ fn main() {
                     iterations: 1,
                     ..Default::default()
                 }),
-                60,
+                200,
             ),
         ];
         for (label, options, max_iterations) in baselines {

@@ -27,9 +27,10 @@
 //! constant within a round. Averaging over v's triangles keeps that form, so the precomputation
 //! folds everything into one weight pair per one-ring entry, and an iteration is two gather passes
 //! over vertices, both parallel (rayon) with no scatter and no atomics:
-//! 1. umbrella means m (and, for the normal-projected variant, the vertex normals from the
-//!    one-ring fan), reading the previous iterate;
-//! 2. x_new = anchor term + Σ (α·m_u + β·x_u) over the closed one-ring; then the boundary curves.
+//! 1. umbrella means m, reading the previous iterate;
+//! 2. x̃ = anchor term + Σ (α·m_u + β·x_u) over the closed one-ring; then the boundary curves;
+//! 3. (normal-projected variant only) x_new = x + n·(n·(x̃ − x)), n the unit normal of v's fan in
+//!    x̃ (the one-ring is stored in fan order for that).
 //!
 //! Every vertex is computed by the same sequence of operations whatever the thread count, so the
 //! output is bit-identical for any rayon pool. Positions, means and weights are f32 (weights are
@@ -352,6 +353,28 @@ impl ConstrainedFairing {
     /// vertices aside).
     pub fn solved_vertices(&self) -> usize {
         self.solved_vertices
+    }
+
+    /// Bytes one [`Self::iterate`] must stream from or to memory with this data layout, if every
+    /// array is read once and gathered neighbours hit the cache: the floor for its run time is
+    /// this divided by the machine's copy bandwidth (read + write bytes per second).
+    pub fn streamed_bytes_per_iteration(&self) -> usize {
+        let vertices = self.vertex_count();
+        let entries = self.ring.len();
+        let offsets = 4 * (vertices + 1);
+        let point = 12 * vertices;
+        // Pass 1: offsets, ring, x; writes means (counted twice: write-allocate).
+        let pass1 = offsets + 4 * entries + 4 * vertices + point + 2 * point;
+        // Pass 2: offsets, ring, ring weights, own weights, anchor terms, means, x; writes x̃.
+        let pass2 = offsets + 12 * entries + 12 * vertices + 3 * point + 2 * point;
+        // Pass 3: offsets, ring, fan flags, x̃, x; writes the result.
+        let pass3 = match self.variant {
+            FairVariant::Paper => 0,
+            FairVariant::NormalProjected => {
+                offsets + 4 * entries + vertices + 2 * point + 2 * point
+            }
+        };
+        pass1 + pass2 + pass3
     }
 
     /// Runs `options.rounds` rounds of up to `options.iterations` iterations on `positions`
