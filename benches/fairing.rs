@@ -39,11 +39,11 @@ fn fairing_iteration(c: &mut Criterion) {
         for variant in [FairVariant::Paper, FairVariant::NormalProjected] {
             let mut fairing =
                 ConstrainedFairing::new(&mesh, &topology, variant, BoundaryMode::Curve);
-            let mut positions = mesh.positions.clone();
-            fairing.set_anchors(&positions);
+            let positions = mesh.positions.clone();
+            fairing.load(&positions);
             group.bench_function(
                 BenchmarkId::new(format!("constrained_{}", variant.name()), name),
-                |b| b.iter(|| black_box(fairing.iterate(&mut positions))),
+                |b| b.iter(|| black_box(fairing.step())),
             );
         }
         let stencil = UmbrellaStencil::new(&topology, BoundaryMode::Curve);

@@ -97,14 +97,14 @@ fn main() {
             let mut fairing =
                 ConstrainedFairing::new(mesh, &topology, variant, BoundaryMode::Curve);
             let precompute_ms = start.elapsed().as_secs_f64() * 1e3;
-            let mut positions = mesh.positions.clone();
-            fairing.set_anchors(&positions);
+            let positions = mesh.positions.clone();
+            fairing.load(&positions);
             let bytes = fairing.streamed_bytes_per_iteration();
             // The floor uses the bandwidth of a copy of the same size (cache effects included).
             let bandwidth = copy_bandwidth(bytes / 2);
             let floor_ms = bytes as f64 / bandwidth * 1e3;
             let (wall, cpu) = time_per_iteration(iterations, || {
-                fairing.iterate(&mut positions);
+                fairing.step();
             });
             println!(
                 "| {name} | constrained iteration ({}) | {wall:.3} | {cpu:.3} | {:.1} | {floor_ms:.3} | {:.1} |",

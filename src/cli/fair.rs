@@ -223,11 +223,11 @@ pub fn bench_rows(mesh: &fairmesh::TriMesh, topology: &fairmesh::Topology) -> Ve
     rows.push(("fair: constrained precomputation".to_string(), precompute));
     for variant in [FairVariant::Paper, FairVariant::NormalProjected] {
         let mut fairing = ConstrainedFairing::new(mesh, topology, variant, BoundaryMode::Curve);
-        let mut positions = mesh.positions.clone();
-        fairing.set_anchors(&positions);
-        fairing.iterate(&mut positions);
+        let positions = mesh.positions.clone();
+        fairing.load(&positions);
+        fairing.step();
         let ms = median_ms(15, || {
-            fairing.iterate(&mut positions);
+            fairing.step();
         });
         rows.push((
             format!("fair: constrained iteration ({})", variant.name()),

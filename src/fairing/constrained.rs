@@ -37,7 +37,7 @@
 //! computed in f64 and rounded): the operator is a contraction towards its fixed point, so rounding
 //! does not accumulate; the tests check volume to 1e-4 relative and equivariance to f32 accuracy.
 
-use super::boundary::BoundaryCurves;
+use super::boundary::{BoundaryCurves, CurvePoint};
 use super::{BoundaryMode, FairOptions, FairReport, FairVariant};
 use crate::mesh::{Topology, TriMesh};
 use rayon::prelude::*;
@@ -156,10 +156,11 @@ pub struct ConstrainedFairing {
 
 #[derive(Clone, Debug, Default)]
 struct Workspace {
-    anchors: Vec<[f32; 3]>,
-    anchor_terms: Vec<[f32; 3]>,
-    means: Vec<[f32; 3]>,
-    next: Vec<[f32; 3]>,
+    current: Vec<Point4>,
+    anchors: Vec<Point4>,
+    anchor_terms: Vec<Point4>,
+    means: Vec<Point4>,
+    next: Vec<Point4>,
     curve_accumulator: Vec<([f64; 3], u32)>,
 }
 
@@ -315,10 +316,11 @@ impl ConstrainedFairing {
             BoundaryMode::Fixed => BoundaryCurves::default(),
         };
         let workspace = Workspace {
-            anchors: vec![[0.0; 3]; vertex_count],
-            anchor_terms: vec![[0.0; 3]; vertex_count],
-            means: vec![[0.0; 3]; vertex_count],
-            next: vec![[0.0; 3]; vertex_count],
+            current: vec![Point4::default(); vertex_count],
+            anchors: vec![Point4::default(); vertex_count],
+            anchor_terms: vec![Point4::default(); vertex_count],
+            means: vec![Point4::default(); vertex_count],
+            next: vec![Point4::default(); vertex_count],
             curve_accumulator: Vec::new(),
         };
         ConstrainedFairing {
@@ -362,7 +364,7 @@ impl ConstrainedFairing {
         let vertices = self.vertex_count();
         let entries = self.ring.len();
         let offsets = 4 * (vertices + 1);
-        let point = 12 * vertices;
+        let point = 16 * vertices;
         // Pass 1: offsets, ring, x; writes means (counted twice: write-allocate).
         let pass1 = offsets + 4 * entries + 4 * vertices + point + 2 * point;
         // Pass 2: offsets, ring, ring weights, own weights, anchor terms, means, x; writes x̃.
@@ -380,35 +382,51 @@ impl ConstrainedFairing {
     /// Runs `options.rounds` rounds of up to `options.iterations` iterations on `positions`
     /// (which must have this connectivity's vertex count). `options.variant` and
     /// `options.boundary` are those given to [`ConstrainedFairing::new`].
-    pub fn run(&mut self, positions: &mut Vec<[f32; 3]>, options: &FairOptions) -> FairReport {
-        assert_eq!(
-            positions.len(),
-            self.vertex_count(),
-            "positions do not fit this connectivity"
-        );
+    pub fn run(&mut self, positions: &mut [[f32; 3]], options: &FairOptions) -> FairReport {
+        self.load(positions);
         let mut report = FairReport::default();
-        for _ in 0..options.rounds {
-            self.set_anchors(positions);
+        for round in 0..options.rounds {
+            if round > 0 {
+                self.reanchor();
+            }
             for _ in 0..options.iterations {
-                report.max_move = self.iterate(positions);
+                report.max_move = self.step();
                 report.iterations_run += 1;
                 if report.max_move < options.tolerance {
                     break;
                 }
             }
         }
+        self.store(positions);
         report
     }
 
-    /// Imposes the constraints on `positions`: they become the anchors P⁰ of the next iterations.
-    pub fn set_anchors(&mut self, positions: &[[f32; 3]]) {
+    /// Takes `positions` as the current state and imposes the constraints on them (they become
+    /// the anchors P⁰ of the next iterations).
+    pub fn load(&mut self, positions: &[[f32; 3]]) {
         assert_eq!(
             positions.len(),
             self.vertex_count(),
             "positions do not fit this connectivity"
         );
+        for (state, p) in self.workspace.current.iter_mut().zip(positions) {
+            *state = Point4::from_xyz(*p);
+        }
+        self.reanchor();
+    }
+
+    /// Copies the current state into `positions`.
+    pub fn store(&self, positions: &mut [[f32; 3]]) {
+        for (p, state) in positions.iter_mut().zip(&self.workspace.current) {
+            *p = state.xyz();
+        }
+    }
+
+    /// Re-imposes the constraints on the current state (the start of a new round).
+    pub fn reanchor(&mut self) {
         let ws = &mut self.workspace;
-        ws.anchors.copy_from_slice(positions);
+        ws.anchors.copy_from_slice(&ws.current);
+        let anchors = &ws.anchors;
         let (offsets, ring, weights, own) = (
             &self.ring_offsets,
             &self.ring,
@@ -423,32 +441,27 @@ impl ConstrainedFairing {
                 for (i, term) in out.iter_mut().enumerate() {
                     let v = start + i;
                     let w = own[v][2] as f64;
-                    let mut sum = positions[v].map(|x| w * x as f64);
+                    let mut sum = anchors[v].xyz().map(|x| w * x as f64);
                     for e in offsets[v] as usize..offsets[v + 1] as usize {
                         let w = weights[e] as f64;
-                        let p = positions[ring[e] as usize];
+                        let p = anchors[ring[e] as usize].0;
                         for k in 0..3 {
                             sum[k] += w * p[k] as f64;
                         }
                     }
-                    *term = sum.map(|s| s as f32);
+                    *term = Point4::from_xyz(sum.map(|s| s as f32));
                 }
             });
     }
 
-    /// One Jacobi iteration on `positions` (anchors from the last [`Self::set_anchors`]). Returns
-    /// the largest vertex move.
-    pub fn iterate(&mut self, positions: &mut Vec<[f32; 3]>) -> f64 {
-        assert_eq!(
-            positions.len(),
-            self.vertex_count(),
-            "positions do not fit this connectivity"
-        );
+    /// One Jacobi iteration of the current state (anchors from the last [`Self::load`] or
+    /// [`Self::reanchor`]). Returns the largest vertex move.
+    pub fn step(&mut self) -> f64 {
         let project = self.variant == FairVariant::NormalProjected;
         let ws = &mut self.workspace;
         let offsets = &self.ring_offsets;
         let ring = &self.ring;
-        let x: &[[f32; 3]] = positions;
+        let x: &[Point4] = &ws.current;
 
         // Pass 1: umbrella means of the previous iterate.
         let inverse_valence = &self.inverse_valence;
@@ -480,19 +493,19 @@ impl ConstrainedFairing {
                 for (i, new_position) in out.iter_mut().enumerate() {
                     let v = start + i;
                     let [wm, wx, _] = self_weights[v];
-                    let (m, p, a) = (means[v], x[v], anchor_terms[v]);
-                    let mut sum: [f32; 3] = std::array::from_fn(|k| a[k] + wm * m[k] + wx * p[k]);
+                    let (m, p, a) = (means[v].0, x[v].0, anchor_terms[v].0);
+                    let mut sum: [f32; 4] = std::array::from_fn(|k| a[k] + wm * m[k] + wx * p[k]);
                     for e in offsets[v] as usize..offsets[v + 1] as usize {
                         let u = ring[e] as usize;
                         let [wm, wx] = ring_weights[e];
-                        let (mu, xu) = (means[u], x[u]);
-                        for k in 0..3 {
+                        let (mu, xu) = (means[u].0, x[u].0);
+                        for k in 0..4 {
                             sum[k] += wm * mu[k] + wx * xu[k];
                         }
                     }
-                    let step: [f32; 3] = std::array::from_fn(|k| sum[k] - p[k]);
-                    max_squared = max_squared.max(dot(step, step));
-                    *new_position = sum;
+                    let step: [f32; 4] = std::array::from_fn(|k| sum[k] - p[k]);
+                    max_squared = max_squared.max(dot4(step, step));
+                    *new_position = Point4(sum);
                 }
                 max_squared
             })
@@ -511,7 +524,7 @@ impl ConstrainedFairing {
             max_move = max_move.max(curve_move);
         }
         if !project {
-            std::mem::swap(positions, &mut ws.next);
+            std::mem::swap(&mut ws.current, &mut ws.next);
             return max_move;
         }
 
@@ -527,71 +540,79 @@ impl ConstrainedFairing {
                 let mut max_squared = 0.0f32;
                 for (i, new_position) in out.iter_mut().enumerate() {
                     let v = start + i;
-                    let p = x[v];
-                    let mut step: [f32; 3] = std::array::from_fn(|k| updated[v][k] - p[k]);
+                    let p = x[v].0;
+                    let mut step: [f32; 4] = std::array::from_fn(|k| updated[v].0[k] - p[k]);
                     if closed_fan[v] {
                         let ring_v = &ring[offsets[v] as usize..offsets[v + 1] as usize];
                         let n = fan_normal(updated, v, ring_v);
-                        let along = dot(n, step);
+                        let along = dot4(n, step);
                         step = n.map(|c| c * along);
                     }
-                    max_squared = max_squared.max(dot(step, step));
-                    *new_position = std::array::from_fn(|k| p[k] + step[k]);
+                    max_squared = max_squared.max(dot4(step, step));
+                    *new_position = Point4(std::array::from_fn(|k| p[k] + step[k]));
                 }
                 max_squared
             })
             .reduce(|| 0.0f32, f32::max);
-        std::mem::swap(positions, &mut ws.means);
+        std::mem::swap(&mut ws.current, &mut ws.means);
         (max_move_squared as f64).sqrt()
     }
 }
 
+/// A position padded to four lanes (the fourth is always 0) and aligned to 16 bytes, so that the
+/// kernels load and combine whole points with single vector instructions.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+#[repr(C, align(16))]
+pub struct Point4(pub [f32; 4]);
+
+impl super::boundary::CurvePoint for Point4 {
+    #[inline]
+    fn xyz(&self) -> [f32; 3] {
+        [self.0[0], self.0[1], self.0[2]]
+    }
+    #[inline]
+    fn from_xyz(p: [f32; 3]) -> Self {
+        Point4([p[0], p[1], p[2], 0.0])
+    }
+}
+
 #[inline]
-fn umbrella_mean(x: &[[f32; 3]], ring: &[u32], inverse_valence: f32) -> [f32; 3] {
-    let mut sum = [0.0f32; 3];
+fn umbrella_mean(x: &[Point4], ring: &[u32], inverse_valence: f32) -> Point4 {
+    let mut sum = [0.0f32; 4];
     for &u in ring {
-        let p = x[u as usize];
-        for k in 0..3 {
+        let p = x[u as usize].0;
+        for k in 0..4 {
             sum[k] += p[k];
         }
     }
-    sum.map(|s| s * inverse_valence)
+    Point4(sum.map(|s| s * inverse_valence))
 }
 
 #[inline]
-fn cross(a: [f32; 3], b: [f32; 3]) -> [f32; 3] {
-    [
-        a[1] * b[2] - a[2] * b[1],
-        a[2] * b[0] - a[0] * b[2],
-        a[0] * b[1] - a[1] * b[0],
-    ]
+fn dot4(a: [f32; 4], b: [f32; 4]) -> f32 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2] + a[3] * b[3]
 }
 
+/// Unit area-weighted normal of the closed fan (v, ring[k], ring[k+1]), fourth lane 0; zero when
+/// degenerate.
 #[inline]
-fn dot(a: [f32; 3], b: [f32; 3]) -> f32 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-}
-
-/// Unit area-weighted normal of the closed fan (v, ring[k], ring[k+1]); zero when degenerate.
-#[inline]
-fn fan_normal(x: &[[f32; 3]], v: usize, ring: &[u32]) -> [f32; 3] {
-    let centre = x[v];
-    let relative = |u: u32| -> [f32; 3] { std::array::from_fn(|k| x[u as usize][k] - centre[k]) };
-    let mut normal = [0.0f32; 3];
+fn fan_normal(x: &[Point4], v: usize, ring: &[u32]) -> [f32; 4] {
+    let centre = x[v].0;
+    let relative = |u: u32| -> [f32; 4] { std::array::from_fn(|k| x[u as usize].0[k] - centre[k]) };
+    let mut normal = [0.0f32; 4];
     let mut previous = relative(ring[ring.len() - 1]);
     for &u in ring {
         let current = relative(u);
-        let c = cross(previous, current);
-        for k in 0..3 {
-            normal[k] += c[k];
-        }
+        normal[0] += previous[1] * current[2] - previous[2] * current[1];
+        normal[1] += previous[2] * current[0] - previous[0] * current[2];
+        normal[2] += previous[0] * current[1] - previous[1] * current[0];
         previous = current;
     }
-    let length = dot(normal, normal).sqrt();
+    let length = dot4(normal, normal).sqrt();
     if length > 0.0 && length.is_finite() {
         normal.map(|c| c / length)
     } else {
-        [0.0; 3]
+        [0.0; 4]
     }
 }
 
@@ -853,10 +874,11 @@ mod tests {
         let anchors = mesh.positions.clone();
         let mut fairing =
             ConstrainedFairing::new(&mesh, &topology, FairVariant::Paper, BoundaryMode::Curve);
-        fairing.set_anchors(&anchors);
+        fairing.load(&anchors);
         for iteration in 0..5 {
             let expected = reference_iteration(&mesh, &topology, &anchors);
-            fairing.iterate(&mut mesh.positions);
+            fairing.step();
+            fairing.store(&mut mesh.positions);
             for (v, (got, want)) in mesh.positions.iter().zip(&expected).enumerate() {
                 for k in 0..3 {
                     assert!(
