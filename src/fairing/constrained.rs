@@ -545,8 +545,13 @@ impl ConstrainedFairing {
                     if closed_fan[v] {
                         let ring_v = &ring[offsets[v] as usize..offsets[v + 1] as usize];
                         let n = fan_normal(updated, v, ring_v);
-                        let along = dot4(n, step);
-                        step = n.map(|c| c * along);
+                        let length_squared = dot4(n, n);
+                        step = if length_squared > 0.0 && length_squared.is_finite() {
+                            let along = dot4(n, step) / length_squared;
+                            n.map(|c| c * along)
+                        } else {
+                            [0.0; 4]
+                        };
                     }
                     max_squared = max_squared.max(dot4(step, step));
                     *new_position = Point4(std::array::from_fn(|k| p[k] + step[k]));
@@ -593,8 +598,8 @@ fn dot4(a: [f32; 4], b: [f32; 4]) -> f32 {
     a[0] * b[0] + a[1] * b[1] + a[2] * b[2] + a[3] * b[3]
 }
 
-/// Unit area-weighted normal of the closed fan (v, ring[k], ring[k+1]), fourth lane 0; zero when
-/// degenerate.
+/// Area-weighted normal (not normalised) of the closed fan (v, ring[k], ring[k+1]), fourth
+/// lane 0.
 #[inline]
 fn fan_normal(x: &[Point4], v: usize, ring: &[u32]) -> [f32; 4] {
     let centre = x[v].0;
@@ -608,12 +613,7 @@ fn fan_normal(x: &[Point4], v: usize, ring: &[u32]) -> [f32; 4] {
         normal[2] += previous[0] * current[1] - previous[1] * current[0];
         previous = current;
     }
-    let length = dot4(normal, normal).sqrt();
-    if length > 0.0 && length.is_finite() {
-        normal.map(|c| c / length)
-    } else {
-        [0.0; 4]
-    }
+    normal
 }
 
 /// The one-ring of interior vertex `v` in the order of its fan of faces (v, ring[k], ring[k+1]),
