@@ -159,8 +159,9 @@ struct Workspace {
     current: Vec<Point4>,
     anchors: Vec<Point4>,
     anchor_terms: Vec<Point4>,
-    means: Vec<Point4>,
+    position_and_mean: Vec<PositionAndMean>,
     next: Vec<Point4>,
+    projected: Vec<Point4>,
     curve_accumulator: Vec<([f64; 3], u32)>,
 }
 
@@ -319,8 +320,12 @@ impl ConstrainedFairing {
             current: vec![Point4::default(); vertex_count],
             anchors: vec![Point4::default(); vertex_count],
             anchor_terms: vec![Point4::default(); vertex_count],
-            means: vec![Point4::default(); vertex_count],
+            position_and_mean: vec![PositionAndMean::default(); vertex_count],
             next: vec![Point4::default(); vertex_count],
+            projected: match variant {
+                FairVariant::NormalProjected => vec![Point4::default(); vertex_count],
+                FairVariant::Paper => Vec::new(),
+            },
             curve_accumulator: Vec::new(),
         };
         ConstrainedFairing {
@@ -365,9 +370,11 @@ impl ConstrainedFairing {
         let entries = self.ring.len();
         let offsets = 4 * (vertices + 1);
         let point = 16 * vertices;
-        // Pass 1: offsets, ring, x; writes means (counted twice: write-allocate).
-        let pass1 = offsets + 4 * entries + 4 * vertices + point + 2 * point;
-        // Pass 2: offsets, ring, ring weights, own weights, anchor terms, means, x; writes x̃.
+        // Pass 1: offsets, ring, 1/n, x; writes positions and means (counted twice:
+        // write-allocate).
+        let pass1 = offsets + 4 * entries + 4 * vertices + point + 4 * point;
+        // Pass 2: offsets, ring, ring weights, own weights, anchor terms, positions and means;
+        // writes x̃.
         let pass2 = offsets + 12 * entries + 12 * vertices + 3 * point + 2 * point;
         // Pass 3: offsets, ring, fan flags, x̃, x; writes the result.
         let pass3 = match self.variant {
@@ -463,23 +470,27 @@ impl ConstrainedFairing {
         let ring = &self.ring;
         let x: &[Point4] = &ws.current;
 
-        // Pass 1: umbrella means of the previous iterate.
+        // Pass 1: umbrella means of the previous iterate, stored next to the positions so that
+        // pass 2 gathers both with one access per neighbour.
         let inverse_valence = &self.inverse_valence;
         let closed_fan = &self.closed_fan;
-        ws.means
+        ws.position_and_mean
             .par_chunks_mut(CHUNK)
             .enumerate()
-            .for_each(|(chunk, means)| {
+            .for_each(|(chunk, pairs)| {
                 let start = chunk * CHUNK;
-                for (i, mean) in means.iter_mut().enumerate() {
+                for (i, pair) in pairs.iter_mut().enumerate() {
                     let v = start + i;
                     let ring_v = &ring[offsets[v] as usize..offsets[v + 1] as usize];
-                    *mean = umbrella_mean(x, ring_v, inverse_valence[v]);
+                    *pair = PositionAndMean {
+                        position: x[v].0,
+                        mean: umbrella_mean(x, ring_v, inverse_valence[v]).0,
+                    };
                 }
             });
 
         // Pass 2: the averaged local solutions (the paper's update).
-        let means = &ws.means;
+        let pairs = &ws.position_and_mean;
         let anchor_terms = &ws.anchor_terms;
         let ring_weights = &self.ring_weights;
         let self_weights = &self.self_weights;
@@ -493,12 +504,19 @@ impl ConstrainedFairing {
                 for (i, new_position) in out.iter_mut().enumerate() {
                     let v = start + i;
                     let [wm, wx, _] = self_weights[v];
-                    let (m, p, a) = (means[v].0, x[v].0, anchor_terms[v].0);
+                    let PositionAndMean {
+                        position: p,
+                        mean: m,
+                    } = pairs[v];
+                    let a = anchor_terms[v].0;
                     let mut sum: [f32; 4] = std::array::from_fn(|k| a[k] + wm * m[k] + wx * p[k]);
                     for e in offsets[v] as usize..offsets[v + 1] as usize {
                         let u = ring[e] as usize;
                         let [wm, wx] = ring_weights[e];
-                        let (mu, xu) = (means[u].0, x[u].0);
+                        let PositionAndMean {
+                            position: xu,
+                            mean: mu,
+                        } = pairs[u];
                         for k in 0..4 {
                             sum[k] += wm * mu[k] + wx * xu[k];
                         }
@@ -529,10 +547,10 @@ impl ConstrainedFairing {
         }
 
         // Pass 3 (normal-projected variant): keep the component of each move along the normal of
-        // the updated fan. The means buffer is free now and receives the result.
+        // the updated fan, into the spare buffer.
         let updated = &ws.next;
         let max_move_squared = ws
-            .means
+            .projected
             .par_chunks_mut(CHUNK)
             .enumerate()
             .map(|(chunk, out)| {
@@ -559,7 +577,7 @@ impl ConstrainedFairing {
                 max_squared
             })
             .reduce(|| 0.0f32, f32::max);
-        std::mem::swap(&mut ws.current, &mut ws.means);
+        std::mem::swap(&mut ws.current, &mut ws.projected);
         (max_move_squared as f64).sqrt()
     }
 }
@@ -579,6 +597,14 @@ impl super::boundary::CurvePoint for Point4 {
     fn from_xyz(p: [f32; 3]) -> Self {
         Point4([p[0], p[1], p[2], 0.0])
     }
+}
+
+/// A vertex's position and umbrella mean side by side (32 bytes, one half cache line).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+#[repr(C, align(32))]
+struct PositionAndMean {
+    position: [f32; 4],
+    mean: [f32; 4],
 }
 
 #[inline]
