@@ -24,20 +24,24 @@
 //! noisy sphere it changes the volume by 0.024% in the first iteration against the paper's 0.005%;
 //! the updated fan's normal gives 0.005%.)
 //!
-//! Measured with `examples/fairing_quality.rs` (10 iterations, one round):
+//! Measured with `examples/fairing_quality.rs` (10 iterations per round):
 //! - Noise-free meshes, mean vertex move in mean edge lengths, paper → normal-projected:
 //!   `bunny00` 0.097 → 0.006, `elephant` 0.104 → 0.032, `mushroom_open` 0.005 → 0.0007.
 //!   Volume changes are the same for both (bunny −0.002%; elephant −0.33% for both: that loss is
 //!   the smoothing of the coarse mesh's thin legs and trunk, not sliding, and projection does not
 //!   remove it).
-//! - Noisy meshes (0.3 mean edge lengths along normals): the surface distance to the clean mesh is
-//!   within 3% of the paper's at equal rounds (slightly worse on bunny and mushroom, slightly
-//!   better on elephant), the vertex RMS to the clean mesh is much lower (bunny, 20 rounds: 0.09
-//!   against 0.22 mean edge lengths) and, unlike the paper's, keeps falling with more rounds.
+//! - Noisy meshes (0.3 mean edge lengths along normals, seed 1; mean surface distance to the
+//!   clean mesh by `metrics::compare`, in mean edge lengths): about equal to the paper's at one
+//!   round (bunny 0.1024 against 0.1026, elephant 0.1007 against 0.1023, mushroom 0.1022 against
+//!   0.1018) and better at many rounds, where the paper's sliding accumulates (best settings:
+//!   bunny 0.0557 at 40 rounds against 0.0567 at 30; elephant 0.0872 against 0.0893 at 3;
+//!   mushroom 0.0427 against 0.0440 at 60). The vertex RMS to the clean mesh is much lower
+//!   (bunny, 20 rounds: 0.09 against 0.22) and keeps falling with rounds. Its volume drifts a
+//!   little more with many rounds on bunny (+0.03% at 40 rounds against −0.01%).
 //!
 //! So the default keeps vertices where they belong (texture coordinates, per-vertex attributes and
-//! triangle shapes stay meaningful, and rounds do not accumulate drift) at a cost of a few percent
-//! in surface distance and one extra gather pass per iteration. [`FairVariant::Paper`] remains
+//! triangle shapes stay meaningful, and rounds do not accumulate drift), is as close or closer to
+//! the clean surface, and costs one extra gather pass per iteration. [`FairVariant::Paper`] remains
 //! available and is the faster of the two.
 //!
 //! Both variants use the paper's uniform weights, so the local matrices depend on the valence
