@@ -177,28 +177,22 @@ impl ConstrainedFairing {
         let triangles = &mesh.triangles;
         let is_boundary = topology.boundary_flags();
 
-        // One-rings, in fan order where possible.
-        let rings: Vec<(Vec<u32>, bool)> = (0..vertex_count as u32)
+        // One-rings, in fan order where possible. A closed fan has as many entries as the vertex
+        // has neighbours, so the rings share the topology's CSR offsets and are written in place.
+        let ring_offsets = topology.neighbor_csr().0.to_vec();
+        let mut ring = vec![0u32; topology.neighbor_csr().1.len()];
+        let mut closed = vec![false; vertex_count];
+        split_by_offsets(&mut ring, &ring_offsets)
             .into_par_iter()
-            .map(|v| {
-                if !is_boundary[v as usize] {
-                    if let Some(fan) = closed_fan(v, topology, triangles) {
-                        return (fan, true);
-                    }
+            .zip(closed.par_iter_mut())
+            .enumerate()
+            .for_each(|(v, (ring_v, closed_v))| {
+                let v = v as u32;
+                *closed_v = !is_boundary[v as usize] && closed_fan(v, topology, triangles, ring_v);
+                if !*closed_v {
+                    ring_v.copy_from_slice(topology.neighbors(v));
                 }
-                (topology.neighbors(v).to_vec(), false)
-            })
-            .collect();
-        let mut ring_offsets = Vec::with_capacity(vertex_count + 1);
-        ring_offsets.push(0u32);
-        let mut ring = Vec::with_capacity(topology.neighbor_csr().1.len());
-        let mut closed = Vec::with_capacity(vertex_count);
-        for (r, is_fan) in &rings {
-            ring.extend_from_slice(r);
-            ring_offsets.push(ring.len() as u32);
-            closed.push(*is_fan);
-        }
-        drop(rings);
+            });
 
         let valence = |v: u32| topology.valence(v);
         let interior = |t: &[u32; 3]| {
@@ -209,102 +203,111 @@ impl ConstrainedFairing {
                 && t[0] != t[2]
         };
 
-        // Local operators of the valence triples that occur, in a dense table.
+        // Local operators of the valence triples that occur, in a dense table, and each triangle's
+        // slot in it (u32::MAX: not an interior triangle), found once per triangle rather than
+        // once per corner. Triples with a valence beyond the table get an operator of their own.
         let table_index = |n: [usize; 3]| (n[0] * TABLE_VALENCE + n[1]) * TABLE_VALENCE + n[2];
-        let mut table_slot = vec![u32::MAX; TABLE_VALENCE * TABLE_VALENCE * TABLE_VALENCE];
-        let mut operators: Vec<LocalOperator> = Vec::new();
-        for t in triangles.iter().filter(|t| interior(t)) {
-            let n = t.map(valence);
-            if n.iter().all(|&k| k < TABLE_VALENCE) && table_slot[table_index(n)] == u32::MAX {
-                table_slot[table_index(n)] = operators.len() as u32;
-                operators.push(LocalOperator::umbrella(n).expect("valences are at least 3"));
-            }
-        }
-        let operator_of = |n: [usize; 3]| -> LocalOperator {
-            if n.iter().all(|&k| k < TABLE_VALENCE) {
-                operators[table_slot[table_index(n)] as usize]
-            } else {
-                LocalOperator::umbrella(n).expect("valences are at least 3")
-            }
-        };
-
-        // Per vertex, gather the weights of its triangles' solutions (f64, then rounded).
-        struct VertexWeights {
-            own: [f32; 3],
-            ring: Vec<[f32; 3]>,
-            solved: bool,
-        }
-        let weights: Vec<VertexWeights> = (0..vertex_count)
-            .into_par_iter()
-            .map(|v| {
-                let ring_v = &ring[ring_offsets[v] as usize..ring_offsets[v + 1] as usize];
-                let mut own = [0.0f64; 3];
-                let mut entries = vec![[0.0f64; 3]; ring_v.len()];
-                let mut count = 0usize;
-                for &f in topology.faces_of(v as u32) {
-                    let t = &triangles[f as usize];
-                    if !interior(t) {
-                        continue;
-                    }
-                    count += 1;
-                    let n = t.map(valence);
-                    let op = operator_of(n);
-                    let r = t
-                        .iter()
-                        .position(|&c| c as usize == v)
-                        .expect("v is a corner");
-                    let k_sum: f64 = (0..3).map(|c| op.g[r][c] / n[c] as f64).sum();
-                    for c in 0..3 {
-                        let mean_weight = op.g[r][c];
-                        let position_weight = op.g[r][c] / n[c] as f64 - k_sum;
-                        let anchor_weight = op.h[r];
-                        let slot = if t[c] as usize == v {
-                            &mut own
-                        } else {
-                            let at = ring_v
-                                .iter()
-                                .position(|&u| u == t[c])
-                                .expect("a triangle's corners are one-ring neighbours");
-                            &mut entries[at]
-                        };
-                        slot[0] += mean_weight;
-                        slot[1] += position_weight;
-                        slot[2] += anchor_weight;
-                    }
-                }
-                if count == 0 {
-                    // No local solution: the vertex keeps its position.
-                    return VertexWeights {
-                        own: [0.0, 1.0, 0.0],
-                        ring: vec![[0.0; 3]; ring_v.len()],
-                        solved: false,
-                    };
-                }
-                let inv = 1.0 / count as f64;
-                VertexWeights {
-                    own: own.map(|w| (w * inv) as f32),
-                    ring: entries
-                        .into_iter()
-                        .map(|e| e.map(|w| (w * inv) as f32))
-                        .collect(),
-                    solved: true,
-                }
-            })
+        let triangle_valences: Vec<Option<[usize; 3]>> = triangles
+            .par_iter()
+            .map(|t| interior(t).then(|| t.map(valence)))
             .collect();
-
-        let mut ring_weights = Vec::with_capacity(ring.len());
-        let mut ring_anchor_weights = Vec::with_capacity(ring.len());
-        let mut self_weights = Vec::with_capacity(vertex_count);
-        let mut solved_vertices = 0;
-        for w in &weights {
-            self_weights.push(w.own);
-            for e in &w.ring {
-                ring_weights.push([e[0], e[1]]);
-                ring_anchor_weights.push(e[2]);
+        let mut table_slot = vec![u32::MAX; TABLE_VALENCE * TABLE_VALENCE * TABLE_VALENCE];
+        let mut operators: Vec<(LocalOperator, [usize; 3])> = Vec::new();
+        let mut operator_slot = |n: [usize; 3]| -> u32 {
+            let in_table = n.iter().all(|&k| k < TABLE_VALENCE);
+            if in_table && table_slot[table_index(n)] != u32::MAX {
+                return table_slot[table_index(n)];
             }
-            solved_vertices += w.solved as usize;
-        }
-        drop(weights);
+            let slot = operators.len() as u32;
+            operators.push((
+                LocalOperator::umbrella(n).expect("valences are at least 3"),
+                n,
+            ));
+            if in_table {
+                table_slot[table_index(n)] = slot;
+            }
+            slot
+        };
+        let triangle_operator: Vec<u32> = triangle_valences
+            .iter()
+            .map(|n| n.map_or(u32::MAX, &mut operator_slot))
+            .collect();
+        drop(triangle_valences);
+
+        // Per vertex, gather the weights of its triangles' solutions (f64, then rounded), written
+        // straight into the vertex's slices of the CSR weight arrays.
+        let mut ring_weights = vec![[0.0f32; 2]; ring.len()];
+        let mut ring_anchor_weights = vec![0.0f32; ring.len()];
+        let mut self_weights = vec![[0.0f32; 3]; vertex_count];
+        let mut solved = vec![false; vertex_count];
+        split_by_offsets(&mut ring_weights, &ring_offsets)
+            .into_par_iter()
+            .zip(split_by_offsets(&mut ring_anchor_weights, &ring_offsets))
+            .zip(self_weights.par_iter_mut().zip(solved.par_iter_mut()))
+            .enumerate()
+            .for_each(
+                |(v, ((ring_weights_v, anchor_weights_v), (own_out, solved_out)))| {
+                    let ring_v = &ring[ring_offsets[v] as usize..ring_offsets[v + 1] as usize];
+                    let mut own = [0.0f64; 3];
+                    let mut stack_entries = [[0.0f64; 3]; 64];
+                    let mut heap_entries = Vec::new();
+                    let entries: &mut [[f64; 3]] = if ring_v.len() <= 64 {
+                        &mut stack_entries[..ring_v.len()]
+                    } else {
+                        heap_entries.resize(ring_v.len(), [0.0f64; 3]);
+                        &mut heap_entries
+                    };
+                    let mut count = 0usize;
+                    for &f in topology.faces_of(v as u32) {
+                        let slot = triangle_operator[f as usize];
+                        if slot == u32::MAX {
+                            continue;
+                        }
+                        count += 1;
+                        let t = &triangles[f as usize];
+                        let (op, n) = &operators[slot as usize];
+                        let r = t
+                            .iter()
+                            .position(|&c| c as usize == v)
+                            .expect("v is a corner");
+                        let k_sum: f64 = (0..3).map(|c| op.g[r][c] / n[c] as f64).sum();
+                        for c in 0..3 {
+                            let mean_weight = op.g[r][c];
+                            let position_weight = op.g[r][c] / n[c] as f64 - k_sum;
+                            let anchor_weight = op.h[r];
+                            let slot = if t[c] as usize == v {
+                                &mut own
+                            } else {
+                                let at = ring_v
+                                    .iter()
+                                    .position(|&u| u == t[c])
+                                    .expect("a triangle's corners are one-ring neighbours");
+                                &mut entries[at]
+                            };
+                            slot[0] += mean_weight;
+                            slot[1] += position_weight;
+                            slot[2] += anchor_weight;
+                        }
+                    }
+                    if count == 0 {
+                        // No local solution: the vertex keeps its position (ring weights stay 0).
+                        *own_out = [0.0, 1.0, 0.0];
+                        return;
+                    }
+                    let inv = 1.0 / count as f64;
+                    *own_out = own.map(|w| (w * inv) as f32);
+                    for ((out, anchor), e) in ring_weights_v
+                        .iter_mut()
+                        .zip(anchor_weights_v.iter_mut())
+                        .zip(entries.iter())
+                    {
+                        *out = [(e[0] * inv) as f32, (e[1] * inv) as f32];
+                        *anchor = (e[2] * inv) as f32;
+                    }
+                    *solved_out = true;
+                },
+            );
+        let solved_vertices = solved.iter().filter(|&&s| s).count();
 
         let inverse_valence = (0..vertex_count as u32)
             .map(|v| match topology.valence(v) {
@@ -642,32 +645,53 @@ fn fan_normal(x: &[Point4], v: usize, ring: &[u32]) -> [f32; 4] {
     normal
 }
 
-/// The one-ring of interior vertex `v` in the order of its fan of faces (v, ring[k], ring[k+1]),
-/// or `None` when its faces do not form one closed, consistently oriented fan.
-fn closed_fan(v: u32, topology: &Topology, triangles: &[[u32; 3]]) -> Option<Vec<u32>> {
+/// Writes v's neighbours in fan order (faces (v, fan[k], fan[k+1])) into `fan` when v has a closed,
+/// consistently oriented fan with as many faces as neighbours; returns whether it does.
+fn closed_fan(v: u32, topology: &Topology, triangles: &[[u32; 3]], fan: &mut [u32]) -> bool {
     let faces = topology.faces_of(v);
-    if faces.len() < 3 || faces.len() != topology.valence(v) {
-        return None;
+    if faces.len() < 3 || faces.len() != topology.valence(v) || faces.len() > 64 {
+        return false;
     }
     // Each face as the directed edge opposite v: (next after v, next after that).
-    let mut edges: Vec<(u32, u32)> = Vec::with_capacity(faces.len());
-    for &f in faces {
+    let mut edge_buffer = [(0u32, 0u32); 64];
+    let edges = &mut edge_buffer[..faces.len()];
+    for (edge, &f) in edges.iter_mut().zip(faces) {
         let t = triangles[f as usize];
-        let r = t.iter().position(|&c| c == v)?;
-        edges.push((t[(r + 1) % 3], t[(r + 2) % 3]));
+        let Some(r) = t.iter().position(|&c| c == v) else {
+            return false;
+        };
+        *edge = (t[(r + 1) % 3], t[(r + 2) % 3]);
     }
-    let mut fan = Vec::with_capacity(faces.len());
-    let mut used = vec![false; edges.len()];
+    let mut used = [false; 64];
     let (first, mut current) = edges[0];
     used[0] = true;
-    fan.push(first);
+    fan[0] = first;
+    let mut len = 1;
     while current != first {
-        fan.push(current);
-        let next = (0..edges.len()).find(|&e| !used[e] && edges[e].0 == current)?;
+        if len == fan.len() {
+            return false;
+        }
+        fan[len] = current;
+        len += 1;
+        let Some(next) = (0..edges.len()).find(|&e| !used[e] && edges[e].0 == current) else {
+            return false;
+        };
         used[next] = true;
         current = edges[next].1;
     }
-    (fan.len() == faces.len() && used.iter().all(|&u| u)).then_some(fan)
+    len == faces.len() && used[..edges.len()].iter().all(|&u| u)
+}
+
+/// `data` cut into the consecutive slices `offsets[v]..offsets[v + 1]`.
+fn split_by_offsets<'a, T>(data: &'a mut [T], offsets: &[u32]) -> Vec<&'a mut [T]> {
+    let mut slices = Vec::with_capacity(offsets.len().saturating_sub(1));
+    let mut rest = data;
+    for w in offsets.windows(2) {
+        let (head, tail) = std::mem::take(&mut rest).split_at_mut((w[1] - w[0]) as usize);
+        slices.push(head);
+        rest = tail;
+    }
+    slices
 }
 
 /// Constrained fairing of `mesh` in place (sections 3.2 and 3.3); `topology` must be built from
@@ -921,7 +945,11 @@ mod tests {
         let mesh = irregular_sphere();
         let topology = Topology::build(&mesh);
         for v in 0..mesh.positions.len() as u32 {
-            let fan = closed_fan(v, &topology, &mesh.triangles).expect("closed manifold");
+            let mut fan = vec![0u32; topology.valence(v)];
+            assert!(
+                closed_fan(v, &topology, &mesh.triangles, &mut fan),
+                "closed manifold"
+            );
             for k in 0..fan.len() {
                 let (a, b) = (fan[k], fan[(k + 1) % fan.len()]);
                 assert!(mesh.triangles.iter().any(
