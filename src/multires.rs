@@ -1,9 +1,43 @@
 //! Multiresolution fairing (paper section 4.2): fair a coarse level, refine, fair, down to M0.
-//! STUB: the API contract; implementation to come.
+//!
+//! For `i` from the start level `k` down to 1: fair `M_i` with constrained fairing (section 3,
+//! on `M_i`'s own connectivity and valences; the anchors are `M_i`'s positions at the start of
+//! that level's fairing), then refine `M_i -> M_(i-1)` by the vertex splits of that level.
+//! Vertices that are not split keep their faired positions.
+//!
+//! Placing a split vertex (interpretations in `paper/NOTES.md`):
+//! - [`MultiresVariant::Paper`]: the vertex starts at the mean of its 1-ring in `M_(i-1)` (a
+//!   boundary vertex at the midpoint of its two loop neighbours), then takes one Kobbelt step
+//!   `x <- x - L²(x)/ν`, `L²(x_i) = (1/n_i) Σ_j L(x_j) - L(x_i)`, `ν = 1 + (1/n_i) Σ_j 1/n_j`,
+//!   uniform umbrella `L`, computed for all split vertices of the level from the placed positions
+//!   and applied together. Boundary vertices use the same step on their loop (curve Laplacian with
+//!   weights ½, so `ν = 3/2`).
+//! - [`MultiresVariant::Improved`]: the paper's placement, then a volume restoration. The build
+//!   recorded, for every collapse `v -> k`, the signed cone volume `c_v = A_v · (x_v - x_k)` of
+//!   the original geometry (`A_v = Σ (x_a - x_k) × (x_b - x_k)` over `v`'s faces `(v, a, b)` that
+//!   do not contain `k`): six times the volume the split adds back. The Kobbelt position adds some
+//!   other volume; the height `t_v = (c_v - A_v · (x_v - x_k)) / |A_v|` along `A_v / |A_v|` would
+//!   restore it exactly. On a clean curved surface `t_v` is the systematic part of the prediction
+//!   error (the 1-ring mean lies inside a convex surface, so the paper's placement loses volume at
+//!   every level, most on thin parts whose curvature radius is a few coarse edges); on a noisy
+//!   mesh it is that plus the vertex's own noise. So `t_v` is low-passed before use: each split
+//!   vertex takes the `|A|`-weighted mean of the `t` of the split vertices within two rings of it
+//!   (its own included), which keeps a coherent deficit and averages noise away.
+//!   Moving along `A_v` is a normal move, so the correction does not disturb the tangential
+//!   distribution of the vertices.
+//!
+//! Start level 0 means single-level fairing of M0. Fairing M0 after the last refinement is
+//! optional (`fair_finest`; the paper's loop ends at the refinement).
+//!
+//! Speed: a [`MultiresWorkspace`] keeps, per level used so far, its connectivity (`TriMesh`
+//! triangles and `Topology`) and loop neighbours, built on first use; a run then only copies
+//! positions and calls the fairing per level, and allocates nothing but its result.
 
-use crate::fairing::BoundaryMode;
+use crate::fairing::{self, BoundaryMode, FairOptions, FairVariant};
 use crate::hierarchy::Hierarchy;
+use crate::mesh::{Topology, TriMesh};
 use crate::Progress;
+use glam::DVec3;
 
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum MultiresVariant {
@@ -36,17 +70,283 @@ impl Default for MultiresOptions {
     }
 }
 
+const NONE: u32 = u32::MAX;
+
+/// Connectivity of one level, built on first use.
+struct LevelData {
+    mesh: TriMesh,
+    topology: Topology,
+    /// Previous and next vertex along the boundary loop (`NONE` for interior vertices); empty when
+    /// the level is closed.
+    loop_neighbors: Vec<[u32; 2]>,
+}
+
 /// Buffers reused between runs (the editor runs this on every slider move).
 #[derive(Default)]
-pub struct MultiresWorkspace {}
+pub struct MultiresWorkspace {
+    hierarchy_id: u64,
+    levels: Vec<Option<LevelData>>,
+    /// Working positions in the hierarchy's internal order (level i: the first V_i).
+    positions: Vec<[f32; 3]>,
+    /// Per split vertex of the level being refined: Kobbelt displacement, then (Improved) the
+    /// unit normal and the height that would restore the split's volume.
+    displacements: Vec<DVec3>,
+    heights: Vec<(DVec3, f64, f64)>,
+    /// Per vertex of the finer level: weighted sum of heights of adjacent split vertices, weights.
+    height_sums: Vec<[f64; 2]>,
+}
+
+impl MultiresWorkspace {
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    /// Builds the connectivity of `level` if not yet cached (all levels up to the coarsest are
+    /// cached after a run from the coarsest level).
+    pub fn prepare(&mut self, hierarchy: &Hierarchy, level: usize) {
+        if self.hierarchy_id != hierarchy.id() || self.levels.len() != hierarchy.level_count() {
+            self.hierarchy_id = hierarchy.id();
+            self.levels.clear();
+            self.levels.resize_with(hierarchy.level_count(), || None);
+        }
+        if self.levels[level].is_some() {
+            return;
+        }
+        let mesh = hierarchy.level_mesh(level);
+        let topology = Topology::build(&mesh);
+        let mut loop_neighbors = Vec::new();
+        if !topology.boundary_loops.is_empty() {
+            loop_neighbors = vec![[NONE; 2]; mesh.vertex_count()];
+            for boundary_loop in &topology.boundary_loops {
+                let m = boundary_loop.len();
+                for (i, &v) in boundary_loop.iter().enumerate() {
+                    loop_neighbors[v as usize] =
+                        [boundary_loop[(i + m - 1) % m], boundary_loop[(i + 1) % m]];
+                }
+            }
+        }
+        self.levels[level] = Some(LevelData {
+            mesh,
+            topology,
+            loop_neighbors,
+        });
+    }
+}
+
+fn point(p: [f32; 3]) -> DVec3 {
+    DVec3::new(p[0] as f64, p[1] as f64, p[2] as f64)
+}
 
 /// Returns M0's positions after fairing (M0's triangles are `hierarchy.base_mesh().triangles`),
 /// or `None` when `progress` cancelled the run.
 pub fn fair_multires(
     hierarchy: &Hierarchy,
-    _options: &MultiresOptions,
-    _workspace: &mut MultiresWorkspace,
-    _progress: &mut dyn Progress,
+    options: &MultiresOptions,
+    workspace: &mut MultiresWorkspace,
+    progress: &mut dyn Progress,
 ) -> Option<Vec<[f32; 3]>> {
-    Some(hierarchy.base_mesh().positions.clone())
+    let start = options.start_level.min(hierarchy.coarsest_level());
+    let fair_options = FairOptions {
+        iterations: options.iterations,
+        rounds: options.rounds.max(1),
+        boundary: options.boundary,
+        tolerance: 0.0,
+        variant: match options.variant {
+            MultiresVariant::Paper => FairVariant::Paper,
+            MultiresVariant::Improved => FairVariant::default(),
+        },
+    };
+    let base_vertices = hierarchy.level_info(0).vertices;
+    workspace.positions.clear();
+    workspace
+        .positions
+        .extend_from_slice(hierarchy.level_positions(start));
+
+    // Progress weights: a level costs about its vertex count.
+    let total: f64 = (0..=start)
+        .map(|i| hierarchy.level_info(i).vertices as f64)
+        .sum::<f64>()
+        .max(1.0);
+    let mut done = 0.0;
+    let fair_last = start == 0 || options.fair_finest;
+    for level in (1..=start).rev() {
+        workspace.prepare(hierarchy, level);
+        fair_level(workspace, level, &fair_options);
+        workspace.prepare(hierarchy, level - 1);
+        refine_positions(hierarchy, workspace, level - 1, options.variant);
+        done += hierarchy.level_info(level).vertices as f64;
+        if !progress.report((done / total) as f32) {
+            return None;
+        }
+    }
+    if fair_last {
+        workspace.prepare(hierarchy, 0);
+        fair_level(workspace, 0, &fair_options);
+        if !progress.report(1.0) {
+            return None;
+        }
+    }
+    debug_assert_eq!(workspace.positions.len(), base_vertices);
+    let mut result = vec![[0f32; 3]; base_vertices];
+    for (v, p) in workspace.positions.iter().enumerate() {
+        result[hierarchy.original_vertex(v as u32) as usize] = *p;
+    }
+    Some(result)
+}
+
+fn fair_level(workspace: &mut MultiresWorkspace, level: usize, options: &FairOptions) {
+    let data = workspace.levels[level]
+        .as_mut()
+        .expect("prepared before fairing");
+    let n = data.mesh.positions.len();
+    data.mesh
+        .positions
+        .copy_from_slice(&workspace.positions[..n]);
+    fairing::fair_constrained(&mut data.mesh, &data.topology, options);
+    workspace.positions[..n].copy_from_slice(&data.mesh.positions);
+}
+
+/// Refines the working positions from level `finer + 1` to `finer`: places the split vertices.
+fn refine_positions(
+    hierarchy: &Hierarchy,
+    workspace: &mut MultiresWorkspace,
+    finer: usize,
+    variant: MultiresVariant,
+) {
+    let coarse_count = hierarchy.level_info(finer + 1).vertices;
+    let fine_count = hierarchy.level_info(finer).vertices;
+    let MultiresWorkspace {
+        levels,
+        positions,
+        displacements,
+        heights,
+        height_sums,
+        ..
+    } = workspace;
+    let data = levels[finer].as_ref().expect("prepared before refining");
+    let topology = &data.topology;
+    let loops = &data.loop_neighbors;
+    let on_loop = |v: usize| !loops.is_empty() && loops[v][0] != NONE;
+    positions.resize(fine_count, [0.0; 3]);
+    let split = coarse_count..fine_count;
+
+    // Start at the 1-ring mean (loop midpoint on the boundary). Split vertices of one level are
+    // never adjacent, so their neighbours all have positions.
+    for v in split.clone() {
+        let x = if on_loop(v) {
+            let [a, b] = loops[v];
+            (point(positions[a as usize]) + point(positions[b as usize])) * 0.5
+        } else {
+            let ring = topology.neighbors(v as u32);
+            ring.iter()
+                .map(|&u| point(positions[u as usize]))
+                .sum::<DVec3>()
+                / ring.len() as f64
+        };
+        positions[v] = x.as_vec3().to_array();
+    }
+
+    // One Kobbelt step for all, from the placed positions, applied together.
+    let laplacian = |v: usize, positions: &[[f32; 3]]| -> DVec3 {
+        if on_loop(v) {
+            let [a, b] = loops[v];
+            (point(positions[a as usize]) + point(positions[b as usize])) * 0.5
+                - point(positions[v])
+        } else {
+            let ring = topology.neighbors(v as u32);
+            ring.iter()
+                .map(|&u| point(positions[u as usize]))
+                .sum::<DVec3>()
+                / ring.len() as f64
+                - point(positions[v])
+        }
+    };
+    displacements.clear();
+    for v in split.clone() {
+        let own = laplacian(v, positions);
+        let (sum, inverse_valences, n) = if on_loop(v) {
+            let [a, b] = loops[v];
+            (
+                laplacian(a as usize, positions) + laplacian(b as usize, positions),
+                1.0,
+                2.0,
+            )
+        } else {
+            let ring = topology.neighbors(v as u32);
+            let mut sum = DVec3::ZERO;
+            let mut inverse_valences = 0.0;
+            for &u in ring {
+                sum += laplacian(u as usize, positions);
+                inverse_valences += 1.0 / topology.valence(u) as f64;
+            }
+            (sum, inverse_valences, ring.len() as f64)
+        };
+        let l2 = sum / n - own;
+        let nu = 1.0 + inverse_valences / n;
+        displacements.push(-l2 / nu);
+    }
+    for (v, d) in split.clone().zip(displacements.iter()) {
+        positions[v] = (point(positions[v]) + *d).as_vec3().to_array();
+    }
+
+    if variant == MultiresVariant::Paper {
+        return;
+    }
+
+    // Improved: restore the volume each split added in the original geometry, low-passed.
+    let triangles = &data.mesh.triangles;
+    let (face_offsets, vertex_faces) = topology.face_csr();
+    heights.clear();
+    for v in split.clone() {
+        let Some(k) = hierarchy.collapse_target(v as u32) else {
+            heights.push((DVec3::ZERO, 0.0, 0.0));
+            continue;
+        };
+        let xk = point(positions[k as usize]);
+        let mut area = DVec3::ZERO;
+        for &f in &vertex_faces[face_offsets[v] as usize..face_offsets[v + 1] as usize] {
+            let t = triangles[f as usize];
+            if t.contains(&k) {
+                continue;
+            }
+            let (a, b) = if t[0] == v as u32 {
+                (t[1], t[2])
+            } else if t[1] == v as u32 {
+                (t[2], t[0])
+            } else {
+                (t[0], t[1])
+            };
+            area += (point(positions[a as usize]) - xk).cross(point(positions[b as usize]) - xk);
+        }
+        let weight = area.length();
+        if weight <= 0.0 || !weight.is_finite() {
+            heights.push((DVec3::ZERO, 0.0, 0.0));
+            continue;
+        }
+        let normal = area / weight;
+        let current = area.dot(point(positions[v]) - xk);
+        let height = (hierarchy.six_split_volume(v as u32) as f64 - current) / weight;
+        heights.push((normal, height, weight));
+    }
+    height_sums.clear();
+    height_sums.resize(fine_count, [0.0; 2]);
+    for (v, &(_, height, weight)) in split.clone().zip(heights.iter()) {
+        for &u in topology.neighbors(v as u32) {
+            let s = &mut height_sums[u as usize];
+            s[0] += height * weight;
+            s[1] += weight;
+        }
+    }
+    for (v, &(normal, _, _)) in split.zip(heights.iter()) {
+        let mut sum = [0.0; 2];
+        for &u in topology.neighbors(v as u32) {
+            let s = height_sums[u as usize];
+            sum[0] += s[0];
+            sum[1] += s[1];
+        }
+        if sum[1] > 0.0 {
+            let height = sum[0] / sum[1];
+            positions[v] = (point(positions[v]) + normal * height).as_vec3().to_array();
+        }
+    }
 }
