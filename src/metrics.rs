@@ -1,7 +1,18 @@
 //! Measures of one mesh (volume, area, bounding box, mean edge length) and comparisons between
-//! two meshes. PROVISIONAL: comparisons are to come.
+//! two meshes.
+//!
+//! Surface distance is the measure that matters for shape: smoothing and vertex splits move
+//! vertices along the surface without changing it, so per-vertex distances overstate the change.
+//! It is sampled both ways: from each mesh, area-weighted samples (each triangle's centroid and
+//! the three points halfway between the centroid and a corner, each carrying a quarter of the
+//! triangle's area) plus every vertex (for the maximum), projected onto the other mesh's surface
+//! through a bounding volume hierarchy. The mean surface distance is the mean of the two one-way
+//! area-weighted means; the Hausdorff estimate is the larger of the two one-way maxima.
+//! Sums are taken in a fixed order so results do not depend on the thread count.
 
 use crate::mesh::TriMesh;
+use glam::DVec3;
+use rayon::prelude::*;
 
 /// Signed volume enclosed by the triangles (divergence theorem, about the bounding box centre to
 /// limit cancellation); meaningful for closed, consistently oriented meshes.
@@ -9,9 +20,15 @@ pub fn signed_volume(mesh: &TriMesh) -> f64 {
     let centre = bounding_box(mesh)
         .map(|(lo, hi)| (lo + hi) * 0.5)
         .unwrap_or_default();
+    signed_volume_about(mesh, centre)
+}
+
+/// Signed volume of the cones from `apex` to every triangle. For a closed mesh it does not depend
+/// on `apex`; for an open mesh it does, so comparisons of open meshes use one apex for both.
+pub fn signed_volume_about(mesh: &TriMesh, apex: DVec3) -> f64 {
     let mut six_volume = 0.0;
     for t in 0..mesh.triangles.len() {
-        let [a, b, c] = mesh.triangle_points(t).map(|p| p - centre);
+        let [a, b, c] = mesh.triangle_points(t).map(|p| p - apex);
         six_volume += a.dot(b.cross(c));
     }
     six_volume / 6.0
@@ -25,11 +42,11 @@ pub fn area(mesh: &TriMesh) -> f64 {
 }
 
 /// Axis-aligned bounding box (min, max) of the positions; `None` for an empty mesh.
-pub fn bounding_box(mesh: &TriMesh) -> Option<(glam::DVec3, glam::DVec3)> {
+pub fn bounding_box(mesh: &TriMesh) -> Option<(DVec3, DVec3)> {
     let mut iter = mesh
         .positions
         .iter()
-        .map(|p| glam::DVec3::new(p[0] as f64, p[1] as f64, p[2] as f64));
+        .map(|p| DVec3::new(p[0] as f64, p[1] as f64, p[2] as f64));
     let first = iter.next()?;
     Some(iter.fold((first, first), |(lo, hi), p| (lo.min(p), hi.max(p))))
 }
@@ -46,4 +63,475 @@ pub fn mean_edge_length(mesh: &TriMesh) -> f64 {
         sum += (b - a).length() + (c - b).length() + (a - c).length();
     }
     sum / (3 * mesh.triangles.len()) as f64
+}
+
+/// One-way surface distance from the samples of one mesh to another mesh's surface.
+#[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize)]
+pub struct SurfaceDistance {
+    /// Area-weighted mean distance.
+    pub mean: f64,
+    /// Largest distance over all samples and vertices.
+    pub max: f64,
+}
+
+/// Comparisons that need the same connectivity (same triangles, vertex for vertex).
+#[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize)]
+pub struct VertexComparison {
+    /// Root mean square vertex displacement.
+    pub rms: f64,
+    /// Largest vertex displacement.
+    pub max_distance: f64,
+    /// Mean angle between corresponding face normals, in degrees (degenerate faces skipped).
+    pub normal_error_deg: f64,
+    /// Mean distance between corresponding triangle barycenters.
+    pub barycenter_drift: f64,
+}
+
+/// OTHER measured against REFERENCE.
+#[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize)]
+pub struct Comparison {
+    pub mean_surface_distance: f64,
+    pub hausdorff: f64,
+    /// (V_other - V_reference) / |V_reference| in percent, both about the reference's bounding
+    /// box centre; `None` when the reference encloses no volume.
+    pub volume_change_percent: Option<f64>,
+    pub reference_to_other: SurfaceDistance,
+    pub other_to_reference: SurfaceDistance,
+    /// Present when both meshes have the same triangles.
+    pub same_connectivity: Option<VertexComparison>,
+}
+
+/// Compare `other` against `reference`.
+pub fn compare(reference: &TriMesh, other: &TriMesh) -> Comparison {
+    let reference_index = ClosestPointIndex::new(reference);
+    let other_index = ClosestPointIndex::new(other);
+    let other_to_reference = reference_index.distance_from(other);
+    let reference_to_other = other_index.distance_from(reference);
+    Comparison {
+        mean_surface_distance: 0.5 * (other_to_reference.mean + reference_to_other.mean),
+        hausdorff: other_to_reference.max.max(reference_to_other.max),
+        volume_change_percent: volume_change_percent(reference, other),
+        reference_to_other,
+        other_to_reference,
+        same_connectivity: compare_vertices(reference, other),
+    }
+}
+
+/// Volume change of `other` against `reference` in percent (see [`Comparison`]).
+pub fn volume_change_percent(reference: &TriMesh, other: &TriMesh) -> Option<f64> {
+    let apex = bounding_box(reference)
+        .map(|(lo, hi)| (lo + hi) * 0.5)
+        .unwrap_or_default();
+    let before = signed_volume_about(reference, apex);
+    let after = signed_volume_about(other, apex);
+    (before.abs() > 0.0 && before.is_finite()).then(|| (after - before) / before.abs() * 100.0)
+}
+
+/// Per-vertex comparisons, when `other` has the same triangles as `reference`.
+pub fn compare_vertices(reference: &TriMesh, other: &TriMesh) -> Option<VertexComparison> {
+    if reference.triangles != other.triangles || reference.positions.len() != other.positions.len()
+    {
+        return None;
+    }
+    let n = reference.positions.len().max(1) as f64;
+    let mut sum_sq = 0.0;
+    let mut max_distance: f64 = 0.0;
+    for v in 0..reference.positions.len() as u32 {
+        let d = reference.point(v).distance(other.point(v));
+        sum_sq += d * d;
+        max_distance = max_distance.max(d);
+    }
+    let mut angle_sum = 0.0;
+    let mut angle_count = 0usize;
+    let mut drift_sum = 0.0;
+    for t in 0..reference.triangles.len() {
+        let (a, b) = (reference.face_normal(t), other.face_normal(t));
+        if a.length_squared() > 0.0 && b.length_squared() > 0.0 {
+            angle_sum += a.angle_between(b).to_degrees();
+            angle_count += 1;
+        }
+        let centre = |m: &TriMesh| m.triangle_points(t).iter().sum::<DVec3>() / 3.0;
+        drift_sum += centre(reference).distance(centre(other));
+    }
+    let faces = reference.triangles.len().max(1) as f64;
+    Some(VertexComparison {
+        rms: (sum_sq / n).sqrt(),
+        max_distance,
+        normal_error_deg: if angle_count > 0 {
+            angle_sum / angle_count as f64
+        } else {
+            0.0
+        },
+        barycenter_drift: drift_sum / faces,
+    })
+}
+
+/// Closest-point queries against a mesh's surface: a bounding volume hierarchy over its triangles
+/// (median split of centroids along the longest axis, up to four triangles a leaf).
+pub struct ClosestPointIndex<'a> {
+    mesh: &'a TriMesh,
+    nodes: Vec<BvhNode>,
+    order: Vec<u32>,
+}
+
+#[derive(Clone, Copy)]
+struct BvhNode {
+    lo: DVec3,
+    hi: DVec3,
+    /// Leaf: first index into `order`; inner node: index of the left child (right is next to it).
+    first: u32,
+    /// Number of triangles in a leaf; 0 for an inner node.
+    count: u32,
+}
+
+const LEAF_SIZE: usize = 4;
+
+impl<'a> ClosestPointIndex<'a> {
+    pub fn new(mesh: &'a TriMesh) -> Self {
+        let faces = mesh.triangles.len();
+        let mut order: Vec<u32> = (0..faces as u32).collect();
+        let centroids: Vec<DVec3> = (0..faces)
+            .map(|t| mesh.triangle_points(t).iter().sum::<DVec3>() / 3.0)
+            .collect();
+        let mut nodes = Vec::with_capacity(2 * faces / LEAF_SIZE + 1);
+        if faces > 0 {
+            nodes.push(BvhNode {
+                lo: DVec3::ZERO,
+                hi: DVec3::ZERO,
+                first: 0,
+                count: faces as u32,
+            });
+            // Split nodes breadth-first with an explicit work list (no recursion depth limits).
+            let mut pending = vec![0usize];
+            while let Some(node_index) = pending.pop() {
+                let BvhNode { first, count, .. } = nodes[node_index];
+                let range = first as usize..(first + count) as usize;
+                let (mut lo, mut hi) =
+                    (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY));
+                let (mut clo, mut chi) = (lo, hi);
+                for &t in &order[range.clone()] {
+                    for p in mesh.triangle_points(t as usize) {
+                        lo = lo.min(p);
+                        hi = hi.max(p);
+                    }
+                    clo = clo.min(centroids[t as usize]);
+                    chi = chi.max(centroids[t as usize]);
+                }
+                nodes[node_index].lo = lo;
+                nodes[node_index].hi = hi;
+                if range.len() <= LEAF_SIZE {
+                    continue;
+                }
+                let extent = chi - clo;
+                let axis = if extent.x >= extent.y && extent.x >= extent.z {
+                    0
+                } else if extent.y >= extent.z {
+                    1
+                } else {
+                    2
+                };
+                let mid = range.len() / 2;
+                order[range.clone()].select_nth_unstable_by(mid, |&a, &b| {
+                    centroids[a as usize][axis]
+                        .total_cmp(&centroids[b as usize][axis])
+                        .then(a.cmp(&b))
+                });
+                let left = nodes.len();
+                nodes.push(BvhNode {
+                    lo,
+                    hi,
+                    first,
+                    count: mid as u32,
+                });
+                nodes.push(BvhNode {
+                    lo,
+                    hi,
+                    first: first + mid as u32,
+                    count: count - mid as u32,
+                });
+                nodes[node_index].first = left as u32;
+                nodes[node_index].count = 0;
+                pending.push(left);
+                pending.push(left + 1);
+            }
+        }
+        Self { mesh, nodes, order }
+    }
+
+    /// Distance from `p` to the closest point of the surface (infinite for a mesh without faces).
+    pub fn distance(&self, p: DVec3) -> f64 {
+        self.closest(p).map_or(f64::INFINITY, |(d2, _)| d2.sqrt())
+    }
+
+    /// Squared distance to, and index of, the closest triangle.
+    pub fn closest(&self, p: DVec3) -> Option<(f64, u32)> {
+        if self.nodes.is_empty() {
+            return None;
+        }
+        let mut best = (f64::INFINITY, u32::MAX);
+        let mut stack: Vec<(f64, u32)> = Vec::with_capacity(64);
+        stack.push((box_distance_sq(&self.nodes[0], p), 0));
+        while let Some((bound, index)) = stack.pop() {
+            if bound >= best.0 {
+                continue;
+            }
+            let node = self.nodes[index as usize];
+            if node.count > 0 {
+                for &t in &self.order[node.first as usize..(node.first + node.count) as usize] {
+                    let [a, b, c] = self.mesh.triangle_points(t as usize);
+                    let d2 = (closest_point_on_triangle(p, a, b, c) - p).length_squared();
+                    if d2 < best.0 || (d2 == best.0 && t < best.1) {
+                        best = (d2, t);
+                    }
+                }
+            } else {
+                let (l, r) = (node.first, node.first + 1);
+                let (dl, dr) = (
+                    box_distance_sq(&self.nodes[l as usize], p),
+                    box_distance_sq(&self.nodes[r as usize], p),
+                );
+                // Visit the nearer child first: push it last.
+                if dl <= dr {
+                    stack.push((dr, r));
+                    stack.push((dl, l));
+                } else {
+                    stack.push((dl, l));
+                    stack.push((dr, r));
+                }
+            }
+        }
+        Some(best)
+    }
+
+    /// One-way distance from `from`'s surface samples and vertices to this surface.
+    pub fn distance_from(&self, from: &TriMesh) -> SurfaceDistance {
+        let per_face: Vec<(f64, f64, f64)> = (0..from.triangles.len())
+            .into_par_iter()
+            .map(|t| {
+                let [a, b, c] = from.triangle_points(t);
+                let area = (b - a).cross(c - a).length() * 0.5;
+                let centroid = (a + b + c) / 3.0;
+                let samples = [
+                    centroid,
+                    (centroid + a) * 0.5,
+                    (centroid + b) * 0.5,
+                    (centroid + c) * 0.5,
+                ];
+                let mut weighted = 0.0;
+                let mut max: f64 = 0.0;
+                for s in samples {
+                    let d = self.distance(s);
+                    weighted += d * area * 0.25;
+                    max = max.max(d);
+                }
+                (weighted, area, max)
+            })
+            .collect();
+        let vertex_max = self.vertex_distances(from).into_iter().fold(0.0, f64::max);
+        let (mut weighted, mut total_area, mut max) = (0.0, 0.0, vertex_max);
+        for (w, a, m) in per_face {
+            weighted += w;
+            total_area += a;
+            max = max.max(m);
+        }
+        SurfaceDistance {
+            mean: if total_area > 0.0 {
+                weighted / total_area
+            } else {
+                0.0
+            },
+            max,
+        }
+    }
+
+    /// Distance from every vertex of `from` to this surface (for heat maps).
+    pub fn vertex_distances(&self, from: &TriMesh) -> Vec<f64> {
+        (0..from.positions.len() as u32)
+            .into_par_iter()
+            .map(|v| self.distance(from.point(v)))
+            .collect()
+    }
+}
+
+fn box_distance_sq(node: &BvhNode, p: DVec3) -> f64 {
+    let d = (node.lo - p).max(DVec3::ZERO).max(p - node.hi);
+    d.length_squared()
+}
+
+/// Closest point to `p` on triangle (a, b, c), by the Voronoi regions of its corners and edges.
+pub fn closest_point_on_triangle(p: DVec3, a: DVec3, b: DVec3, c: DVec3) -> DVec3 {
+    let ab = b - a;
+    let ac = c - a;
+    let ap = p - a;
+    let d1 = ab.dot(ap);
+    let d2 = ac.dot(ap);
+    if d1 <= 0.0 && d2 <= 0.0 {
+        return a;
+    }
+    let bp = p - b;
+    let d3 = ab.dot(bp);
+    let d4 = ac.dot(bp);
+    if d3 >= 0.0 && d4 <= d3 {
+        return b;
+    }
+    let vc = d1 * d4 - d3 * d2;
+    if vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0 {
+        return a + ab * (d1 / (d1 - d3));
+    }
+    let cp = p - c;
+    let d5 = ab.dot(cp);
+    let d6 = ac.dot(cp);
+    if d6 >= 0.0 && d5 <= d6 {
+        return c;
+    }
+    let vb = d5 * d2 - d1 * d6;
+    if vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0 {
+        return a + ac * (d2 / (d2 - d6));
+    }
+    let va = d3 * d6 - d5 * d4;
+    if va <= 0.0 && (d4 - d3) >= 0.0 && (d5 - d6) >= 0.0 {
+        return b + (c - b) * ((d4 - d3) / ((d4 - d3) + (d5 - d6)));
+    }
+    let denom = va + vb + vc;
+    if denom.abs() < f64::MIN_POSITIVE {
+        // Degenerate triangle: fall back to the closest of its edges' endpoints.
+        return [a, b, c]
+            .into_iter()
+            .min_by(|x, y| {
+                (*x - p)
+                    .length_squared()
+                    .total_cmp(&(*y - p).length_squared())
+            })
+            .unwrap_or(a);
+    }
+    let v = vb / denom;
+    let w = vc / denom;
+    a + ab * v + ac * w
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn octahedron(scale: f32) -> TriMesh {
+        TriMesh::new(
+            vec![
+                [scale, 0., 0.],
+                [-scale, 0., 0.],
+                [0., scale, 0.],
+                [0., -scale, 0.],
+                [0., 0., scale],
+                [0., 0., -scale],
+            ],
+            vec![
+                [0, 2, 4],
+                [2, 1, 4],
+                [1, 3, 4],
+                [3, 0, 4],
+                [2, 0, 5],
+                [1, 2, 5],
+                [3, 1, 5],
+                [0, 3, 5],
+            ],
+        )
+    }
+
+    #[test]
+    fn octahedron_volume_area_and_edges() {
+        let mesh = octahedron(1.0);
+        assert!((signed_volume(&mesh) - 4.0 / 3.0).abs() < 1e-12);
+        assert!((area(&mesh) - 8.0 * 3f64.sqrt() / 2.0 * 2.0 / 2.0).abs() < 1e-12);
+        assert!((mean_edge_length(&mesh) - 2f64.sqrt()).abs() < 1e-12);
+    }
+
+    #[test]
+    fn closest_point_regions() {
+        let (a, b, c) = (DVec3::ZERO, DVec3::X, DVec3::Y);
+        assert!(
+            (closest_point_on_triangle(DVec3::new(0.2, 0.2, 5.0), a, b, c)
+                - DVec3::new(0.2, 0.2, 0.0))
+            .length()
+                < 1e-15
+        );
+        assert_eq!(
+            closest_point_on_triangle(DVec3::new(-1.0, -1.0, 0.0), a, b, c),
+            a
+        );
+        assert_eq!(
+            closest_point_on_triangle(DVec3::new(2.0, -0.5, 0.0), a, b, c),
+            b
+        );
+        assert_eq!(
+            closest_point_on_triangle(DVec3::new(0.5, -1.0, 1.0), a, b, c),
+            DVec3::new(0.5, 0.0, 0.0)
+        );
+        let on_hypotenuse = closest_point_on_triangle(DVec3::new(1.0, 1.0, 0.0), a, b, c);
+        assert!((on_hypotenuse - DVec3::new(0.5, 0.5, 0.0)).length() < 1e-15);
+    }
+
+    #[test]
+    fn scaled_copy_is_as_far_as_the_scaling_moves_it() {
+        // Octahedron scaled by 1.1: every face plane moves out by 0.1/sqrt(3), the corners by 0.1.
+        let (reference, other) = (octahedron(1.0), octahedron(1.1));
+        let result = compare(&reference, &other);
+        let plane_offset = 0.1 / 3f64.sqrt();
+        assert!((result.other_to_reference.max - 0.1).abs() < 1e-6);
+        assert!(
+            result.mean_surface_distance > 0.9 * plane_offset && result.mean_surface_distance < 0.1
+        );
+        assert!((result.hausdorff - 0.1).abs() < 1e-6);
+        assert!(
+            (result.volume_change_percent.unwrap() - (1.1f64.powi(3) - 1.0) * 100.0).abs() < 1e-4
+        );
+        let v = result.same_connectivity.unwrap();
+        assert!((v.rms - 0.1).abs() < 1e-6 && (v.max_distance - 0.1).abs() < 1e-6);
+        assert!(v.normal_error_deg.abs() < 1e-4);
+        assert!((v.barycenter_drift - plane_offset).abs() < 1e-6);
+    }
+
+    #[test]
+    fn sliding_vertices_along_the_surface_changes_no_surface_distance() {
+        // Same flat square, two triangulations with the shared vertex moved within the plane.
+        let a = TriMesh::new(
+            vec![
+                [0., 0., 0.],
+                [1., 0., 0.],
+                [1., 1., 0.],
+                [0., 1., 0.],
+                [0.5, 0.5, 0.],
+            ],
+            vec![[0, 1, 4], [1, 2, 4], [2, 3, 4], [3, 0, 4]],
+        );
+        let mut b = a.clone();
+        b.positions[4] = [0.3, 0.6, 0.0];
+        let result = compare(&a, &b);
+        assert!(result.mean_surface_distance < 1e-12 && result.hausdorff < 1e-12);
+        // One of five vertices moved by sqrt(0.05): the vertex measures see it.
+        let moved = 0.05f64.sqrt();
+        let v = result.same_connectivity.unwrap();
+        assert!(
+            (v.max_distance - moved).abs() < 1e-7 && (v.rms - moved / 5f64.sqrt()).abs() < 1e-7
+        );
+    }
+
+    #[test]
+    fn bvh_agrees_with_brute_force() {
+        let mesh = crate::mesh::subdivide_loop(&crate::mesh::subdivide_loop(&octahedron(1.0)));
+        let index = ClosestPointIndex::new(&mesh);
+        for i in 0..200 {
+            let f = i as f64;
+            let p = DVec3::new(
+                (f * 0.37).sin() * 1.5,
+                (f * 0.71).cos() * 1.2,
+                (f * 0.13).sin(),
+            );
+            let brute = (0..mesh.face_count())
+                .map(|t| {
+                    let [a, b, c] = mesh.triangle_points(t);
+                    (closest_point_on_triangle(p, a, b, c) - p).length()
+                })
+                .fold(f64::INFINITY, f64::min);
+            assert!((index.distance(p) - brute).abs() < 1e-12, "query {i}");
+        }
+    }
 }

@@ -1,48 +1,280 @@
-//! `info`, `noise`, `convert`, `compare` (PROVISIONAL).
-use clap::Args;
-use std::path::PathBuf;
+//! `info`, `noise`, `convert` and `compare`: the mesh-core subcommands.
+
+use anyhow::Context;
+use clap::{Args, ValueEnum};
+use fairmesh::io::{self, LoadOptions, Loaded};
+use fairmesh::metrics;
+use fairmesh::noise::{self, NoiseMode, NoiseOptions};
+use serde_json::json;
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
 
 #[derive(Args, Debug)]
 pub struct InfoArgs {
+    /// Mesh file (.obj .gltf .glb .ply .stl .off).
     pub file: PathBuf,
+    /// Print one JSON object instead of text.
     #[arg(long)]
     pub json: bool,
+    /// Keep vertices with identical positions apart (by default they are merged).
+    #[arg(long)]
+    pub no_weld: bool,
 }
+
+#[derive(Clone, Copy, Debug, ValueEnum)]
+pub enum ModeArg {
+    /// Each vertex moves along a random direction by a Gaussian distance.
+    Direction,
+    /// Independent Gaussian noise on each coordinate.
+    Iso,
+    /// Each vertex moves along its normal by a Gaussian distance.
+    Normal,
+}
+
 #[derive(Args, Debug)]
 pub struct NoiseArgs {
+    /// Input mesh.
     pub input: PathBuf,
+    /// Output mesh (format by extension).
     #[arg(short, long)]
     pub output: PathBuf,
+    /// Standard deviation as a fraction of the mean edge length.
+    #[arg(long, default_value_t = 0.3)]
+    pub sigma: f64,
+    /// Random seed: the same seed gives the same noise on every machine.
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
+    /// How vertices move.
+    #[arg(long, value_enum, default_value_t = ModeArg::Normal)]
+    pub mode: ModeArg,
 }
+
 #[derive(Args, Debug)]
 pub struct ConvertArgs {
+    /// Input mesh.
     pub input: PathBuf,
+    /// Output mesh; the format is chosen by its extension (.obj .gltf .glb .ply).
     #[arg(short, long)]
     pub output: PathBuf,
+    /// Keep vertices with identical positions apart (by default they are merged).
+    #[arg(long)]
+    pub no_weld: bool,
 }
+
 #[derive(Args, Debug)]
 pub struct CompareArgs {
+    /// The mesh to measure against (e.g. the clean original).
     pub reference: PathBuf,
+    /// The mesh to measure (e.g. the faired result).
     pub other: PathBuf,
+    /// Print one JSON object instead of text.
     #[arg(long)]
     pub json: bool,
 }
 
+pub(crate) fn load(path: &Path, weld: bool) -> anyhow::Result<Loaded> {
+    Ok(io::load_with(
+        path,
+        &LoadOptions {
+            weld,
+            ..Default::default()
+        },
+    )?)
+}
+
 pub fn info(args: InfoArgs) -> anyhow::Result<()> {
-    let loaded = fairmesh::io::load(&args.file)?;
-    println!(
-        "{} vertices, {} faces",
+    let loaded = load(&args.file, !args.no_weld)?;
+    let (mesh, topology, report) = (&loaded.mesh, &loaded.topology, &loaded.report);
+    let closed = topology.is_closed();
+    let volume = closed.then(|| metrics::signed_volume(mesh));
+    let bbox = metrics::bounding_box(mesh);
+    let genus: Vec<Option<i64>> = topology.components.iter().map(|c| c.genus).collect();
+    let summary = json!({
+        "file": args.file.display().to_string(),
+        "vertices": mesh.vertex_count(),
+        "faces": mesh.face_count(),
+        "edges": topology.edge_count(),
+        "boundary_loops": topology.boundary_loops.len(),
+        "boundary_loop_lengths": topology.boundary_loops.iter().map(|l| l.len()).collect::<Vec<_>>(),
+        "components": topology.components.len(),
+        "genus": genus,
+        "euler_characteristic": topology.euler_characteristic(),
+        "closed": closed,
+        "manifold": topology.is_manifold(),
+        "oriented": topology.inconsistent_edges == 0,
+        "non_manifold_edges": topology.non_manifold_edges.len(),
+        "non_manifold_vertices": topology.non_manifold_vertices.len(),
+        "inconsistently_oriented_edges": topology.inconsistent_edges,
+        "volume": volume,
+        "area": metrics::area(mesh),
+        "mean_edge_length": metrics::mean_edge_length(mesh),
+        "bounding_box": bbox.map(|(lo, hi)| json!({"min": lo.to_array(), "max": hi.to_array()})),
+        "welded_vertices": report.welded_vertices,
+        "removed_degenerate_faces": report.removed_degenerate_faces,
+        "removed_unreferenced_vertices": report.removed_unreferenced_vertices,
+        "warnings": report.warnings,
+    });
+    if args.json {
+        return super::emit(&format!("{}\n", serde_json::to_string_pretty(&summary)?));
+    }
+    let mut out = String::new();
+    writeln!(out, "{}", args.file.display())?;
+    writeln!(out, "  vertices            {}", mesh.vertex_count())?;
+    writeln!(out, "  faces               {}", mesh.face_count())?;
+    writeln!(out, "  edges               {}", topology.edge_count())?;
+    writeln!(out, "  components          {}", topology.components.len())?;
+    for (i, c) in topology.components.iter().enumerate().take(10) {
+        let genus = c
+            .genus
+            .map_or("n/a (non-manifold)".to_string(), |g| g.to_string());
+        writeln!(
+            out,
+            "    #{i}: {} vertices, {} faces, {} boundary loops, genus {genus}",
+            c.vertices, c.faces, c.boundary_loops
+        )?;
+    }
+    writeln!(
+        out,
+        "  boundary loops      {}",
+        topology.boundary_loops.len()
+    )?;
+    writeln!(out, "  closed              {closed}")?;
+    writeln!(
+        out,
+        "  manifold            {} ({} non-manifold edges, {} non-manifold vertices, {} inconsistently oriented edges)",
+        topology.is_manifold(),
+        topology.non_manifold_edges.len(),
+        topology.non_manifold_vertices.len(),
+        topology.inconsistent_edges
+    )?;
+    match volume {
+        Some(v) => writeln!(out, "  volume              {v:.6e}")?,
+        None => writeln!(out, "  volume              n/a (open mesh)")?,
+    }
+    writeln!(out, "  area                {:.6e}", metrics::area(mesh))?;
+    writeln!(
+        out,
+        "  mean edge length    {:.6e}",
+        metrics::mean_edge_length(mesh)
+    )?;
+    if let Some((lo, hi)) = bbox {
+        writeln!(
+            out,
+            "  bounding box        [{:.4}, {:.4}, {:.4}] .. [{:.4}, {:.4}, {:.4}]",
+            lo.x, lo.y, lo.z, hi.x, hi.y, hi.z
+        )?;
+    }
+    writeln!(out, "  welded vertices     {}", report.welded_vertices)?;
+    writeln!(
+        out,
+        "  removed             {} degenerate faces, {} unused vertices",
+        report.removed_degenerate_faces, report.removed_unreferenced_vertices
+    )?;
+    for warning in &report.warnings {
+        writeln!(out, "  warning: {warning}")?;
+    }
+    super::emit(&out)
+}
+
+pub fn noise(args: NoiseArgs) -> anyhow::Result<()> {
+    anyhow::ensure!(
+        args.sigma.is_finite() && args.sigma >= 0.0,
+        "--sigma must be a finite number >= 0, got {}",
+        args.sigma
+    );
+    let mut loaded = load(&args.input, true)?;
+    let mode = match args.mode {
+        ModeArg::Direction => NoiseMode::Direction,
+        ModeArg::Iso => NoiseMode::Isotropic,
+        ModeArg::Normal => NoiseMode::Normal,
+    };
+    let absolute = noise::add_noise(
+        &mut loaded.mesh,
+        &NoiseOptions {
+            sigma: args.sigma,
+            seed: args.seed,
+            mode,
+        },
+    );
+    io::save(&args.output, &loaded.mesh)?;
+    eprintln!(
+        "wrote {} (sigma {:.4e} model units, {:?}, seed {})",
+        args.output.display(),
+        absolute,
+        mode,
+        args.seed
+    );
+    Ok(())
+}
+
+pub fn convert(args: ConvertArgs) -> anyhow::Result<()> {
+    let loaded = load(&args.input, !args.no_weld)?;
+    io::save(&args.output, &loaded.mesh)?;
+    eprintln!(
+        "wrote {} ({} vertices, {} faces)",
+        args.output.display(),
         loaded.mesh.vertex_count(),
         loaded.mesh.face_count()
     );
     Ok(())
 }
-pub fn noise(_args: NoiseArgs) -> anyhow::Result<()> {
-    anyhow::bail!("not yet")
-}
-pub fn convert(_args: ConvertArgs) -> anyhow::Result<()> {
-    anyhow::bail!("not yet")
-}
-pub fn compare(_args: CompareArgs) -> anyhow::Result<()> {
-    anyhow::bail!("not yet")
+
+pub fn compare(args: CompareArgs) -> anyhow::Result<()> {
+    let reference = load(&args.reference, true).context("loading the reference")?;
+    let other = load(&args.other, true).context("loading the mesh to compare")?;
+    let result = metrics::compare(&reference.mesh, &other.mesh);
+    let mut object = json!({
+        "reference": args.reference.display().to_string(),
+        "other": args.other.display().to_string(),
+        "mean_surface_distance": result.mean_surface_distance,
+        "hausdorff": result.hausdorff,
+        "volume_change_percent": result.volume_change_percent,
+        "reference_to_other": result.reference_to_other,
+        "other_to_reference": result.other_to_reference,
+        "same_connectivity": result.same_connectivity.is_some(),
+        "reference_mean_edge_length": metrics::mean_edge_length(&reference.mesh),
+    });
+    if let (Some(v), Some(map)) = (result.same_connectivity, object.as_object_mut()) {
+        map.insert("rms".into(), json!(v.rms));
+        map.insert("max_distance".into(), json!(v.max_distance));
+        map.insert("normal_error_deg".into(), json!(v.normal_error_deg));
+        map.insert("barycenter_drift".into(), json!(v.barycenter_drift));
+    }
+    if args.json {
+        return super::emit(&format!("{}\n", serde_json::to_string_pretty(&object)?));
+    }
+    let mut out = String::new();
+    writeln!(
+        out,
+        "{} against {}",
+        args.other.display(),
+        args.reference.display()
+    )?;
+    writeln!(
+        out,
+        "  mean surface distance  {:.6e}",
+        result.mean_surface_distance
+    )?;
+    writeln!(out, "  Hausdorff (estimate)   {:.6e}", result.hausdorff)?;
+    match result.volume_change_percent {
+        Some(p) => writeln!(out, "  volume change          {p:+.4}%")?,
+        None => writeln!(
+            out,
+            "  volume change          n/a (reference encloses no volume)"
+        )?,
+    }
+    match result.same_connectivity {
+        Some(v) => {
+            writeln!(out, "  vertex RMS             {:.6e}", v.rms)?;
+            writeln!(out, "  max vertex distance    {:.6e}", v.max_distance)?;
+            writeln!(
+                out,
+                "  mean normal error      {:.4} deg",
+                v.normal_error_deg
+            )?;
+            writeln!(out, "  barycenter drift       {:.6e}", v.barycenter_drift)?;
+        }
+        None => writeln!(out, "  (different connectivity: no per-vertex measures)")?,
+    }
+    super::emit(&out)
 }

@@ -1,19 +1,88 @@
-//! `fairmesh bench` (PROVISIONAL).
+//! `fairmesh bench FILE`: a table of the timings that matter on one mesh, as medians of several
+//! runs. Each part of the library adds its own rows (`fair::bench_rows`, `hierarchy::bench_rows`).
+
 use clap::Args;
+use fairmesh::{io, mesh, metrics, Topology};
 use std::path::PathBuf;
+use std::time::Instant;
 
 #[derive(Args, Debug)]
 pub struct BenchArgs {
+    /// Mesh to time the operations on.
     pub input: PathBuf,
+    /// Runs per operation (the median is shown).
+    #[arg(long, default_value_t = 5)]
+    pub runs: usize,
+    /// Subdivide the mesh this many times first (Loop; each time 4x the faces), to time large meshes.
+    #[arg(long, default_value_t = 0)]
+    pub subdivide: usize,
+}
+
+/// Median wall time of `runs` calls of `f`, in milliseconds.
+pub fn median_ms(runs: usize, mut f: impl FnMut()) -> f64 {
+    let mut times: Vec<f64> = (0..runs.max(1))
+        .map(|_| {
+            let start = Instant::now();
+            f();
+            start.elapsed().as_secs_f64() * 1e3
+        })
+        .collect();
+    times.sort_by(f64::total_cmp);
+    times[times.len() / 2]
 }
 
 pub fn run(args: BenchArgs) -> anyhow::Result<()> {
-    let loaded = fairmesh::io::load(&args.input)?;
-    for (name, ms) in super::fair::bench_rows(&loaded.mesh, &loaded.topology)
-        .into_iter()
-        .chain(super::hierarchy::bench_rows(&loaded.mesh))
-    {
-        println!("{name:<40} {ms:>10.3} ms");
+    let mut rows: Vec<(String, f64)> = Vec::new();
+    let load_ms = median_ms(args.runs, || {
+        let _ = io::load(&args.input);
+    });
+    let mut loaded = io::load(&args.input)?;
+    rows.push(("load + weld + clean + topology".into(), load_ms));
+    for _ in 0..args.subdivide {
+        loaded.mesh = mesh::subdivide_loop(&loaded.mesh);
     }
-    Ok(())
+    let mesh = loaded.mesh;
+    let mut topology = Topology::default();
+    rows.push((
+        "topology".into(),
+        median_ms(args.runs, || topology = Topology::build(&mesh)),
+    ));
+    rows.push((
+        "weld (already welded mesh)".into(),
+        median_ms(args.runs, || {
+            let mut copy = mesh.clone();
+            mesh::weld(&mut copy);
+        }),
+    ));
+    rows.push((
+        "volume + area + mean edge length".into(),
+        median_ms(args.runs, || {
+            std::hint::black_box((
+                metrics::signed_volume(&mesh),
+                metrics::area(&mesh),
+                metrics::mean_edge_length(&mesh),
+            ));
+        }),
+    ));
+    rows.extend(super::fair::bench_rows(&mesh, &topology));
+    rows.extend(super::hierarchy::bench_rows(&mesh));
+
+    let mut out = format!(
+        "{}: {} vertices, {} faces{} ({} threads; median of {} runs)\n",
+        args.input.display(),
+        mesh.vertex_count(),
+        mesh.face_count(),
+        if args.subdivide > 0 {
+            format!(" after {} subdivisions", args.subdivide)
+        } else {
+            String::new()
+        },
+        rayon::current_num_threads(),
+        args.runs
+    );
+    out.push_str(&format!("{:<48} {:>12}\n", "operation", "ms"));
+    for (name, ms) in rows {
+        out.push_str(&format!("{name:<48} {ms:>12.3}\n"));
+    }
+    super::emit(&out)
 }

@@ -432,29 +432,25 @@ fn scan_vertex(v: u32, faces: &[u32], triangles: &[[u32; 3]], slot: &mut [u32]) 
     scan.neighbor_count = write as u32;
 
     // Fans: union the two other corners of each face over v's local neighbour indices; a single
-    // fan is a single connected link.
+    // fan is a single connected link. Valences up to 64 use a stack array (no allocation).
     if !faces.is_empty() && !scan.non_manifold_edge {
         let neighbors = &slot[..write];
-        let mut parent: Vec<u8> = Vec::new();
-        let mut parent_wide: Vec<u32> = Vec::new();
-        let small = write <= u8::MAX as usize;
-        if small {
-            parent.extend(0..write as u8);
+        let mut stack_parent = [0u32; 64];
+        let mut heap_parent = Vec::new();
+        let parent: &mut [u32] = if write <= 64 {
+            &mut stack_parent[..write]
         } else {
-            parent_wide.extend(0..write as u32);
+            heap_parent.resize(write, 0);
+            &mut heap_parent
+        };
+        for (i, p) in parent.iter_mut().enumerate() {
+            *p = i as u32;
         }
         let local = |x: u32| neighbors.binary_search(&x).unwrap_or(0);
         let mut components = write;
         for &f in faces {
             let t = triangles[f as usize];
-            let a = local(next_in_face(t, v));
-            let b = local(prev_in_face(t, v));
-            let merged = if small {
-                union_small(&mut parent, a, b)
-            } else {
-                union_wide(&mut parent_wide, a, b)
-            };
-            if merged {
+            if union(parent, local(next_in_face(t, v)), local(prev_in_face(t, v))) {
                 components -= 1;
             }
         }
@@ -463,22 +459,7 @@ fn scan_vertex(v: u32, faces: &[u32], triangles: &[[u32; 3]], slot: &mut [u32]) 
     scan
 }
 
-fn union_small(parent: &mut [u8], a: usize, b: usize) -> bool {
-    let find = |parent: &mut [u8], mut x: usize| {
-        while parent[x] as usize != x {
-            x = parent[x] as usize;
-        }
-        x
-    };
-    let (ra, rb) = (find(parent, a), find(parent, b));
-    if ra == rb {
-        return false;
-    }
-    parent[ra.max(rb)] = ra.min(rb) as u8;
-    true
-}
-
-fn union_wide(parent: &mut [u32], a: usize, b: usize) -> bool {
+fn union(parent: &mut [u32], a: usize, b: usize) -> bool {
     let find = |parent: &mut [u32], mut x: usize| {
         while parent[x] as usize != x {
             x = parent[x] as usize;
