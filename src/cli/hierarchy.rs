@@ -63,6 +63,9 @@ pub struct HierarchyArgs {
     /// Format of the written levels.
     #[arg(long, value_enum, default_value_t = LevelFormat::Obj)]
     pub format: LevelFormat,
+    /// Loop-subdivide the input this many times first (to time large meshes).
+    #[arg(long, default_value_t = 0)]
+    pub subdivide: usize,
     #[command(flatten)]
     pub build: BuildArgs,
 }
@@ -127,7 +130,10 @@ fn build(mesh: &TriMesh, args: &BuildArgs) -> anyhow::Result<Hierarchy> {
 }
 
 pub fn run_hierarchy(args: HierarchyArgs) -> anyhow::Result<()> {
-    let loaded = super::basic::load(&args.input, true)?;
+    let mut loaded = super::basic::load(&args.input, true)?;
+    for _ in 0..args.subdivide {
+        loaded.mesh = fairmesh::mesh::subdivide_loop(&loaded.mesh);
+    }
     let started = Instant::now();
     let hierarchy = build(&loaded.mesh, &args.build)
         .with_context(|| format!("building the hierarchy of {}", args.input.display()))?;

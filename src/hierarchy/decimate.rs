@@ -141,6 +141,16 @@ pub(super) fn build(
             }
         }
 
+        if pass == 0 {
+            if let Some(v) = first_non_manifold_vertex(&face_offsets, &vertex_faces, &corners) {
+                return Err(HierarchyError::Unsupported(format!(
+                    "the mesh is not an oriented 2-manifold at vertex {v}: its faces do not form \
+                     one consistently oriented fan (an edge with more than two faces, two fans \
+                     meeting at the vertex, or faces of opposite orientation)"
+                )));
+            }
+        }
+
         // Costs on the current level.
         for &v in &alive_vertices {
             edge_min[v as usize] = f32::INFINITY;
@@ -249,6 +259,50 @@ pub(super) fn build(
         out.pass_ms.push(started.elapsed().as_secs_f64() * 1e3);
     }
     Ok(out)
+}
+
+/// A vertex whose faces are not a single consistently oriented fan, if any: with the faces
+/// `(v, a, b)` of `v`, every `a` and every `b` must be distinct and following `a -> b` from the
+/// fan's start (an `a` that is no `b`, or any `a` when the fan is closed) must visit every face.
+fn first_non_manifold_vertex(
+    face_offsets: &[u32],
+    vertex_faces: &[u32],
+    corners: &[[u32; 3]],
+) -> Option<usize> {
+    let n = face_offsets.len() - 1;
+    (0..n).into_par_iter().find_first(|&v| {
+        let faces = &vertex_faces[face_offsets[v] as usize..face_offsets[v + 1] as usize];
+        if faces.is_empty() {
+            return false;
+        }
+        let mut fan: Vec<(u32, u32)> = Vec::with_capacity(faces.len());
+        for &f in faces {
+            let t = corners[f as usize];
+            let i = t.iter().position(|&c| c == v as u32).unwrap_or(0);
+            fan.push((t[(i + 1) % 3], t[(i + 2) % 3]));
+        }
+        for i in 0..fan.len() {
+            for j in i + 1..fan.len() {
+                if fan[i].0 == fan[j].0 || fan[i].1 == fan[j].1 {
+                    return true;
+                }
+            }
+        }
+        let start = fan
+            .iter()
+            .position(|&(a, _)| !fan.iter().any(|&(_, b)| b == a))
+            .unwrap_or(0);
+        let mut current = start;
+        for step in 1..=fan.len() {
+            let b = fan[current].1;
+            match fan.iter().position(|&(a, _)| a == b) {
+                Some(next) if next == start => return step != fan.len(),
+                Some(next) => current = next,
+                None => return step != fan.len(),
+            }
+        }
+        true
+    })
 }
 
 /// Read-only view of the pass state for choosing a collapse.

@@ -309,28 +309,6 @@ pub fn build_hierarchy(
             "face {f} {t:?} repeats a vertex or refers to a missing one"
         )));
     }
-    let topology = crate::mesh::Topology::build(mesh);
-    if let Some(e) = topology.non_manifold_edges.first() {
-        return Err(HierarchyError::Unsupported(format!(
-            "the mesh is not a 2-manifold: {} edges have more than two faces (first: vertices {} and {})",
-            topology.non_manifold_edges.len(),
-            e[0],
-            e[1]
-        )));
-    }
-    if let Some(v) = topology.non_manifold_vertices.first() {
-        return Err(HierarchyError::Unsupported(format!(
-            "the mesh is not a 2-manifold: {} vertices have more than one fan of faces (first: vertex {v})",
-            topology.non_manifold_vertices.len()
-        )));
-    }
-    if topology.inconsistent_edges > 0 {
-        return Err(HierarchyError::Unsupported(format!(
-            "the faces are not consistently oriented ({} edges are traversed the same way by both faces)",
-            topology.inconsistent_edges
-        )));
-    }
-    drop(topology);
     let setup_ms = started.elapsed().as_secs_f64() * 1e3;
 
     let built = decimate::build(mesh, options, progress)?;
