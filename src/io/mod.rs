@@ -1,12 +1,110 @@
-//! Reading and writing meshes. `load(path)` and `save(path, mesh)` dispatch on the extension.
-//! PROVISIONAL: OBJ only through tobj; the full set of formats and errors is to come.
+//! Reading and writing meshes: OBJ, glTF/GLB, PLY, STL and OFF.
+//!
+//! `load(path)` and `save(path, mesh)` dispatch on the file extension ([`Format::from_path`]);
+//! [`load_from_bytes`] parses a buffer already in memory (drag and drop, fuzzing). One file per
+//! format; this file holds the dispatch, the shared checks and the post-processing.
+//!
+//! Choices:
+//! - Files are read whole into memory and parsed from the slice: it is the fastest way for every
+//!   format here and lets binary parsers check lengths before they allocate.
+//! - Every parser checks what it reads (finite coordinates, indices in range, lengths) and reports
+//!   the line (text formats) or byte offset / element (binary formats) at fault; [`IoError`]'s
+//!   `Display` always starts with the path. No parser panics on any input (they are fuzzed, see
+//!   `fuzz/`).
+//! - After parsing, [`finish`] welds bit-identical positions (seams), drops degenerate triangles
+//!   and unused vertices and builds the topology; non-manifold or inconsistently oriented input is
+//!   loaded, with a warning in [`LoadReport::warnings`].
+//! - Writes are atomic ([`atomic`]): a temporary file beside the target is renamed into place, so a
+//!   failed export never leaves a partial file or damages an existing one. Meshes with non-finite
+//!   positions or out-of-range indices are refused before anything is written.
+
+mod atomic;
+mod error;
+mod gltf;
+mod obj;
+mod off;
+mod ply;
+mod stl;
+mod text;
+
+pub use error::{IoError, Location};
 
 use crate::mesh::{self, Topology, TriMesh};
 use std::path::{Path, PathBuf};
 
+/// A mesh file format, chosen from the file extension.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Format {
+    /// Wavefront OBJ (text), read through tobj.
+    Obj,
+    /// glTF 2.0 JSON (`.gltf`) with external or embedded (data: URI) buffers.
+    Gltf,
+    /// glTF 2.0 binary container (`.glb`).
+    Glb,
+    /// Stanford PLY, ASCII or binary (either endianness); written as binary little endian.
+    Ply,
+    /// STL, ASCII or binary; written as binary.
+    Stl,
+    /// Object File Format (text).
+    Off,
+}
+
+impl Format {
+    /// Every supported format.
+    pub const ALL: [Format; 6] = [
+        Format::Obj,
+        Format::Gltf,
+        Format::Glb,
+        Format::Ply,
+        Format::Stl,
+        Format::Off,
+    ];
+
+    /// The format for a file extension (case-insensitive, without the dot).
+    pub fn from_extension(extension: &str) -> Option<Format> {
+        let lower = extension.to_ascii_lowercase();
+        Format::ALL
+            .into_iter()
+            .find(|format| format.extension() == lower)
+    }
+
+    /// The format for a path, from its extension.
+    pub fn from_path(path: &Path) -> Option<Format> {
+        path.extension()
+            .and_then(|e| e.to_str())
+            .and_then(Format::from_extension)
+    }
+
+    /// The usual extension, lower case, without the dot.
+    pub fn extension(self) -> &'static str {
+        match self {
+            Format::Obj => "obj",
+            Format::Gltf => "gltf",
+            Format::Glb => "glb",
+            Format::Ply => "ply",
+            Format::Stl => "stl",
+            Format::Off => "off",
+        }
+    }
+}
+
+impl std::fmt::Display for Format {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(match self {
+            Format::Obj => "OBJ",
+            Format::Gltf => "glTF",
+            Format::Glb => "GLB",
+            Format::Ply => "PLY",
+            Format::Stl => "STL",
+            Format::Off => "OFF",
+        })
+    }
+}
+
 #[derive(Clone, Debug)]
 pub struct LoadOptions {
-    /// Merge vertices with identical positions (seams in OBJ and glTF files).
+    /// Merge vertices with identical positions (seams in OBJ and glTF files, STL's unshared
+    /// corners).
     pub weld: bool,
 }
 
@@ -33,50 +131,125 @@ pub struct Loaded {
     pub report: LoadReport,
 }
 
-#[derive(Debug, thiserror::Error)]
-pub enum IoError {
-    #[error("{path}: {message}")]
-    Invalid { path: PathBuf, message: String },
-    #[error("{path}: {source}")]
-    Io {
-        path: PathBuf,
-        source: std::io::Error,
-    },
+/// What a format parser hands back: the raw mesh (indices checked, positions finite) and
+/// warnings about what it skipped.
+#[derive(Debug)]
+pub(crate) struct Parsed {
+    pub mesh: TriMesh,
+    pub warnings: Vec<String>,
 }
 
+impl Parsed {
+    fn new(mesh: TriMesh) -> Parsed {
+        Parsed {
+            mesh,
+            warnings: Vec::new(),
+        }
+    }
+}
+
+/// Load a mesh, welded and cleaned, with default options.
 pub fn load(path: &Path) -> Result<Loaded, IoError> {
     load_with(path, &LoadOptions::default())
 }
 
+/// Load a mesh; the format comes from the extension.
 pub fn load_with(path: &Path, options: &LoadOptions) -> Result<Loaded, IoError> {
-    let (models, _) = tobj::load_obj(
-        path,
-        &tobj::LoadOptions {
-            triangulate: true,
-            single_index: false,
-            ..Default::default()
-        },
-    )
-    .map_err(|e| IoError::Invalid {
+    let format = format_of(path)?;
+    let bytes = std::fs::read(path).map_err(|source| IoError::Read {
         path: path.to_owned(),
-        message: e.to_string(),
+        source,
     })?;
-    let mut raw = TriMesh::default();
-    for m in models {
-        let base = raw.positions.len() as u32;
-        raw.positions
-            .extend(m.mesh.positions.chunks_exact(3).map(|c| [c[0], c[1], c[2]]));
-        raw.triangles.extend(
-            m.mesh
-                .indices
-                .chunks_exact(3)
-                .map(|c| [c[0] + base, c[1] + base, c[2] + base]),
-        );
-    }
-    Ok(finish(raw, options))
+    let base_dir = path.parent().map(Path::to_path_buf);
+    load_bytes_impl(&bytes, format, path, base_dir.as_deref(), options)
 }
 
-/// Weld, clean and build the topology of a freshly parsed mesh.
+/// Parse a mesh from bytes in memory. `name` stands for the path in error messages (a file name,
+/// or e.g. "dropped file"). A glTF that refers to external buffer files cannot be loaded this way
+/// (there is no directory to resolve them in); embedded (data: URI) buffers and GLB work.
+pub fn load_from_bytes(
+    bytes: &[u8],
+    format: Format,
+    name: &str,
+    options: &LoadOptions,
+) -> Result<Loaded, IoError> {
+    load_bytes_impl(bytes, format, Path::new(name), None, options)
+}
+
+fn load_bytes_impl(
+    bytes: &[u8],
+    format: Format,
+    path: &Path,
+    base_dir: Option<&Path>,
+    options: &LoadOptions,
+) -> Result<Loaded, IoError> {
+    if bytes.is_empty() {
+        return Err(IoError::invalid(path, "the file is empty"));
+    }
+    let parsed = match format {
+        Format::Obj => obj::parse(bytes, path)?,
+        Format::Gltf | Format::Glb => gltf::parse(bytes, path, base_dir)?,
+        Format::Ply => ply::parse(bytes, path)?,
+        Format::Stl => stl::parse(bytes, path)?,
+        Format::Off => off::parse(bytes, path)?,
+    };
+    check_parsed(&parsed.mesh, path)?;
+    let mut loaded = finish(parsed.mesh, options);
+    if loaded.mesh.triangles.is_empty() {
+        return Err(IoError::invalid(
+            path,
+            format!(
+                "no triangles left: all {} triangles repeat a vertex",
+                loaded.report.removed_degenerate_faces
+            ),
+        ));
+    }
+    let mut warnings = parsed.warnings;
+    warnings.append(&mut loaded.report.warnings);
+    loaded.report.warnings = warnings;
+    Ok(loaded)
+}
+
+/// A safety net behind the parsers' own checks (which name the line or byte): `finish` needs
+/// indices in range and finite positions.
+fn check_parsed(mesh: &TriMesh, path: &Path) -> Result<(), IoError> {
+    if mesh.triangles.is_empty() {
+        return Err(IoError::invalid(path, "the file has no triangles"));
+    }
+    if let Some(v) = mesh.first_non_finite_vertex() {
+        return Err(IoError::invalid(
+            path,
+            format!("vertex {v} has a NaN or infinite coordinate"),
+        ));
+    }
+    let n = mesh.positions.len();
+    if let Some((f, t)) = mesh
+        .triangles
+        .iter()
+        .enumerate()
+        .find(|(_, t)| t.iter().any(|&v| v as usize >= n))
+    {
+        return Err(IoError::invalid(
+            path,
+            format!("triangle {f} {t:?} refers to a vertex out of range (there are {n} vertices)"),
+        ));
+    }
+    Ok(())
+}
+
+fn format_of(path: &Path) -> Result<Format, IoError> {
+    Format::from_path(path).ok_or_else(|| IoError::UnknownFormat {
+        path: path.to_owned(),
+        extension: path
+            .extension()
+            .map(|e| e.to_string_lossy().into_owned())
+            .unwrap_or_default(),
+    })
+}
+
+/// Weld, clean and build the topology of a freshly parsed mesh. Indices must be in range and
+/// positions finite (every parser checks both). Non-manifold and inconsistently oriented input
+/// gets a warning in the report.
 pub fn finish(mut mesh: TriMesh, options: &LoadOptions) -> Loaded {
     let mut report = LoadReport::default();
     if options.weld {
@@ -86,6 +259,26 @@ pub fn finish(mut mesh: TriMesh, options: &LoadOptions) -> Loaded {
     report.removed_degenerate_faces = cleaned.removed_degenerate_faces;
     report.removed_unreferenced_vertices = cleaned.removed_unreferenced_vertices;
     let topology = Topology::build(&mesh);
+    if !topology.non_manifold_edges.is_empty() {
+        let [a, b] = topology.non_manifold_edges[0];
+        report.warnings.push(format!(
+            "{} non-manifold edges (used by more than two triangles), e.g. between vertices {a} and {b}",
+            topology.non_manifold_edges.len()
+        ));
+    }
+    if !topology.non_manifold_vertices.is_empty() {
+        report.warnings.push(format!(
+            "{} non-manifold vertices (their triangles do not form a single fan), e.g. vertex {}",
+            topology.non_manifold_vertices.len(),
+            topology.non_manifold_vertices[0]
+        ));
+    }
+    if topology.inconsistent_edges > 0 {
+        report.warnings.push(format!(
+            "{} edges where neighbouring triangles have opposite orientations",
+            topology.inconsistent_edges
+        ));
+    }
     Loaded {
         mesh,
         topology,
@@ -93,9 +286,112 @@ pub fn finish(mut mesh: TriMesh, options: &LoadOptions) -> Loaded {
     }
 }
 
-pub fn save(path: &Path, _mesh: &TriMesh) -> Result<(), IoError> {
-    Err(IoError::Invalid {
+/// Save a mesh; the format comes from the extension. The write is atomic: on any error nothing
+/// is left behind and an existing file is unchanged. A `.gltf` also writes `<stem>.bin` beside it.
+pub fn save(path: &Path, mesh: &TriMesh) -> Result<(), IoError> {
+    save_as(path, mesh, format_of(path)?)
+}
+
+/// Save in an explicit format, whatever the extension.
+pub fn save_as(path: &Path, mesh: &TriMesh, format: Format) -> Result<(), IoError> {
+    check_writable(mesh, path)?;
+    match format {
+        Format::Obj => atomic::write(path, |w| obj::write(w, mesh)),
+        Format::Glb => atomic::write(path, |w| gltf::write_glb(w, mesh)),
+        Format::Gltf => gltf::write_gltf(path, mesh),
+        Format::Ply => atomic::write(path, |w| ply::write(w, mesh)),
+        Format::Stl => atomic::write(path, |w| stl::write(w, mesh)),
+        Format::Off => atomic::write(path, |w| off::write(w, mesh)),
+    }
+}
+
+/// Refuse meshes that no reader could load back: no triangles, NaN/inf, indices out of range.
+fn check_writable(mesh: &TriMesh, path: &Path) -> Result<(), IoError> {
+    let refuse = |message: String| IoError::Refused {
         path: path.to_owned(),
-        message: "saving is not implemented yet".into(),
-    })
+        message,
+    };
+    if mesh.triangles.is_empty() {
+        return Err(refuse("the mesh has no triangles".into()));
+    }
+    if let Some(v) = mesh.first_non_finite_vertex() {
+        return Err(refuse(format!(
+            "vertex {v} has a non-finite coordinate {:?}",
+            mesh.positions[v]
+        )));
+    }
+    let n = mesh.positions.len();
+    if let Some(f) = mesh
+        .triangles
+        .iter()
+        .position(|t| t.iter().any(|&v| v as usize >= n))
+    {
+        return Err(refuse(format!(
+            "triangle {f} {:?} refers to a vertex out of range (there are {n} vertices)",
+            mesh.triangles[f]
+        )));
+    }
+    Ok(())
+}
+
+/// Where a `.gltf` file's buffer goes: `<stem>.bin` beside it.
+pub fn gltf_bin_path(gltf_path: &Path) -> PathBuf {
+    gltf_path.with_extension("bin")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn format_from_path_is_case_insensitive_and_rejects_unknown() {
+        assert_eq!(Format::from_path(Path::new("a/b.OBJ")), Some(Format::Obj));
+        assert_eq!(Format::from_path(Path::new("x.glb")), Some(Format::Glb));
+        assert_eq!(Format::from_path(Path::new("x.Ply")), Some(Format::Ply));
+        assert_eq!(Format::from_path(Path::new("x.txt")), None);
+        assert_eq!(Format::from_path(Path::new("noext")), None);
+        let err = load(Path::new("/nowhere/mesh.xyz")).unwrap_err();
+        assert!(err.to_string().starts_with("/nowhere/mesh.xyz: "), "{err}");
+        assert!(err.to_string().contains("xyz"), "{err}");
+    }
+
+    #[test]
+    fn save_refuses_bad_meshes_before_writing() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("bad.obj");
+        let nan = TriMesh::new(
+            vec![[0.0, 0.0, 0.0], [1.0, f32::NAN, 0.0], [0.0, 1.0, 0.0]],
+            vec![[0, 1, 2]],
+        );
+        let err = save(&path, &nan).unwrap_err();
+        assert!(err.to_string().contains("vertex 1"), "{err}");
+        let out_of_range = TriMesh::new(vec![[0.0; 3]; 3], vec![[0, 1, 3]]);
+        assert!(save(&path, &out_of_range).is_err());
+        assert!(save(&path, &TriMesh::default()).is_err());
+        assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 0);
+    }
+
+    #[test]
+    fn finish_warns_about_non_manifold_edges() {
+        let mesh = TriMesh::new(
+            vec![
+                [0., 0., 0.],
+                [1., 0., 0.],
+                [0., 1., 0.],
+                [0., -1., 0.],
+                [0., 0., 1.],
+            ],
+            vec![[0, 1, 2], [1, 0, 3], [0, 1, 4]],
+        );
+        let loaded = finish(mesh, &LoadOptions::default());
+        assert!(
+            loaded
+                .report
+                .warnings
+                .iter()
+                .any(|w| w.contains("non-manifold edges")),
+            "{:?}",
+            loaded.report.warnings
+        );
+    }
 }

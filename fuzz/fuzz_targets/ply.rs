@@ -1,0 +1,9 @@
+//! Fuzz target: the Ply loader must return Ok or Err, never panic, on any bytes.
+#![no_main]
+
+use fairmesh::io::{load_from_bytes, Format, LoadOptions};
+use libfuzzer_sys::fuzz_target;
+
+fuzz_target!(|data: &[u8]| {
+    let _ = load_from_bytes(data, Format::Ply, "fuzz.ply", &LoadOptions::default());
+});

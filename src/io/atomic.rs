@@ -1,0 +1,113 @@
+//! Atomic file writes: the data goes to a temporary file in the target's directory
+//! (`.<name>.tmp-<pid>`), is flushed and synced, then renamed over the target. On any error the
+//! temporary file is removed, so a failed export leaves nothing behind and an existing target is
+//! untouched. Rename within one directory is atomic on POSIX file systems and on NTFS.
+//!
+//! [`stage`] and [`Staged::commit`] split the two steps so that a pair of files (`.gltf` + `.bin`)
+//! is only renamed into place once both are complete; a staged file that is dropped uncommitted is
+//! removed.
+
+use super::IoError;
+use std::fs::File;
+use std::io::{BufWriter, Write};
+use std::path::{Path, PathBuf};
+
+/// The temporary sibling of `path` that is written before renaming.
+pub(crate) fn temp_path(path: &Path) -> PathBuf {
+    let name = path
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_else(|| "mesh".into());
+    path.with_file_name(format!(".{name}.tmp-{}", std::process::id()))
+}
+
+/// A complete, synced temporary file waiting to be renamed over its target.
+pub(crate) struct Staged {
+    temp: PathBuf,
+    target: PathBuf,
+    committed: bool,
+}
+
+impl Staged {
+    /// Rename the temporary file over the target.
+    pub(crate) fn commit(mut self) -> Result<(), IoError> {
+        std::fs::rename(&self.temp, &self.target).map_err(|source| IoError::Write {
+            path: self.target.clone(),
+            source,
+        })?;
+        self.committed = true;
+        Ok(())
+    }
+}
+
+impl Drop for Staged {
+    fn drop(&mut self) {
+        if !self.committed {
+            let _ = std::fs::remove_file(&self.temp);
+        }
+    }
+}
+
+/// Write the temporary file for `path` with `fill`, which writes the whole content.
+pub(crate) fn stage(
+    path: &Path,
+    fill: impl FnOnce(&mut dyn Write) -> std::io::Result<()>,
+) -> Result<Staged, IoError> {
+    let staged = Staged {
+        temp: temp_path(path),
+        target: path.to_owned(),
+        committed: false,
+    };
+    let result = (|| {
+        let file = File::create(&staged.temp)?;
+        let mut writer = BufWriter::with_capacity(1 << 20, file);
+        fill(&mut writer)?;
+        let file = writer.into_inner().map_err(|e| e.into_error())?;
+        file.sync_all()
+    })();
+    // On error, dropping `staged` removes the temporary file.
+    result.map_err(|source| IoError::Write {
+        path: path.to_owned(),
+        source,
+    })?;
+    Ok(staged)
+}
+
+/// Write `path` atomically with `fill`, which writes the whole content.
+pub(crate) fn write(
+    path: &Path,
+    fill: impl FnOnce(&mut dyn Write) -> std::io::Result<()>,
+) -> Result<(), IoError> {
+    stage(path, fill)?.commit()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn failed_write_leaves_existing_file_and_no_temp() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("out.obj");
+        std::fs::write(&path, b"original").unwrap();
+        let err = write(&path, |w| {
+            w.write_all(b"partial")?;
+            Err(std::io::Error::other("disk full"))
+        })
+        .unwrap_err();
+        assert!(err.to_string().contains("out.obj"), "{err}");
+        assert!(err.to_string().contains("disk full"), "{err}");
+        assert_eq!(std::fs::read(&path).unwrap(), b"original");
+        assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1);
+
+        write(&path, |w| w.write_all(b"new")).unwrap();
+        assert_eq!(std::fs::read(&path).unwrap(), b"new");
+        assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1);
+
+        // A staged file dropped without commit disappears.
+        let staged = stage(&dir.path().join("other.obj"), |w| w.write_all(b"x")).unwrap();
+        assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 2);
+        drop(staged);
+        assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1);
+    }
+}

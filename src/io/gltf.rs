@@ -1,0 +1,850 @@
+//! glTF 2.0, JSON (`.gltf`) and binary (`.glb`): read with the `gltf` crate's document model and
+//! our own bounds-checked accessor reading; written with `gltf-json`.
+//!
+//! Reading:
+//! - The document is parsed and validated by `gltf` (JSON syntax errors give the line; schema
+//!   errors the JSON path). Buffers come from the GLB BIN chunk, from base64 `data:` URIs (decoded
+//!   here: the crate's `import` feature would pull in image decoders) or from files relative to
+//!   the `.gltf` (not available from `load_from_bytes`).
+//! - Every triangle primitive of every node of the default scene (or the first scene) is read,
+//!   with the node's world transform (composed down the hierarchy in f64) applied; a transform with
+//!   a negative determinant mirrors the mesh, so the triangles' winding is flipped back. Identity
+//!   transforms are not applied at all, so untransformed positions stay bit-exact. If the file has
+//!   no scene, every mesh is read once, untransformed, with a warning.
+//! - Triangle strips and fans become triangles (glTF 2.0 spec, section 3.7.2.1); points and lines
+//!   are skipped with a warning, or give an error if the file has no triangles at all.
+//! - Accessors are read with every offset and length checked against the buffer view and buffer
+//!   (the `gltf` crate's readers trust the file); positions may be float or (normalized) integers
+//!   (KHR_mesh_quantization); indices u8/u16/u32. Sparse accessors are refused.
+//! - Nodes must form a tree: a node reached twice (a cycle, or a shared child) is an error, which
+//!   also bounds the work on hostile files.
+//!
+//! Writing: one buffer with positions, area-weighted unit vertex normals (a vertex whose normal
+//! sums to zero takes an incident face's normal, or +Z) and u32 indices, three buffer views with
+//! targets, position min/max, one mesh, one node, one default scene, asset.generator "fairmesh".
+//! `.glb` is one atomic write; `.gltf` writes `<stem>.bin` and the JSON, both staged as temporary
+//! files first and renamed only when both are complete.
+
+use super::atomic;
+use super::{IoError, Parsed};
+use crate::mesh::TriMesh;
+use ::gltf::accessor::{DataType, Dimensions};
+use ::gltf::mesh::Mode;
+use ::gltf::Semantic;
+use glam::{DMat4, DQuat, DVec3};
+use gltf_json as json;
+use std::borrow::Cow;
+use std::io::Write;
+use std::path::Path;
+
+pub(crate) fn parse(bytes: &[u8], path: &Path, base_dir: Option<&Path>) -> Result<Parsed, IoError> {
+    let document = ::gltf::Gltf::from_slice(bytes).map_err(|e| describe(e, path))?;
+    let buffers = load_buffers(&document, path, base_dir)?;
+    let mut reader = SceneReader {
+        path,
+        buffers: &buffers,
+        mesh: TriMesh::default(),
+        warnings: Vec::new(),
+        skipped_points: 0,
+        skipped_lines: 0,
+    };
+    let scene = document
+        .default_scene()
+        .or_else(|| document.scenes().next());
+    match scene {
+        Some(scene) => reader.read_scene(&scene, document.nodes().len())?,
+        None => {
+            if document.meshes().len() > 0 {
+                reader.warnings.push(
+                    "the file has no scene: every mesh was read once, without transforms".into(),
+                );
+            }
+            for mesh in document.meshes() {
+                reader.read_mesh(&mesh, None, DMat4::IDENTITY)?;
+            }
+        }
+    }
+    let skipped = reader.skipped_points + reader.skipped_lines;
+    if reader.mesh.triangles.is_empty() {
+        let detail = if skipped > 0 {
+            format!(
+                ": the scene has only point and line primitives ({} point, {} line)",
+                reader.skipped_points, reader.skipped_lines
+            )
+        } else {
+            String::new()
+        };
+        return Err(IoError::invalid(path, format!("no triangles{detail}")));
+    }
+    if skipped > 0 {
+        reader.warnings.push(format!(
+            "{} point and {} line primitives were skipped",
+            reader.skipped_points, reader.skipped_lines
+        ));
+    }
+    Ok(Parsed {
+        mesh: reader.mesh,
+        warnings: reader.warnings,
+    })
+}
+
+fn describe(error: ::gltf::Error, path: &Path) -> IoError {
+    match error {
+        ::gltf::Error::Deserialize(e) if e.line() > 0 => IoError::at_line(
+            path,
+            e.line(),
+            format!("invalid glTF JSON (column {}): {e}", e.column()),
+        ),
+        ::gltf::Error::Deserialize(e) => IoError::invalid(path, format!("invalid glTF JSON: {e}")),
+        ::gltf::Error::Binary(e) => {
+            IoError::at_element(path, "GLB container", format!("invalid GLB: {e}"))
+        }
+        ::gltf::Error::Validation(errors) => {
+            let count = errors.len();
+            match errors.into_iter().next() {
+                Some((where_, what)) => IoError::at_element(
+                    path,
+                    where_.to_string(),
+                    format!("invalid glTF: {what} ({count} problems in all)"),
+                ),
+                None => IoError::invalid(path, "invalid glTF"),
+            }
+        }
+        other => IoError::invalid(path, format!("invalid glTF: {other}")),
+    }
+}
+
+fn load_buffers<'a>(
+    document: &'a ::gltf::Gltf,
+    path: &Path,
+    base_dir: Option<&Path>,
+) -> Result<Vec<Cow<'a, [u8]>>, IoError> {
+    let mut buffers = Vec::new();
+    for buffer in document.buffers() {
+        let label = format!("buffer {}", buffer.index());
+        let at = |message: String| IoError::at_element(path, label.clone(), message);
+        let data: Cow<[u8]> = match buffer.source() {
+            ::gltf::buffer::Source::Bin => match document.blob.as_deref() {
+                Some(blob) => Cow::Borrowed(blob),
+                None => return Err(at("has no uri and the file has no GLB BIN chunk".into())),
+            },
+            ::gltf::buffer::Source::Uri(uri) => {
+                if let Some(rest) = uri.strip_prefix("data:") {
+                    let Some((_, payload)) = rest.split_once(";base64,") else {
+                        return Err(at("only base64 data: URIs are supported".into()));
+                    };
+                    Cow::Owned(decode_base64(payload.as_bytes()).map_err(|offset| {
+                        at(format!("bad base64 at character {offset} of its data URI"))
+                    })?)
+                } else {
+                    let relative = percent_decode(uri)
+                        .ok_or_else(|| at(format!("cannot decode the uri {uri:?}")))?;
+                    if relative.contains("://") || Path::new(&relative).is_absolute() {
+                        return Err(at(format!("the uri {uri:?} is not a relative file path")));
+                    }
+                    let Some(dir) = base_dir else {
+                        return Err(at(format!(
+                            "refers to the external file {uri:?}, which cannot be resolved when loading from memory"
+                        )));
+                    };
+                    let file = dir.join(&relative);
+                    Cow::Owned(
+                        std::fs::read(&file)
+                            .map_err(|e| at(format!("cannot read {}: {e}", file.display())))?,
+                    )
+                }
+            }
+        };
+        if data.len() < buffer.length() {
+            return Err(at(format!(
+                "has {} bytes but its byteLength is {}",
+                data.len(),
+                buffer.length()
+            )));
+        }
+        buffers.push(data);
+    }
+    Ok(buffers)
+}
+
+/// Standard base64 (RFC 4648), padding optional. On error, the offset of the bad character.
+fn decode_base64(text: &[u8]) -> Result<Vec<u8>, usize> {
+    let value = |c: u8| -> Option<u32> {
+        Some(match c {
+            b'A'..=b'Z' => c - b'A',
+            b'a'..=b'z' => c - b'a' + 26,
+            b'0'..=b'9' => c - b'0' + 52,
+            b'+' | b'-' => 62,
+            b'/' | b'_' => 63,
+            _ => return None,
+        } as u32)
+    };
+    let end = text.iter().rposition(|&c| c != b'=').map_or(0, |i| i + 1);
+    if text.len() - end > 2 {
+        return Err(end);
+    }
+    let mut out = Vec::with_capacity(end / 4 * 3 + 3);
+    let mut bits = 0u32;
+    let mut count = 0u32;
+    for (offset, &c) in text[..end].iter().enumerate() {
+        bits = (bits << 6) | value(c).ok_or(offset)?;
+        count += 1;
+        if count == 4 {
+            out.extend_from_slice(&bits.to_be_bytes()[1..]);
+            bits = 0;
+            count = 0;
+        }
+    }
+    match count {
+        0 => {}
+        2 => out.push((bits >> 4) as u8),
+        3 => out.extend_from_slice(&((bits >> 2) as u16).to_be_bytes()),
+        _ => return Err(end),
+    }
+    Ok(out)
+}
+
+/// Decode `%XX` escapes (UTF-8); `None` for a bad escape or invalid UTF-8.
+fn percent_decode(uri: &str) -> Option<String> {
+    let bytes = uri.as_bytes();
+    let mut out = Vec::with_capacity(bytes.len());
+    let mut i = 0;
+    while i < bytes.len() {
+        if bytes[i] == b'%' {
+            let hex = std::str::from_utf8(bytes.get(i + 1..i + 3)?).ok()?;
+            out.push(u8::from_str_radix(hex, 16).ok()?);
+            i += 3;
+        } else {
+            out.push(bytes[i]);
+            i += 1;
+        }
+    }
+    String::from_utf8(out).ok()
+}
+
+/// Encode everything but unreserved characters, for a file name used as a URI.
+fn percent_encode(name: &str) -> String {
+    let mut out = String::with_capacity(name.len());
+    for b in name.bytes() {
+        if b.is_ascii_alphanumeric() || b"-_.~".contains(&b) {
+            out.push(b as char);
+        } else {
+            out.push_str(&format!("%{b:02X}"));
+        }
+    }
+    out
+}
+
+struct SceneReader<'a> {
+    path: &'a Path,
+    buffers: &'a [Cow<'a, [u8]>],
+    mesh: TriMesh,
+    warnings: Vec<String>,
+    skipped_points: usize,
+    skipped_lines: usize,
+}
+
+fn local_matrix(node: &::gltf::Node) -> DMat4 {
+    match node.transform() {
+        ::gltf::scene::Transform::Matrix { matrix } => {
+            DMat4::from_cols_array_2d(&matrix.map(|col| col.map(f64::from)))
+        }
+        ::gltf::scene::Transform::Decomposed {
+            translation,
+            rotation,
+            scale,
+        } => {
+            let [x, y, z, w] = rotation.map(f64::from);
+            let q = DQuat::from_xyzw(x, y, z, w);
+            let q = if q.length_squared() > 0.0 {
+                q.normalize()
+            } else {
+                DQuat::IDENTITY
+            };
+            DMat4::from_scale_rotation_translation(
+                DVec3::from_array(scale.map(f64::from)),
+                q,
+                DVec3::from_array(translation.map(f64::from)),
+            )
+        }
+    }
+}
+
+impl SceneReader<'_> {
+    fn read_scene(&mut self, scene: &::gltf::Scene, node_count: usize) -> Result<(), IoError> {
+        let mut visited = vec![false; node_count];
+        let mut stack: Vec<(::gltf::Node, DMat4)> =
+            scene.nodes().map(|n| (n, DMat4::IDENTITY)).collect();
+        stack.reverse();
+        while let Some((node, parent)) = stack.pop() {
+            let seen = visited.get_mut(node.index()).ok_or_else(|| {
+                IoError::at_element(
+                    self.path,
+                    format!("node {}", node.index()),
+                    "does not exist",
+                )
+            })?;
+            if *seen {
+                return Err(IoError::at_element(
+                    self.path,
+                    format!("node {}", node.index()),
+                    format!(
+                        "is reached twice from scene {} (glTF nodes must form a tree)",
+                        scene.index()
+                    ),
+                ));
+            }
+            *seen = true;
+            let world = parent * local_matrix(&node);
+            if let Some(mesh) = node.mesh() {
+                self.read_mesh(&mesh, Some(node.index()), world)?;
+            }
+            let children: Vec<_> = node.children().collect();
+            for child in children.into_iter().rev() {
+                stack.push((child, world));
+            }
+        }
+        Ok(())
+    }
+
+    fn read_mesh(
+        &mut self,
+        mesh: &::gltf::Mesh,
+        node: Option<usize>,
+        world: DMat4,
+    ) -> Result<(), IoError> {
+        for primitive in mesh.primitives() {
+            let label = match node {
+                Some(n) => format!(
+                    "node {n}, mesh {}, primitive {}",
+                    mesh.index(),
+                    primitive.index()
+                ),
+                None => format!("mesh {}, primitive {}", mesh.index(), primitive.index()),
+            };
+            let at = |message: String| IoError::at_element(self.path, label.clone(), message);
+            match primitive.mode() {
+                Mode::Points => {
+                    self.skipped_points += 1;
+                    continue;
+                }
+                Mode::Lines | Mode::LineLoop | Mode::LineStrip => {
+                    self.skipped_lines += 1;
+                    continue;
+                }
+                Mode::Triangles | Mode::TriangleStrip | Mode::TriangleFan => {}
+            }
+            let Some(position_accessor) = primitive.get(&Semantic::Positions) else {
+                self.warnings
+                    .push(format!("{label}: no POSITION attribute, skipped"));
+                continue;
+            };
+            let mut positions = read_positions(&position_accessor, self.buffers).map_err(|m| {
+                at(format!(
+                    "POSITION accessor {}: {m}",
+                    position_accessor.index()
+                ))
+            })?;
+            if world != DMat4::IDENTITY {
+                for p in &mut positions {
+                    let q = world.transform_point3(DVec3::from_array(p.map(f64::from)));
+                    *p = q.as_vec3().to_array();
+                }
+            }
+            if let Some((v, _)) = positions
+                .iter()
+                .enumerate()
+                .find(|(_, p)| !p.iter().all(|c| c.is_finite()))
+            {
+                return Err(at(format!(
+                    "vertex {v} has a NaN or infinite coordinate{}",
+                    if world != DMat4::IDENTITY {
+                        " (after the node's transform)"
+                    } else {
+                        ""
+                    }
+                )));
+            }
+            let vertex_count = positions.len();
+            let corners: Vec<u32> = match primitive.indices() {
+                Some(accessor) => {
+                    let indices = read_indices(&accessor, self.buffers)
+                        .map_err(|m| at(format!("index accessor {}: {m}", accessor.index())))?;
+                    if let Some((k, i)) = indices
+                        .iter()
+                        .enumerate()
+                        .find(|(_, &i)| i as usize >= vertex_count)
+                    {
+                        return Err(at(format!(
+                            "index accessor {}, element {k}: index {i} is out of range (the POSITION accessor has {vertex_count} vertices)",
+                            accessor.index()
+                        )));
+                    }
+                    indices
+                }
+                None => {
+                    let n = u32::try_from(vertex_count)
+                        .map_err(|_| at("too many vertices for 32-bit indices".into()))?;
+                    (0..n).collect()
+                }
+            };
+            let base = u32::try_from(self.mesh.positions.len())
+                .ok()
+                .filter(|b| (*b as u64) + vertex_count as u64 <= u32::MAX as u64)
+                .ok_or_else(|| at("too many vertices in all for 32-bit indices".into()))?;
+            let flip = world.determinant() < 0.0;
+            let before = self.mesh.triangles.len();
+            let mut push = |t: [u32; 3]| {
+                let t = if flip { [t[0], t[2], t[1]] } else { t };
+                self.mesh.triangles.push(t.map(|v| v + base));
+            };
+            match primitive.mode() {
+                Mode::TriangleStrip => {
+                    for (i, w) in corners.windows(3).enumerate() {
+                        push(if i % 2 == 0 {
+                            [w[0], w[1], w[2]]
+                        } else {
+                            [w[0], w[2], w[1]]
+                        });
+                    }
+                }
+                Mode::TriangleFan => {
+                    if let Some((&first, rest)) = corners.split_first() {
+                        for w in rest.windows(2) {
+                            push([w[0], w[1], first]);
+                        }
+                    }
+                }
+                _ => {
+                    for c in corners.chunks_exact(3) {
+                        push([c[0], c[1], c[2]]);
+                    }
+                    if corners.len() % 3 != 0 {
+                        self.warnings.push(format!(
+                            "{label}: {} indices is not a multiple of 3; the last {} were ignored",
+                            corners.len(),
+                            corners.len() % 3
+                        ));
+                    }
+                }
+            }
+            if self.mesh.triangles.len() > before {
+                self.mesh.positions.extend_from_slice(&positions);
+            }
+        }
+        Ok(())
+    }
+}
+
+/// The bytes of an accessor's elements, checked: `(data, stride, element size)`, `data` starting
+/// at the first element and holding all `count` of them.
+fn accessor_bytes<'a>(
+    accessor: &::gltf::Accessor,
+    buffers: &'a [Cow<'a, [u8]>],
+) -> Result<(&'a [u8], usize, usize), String> {
+    if accessor.sparse().is_some() {
+        return Err("sparse accessors are not supported".into());
+    }
+    let view = accessor
+        .view()
+        .ok_or("has no bufferView (all zeros), which gives no usable geometry")?;
+    let buffer = buffers
+        .get(view.buffer().index())
+        .ok_or("its buffer does not exist")?;
+    let element = accessor
+        .data_type()
+        .size()
+        .checked_mul(accessor.dimensions().multiplicity())
+        .ok_or("element size overflows")?;
+    let stride = view.stride().unwrap_or(element);
+    if stride < element {
+        return Err(format!(
+            "buffer view {} has byteStride {stride}, less than the element size {element}",
+            view.index()
+        ));
+    }
+    let view_end = view
+        .offset()
+        .checked_add(view.length())
+        .filter(|&end| end <= buffer.len())
+        .ok_or_else(|| {
+            format!(
+                "buffer view {} (bytes {}..+{}) runs past the end of buffer {} ({} bytes)",
+                view.index(),
+                view.offset(),
+                view.length(),
+                view.buffer().index(),
+                buffer.len()
+            )
+        })?;
+    let view_bytes = buffer.get(view.offset()..view_end).unwrap_or_default();
+    let count = accessor.count();
+    let needed = match count {
+        0 => 0,
+        n => (n - 1)
+            .checked_mul(stride)
+            .and_then(|b| b.checked_add(element))
+            .and_then(|b| b.checked_add(accessor.offset()))
+            .ok_or("its size overflows")?,
+    };
+    if needed > view_bytes.len() {
+        return Err(format!(
+            "{count} elements at byteOffset {} need {needed} bytes but buffer view {} has {}",
+            accessor.offset(),
+            view.index(),
+            view_bytes.len()
+        ));
+    }
+    let data = view_bytes
+        .get(accessor.offset().min(needed)..needed)
+        .unwrap_or_default();
+    Ok((data, stride, element))
+}
+
+fn component_f32(kind: DataType, normalized: bool, b: &[u8]) -> Option<f32> {
+    macro_rules! get {
+        ($t:ty, $n:literal) => {
+            <$t>::from_le_bytes(b.get(..$n)?.try_into().ok()?)
+        };
+    }
+    Some(match (kind, normalized) {
+        (DataType::F32, _) => get!(f32, 4),
+        (DataType::I8, true) => (get!(i8, 1) as f32 / 127.0).max(-1.0),
+        (DataType::U8, true) => get!(u8, 1) as f32 / 255.0,
+        (DataType::I16, true) => (get!(i16, 2) as f32 / 32767.0).max(-1.0),
+        (DataType::U16, true) => get!(u16, 2) as f32 / 65535.0,
+        (DataType::U32, true) => (get!(u32, 4) as f64 / u32::MAX as f64) as f32,
+        (DataType::I8, false) => get!(i8, 1) as f32,
+        (DataType::U8, false) => get!(u8, 1) as f32,
+        (DataType::I16, false) => get!(i16, 2) as f32,
+        (DataType::U16, false) => get!(u16, 2) as f32,
+        (DataType::U32, false) => get!(u32, 4) as f32,
+    })
+}
+
+fn read_positions(
+    accessor: &::gltf::Accessor,
+    buffers: &[Cow<[u8]>],
+) -> Result<Vec<[f32; 3]>, String> {
+    if accessor.dimensions() != Dimensions::Vec3 {
+        return Err(format!(
+            "type is {:?}, expected VEC3",
+            accessor.dimensions()
+        ));
+    }
+    let (data, stride, _) = accessor_bytes(accessor, buffers)?;
+    let kind = accessor.data_type();
+    let size = kind.size();
+    let normalized = accessor.normalized();
+    let mut positions = Vec::with_capacity(accessor.count());
+    for k in 0..accessor.count() {
+        let mut p = [0f32; 3];
+        for (axis, c) in p.iter_mut().enumerate() {
+            *c = data
+                .get(k * stride + axis * size..)
+                .and_then(|b| component_f32(kind, normalized, b))
+                .ok_or_else(|| format!("element {k} is out of bounds"))?;
+        }
+        positions.push(p);
+    }
+    Ok(positions)
+}
+
+fn read_indices(accessor: &::gltf::Accessor, buffers: &[Cow<[u8]>]) -> Result<Vec<u32>, String> {
+    if accessor.dimensions() != Dimensions::Scalar {
+        return Err(format!(
+            "type is {:?}, expected SCALAR",
+            accessor.dimensions()
+        ));
+    }
+    let kind = accessor.data_type();
+    if !matches!(kind, DataType::U8 | DataType::U16 | DataType::U32) {
+        return Err(format!("component type {kind:?} is not an index type"));
+    }
+    let (data, stride, _) = accessor_bytes(accessor, buffers)?;
+    let mut indices = Vec::with_capacity(accessor.count());
+    for k in 0..accessor.count() {
+        let b = data
+            .get(k * stride..)
+            .ok_or_else(|| format!("element {k} is out of bounds"))?;
+        let index = match kind {
+            DataType::U8 => b.first().map(|&x| x as u32),
+            DataType::U16 => b.get(..2).map(|x| u16::from_le_bytes([x[0], x[1]]) as u32),
+            _ => b
+                .get(..4)
+                .map(|x| u32::from_le_bytes([x[0], x[1], x[2], x[3]])),
+        }
+        .ok_or_else(|| format!("element {k} is out of bounds"))?;
+        indices.push(index);
+    }
+    Ok(indices)
+}
+
+/// Area-weighted unit vertex normals in f32; never NaN (see the file's doc comment).
+pub(crate) fn unit_vertex_normals(mesh: &TriMesh) -> Vec<[f32; 3]> {
+    let mut sums = vec![DVec3::ZERO; mesh.positions.len()];
+    let mut fallback = vec![DVec3::ZERO; mesh.positions.len()];
+    for t in 0..mesh.triangles.len() {
+        let n = mesh.face_normal(t);
+        let unit = n.normalize_or_zero();
+        for &v in &mesh.triangles[t] {
+            sums[v as usize] += n;
+            if fallback[v as usize] == DVec3::ZERO {
+                fallback[v as usize] = unit;
+            }
+        }
+    }
+    sums.iter()
+        .zip(&fallback)
+        .map(|(sum, fallback)| {
+            let n = sum.normalize_or_zero();
+            let n = if n != DVec3::ZERO {
+                n
+            } else if *fallback != DVec3::ZERO {
+                *fallback
+            } else {
+                DVec3::Z
+            };
+            n.as_vec3().to_array()
+        })
+        .collect()
+}
+
+/// The glTF document and its binary buffer for `mesh`. `uri` names the buffer file (`.gltf`),
+/// or is `None` for the GLB BIN chunk.
+fn build(mesh: &TriMesh, uri: Option<String>) -> std::io::Result<(json::Root, Vec<u8>)> {
+    use json::validation::{Checked::Valid, USize64};
+    let too_big =
+        || std::io::Error::new(std::io::ErrorKind::InvalidInput, "mesh too large for glTF");
+    let n = mesh.positions.len();
+    let m = mesh.triangles.len();
+    let normals = unit_vertex_normals(mesh);
+    let positions_len = n.checked_mul(12).ok_or_else(too_big)?;
+    let indices_len = m.checked_mul(12).ok_or_else(too_big)?;
+    let total = positions_len
+        .checked_mul(2)
+        .and_then(|b| b.checked_add(indices_len))
+        .filter(|&t| t <= u32::MAX as usize - 1024)
+        .ok_or_else(too_big)?;
+    let mut bin = Vec::with_capacity(total);
+    for p in &mesh.positions {
+        for c in p {
+            bin.extend_from_slice(&c.to_le_bytes());
+        }
+    }
+    for p in &normals {
+        for c in p {
+            bin.extend_from_slice(&c.to_le_bytes());
+        }
+    }
+    for t in &mesh.triangles {
+        for v in t {
+            bin.extend_from_slice(&v.to_le_bytes());
+        }
+    }
+    let mut min = [f32::INFINITY; 3];
+    let mut max = [f32::NEG_INFINITY; 3];
+    for p in &mesh.positions {
+        for axis in 0..3 {
+            min[axis] = min[axis].min(p[axis]);
+            max[axis] = max[axis].max(p[axis]);
+        }
+    }
+
+    let mut root = json::Root::default();
+    root.asset.generator = Some("fairmesh".into());
+    let buffer = root.push(json::Buffer {
+        byte_length: USize64(total as u64),
+        name: None,
+        uri,
+        extensions: Default::default(),
+        extras: Default::default(),
+    });
+    let view = |offset: usize, length: usize, target: json::buffer::Target| json::buffer::View {
+        buffer,
+        byte_length: USize64(length as u64),
+        byte_offset: Some(USize64(offset as u64)),
+        byte_stride: None,
+        name: None,
+        target: Some(Valid(target)),
+        extensions: Default::default(),
+        extras: Default::default(),
+    };
+    let position_view = view(0, positions_len, json::buffer::Target::ArrayBuffer);
+    let normal_view = view(
+        positions_len,
+        positions_len,
+        json::buffer::Target::ArrayBuffer,
+    );
+    let index_view = view(
+        2 * positions_len,
+        indices_len,
+        json::buffer::Target::ElementArrayBuffer,
+    );
+    let position_view = root.push(position_view);
+    let normal_view = root.push(normal_view);
+    let index_view = root.push(index_view);
+    let accessor = |view, count: usize, component, type_, bounds: Option<([f32; 3], [f32; 3])>| {
+        json::Accessor {
+            buffer_view: Some(view),
+            byte_offset: None,
+            count: USize64(count as u64),
+            component_type: Valid(json::accessor::GenericComponentType(component)),
+            extensions: Default::default(),
+            extras: Default::default(),
+            type_: Valid(type_),
+            min: bounds.map(|(lo, _)| json::Value::from(lo.to_vec())),
+            max: bounds.map(|(_, hi)| json::Value::from(hi.to_vec())),
+            name: None,
+            normalized: false,
+            sparse: None,
+        }
+    };
+    let positions = root.push(accessor(
+        position_view,
+        n,
+        json::accessor::ComponentType::F32,
+        json::accessor::Type::Vec3,
+        Some((min, max)),
+    ));
+    let normals = root.push(accessor(
+        normal_view,
+        n,
+        json::accessor::ComponentType::F32,
+        json::accessor::Type::Vec3,
+        None,
+    ));
+    let indices = root.push(accessor(
+        index_view,
+        3 * m,
+        json::accessor::ComponentType::U32,
+        json::accessor::Type::Scalar,
+        None,
+    ));
+    let primitive = json::mesh::Primitive {
+        attributes: [
+            (Valid(json::mesh::Semantic::Positions), positions),
+            (Valid(json::mesh::Semantic::Normals), normals),
+        ]
+        .into_iter()
+        .collect(),
+        extensions: Default::default(),
+        extras: Default::default(),
+        indices: Some(indices),
+        material: None,
+        mode: Valid(json::mesh::Mode::Triangles),
+        targets: None,
+    };
+    let mesh_index = root.push(json::Mesh {
+        extensions: Default::default(),
+        extras: Default::default(),
+        name: None,
+        primitives: vec![primitive],
+        weights: None,
+    });
+    let node = root.push(json::Node {
+        mesh: Some(mesh_index),
+        ..Default::default()
+    });
+    let scene = root.push(json::Scene {
+        extensions: Default::default(),
+        extras: Default::default(),
+        name: None,
+        nodes: vec![node],
+    });
+    root.scene = Some(scene);
+    Ok((root, bin))
+}
+
+pub(crate) fn write_glb(out: &mut dyn Write, mesh: &TriMesh) -> std::io::Result<()> {
+    let (root, bin) = build(mesh, None)?;
+    let mut json_bytes = json::serialize::to_vec(&root).map_err(std::io::Error::other)?;
+    while json_bytes.len() % 4 != 0 {
+        json_bytes.push(b' ');
+    }
+    let total = 12 + 8 + json_bytes.len() + 8 + bin.len();
+    let total = u32::try_from(total).map_err(|_| {
+        std::io::Error::new(
+            std::io::ErrorKind::InvalidInput,
+            "GLB files hold at most 4 GiB",
+        )
+    })?;
+    out.write_all(b"glTF")?;
+    out.write_all(&2u32.to_le_bytes())?;
+    out.write_all(&total.to_le_bytes())?;
+    out.write_all(&(json_bytes.len() as u32).to_le_bytes())?;
+    out.write_all(b"JSON")?;
+    out.write_all(&json_bytes)?;
+    out.write_all(&(bin.len() as u32).to_le_bytes())?;
+    out.write_all(b"BIN\0")?;
+    out.write_all(&bin)
+}
+
+/// Write `path` (.gltf) and `<stem>.bin` beside it: both are staged, then renamed into place.
+pub(crate) fn write_gltf(path: &Path, mesh: &TriMesh) -> Result<(), IoError> {
+    let bin_path = super::gltf_bin_path(path);
+    let bin_name = bin_path
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_else(|| "mesh.bin".into());
+    let (root, bin) =
+        build(mesh, Some(percent_encode(&bin_name))).map_err(|source| IoError::Write {
+            path: path.to_owned(),
+            source,
+        })?;
+    let json_bytes = json::serialize::to_vec_pretty(&root).map_err(|e| IoError::Write {
+        path: path.to_owned(),
+        source: std::io::Error::other(e),
+    })?;
+    let staged_bin = atomic::stage(&bin_path, |w| w.write_all(&bin))?;
+    let staged_json = atomic::stage(path, |w| w.write_all(&json_bytes))?;
+    staged_bin.commit()?;
+    staged_json.commit()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn base64_decodes_with_and_without_padding() {
+        assert_eq!(decode_base64(b"aGVsbG8=").unwrap(), b"hello");
+        assert_eq!(decode_base64(b"aGVsbG8").unwrap(), b"hello");
+        assert_eq!(decode_base64(b"aGk=").unwrap(), b"hi");
+        assert_eq!(decode_base64(b"").unwrap(), b"");
+        assert_eq!(decode_base64(b"aG!k"), Err(2));
+        assert!(decode_base64(b"a").is_err());
+    }
+
+    #[test]
+    fn percent_coding_round_trips() {
+        assert_eq!(percent_encode("my mesh.bin"), "my%20mesh.bin");
+        assert_eq!(percent_decode("my%20mesh.bin").unwrap(), "my mesh.bin");
+        assert!(percent_decode("bad%2").is_none());
+    }
+
+    #[test]
+    fn normals_are_unit_and_never_nan() {
+        // A degenerate triangle (all corners equal) and two opposite faces sharing a vertex set.
+        let mesh = TriMesh::new(
+            vec![[0., 0., 0.], [1., 0., 0.], [0., 1., 0.], [5., 5., 5.]],
+            vec![[0, 1, 2], [0, 2, 1], [3, 3, 3]],
+        );
+        for n in unit_vertex_normals(&mesh) {
+            let length = (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt();
+            assert!((length - 1.0).abs() < 1e-6, "{n:?}");
+        }
+    }
+
+    #[test]
+    fn glb_round_trip_is_bit_exact() {
+        let mesh = TriMesh::new(
+            vec![[0.1, 0.2, 0.3], [1.0, -0.0, 0.0], [0.0, 1.0, 1e-20]],
+            vec![[0, 1, 2]],
+        );
+        let mut bytes = Vec::new();
+        write_glb(&mut bytes, &mesh).unwrap();
+        let parsed = parse(&bytes, Path::new("t.glb"), None).unwrap();
+        assert_eq!(parsed.mesh, mesh);
+    }
+}
