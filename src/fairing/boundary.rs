@@ -15,6 +15,23 @@
 //! - The normal-projected variant keeps only the part of each boundary move orthogonal to the
 //!   loop's tangent (p_{i+1} − p_{i−1}), the curve's analogue of the surface's normal projection.
 
+/// A point type the curve operator reads and writes: plain `[f32; 3]` or a padded layout.
+pub trait CurvePoint: Copy {
+    fn xyz(&self) -> [f32; 3];
+    fn from_xyz(p: [f32; 3]) -> Self;
+}
+
+impl CurvePoint for [f32; 3] {
+    #[inline]
+    fn xyz(&self) -> [f32; 3] {
+        *self
+    }
+    #[inline]
+    fn from_xyz(p: [f32; 3]) -> Self {
+        p
+    }
+}
+
 /// The boundary loops of a mesh, flattened for the curve operators.
 #[derive(Clone, Debug, Default)]
 pub struct BoundaryCurves {
@@ -68,17 +85,17 @@ impl BoundaryCurves {
 
     /// One constrained curve step (section 3.3): reads `previous` and `anchors`, writes the
     /// boundary vertices of `next`. `accumulator` is a reusable buffer. Returns the largest move.
-    pub fn constrained_step(
+    pub fn constrained_step<P: CurvePoint>(
         &self,
-        previous: &[[f32; 3]],
-        anchors: &[[f32; 3]],
-        next: &mut [[f32; 3]],
+        previous: &[P],
+        anchors: &[P],
+        next: &mut [P],
         normal_projected: bool,
         accumulator: &mut Vec<([f64; 3], u32)>,
     ) -> f64 {
         accumulator.clear();
         accumulator.resize(self.vertices.len(), ([0.0; 3], 0));
-        let point = |p: &[f32; 3]| [p[0] as f64, p[1] as f64, p[2] as f64];
+        let point = |p: &P| p.xyz().map(|c| c as f64);
         for (stencil, &slot) in self.stencils.iter().zip(&self.slot_of_stencil) {
             let [before2, before, v, after, after2] = stencil.map(|u| point(&previous[u as usize]));
             let anchor_before = point(&anchors[stencil[1] as usize]);
@@ -121,11 +138,11 @@ impl BoundaryCurves {
             let inv = 1.0 / *count as f64;
             let step = step_sum.map(|s| s * inv);
             max_move = max_move.max(dot(step, step).sqrt());
-            next[v as usize] = [
+            next[v as usize] = P::from_xyz([
                 (old[0] + step[0]) as f32,
                 (old[1] + step[1]) as f32,
                 (old[2] + step[2]) as f32,
-            ];
+            ]);
         }
         max_move
     }

@@ -27,16 +27,17 @@
 //! constant within a round. Averaging over v's triangles keeps that form, so the precomputation
 //! folds everything into one weight pair per one-ring entry, and an iteration is two gather passes
 //! over vertices, both parallel (rayon) with no scatter and no atomics:
-//! 1. umbrella means m (and, for the normal-projected variant, the vertex normals from the
-//!    one-ring fan), reading the previous iterate;
-//! 2. x_new = anchor term + Σ (α·m_u + β·x_u) over the closed one-ring; then the boundary curves.
+//! 1. umbrella means m, reading the previous iterate;
+//! 2. x̃ = anchor term + Σ (α·m_u + β·x_u) over the closed one-ring; then the boundary curves;
+//! 3. (normal-projected variant only) x_new = x + n·(n·(x̃ − x)), n the unit normal of v's fan in
+//!    x̃ (the one-ring is stored in fan order for that).
 //!
 //! Every vertex is computed by the same sequence of operations whatever the thread count, so the
 //! output is bit-identical for any rayon pool. Positions, means and weights are f32 (weights are
 //! computed in f64 and rounded): the operator is a contraction towards its fixed point, so rounding
 //! does not accumulate; the tests check volume to 1e-4 relative and equivariance to f32 accuracy.
 
-use super::boundary::BoundaryCurves;
+use super::boundary::{BoundaryCurves, CurvePoint};
 use super::{BoundaryMode, FairOptions, FairReport, FairVariant};
 use crate::mesh::{Topology, TriMesh};
 use rayon::prelude::*;
@@ -155,11 +156,11 @@ pub struct ConstrainedFairing {
 
 #[derive(Clone, Debug, Default)]
 struct Workspace {
-    anchors: Vec<[f32; 3]>,
-    anchor_terms: Vec<[f32; 3]>,
-    means: Vec<[f32; 3]>,
-    normals: Vec<[f32; 3]>,
-    next: Vec<[f32; 3]>,
+    current: Vec<Point4>,
+    anchors: Vec<Point4>,
+    anchor_terms: Vec<Point4>,
+    means: Vec<Point4>,
+    next: Vec<Point4>,
     curve_accumulator: Vec<([f64; 3], u32)>,
 }
 
@@ -315,14 +316,11 @@ impl ConstrainedFairing {
             BoundaryMode::Fixed => BoundaryCurves::default(),
         };
         let workspace = Workspace {
-            anchors: vec![[0.0; 3]; vertex_count],
-            anchor_terms: vec![[0.0; 3]; vertex_count],
-            means: vec![[0.0; 3]; vertex_count],
-            normals: match variant {
-                FairVariant::NormalProjected => vec![[0.0; 3]; vertex_count],
-                FairVariant::Paper => Vec::new(),
-            },
-            next: vec![[0.0; 3]; vertex_count],
+            current: vec![Point4::default(); vertex_count],
+            anchors: vec![Point4::default(); vertex_count],
+            anchor_terms: vec![Point4::default(); vertex_count],
+            means: vec![Point4::default(); vertex_count],
+            next: vec![Point4::default(); vertex_count],
             curve_accumulator: Vec::new(),
         };
         ConstrainedFairing {
@@ -359,38 +357,76 @@ impl ConstrainedFairing {
         self.solved_vertices
     }
 
+    /// Bytes one [`Self::iterate`] must stream from or to memory with this data layout, if every
+    /// array is read once and gathered neighbours hit the cache: the floor for its run time is
+    /// this divided by the machine's copy bandwidth (read + write bytes per second).
+    pub fn streamed_bytes_per_iteration(&self) -> usize {
+        let vertices = self.vertex_count();
+        let entries = self.ring.len();
+        let offsets = 4 * (vertices + 1);
+        let point = 16 * vertices;
+        // Pass 1: offsets, ring, x; writes means (counted twice: write-allocate).
+        let pass1 = offsets + 4 * entries + 4 * vertices + point + 2 * point;
+        // Pass 2: offsets, ring, ring weights, own weights, anchor terms, means, x; writes x̃.
+        let pass2 = offsets + 12 * entries + 12 * vertices + 3 * point + 2 * point;
+        // Pass 3: offsets, ring, fan flags, x̃, x; writes the result.
+        let pass3 = match self.variant {
+            FairVariant::Paper => 0,
+            FairVariant::NormalProjected => {
+                offsets + 4 * entries + vertices + 2 * point + 2 * point
+            }
+        };
+        pass1 + pass2 + pass3
+    }
+
     /// Runs `options.rounds` rounds of up to `options.iterations` iterations on `positions`
     /// (which must have this connectivity's vertex count). `options.variant` and
     /// `options.boundary` are those given to [`ConstrainedFairing::new`].
-    pub fn run(&mut self, positions: &mut Vec<[f32; 3]>, options: &FairOptions) -> FairReport {
-        assert_eq!(
-            positions.len(),
-            self.vertex_count(),
-            "positions do not fit this connectivity"
-        );
+    pub fn run(&mut self, positions: &mut [[f32; 3]], options: &FairOptions) -> FairReport {
+        self.load(positions);
         let mut report = FairReport::default();
-        for _ in 0..options.rounds {
-            self.set_anchors(positions);
+        for round in 0..options.rounds {
+            if round > 0 {
+                self.reanchor();
+            }
             for _ in 0..options.iterations {
-                report.max_move = self.iterate(positions);
+                report.max_move = self.step();
                 report.iterations_run += 1;
                 if report.max_move < options.tolerance {
                     break;
                 }
             }
         }
+        self.store(positions);
         report
     }
 
-    /// Imposes the constraints on `positions`: they become the anchors P⁰ of the next iterations.
-    pub fn set_anchors(&mut self, positions: &[[f32; 3]]) {
+    /// Takes `positions` as the current state and imposes the constraints on them (they become
+    /// the anchors P⁰ of the next iterations).
+    pub fn load(&mut self, positions: &[[f32; 3]]) {
         assert_eq!(
             positions.len(),
             self.vertex_count(),
             "positions do not fit this connectivity"
         );
+        for (state, p) in self.workspace.current.iter_mut().zip(positions) {
+            *state = Point4::from_xyz(*p);
+        }
+        self.reanchor();
+    }
+
+    /// Copies the current state into `positions`.
+    pub fn store(&self, positions: &mut [[f32; 3]]) {
+        for (p, state) in positions.iter_mut().zip(&self.workspace.current) {
+            *p = state.xyz();
+        }
+    }
+
+    /// Re-imposes the constraints on the current state (the start of a new round).
+    pub fn reanchor(&mut self) {
         let ws = &mut self.workspace;
-        ws.anchors.copy_from_slice(positions);
+        ws.anchors.copy_from_slice(&ws.current);
+        let anchors = &ws.anchors;
         let (offsets, ring, weights, own) = (
             &self.ring_offsets,
             &self.ring,
@@ -405,72 +441,45 @@ impl ConstrainedFairing {
                 for (i, term) in out.iter_mut().enumerate() {
                     let v = start + i;
                     let w = own[v][2] as f64;
-                    let mut sum = positions[v].map(|x| w * x as f64);
+                    let mut sum = anchors[v].xyz().map(|x| w * x as f64);
                     for e in offsets[v] as usize..offsets[v + 1] as usize {
                         let w = weights[e] as f64;
-                        let p = positions[ring[e] as usize];
+                        let p = anchors[ring[e] as usize].0;
                         for k in 0..3 {
                             sum[k] += w * p[k] as f64;
                         }
                     }
-                    *term = sum.map(|s| s as f32);
+                    *term = Point4::from_xyz(sum.map(|s| s as f32));
                 }
             });
     }
 
-    /// One Jacobi iteration on `positions` (anchors from the last [`Self::set_anchors`]). Returns
-    /// the largest vertex move.
-    pub fn iterate(&mut self, positions: &mut Vec<[f32; 3]>) -> f64 {
-        assert_eq!(
-            positions.len(),
-            self.vertex_count(),
-            "positions do not fit this connectivity"
-        );
+    /// One Jacobi iteration of the current state (anchors from the last [`Self::load`] or
+    /// [`Self::reanchor`]). Returns the largest vertex move.
+    pub fn step(&mut self) -> f64 {
         let project = self.variant == FairVariant::NormalProjected;
         let ws = &mut self.workspace;
         let offsets = &self.ring_offsets;
         let ring = &self.ring;
-        let x: &[[f32; 3]] = positions;
+        let x: &[Point4] = &ws.current;
 
-        // Pass 1: umbrella means (and normals) of the previous iterate.
+        // Pass 1: umbrella means of the previous iterate.
         let inverse_valence = &self.inverse_valence;
         let closed_fan = &self.closed_fan;
-        if project {
-            ws.means
-                .par_chunks_mut(CHUNK)
-                .zip(ws.normals.par_chunks_mut(CHUNK))
-                .enumerate()
-                .for_each(|(chunk, (means, normals))| {
-                    let start = chunk * CHUNK;
-                    for (i, (mean, normal)) in means.iter_mut().zip(normals.iter_mut()).enumerate()
-                    {
-                        let v = start + i;
-                        let ring_v = &ring[offsets[v] as usize..offsets[v + 1] as usize];
-                        *mean = umbrella_mean(x, ring_v, inverse_valence[v]);
-                        *normal = if closed_fan[v] {
-                            fan_normal(x, v, ring_v)
-                        } else {
-                            [0.0; 3]
-                        };
-                    }
-                });
-        } else {
-            ws.means
-                .par_chunks_mut(CHUNK)
-                .enumerate()
-                .for_each(|(chunk, means)| {
-                    let start = chunk * CHUNK;
-                    for (i, mean) in means.iter_mut().enumerate() {
-                        let v = start + i;
-                        let ring_v = &ring[offsets[v] as usize..offsets[v + 1] as usize];
-                        *mean = umbrella_mean(x, ring_v, inverse_valence[v]);
-                    }
-                });
-        }
+        ws.means
+            .par_chunks_mut(CHUNK)
+            .enumerate()
+            .for_each(|(chunk, means)| {
+                let start = chunk * CHUNK;
+                for (i, mean) in means.iter_mut().enumerate() {
+                    let v = start + i;
+                    let ring_v = &ring[offsets[v] as usize..offsets[v + 1] as usize];
+                    *mean = umbrella_mean(x, ring_v, inverse_valence[v]);
+                }
+            });
 
-        // Pass 2: the averaged local solutions.
+        // Pass 2: the averaged local solutions (the paper's update).
         let means = &ws.means;
-        let normals = &ws.normals;
         let anchor_terms = &ws.anchor_terms;
         let ring_weights = &self.ring_weights;
         let self_weights = &self.self_weights;
@@ -484,25 +493,19 @@ impl ConstrainedFairing {
                 for (i, new_position) in out.iter_mut().enumerate() {
                     let v = start + i;
                     let [wm, wx, _] = self_weights[v];
-                    let (m, p, a) = (means[v], x[v], anchor_terms[v]);
-                    let mut sum: [f32; 3] = std::array::from_fn(|k| a[k] + wm * m[k] + wx * p[k]);
+                    let (m, p, a) = (means[v].0, x[v].0, anchor_terms[v].0);
+                    let mut sum: [f32; 4] = std::array::from_fn(|k| a[k] + wm * m[k] + wx * p[k]);
                     for e in offsets[v] as usize..offsets[v + 1] as usize {
                         let u = ring[e] as usize;
                         let [wm, wx] = ring_weights[e];
-                        let (mu, xu) = (means[u], x[u]);
-                        for k in 0..3 {
+                        let (mu, xu) = (means[u].0, x[u].0);
+                        for k in 0..4 {
                             sum[k] += wm * mu[k] + wx * xu[k];
                         }
                     }
-                    let mut step: [f32; 3] = std::array::from_fn(|k| sum[k] - p[k]);
-                    if project && closed_fan[v] {
-                        let n = normals[v];
-                        let along = n[0] * step[0] + n[1] * step[1] + n[2] * step[2];
-                        step = n.map(|c| c * along);
-                    }
-                    max_squared =
-                        max_squared.max(step[0] * step[0] + step[1] * step[1] + step[2] * step[2]);
-                    *new_position = std::array::from_fn(|k| p[k] + step[k]);
+                    let step: [f32; 4] = std::array::from_fn(|k| sum[k] - p[k]);
+                    max_squared = max_squared.max(dot4(step, step));
+                    *new_position = Point4(sum);
                 }
                 max_squared
             })
@@ -520,32 +523,88 @@ impl ConstrainedFairing {
             );
             max_move = max_move.max(curve_move);
         }
-        std::mem::swap(positions, &mut ws.next);
-        max_move
+        if !project {
+            std::mem::swap(&mut ws.current, &mut ws.next);
+            return max_move;
+        }
+
+        // Pass 3 (normal-projected variant): keep the component of each move along the normal of
+        // the updated fan. The means buffer is free now and receives the result.
+        let updated = &ws.next;
+        let max_move_squared = ws
+            .means
+            .par_chunks_mut(CHUNK)
+            .enumerate()
+            .map(|(chunk, out)| {
+                let start = chunk * CHUNK;
+                let mut max_squared = 0.0f32;
+                for (i, new_position) in out.iter_mut().enumerate() {
+                    let v = start + i;
+                    let p = x[v].0;
+                    let mut step: [f32; 4] = std::array::from_fn(|k| updated[v].0[k] - p[k]);
+                    if closed_fan[v] {
+                        let ring_v = &ring[offsets[v] as usize..offsets[v + 1] as usize];
+                        let n = fan_normal(updated, v, ring_v);
+                        let length_squared = dot4(n, n);
+                        step = if length_squared > 0.0 && length_squared.is_finite() {
+                            let along = dot4(n, step) / length_squared;
+                            n.map(|c| c * along)
+                        } else {
+                            [0.0; 4]
+                        };
+                    }
+                    max_squared = max_squared.max(dot4(step, step));
+                    *new_position = Point4(std::array::from_fn(|k| p[k] + step[k]));
+                }
+                max_squared
+            })
+            .reduce(|| 0.0f32, f32::max);
+        std::mem::swap(&mut ws.current, &mut ws.means);
+        (max_move_squared as f64).sqrt()
+    }
+}
+
+/// A position padded to four lanes (the fourth is always 0) and aligned to 16 bytes, so that the
+/// kernels load and combine whole points with single vector instructions.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+#[repr(C, align(16))]
+pub struct Point4(pub [f32; 4]);
+
+impl super::boundary::CurvePoint for Point4 {
+    #[inline]
+    fn xyz(&self) -> [f32; 3] {
+        [self.0[0], self.0[1], self.0[2]]
+    }
+    #[inline]
+    fn from_xyz(p: [f32; 3]) -> Self {
+        Point4([p[0], p[1], p[2], 0.0])
     }
 }
 
 #[inline]
-fn umbrella_mean(x: &[[f32; 3]], ring: &[u32], inverse_valence: f32) -> [f32; 3] {
-    let mut sum = [0.0f32; 3];
+fn umbrella_mean(x: &[Point4], ring: &[u32], inverse_valence: f32) -> Point4 {
+    let mut sum = [0.0f32; 4];
     for &u in ring {
-        let p = x[u as usize];
-        for k in 0..3 {
+        let p = x[u as usize].0;
+        for k in 0..4 {
             sum[k] += p[k];
         }
     }
-    sum.map(|s| s * inverse_valence)
+    Point4(sum.map(|s| s * inverse_valence))
 }
 
-/// Unit area-weighted normal of the closed fan (v, ring[k], ring[k+1]); zero when degenerate.
 #[inline]
-fn fan_normal(x: &[[f32; 3]], v: usize, ring: &[u32]) -> [f32; 3] {
-    let centre = x[v];
-    let relative = |u: u32| {
-        let p = x[u as usize];
-        [p[0] - centre[0], p[1] - centre[1], p[2] - centre[2]]
-    };
-    let mut normal = [0.0f32; 3];
+fn dot4(a: [f32; 4], b: [f32; 4]) -> f32 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2] + a[3] * b[3]
+}
+
+/// Area-weighted normal (not normalised) of the closed fan (v, ring[k], ring[k+1]), fourth
+/// lane 0.
+#[inline]
+fn fan_normal(x: &[Point4], v: usize, ring: &[u32]) -> [f32; 4] {
+    let centre = x[v].0;
+    let relative = |u: u32| -> [f32; 4] { std::array::from_fn(|k| x[u as usize].0[k] - centre[k]) };
+    let mut normal = [0.0f32; 4];
     let mut previous = relative(ring[ring.len() - 1]);
     for &u in ring {
         let current = relative(u);
@@ -554,12 +613,7 @@ fn fan_normal(x: &[[f32; 3]], v: usize, ring: &[u32]) -> [f32; 3] {
         normal[2] += previous[0] * current[1] - previous[1] * current[0];
         previous = current;
     }
-    let length = (normal[0] * normal[0] + normal[1] * normal[1] + normal[2] * normal[2]).sqrt();
-    if length > 0.0 && length.is_finite() {
-        normal.map(|c| c / length)
-    } else {
-        [0.0; 3]
-    }
+    normal
 }
 
 /// The one-ring of interior vertex `v` in the order of its fan of faces (v, ring[k], ring[k+1]),
@@ -820,10 +874,11 @@ mod tests {
         let anchors = mesh.positions.clone();
         let mut fairing =
             ConstrainedFairing::new(&mesh, &topology, FairVariant::Paper, BoundaryMode::Curve);
-        fairing.set_anchors(&anchors);
+        fairing.load(&anchors);
         for iteration in 0..5 {
             let expected = reference_iteration(&mesh, &topology, &anchors);
-            fairing.iterate(&mut mesh.positions);
+            fairing.step();
+            fairing.store(&mut mesh.positions);
             for (v, (got, want)) in mesh.positions.iter().zip(&expected).enumerate() {
                 for k in 0..3 {
                     assert!(
