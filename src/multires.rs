@@ -202,8 +202,8 @@ pub fn fair_multires(
     let fair_last = start == 0 || options.fair_finest;
     for level in (1..=start).rev() {
         workspace.prepare(hierarchy, level);
-        fair_level(workspace, level, &fair_options);
-        if options.variant == MultiresVariant::Improved {
+        let faired = fair_level(workspace, level, &fair_options);
+        if faired && options.variant == MultiresVariant::Improved {
             remove_low_frequency_shrinkage(workspace, level);
         }
         workspace.prepare(hierarchy, level - 1);
@@ -228,12 +228,13 @@ pub fn fair_multires(
     Some(result)
 }
 
-fn fair_level(workspace: &mut MultiresWorkspace, level: usize, options: &FairOptions) {
+/// Fairs the working positions of `level`; false when there was nothing to do.
+fn fair_level(workspace: &mut MultiresWorkspace, level: usize, options: &FairOptions) -> bool {
     let data = workspace.levels[level]
         .as_mut()
         .expect("prepared before fairing");
     if options.iterations == 0 || options.rounds == 0 || data.mesh.positions.is_empty() {
-        return;
+        return false;
     }
     let fits = data
         .fairing
@@ -259,6 +260,7 @@ fn fair_level(workspace: &mut MultiresWorkspace, level: usize, options: &FairOpt
         fairing.run(&mut data.mesh.positions, options);
     }
     workspace.positions[..n].copy_from_slice(&data.mesh.positions);
+    true
 }
 
 /// Improved: removes the smooth part of the normal displacement the level's fairing made.
