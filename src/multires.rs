@@ -49,6 +49,7 @@ use crate::hierarchy::Hierarchy;
 use crate::mesh::{Topology, TriMesh};
 use crate::Progress;
 use glam::DVec3;
+use rayon::prelude::*;
 
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum MultiresVariant {
@@ -279,49 +280,66 @@ fn remove_low_frequency_shrinkage(workspace: &mut MultiresWorkspace, level: usiz
     } = workspace;
     let data = levels[level].as_ref().expect("prepared before fairing");
     let n = data.mesh.positions.len();
-    normals.clear();
-    normals.resize(n, DVec3::ZERO);
-    for t in &data.mesh.triangles {
-        let [a, b, c] = t.map(|v| point(positions[v as usize]));
-        let normal = (b - a).cross(c - a);
-        for &v in t {
-            normals[v as usize] += normal;
-        }
-    }
     let topology = &data.topology;
-    normal_moves.clear();
-    for v in 0..n {
-        let area = normals[v].length();
-        let unit = if area > 0.0 {
-            normals[v] / area
-        } else {
-            DVec3::ZERO
-        };
-        normals[v] = unit;
-        let moved = point(positions[v]) - point(before_fairing[v]);
-        normal_moves.push([moved.dot(unit) * area, area]);
-    }
-    for _ in 0..SHRINKAGE_SMOOTHING_ROUNDS {
-        smoothed_moves.clear();
-        for v in 0..n {
-            let mut sum = normal_moves[v];
-            for &u in topology.neighbors(v as u32) {
-                let m = normal_moves[u as usize];
-                sum[0] += m[0];
-                sum[1] += m[1];
+    let triangles = &data.mesh.triangles;
+    let (face_offsets, vertex_faces) = topology.face_csr();
+    let positions_now: &[[f32; 3]] = positions;
+    (0..n)
+        .into_par_iter()
+        .map(|v| {
+            let mut sum = DVec3::ZERO;
+            for &f in &vertex_faces[face_offsets[v] as usize..face_offsets[v + 1] as usize] {
+                let [a, b, c] = triangles[f as usize].map(|u| point(positions_now[u as usize]));
+                sum += (b - a).cross(c - a);
             }
-            let mean = if sum[1] > 0.0 { sum[0] / sum[1] } else { 0.0 };
-            smoothed_moves.push([mean * normal_moves[v][1], normal_moves[v][1]]);
-        }
+            sum
+        })
+        .collect_into_vec(normals);
+    let before: &[[f32; 3]] = before_fairing;
+    normals
+        .par_iter_mut()
+        .enumerate()
+        .map(|(v, normal)| {
+            let area = normal.length();
+            let unit = if area > 0.0 {
+                *normal / area
+            } else {
+                DVec3::ZERO
+            };
+            *normal = unit;
+            let moved = point(positions_now[v]) - point(before[v]);
+            [moved.dot(unit) * area, area]
+        })
+        .collect_into_vec(normal_moves);
+    for _ in 0..SHRINKAGE_SMOOTHING_ROUNDS {
+        let moves: &[[f64; 2]] = normal_moves;
+        (0..n)
+            .into_par_iter()
+            .map(|v| {
+                let mut sum = moves[v];
+                for &u in topology.neighbors(v as u32) {
+                    let m = moves[u as usize];
+                    sum[0] += m[0];
+                    sum[1] += m[1];
+                }
+                let mean = if sum[1] > 0.0 { sum[0] / sum[1] } else { 0.0 };
+                [mean * moves[v][1], moves[v][1]]
+            })
+            .collect_into_vec(smoothed_moves);
         std::mem::swap(normal_moves, smoothed_moves);
     }
-    for v in 0..n {
-        let [weighted, area] = normal_moves[v];
-        if area > 0.0 {
-            let back = normals[v] * (weighted / area);
-            positions[v] = (point(positions[v]) - back).as_vec3().to_array();
-        }
-    }
+    let (moves, normals): (&[[f64; 2]], &[DVec3]) = (normal_moves, normals);
+    positions[..n]
+        .par_iter_mut()
+        .enumerate()
+        .for_each(|(v, p)| {
+            let [weighted, area] = moves[v];
+            if area > 0.0 {
+                *p = (point(*p) - normals[v] * (weighted / area))
+                    .as_vec3()
+                    .to_array();
+            }
+        });
 }
 
 /// Refines the working positions from level `finer + 1` to `finer`: places the split vertices.
@@ -349,19 +367,24 @@ fn refine_positions(
     let split = coarse_count..fine_count;
 
     // Start at the 1-ring mean (loop midpoint on the boundary). Split vertices of one level are
-    // never adjacent, so their neighbours all have positions.
-    for v in split.clone() {
-        let x = if on_loop(v) {
-            let [a, b] = loops[v];
-            (point(positions[a as usize]) + point(positions[b as usize])) * 0.5
-        } else {
-            let ring = topology.neighbors(v as u32);
-            ring.iter()
-                .map(|&u| point(positions[u as usize]))
-                .sum::<DVec3>()
-                / ring.len() as f64
-        };
-        positions[v] = x.as_vec3().to_array();
+    // never adjacent, so their neighbours all come before them and have positions.
+    {
+        let (coarse, fine) = positions.split_at_mut(coarse_count);
+        let coarse: &[[f32; 3]] = coarse;
+        fine.par_iter_mut().enumerate().for_each(|(i, p)| {
+            let v = coarse_count + i;
+            let x = if on_loop(v) {
+                let [a, b] = loops[v];
+                (point(coarse[a as usize]) + point(coarse[b as usize])) * 0.5
+            } else {
+                let ring = topology.neighbors(v as u32);
+                ring.iter()
+                    .map(|&u| point(coarse[u as usize]))
+                    .sum::<DVec3>()
+                    / ring.len() as f64
+            };
+            *p = x.as_vec3().to_array();
+        });
     }
 
     // One Kobbelt step for all, from the placed positions, applied together.
@@ -379,33 +402,40 @@ fn refine_positions(
                 - point(positions[v])
         }
     };
-    displacements.clear();
-    for v in split.clone() {
-        let own = laplacian(v, positions);
-        let (sum, inverse_valences, n) = if on_loop(v) {
-            let [a, b] = loops[v];
-            (
-                laplacian(a as usize, positions) + laplacian(b as usize, positions),
-                1.0,
-                2.0,
-            )
-        } else {
-            let ring = topology.neighbors(v as u32);
-            let mut sum = DVec3::ZERO;
-            let mut inverse_valences = 0.0;
-            for &u in ring {
-                sum += laplacian(u as usize, positions);
-                inverse_valences += 1.0 / topology.valence(u) as f64;
-            }
-            (sum, inverse_valences, ring.len() as f64)
-        };
-        let l2 = sum / n - own;
-        let nu = 1.0 + inverse_valences / n;
-        displacements.push(-l2 / nu);
+    {
+        let placed: &[[f32; 3]] = positions;
+        split
+            .clone()
+            .into_par_iter()
+            .map(|v| {
+                let own = laplacian(v, placed);
+                let (sum, inverse_valences, n) = if on_loop(v) {
+                    let [a, b] = loops[v];
+                    (
+                        laplacian(a as usize, placed) + laplacian(b as usize, placed),
+                        1.0,
+                        2.0,
+                    )
+                } else {
+                    let ring = topology.neighbors(v as u32);
+                    let mut sum = DVec3::ZERO;
+                    let mut inverse_valences = 0.0;
+                    for &u in ring {
+                        sum += laplacian(u as usize, placed);
+                        inverse_valences += 1.0 / topology.valence(u) as f64;
+                    }
+                    (sum, inverse_valences, ring.len() as f64)
+                };
+                let l2 = sum / n - own;
+                let nu = 1.0 + inverse_valences / n;
+                -l2 / nu
+            })
+            .collect_into_vec(displacements);
     }
-    for (v, d) in split.clone().zip(displacements.iter()) {
-        positions[v] = (point(positions[v]) + *d).as_vec3().to_array();
-    }
+    positions[coarse_count..]
+        .par_iter_mut()
+        .zip(displacements.par_iter())
+        .for_each(|(p, d)| *p = (point(*p) + *d).as_vec3().to_array());
 
     if variant == MultiresVariant::Paper {
         return;
@@ -414,37 +444,41 @@ fn refine_positions(
     // Improved: restore the volume each split added in the original geometry, low-passed.
     let triangles = &data.mesh.triangles;
     let (face_offsets, vertex_faces) = topology.face_csr();
-    heights.clear();
-    for v in split.clone() {
-        let Some(k) = hierarchy.collapse_target(v as u32) else {
-            heights.push((DVec3::ZERO, 0.0, 0.0));
-            continue;
-        };
-        let xk = point(positions[k as usize]);
-        let mut area = DVec3::ZERO;
-        for &f in &vertex_faces[face_offsets[v] as usize..face_offsets[v + 1] as usize] {
-            let t = triangles[f as usize];
-            if t.contains(&k) {
-                continue;
-            }
-            let (a, b) = if t[0] == v as u32 {
-                (t[1], t[2])
-            } else if t[1] == v as u32 {
-                (t[2], t[0])
-            } else {
-                (t[0], t[1])
-            };
-            area += (point(positions[a as usize]) - xk).cross(point(positions[b as usize]) - xk);
-        }
-        let weight = area.length();
-        if weight <= 0.0 || !weight.is_finite() {
-            heights.push((DVec3::ZERO, 0.0, 0.0));
-            continue;
-        }
-        let normal = area / weight;
-        let current = area.dot(point(positions[v]) - xk);
-        let height = (hierarchy.six_split_volume(v as u32) as f64 - current) / weight;
-        heights.push((normal, height, weight));
+    {
+        let placed: &[[f32; 3]] = positions;
+        split
+            .clone()
+            .into_par_iter()
+            .map(|v| {
+                let Some(k) = hierarchy.collapse_target(v as u32) else {
+                    return (DVec3::ZERO, 0.0, 0.0);
+                };
+                let xk = point(placed[k as usize]);
+                let mut area = DVec3::ZERO;
+                for &f in &vertex_faces[face_offsets[v] as usize..face_offsets[v + 1] as usize] {
+                    let t = triangles[f as usize];
+                    if t.contains(&k) {
+                        continue;
+                    }
+                    let (a, b) = if t[0] == v as u32 {
+                        (t[1], t[2])
+                    } else if t[1] == v as u32 {
+                        (t[2], t[0])
+                    } else {
+                        (t[0], t[1])
+                    };
+                    area += (point(placed[a as usize]) - xk).cross(point(placed[b as usize]) - xk);
+                }
+                let weight = area.length();
+                if weight <= 0.0 || !weight.is_finite() {
+                    return (DVec3::ZERO, 0.0, 0.0);
+                }
+                let normal = area / weight;
+                let current = area.dot(point(placed[v]) - xk);
+                let height = (hierarchy.six_split_volume(v as u32) as f64 - current) / weight;
+                (normal, height, weight)
+            })
+            .collect_into_vec(heights);
     }
     for _ in 0..HEIGHT_SMOOTHING_ROUNDS {
         height_sums.clear();
@@ -456,19 +490,23 @@ fn refine_positions(
                 s[1] += weight;
             }
         }
-        for (v, entry) in split.clone().zip(heights.iter_mut()) {
+        let sums: &[[f64; 2]] = height_sums;
+        heights.par_iter_mut().enumerate().for_each(|(i, entry)| {
             let mut sum = [0.0; 2];
-            for &u in topology.neighbors(v as u32) {
-                let s = height_sums[u as usize];
+            for &u in topology.neighbors((coarse_count + i) as u32) {
+                let s = sums[u as usize];
                 sum[0] += s[0];
                 sum[1] += s[1];
             }
             if sum[1] > 0.0 {
                 entry.1 = sum[0] / sum[1];
             }
-        }
+        });
     }
-    for (v, &(normal, height, _)) in split.zip(heights.iter()) {
-        positions[v] = (point(positions[v]) + normal * height).as_vec3().to_array();
-    }
+    positions[coarse_count..]
+        .par_iter_mut()
+        .zip(heights.par_iter())
+        .for_each(|(p, &(normal, height, _))| {
+            *p = (point(*p) + normal * height).as_vec3().to_array()
+        });
 }
