@@ -302,7 +302,7 @@ fn build_ordered(
         let mut removed = 0usize;
         for &key in &keys {
             visits += 1;
-            if visits % REPORT_EVERY == 0 {
+            if visits.is_multiple_of(REPORT_EVERY) {
                 let done = (start_vertices - vertex_count as f64 + isolated as f64) / goal;
                 if !progress.report(done.clamp(0.0, 1.0) as f32) {
                     return Err(BuildFailure::Cancelled);
