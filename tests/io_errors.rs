@@ -422,7 +422,7 @@ fn glb_parts() -> (serde_json::Value, Vec<u8>) {
 
 fn make_glb(json: &serde_json::Value, bin: &[u8]) -> Vec<u8> {
     let mut json_bytes = serde_json::to_vec(json).unwrap();
-    while json_bytes.len() % 4 != 0 {
+    while !json_bytes.len().is_multiple_of(4) {
         json_bytes.push(b' ');
     }
     let mut out = b"glTF".to_vec();
@@ -451,9 +451,20 @@ fn broken_gltf_and_glb_files() {
         d,
         "truncated.glb",
         &good[..good.len() - 10],
-        &["GLB container", "invalid GLB"],
+        &["byte 8", "GLB container", "truncated"],
     );
-    expect_error(d, "header.glb", &good[..10], &["GLB container"]);
+    expect_error(
+        d,
+        "header.glb",
+        &good[..10],
+        &["byte 0", "GLB container", "truncated"],
+    );
+    let mut short = good.clone();
+    short[8..12].copy_from_slice(&4u32.to_le_bytes());
+    expect_error(d, "length.glb", &short, &["byte 8", "less than the header"]);
+    let mut chunk = good.clone();
+    chunk[12..16].copy_from_slice(&100_000u32.to_le_bytes());
+    expect_error(d, "chunk.glb", &chunk, &["GLB container", "invalid GLB"]);
     expect_error(
         d,
         "syntax.gltf",
@@ -531,6 +542,15 @@ fn broken_gltf_and_glb_files() {
         "dangling.glb",
         &edit(&|j| j["accessors"][0]["bufferView"] = 17.into()),
         &["accessors[0].bufferView", "invalid glTF"],
+    );
+    expect_error(
+        d,
+        "no_accessors.glb",
+        &edit(&|j| j["accessors"] = serde_json::json!([])),
+        &[
+            "meshes[0].primitives[0].attributes.POSITION",
+            "accessor 0 does not exist",
+        ],
     );
     expect_error(
         d,

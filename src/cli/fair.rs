@@ -1,19 +1,245 @@
-//! `fairmesh fair` (STUB: to be filled by the fairing work).
-use clap::Args;
+//! `fairmesh fair`: smooth a mesh with constrained fairing (the paper's method) or one of the
+//! baselines, and write the result; `bench_rows` gives `fairmesh bench` its fairing timings.
+use clap::{Args, ValueEnum};
+use fairmesh::fairing::{
+    self, baseline::UmbrellaStencil, BoundaryMode, ConstrainedFairing, FairOptions, FairVariant,
+    HcOptions, LaplacianOptions, MethodOptions, TaubinOptions,
+};
 use std::path::PathBuf;
+use std::time::Instant;
+
+#[derive(Clone, Copy, Debug, ValueEnum)]
+pub enum MethodArg {
+    /// Constrained fairing (the paper's method): smooths without shrinking.
+    Constrained,
+    /// Umbrella Laplacian smoothing (shrinks; for comparison).
+    Laplacian,
+    /// Taubin's λ|μ smoothing (for comparison).
+    Taubin,
+    /// HC Laplacian of Vollmer et al. (for comparison).
+    Hc,
+}
+
+#[derive(Clone, Copy, Debug, ValueEnum)]
+pub enum BoundaryArg {
+    /// Smooth each boundary loop as a curve (paper section 3.3).
+    Curve,
+    /// Keep boundary vertices where they are.
+    Fixed,
+}
+
+#[derive(Clone, Copy, Debug, ValueEnum)]
+pub enum VariantArg {
+    /// The paper's operator exactly (vertices may slide along the surface).
+    Paper,
+    /// The paper's update projected on the vertex normal (no sliding; the default).
+    NormalProjected,
+}
 
 #[derive(Args, Debug)]
+#[command(after_help = "Examples:\n  \
+    fairmesh fair noisy.obj -o smooth.obj\n  \
+    fairmesh fair noisy.obj -o smoother.obj --rounds 5\n  \
+    fairmesh fair noisy.obj -o taubin.obj --method taubin --iterations 20 --json")]
 pub struct FairArgs {
+    /// Mesh to smooth (.obj .gltf .glb .ply .stl .off).
     pub input: PathBuf,
+    /// Where to write the smoothed mesh (format from the extension).
     #[arg(short, long)]
     pub output: PathBuf,
+    /// Smoothing method.
+    #[arg(long, value_enum, default_value_t = MethodArg::Constrained)]
+    pub method: MethodArg,
+    /// Iterations (per round for constrained fairing). Constrained fairing settles after 5 to
+    /// 10 iterations; use --rounds to smooth more.
+    #[arg(long, default_value_t = 10)]
+    pub iterations: usize,
+    /// Constrained only: rounds; each round re-anchors the triangle centres at the current
+    /// positions, so more rounds smooth more (and drift further from the input).
+    #[arg(long, default_value_t = 1)]
+    pub rounds: usize,
+    /// Constrained only: stop a round early once no vertex moves more than this many mean edge
+    /// lengths in one iteration (0: always run all iterations).
+    #[arg(long, default_value_t = 0.0)]
+    pub tolerance: f64,
+    /// How boundary vertices of open meshes move.
+    #[arg(long, value_enum, default_value_t = BoundaryArg::Curve)]
+    pub boundary: BoundaryArg,
+    /// Constrained only: the operator variant.
+    #[arg(long, value_enum, default_value_t = VariantArg::NormalProjected)]
+    pub variant: VariantArg,
+    /// Laplacian and Taubin: the (shrinking) step size λ [default: 0.5].
+    #[arg(long)]
+    pub lambda: Option<f64>,
+    /// Taubin: the inflating step μ, negative [default: -0.53].
+    #[arg(long, allow_hyphen_values = true)]
+    pub mu: Option<f64>,
+    /// HC: pull towards the input positions, 0 to 1 [default: 0].
+    #[arg(long)]
+    pub alpha: Option<f64>,
+    /// HC: weight of a vertex's own correction against its neighbours' [default: 0.5].
+    #[arg(long)]
+    pub beta: Option<f64>,
+    /// Print one JSON object (method, iterations_run, time_ms, volume_change_percent, max_move,
+    /// ...) instead of a sentence.
+    #[arg(long)]
+    pub json: bool,
 }
 
-pub fn run(_args: FairArgs) -> anyhow::Result<()> {
-    anyhow::bail!("fair is not implemented yet")
+impl FairArgs {
+    fn method_options(&self, mean_edge_length: f64) -> MethodOptions {
+        let boundary = match self.boundary {
+            BoundaryArg::Curve => BoundaryMode::Curve,
+            BoundaryArg::Fixed => BoundaryMode::Fixed,
+        };
+        match self.method {
+            MethodArg::Constrained => MethodOptions::Constrained(FairOptions {
+                iterations: self.iterations,
+                tolerance: self.tolerance * mean_edge_length,
+                rounds: self.rounds,
+                boundary,
+                variant: match self.variant {
+                    VariantArg::Paper => FairVariant::Paper,
+                    VariantArg::NormalProjected => FairVariant::NormalProjected,
+                },
+            }),
+            MethodArg::Laplacian => {
+                let defaults = LaplacianOptions::default();
+                MethodOptions::Laplacian(LaplacianOptions {
+                    iterations: self.iterations,
+                    lambda: self.lambda.unwrap_or(defaults.lambda),
+                    boundary,
+                })
+            }
+            MethodArg::Taubin => {
+                let defaults = TaubinOptions::default();
+                MethodOptions::Taubin(TaubinOptions {
+                    iterations: self.iterations,
+                    lambda: self.lambda.unwrap_or(defaults.lambda),
+                    mu: self.mu.unwrap_or(defaults.mu),
+                    boundary,
+                })
+            }
+            MethodArg::Hc => {
+                let defaults = HcOptions::default();
+                MethodOptions::Hc(HcOptions {
+                    iterations: self.iterations,
+                    alpha: self.alpha.unwrap_or(defaults.alpha),
+                    beta: self.beta.unwrap_or(defaults.beta),
+                    boundary,
+                })
+            }
+        }
+    }
 }
 
-/// Rows for `fairmesh bench`: (operation, milliseconds).
-pub fn bench_rows(_mesh: &fairmesh::TriMesh, _topology: &fairmesh::Topology) -> Vec<(String, f64)> {
-    Vec::new()
+pub fn run(args: FairArgs) -> anyhow::Result<()> {
+    let loaded = fairmesh::io::load(&args.input)?;
+    let (mut mesh, topology) = (loaded.mesh, loaded.topology);
+    let options = args.method_options(fairmesh::metrics::mean_edge_length(&mesh));
+    let volume_before = fairmesh::metrics::signed_volume(&mesh);
+
+    let start = Instant::now();
+    let report = fairing::fair(&mut mesh, &topology, &options);
+    let time_ms = start.elapsed().as_secs_f64() * 1e3;
+
+    let volume_after = fairmesh::metrics::signed_volume(&mesh);
+    let volume_change_percent = if volume_before != 0.0 {
+        100.0 * (volume_after - volume_before) / volume_before.abs()
+    } else {
+        0.0
+    };
+    fairmesh::io::save(&args.output, &mesh)?;
+
+    let method = options.method().name();
+    let variant = match &options {
+        MethodOptions::Constrained(o) => Some(o.variant.name()),
+        _ => None,
+    };
+    if args.json {
+        let json = serde_json::json!({
+            "method": method,
+            "variant": variant,
+            "input": args.input.display().to_string(),
+            "output": args.output.display().to_string(),
+            "vertices": mesh.vertex_count(),
+            "faces": mesh.face_count(),
+            "closed": topology.is_closed(),
+            "iterations_run": report.iterations_run,
+            "time_ms": time_ms,
+            "volume_change_percent": volume_change_percent,
+            "max_move": report.max_move,
+        });
+        println!("{json}");
+    } else {
+        let closed_note = if topology.is_closed() {
+            ""
+        } else {
+            " (the mesh is open: volume is only indicative)"
+        };
+        println!(
+            "{}{}: {} iterations in {:.1} ms, volume change {:+.4}%{}, last largest move {:.3e}; \
+             wrote {}",
+            method,
+            variant.map(|v| format!(" ({v})")).unwrap_or_default(),
+            report.iterations_run,
+            time_ms,
+            volume_change_percent,
+            closed_note,
+            report.max_move,
+            args.output.display()
+        );
+    }
+    Ok(())
+}
+
+/// Median time in milliseconds of `runs` calls of `work`.
+fn median_ms(runs: usize, mut work: impl FnMut()) -> f64 {
+    let mut times: Vec<f64> = (0..runs.max(1))
+        .map(|_| {
+            let start = Instant::now();
+            work();
+            start.elapsed().as_secs_f64() * 1e3
+        })
+        .collect();
+    times.sort_by(f64::total_cmp);
+    times[times.len() / 2]
+}
+
+/// Rows for `fairmesh bench`: (operation, milliseconds), medians of several runs.
+pub fn bench_rows(mesh: &fairmesh::TriMesh, topology: &fairmesh::Topology) -> Vec<(String, f64)> {
+    if mesh.positions.is_empty() {
+        return Vec::new();
+    }
+    let mut rows = Vec::new();
+    let precompute = median_ms(5, || {
+        std::hint::black_box(ConstrainedFairing::new(
+            mesh,
+            topology,
+            FairVariant::NormalProjected,
+            BoundaryMode::Curve,
+        ));
+    });
+    rows.push(("fair: constrained precomputation".to_string(), precompute));
+    for variant in [FairVariant::Paper, FairVariant::NormalProjected] {
+        let mut fairing = ConstrainedFairing::new(mesh, topology, variant, BoundaryMode::Curve);
+        let positions = mesh.positions.clone();
+        fairing.load(&positions);
+        fairing.step();
+        let ms = median_ms(15, || {
+            fairing.step();
+        });
+        rows.push((
+            format!("fair: constrained iteration ({})", variant.name()),
+            ms,
+        ));
+    }
+    let stencil = UmbrellaStencil::new(topology, BoundaryMode::Curve);
+    let positions = mesh.positions.clone();
+    let mut next = positions.clone();
+    let ms = median_ms(15, || {
+        stencil.relax(&positions, &mut next, 0.5);
+    });
+    rows.push(("fair: Laplacian iteration".to_string(), ms));
+    rows
 }

@@ -1,28 +1,336 @@
-//! `fairmesh hierarchy` and `fairmesh multires` (STUB: to be filled by the hierarchy work).
-use clap::Args;
+//! `fairmesh hierarchy` (build the decimation hierarchy of section 4.1, print or write its
+//! levels) and `fairmesh multires` (multiresolution fairing of section 4.2 from a start level).
+
+use anyhow::Context;
+use clap::{Args, ValueEnum};
+use fairmesh::fairing::BoundaryMode;
+use fairmesh::hierarchy::{build_hierarchy, Hierarchy, HierarchyOptions};
+use fairmesh::multires::{fair_multires, MultiresOptions, MultiresVariant, MultiresWorkspace};
+use fairmesh::noise::{self, NoiseOptions};
+use fairmesh::{io, metrics, NoProgress, TriMesh};
+use serde_json::json;
+use std::fmt::Write as _;
 use std::path::PathBuf;
+use std::time::Instant;
+
+#[derive(Args, Debug, Clone)]
+pub struct BuildArgs {
+    /// Weight of the shortest incident edge in the vertex cost.
+    #[arg(long, default_value_t = 1.0)]
+    pub alpha: f64,
+    /// Weight of the longest incident edge in the vertex cost.
+    #[arg(long, default_value_t = 0.01)]
+    pub beta: f64,
+    /// Stop when a level has at most this many vertices.
+    #[arg(long, default_value_t = 100)]
+    pub min_vertices: usize,
+    /// At most this many levels above M0.
+    #[arg(long, default_value_t = 64)]
+    pub max_levels: usize,
+    /// Never collapse boundary vertices.
+    #[arg(long)]
+    pub keep_boundary: bool,
+}
+
+impl BuildArgs {
+    fn options(&self) -> HierarchyOptions {
+        HierarchyOptions {
+            alpha: self.alpha,
+            beta: self.beta,
+            min_vertices: self.min_vertices,
+            max_levels: self.max_levels,
+            keep_boundary: self.keep_boundary,
+        }
+    }
+}
+
+#[derive(Clone, Copy, Debug, ValueEnum, PartialEq, Eq)]
+pub enum LevelFormat {
+    Obj,
+    Glb,
+}
 
 #[derive(Args, Debug)]
 pub struct HierarchyArgs {
+    /// Input mesh.
     pub input: PathBuf,
+    /// Print one JSON object: {"levels":[{"level","vertices","faces","time_ms"}...]}.
+    #[arg(long)]
+    pub json: bool,
+    /// Write every level's mesh into this directory (level_00.obj, level_01.obj, ...).
+    #[arg(long)]
+    pub write_levels: Option<PathBuf>,
+    /// Format of the written levels.
+    #[arg(long, value_enum, default_value_t = LevelFormat::Obj)]
+    pub format: LevelFormat,
+    /// Loop-subdivide the input this many times first (to time large meshes).
+    #[arg(long, default_value_t = 0)]
+    pub subdivide: usize,
+    #[command(flatten)]
+    pub build: BuildArgs,
+}
+
+#[derive(Clone, Copy, Debug, ValueEnum, PartialEq, Eq)]
+pub enum BoundaryArg {
+    Curve,
+    Fixed,
+}
+
+#[derive(Clone, Copy, Debug, ValueEnum, PartialEq, Eq)]
+pub enum VariantArg {
+    /// The paper's placement of split vertices (1-ring mean plus one Kobbelt step).
+    Paper,
+    /// Kobbelt placement plus a low-passed volume restoration (see the multires module docs).
+    Improved,
 }
 
 #[derive(Args, Debug)]
 pub struct MultiresArgs {
+    /// Input mesh.
     pub input: PathBuf,
+    /// Output mesh (format by extension); optional when only measuring.
     #[arg(short, long)]
-    pub output: PathBuf,
+    pub output: Option<PathBuf>,
+    /// Start level(s): 0 is M0 (single-level fairing), larger is coarser and smoother. Several,
+    /// comma separated, run one after another (with --json: one object each, as an array).
+    #[arg(long, value_delimiter = ',', default_value = "1")]
+    pub level: Vec<usize>,
+    /// Fairing iterations per level and round.
+    #[arg(long, default_value_t = 5)]
+    pub iterations: usize,
+    /// Fairing rounds per level (each re-imposes the constraints).
+    #[arg(long, default_value_t = 1)]
+    pub rounds: usize,
+    #[arg(long, value_enum, default_value_t = BoundaryArg::Curve)]
+    pub boundary: BoundaryArg,
+    /// Also fair M0 after the last refinement.
+    #[arg(long)]
+    pub fair_finest: bool,
+    /// Placement of split vertices; several, comma separated, run one after another.
+    #[arg(long, value_enum, value_delimiter = ',', default_value = "improved")]
+    pub variant: Vec<VariantArg>,
+    /// Add seeded normal noise of this many mean edge lengths first, and measure the result
+    /// against the clean input.
+    #[arg(long)]
+    pub noise: Option<f64>,
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
+    /// Measure the result against this mesh (default: the input, before any noise).
+    #[arg(long)]
+    pub reference: Option<PathBuf>,
+    /// Print JSON instead of text.
+    #[arg(long)]
+    pub json: bool,
+    #[command(flatten)]
+    pub build: BuildArgs,
 }
 
-pub fn run_hierarchy(_args: HierarchyArgs) -> anyhow::Result<()> {
-    anyhow::bail!("hierarchy is not implemented yet")
+fn build(mesh: &TriMesh, args: &BuildArgs) -> anyhow::Result<Hierarchy> {
+    Ok(build_hierarchy(mesh, &args.options(), &mut NoProgress)?)
 }
 
-pub fn run_multires(_args: MultiresArgs) -> anyhow::Result<()> {
-    anyhow::bail!("multires is not implemented yet")
+pub fn run_hierarchy(args: HierarchyArgs) -> anyhow::Result<()> {
+    let mut loaded = super::basic::load(&args.input, true)?;
+    for _ in 0..args.subdivide {
+        loaded.mesh = fairmesh::mesh::subdivide_loop(&loaded.mesh);
+    }
+    let started = Instant::now();
+    let hierarchy = build(&loaded.mesh, &args.build)
+        .with_context(|| format!("building the hierarchy of {}", args.input.display()))?;
+    let total_ms = started.elapsed().as_secs_f64() * 1e3;
+    if let Some(dir) = &args.write_levels {
+        std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
+        let extension = match args.format {
+            LevelFormat::Obj => "obj",
+            LevelFormat::Glb => "glb",
+        };
+        for level in 0..hierarchy.level_count() {
+            let path = dir.join(format!("level_{level:02}.{extension}"));
+            io::save(&path, &hierarchy.level_mesh(level))
+                .with_context(|| format!("writing level {level}"))?;
+        }
+    }
+    let levels: Vec<_> = (0..hierarchy.level_count())
+        .map(|level| {
+            let info = hierarchy.level_info(level);
+            json!({
+                "level": level,
+                "vertices": info.vertices,
+                "faces": info.faces,
+                "time_ms": hierarchy.level_build_ms(level),
+            })
+        })
+        .collect();
+    if args.json {
+        let object = json!({
+            "levels": levels,
+            "total_ms": total_ms,
+            "record_bytes_per_vertex":
+                hierarchy.record_bytes() as f64 / loaded.mesh.vertex_count().max(1) as f64,
+        });
+        return super::emit(&format!("{}\n", serde_json::to_string_pretty(&object)?));
+    }
+    let mut out = format!(
+        "{}: {} levels in {:.1} ms ({:.1} bytes of collapse records per vertex)\nlevel  vertices     faces   time ms\n",
+        args.input.display(),
+        hierarchy.level_count(),
+        total_ms,
+        hierarchy.record_bytes() as f64 / loaded.mesh.vertex_count().max(1) as f64
+    );
+    for level in 0..hierarchy.level_count() {
+        let info = hierarchy.level_info(level);
+        writeln!(
+            out,
+            "{level:>5} {:>9} {:>9} {:>9.2}",
+            info.vertices,
+            info.faces,
+            hierarchy.level_build_ms(level)
+        )?;
+    }
+    super::emit(&out)
+}
+
+pub fn run_multires(args: MultiresArgs) -> anyhow::Result<()> {
+    let loaded = super::basic::load(&args.input, true)?;
+    let clean = loaded.mesh;
+    let reference = match &args.reference {
+        Some(path) => super::basic::load(path, true)?.mesh,
+        None => clean.clone(),
+    };
+    let mut input = clean.clone();
+    if let Some(sigma) = args.noise {
+        noise::add_noise(
+            &mut input,
+            &NoiseOptions {
+                sigma,
+                seed: args.seed,
+                ..Default::default()
+            },
+        );
+    }
+    let started = Instant::now();
+    let hierarchy = build(&input, &args.build)?;
+    let hierarchy_ms = started.elapsed().as_secs_f64() * 1e3;
+    let mut workspace = MultiresWorkspace::new();
+    let mut results = Vec::new();
+    let mut last = None;
+    for &variant in &args.variant {
+        for &level in &args.level {
+            let options = MultiresOptions {
+                start_level: level,
+                iterations: args.iterations,
+                rounds: args.rounds,
+                boundary: match args.boundary {
+                    BoundaryArg::Curve => BoundaryMode::Curve,
+                    BoundaryArg::Fixed => BoundaryMode::Fixed,
+                },
+                fair_finest: args.fair_finest,
+                variant: match variant {
+                    VariantArg::Paper => MultiresVariant::Paper,
+                    VariantArg::Improved => MultiresVariant::Improved,
+                },
+            };
+            // The first run also builds the per-level connectivity; time a second run too.
+            let started = Instant::now();
+            let positions = fair_multires(&hierarchy, &options, &mut workspace, &mut NoProgress)
+                .context("multires fairing was cancelled")?;
+            let first_ms = started.elapsed().as_secs_f64() * 1e3;
+            let started = Instant::now();
+            let positions_again =
+                fair_multires(&hierarchy, &options, &mut workspace, &mut NoProgress)
+                    .context("multires fairing was cancelled")?;
+            let time_ms = started.elapsed().as_secs_f64() * 1e3;
+            debug_assert_eq!(positions, positions_again);
+            let result = TriMesh::new(positions, input.triangles.clone());
+            let comparison = metrics::compare(&reference, &result);
+            let start = level.min(hierarchy.coarsest_level());
+            results.push(json!({
+                "level": start,
+                "level_vertices": hierarchy.level_info(start).vertices,
+                "variant": format!("{variant:?}").to_lowercase(),
+                "time_ms": time_ms,
+                "first_run_ms": first_ms,
+                "hierarchy_ms": hierarchy_ms,
+                "volume_change_percent": comparison.volume_change_percent,
+                "mean_surface_distance": comparison.mean_surface_distance,
+                "mean_surface_distance_edges":
+                    comparison.mean_surface_distance / metrics::mean_edge_length(&reference),
+                "hausdorff": comparison.hausdorff,
+                "normal_error_deg": comparison.same_connectivity.map(|c| c.normal_error_deg),
+                "rms": comparison.same_connectivity.map(|c| c.rms),
+            }));
+            last = Some(result);
+        }
+    }
+    if let (Some(path), Some(result)) = (&args.output, &last) {
+        io::save(path, result).with_context(|| format!("writing {}", path.display()))?;
+    }
+    if args.json {
+        let value = if results.len() == 1 {
+            results.pop().unwrap_or_default()
+        } else {
+            serde_json::Value::Array(results)
+        };
+        return super::emit(&format!("{}\n", serde_json::to_string_pretty(&value)?));
+    }
+    let mut out = format!(
+        "{}: hierarchy of {} levels in {:.1} ms{}\nlevel  vertices  variant   time ms   volume %   mean dist (edges)  normal err deg\n",
+        args.input.display(),
+        hierarchy.level_count(),
+        hierarchy_ms,
+        match args.noise {
+            Some(s) => format!(", noise {s} mean edge lengths (seed {})", args.seed),
+            None => String::new(),
+        }
+    );
+    for r in &results {
+        writeln!(
+            out,
+            "{:>5} {:>9}  {:<8} {:>8.2} {:>+10.4} {:>18.5} {:>15.3}",
+            r["level"],
+            r["level_vertices"],
+            r["variant"].as_str().unwrap_or(""),
+            r["time_ms"].as_f64().unwrap_or(0.0),
+            r["volume_change_percent"].as_f64().unwrap_or(f64::NAN),
+            r["mean_surface_distance_edges"]
+                .as_f64()
+                .unwrap_or(f64::NAN),
+            r["normal_error_deg"].as_f64().unwrap_or(f64::NAN),
+        )?;
+    }
+    super::emit(&out)
 }
 
 /// Rows for `fairmesh bench`: (operation, milliseconds).
-pub fn bench_rows(_mesh: &fairmesh::TriMesh) -> Vec<(String, f64)> {
-    Vec::new()
+pub fn bench_rows(mesh: &TriMesh) -> Vec<(String, f64)> {
+    let runs = 5;
+    let options = HierarchyOptions::default();
+    let mut hierarchy = None;
+    let build_ms = super::bench::median_ms(runs, || {
+        hierarchy = build_hierarchy(mesh, &options, &mut NoProgress).ok();
+    });
+    let mut rows = vec![("hierarchy build".to_string(), build_ms)];
+    let Some(hierarchy) = hierarchy else {
+        return rows;
+    };
+    let mut workspace = MultiresWorkspace::new();
+    let coarsest = hierarchy.coarsest_level();
+    for (name, level) in [("coarsest", coarsest), ("middle", coarsest / 2)] {
+        let options = MultiresOptions {
+            start_level: level,
+            ..Default::default()
+        };
+        // Warm the workspace (per-level connectivity) once, then time.
+        let _ = fair_multires(&hierarchy, &options, &mut workspace, &mut NoProgress);
+        let ms = super::bench::median_ms(runs, || {
+            std::hint::black_box(fair_multires(
+                &hierarchy,
+                &options,
+                &mut workspace,
+                &mut NoProgress,
+            ));
+        });
+        rows.push((format!("multires from {name} level {level}"), ms));
+    }
+    rows
 }

@@ -1,8 +1,33 @@
 //! Volume-preserving decimation hierarchy (paper section 4.1) and moving between its levels.
-//! STUB: the API contract; implementation to come.
+//!
+//! [`build_hierarchy`] runs the passes of [`decimate`] (one pass per level, see that module for
+//! the cost, the independent set, the cone volume and the validity rules) and then stores the
+//! result in a form where every level is cheap to reach:
+//!
+//! - Vertices are renumbered ("internal" ids) by the level at which they disappear, those that
+//!   survive to the coarsest level first, those removed by the first pass last. The vertices of
+//!   level `i` are then exactly the internal ids `0..V_i`, so the positions of level `i` are a
+//!   prefix of one array and refining by a level appends the split vertices.
+//! - Faces are renumbered the same way, so the faces of level `i` are the first `F_i` faces.
+//! - The collapse record of a removed vertex `v` is its target `k = target[v]` (an internal id
+//!   of the next coarser level, so always smaller than `v`'s), the signed cone volume of the
+//!   collapse, and (implicitly, through the face order) the faces it removed. The faces it
+//!   rewrites need not be stored: a face's corner at level `i` is its M0 corner followed along
+//!   `target` while it is not a vertex of level `i`. Coarsening by one level is one relabelling
+//!   pass (`c -> target[c]` for the removed `c`) that drops the faces at the end of the level's
+//!   range; refining (the vertex splits of a level) re-resolves the face range of the finer level
+//!   from M0's corners. Both are exact: coarsening to the top and refining back gives M0's faces,
+//!   in M0's order once mapped back through [`Hierarchy::original_vertex`].
+//!
+//! Storage per M0 vertex: target 4 bytes, cone volume 4, the vertex order both ways 8, and the
+//! face order (about two faces per vertex) 8: 24 bytes, besides M0 itself in internal order.
+
+mod decimate;
 
 use crate::mesh::TriMesh;
 use crate::Progress;
+use decimate::NEVER;
+use std::sync::atomic::{AtomicU64, Ordering};
 
 #[derive(Clone, Debug)]
 pub struct HierarchyOptions {
@@ -43,37 +68,333 @@ pub struct LevelInfo {
     pub faces: usize,
 }
 
+/// One half-edge collapse `vertex -> target` of a level, in internal (level-mesh) ids.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Collapse {
+    pub vertex: u32,
+    pub target: u32,
+    /// Signed cone volume: six times the volume the matching vertex split adds (on closed meshes
+    /// the collapse changes the volume by minus a sixth of this).
+    pub six_split_volume: f32,
+}
+
+static NEXT_HIERARCHY_ID: AtomicU64 = AtomicU64::new(1);
+
 /// M0 (the input) and the collapse records that lead to ever coarser levels M1..Mn.
 #[derive(Clone, Debug, Default)]
 pub struct Hierarchy {
     base: TriMesh,
+    /// Identifies one build (clones share it): lets workspaces cache per-level data.
+    id: u64,
+    /// Internal id -> M0 vertex id.
+    order: Vec<u32>,
+    /// M0 vertex id -> internal id.
+    rank: Vec<u32>,
+    /// M0's positions in internal order: level `i`'s positions are the first `V_i`.
+    positions: Vec<[f32; 3]>,
+    /// M0's faces in internal order, with internal vertex ids.
+    triangles: Vec<[u32; 3]>,
+    /// Internal face id -> M0 face index.
+    face_order: Vec<u32>,
+    /// Collapse target of each internal vertex (`u32::MAX` for vertices of the coarsest level).
+    target: Vec<u32>,
+    six_split_volume: Vec<f32>,
+    /// `V_i` and `F_i` per level, level 0 first.
+    level_vertices: Vec<u32>,
+    level_faces: Vec<u32>,
+    /// Milliseconds the pass building level `i` took (`level_ms[0]` is the setup of M0).
+    level_ms: Vec<f64>,
 }
 
 impl Hierarchy {
     /// Number of levels including M0 (so the coarsest is `level_count() - 1`).
     pub fn level_count(&self) -> usize {
-        1
+        self.level_vertices.len().max(1)
     }
-    pub fn level_info(&self, _level: usize) -> LevelInfo {
-        LevelInfo {
-            vertices: self.base.vertex_count(),
-            faces: self.base.face_count(),
+    /// The coarsest level's index.
+    pub fn coarsest_level(&self) -> usize {
+        self.level_count() - 1
+    }
+    pub fn level_info(&self, level: usize) -> LevelInfo {
+        if self.level_vertices.is_empty() {
+            return LevelInfo {
+                vertices: self.base.vertex_count(),
+                faces: self.base.face_count(),
+            };
         }
+        let level = level.min(self.coarsest_level());
+        LevelInfo {
+            vertices: self.level_vertices[level] as usize,
+            faces: self.level_faces[level] as usize,
+        }
+    }
+    /// Milliseconds spent building `level` (its decimation pass; for level 0 the set-up).
+    pub fn level_build_ms(&self, level: usize) -> f64 {
+        self.level_ms.get(level).copied().unwrap_or(0.0)
     }
     /// M0, the mesh the hierarchy was built from.
     pub fn base_mesh(&self) -> &TriMesh {
         &self.base
     }
-    /// The mesh of one level, compacted (its own vertex numbering).
-    pub fn level_mesh(&self, _level: usize) -> TriMesh {
-        self.base.clone()
+    /// The mesh of one level, compacted: its vertex `j` is internal vertex `j`, M0's vertex
+    /// [`Hierarchy::original_vertex`]`(j)`, at its M0 position.
+    pub fn level_mesh(&self, level: usize) -> TriMesh {
+        if self.level_vertices.is_empty() {
+            return self.base.clone();
+        }
+        TriMesh::new(
+            self.level_positions(level).to_vec(),
+            self.level_triangles(level),
+        )
+    }
+    /// M0 positions of the vertices of `level`, in internal order.
+    pub fn level_positions(&self, level: usize) -> &[[f32; 3]] {
+        &self.positions[..self.level_info(level).vertices]
+    }
+    /// Faces of `level` in internal vertex ids (the order is that of [`Hierarchy::level_mesh`]).
+    pub fn level_triangles(&self, level: usize) -> Vec<[u32; 3]> {
+        let info = self.level_info(level);
+        let mut triangles = Vec::new();
+        self.resolve_faces(0..info.faces, info.vertices as u32, &mut triangles);
+        triangles
+    }
+    /// M0 vertex id of internal vertex `v`.
+    pub fn original_vertex(&self, v: u32) -> u32 {
+        self.order[v as usize]
+    }
+    /// Internal id of M0 vertex `v`.
+    pub fn internal_vertex(&self, v: u32) -> u32 {
+        self.rank[v as usize]
+    }
+    /// M0 face index of internal face `f`.
+    pub fn original_face(&self, f: u32) -> u32 {
+        self.face_order[f as usize]
+    }
+    /// Internal id -> M0 vertex id for every vertex (level `i`'s vertices are the first `V_i`).
+    pub fn vertex_order(&self) -> &[u32] {
+        &self.order
+    }
+    /// The collapses that lead from `level` to `level + 1` (empty for the coarsest level).
+    pub fn collapses(&self, level: usize) -> impl Iterator<Item = Collapse> + '_ {
+        let range = if level + 1 < self.level_count() {
+            self.level_vertices[level + 1]..self.level_vertices[level]
+        } else {
+            0..0
+        };
+        range.map(move |v| Collapse {
+            vertex: v,
+            target: self.target[v as usize],
+            six_split_volume: self.six_split_volume[v as usize],
+        })
+    }
+    /// Collapse target (internal id) of internal vertex `v`, `None` on the coarsest level.
+    pub fn collapse_target(&self, v: u32) -> Option<u32> {
+        let k = self.target[v as usize];
+        (k != NEVER).then_some(k)
+    }
+    /// Six times the signed volume the split of internal vertex `v` adds (0 if never removed).
+    pub fn six_split_volume(&self, v: u32) -> f32 {
+        self.six_split_volume[v as usize]
+    }
+    /// Heap bytes of the collapse records (targets, cone volumes, vertex and face orders).
+    pub fn record_bytes(&self) -> usize {
+        4 * (self.target.len() + self.six_split_volume.len())
+            + 4 * (self.order.len() + self.rank.len())
+            + 4 * self.face_order.len()
+    }
+    pub(crate) fn id(&self) -> u64 {
+        self.id
+    }
+
+    /// Appends the faces `range` with their corners resolved to a level with `vertex_count`
+    /// vertices.
+    fn resolve_faces(
+        &self,
+        range: std::ops::Range<usize>,
+        vertex_count: u32,
+        out: &mut Vec<[u32; 3]>,
+    ) {
+        let resolve = |mut c: u32| {
+            while c >= vertex_count {
+                c = self.target[c as usize];
+            }
+            c
+        };
+        out.extend(self.triangles[range].iter().map(|t| t.map(resolve)));
+    }
+}
+
+/// A level's connectivity, to move up and down the hierarchy by whole levels.
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct LevelCursor {
+    pub level: usize,
+    /// The faces of `level`, internal ids (vertices `0..V_level`).
+    pub triangles: Vec<[u32; 3]>,
+}
+
+impl LevelCursor {
+    /// The cursor at M0.
+    pub fn new(hierarchy: &Hierarchy) -> Self {
+        Self::at(hierarchy, 0)
+    }
+    pub fn at(hierarchy: &Hierarchy, level: usize) -> Self {
+        let level = level.min(hierarchy.coarsest_level());
+        Self {
+            level,
+            triangles: hierarchy.level_triangles(level),
+        }
+    }
+    /// Applies the collapses of the current level (one relabelling pass). False at the top.
+    pub fn coarsen(&mut self, hierarchy: &Hierarchy) -> bool {
+        if self.level >= hierarchy.coarsest_level() {
+            return false;
+        }
+        let next = hierarchy.level_info(self.level + 1);
+        let vertex_count = next.vertices as u32;
+        self.triangles.truncate(next.faces);
+        for t in &mut self.triangles {
+            for c in t.iter_mut() {
+                if *c >= vertex_count {
+                    *c = hierarchy.target[*c as usize];
+                }
+            }
+        }
+        self.level += 1;
+        true
+    }
+    /// Applies the vertex splits that undo the collapses of the next finer level. False at M0.
+    pub fn refine(&mut self, hierarchy: &Hierarchy) -> bool {
+        if self.level == 0 {
+            return false;
+        }
+        let finer = hierarchy.level_info(self.level - 1);
+        let vertex_count = finer.vertices as u32;
+        // A face keeps its corners unless one of them is the target of a split vertex whose M0
+        // corner chain passes through it: re-resolve every face from M0 (chains are short).
+        self.triangles.clear();
+        hierarchy.resolve_faces(0..finer.faces, vertex_count, &mut self.triangles);
+        self.level -= 1;
+        true
+    }
+    /// The level's faces in M0 vertex ids.
+    pub fn original_triangles(&self, hierarchy: &Hierarchy) -> Vec<[u32; 3]> {
+        self.triangles
+            .iter()
+            .map(|t| t.map(|c| hierarchy.order[c as usize]))
+            .collect()
     }
 }
 
 pub fn build_hierarchy(
     mesh: &TriMesh,
-    _options: &HierarchyOptions,
-    _progress: &mut dyn Progress,
+    options: &HierarchyOptions,
+    progress: &mut dyn Progress,
 ) -> Result<Hierarchy, HierarchyError> {
-    Ok(Hierarchy { base: mesh.clone() })
+    let started = std::time::Instant::now();
+    let n = mesh.vertex_count();
+    if n >= u32::MAX as usize / 2 {
+        return Err(HierarchyError::Unsupported(format!(
+            "{n} vertices is more than this hierarchy can number"
+        )));
+    }
+    if let Some(v) = mesh.first_non_finite_vertex() {
+        return Err(HierarchyError::Unsupported(format!(
+            "vertex {v} has a non-finite coordinate"
+        )));
+    }
+    if let Some((f, t)) = mesh.triangles.iter().enumerate().find(|(_, t)| {
+        t.iter().any(|&c| c as usize >= n) || t[0] == t[1] || t[1] == t[2] || t[0] == t[2]
+    }) {
+        return Err(HierarchyError::Unsupported(format!(
+            "face {f} {t:?} repeats a vertex or refers to a missing one"
+        )));
+    }
+    let setup_ms = started.elapsed().as_secs_f64() * 1e3;
+
+    let built = decimate::build(mesh, options, progress)?;
+    let finishing = std::time::Instant::now();
+    let passes = built.pass_ms.len();
+
+    // Internal order: by pass of removal, latest (or never) first; ties by id. `bucket(p)` is 0
+    // for survivors, `passes - p` for vertices removed in pass p.
+    let bucket = |p: u32| if p == NEVER { 0 } else { passes - p as usize };
+    let order = counting_order(&built.removed_in_pass, passes + 1, bucket);
+    let mut rank = vec![0u32; n];
+    for (i, &v) in order.iter().enumerate() {
+        rank[v as usize] = i as u32;
+    }
+    let face_order = counting_order(&built.face_removed_in_pass, passes + 1, bucket);
+
+    // V_i = vertices not removed in passes 0..i (suffix sums of a histogram by pass).
+    let level_sizes = |removed_in_pass: &[u32]| {
+        let mut sizes = vec![0u32; passes + 2];
+        for &p in removed_in_pass {
+            sizes[if p == NEVER { passes } else { p as usize }] += 1;
+        }
+        for i in (0..=passes).rev() {
+            sizes[i] += sizes[i + 1];
+        }
+        sizes.truncate(passes + 1);
+        sizes
+    };
+    let level_vertices = level_sizes(&built.removed_in_pass);
+    let level_faces = level_sizes(&built.face_removed_in_pass);
+    let positions = order.iter().map(|&v| mesh.positions[v as usize]).collect();
+    let triangles = face_order
+        .iter()
+        .map(|&f| mesh.triangles[f as usize].map(|c| rank[c as usize]))
+        .collect();
+    let target = order
+        .iter()
+        .map(|&v| {
+            let k = built.target[v as usize];
+            if k == NEVER {
+                NEVER
+            } else {
+                rank[k as usize]
+            }
+        })
+        .collect();
+    let six_split_volume = order
+        .iter()
+        .map(|&v| built.six_split_volume[v as usize])
+        .collect();
+    let mut level_ms = vec![setup_ms + finishing.elapsed().as_secs_f64() * 1e3];
+    level_ms.extend_from_slice(&built.pass_ms);
+
+    Ok(Hierarchy {
+        base: mesh.clone(),
+        id: NEXT_HIERARCHY_ID.fetch_add(1, Ordering::Relaxed),
+        order,
+        rank,
+        positions,
+        triangles,
+        face_order,
+        target,
+        six_split_volume,
+        level_vertices,
+        level_faces,
+        level_ms,
+    })
 }
+
+/// Indices `0..keys.len()` sorted by `bucket(keys[i])` ascending, stable.
+fn counting_order(keys: &[u32], buckets: usize, bucket: impl Fn(u32) -> usize) -> Vec<u32> {
+    let mut starts = vec![0u32; buckets + 1];
+    for &k in keys {
+        starts[bucket(k) + 1] += 1;
+    }
+    for b in 0..buckets {
+        starts[b + 1] += starts[b];
+    }
+    let mut order = vec![0u32; keys.len()];
+    for (i, &k) in keys.iter().enumerate() {
+        let slot = &mut starts[bucket(k)];
+        order[*slot as usize] = i as u32;
+        *slot += 1;
+    }
+    order
+}
+
+#[cfg(test)]
+mod tests;

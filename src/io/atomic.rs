@@ -1,5 +1,5 @@
 //! Atomic file writes: the data goes to a temporary file in the target's directory
-//! (`.<name>.tmp-<pid>`), is flushed and synced, then renamed over the target. On any error the
+//! (`.<name>.tmp-<pid>-<n>`), is flushed and synced, then renamed over the target. On any error the
 //! temporary file is removed, so a failed export leaves nothing behind and an existing target is
 //! untouched. Rename within one directory is atomic on POSIX file systems and on NTFS.
 //!
@@ -11,14 +11,18 @@ use super::IoError;
 use std::fs::File;
 use std::io::{BufWriter, Write};
 use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicUsize, Ordering};
 
-/// The temporary sibling of `path` that is written before renaming.
+/// The temporary sibling of `path` that is written before renaming: `.<name>.tmp-<pid>-<n>`, `n`
+/// counting the writes of this process, so that two threads saving to one path do not share it.
 pub(crate) fn temp_path(path: &Path) -> PathBuf {
+    static WRITES: AtomicUsize = AtomicUsize::new(0);
     let name = path
         .file_name()
         .map(|n| n.to_string_lossy().into_owned())
         .unwrap_or_else(|| "mesh".into());
-    path.with_file_name(format!(".{name}.tmp-{}", std::process::id()))
+    let n = WRITES.fetch_add(1, Ordering::Relaxed);
+    path.with_file_name(format!(".{name}.tmp-{}-{n}", std::process::id()))
 }
 
 /// A complete, synced temporary file waiting to be renamed over its target.

@@ -38,7 +38,10 @@ use std::io::Write;
 use std::path::Path;
 
 pub(crate) fn parse(bytes: &[u8], path: &Path, base_dir: Option<&Path>) -> Result<Parsed, IoError> {
-    let document = ::gltf::Gltf::from_slice(bytes).map_err(|e| describe(e, path))?;
+    check_glb_header(bytes, path)?;
+    let document =
+        ::gltf::Gltf::from_slice_without_validation(bytes).map_err(|e| describe(e, path))?;
+    validate(document.as_json(), path)?;
     let buffers = load_buffers(&document, path, base_dir)?;
     let mut reader = SceneReader {
         path,
@@ -86,6 +89,80 @@ pub(crate) fn parse(bytes: &[u8], path: &Path, base_dir: Option<&Path>) -> Resul
         mesh: reader.mesh,
         warnings: reader.warnings,
     })
+}
+
+/// The GLB header's length, checked before the `gltf` crate sees it: gltf 1.4 subtracts the
+/// header size from it unchecked (an overflow panic in debug builds, found by fuzzing).
+fn check_glb_header(bytes: &[u8], path: &Path) -> Result<(), IoError> {
+    if !bytes.starts_with(b"glTF") {
+        return Ok(());
+    }
+    let Some(declared) = bytes
+        .get(8..12)
+        .and_then(|b| b.try_into().ok())
+        .map(u32::from_le_bytes)
+    else {
+        return Err(IoError::at_byte(
+            path,
+            0,
+            format!(
+                "GLB container: the file is truncated: the 12-byte header is cut off at {} bytes",
+                bytes.len()
+            ),
+        ));
+    };
+    if declared < 12 {
+        return Err(IoError::at_byte(
+            path,
+            8,
+            format!("GLB container: the header declares a total length of {declared} bytes, less than the header itself"),
+        ));
+    }
+    if declared as usize > bytes.len() {
+        return Err(IoError::at_byte(
+            path,
+            8,
+            format!(
+                "GLB container: the file is truncated: the header declares {declared} bytes but the file has {}",
+                bytes.len()
+            ),
+        ));
+    }
+    Ok(())
+}
+
+/// What `gltf::Gltf::from_slice` validates, after a check that its validation needs: gltf-json
+/// 1.4 looks up every primitive's POSITION accessor by index without a bounds check (a panic,
+/// found by fuzzing).
+fn validate(root: &json::Root, path: &Path) -> Result<(), IoError> {
+    use json::validation::{Checked, Validate};
+    for (m, mesh) in root.meshes.iter().enumerate() {
+        for (p, primitive) in mesh.primitives.iter().enumerate() {
+            let position = primitive
+                .attributes
+                .get(&Checked::Valid(json::mesh::Semantic::Positions));
+            if let Some(index) = position.filter(|i| i.value() >= root.accessors.len()) {
+                return Err(IoError::at_element(
+                    path,
+                    format!("meshes[{m}].primitives[{p}].attributes.POSITION"),
+                    format!(
+                        "invalid glTF: accessor {} does not exist (the file has {})",
+                        index.value(),
+                        root.accessors.len()
+                    ),
+                ));
+            }
+        }
+    }
+    let mut errors = Vec::new();
+    root.validate(root, json::Path::new, &mut |where_, what| {
+        errors.push((where_(), what))
+    });
+    if errors.is_empty() {
+        Ok(())
+    } else {
+        Err(describe(::gltf::Error::Validation(errors), path))
+    }
 }
 
 fn describe(error: ::gltf::Error, path: &Path) -> IoError {
@@ -419,7 +496,7 @@ impl SceneReader<'_> {
                     for c in corners.chunks_exact(3) {
                         push([c[0], c[1], c[2]]);
                     }
-                    if corners.len() % 3 != 0 {
+                    if !corners.len().is_multiple_of(3) {
                         self.warnings.push(format!(
                             "{label}: {} indices is not a multiple of 3; the last {} were ignored",
                             corners.len(),

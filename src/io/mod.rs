@@ -35,7 +35,7 @@ use std::path::{Path, PathBuf};
 /// A mesh file format, chosen from the file extension.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum Format {
-    /// Wavefront OBJ (text), read through tobj.
+    /// Wavefront OBJ (text).
     Obj,
     /// glTF 2.0 JSON (`.gltf`) with external or embedded (data: URI) buffers.
     Gltf,

@@ -659,7 +659,7 @@ fn read_binary<const BIG: bool>(
                                 )
                             })?;
                         pos += count.size();
-                        let list_len = n.checked_mul(item.size()).unwrap_or(usize::MAX);
+                        let list_len = n.saturating_mul(item.size());
                         if list_len > end - pos {
                             return Err(cut(pos));
                         }

@@ -431,32 +431,59 @@ fn scan_vertex(v: u32, faces: &[u32], triangles: &[[u32; 3]], slot: &mut [u32]) 
     }
     scan.neighbor_count = write as u32;
 
-    // Fans: union the two other corners of each face over v's local neighbour indices; a single
-    // fan is a single connected link. Valences up to 64 use a stack array (no allocation).
     if !faces.is_empty() && !scan.non_manifold_edge {
-        let neighbors = &slot[..write];
-        let mut stack_parent = [0u32; 64];
-        let mut heap_parent = Vec::new();
-        let parent: &mut [u32] = if write <= 64 {
-            &mut stack_parent[..write]
+        scan.multiple_fans = if scan.inconsistent_edges == 0 && faces.len() <= 64 {
+            !single_fan_by_walk(v, faces, triangles)
         } else {
-            heap_parent.resize(write, 0);
-            &mut heap_parent
+            !single_fan_by_union(v, faces, triangles, &slot[..write])
         };
-        for (i, p) in parent.iter_mut().enumerate() {
-            *p = i as u32;
-        }
-        let local = |x: u32| neighbors.binary_search(&x).unwrap_or(0);
-        let mut components = write;
-        for &f in faces {
-            let t = triangles[f as usize];
-            if union(parent, local(next_in_face(t, v)), local(prev_in_face(t, v))) {
-                components -= 1;
-            }
-        }
-        scan.multiple_fans = components > 1;
     }
     scan
+}
+
+/// With consistent orientation each face (v, a, b) is a link edge a -> b, and every link vertex has
+/// at most one edge in and one out; the faces form one fan exactly when walking the link from a
+/// fan's start (a link vertex no edge enters, or any face of a closed fan) visits every face.
+fn single_fan_by_walk(v: u32, faces: &[u32], triangles: &[[u32; 3]]) -> bool {
+    let mut links = [(0u32, 0u32); 64];
+    let links = &mut links[..faces.len()];
+    for (link, &f) in links.iter_mut().zip(faces) {
+        let t = triangles[f as usize];
+        *link = (next_in_face(t, v), prev_in_face(t, v));
+    }
+    let start = links
+        .iter()
+        .position(|&(a, _)| !links.iter().any(|&(_, b)| b == a))
+        .unwrap_or(0);
+    let mut visited = 1;
+    let mut current = links[start].1;
+    while let Some(next) = links.iter().position(|&(a, _)| a == current) {
+        if next == start || visited == links.len() {
+            break;
+        }
+        visited += 1;
+        current = links[next].1;
+    }
+    visited == links.len()
+}
+
+/// The orientation-agnostic fan check: union the two other corners of each face over v's local
+/// neighbour indices; a single fan is a single connected link.
+fn single_fan_by_union(v: u32, faces: &[u32], triangles: &[[u32; 3]], neighbors: &[u32]) -> bool {
+    let mut parent: Vec<u32> = (0..neighbors.len() as u32).collect();
+    let local = |x: u32| neighbors.binary_search(&x).unwrap_or(0);
+    let mut components = neighbors.len();
+    for &f in faces {
+        let t = triangles[f as usize];
+        if union(
+            &mut parent,
+            local(next_in_face(t, v)),
+            local(prev_in_face(t, v)),
+        ) {
+            components -= 1;
+        }
+    }
+    components == 1
 }
 
 fn union(parent: &mut [u32], a: usize, b: usize) -> bool {

@@ -1,0 +1,60 @@
+//! Criterion benchmarks of one fairing iteration: constrained (both variants) and Laplacian, on
+//! `assets/bunny00.obj` (75k faces) and on it Loop-subdivided twice (1.2M faces) with noise.
+//! Run: `cargo bench --no-default-features --bench fairing`.
+
+use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion};
+use fairmesh::fairing::{baseline::UmbrellaStencil, BoundaryMode, ConstrainedFairing, FairVariant};
+use fairmesh::noise::{add_noise, NoiseOptions};
+use fairmesh::{Topology, TriMesh};
+use std::hint::black_box;
+
+fn meshes() -> Vec<(&'static str, TriMesh)> {
+    let bunny = fairmesh::io::load(std::path::Path::new("assets/bunny00.obj"))
+        .expect("assets/bunny00.obj")
+        .mesh;
+    let mut big = fairmesh::mesh::subdivide_loop(&fairmesh::mesh::subdivide_loop(&bunny));
+    add_noise(
+        &mut big,
+        &NoiseOptions {
+            sigma: 0.3,
+            ..Default::default()
+        },
+    );
+    let mut noisy_bunny = bunny;
+    add_noise(
+        &mut noisy_bunny,
+        &NoiseOptions {
+            sigma: 0.3,
+            ..Default::default()
+        },
+    );
+    vec![("bunny00", noisy_bunny), ("bunny00_x16", big)]
+}
+
+fn fairing_iteration(c: &mut Criterion) {
+    let mut group = c.benchmark_group("fairing_iteration");
+    group.sample_size(20);
+    for (name, mesh) in meshes() {
+        let topology = Topology::build(&mesh);
+        for variant in [FairVariant::Paper, FairVariant::NormalProjected] {
+            let mut fairing =
+                ConstrainedFairing::new(&mesh, &topology, variant, BoundaryMode::Curve);
+            let positions = mesh.positions.clone();
+            fairing.load(&positions);
+            group.bench_function(
+                BenchmarkId::new(format!("constrained_{}", variant.name()), name),
+                |b| b.iter(|| black_box(fairing.step())),
+            );
+        }
+        let stencil = UmbrellaStencil::new(&topology, BoundaryMode::Curve);
+        let positions = mesh.positions.clone();
+        let mut next = positions.clone();
+        group.bench_function(BenchmarkId::new("laplacian", name), |b| {
+            b.iter(|| black_box(stencil.relax(&positions, &mut next, 0.5)))
+        });
+    }
+    group.finish();
+}
+
+criterion_group!(benches, fairing_iteration);
+criterion_main!(benches);

@@ -1,0 +1,988 @@
+//! Constrained fairing (paper section 3.2): the local least-squares problem (6) of every interior
+//! triangle, solved in closed form (eq 7), averaged per vertex, iterated Jacobi-style.
+//!
+//! Interpretations (see `paper/NOTES.md`, which this follows):
+//! - Weights ω_ij = 1/n_i with n_i the number of distinct one-ring neighbours. For triangle
+//!   ⟨i, j, k⟩ the local energy is ‖AP − Q‖² with A = I − (ω between the three corners) and
+//!   q_i = Σ ω_ij x_j over the n_i − 2 neighbours of i that are not corners of the triangle.
+//! - Eq (7) read as a matrix product, P = A⁻¹Q + A⁻¹A⁻ᵀBᵀ(C − BA⁻¹Q)/‖BA⁻¹‖², B = [1 1 1],
+//!   C = BP⁰. It is precomputed as P = G·Q + h·C with G = A⁻¹ − A⁻¹A⁻ᵀBᵀBA⁻¹/‖BA⁻¹‖² and
+//!   h = A⁻¹A⁻ᵀBᵀ/‖BA⁻¹‖² ([`LocalOperator`]). A depends on the valence triple only, so G and h
+//!   are computed once per distinct triple.
+//! - "Interior triangle" = none of its corners is a boundary vertex (and every corner has valence
+//!   three or more, so that A is invertible). Only interior triangles are solved.
+//! - Jacobi: every local solve of one iteration reads the previous iterate. The new position of a
+//!   vertex is the mean of its triangles' solutions; a vertex with no solution (all its triangles
+//!   touch the boundary, or it is unreferenced) keeps its position (the paper's pseudocode would
+//!   send it to the origin). Boundary vertices are moved by the curve operator of section 3.3
+//!   ([`super::boundary`]) in the same iteration, or kept ([`BoundaryMode::Fixed`]).
+//! - Anchors P⁰ are the positions at the start of each round; a round re-imposes the constraints
+//!   on the current positions ("imposing and relaxing the centre constraints by turns").
+//!
+//! # How it is computed
+//! Write m_u for the umbrella mean (1/n_u)·Σ_{w∈S(u)} x_w. For triangle t with corners c and
+//! vertex v at row r, q_c = m_c − (x_a + x_b)/n_c, so v's solution is
+//! Σ_c G_rc·m_c + Σ_c (G_rc/n_c − Σ_c' G_rc'/n_c')·x_c + h_r·C_t: a linear combination of the
+//! umbrella means and positions of v's closed one-ring, plus the anchors' contribution, which is
+//! constant within a round. Averaging over v's triangles keeps that form, so the precomputation
+//! folds everything into one weight pair per one-ring entry, and an iteration is two gather passes
+//! over vertices, both parallel (rayon) with no scatter and no atomics:
+//! 1. umbrella means m, reading the previous iterate;
+//! 2. x̃ = anchor term + Σ (α·m_u + β·x_u) over the closed one-ring; then the boundary curves;
+//! 3. (normal-projected variant only) x_new = x + n·(n·(x̃ − x)), n the unit normal of v's fan in
+//!    x̃ (the one-ring is stored in fan order for that).
+//!
+//! Every vertex is computed by the same sequence of operations whatever the thread count, so the
+//! output is bit-identical for any rayon pool. Positions, means and weights are f32 (weights are
+//! computed in f64 and rounded): the operator is a contraction towards its fixed point, so rounding
+//! does not accumulate; the tests check volume to 1e-4 relative and equivariance to f32 accuracy.
+
+use super::boundary::{BoundaryCurves, CurvePoint};
+use super::{BoundaryMode, FairOptions, FairReport, FairVariant};
+use crate::mesh::{Topology, TriMesh};
+use rayon::prelude::*;
+
+/// A 3×3 matrix, rows first.
+pub type Matrix3 = [[f64; 3]; 3];
+
+/// Eq (7) in precomputed form for one local matrix A: P = G·Q + h·C, where P and Q hold one row
+/// per triangle corner and C = BP⁰ is the sum of the corners' anchors.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct LocalOperator {
+    pub g: Matrix3,
+    pub h: [f64; 3],
+}
+
+impl LocalOperator {
+    /// The operator for an invertible local matrix `a` and B = [1 1 1]; `None` when `a` is
+    /// singular or BA⁻¹ vanishes.
+    pub fn from_matrix(a: &Matrix3) -> Option<Self> {
+        let inverse = invert3(a)?;
+        // w = (BA⁻¹)ᵀ: the column sums of A⁻¹.
+        let w: [f64; 3] = std::array::from_fn(|c| inverse[0][c] + inverse[1][c] + inverse[2][c]);
+        let norm_squared = w[0] * w[0] + w[1] * w[1] + w[2] * w[2];
+        if !(norm_squared > 0.0 && norm_squared.is_finite()) {
+            return None;
+        }
+        // A⁻¹A⁻ᵀBᵀ = A⁻¹w.
+        let h: [f64; 3] = std::array::from_fn(|r| {
+            (inverse[r][0] * w[0] + inverse[r][1] * w[1] + inverse[r][2] * w[2]) / norm_squared
+        });
+        let g = std::array::from_fn(|r| std::array::from_fn(|c| inverse[r][c] - h[r] * w[c]));
+        Some(LocalOperator { g, h })
+    }
+
+    /// The operator for the paper's uniform weights and the corners' valences.
+    pub fn umbrella(valences: [usize; 3]) -> Option<Self> {
+        if valences.iter().any(|&n| n < 3) {
+            return None;
+        }
+        Self::from_matrix(&umbrella_local_matrix(valences))
+    }
+
+    /// P = G·Q + h·C; `q` and the result have one row per corner, one column per coordinate.
+    pub fn solve(&self, q: &Matrix3, c: [f64; 3]) -> Matrix3 {
+        std::array::from_fn(|r| {
+            std::array::from_fn(|k| {
+                self.g[r][0] * q[0][k]
+                    + self.g[r][1] * q[1][k]
+                    + self.g[r][2] * q[2][k]
+                    + self.h[r] * c[k]
+            })
+        })
+    }
+}
+
+/// A of section 3.2 for uniform weights: 1 on the diagonal, −1/n_r off it in row r.
+pub fn umbrella_local_matrix(valences: [usize; 3]) -> Matrix3 {
+    std::array::from_fn(|r| {
+        std::array::from_fn(|c| {
+            if r == c {
+                1.0
+            } else {
+                -1.0 / valences[r] as f64
+            }
+        })
+    })
+}
+
+/// Inverse by the adjugate; `None` when (nearly) singular.
+pub fn invert3(a: &Matrix3) -> Option<Matrix3> {
+    let cofactor = |r: usize, c: usize| {
+        let (r1, r2) = ((r + 1) % 3, (r + 2) % 3);
+        let (c1, c2) = ((c + 1) % 3, (c + 2) % 3);
+        a[r1][c1] * a[r2][c2] - a[r1][c2] * a[r2][c1]
+    };
+    let det = a[0][0] * cofactor(0, 0) + a[0][1] * cofactor(0, 1) + a[0][2] * cofactor(0, 2);
+    let scale = a.iter().flatten().fold(0.0f64, |m, x| m.max(x.abs()));
+    if !(det.abs() > 1e-12 * scale * scale * scale) {
+        return None;
+    }
+    Some(std::array::from_fn(|r| {
+        std::array::from_fn(|c| cofactor(c, r) / det)
+    }))
+}
+
+/// Valences below this index a dense table of local operators; larger ones are computed on the fly.
+const TABLE_VALENCE: usize = 32;
+/// Vertices per parallel work item.
+const CHUNK: usize = 2048;
+
+/// Precomputed constrained fairing for one mesh connectivity, with its workspace buffers: build it
+/// once, then run it on as many position sets (of that connectivity) as wanted.
+#[derive(Clone, Debug)]
+pub struct ConstrainedFairing {
+    variant: FairVariant,
+    boundary: BoundaryMode,
+    /// One-ring of each vertex: in fan order (faces (v, ring[k], ring[k+1])) when the vertex has a
+    /// closed, consistently oriented fan, otherwise the topology's sorted neighbours.
+    ring_offsets: Vec<u32>,
+    ring: Vec<u32>,
+    /// Per one-ring entry: weights of the neighbour's umbrella mean and of its position.
+    ring_weights: Vec<[f32; 2]>,
+    /// Per one-ring entry: weight of the neighbour's anchor.
+    ring_anchor_weights: Vec<f32>,
+    /// Per vertex: weights of its own umbrella mean, position and anchor.
+    self_weights: Vec<[f32; 3]>,
+    /// 1/n_v (0 for unreferenced vertices).
+    inverse_valence: Vec<f32>,
+    /// Whether `ring` is a closed fan, so the vertex normal can be taken from it.
+    closed_fan: Vec<bool>,
+    curves: BoundaryCurves,
+    /// Number of vertices that get at least one local solution.
+    solved_vertices: usize,
+    workspace: Workspace,
+}
+
+#[derive(Clone, Debug, Default)]
+struct Workspace {
+    current: Vec<Point4>,
+    anchors: Vec<Point4>,
+    anchor_terms: Vec<Point4>,
+    position_and_mean: Vec<PositionAndMean>,
+    next: Vec<Point4>,
+    projected: Vec<Point4>,
+    curve_accumulator: Vec<([f64; 3], u32)>,
+}
+
+impl ConstrainedFairing {
+    /// Precomputes the operator for `mesh`'s connectivity (`topology` must be built from it).
+    pub fn new(
+        mesh: &TriMesh,
+        topology: &Topology,
+        variant: FairVariant,
+        boundary: BoundaryMode,
+    ) -> Self {
+        let vertex_count = mesh.positions.len();
+        let triangles = &mesh.triangles;
+        let is_boundary = topology.boundary_flags();
+
+        // One-rings, in fan order where possible. A closed fan has as many entries as the vertex
+        // has neighbours, so the rings share the topology's CSR offsets and are written in place.
+        let ring_offsets = topology.neighbor_csr().0.to_vec();
+        let mut ring = vec![0u32; topology.neighbor_csr().1.len()];
+        let mut closed = vec![false; vertex_count];
+        split_by_offsets(&mut ring, &ring_offsets)
+            .into_par_iter()
+            .zip(closed.par_iter_mut())
+            .enumerate()
+            .for_each(|(v, (ring_v, closed_v))| {
+                let v = v as u32;
+                *closed_v = !is_boundary[v as usize] && closed_fan(v, topology, triangles, ring_v);
+                if !*closed_v {
+                    ring_v.copy_from_slice(topology.neighbors(v));
+                }
+            });
+
+        let valence = |v: u32| topology.valence(v);
+        let interior = |t: &[u32; 3]| {
+            t.iter()
+                .all(|&c| !is_boundary[c as usize] && valence(c) >= 3)
+                && t[0] != t[1]
+                && t[1] != t[2]
+                && t[0] != t[2]
+        };
+
+        // Local operators of the valence triples that occur, in a dense table, and each triangle's
+        // slot in it (u32::MAX: not an interior triangle), found once per triangle rather than
+        // once per corner. Triples with a valence beyond the table get an operator of their own.
+        let table_index = |n: [usize; 3]| (n[0] * TABLE_VALENCE + n[1]) * TABLE_VALENCE + n[2];
+        let triangle_valences: Vec<Option<[usize; 3]>> = triangles
+            .par_iter()
+            .map(|t| interior(t).then(|| t.map(valence)))
+            .collect();
+        let mut table_slot = vec![u32::MAX; TABLE_VALENCE * TABLE_VALENCE * TABLE_VALENCE];
+        let mut operators: Vec<(LocalOperator, [usize; 3])> = Vec::new();
+        let mut operator_slot = |n: [usize; 3]| -> u32 {
+            let in_table = n.iter().all(|&k| k < TABLE_VALENCE);
+            if in_table && table_slot[table_index(n)] != u32::MAX {
+                return table_slot[table_index(n)];
+            }
+            let slot = operators.len() as u32;
+            operators.push((
+                LocalOperator::umbrella(n).expect("valences are at least 3"),
+                n,
+            ));
+            if in_table {
+                table_slot[table_index(n)] = slot;
+            }
+            slot
+        };
+        let triangle_operator: Vec<u32> = triangle_valences
+            .iter()
+            .map(|n| n.map_or(u32::MAX, &mut operator_slot))
+            .collect();
+        drop(triangle_valences);
+
+        // Per vertex, gather the weights of its triangles' solutions (f64, then rounded), written
+        // straight into the vertex's slices of the CSR weight arrays.
+        let mut ring_weights = vec![[0.0f32; 2]; ring.len()];
+        let mut ring_anchor_weights = vec![0.0f32; ring.len()];
+        let mut self_weights = vec![[0.0f32; 3]; vertex_count];
+        let mut solved = vec![false; vertex_count];
+        split_by_offsets(&mut ring_weights, &ring_offsets)
+            .into_par_iter()
+            .zip(split_by_offsets(&mut ring_anchor_weights, &ring_offsets))
+            .zip(self_weights.par_iter_mut().zip(solved.par_iter_mut()))
+            .enumerate()
+            .for_each(
+                |(v, ((ring_weights_v, anchor_weights_v), (own_out, solved_out)))| {
+                    let ring_v = &ring[ring_offsets[v] as usize..ring_offsets[v + 1] as usize];
+                    let mut own = [0.0f64; 3];
+                    let mut stack_entries = [[0.0f64; 3]; 64];
+                    let mut heap_entries = Vec::new();
+                    let entries: &mut [[f64; 3]] = if ring_v.len() <= 64 {
+                        &mut stack_entries[..ring_v.len()]
+                    } else {
+                        heap_entries.resize(ring_v.len(), [0.0f64; 3]);
+                        &mut heap_entries
+                    };
+                    let mut count = 0usize;
+                    for &f in topology.faces_of(v as u32) {
+                        let slot = triangle_operator[f as usize];
+                        if slot == u32::MAX {
+                            continue;
+                        }
+                        count += 1;
+                        let t = &triangles[f as usize];
+                        let (op, n) = &operators[slot as usize];
+                        let r = t
+                            .iter()
+                            .position(|&c| c as usize == v)
+                            .expect("v is a corner");
+                        let k_sum: f64 = (0..3).map(|c| op.g[r][c] / n[c] as f64).sum();
+                        for c in 0..3 {
+                            let mean_weight = op.g[r][c];
+                            let position_weight = op.g[r][c] / n[c] as f64 - k_sum;
+                            let anchor_weight = op.h[r];
+                            let slot = if t[c] as usize == v {
+                                &mut own
+                            } else {
+                                let at = ring_v
+                                    .iter()
+                                    .position(|&u| u == t[c])
+                                    .expect("a triangle's corners are one-ring neighbours");
+                                &mut entries[at]
+                            };
+                            slot[0] += mean_weight;
+                            slot[1] += position_weight;
+                            slot[2] += anchor_weight;
+                        }
+                    }
+                    if count == 0 {
+                        // No local solution: the vertex keeps its position (ring weights stay 0).
+                        *own_out = [0.0, 1.0, 0.0];
+                        return;
+                    }
+                    let inv = 1.0 / count as f64;
+                    *own_out = own.map(|w| (w * inv) as f32);
+                    for ((out, anchor), e) in ring_weights_v
+                        .iter_mut()
+                        .zip(anchor_weights_v.iter_mut())
+                        .zip(entries.iter())
+                    {
+                        *out = [(e[0] * inv) as f32, (e[1] * inv) as f32];
+                        *anchor = (e[2] * inv) as f32;
+                    }
+                    *solved_out = true;
+                },
+            );
+        let solved_vertices = solved.iter().filter(|&&s| s).count();
+
+        let inverse_valence = (0..vertex_count as u32)
+            .map(|v| match topology.valence(v) {
+                0 => 0.0,
+                n => 1.0 / n as f32,
+            })
+            .collect();
+        let curves = match boundary {
+            BoundaryMode::Curve => BoundaryCurves::new(&topology.boundary_loops, vertex_count),
+            BoundaryMode::Fixed => BoundaryCurves::default(),
+        };
+        let workspace = Workspace {
+            current: vec![Point4::default(); vertex_count],
+            anchors: vec![Point4::default(); vertex_count],
+            anchor_terms: vec![Point4::default(); vertex_count],
+            position_and_mean: vec![PositionAndMean::default(); vertex_count],
+            next: vec![Point4::default(); vertex_count],
+            projected: match variant {
+                FairVariant::NormalProjected => vec![Point4::default(); vertex_count],
+                FairVariant::Paper => Vec::new(),
+            },
+            curve_accumulator: Vec::new(),
+        };
+        ConstrainedFairing {
+            variant,
+            boundary,
+            ring_offsets,
+            ring,
+            ring_weights,
+            ring_anchor_weights,
+            self_weights,
+            inverse_valence,
+            closed_fan: closed,
+            curves,
+            solved_vertices,
+            workspace,
+        }
+    }
+
+    pub fn variant(&self) -> FairVariant {
+        self.variant
+    }
+
+    pub fn boundary(&self) -> BoundaryMode {
+        self.boundary
+    }
+
+    pub fn vertex_count(&self) -> usize {
+        self.self_weights.len()
+    }
+
+    /// Vertices that get at least one local solution (the others keep their positions, boundary
+    /// vertices aside).
+    pub fn solved_vertices(&self) -> usize {
+        self.solved_vertices
+    }
+
+    /// Bytes one [`Self::iterate`] must stream from or to memory with this data layout, if every
+    /// array is read once and gathered neighbours hit the cache: the floor for its run time is
+    /// this divided by the machine's copy bandwidth (read + write bytes per second).
+    pub fn streamed_bytes_per_iteration(&self) -> usize {
+        let vertices = self.vertex_count();
+        let entries = self.ring.len();
+        let offsets = 4 * (vertices + 1);
+        let point = 16 * vertices;
+        // Pass 1: offsets, ring, 1/n, x; writes positions and means (counted twice:
+        // write-allocate).
+        let pass1 = offsets + 4 * entries + 4 * vertices + point + 4 * point;
+        // Pass 2: offsets, ring, ring weights, own weights, anchor terms, positions and means;
+        // writes x̃.
+        let pass2 = offsets + 12 * entries + 12 * vertices + 3 * point + 2 * point;
+        // Pass 3: offsets, ring, fan flags, x̃, x; writes the result.
+        let pass3 = match self.variant {
+            FairVariant::Paper => 0,
+            FairVariant::NormalProjected => {
+                offsets + 4 * entries + vertices + 2 * point + 2 * point
+            }
+        };
+        pass1 + pass2 + pass3
+    }
+
+    /// Runs `options.rounds` rounds of up to `options.iterations` iterations on `positions`
+    /// (which must have this connectivity's vertex count). `options.variant` and
+    /// `options.boundary` are those given to [`ConstrainedFairing::new`].
+    pub fn run(&mut self, positions: &mut [[f32; 3]], options: &FairOptions) -> FairReport {
+        self.load(positions);
+        let mut report = FairReport::default();
+        for round in 0..options.rounds {
+            if round > 0 {
+                self.reanchor();
+            }
+            for _ in 0..options.iterations {
+                report.max_move = self.step();
+                report.iterations_run += 1;
+                if report.max_move < options.tolerance {
+                    break;
+                }
+            }
+        }
+        self.store(positions);
+        report
+    }
+
+    /// Takes `positions` as the current state and imposes the constraints on them (they become
+    /// the anchors P⁰ of the next iterations).
+    pub fn load(&mut self, positions: &[[f32; 3]]) {
+        assert_eq!(
+            positions.len(),
+            self.vertex_count(),
+            "positions do not fit this connectivity"
+        );
+        for (state, p) in self.workspace.current.iter_mut().zip(positions) {
+            *state = Point4::from_xyz(*p);
+        }
+        self.reanchor();
+    }
+
+    /// Copies the current state into `positions`.
+    pub fn store(&self, positions: &mut [[f32; 3]]) {
+        for (p, state) in positions.iter_mut().zip(&self.workspace.current) {
+            *p = state.xyz();
+        }
+    }
+
+    /// Re-imposes the constraints on the current state (the start of a new round).
+    pub fn reanchor(&mut self) {
+        let ws = &mut self.workspace;
+        ws.anchors.copy_from_slice(&ws.current);
+        let anchors = &ws.anchors;
+        let (offsets, ring, weights, own) = (
+            &self.ring_offsets,
+            &self.ring,
+            &self.ring_anchor_weights,
+            &self.self_weights,
+        );
+        ws.anchor_terms
+            .par_chunks_mut(CHUNK)
+            .enumerate()
+            .for_each(|(chunk, out)| {
+                let start = chunk * CHUNK;
+                for (i, term) in out.iter_mut().enumerate() {
+                    let v = start + i;
+                    let w = own[v][2] as f64;
+                    let mut sum = anchors[v].xyz().map(|x| w * x as f64);
+                    for e in offsets[v] as usize..offsets[v + 1] as usize {
+                        let w = weights[e] as f64;
+                        let p = anchors[ring[e] as usize].0;
+                        for k in 0..3 {
+                            sum[k] += w * p[k] as f64;
+                        }
+                    }
+                    *term = Point4::from_xyz(sum.map(|s| s as f32));
+                }
+            });
+    }
+
+    /// One Jacobi iteration of the current state (anchors from the last [`Self::load`] or
+    /// [`Self::reanchor`]). Returns the largest vertex move.
+    pub fn step(&mut self) -> f64 {
+        let project = self.variant == FairVariant::NormalProjected;
+        let ws = &mut self.workspace;
+        let offsets = &self.ring_offsets;
+        let ring = &self.ring;
+        let x: &[Point4] = &ws.current;
+
+        // Pass 1: umbrella means of the previous iterate, stored next to the positions so that
+        // pass 2 gathers both with one access per neighbour.
+        let inverse_valence = &self.inverse_valence;
+        let closed_fan = &self.closed_fan;
+        ws.position_and_mean
+            .par_chunks_mut(CHUNK)
+            .enumerate()
+            .for_each(|(chunk, pairs)| {
+                let start = chunk * CHUNK;
+                for (i, pair) in pairs.iter_mut().enumerate() {
+                    let v = start + i;
+                    let ring_v = &ring[offsets[v] as usize..offsets[v + 1] as usize];
+                    *pair = PositionAndMean {
+                        position: x[v].0,
+                        mean: umbrella_mean(x, ring_v, inverse_valence[v]).0,
+                    };
+                }
+            });
+
+        // Pass 2: the averaged local solutions (the paper's update).
+        let pairs = &ws.position_and_mean;
+        let anchor_terms = &ws.anchor_terms;
+        let ring_weights = &self.ring_weights;
+        let self_weights = &self.self_weights;
+        let max_move_squared = ws
+            .next
+            .par_chunks_mut(CHUNK)
+            .enumerate()
+            .map(|(chunk, out)| {
+                let start = chunk * CHUNK;
+                let mut max_squared = 0.0f32;
+                for (i, new_position) in out.iter_mut().enumerate() {
+                    let v = start + i;
+                    let [wm, wx, _] = self_weights[v];
+                    let PositionAndMean {
+                        position: p,
+                        mean: m,
+                    } = pairs[v];
+                    let a = anchor_terms[v].0;
+                    let mut sum: [f32; 4] = std::array::from_fn(|k| a[k] + wm * m[k] + wx * p[k]);
+                    for e in offsets[v] as usize..offsets[v + 1] as usize {
+                        let u = ring[e] as usize;
+                        let [wm, wx] = ring_weights[e];
+                        let PositionAndMean {
+                            position: xu,
+                            mean: mu,
+                        } = pairs[u];
+                        for k in 0..4 {
+                            sum[k] += wm * mu[k] + wx * xu[k];
+                        }
+                    }
+                    let step: [f32; 4] = std::array::from_fn(|k| sum[k] - p[k]);
+                    max_squared = max_squared.max(dot4(step, step));
+                    *new_position = Point4(sum);
+                }
+                max_squared
+            })
+            .reduce(|| 0.0f32, f32::max);
+        let mut max_move = (max_move_squared as f64).sqrt();
+
+        // The boundary curves, from the same previous iterate.
+        if !self.curves.is_empty() {
+            let curve_move = self.curves.constrained_step(
+                x,
+                &ws.anchors,
+                &mut ws.next,
+                project,
+                &mut ws.curve_accumulator,
+            );
+            max_move = max_move.max(curve_move);
+        }
+        if !project {
+            std::mem::swap(&mut ws.current, &mut ws.next);
+            return max_move;
+        }
+
+        // Pass 3 (normal-projected variant): keep the component of each move along the normal of
+        // the updated fan, into the spare buffer.
+        let updated = &ws.next;
+        let max_move_squared = ws
+            .projected
+            .par_chunks_mut(CHUNK)
+            .enumerate()
+            .map(|(chunk, out)| {
+                let start = chunk * CHUNK;
+                let mut max_squared = 0.0f32;
+                for (i, new_position) in out.iter_mut().enumerate() {
+                    let v = start + i;
+                    let p = x[v].0;
+                    let mut step: [f32; 4] = std::array::from_fn(|k| updated[v].0[k] - p[k]);
+                    if closed_fan[v] {
+                        let ring_v = &ring[offsets[v] as usize..offsets[v + 1] as usize];
+                        let n = fan_normal(updated, v, ring_v);
+                        let length_squared = dot4(n, n);
+                        step = if length_squared > 0.0 && length_squared.is_finite() {
+                            let along = dot4(n, step) / length_squared;
+                            n.map(|c| c * along)
+                        } else {
+                            [0.0; 4]
+                        };
+                    }
+                    max_squared = max_squared.max(dot4(step, step));
+                    *new_position = Point4(std::array::from_fn(|k| p[k] + step[k]));
+                }
+                max_squared
+            })
+            .reduce(|| 0.0f32, f32::max);
+        std::mem::swap(&mut ws.current, &mut ws.projected);
+        (max_move_squared as f64).sqrt()
+    }
+}
+
+/// A position padded to four lanes (the fourth is always 0) and aligned to 16 bytes, so that the
+/// kernels load and combine whole points with single vector instructions.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+#[repr(C, align(16))]
+pub struct Point4(pub [f32; 4]);
+
+impl super::boundary::CurvePoint for Point4 {
+    #[inline]
+    fn xyz(&self) -> [f32; 3] {
+        [self.0[0], self.0[1], self.0[2]]
+    }
+    #[inline]
+    fn from_xyz(p: [f32; 3]) -> Self {
+        Point4([p[0], p[1], p[2], 0.0])
+    }
+}
+
+/// A vertex's position and umbrella mean side by side (32 bytes, one half cache line).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+#[repr(C, align(32))]
+struct PositionAndMean {
+    position: [f32; 4],
+    mean: [f32; 4],
+}
+
+#[inline]
+fn umbrella_mean(x: &[Point4], ring: &[u32], inverse_valence: f32) -> Point4 {
+    let mut sum = [0.0f32; 4];
+    for &u in ring {
+        let p = x[u as usize].0;
+        for k in 0..4 {
+            sum[k] += p[k];
+        }
+    }
+    Point4(sum.map(|s| s * inverse_valence))
+}
+
+#[inline]
+fn dot4(a: [f32; 4], b: [f32; 4]) -> f32 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2] + a[3] * b[3]
+}
+
+/// Area-weighted normal (not normalised) of the closed fan (v, ring[k], ring[k+1]), fourth
+/// lane 0.
+#[inline]
+fn fan_normal(x: &[Point4], v: usize, ring: &[u32]) -> [f32; 4] {
+    let centre = x[v].0;
+    let relative = |u: u32| -> [f32; 4] { std::array::from_fn(|k| x[u as usize].0[k] - centre[k]) };
+    let mut normal = [0.0f32; 4];
+    let mut previous = relative(ring[ring.len() - 1]);
+    for &u in ring {
+        let current = relative(u);
+        normal[0] += previous[1] * current[2] - previous[2] * current[1];
+        normal[1] += previous[2] * current[0] - previous[0] * current[2];
+        normal[2] += previous[0] * current[1] - previous[1] * current[0];
+        previous = current;
+    }
+    normal
+}
+
+/// Writes v's neighbours in fan order (faces (v, fan[k], fan[k+1])) into `fan` when v has a closed,
+/// consistently oriented fan with as many faces as neighbours; returns whether it does.
+fn closed_fan(v: u32, topology: &Topology, triangles: &[[u32; 3]], fan: &mut [u32]) -> bool {
+    let faces = topology.faces_of(v);
+    if faces.len() < 3 || faces.len() != topology.valence(v) || faces.len() > 64 {
+        return false;
+    }
+    // Each face as the directed edge opposite v: (next after v, next after that).
+    let mut edge_buffer = [(0u32, 0u32); 64];
+    let edges = &mut edge_buffer[..faces.len()];
+    for (edge, &f) in edges.iter_mut().zip(faces) {
+        let t = triangles[f as usize];
+        let Some(r) = t.iter().position(|&c| c == v) else {
+            return false;
+        };
+        *edge = (t[(r + 1) % 3], t[(r + 2) % 3]);
+    }
+    let mut used = [false; 64];
+    let (first, mut current) = edges[0];
+    used[0] = true;
+    fan[0] = first;
+    let mut len = 1;
+    while current != first {
+        if len == fan.len() {
+            return false;
+        }
+        fan[len] = current;
+        len += 1;
+        let Some(next) = (0..edges.len()).find(|&e| !used[e] && edges[e].0 == current) else {
+            return false;
+        };
+        used[next] = true;
+        current = edges[next].1;
+    }
+    len == faces.len() && used[..edges.len()].iter().all(|&u| u)
+}
+
+/// `data` cut into the consecutive slices `offsets[v]..offsets[v + 1]`.
+fn split_by_offsets<'a, T>(data: &'a mut [T], offsets: &[u32]) -> Vec<&'a mut [T]> {
+    let mut slices = Vec::with_capacity(offsets.len().saturating_sub(1));
+    let mut rest = data;
+    for w in offsets.windows(2) {
+        let (head, tail) = std::mem::take(&mut rest).split_at_mut((w[1] - w[0]) as usize);
+        slices.push(head);
+        rest = tail;
+    }
+    slices
+}
+
+/// Constrained fairing of `mesh` in place (sections 3.2 and 3.3); `topology` must be built from
+/// `mesh`. Precomputes the operator (see [`ConstrainedFairing`] to reuse it) and runs
+/// `options.rounds` rounds of up to `options.iterations` iterations each.
+pub fn fair_constrained(
+    mesh: &mut TriMesh,
+    topology: &Topology,
+    options: &FairOptions,
+) -> FairReport {
+    if options.rounds == 0 || options.iterations == 0 || mesh.positions.is_empty() {
+        return FairReport::default();
+    }
+    let mut fairing = ConstrainedFairing::new(mesh, topology, options.variant, options.boundary);
+    fairing.run(&mut mesh.positions, options)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Small deterministic generator (xorshift) so the tests need no seeds from outside.
+    struct Rng(u64);
+    impl Rng {
+        fn next(&mut self) -> f64 {
+            self.0 ^= self.0 << 13;
+            self.0 ^= self.0 >> 7;
+            self.0 ^= self.0 << 17;
+            (self.0 >> 11) as f64 / (1u64 << 53) as f64
+        }
+        fn range(&mut self, lo: f64, hi: f64) -> f64 {
+            lo + (hi - lo) * self.next()
+        }
+    }
+
+    /// Solves the dense system `m·x = rhs` by Gaussian elimination with partial pivoting.
+    fn gauss_solve<const N: usize>(mut m: [[f64; N]; N], mut rhs: [f64; N]) -> [f64; N] {
+        for col in 0..N {
+            let pivot = (col..N)
+                .max_by(|&a, &b| m[a][col].abs().total_cmp(&m[b][col].abs()))
+                .unwrap();
+            m.swap(col, pivot);
+            rhs.swap(col, pivot);
+            for row in col + 1..N {
+                let factor = m[row][col] / m[col][col];
+                for k in col..N {
+                    m[row][k] -= factor * m[col][k];
+                }
+                rhs[row] -= factor * rhs[col];
+            }
+        }
+        let mut x = [0.0; N];
+        for row in (0..N).rev() {
+            let tail: f64 = (row + 1..N).map(|k| m[row][k] * x[k]).sum();
+            x[row] = (rhs[row] - tail) / m[row][row];
+        }
+        x
+    }
+
+    /// The KKT system of min ‖AP − Q‖² s.t. BP = C, one coordinate:
+    /// [2AᵀA Bᵀ; B 0]·[P; λ] = [2AᵀQ; C].
+    fn kkt_solve(a: &Matrix3, q: [f64; 3], c: f64) -> [f64; 3] {
+        let mut m = [[0.0; 4]; 4];
+        let mut rhs = [0.0; 4];
+        for r in 0..3 {
+            for s in 0..3 {
+                m[r][s] = 2.0 * (0..3).map(|k| a[k][r] * a[k][s]).sum::<f64>();
+            }
+            m[r][3] = 1.0;
+            m[3][r] = 1.0;
+            rhs[r] = 2.0 * (0..3).map(|k| a[k][r] * q[k]).sum::<f64>();
+        }
+        rhs[3] = c;
+        let x = gauss_solve(m, rhs);
+        [x[0], x[1], x[2]]
+    }
+
+    #[test]
+    fn eq7_matches_kkt_and_keeps_the_barycentre() {
+        let mut rng = Rng(0x9e3779b97f4a7c15);
+        for case in 0..2000 {
+            // Uniform weights from random valences, and every fourth case general weights
+            // (eq 7 holds for any invertible A).
+            let a = if case % 4 == 3 {
+                std::array::from_fn(|r| {
+                    std::array::from_fn(|c| if r == c { 1.0 } else { -rng.range(0.0, 0.45) })
+                })
+            } else {
+                let n = [0; 3].map(|_| 3 + (rng.next() * 12.0) as usize);
+                umbrella_local_matrix(n)
+            };
+            let op = LocalOperator::from_matrix(&a).expect("diagonally dominant");
+            let q: Matrix3 = std::array::from_fn(|_| std::array::from_fn(|_| rng.range(-5.0, 5.0)));
+            let c: [f64; 3] = std::array::from_fn(|_| rng.range(-5.0, 5.0));
+            let p = op.solve(&q, c);
+            for k in 0..3 {
+                let direct = kkt_solve(&a, [q[0][k], q[1][k], q[2][k]], c[k]);
+                let scale = direct.iter().fold(1.0f64, |m, x| m.max(x.abs()));
+                for r in 0..3 {
+                    let error = (p[r][k] - direct[r]).abs() / scale;
+                    assert!(error < 1e-9, "case {case}: relative error {error}");
+                }
+                let barycentre_error = (p[0][k] + p[1][k] + p[2][k] - c[k]).abs();
+                assert!(barycentre_error < 1e-12, "case {case}: {barycentre_error}");
+            }
+        }
+    }
+
+    #[test]
+    fn eq7_literal_form_equals_precomputed_form() {
+        // P = A⁻¹Q + A⁻¹A⁻ᵀBᵀ(C − BA⁻¹Q)/‖BA⁻¹‖², evaluated literally, one coordinate.
+        let n = [5, 6, 7];
+        let a = umbrella_local_matrix(n);
+        let inv = invert3(&a).unwrap();
+        let q = [0.3, -1.2, 2.5];
+        let c = 0.7;
+        let ainv_q: [f64; 3] = std::array::from_fn(|r| (0..3).map(|k| inv[r][k] * q[k]).sum());
+        let b_ainv: [f64; 3] = std::array::from_fn(|k| (0..3).map(|r| inv[r][k]).sum());
+        let norm2: f64 = b_ainv.iter().map(|x| x * x).sum();
+        let ainv_ainvt_bt: [f64; 3] =
+            std::array::from_fn(|r| (0..3).map(|k| inv[r][k] * b_ainv[k]).sum());
+        let residual = c - ainv_q.iter().sum::<f64>();
+        let literal: [f64; 3] =
+            std::array::from_fn(|r| ainv_q[r] + ainv_ainvt_bt[r] * residual / norm2);
+        let q3 = [[q[0], 0.0, 0.0], [q[1], 0.0, 0.0], [q[2], 0.0, 0.0]];
+        let p = LocalOperator::umbrella(n)
+            .unwrap()
+            .solve(&q3, [c, 0.0, 0.0]);
+        for r in 0..3 {
+            assert!((p[r][0] - literal[r]).abs() < 1e-14);
+        }
+    }
+
+    /// A small irregular closed mesh: an octahedron subdivided irregularly, with bumps.
+    fn irregular_sphere() -> TriMesh {
+        let mut positions: Vec<[f32; 3]> = vec![
+            [1.0, 0.0, 0.0],
+            [-1.0, 0.0, 0.0],
+            [0.0, 1.0, 0.0],
+            [0.0, -1.0, 0.0],
+            [0.0, 0.0, 1.0],
+            [0.0, 0.0, -1.0],
+        ];
+        let mut triangles: Vec<[u32; 3]> = vec![
+            [0, 2, 4],
+            [2, 1, 4],
+            [1, 3, 4],
+            [3, 0, 4],
+            [2, 0, 5],
+            [1, 2, 5],
+            [3, 1, 5],
+            [0, 3, 5],
+        ];
+        // Split some faces at their centre (1-to-3) to make valences irregular.
+        let mut rng = Rng(12345);
+        for round in 0..3 {
+            let count = triangles.len();
+            for f in (0..count).filter(|f| (f + round) % 2 == 0) {
+                let [a, b, c] = triangles[f];
+                let centre: [f32; 3] = std::array::from_fn(|k| {
+                    (positions[a as usize][k] + positions[b as usize][k] + positions[c as usize][k])
+                        / 3.0
+                });
+                let length = centre.iter().map(|x| x * x).sum::<f32>().sqrt();
+                let bump = 1.0 + 0.1 * rng.range(-1.0, 1.0) as f32;
+                positions.push(centre.map(|x| x / length * bump));
+                let m = positions.len() as u32 - 1;
+                triangles[f] = [a, b, m];
+                triangles.push([b, c, m]);
+                triangles.push([c, a, m]);
+            }
+        }
+        TriMesh::new(positions, triangles)
+    }
+
+    /// The paper's pseudocode, literally (scatter over triangles, f64), for comparison.
+    fn reference_iteration(
+        mesh: &TriMesh,
+        topology: &Topology,
+        anchors: &[[f32; 3]],
+    ) -> Vec<[f64; 3]> {
+        let point = |p: [f32; 3]| p.map(|x| x as f64);
+        let mut sums = vec![[0.0f64; 3]; mesh.positions.len()];
+        let mut counts = vec![0usize; mesh.positions.len()];
+        for t in &mesh.triangles {
+            if t.iter().any(|&c| topology.is_boundary_vertex(c)) {
+                continue;
+            }
+            let n = t.map(|c| topology.valence(c));
+            let op = LocalOperator::umbrella(n).unwrap();
+            let q: Matrix3 = std::array::from_fn(|r| {
+                let mut q = [0.0; 3];
+                for &u in topology.neighbors(t[r]) {
+                    if !t.contains(&u) {
+                        for k in 0..3 {
+                            q[k] += point(mesh.positions[u as usize])[k] / n[r] as f64;
+                        }
+                    }
+                }
+                q
+            });
+            let c: [f64; 3] =
+                std::array::from_fn(|k| t.iter().map(|&v| anchors[v as usize][k] as f64).sum());
+            let p = op.solve(&q, c);
+            for r in 0..3 {
+                for k in 0..3 {
+                    sums[t[r] as usize][k] += p[r][k];
+                }
+                counts[t[r] as usize] += 1;
+            }
+        }
+        sums.iter()
+            .zip(&counts)
+            .enumerate()
+            .map(|(v, (s, &n))| {
+                if n == 0 {
+                    point(mesh.positions[v])
+                } else {
+                    s.map(|x| x / n as f64)
+                }
+            })
+            .collect()
+    }
+
+    #[test]
+    fn fast_iteration_equals_the_papers_pseudocode() {
+        let mut mesh = irregular_sphere();
+        let topology = Topology::build(&mesh);
+        assert!(topology.is_closed());
+        let anchors = mesh.positions.clone();
+        let mut fairing =
+            ConstrainedFairing::new(&mesh, &topology, FairVariant::Paper, BoundaryMode::Curve);
+        fairing.load(&anchors);
+        for iteration in 0..5 {
+            let expected = reference_iteration(&mesh, &topology, &anchors);
+            fairing.step();
+            fairing.store(&mut mesh.positions);
+            for (v, (got, want)) in mesh.positions.iter().zip(&expected).enumerate() {
+                for k in 0..3 {
+                    assert!(
+                        (got[k] as f64 - want[k]).abs() < 1e-5,
+                        "iteration {iteration}, vertex {v}: {got:?} vs {want:?}"
+                    );
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn fan_order_follows_the_faces() {
+        let mesh = irregular_sphere();
+        let topology = Topology::build(&mesh);
+        for v in 0..mesh.positions.len() as u32 {
+            let mut fan = vec![0u32; topology.valence(v)];
+            assert!(
+                closed_fan(v, &topology, &mesh.triangles, &mut fan),
+                "closed manifold"
+            );
+            for k in 0..fan.len() {
+                let (a, b) = (fan[k], fan[(k + 1) % fan.len()]);
+                assert!(mesh.triangles.iter().any(
+                    |t| (0..3).any(|r| t[r] == v && t[(r + 1) % 3] == a && t[(r + 2) % 3] == b)
+                ));
+            }
+        }
+    }
+
+    #[test]
+    fn a_vertex_with_no_interior_triangle_keeps_its_position() {
+        // A fan of 6 triangles around a centre: every triangle touches the boundary, so the centre
+        // has no local solution and must stay (the pseudocode would move it to the origin).
+        let mut positions = vec![[0.3f32, 0.2, 0.5]];
+        for i in 0..6 {
+            let a = i as f32 / 6.0 * std::f32::consts::TAU;
+            positions.push([a.cos(), a.sin(), 0.0]);
+        }
+        let triangles = (0..6u32).map(|i| [0, 1 + i, 1 + (i + 1) % 6]).collect();
+        let mut mesh = TriMesh::new(positions, triangles);
+        let topology = Topology::build(&mesh);
+        for variant in [FairVariant::Paper, FairVariant::NormalProjected] {
+            let before = mesh.positions.clone();
+            fair_constrained(
+                &mut mesh,
+                &topology,
+                &FairOptions {
+                    boundary: BoundaryMode::Fixed,
+                    variant,
+                    ..Default::default()
+                },
+            );
+            assert_eq!(mesh.positions, before);
+        }
+    }
+}

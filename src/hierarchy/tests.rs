@@ -1,0 +1,229 @@
+//! Invariants of the hierarchy on small hand-built meshes.
+
+use super::*;
+use crate::mesh::{subdivide_loop, Topology};
+use crate::NoProgress;
+
+fn octahedron() -> TriMesh {
+    TriMesh::new(
+        vec![
+            [1., 0., 0.],
+            [-1., 0., 0.],
+            [0., 1., 0.],
+            [0., -1., 0.],
+            [0., 0., 1.],
+            [0., 0., -1.],
+        ],
+        vec![
+            [0, 2, 4],
+            [2, 1, 4],
+            [1, 3, 4],
+            [3, 0, 4],
+            [2, 0, 5],
+            [1, 2, 5],
+            [3, 1, 5],
+            [0, 3, 5],
+        ],
+    )
+}
+
+/// A sphere-like closed mesh: the octahedron subdivided `times` times, pushed onto the sphere.
+fn sphere(times: usize) -> TriMesh {
+    let mut mesh = octahedron();
+    for _ in 0..times {
+        mesh = subdivide_loop(&mesh);
+    }
+    for p in &mut mesh.positions {
+        let l = (p[0] * p[0] + p[1] * p[1] + p[2] * p[2]).sqrt();
+        *p = p.map(|c| c / l);
+    }
+    mesh
+}
+
+/// An open, gently curved grid of `n x n` quads, each split in two.
+fn grid(n: u32) -> TriMesh {
+    let mut positions = Vec::new();
+    for y in 0..=n {
+        for x in 0..=n {
+            let (fx, fy) = (x as f32 / n as f32, y as f32 / n as f32);
+            positions.push([fx, fy, 0.3 * (fx * 3.0).sin() * (fy * 2.0).cos()]);
+        }
+    }
+    let mut triangles = Vec::new();
+    let at = |x: u32, y: u32| y * (n + 1) + x;
+    for y in 0..n {
+        for x in 0..n {
+            triangles.push([at(x, y), at(x + 1, y), at(x + 1, y + 1)]);
+            triangles.push([at(x, y), at(x + 1, y + 1), at(x, y + 1)]);
+        }
+    }
+    TriMesh::new(positions, triangles)
+}
+
+fn check_levels(mesh: &TriMesh, options: &HierarchyOptions) -> Hierarchy {
+    let h = build_hierarchy(mesh, options, &mut NoProgress).unwrap();
+    let base = Topology::build(mesh);
+    assert!(h.level_count() > 1, "no level was built");
+    for level in 0..h.level_count() {
+        let m = h.level_mesh(level);
+        let topo = Topology::build(&m);
+        assert!(
+            topo.is_oriented_manifold(),
+            "level {level} is not an oriented manifold"
+        );
+        assert_eq!(
+            topo.euler_characteristic(),
+            base.euler_characteristic(),
+            "level {level}"
+        );
+        assert_eq!(
+            topo.boundary_loops.len(),
+            base.boundary_loops.len(),
+            "level {level}"
+        );
+        assert_eq!(m.face_count(), h.level_info(level).faces);
+        // Removed vertices are pairwise non-adjacent in the level they are removed from.
+        let removed_from = h.level_info(level + 1).vertices as u32;
+        if level + 1 < h.level_count() {
+            for c in h.collapses(level) {
+                assert!(topo.neighbors(c.vertex).iter().all(|&u| u < removed_from));
+                assert!(topo.neighbors(c.vertex).contains(&c.target));
+            }
+        }
+    }
+    h
+}
+
+#[test]
+fn closed_sphere_levels_stay_manifold_and_coarsen() {
+    let mesh = sphere(3);
+    let options = HierarchyOptions {
+        min_vertices: 10,
+        ..Default::default()
+    };
+    let h = check_levels(&mesh, &options);
+    assert!(h.level_info(h.coarsest_level()).vertices < 60);
+}
+
+#[test]
+fn open_grid_keeps_its_boundary_loop() {
+    let mesh = grid(12);
+    let h = check_levels(
+        &mesh,
+        &HierarchyOptions {
+            min_vertices: 8,
+            ..Default::default()
+        },
+    );
+    assert!(h.level_info(h.coarsest_level()).vertices < 40);
+    let kept = check_levels(
+        &mesh,
+        &HierarchyOptions {
+            min_vertices: 8,
+            keep_boundary: true,
+            ..Default::default()
+        },
+    );
+    let top = kept.level_mesh(kept.coarsest_level());
+    let topo = Topology::build(&top);
+    assert_eq!(
+        topo.boundary_loops[0].len(),
+        48,
+        "keep_boundary kept every boundary vertex"
+    );
+}
+
+#[test]
+fn cone_volume_is_six_times_each_collapse_volume_change() {
+    let mesh = sphere(3);
+    let h = build_hierarchy(&mesh, &HierarchyOptions::default(), &mut NoProgress).unwrap();
+    for level in 0..2 {
+        let mut positions = h.level_positions(level).to_vec();
+        positions.truncate(h.level_info(level).vertices);
+        let mut triangles = h.level_triangles(level);
+        for c in h.collapses(level).collect::<Vec<_>>() {
+            let before =
+                crate::metrics::signed_volume(&TriMesh::new(positions.clone(), triangles.clone()));
+            triangles.retain(|t| !(t.contains(&c.vertex) && t.contains(&c.target)));
+            for t in &mut triangles {
+                for x in t.iter_mut() {
+                    if *x == c.vertex {
+                        *x = c.target;
+                    }
+                }
+            }
+            let after =
+                crate::metrics::signed_volume(&TriMesh::new(positions.clone(), triangles.clone()));
+            let change = after - before;
+            assert!(
+                (6.0 * change + c.six_split_volume as f64).abs() < 1e-5,
+                "collapse {c:?}: 6 x volume change {} vs cone {}",
+                6.0 * change,
+                c.six_split_volume
+            );
+        }
+        let _ = &mut positions;
+    }
+}
+
+#[test]
+fn coarsen_to_top_and_refine_back_restores_m0() {
+    for mesh in [sphere(3), grid(10)] {
+        let h = build_hierarchy(&mesh, &HierarchyOptions::default(), &mut NoProgress).unwrap();
+        let mut cursor = LevelCursor::new(&h);
+        while cursor.coarsen(&h) {
+            assert_eq!(cursor.triangles, h.level_triangles(cursor.level));
+        }
+        assert_eq!(cursor.level, h.coarsest_level());
+        while cursor.refine(&h) {
+            assert_eq!(cursor.triangles, h.level_triangles(cursor.level));
+        }
+        let restored = cursor.original_triangles(&h);
+        let mut expected = vec![[0u32; 3]; mesh.face_count()];
+        for (f, t) in restored.iter().enumerate() {
+            expected[h.original_face(f as u32) as usize] = *t;
+        }
+        assert_eq!(expected, mesh.triangles);
+    }
+}
+
+#[test]
+fn refuses_non_manifold_input() {
+    let mesh = TriMesh::new(
+        vec![
+            [0., 0., 0.],
+            [1., 0., 0.],
+            [0., 1., 0.],
+            [0., -1., 0.],
+            [0., 0., 1.],
+        ],
+        vec![[0, 1, 2], [1, 0, 3], [0, 1, 4]],
+    );
+    let error = build_hierarchy(&mesh, &HierarchyOptions::default(), &mut NoProgress);
+    assert!(matches!(error, Err(HierarchyError::Unsupported(m)) if m.contains("2-manifold")));
+}
+
+#[test]
+fn tetrahedron_is_not_collapsed_and_cancel_stops() {
+    let tetra = TriMesh::new(
+        vec![[0., 0., 0.], [1., 0., 0.], [0., 1., 0.], [0., 0., 1.]],
+        vec![[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]],
+    );
+    let h = build_hierarchy(
+        &tetra,
+        &HierarchyOptions {
+            min_vertices: 0,
+            ..Default::default()
+        },
+        &mut NoProgress,
+    )
+    .unwrap();
+    assert_eq!(h.level_count(), 1);
+
+    let mesh = sphere(5);
+    let mut cancel = |_f: f32| false;
+    assert!(matches!(
+        build_hierarchy(&mesh, &HierarchyOptions::default(), &mut cancel),
+        Err(HierarchyError::Cancelled)
+    ));
+}
