@@ -207,7 +207,8 @@ pub enum JobResult {
     Hierarchy {
         document: u64,
         hierarchy: u64,
-        result: Result<Arc<Hierarchy>, HierarchyError>,
+        /// The hierarchy, and whether its M0 has the loaded mesh's triangles.
+        result: Result<(Arc<Hierarchy>, bool), HierarchyError>,
         elapsed: Duration,
     },
     Faired {

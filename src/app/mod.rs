@@ -441,8 +441,13 @@ impl App {
                 hierarchy_generation.is_current(generation)
             };
             let result =
-                hierarchy::build_hierarchy(&mesh, &HierarchyOptions::default(), &mut progress)
-                    .map(Arc::new);
+                hierarchy::build_hierarchy(&mesh, &HierarchyOptions::default(), &mut progress).map(
+                    |built| {
+                        // Compared here, not on the UI thread (millions of triangles).
+                        let matches = built.base_mesh().triangles == mesh.triangles;
+                        (Arc::new(built), matches)
+                    },
+                );
             let message = JobResult::Hierarchy {
                 document: document_generation,
                 hierarchy: generation,
@@ -677,6 +682,12 @@ impl App {
                             self.settings.last_dir = Some(dir.to_path_buf());
                         }
                         let loaded = *loaded;
+                        let previous = self.document.take();
+                        // Freeing a big mesh and its hierarchy takes tens of milliseconds:
+                        // not on the UI thread.
+                        if previous.is_some() {
+                            self.io.submit(move || drop(previous));
+                        }
                         self.document = Some(Document::new(
                             path,
                             generation,
@@ -710,14 +721,13 @@ impl App {
                     return;
                 };
                 match result {
-                    Ok(hierarchy) => {
+                    Ok((hierarchy, base_matches_original)) => {
                         let levels = (0..hierarchy.level_count())
                             .map(|l| hierarchy.level_info(l))
                             .collect::<Vec<_>>();
                         current.level = current.level.min(levels.len().saturating_sub(1));
                         current.hierarchy = HierarchyState::Ready {
-                            base_matches_original: hierarchy.base_mesh().triangles
-                                == current.original.triangles,
+                            base_matches_original,
                             hierarchy,
                             levels,
                             build_time: elapsed,
