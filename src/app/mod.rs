@@ -134,19 +134,22 @@ pub struct FrameStats {
     recent: VecDeque<Duration>,
     /// Longest frame while a background job was running.
     pub max_while_busy: Duration,
+    /// That frame split into applying results, uploading to the GPU, and drawing widgets.
+    pub max_while_busy_parts: [Duration; 3],
     pub frames: u64,
 }
 
 impl FrameStats {
     const WINDOW: usize = 240;
 
-    fn record(&mut self, elapsed: Duration, busy: bool) {
+    fn record(&mut self, elapsed: Duration, parts: [Duration; 3], busy: bool) {
         if self.recent.len() == Self::WINDOW {
             self.recent.pop_front();
         }
         self.recent.push_back(elapsed);
-        if busy {
-            self.max_while_busy = self.max_while_busy.max(elapsed);
+        if busy && elapsed > self.max_while_busy {
+            self.max_while_busy = elapsed;
+            self.max_while_busy_parts = parts;
         }
         self.frames += 1;
     }
@@ -165,6 +168,7 @@ impl FrameStats {
     }
     pub fn reset_busy_max(&mut self) {
         self.max_while_busy = Duration::ZERO;
+        self.max_while_busy_parts = [Duration::ZERO; 3];
     }
 }
 
@@ -990,21 +994,32 @@ impl eframe::App for App {
     fn ui(&mut self, ui: &mut egui::Ui, _frame: &mut eframe::Frame) {
         let started = Instant::now();
         let ctx = ui.ctx().clone();
+        // Busy at the start counts too: the frame that applies the last result is a working one.
+        let busy_before = self.busy();
         self.poll_results();
         self.handle_global_input(&ctx);
+        let results_done = Instant::now();
         // Upload before drawing, so the viewport draws what the panels describe.
         self.sync_viewport();
+        let upload_done = Instant::now();
         panels::show(self, ui);
         for command in std::mem::take(&mut self.commands) {
             self.apply(command);
         }
+        let widgets_done = Instant::now();
         self.sync_viewport();
+        let parts = [
+            results_done - started,
+            (upload_done - results_done) + widgets_done.elapsed(),
+            widgets_done - upload_done,
+        ];
         let busy = self.busy();
         if busy {
             // Progress bars move without input events.
             ctx.request_repaint_after(Duration::from_millis(50));
         }
-        self.frame_stats.record(started.elapsed(), busy);
+        self.frame_stats
+            .record(started.elapsed(), parts, busy || busy_before);
     }
 
     fn save(&mut self, storage: &mut dyn eframe::Storage) {

@@ -315,6 +315,15 @@ fn performance(app: &mut App, ui: &mut egui::Ui) {
                     ui.label("max while working");
                     ui.label(milliseconds(stats.max_while_busy));
                     ui.end_row();
+                    ui.label("  results / upload / widgets");
+                    let [results, upload, widgets] = stats.max_while_busy_parts;
+                    ui.label(format!(
+                        "{} / {} / {}",
+                        milliseconds(results),
+                        milliseconds(upload),
+                        milliseconds(widgets)
+                    ));
+                    ui.end_row();
                     ui.label("frames");
                     ui.label(stats.frames.to_string());
                     ui.end_row();
