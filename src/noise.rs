@@ -6,6 +6,7 @@
 //!   distance (the paper's "random direction" noise).
 //! - `Isotropic`: each coordinate gets independent N(0, sigma) noise.
 //! - `Normal`: each vertex moves along its area-weighted normal by a N(0, sigma) distance.
+//!
 //! The generator is PCG (rand_pcg::Pcg64Mcg) seeded with `seed`, drawn in vertex order, so a seed
 //! gives the same mesh on every machine and thread count.
 
