@@ -414,26 +414,7 @@ mod tests {
     use super::*;
 
     fn octahedron(scale: f32) -> TriMesh {
-        TriMesh::new(
-            vec![
-                [scale, 0., 0.],
-                [-scale, 0., 0.],
-                [0., scale, 0.],
-                [0., -scale, 0.],
-                [0., 0., scale],
-                [0., 0., -scale],
-            ],
-            vec![
-                [0, 2, 4],
-                [2, 1, 4],
-                [1, 3, 4],
-                [3, 0, 4],
-                [2, 0, 5],
-                [1, 2, 5],
-                [3, 1, 5],
-                [0, 3, 5],
-            ],
-        )
+        crate::mesh::fixtures::octahedron(scale)
     }
 
     #[test]

@@ -5,26 +5,7 @@ use crate::mesh::{subdivide_loop, Topology};
 use crate::NoProgress;
 
 fn octahedron() -> TriMesh {
-    TriMesh::new(
-        vec![
-            [1., 0., 0.],
-            [-1., 0., 0.],
-            [0., 1., 0.],
-            [0., -1., 0.],
-            [0., 0., 1.],
-            [0., 0., -1.],
-        ],
-        vec![
-            [0, 2, 4],
-            [2, 1, 4],
-            [1, 3, 4],
-            [3, 0, 4],
-            [2, 0, 5],
-            [1, 2, 5],
-            [3, 1, 5],
-            [0, 3, 5],
-        ],
-    )
+    crate::mesh::fixtures::octahedron(1.0)
 }
 
 /// A sphere-like closed mesh: the octahedron subdivided `times` times, pushed onto the sphere.
@@ -189,16 +170,7 @@ fn coarsen_to_top_and_refine_back_restores_m0() {
 
 #[test]
 fn refuses_non_manifold_input() {
-    let mesh = TriMesh::new(
-        vec![
-            [0., 0., 0.],
-            [1., 0., 0.],
-            [0., 1., 0.],
-            [0., -1., 0.],
-            [0., 0., 1.],
-        ],
-        vec![[0, 1, 2], [1, 0, 3], [0, 1, 4]],
-    );
+    let mesh = crate::mesh::fixtures::three_triangles_on_one_edge();
     let error = build_hierarchy(&mesh, &HierarchyOptions::default(), &mut NoProgress);
     assert!(matches!(error, Err(HierarchyError::Unsupported(m)) if m.contains("2-manifold")));
 }

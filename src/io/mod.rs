@@ -373,16 +373,7 @@ mod tests {
 
     #[test]
     fn finish_warns_about_non_manifold_edges() {
-        let mesh = TriMesh::new(
-            vec![
-                [0., 0., 0.],
-                [1., 0., 0.],
-                [0., 1., 0.],
-                [0., -1., 0.],
-                [0., 0., 1.],
-            ],
-            vec![[0, 1, 2], [1, 0, 3], [0, 1, 4]],
-        );
+        let mesh = crate::mesh::fixtures::three_triangles_on_one_edge();
         let loaded = finish(mesh, &LoadOptions::default());
         assert!(
             loaded

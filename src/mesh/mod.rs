@@ -8,6 +8,8 @@
 //!   output files keep the input's vertex order.
 
 mod clean;
+#[cfg(test)]
+pub(crate) mod fixtures;
 mod subdivide;
 mod topology;
 

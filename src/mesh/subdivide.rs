@@ -93,26 +93,7 @@ mod tests {
 
     #[test]
     fn subdivided_octahedron_is_a_closed_sphere_with_four_times_the_faces() {
-        let mesh = TriMesh::new(
-            vec![
-                [1., 0., 0.],
-                [-1., 0., 0.],
-                [0., 1., 0.],
-                [0., -1., 0.],
-                [0., 0., 1.],
-                [0., 0., -1.],
-            ],
-            vec![
-                [0, 2, 4],
-                [2, 1, 4],
-                [1, 3, 4],
-                [3, 0, 4],
-                [2, 0, 5],
-                [1, 2, 5],
-                [3, 1, 5],
-                [0, 3, 5],
-            ],
-        );
+        let mesh = crate::mesh::fixtures::octahedron(1.0);
         let fine = subdivide_loop(&mesh);
         assert_eq!(fine.face_count(), 32);
         assert_eq!(fine.vertex_count(), 6 + 12);

@@ -505,28 +505,8 @@ fn union(parent: &mut [u32], a: usize, b: usize) -> bool {
 mod tests {
     use super::*;
 
-    /// Octahedron: closed, genus 0, every vertex of valence 4.
-    pub(crate) fn octahedron() -> TriMesh {
-        TriMesh::new(
-            vec![
-                [1., 0., 0.],
-                [-1., 0., 0.],
-                [0., 1., 0.],
-                [0., -1., 0.],
-                [0., 0., 1.],
-                [0., 0., -1.],
-            ],
-            vec![
-                [0, 2, 4],
-                [2, 1, 4],
-                [1, 3, 4],
-                [3, 0, 4],
-                [2, 0, 5],
-                [1, 2, 5],
-                [3, 1, 5],
-                [0, 3, 5],
-            ],
-        )
+    fn octahedron() -> TriMesh {
+        crate::mesh::fixtures::octahedron(1.0)
     }
 
     #[test]
@@ -565,16 +545,7 @@ mod tests {
     #[test]
     fn finds_non_manifold_edge_and_vertex() {
         // Three triangles on one edge (0,1).
-        let mesh = TriMesh::new(
-            vec![
-                [0., 0., 0.],
-                [1., 0., 0.],
-                [0., 1., 0.],
-                [0., -1., 0.],
-                [0., 0., 1.],
-            ],
-            vec![[0, 1, 2], [1, 0, 3], [0, 1, 4]],
-        );
+        let mesh = crate::mesh::fixtures::three_triangles_on_one_edge();
         let topo = Topology::build(&mesh);
         assert_eq!(topo.non_manifold_edges, vec![[0, 1]]);
         assert!(!topo.is_manifold());
