@@ -80,7 +80,11 @@ fn fs_mesh(in: MeshOut, @builtin(front_facing) front: bool) -> @location(0) vec4
     }
     let key = max(dot(normal, u.light_dir.xyz), 0.0);
     let fill = max(dot(normal, to_eye), 0.0);
-    let shade = 0.08 + 0.72 * key + 0.25 * fill;
+    var shade = 0.08 + 0.72 * key + 0.25 * fill;
+    if (u.scalar_range.z > 0.5) {
+        // Flatter lighting for the heat map, so its colours read as the legend shows them.
+        shade = 0.55 + 0.3 * key + 0.2 * fill;
+    }
     return vec4<f32>(albedo * shade, 1.0);
 }
 

@@ -1334,13 +1334,7 @@ impl App {
         if let Some(reference) = wanted.heat {
             if let Some(scalars) = self.heat_scalars(wanted.what, reference) {
                 if viewport.is_none_or(|v| v.set_scalars(&scalars)) {
-                    heat_max = Some(
-                        scalars
-                            .iter()
-                            .copied()
-                            .filter(|d| d.is_finite())
-                            .fold(0.0f32, f32::max),
-                    );
+                    heat_max = Some(heat_map_top(&scalars));
                 }
             }
         }
@@ -1456,6 +1450,22 @@ impl App {
             self.settings.heat_map = !self.settings.heat_map;
         }
     }
+}
+
+/// The heat map's top: the 99th percentile of the distances, so a few outliers do not turn the
+/// rest of the mesh into the map's darkest colour (larger values take the top colour).
+fn heat_map_top(distances: &[f32]) -> f32 {
+    let mut finite: Vec<f32> = distances
+        .iter()
+        .copied()
+        .filter(|d| d.is_finite())
+        .collect();
+    if finite.is_empty() {
+        return 0.0;
+    }
+    let rank = ((finite.len() - 1) as f64 * 0.99).round() as usize;
+    let (_, value, _) = finite.select_nth_unstable_by(rank, f32::total_cmp);
+    value.max(0.0)
 }
 
 enum ExportTriangles {
