@@ -251,8 +251,8 @@ fn mesh_colour(image: &image::RgbaImage, x0: u32, x1: u32) -> [f64; 3] {
         for x in x0..x1.min(image.width()) {
             let p = image.get_pixel(x, y);
             if p.0[..3] != background.0[..3] {
-                for c in 0..3 {
-                    sum[c] += p.0[c] as f64;
+                for (total, value) in sum.iter_mut().zip(p.0) {
+                    *total += value as f64;
                 }
                 n += 1.0;
             }

@@ -837,7 +837,8 @@ fn tick_text(value: f64, spacing: f64) -> String {
     if value == 0.0 {
         return "0".into();
     }
-    if !(spacing > 0.0) || spacing < 1e-3 || spacing >= 1e5 {
+    // NaN, zero and negative spacings fall outside the range too.
+    if !(1e-3..1e5).contains(&spacing) {
         return format!("{value:.0e}");
     }
     let decimals = (-spacing.log10().floor()).max(0.0) as usize;
