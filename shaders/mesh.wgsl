@@ -1,6 +1,6 @@
 // fairmesh viewport shader: flat-shaded triangles (one normal per triangle, from the screen-space
 // derivatives of the world position, so positions are uploaded once and shared by all corners),
-// an optional per-vertex heat map, and a wireframe drawn as lines over the filled mesh.
+// an optional per-vertex heat map (viridis), and a wireframe drawn as lines over the filled mesh.
 
 struct Uniforms {
     view_proj: mat4x4<f32>,
@@ -31,13 +31,28 @@ fn vs_mesh(@location(0) position: vec3<f32>, @location(1) scalar: f32) -> MeshOu
     return out;
 }
 
-// Blue - cyan - green - yellow - red ramp for t in 0..1.
-fn heat(t: f32) -> vec3<f32> {
-    let x = clamp(t, 0.0, 1.0);
-    let r = clamp(1.5 - abs(4.0 * x - 3.0), 0.0, 1.0);
-    let g = clamp(1.5 - abs(4.0 * x - 2.0), 0.0, 1.0);
-    let b = clamp(1.5 - abs(4.0 * x - 1.0), 0.0, 1.0);
-    return vec3<f32>(r, g, b);
+// Viridis for t in 0..1: the ten sRGB key colours of `src/render/colormap.rs` (which the legend
+// uses), interpolated in sRGB as there, then made linear because the target is an sRGB format.
+fn viridis(t: f32) -> vec3<f32> {
+    var keys = array<vec3<f32>, 10>(
+        vec3<f32>(68.0, 1.0, 84.0),
+        vec3<f32>(72.0, 40.0, 120.0),
+        vec3<f32>(62.0, 74.0, 137.0),
+        vec3<f32>(49.0, 104.0, 142.0),
+        vec3<f32>(38.0, 130.0, 142.0),
+        vec3<f32>(31.0, 158.0, 137.0),
+        vec3<f32>(53.0, 183.0, 121.0),
+        vec3<f32>(109.0, 205.0, 89.0),
+        vec3<f32>(180.0, 222.0, 44.0),
+        vec3<f32>(253.0, 231.0, 37.0),
+    );
+    let x = clamp(t, 0.0, 1.0) * 9.0;
+    let i = min(u32(floor(x)), 8u);
+    let f = x - f32(i);
+    let srgb = mix(keys[i], keys[i + 1u], f) / 255.0;
+    let low = srgb / 12.92;
+    let high = pow((srgb + 0.055) / 1.055, vec3<f32>(2.4));
+    return select(high, low, srgb <= vec3<f32>(0.04045));
 }
 
 @fragment
@@ -57,7 +72,7 @@ fn fs_mesh(in: MeshOut, @builtin(front_facing) front: bool) -> @location(0) vec4
     var albedo = u.base_color.rgb;
     if (u.scalar_range.z > 0.5) {
         let span = max(u.scalar_range.y - u.scalar_range.x, 1e-20);
-        albedo = heat((in.scalar - u.scalar_range.x) / span);
+        albedo = viridis((in.scalar - u.scalar_range.x) / span);
     }
     if (!front) {
         // Back faces (holes, inverted patches) in a cooler, darker tone.
@@ -65,7 +80,11 @@ fn fs_mesh(in: MeshOut, @builtin(front_facing) front: bool) -> @location(0) vec4
     }
     let key = max(dot(normal, u.light_dir.xyz), 0.0);
     let fill = max(dot(normal, to_eye), 0.0);
-    let shade = 0.08 + 0.72 * key + 0.25 * fill;
+    var shade = 0.08 + 0.72 * key + 0.25 * fill;
+    if (u.scalar_range.z > 0.5) {
+        // Flatter lighting for the heat map, so its colours read as the legend shows them.
+        shade = 0.55 + 0.3 * key + 0.2 * fill;
+    }
     return vec4<f32>(albedo * shade, 1.0);
 }
 

@@ -22,7 +22,11 @@ pub struct History<T> {
 
 impl<T: SizeInBytes> History<T> {
     pub fn new(budget_bytes: usize) -> Self {
-        Self { undo: VecDeque::new(), redo: Vec::new(), budget_bytes }
+        Self {
+            undo: VecDeque::new(),
+            redo: Vec::new(),
+            budget_bytes,
+        }
     }
 
     /// Records `previous` (the state before a change named `label`) and forgets the redo stack.
@@ -78,7 +82,12 @@ impl<T: SizeInBytes> History<T> {
     }
 
     fn trim(&mut self) {
-        let mut total: usize = self.undo.iter().chain(self.redo.iter()).map(|(_, s)| s.size_in_bytes()).sum();
+        let mut total: usize = self
+            .undo
+            .iter()
+            .chain(self.redo.iter())
+            .map(|(_, s)| s.size_in_bytes())
+            .sum();
         while total > self.budget_bytes && self.undo.len() > 1 {
             if let Some((_, dropped)) = self.undo.pop_front() {
                 total -= dropped.size_in_bytes();
@@ -102,7 +111,10 @@ mod tests {
         let mut history = History::new(1 << 20);
         let mut current = vec![0u8];
         for step in 1..=3u8 {
-            history.record(format!("step {step}"), std::mem::replace(&mut current, vec![step]));
+            history.record(
+                format!("step {step}"),
+                std::mem::replace(&mut current, vec![step]),
+            );
         }
         assert_eq!(history.undo_label(), Some("step 3"));
         current = history.undo(current).unwrap();

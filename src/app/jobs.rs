@@ -20,6 +20,8 @@ use crate::hierarchy::{Hierarchy, HierarchyError};
 use crate::io::Loaded;
 use crate::TriMesh;
 
+use super::state::Measures;
+
 type Job = Box<dyn FnOnce() + Send + 'static>;
 
 struct Queued {
@@ -194,6 +196,10 @@ pub struct Faired {
     /// Root mean square of the vertex displacements against the loaded mesh (model units).
     pub rms_displacement: f64,
     pub elapsed: Duration,
+    /// The result measured against the document's mesh and against the clean mesh.
+    pub against_document: Option<Measures>,
+    pub against_clean: Option<Measures>,
+    pub measure_time: Duration,
 }
 
 /// A job's answer to the UI. Each carries the generation it was started under.
@@ -224,9 +230,24 @@ pub enum JobResult {
         level: usize,
         mesh: Arc<TriMesh>,
     },
+    /// Noise was added to a copy of the document's mesh.
+    Noised {
+        document: u64,
+        label: String,
+        noisy: Arc<TriMesh>,
+        clean: Arc<TriMesh>,
+        /// The noisy mesh against the clean one.
+        against_clean: Box<Measures>,
+    },
     Exported {
         path: PathBuf,
         result: Result<(), String>,
+        elapsed: Duration,
+    },
+    /// The level chain was written, one GLB per level.
+    LevelsExported {
+        folder: PathBuf,
+        result: Result<Vec<PathBuf>, String>,
         elapsed: Duration,
     },
     /// A file dialog closed; `None` when it was cancelled or no dialog could be shown.

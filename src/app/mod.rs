@@ -16,6 +16,7 @@
 //! one through their generation numbers.
 
 pub mod camera;
+pub mod history;
 pub mod jobs;
 pub mod panels;
 pub mod state;
@@ -31,10 +32,14 @@ use crate::multires::{self, MultiresWorkspace};
 use crate::{metrics, TriMesh};
 
 use camera::OrbitCamera;
+use history::History;
 use jobs::{
     DialogPurpose, Faired, Generation, JobCounter, JobResult, JobTicket, SharedProgress, Worker,
 };
-use state::{Document, FairedResult, HierarchyState, Settings, ViewMode};
+use state::{
+    CompareView, Document, DocumentSnapshot, FairedResult, HeatReference, HierarchyState, Measures,
+    Settings, ViewMode,
+};
 
 use crate::render::{DrawParams, Viewport3d};
 
@@ -100,6 +105,14 @@ pub enum Command {
     CancelHierarchy,
     RebuildHierarchy,
     DismissError,
+    /// Add noise (the settings' sigma, seed and mode) to the document's mesh.
+    AddNoise,
+    /// Make the faired result the document's mesh.
+    ApplyResult,
+    Undo,
+    Redo,
+    /// Write the levels of the hierarchy (the settings' range) as GLB files into a folder.
+    ExportLevels,
 }
 
 /// What the viewport has uploaded, to know when to upload again.
@@ -107,6 +120,16 @@ pub enum Command {
 struct Shown {
     document: u64,
     what: ShownMesh,
+    /// The heat map's reference, when the heat map is on.
+    heat: Option<HeatReference>,
+}
+
+/// The two viewports: the main one (the view mode's mesh: the result, a level, the original)
+/// and the "before" one (the document's mesh) for the toggle, split and side-by-side views.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Slot {
+    Main = 0,
+    Before = 1,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -216,8 +239,14 @@ pub struct App {
     dialog_open: bool,
     ctx: egui::Context,
     viewport: Option<Viewport3d>,
+    viewport_before: Option<Viewport3d>,
     camera: OrbitCamera,
     shown: Option<Shown>,
+    shown_before: Option<Shown>,
+    /// Largest heat-map scalar uploaded per slot (the legend's and the colour map's top).
+    heat_max: [Option<f32>; 2],
+    /// The single view shows "before" instead of "after" (toggled with B).
+    show_before: bool,
     shown_counts: (usize, usize),
     error: Option<String>,
     message: Option<String>,
@@ -228,7 +257,12 @@ pub struct App {
     frame_stats: FrameStats,
     /// Where the viewport was drawn in the last frame (points).
     viewport_rect: Option<egui::Rect>,
+    /// Earlier and later document states (noise, applied results, loading).
+    history: History<DocumentSnapshot>,
 }
+
+/// Memory the undo history may keep alive.
+const HISTORY_BUDGET_BYTES: usize = 1 << 30;
 
 impl App {
     /// The app as the window runs it: settings from eframe's storage when `persistence` is on.
@@ -269,8 +303,12 @@ impl App {
             dialog_open: false,
             ctx: cc.egui_ctx.clone(),
             viewport: cc.wgpu_render_state.as_ref().map(Viewport3d::new),
+            viewport_before: cc.wgpu_render_state.as_ref().map(Viewport3d::new),
             camera: OrbitCamera::default(),
             shown: None,
+            shown_before: None,
+            heat_max: [None; 2],
+            show_before: false,
             shown_counts: (0, 0),
             error: None,
             message: None,
@@ -279,6 +317,7 @@ impl App {
             next_serial: 0,
             frame_stats: FrameStats::default(),
             viewport_rect: None,
+            history: History::new(HISTORY_BUDGET_BYTES),
         };
         app.open(file);
         app
@@ -317,6 +356,16 @@ impl App {
         &self.settings
     }
 
+    /// Whether the single view shows "before" (the document's mesh) instead of the result.
+    pub fn showing_before(&self) -> bool {
+        self.show_before
+    }
+
+    /// The heat map's top value (the legend's range is 0 to this), while the heat map is shown.
+    pub fn heat_map_top(&self) -> Option<f32> {
+        self.heat_top()
+    }
+
     /// Where the 3D view was drawn in the last frame, in points.
     pub fn viewport_rect(&self) -> Option<egui::Rect> {
         self.viewport_rect
@@ -324,6 +373,46 @@ impl App {
 
     pub fn camera(&self) -> &OrbitCamera {
         &self.camera
+    }
+
+    /// The document's mesh (as loaded, noisy, or an applied result).
+    pub fn document_mesh(&self) -> Option<Arc<TriMesh>> {
+        self.document.as_ref().map(|d| d.original.clone())
+    }
+
+    /// The mesh kept from before noise was injected.
+    pub fn clean_mesh(&self) -> Option<Arc<TriMesh>> {
+        self.document.as_ref().and_then(|d| d.clean.clone())
+    }
+
+    /// Positions of the faired result on record.
+    pub fn faired_positions(&self) -> Option<Arc<Vec<[f32; 3]>>> {
+        self.document
+            .as_ref()
+            .and_then(|d| d.faired.as_ref())
+            .map(|f| f.positions.clone())
+    }
+
+    /// The faired result's numbers against the document mesh and against the clean mesh.
+    pub fn faired_measures(&self) -> (Option<Measures>, Option<Measures>) {
+        let faired = self.document.as_ref().and_then(|d| d.faired.as_ref());
+        (
+            faired.and_then(|f| f.against_document.clone()),
+            faired.and_then(|f| f.against_clean.clone()),
+        )
+    }
+
+    /// The document's mesh measured against the clean mesh (after noise).
+    pub fn noise_measures(&self) -> Option<Measures> {
+        self.document.as_ref().and_then(|d| d.against_clean.clone())
+    }
+
+    /// Labels of what undo and redo would do now.
+    pub fn undo_redo_labels(&self) -> (Option<String>, Option<String>) {
+        (
+            self.history.undo_label().map(str::to_owned),
+            self.history.redo_label().map(str::to_owned),
+        )
     }
 
     pub fn status(&self) -> AppStatus {
@@ -392,6 +481,134 @@ impl App {
             }
             Command::RebuildHierarchy => self.start_hierarchy(),
             Command::DismissError => self.error = None,
+            Command::AddNoise => self.add_noise(),
+            Command::ApplyResult => self.apply_faired_result(),
+            Command::Undo => self.undo(),
+            Command::Redo => self.redo(),
+            Command::ExportLevels => self.export_levels(),
+        }
+    }
+
+    /// Makes `snapshot` the document. With `record`, the current document goes on the undo
+    /// stack under that label first. Jobs of the replaced document become stale; the hierarchy
+    /// is rebuilt unless the snapshot kept one.
+    fn install(&mut self, snapshot: DocumentSnapshot, record: Option<String>) {
+        if let (Some(label), Some(current)) = (record, &self.document) {
+            self.history.record(label, current.snapshot());
+        }
+        let previous = self.document.take();
+        // Freeing a big mesh and its hierarchy takes tens of milliseconds: not on the UI thread
+        // (what the history keeps is shared, so this frees only what nobody else holds).
+        if previous.is_some() {
+            self.io.submit(move || drop(previous));
+        }
+        let generation = self.document_generation.bump();
+        let document = Document::from_snapshot(snapshot, generation);
+        let needs_build = matches!(document.hierarchy, HierarchyState::Building);
+        self.document = Some(document);
+        self.applied_view = 0;
+        self.applied_level_view = 0;
+        self.fair_in_flight = false;
+        if needs_build {
+            self.start_hierarchy();
+        } else {
+            // Whatever was building belonged to the document just replaced.
+            self.hierarchy_generation.bump();
+            self.refresh_view();
+        }
+    }
+
+    /// Adds noise to a copy of the document's mesh on the io worker (see `JobResult::Noised`).
+    fn add_noise(&mut self) {
+        let Some(document) = &self.document else {
+            self.error = Some("Nothing to add noise to: no mesh is loaded".into());
+            return;
+        };
+        let options = self.settings.noise_options();
+        if options.sigma <= 0.0 {
+            self.error = Some("Noise: sigma must be above 0".into());
+            return;
+        }
+        let mesh = document.original.clone();
+        let clean = document.clean.clone().unwrap_or_else(|| mesh.clone());
+        let document = document.generation;
+        let document_generation = self.document_generation.clone();
+        let label = format!(
+            "Noise σ {} × edge, seed {}, {:?}",
+            options.sigma, options.seed, options.mode
+        );
+        self.message = Some(format!("Adding noise ({label}) …"));
+        let (tx, ctx, ticket) = (self.results_tx.clone(), self.ctx.clone(), self.jobs.start());
+        self.io.submit(move || {
+            if !document_generation.is_current(document) {
+                return;
+            }
+            let mut noisy = mesh.as_ref().clone();
+            crate::noise::add_noise(&mut noisy, &options);
+            let against_clean = Box::new(Measures::of(&clean, &noisy));
+            let message = JobResult::Noised {
+                document,
+                label,
+                noisy: Arc::new(noisy),
+                clean,
+                against_clean,
+            };
+            Self::send_result(&tx, &ctx, message, ticket);
+        });
+    }
+
+    /// "Apply": the faired result becomes the document's mesh (undoable).
+    fn apply_faired_result(&mut self) {
+        let Some(document) = &self.document else {
+            return;
+        };
+        let Some(faired) = &document.faired else {
+            self.error = Some("Nothing to apply: no faired result yet".into());
+            return;
+        };
+        let triangles = match &document.hierarchy {
+            HierarchyState::Ready { hierarchy, .. } => hierarchy.base_mesh().triangles.clone(),
+            _ => document.original.triangles.clone(),
+        };
+        if triangles
+            .iter()
+            .flatten()
+            .any(|&c| c as usize >= faired.positions.len())
+        {
+            self.error = Some("The faired result does not fit the mesh".into());
+            return;
+        }
+        let label = format!("Apply result (faired from M{})", faired.level);
+        let mut snapshot = document.snapshot();
+        snapshot.mesh = Arc::new(TriMesh {
+            positions: faired.positions.as_ref().clone(),
+            triangles,
+        });
+        snapshot.against_clean = faired.against_clean.clone();
+        snapshot.hierarchy = None;
+        self.install(snapshot, Some(label.clone()));
+        self.message = Some(format!("{label}: the result is now the document"));
+    }
+
+    fn undo(&mut self) {
+        let Some(current) = self.document.as_ref().map(Document::snapshot) else {
+            return;
+        };
+        let label = self.history.undo_label().map(str::to_owned);
+        if let (Ok(previous), Some(label)) = (self.history.undo(current), label) {
+            self.install(previous, None);
+            self.message = Some(format!("Undone: {label}"));
+        }
+    }
+
+    fn redo(&mut self) {
+        let Some(current) = self.document.as_ref().map(Document::snapshot) else {
+            return;
+        };
+        let label = self.history.redo_label().map(str::to_owned);
+        if let (Ok(next), Some(label)) = (self.history.redo(current), label) {
+            self.install(next, None);
+            self.message = Some(format!("Redone: {label}"));
         }
     }
 
@@ -490,9 +707,11 @@ impl App {
         view: u64,
     ) {
         let options = self.settings.multires_options(level);
+        let baseline = self.settings.baseline_options();
         let document_generation = self.document_generation.clone();
         let progress_out = self.fair_progress.clone();
         let workspace = self.workspace.clone();
+        let clean = self.document.as_ref().and_then(|d| d.clean.clone());
         let (tx, ctx, ticket) = (self.results_tx.clone(), self.ctx.clone(), self.jobs.start());
         self.fair_in_flight = true;
         self.fair_progress.set(0.0);
@@ -507,18 +726,42 @@ impl App {
                 progress_out.set(fraction);
                 document_generation.is_current(document)
             };
-            let mut workspace = workspace.lock().unwrap_or_else(PoisonError::into_inner);
-            let positions =
-                multires::fair_multires(&hierarchy, &options, &mut workspace, &mut progress);
-            drop(workspace);
+            let positions = match &baseline {
+                // A baseline smooths the document's mesh itself; the level does not apply.
+                Some(method) => {
+                    let mut mesh = hierarchy.base_mesh().clone();
+                    let topology = crate::Topology::build(&mesh);
+                    crate::fairing::fair(&mut mesh, &topology, method);
+                    progress(1.0);
+                    Some(mesh.positions)
+                }
+                None => {
+                    let mut workspace = workspace.lock().unwrap_or_else(PoisonError::into_inner);
+                    multires::fair_multires(&hierarchy, &options, &mut workspace, &mut progress)
+                }
+            };
             let result = positions.map(|positions| {
                 let base = hierarchy.base_mesh();
                 let (volume_change, rms_displacement) = compare_to_base(base, &positions);
-                Faired {
+                let elapsed = started.elapsed();
+                let measuring = Instant::now();
+                let faired = TriMesh {
                     positions,
+                    triangles: base.triangles.clone(),
+                };
+                let against_document = Measures::of(base, &faired);
+                let against_clean = clean
+                    .as_deref()
+                    .filter(|_| document_generation.is_current(document))
+                    .map(|clean| Measures::of(clean, &faired));
+                Faired {
+                    positions: faired.positions,
                     volume_change,
                     rms_displacement,
-                    elapsed: started.elapsed(),
+                    elapsed,
+                    against_document: Some(against_document),
+                    against_clean,
+                    measure_time: measuring.elapsed(),
                 }
             });
             let message = JobResult::Faired {
@@ -590,6 +833,67 @@ impl App {
             let result = crate::io::save(&path, &mesh).map_err(|error| error.to_string());
             let message = JobResult::Exported {
                 path,
+                result,
+                elapsed: started.elapsed(),
+            };
+            Self::send_result(&tx, &ctx, message, ticket);
+        });
+    }
+
+    /// The folder the level chain goes to: the typed one, or `<stem>_levels` next to the file.
+    pub fn levels_folder(&self) -> Option<PathBuf> {
+        let typed = self.settings.levels_folder.trim();
+        if !typed.is_empty() {
+            return Some(PathBuf::from(typed));
+        }
+        let path = &self.document.as_ref()?.path;
+        let stem = path.file_stem()?.to_string_lossy().into_owned();
+        Some(path.with_file_name(format!("{stem}_levels")))
+    }
+
+    /// Writes levels `levels_from..=levels_to` as `<stem>_L<level>.glb` on the io worker.
+    fn export_levels(&mut self) {
+        let Some(document) = &self.document else {
+            self.error = Some("Nothing to export: no mesh is loaded".into());
+            return;
+        };
+        let HierarchyState::Ready { hierarchy, .. } = &document.hierarchy else {
+            self.error = Some("Export levels: the hierarchy is not built yet".into());
+            return;
+        };
+        let Some(folder) = self.levels_folder() else {
+            self.error = Some("Export levels: type a folder first".into());
+            return;
+        };
+        let hierarchy = hierarchy.clone();
+        let top = hierarchy.level_count().saturating_sub(1);
+        let to = self.settings.levels_to.min(top);
+        let from = self.settings.levels_from.min(to);
+        let stem = document
+            .path
+            .file_stem()
+            .map_or_else(|| "mesh".to_owned(), |s| s.to_string_lossy().into_owned());
+        self.message = Some(format!(
+            "Exporting levels M{from} … M{to} to {} …",
+            folder.display()
+        ));
+        let (tx, ctx, ticket) = (self.results_tx.clone(), self.ctx.clone(), self.jobs.start());
+        self.io.submit(move || {
+            let started = Instant::now();
+            let result = std::fs::create_dir_all(&folder)
+                .map_err(|error| format!("cannot create {}: {error}", folder.display()))
+                .and_then(|()| {
+                    (from..=to)
+                        .map(|level| {
+                            let path = folder.join(format!("{stem}_L{level:02}.glb"));
+                            crate::io::save(&path, &hierarchy.level_mesh(level))
+                                .map(|()| path)
+                                .map_err(|error| error.to_string())
+                        })
+                        .collect::<Result<Vec<_>, _>>()
+                });
+            let message = JobResult::LevelsExported {
+                folder,
                 result,
                 elapsed: started.elapsed(),
             };
@@ -681,30 +985,28 @@ impl App {
                 self.loading = None;
                 match result {
                     Ok(loaded) => {
-                        let generation = self.document_generation.bump();
                         if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
                             self.settings.last_dir = Some(dir.to_path_buf());
                         }
                         let loaded = *loaded;
-                        let previous = self.document.take();
-                        // Freeing a big mesh and its hierarchy takes tens of milliseconds:
-                        // not on the UI thread.
-                        if previous.is_some() {
-                            self.io.submit(move || drop(previous));
-                        }
-                        self.document = Some(Document::new(
+                        let name = path
+                            .file_name()
+                            .map(|n| n.to_string_lossy().into_owned())
+                            .unwrap_or_else(|| path.display().to_string());
+                        let snapshot = DocumentSnapshot {
+                            export_path: state::default_export_path(&path).display().to_string(),
                             path,
-                            generation,
-                            loaded.mesh,
-                            loaded.report,
-                            elapsed,
-                        ));
-                        self.applied_view = 0;
-                        self.applied_level_view = 0;
-                        self.fair_in_flight = false;
+                            mesh: Arc::new(loaded.mesh),
+                            clean: None,
+                            against_clean: None,
+                            report: loaded.report,
+                            load_time: elapsed,
+                            level: 0,
+                            hierarchy: None,
+                        };
+                        self.install(snapshot, Some(format!("Open {name}")));
                         self.error = None;
                         self.fit_view();
-                        self.start_hierarchy();
                     }
                     Err(error) => {
                         self.error = Some(format!("Could not open the file: {error}"));
@@ -775,6 +1077,9 @@ impl App {
                         rms_displacement: faired.rms_displacement,
                         elapsed: faired.elapsed,
                         serial: self.next_serial,
+                        against_document: faired.against_document,
+                        against_clean: faired.against_clean,
+                        measure_time: faired.measure_time,
                     });
                 }
             }
@@ -794,6 +1099,27 @@ impl App {
                 self.applied_level_view = view;
                 current.level_mesh = Some((level, mesh));
             }
+            JobResult::Noised {
+                document,
+                label,
+                noisy,
+                clean,
+                against_clean,
+            } => {
+                let Some(current) = self.document.as_ref().filter(|d| d.generation == document)
+                else {
+                    return;
+                };
+                let mut snapshot = current.snapshot();
+                snapshot.mesh = noisy;
+                snapshot.clean = Some(clean);
+                snapshot.against_clean = Some(*against_clean);
+                snapshot.hierarchy = None;
+                self.install(snapshot, Some(label.clone()));
+                self.message = Some(format!(
+                    "{label}: the mesh before the noise is kept as the clean reference"
+                ));
+            }
             JobResult::Exported {
                 path,
                 result,
@@ -812,6 +1138,24 @@ impl App {
                 Err(error) => {
                     self.message = None;
                     self.error = Some(format!("Export failed: {error}"));
+                }
+            },
+            JobResult::LevelsExported {
+                folder,
+                result,
+                elapsed,
+            } => match result {
+                Ok(paths) => {
+                    self.message = Some(format!(
+                        "Exported {} levels to {} ({:.2} s)",
+                        paths.len(),
+                        folder.display(),
+                        elapsed.as_secs_f64()
+                    ));
+                }
+                Err(error) => {
+                    self.message = None;
+                    self.error = Some(format!("Level export failed: {error}"));
                 }
             },
             JobResult::DialogPicked { purpose, path } => {
@@ -836,10 +1180,36 @@ impl App {
 
     // ---- viewport -------------------------------------------------------------------------
 
-    /// What the viewport should show now: the view mode's mesh when it exists, otherwise the
-    /// last good mesh of this document, otherwise the loaded mesh.
-    fn wanted_mesh(&self) -> Option<Shown> {
+    /// The heat map's reference now: `None` when it is off; the clean mesh only when there is one.
+    fn heat_reference(&self) -> Option<HeatReference> {
+        if !self.settings.heat_map {
+            return None;
+        }
+        let has_clean = self.document.as_ref().is_some_and(|d| d.clean.is_some());
+        Some(match self.settings.heat_reference {
+            HeatReference::Clean if has_clean => HeatReference::Clean,
+            _ => HeatReference::Document,
+        })
+    }
+
+    /// Whether the before viewport is on screen.
+    fn before_needed(&self) -> bool {
+        self.settings.compare != CompareView::Single || self.show_before
+    }
+
+    /// What a viewport should show now: for the main one the view mode's mesh when it exists,
+    /// otherwise the last good mesh of this document, otherwise the loaded mesh; for the before
+    /// one the document's mesh.
+    fn wanted_mesh(&self, slot: Slot) -> Option<Shown> {
         let document = self.document.as_ref()?;
+        let heat = self.heat_reference();
+        if slot == Slot::Before {
+            return Some(Shown {
+                document: document.generation,
+                what: ShownMesh::Original,
+                heat,
+            });
+        }
         let previous = self
             .shown
             .filter(|s| s.document == document.generation)
@@ -860,69 +1230,151 @@ impl App {
         Some(Shown {
             document: document.generation,
             what,
+            heat,
         })
     }
 
-    /// Uploads the wanted mesh when it differs from the one on the GPU.
+    /// Distance of each vertex of `what` from the heat map's reference (`None`: no heat map for
+    /// that mesh, as for level meshes, or not computed yet).
+    fn heat_scalars(&self, what: ShownMesh, reference: HeatReference) -> Option<Arc<Vec<f32>>> {
+        let document = self.document.as_ref()?;
+        match what {
+            ShownMesh::Faired { .. } => {
+                let faired = document.faired.as_ref()?;
+                let measures = match reference {
+                    HeatReference::Clean => faired.against_clean.as_ref(),
+                    HeatReference::Document => faired.against_document.as_ref(),
+                }?;
+                Some(measures.vertex_distances.clone())
+            }
+            ShownMesh::Original => match reference {
+                HeatReference::Clean => document
+                    .against_clean
+                    .as_ref()
+                    .map(|m| m.vertex_distances.clone()),
+                // The document's mesh is its own reference: zero everywhere.
+                HeatReference::Document => {
+                    Some(Arc::new(vec![0.0; document.original.vertex_count()]))
+                }
+            },
+            ShownMesh::Level { .. } => None,
+        }
+    }
+
     fn sync_viewport(&mut self) {
-        let Some(wanted) = self.wanted_mesh() else {
+        self.sync_slot(Slot::Main);
+        if self.before_needed() {
+            self.sync_slot(Slot::Before);
+        }
+    }
+
+    /// Uploads the wanted mesh (and heat-map scalars) when they differ from what is on the GPU.
+    fn sync_slot(&mut self, slot: Slot) {
+        let Some(wanted) = self.wanted_mesh(slot) else {
             return;
         };
-        if self.shown == Some(wanted) {
+        let shown = match slot {
+            Slot::Main => self.shown,
+            Slot::Before => self.shown_before,
+        };
+        if shown == Some(wanted) {
             return;
         }
         let Some(document) = &self.document else {
             return;
         };
-        let base = match &document.hierarchy {
-            HierarchyState::Ready {
-                hierarchy,
-                base_matches_original,
-                ..
-            } => Some((hierarchy.clone(), *base_matches_original)),
-            _ => None,
+        let viewport = match slot {
+            Slot::Main => self.viewport.as_ref(),
+            Slot::Before => self.viewport_before.as_ref(),
         };
-        let matches = base.as_ref().is_none_or(|b| b.1);
-        let same_connectivity = self.shown.is_some_and(|shown| {
-            shown.document == wanted.document
-                && shown.what.connectivity(matches) == wanted.what.connectivity(matches)
-        });
-        let (positions, triangles): (&[[f32; 3]], &[[u32; 3]]) = match wanted.what {
-            ShownMesh::Original => (&document.original.positions, &document.original.triangles),
-            ShownMesh::Faired { .. } => {
-                let Some(faired) = &document.faired else {
-                    return;
-                };
-                let triangles = match &base {
-                    Some((hierarchy, false)) => &hierarchy.base_mesh().triangles,
-                    _ => &document.original.triangles,
-                };
-                (&faired.positions, triangles)
+        let mesh_changed =
+            shown.is_none_or(|s| (s.document, s.what) != (wanted.document, wanted.what));
+        let mut counts = None;
+        if mesh_changed {
+            let base = match &document.hierarchy {
+                HierarchyState::Ready {
+                    hierarchy,
+                    base_matches_original,
+                    ..
+                } => Some((hierarchy.clone(), *base_matches_original)),
+                _ => None,
+            };
+            let matches = base.as_ref().is_none_or(|b| b.1);
+            let same_connectivity = shown.is_some_and(|shown| {
+                shown.document == wanted.document
+                    && shown.what.connectivity(matches) == wanted.what.connectivity(matches)
+            });
+            let (positions, triangles): (&[[f32; 3]], &[[u32; 3]]) = match wanted.what {
+                ShownMesh::Original => (&document.original.positions, &document.original.triangles),
+                ShownMesh::Faired { .. } => {
+                    let Some(faired) = &document.faired else {
+                        return;
+                    };
+                    let triangles = match &base {
+                        Some((hierarchy, false)) => &hierarchy.base_mesh().triangles,
+                        _ => &document.original.triangles,
+                    };
+                    (&faired.positions, triangles)
+                }
+                ShownMesh::Level { .. } => {
+                    let Some((_, mesh)) = &document.level_mesh else {
+                        return;
+                    };
+                    (&mesh.positions, &mesh.triangles)
+                }
+            };
+            if let Some(viewport) = viewport {
+                if !(same_connectivity && viewport.set_positions(positions)) {
+                    viewport.set_mesh(positions, triangles, None);
+                }
             }
-            ShownMesh::Level { .. } => {
-                let Some((_, mesh)) = &document.level_mesh else {
-                    return;
-                };
-                (&mesh.positions, &mesh.triangles)
-            }
-        };
-        if let Some(viewport) = &self.viewport {
-            if !(same_connectivity && viewport.set_positions(positions)) {
-                viewport.set_mesh(positions, triangles, None);
+            counts = Some((positions.len(), triangles.len()));
+        }
+        let mut heat_max = None;
+        if let Some(reference) = wanted.heat {
+            if let Some(scalars) = self.heat_scalars(wanted.what, reference) {
+                if viewport.is_none_or(|v| v.set_scalars(&scalars)) {
+                    heat_max = Some(heat_map_top(&scalars));
+                }
             }
         }
-        self.shown_counts = (positions.len(), triangles.len());
-        self.shown = Some(wanted);
+        self.heat_max[slot as usize] = heat_max;
+        match slot {
+            Slot::Main => {
+                if let Some(counts) = counts {
+                    self.shown_counts = counts;
+                }
+                self.shown = Some(wanted);
+            }
+            Slot::Before => self.shown_before = Some(wanted),
+        }
     }
 
-    fn draw_params(&self, rect: egui::Rect) -> DrawParams {
+    /// The heat map's top value for the slots on screen (shared, so the colours compare).
+    fn heat_top(&self) -> Option<f32> {
+        self.heat_reference()?;
+        let main = self.heat_max[Slot::Main as usize];
+        let before = self
+            .before_needed()
+            .then(|| self.heat_max[Slot::Before as usize])
+            .flatten();
+        match (main, before) {
+            (Some(a), Some(b)) => Some(a.max(b)),
+            (a, b) => a.or(b),
+        }
+        .map(|top| top.max(f32::MIN_POSITIVE))
+    }
+
+    fn draw_params(&self, rect: egui::Rect, slot: Slot) -> DrawParams {
         let aspect = rect.width() / rect.height().max(1.0);
+        let top = self.heat_top();
+        let scalar_range = self.heat_max[slot as usize].and(top).map(|top| [0.0, top]);
         DrawParams {
             view_proj: self.camera.view_proj(aspect).to_cols_array_2d(),
             eye: self.camera.eye().to_array(),
             light_dir: self.camera.light_dir().to_array(),
             wireframe: self.settings.wireframe,
-            scalar_range: None,
+            scalar_range,
             size: [0, 0],
         }
     }
@@ -939,13 +1391,50 @@ impl App {
         if let Some(path) = dropped.into_iter().next() {
             self.commands.push(Command::Open(path));
         }
-        if ctx.egui_wants_keyboard_input() {
+        // Shortcuts work unless a text field has the keyboard (it has its own undo, and typing
+        // an F or a W must not fit the view or toggle the wireframe).
+        let text_focus = ctx.text_edit_focused();
+        let (undo, redo) = ctx.input(|i| {
+            let command = i.modifiers.command;
+            (
+                command && !i.modifiers.shift && i.key_pressed(egui::Key::Z),
+                command
+                    && ((i.modifiers.shift && i.key_pressed(egui::Key::Z))
+                        || i.key_pressed(egui::Key::Y)),
+            )
+        });
+        let (open, export) = ctx.input(|i| {
+            let command_only = i.modifiers.command && !i.modifiers.shift && !i.modifiers.alt;
+            (
+                command_only && i.key_pressed(egui::Key::O),
+                command_only && i.key_pressed(egui::Key::E),
+            )
+        });
+        if open {
+            self.commands.push(Command::OpenDialog);
+        }
+        if export {
+            if let Some(document) = &self.document {
+                let path = PathBuf::from(document.export_path.trim());
+                self.commands.push(Command::Export(path));
+            }
+        }
+        if !text_focus && undo {
+            self.commands.push(Command::Undo);
+        }
+        if !text_focus && redo {
+            self.commands.push(Command::Redo);
+        }
+        if text_focus {
             return;
         }
-        let (fit, wire) = ctx.input(|i| {
+        let plain = |i: &egui::InputState, key| i.key_pressed(key) && i.modifiers.is_none();
+        let (fit, wire, before, heat) = ctx.input(|i| {
             (
-                i.key_pressed(egui::Key::F) && i.modifiers.is_none(),
-                i.key_pressed(egui::Key::W) && i.modifiers.is_none(),
+                plain(i, egui::Key::F),
+                plain(i, egui::Key::W),
+                plain(i, egui::Key::B),
+                plain(i, egui::Key::H),
             )
         });
         if fit {
@@ -954,7 +1443,29 @@ impl App {
         if wire {
             self.settings.wireframe = !self.settings.wireframe;
         }
+        if before {
+            self.show_before = !self.show_before;
+        }
+        if heat {
+            self.settings.heat_map = !self.settings.heat_map;
+        }
     }
+}
+
+/// The heat map's top: the 99th percentile of the distances, so a few outliers do not turn the
+/// rest of the mesh into the map's darkest colour (larger values take the top colour).
+fn heat_map_top(distances: &[f32]) -> f32 {
+    let mut finite: Vec<f32> = distances
+        .iter()
+        .copied()
+        .filter(|d| d.is_finite())
+        .collect();
+    if finite.is_empty() {
+        return 0.0;
+    }
+    let rank = ((finite.len() - 1) as f64 * 0.99).round() as usize;
+    let (_, value, _) = finite.select_nth_unstable_by(rank, f32::total_cmp);
+    value.max(0.0)
 }
 
 enum ExportTriangles {

@@ -5,8 +5,13 @@
 
 use std::path::PathBuf;
 
-use super::state::{BoundarySetting, HierarchyState, VariantSetting, ViewMode};
-use super::{App, Command};
+use super::state::{
+    BoundarySetting, CompareView, HeatReference, HierarchyState, Measures, MethodSetting,
+    VariantSetting, ViewMode,
+};
+use super::{App, Command, Slot};
+use crate::noise::NoiseMode;
+use crate::render::colormap::{legend_ticks, viridis_strip};
 
 pub fn show(app: &mut App, ui: &mut egui::Ui) {
     egui::Panel::top("fairmesh-toolbar").show(ui, |ui| toolbar(app, ui));
@@ -24,7 +29,7 @@ fn toolbar(app: &mut App, ui: &mut egui::Ui) {
     ui.horizontal(|ui| {
         if ui
             .button("Open…")
-            .on_hover_text("Pick a mesh file")
+            .on_hover_text("Pick a mesh file (Ctrl+O)")
             .clicked()
         {
             app.commands.push(Command::OpenDialog);
@@ -47,10 +52,15 @@ fn toolbar(app: &mut App, ui: &mut egui::Ui) {
             }
         }
         ui.separator();
-        if ui.button("Fit view (F)").clicked() {
+        if ui
+            .button("Fit view (F)")
+            .on_hover_text("Fit the mesh into the view (F)")
+            .clicked()
+        {
             app.commands.push(Command::FitView);
         }
-        ui.checkbox(&mut app.settings.wireframe, "Wireframe (W)");
+        ui.checkbox(&mut app.settings.wireframe, "Wireframe (W)")
+            .on_hover_text("Draw the edges over the faces (W)");
         ui.separator();
         let mut mode = app.settings.view_mode;
         ui.selectable_value(&mut mode, ViewMode::Faired, "Faired");
@@ -58,6 +68,32 @@ fn toolbar(app: &mut App, ui: &mut egui::Ui) {
         ui.selectable_value(&mut mode, ViewMode::Original, "Original");
         if mode != app.settings.view_mode {
             app.commands.push(Command::SetViewMode(mode));
+        }
+        ui.separator();
+        let undo_label = app.history.undo_label().map(str::to_owned);
+        let redo_label = app.history.redo_label().map(str::to_owned);
+        let undo = ui
+            .add_enabled(undo_label.is_some(), egui::Button::new("Undo"))
+            .on_hover_text(match &undo_label {
+                Some(label) => format!("Undo {label} (Ctrl+Z)"),
+                None => "Nothing to undo (Ctrl+Z)".into(),
+            })
+            .on_disabled_hover_text("Nothing to undo (Ctrl+Z)");
+        if undo.clicked() {
+            app.commands.push(Command::Undo);
+        }
+        let redo = ui
+            .add_enabled(redo_label.is_some(), egui::Button::new("Redo"))
+            .on_hover_text(match &redo_label {
+                Some(label) => format!("Redo {label} (Ctrl+Shift+Z, Ctrl+Y)"),
+                None => "Nothing to redo (Ctrl+Shift+Z, Ctrl+Y)".into(),
+            })
+            .on_disabled_hover_text("Nothing to redo (Ctrl+Shift+Z, Ctrl+Y)");
+        if redo.clicked() {
+            app.commands.push(Command::Redo);
+        }
+        if let Some(label) = &undo_label {
+            ui.small(format!("undo: {label}"));
         }
     });
     if let Some(path) = &app.loading {
@@ -87,13 +123,20 @@ fn toolbar(app: &mut App, ui: &mut egui::Ui) {
 }
 
 fn controls(app: &mut App, ui: &mut egui::Ui) {
-    let Some(document) = &app.document else {
+    if app.document.is_none() {
         ui.heading("No mesh");
         ui.label("Open a file, type a path above, or drop a mesh file on the window.");
         performance(app, ui);
         return;
     };
 
+    ui.heading("View");
+    view_bar(app, ui);
+    let Some(document) = &app.document else {
+        return;
+    };
+
+    ui.separator();
     ui.heading("Mesh");
     let name = document
         .path
@@ -122,6 +165,40 @@ fn controls(app: &mut App, ui: &mut egui::Ui) {
     }
     for warning in &report.warnings {
         ui.small(format!("Warning: {warning}"));
+    }
+
+    if let Some(clean) = &document.clean {
+        ui.small(format!(
+            "Noisy; clean reference kept ({} vertices)",
+            clean.vertex_count()
+        ));
+    }
+
+    ui.separator();
+    ui.heading("Noise");
+    ui.add(egui::Slider::new(&mut app.settings.noise_sigma, 0.0..=2.0).text("Sigma (× mean edge)"));
+    ui.horizontal(|ui| {
+        let label = ui.label("Seed");
+        ui.add(egui::DragValue::new(&mut app.settings.noise_seed))
+            .labelled_by(label.id);
+    });
+    egui::ComboBox::from_label("Noise direction")
+        .selected_text(noise_mode_name(app.settings.noise_mode))
+        .show_ui(ui, |ui| {
+            for mode in [
+                NoiseMode::Normal,
+                NoiseMode::Direction,
+                NoiseMode::Isotropic,
+            ] {
+                ui.selectable_value(&mut app.settings.noise_mode, mode, noise_mode_name(mode));
+            }
+        });
+    if ui
+        .button("Add noise")
+        .on_hover_text("Adds noise to the mesh; the mesh before it is kept as the clean reference")
+        .clicked()
+    {
+        app.commands.push(Command::AddNoise);
     }
 
     ui.separator();
@@ -182,8 +259,31 @@ fn controls(app: &mut App, ui: &mut egui::Ui) {
         app.commands.push(Command::SetLevel(level));
     }
     let before = app.settings.clone();
-    ui.add(egui::Slider::new(&mut app.settings.iterations, 1..=50).text("Iterations per level"));
-    ui.add(egui::Slider::new(&mut app.settings.rounds, 1..=10).text("Rounds"));
+    egui::ComboBox::from_label("Method")
+        .selected_text(app.settings.method.label())
+        .show_ui(ui, |ui| {
+            for method in MethodSetting::ALL {
+                ui.selectable_value(&mut app.settings.method, method, method.label());
+            }
+        });
+    let baseline = app.settings.method != MethodSetting::Constrained;
+    if baseline {
+        ui.small("A baseline smooths the mesh itself (no hierarchy): watch the volume change.");
+        ui.add(
+            egui::Slider::new(&mut app.settings.baseline_iterations, 1..=200).text("Iterations"),
+        );
+        if matches!(
+            app.settings.method,
+            MethodSetting::Laplacian | MethodSetting::Taubin
+        ) {
+            ui.add(egui::Slider::new(&mut app.settings.baseline_lambda, 0.05..=1.0).text("Lambda"));
+        }
+    } else {
+        ui.add(
+            egui::Slider::new(&mut app.settings.iterations, 1..=50).text("Iterations per level"),
+        );
+        ui.add(egui::Slider::new(&mut app.settings.rounds, 1..=10).text("Rounds"));
+    }
     egui::ComboBox::from_label("Boundary")
         .selected_text(match app.settings.boundary {
             BoundarySetting::Curve => "Smooth as curve",
@@ -224,8 +324,136 @@ fn controls(app: &mut App, ui: &mut egui::Ui) {
         });
     }
 
+    if ui
+        .add_enabled(document.faired.is_some(), egui::Button::new("Apply result"))
+        .on_hover_text("Make the faired result the document's mesh (undo with Ctrl+Z)")
+        .clicked()
+    {
+        app.commands.push(Command::ApplyResult);
+    }
+
+    ui.separator();
+    ui.heading("Export");
+    let mut export_path = document.export_path.clone();
+    let label = ui.label("Export path:");
+    ui.add(egui::TextEdit::singleline(&mut export_path).desired_width(f32::INFINITY))
+        .labelled_by(label.id);
+    ui.small("GLB, glTF, OBJ or PLY, by extension");
+    ui.horizontal(|ui| {
+        if ui
+            .button("Export")
+            .on_hover_text("Write the result to the export path (Ctrl+E)")
+            .clicked()
+        {
+            app.commands
+                .push(Command::Export(PathBuf::from(export_path.trim())));
+        }
+        if ui.button("Export as…").clicked() {
+            app.commands.push(Command::ExportDialog);
+        }
+    });
+    if let Some(document) = &mut app.document {
+        document.export_path = export_path;
+    }
+
+    ui.add_space(4.0);
+    ui.strong("Level chain (LOD)");
+    let placeholder = app
+        .levels_folder()
+        .map_or_else(String::new, |p| p.display().to_string());
+    let label = ui.label("Levels folder:");
+    ui.add(
+        egui::TextEdit::singleline(&mut app.settings.levels_folder)
+            .hint_text(placeholder)
+            .desired_width(f32::INFINITY),
+    )
+    .labelled_by(label.id);
+    let top = app
+        .document
+        .as_ref()
+        .and_then(|d| d.level_count())
+        .unwrap_or(1)
+        .saturating_sub(1);
+    // Edit copies: the stored range may reach past this mesh's levels (its end "to the top").
+    let mut to = app.settings.levels_to.min(top);
+    let mut from = app.settings.levels_from.min(to);
+    ui.horizontal(|ui| {
+        ui.label("Levels");
+        let a = ui.add(egui::DragValue::new(&mut from).range(0..=top).prefix("M"));
+        ui.label("to");
+        let b = ui.add(egui::DragValue::new(&mut to).range(0..=top).prefix("M"));
+        if a.changed() {
+            app.settings.levels_from = from;
+        }
+        if b.changed() {
+            app.settings.levels_to = if to == top { usize::MAX } else { to };
+        }
+    });
+    if ui
+        .add_enabled(
+            app.document
+                .as_ref()
+                .is_some_and(|d| d.level_count().is_some()),
+            egui::Button::new("Export levels"),
+        )
+        .on_hover_text("One GLB per level of the hierarchy, for LOD")
+        .clicked()
+    {
+        app.commands.push(Command::ExportLevels);
+    }
+
+    let Some(document) = &app.document else {
+        return;
+    };
     ui.separator();
     ui.heading("Numbers");
+    let faired = document.faired.as_ref();
+    let against_document = faired.and_then(|f| f.against_document.as_ref());
+    let against_clean = faired.and_then(|f| f.against_clean.as_ref());
+    let has_clean = document.clean.is_some();
+    egui::Grid::new("fairmesh-measures")
+        .num_columns(if has_clean { 3 } else { 2 })
+        .striped(true)
+        .show(ui, |ui| {
+            ui.strong("Result vs.");
+            ui.strong(if has_clean { "noisy" } else { "loaded" });
+            if has_clean {
+                ui.strong("clean");
+            }
+            ui.end_row();
+            type Row = fn(&Measures) -> String;
+            let rows: [(&str, Row); 5] = [
+                ("Volume change", |m| {
+                    m.volume_change_percent
+                        .map_or("–".into(), |v| format!("{v:+.4} %"))
+                }),
+                ("Mean distance", |m| format!("{:.3e}", m.mean_distance)),
+                ("Max distance", |m| format!("{:.3e}", m.max_distance)),
+                ("Vertex RMS", |m| {
+                    m.vertex_rms.map_or("–".into(), |v| format!("{v:.3e}"))
+                }),
+                ("Barycenter drift", |m| {
+                    m.barycenter_drift
+                        .map_or("–".into(), |v| format!("{v:.3e}"))
+                }),
+            ];
+            for (name, row) in rows {
+                ui.label(name);
+                ui.label(against_document.map_or("–".into(), row));
+                if has_clean {
+                    ui.label(against_clean.map_or("–".into(), row));
+                }
+                ui.end_row();
+            }
+            if let Some(noisy) = &document.against_clean {
+                ui.label("Noisy vs. clean");
+                ui.label(format!("{:.3e}", noisy.mean_distance))
+                    .on_hover_text("mean surface distance of the noisy mesh from the clean one");
+                ui.end_row();
+            }
+        });
+    ui.small("Distances in model units.");
+
     egui::Grid::new("fairmesh-numbers")
         .num_columns(2)
         .show(ui, |ui| {
@@ -234,12 +462,6 @@ fn controls(app: &mut App, ui: &mut egui::Ui) {
             ui.end_row();
             ui.label("Shown faces");
             ui.label(app.shown_counts.1.to_string());
-            ui.end_row();
-            let faired = document.faired.as_ref();
-            ui.label("Volume change");
-            ui.label(faired.map_or("–".into(), |f| {
-                format!("{:+.4} %", f.volume_change * 100.0)
-            }));
             ui.end_row();
             ui.label("RMS displacement");
             let (lo, hi) = document.bounds;
@@ -268,27 +490,10 @@ fn controls(app: &mut App, ui: &mut egui::Ui) {
             ui.label("Last fairing");
             ui.label(faired.map_or("–".into(), |f| seconds(f.elapsed)));
             ui.end_row();
+            ui.label("Measuring");
+            ui.label(faired.map_or("–".into(), |f| seconds(f.measure_time)));
+            ui.end_row();
         });
-
-    ui.separator();
-    ui.heading("Export");
-    let mut export_path = document.export_path.clone();
-    let label = ui.label("Export path:");
-    ui.add(egui::TextEdit::singleline(&mut export_path).desired_width(f32::INFINITY))
-        .labelled_by(label.id);
-    ui.small("GLB, glTF, OBJ or PLY, by extension");
-    ui.horizontal(|ui| {
-        if ui.button("Export").clicked() {
-            app.commands
-                .push(Command::Export(PathBuf::from(export_path.trim())));
-        }
-        if ui.button("Export as…").clicked() {
-            app.commands.push(Command::ExportDialog);
-        }
-    });
-    if let Some(document) = &mut app.document {
-        document.export_path = export_path;
-    }
 
     performance(app, ui);
 }
@@ -347,13 +552,36 @@ fn viewport(app: &mut App, ui: &mut egui::Ui) {
     let rect = ui.available_rect_before_wrap();
     let response = ui.allocate_rect(rect, egui::Sense::click_and_drag());
     app.viewport_rect = Some(rect);
-    if response.dragged_by(egui::PointerButton::Primary) {
-        app.camera.orbit(response.drag_delta());
+    // The split view's divider sits on top of the camera's area and takes its drags first.
+    let divider_x = rect.left() + rect.width() * app.settings.split.clamp(0.0, 1.0);
+    let mut divider_dragged = false;
+    if app.settings.compare == CompareView::Split {
+        let handle = egui::Rect::from_x_y_ranges(divider_x - 6.0..=divider_x + 6.0, rect.y_range());
+        let divider = ui
+            .interact(
+                handle,
+                ui.scope_id().with("fairmesh-split-divider"),
+                egui::Sense::drag(),
+            )
+            .on_hover_cursor(egui::CursorIcon::ResizeHorizontal)
+            .on_hover_text("Drag to move the divider: before on the left, after on the right");
+        if divider.dragged() {
+            divider_dragged = true;
+            let x = divider
+                .interact_pointer_pos()
+                .map_or(divider_x + divider.drag_delta().x, |p| p.x);
+            app.settings.split = ((x - rect.left()) / rect.width().max(1.0)).clamp(0.02, 0.98);
+        }
     }
-    if response.dragged_by(egui::PointerButton::Secondary)
-        || response.dragged_by(egui::PointerButton::Middle)
-    {
-        app.camera.pan(response.drag_delta(), rect.height());
+    if !divider_dragged {
+        if response.dragged_by(egui::PointerButton::Primary) {
+            app.camera.orbit(response.drag_delta());
+        }
+        if response.dragged_by(egui::PointerButton::Secondary)
+            || response.dragged_by(egui::PointerButton::Middle)
+        {
+            app.camera.pan(response.drag_delta(), rect.height());
+        }
     }
     if response.hovered() {
         let scroll = ui.input(|i| i.smooth_scroll_delta().y);
@@ -361,27 +589,268 @@ fn viewport(app: &mut App, ui: &mut egui::Ui) {
             app.camera.zoom(scroll);
         }
     }
-    let params = app.draw_params(rect);
     let painter = ui.painter_at(rect);
-    match &mut app.viewport {
-        Some(viewport) => viewport.paint(&painter, rect, params),
-        None => {
-            painter.text(
-                rect.center(),
-                egui::Align2::CENTER_CENTER,
-                "No wgpu renderer: the 3D view needs eframe's wgpu backend",
-                egui::FontId::proportional(16.0),
-                ui.visuals().text_color(),
+    if app.viewport.is_none() {
+        painter.text(
+            rect.center(),
+            egui::Align2::CENTER_CENTER,
+            "No wgpu renderer: the 3D view needs eframe's wgpu backend",
+            egui::FontId::proportional(16.0),
+            ui.visuals().text_color(),
+        );
+    }
+    let caption = |painter: &egui::Painter, at: egui::Pos2, align: egui::Align2, text: &str| {
+        painter.text(
+            at,
+            align,
+            text,
+            egui::FontId::proportional(15.0),
+            egui::Color32::from_gray(220),
+        );
+    };
+    let after_name = match app.settings.view_mode {
+        ViewMode::Faired => "After (faired)",
+        ViewMode::Level => "Level mesh",
+        ViewMode::Original => "Document mesh",
+    };
+    match app.settings.compare {
+        CompareView::Single => {
+            let slot = if app.show_before {
+                Slot::Before
+            } else {
+                Slot::Main
+            };
+            let params = app.draw_params(rect, slot);
+            let viewport = match slot {
+                Slot::Main => &mut app.viewport,
+                Slot::Before => &mut app.viewport_before,
+            };
+            if let Some(viewport) = viewport {
+                viewport.paint(&painter, rect, params);
+            }
+            let name = if app.show_before {
+                "Before (B)"
+            } else {
+                after_name
+            };
+            caption(
+                &painter,
+                rect.left_top() + egui::vec2(10.0, 8.0),
+                egui::Align2::LEFT_TOP,
+                name,
+            );
+        }
+        CompareView::Split => {
+            let (left, right) = rect.split_left_right_at_x(divider_x);
+            let before_params = app.draw_params(rect, Slot::Before);
+            let after_params = app.draw_params(rect, Slot::Main);
+            if let Some(viewport) = &mut app.viewport_before {
+                viewport.paint_part(&painter, rect, left, before_params);
+            }
+            if let Some(viewport) = &mut app.viewport {
+                viewport.paint_part(&painter, rect, right, after_params);
+            }
+            painter.line_segment(
+                [
+                    egui::pos2(divider_x, rect.top()),
+                    egui::pos2(divider_x, rect.bottom()),
+                ],
+                egui::Stroke::new(2.0, egui::Color32::from_gray(230)),
+            );
+            caption(
+                &painter,
+                rect.left_top() + egui::vec2(10.0, 8.0),
+                egui::Align2::LEFT_TOP,
+                "Before",
+            );
+            caption(
+                &painter,
+                rect.right_top() + egui::vec2(-10.0, 8.0),
+                egui::Align2::RIGHT_TOP,
+                after_name,
+            );
+        }
+        CompareView::SideBySide => {
+            let (left, right) = rect.split_left_right_at_fraction(0.5);
+            let before_params = app.draw_params(left, Slot::Before);
+            let after_params = app.draw_params(right, Slot::Main);
+            if let Some(viewport) = &mut app.viewport_before {
+                viewport.paint(&painter, left, before_params);
+            }
+            if let Some(viewport) = &mut app.viewport {
+                viewport.paint(&painter, right, after_params);
+            }
+            painter.line_segment(
+                [
+                    egui::pos2(right.left(), rect.top()),
+                    egui::pos2(right.left(), rect.bottom()),
+                ],
+                egui::Stroke::new(1.0, egui::Color32::from_gray(90)),
+            );
+            caption(
+                &painter,
+                left.left_top() + egui::vec2(10.0, 8.0),
+                egui::Align2::LEFT_TOP,
+                "Before",
+            );
+            caption(
+                &painter,
+                right.left_top() + egui::vec2(10.0, 8.0),
+                egui::Align2::LEFT_TOP,
+                after_name,
             );
         }
     }
     painter.text(
         rect.left_bottom() + egui::vec2(8.0, -8.0),
         egui::Align2::LEFT_BOTTOM,
-        "Left drag: orbit · right/middle drag: pan · scroll: zoom · F: fit · W: wireframe",
+        "Left drag: orbit · right/middle drag: pan · scroll: zoom · F: fit · W: wireframe · B: before/after",
         egui::FontId::proportional(12.0),
         egui::Color32::from_gray(150),
     );
+    if let (Some(top), Some(reference)) = (app.heat_top(), app.heat_reference()) {
+        heat_legend(ui, rect, top, reference);
+    }
+}
+
+/// The compare and heat-map controls (top of the side panel, so they never take the viewport's room).
+fn view_bar(app: &mut App, ui: &mut egui::Ui) {
+    ui.horizontal(|ui| {
+        ui.label("Compare:");
+        let mut compare = app.settings.compare;
+        ui.selectable_value(&mut compare, CompareView::Single, "Single")
+            .on_hover_text("One view; B toggles before and after");
+        ui.selectable_value(&mut compare, CompareView::Split, "Split")
+            .on_hover_text("Before left of the divider, after right of it (drag the divider)");
+        ui.selectable_value(&mut compare, CompareView::SideBySide, "Side by side")
+            .on_hover_text("Before and after next to each other, one camera");
+        app.settings.compare = compare;
+    });
+    ui.horizontal(|ui| {
+        ui.add_enabled(
+            app.settings.compare == CompareView::Single,
+            egui::Button::selectable(app.show_before, "Before (B)"),
+        )
+        .on_hover_text("Show the document's mesh instead of the result (B)")
+        .clicked()
+        .then(|| app.show_before = !app.show_before);
+        ui.checkbox(&mut app.settings.heat_map, "Heat map (H)")
+            .on_hover_text("Colour each vertex by its distance from the reference mesh (H)");
+    });
+    ui.horizontal(|ui| {
+        let has_clean = app.document.as_ref().is_some_and(|d| d.clean.is_some());
+        ui.add_enabled_ui(app.settings.heat_map, |ui| {
+            ui.label("against");
+            ui.selectable_value(
+                &mut app.settings.heat_reference,
+                HeatReference::Document,
+                if has_clean {
+                    "noisy mesh"
+                } else {
+                    "loaded mesh"
+                },
+            );
+            ui.add_enabled(
+                has_clean,
+                egui::Button::selectable(
+                    app.settings.heat_reference == HeatReference::Clean,
+                    "clean mesh",
+                ),
+            )
+            .on_disabled_hover_text("Add noise first: the mesh before it becomes the clean one")
+            .clicked()
+            .then(|| app.settings.heat_reference = HeatReference::Clean);
+        });
+    });
+}
+
+/// The heat map's legend: the viridis strip with round tick values in model units.
+fn heat_legend(ui: &mut egui::Ui, viewport: egui::Rect, top: f32, reference: HeatReference) {
+    const WIDTH: f32 = 240.0;
+    let area = egui::Rect::from_min_size(
+        viewport.right_bottom() + egui::vec2(-WIDTH - 28.0, -92.0),
+        egui::vec2(WIDTH + 20.0, 84.0),
+    );
+    ui.scope_builder(egui::UiBuilder::new().max_rect(area), |ui| {
+        egui::Frame::new()
+            .fill(egui::Color32::from_black_alpha(180))
+            .inner_margin(8.0)
+            .corner_radius(4.0)
+            .show(ui, |ui| {
+                let title = match reference {
+                    HeatReference::Clean => "Distance to the clean mesh (model units)",
+                    HeatReference::Document => "Distance to the document mesh (model units)",
+                };
+                ui.label(
+                    egui::RichText::new(title)
+                        .small()
+                        .color(egui::Color32::WHITE),
+                );
+                let (strip, _) =
+                    ui.allocate_exact_size(egui::vec2(WIDTH, 14.0), egui::Sense::hover());
+                let colours = viridis_strip(64);
+                let step = strip.width() / colours.len() as f32;
+                for (i, [r, g, b, _]) in colours.into_iter().enumerate() {
+                    let x = strip.left() + i as f32 * step;
+                    ui.painter().rect_filled(
+                        egui::Rect::from_x_y_ranges(x..=x + step + 0.5, strip.y_range()),
+                        0.0,
+                        egui::Color32::from_rgb(r, g, b),
+                    );
+                }
+                let (labels, _) =
+                    ui.allocate_exact_size(egui::vec2(WIDTH, 16.0), egui::Sense::hover());
+                let ticks = legend_ticks(top as f64, 4);
+                let spacing = ticks.get(1).copied().unwrap_or(top as f64);
+                for value in ticks {
+                    let x = strip.left() + strip.width() * (value / top as f64) as f32;
+                    ui.painter().line_segment(
+                        [
+                            egui::pos2(x, strip.bottom()),
+                            egui::pos2(x, strip.bottom() + 3.0),
+                        ],
+                        egui::Stroke::new(1.0, egui::Color32::WHITE),
+                    );
+                    let text = tick_text(value, spacing);
+                    let at = egui::Rect::from_center_size(
+                        egui::pos2(
+                            x.clamp(labels.left() + 18.0, labels.right() - 18.0),
+                            labels.center().y,
+                        ),
+                        egui::vec2(44.0, 16.0),
+                    );
+                    ui.put(
+                        at,
+                        egui::Label::new(
+                            egui::RichText::new(text)
+                                .small()
+                                .color(egui::Color32::WHITE),
+                        ),
+                    );
+                }
+            });
+    });
+}
+
+/// A tick value with as many decimals as the tick spacing needs.
+fn tick_text(value: f64, spacing: f64) -> String {
+    if value == 0.0 {
+        return "0".into();
+    }
+    // NaN, zero and negative spacings fall outside the range too.
+    if !(1e-3..1e5).contains(&spacing) {
+        return format!("{value:.0e}");
+    }
+    let decimals = (-spacing.log10().floor()).max(0.0) as usize;
+    format!("{value:.decimals$}")
+}
+
+fn noise_mode_name(mode: NoiseMode) -> &'static str {
+    match mode {
+        NoiseMode::Normal => "Along the normal",
+        NoiseMode::Direction => "Random direction",
+        NoiseMode::Isotropic => "Isotropic",
+    }
 }
 
 fn seconds(duration: std::time::Duration) -> String {

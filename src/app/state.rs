@@ -11,11 +11,14 @@ use std::time::Duration;
 
 use serde::{Deserialize, Serialize};
 
-use crate::fairing::BoundaryMode;
+use crate::fairing::{BoundaryMode, HcOptions, LaplacianOptions, MethodOptions, TaubinOptions};
 use crate::hierarchy::{Hierarchy, LevelInfo};
 use crate::io::LoadReport;
 use crate::multires::{MultiresOptions, MultiresVariant};
+use crate::noise::{NoiseMode, NoiseOptions};
 use crate::TriMesh;
+
+use super::history::SizeInBytes;
 
 /// Boundary handling, as stored in the settings.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
@@ -33,6 +36,35 @@ pub enum VariantSetting {
     Improved,
 }
 
+/// The smoothing method of the fairing panel: the paper's (coarse to fine over the hierarchy) or
+/// a baseline run on the document's mesh, to see its shrinkage next to the paper's.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+pub enum MethodSetting {
+    #[default]
+    Constrained,
+    Laplacian,
+    Taubin,
+    Hc,
+}
+
+impl MethodSetting {
+    pub const ALL: [MethodSetting; 4] = [
+        MethodSetting::Constrained,
+        MethodSetting::Laplacian,
+        MethodSetting::Taubin,
+        MethodSetting::Hc,
+    ];
+
+    pub fn label(self) -> &'static str {
+        match self {
+            MethodSetting::Constrained => "Constrained (paper)",
+            MethodSetting::Laplacian => "Laplacian",
+            MethodSetting::Taubin => "Taubin λ|μ",
+            MethodSetting::Hc => "HC Laplacian",
+        }
+    }
+}
+
 /// What the viewport shows.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
 pub enum ViewMode {
@@ -43,6 +75,28 @@ pub enum ViewMode {
     Level,
     /// The mesh as loaded.
     Original,
+}
+
+/// Which mesh the heat map and the second column of numbers measure against.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+pub enum HeatReference {
+    /// The document's mesh as loaded (or as it became after noise or an applied result).
+    #[default]
+    Document,
+    /// The clean mesh kept when noise was injected (falls back to the document without one).
+    Clean,
+}
+
+/// How before (the document's mesh) and after (the faired result) are shown.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+pub enum CompareView {
+    /// One mesh; a key toggles between before and after.
+    #[default]
+    Single,
+    /// One image, before left of a draggable divider, after right of it.
+    Split,
+    /// Two views next to each other, one camera.
+    SideBySide,
 }
 
 /// Settings that persist between runs.
@@ -59,6 +113,24 @@ pub struct Settings {
     pub show_performance: bool,
     /// Directory of the last file opened or exported, where dialogs start.
     pub last_dir: Option<PathBuf>,
+    /// Noise injection: standard deviation as a fraction of the mean edge length.
+    pub noise_sigma: f64,
+    pub noise_seed: u64,
+    pub noise_mode: NoiseMode,
+    /// Colour the mesh by its distance from the reference.
+    pub heat_map: bool,
+    pub heat_reference: HeatReference,
+    pub compare: CompareView,
+    /// Where the split view's divider sits, as a fraction of the view's width.
+    pub split: f32,
+    pub method: MethodSetting,
+    /// Iterations and step of the baseline methods.
+    pub baseline_iterations: usize,
+    pub baseline_lambda: f64,
+    /// Folder and level range of the level-chain export.
+    pub levels_folder: String,
+    pub levels_from: usize,
+    pub levels_to: usize,
 }
 
 impl Default for Settings {
@@ -74,6 +146,19 @@ impl Default for Settings {
             view_mode: ViewMode::Faired,
             show_performance: false,
             last_dir: None,
+            noise_sigma: NoiseOptions::default().sigma,
+            noise_seed: NoiseOptions::default().seed,
+            noise_mode: NoiseOptions::default().mode,
+            heat_map: false,
+            heat_reference: HeatReference::Document,
+            compare: CompareView::Single,
+            split: 0.5,
+            method: MethodSetting::Constrained,
+            baseline_iterations: 10,
+            baseline_lambda: 0.5,
+            levels_folder: String::new(),
+            levels_from: 0,
+            levels_to: usize::MAX,
         }
     }
 }
@@ -82,14 +167,76 @@ impl Settings {
     pub const STORAGE_KEY: &'static str = "fairmesh.settings";
 
     /// The settings that change the fairing result (a change means: run again).
-    pub fn fairing_key(&self) -> (usize, usize, BoundarySetting, bool, VariantSetting) {
+    #[allow(clippy::type_complexity)]
+    pub fn fairing_key(
+        &self,
+    ) -> (
+        usize,
+        usize,
+        BoundarySetting,
+        bool,
+        VariantSetting,
+        MethodSetting,
+        usize,
+        u64,
+    ) {
         (
             self.iterations,
             self.rounds,
             self.boundary,
             self.fair_finest,
             self.variant,
+            self.method,
+            self.baseline_iterations,
+            self.baseline_lambda.to_bits(),
         )
+    }
+
+    /// The baseline method's options, or `None` for the paper's method.
+    pub fn baseline_options(&self) -> Option<MethodOptions> {
+        let iterations = self.baseline_iterations.clamp(1, 1000);
+        let lambda = if self.baseline_lambda.is_finite() {
+            self.baseline_lambda.clamp(0.01, 1.0)
+        } else {
+            0.5
+        };
+        let boundary = match self.boundary {
+            BoundarySetting::Curve => BoundaryMode::Curve,
+            BoundarySetting::Fixed => BoundaryMode::Fixed,
+        };
+        match self.method {
+            MethodSetting::Constrained => None,
+            MethodSetting::Laplacian => Some(MethodOptions::Laplacian(LaplacianOptions {
+                iterations,
+                lambda,
+                boundary,
+            })),
+            // Taubin's pass band k_PB = 0.1: 1/λ + 1/μ = 0.1.
+            MethodSetting::Taubin => Some(MethodOptions::Taubin(TaubinOptions {
+                iterations,
+                lambda,
+                mu: -lambda / (1.0 - 0.1 * lambda),
+                boundary,
+            })),
+            MethodSetting::Hc => Some(MethodOptions::Hc(HcOptions {
+                iterations,
+                boundary,
+                ..HcOptions::default()
+            })),
+        }
+    }
+
+    /// The noise these settings ask for (sigma clamped to a sane range).
+    pub fn noise_options(&self) -> NoiseOptions {
+        NoiseOptions {
+            sigma: if self.noise_sigma.is_finite() {
+                self.noise_sigma.clamp(0.0, 10.0)
+            } else {
+                0.0
+            },
+            seed: self.noise_seed,
+            mode: self.noise_mode,
+        }
     }
 
     /// The multires options these settings give for `start_level`.
@@ -125,6 +272,45 @@ pub enum HierarchyState {
     Failed(String),
 }
 
+/// How far one mesh is from a reference mesh (computed on the worker with every result).
+#[derive(Clone, Debug)]
+pub struct Measures {
+    /// Enclosed volume change in percent (`None` when the reference encloses no volume).
+    pub volume_change_percent: Option<f64>,
+    /// Mean (area-weighted, both ways) and maximum (Hausdorff) surface distance, model units.
+    pub mean_distance: f64,
+    pub max_distance: f64,
+    /// Per-vertex comparisons, present when both meshes share their triangles.
+    pub vertex_rms: Option<f64>,
+    pub barycenter_drift: Option<f64>,
+    /// Distance of every vertex from the reference surface (the heat map), model units.
+    pub vertex_distances: Arc<Vec<f32>>,
+}
+
+impl Measures {
+    /// `other` measured against `reference`.
+    pub fn of(reference: &TriMesh, other: &TriMesh) -> Self {
+        let reference_index = crate::metrics::ClosestPointIndex::new(reference);
+        let other_index = crate::metrics::ClosestPointIndex::new(other);
+        let forth = reference_index.distance_from(other);
+        let back = other_index.distance_from(reference);
+        let vertices = crate::metrics::compare_vertices(reference, other);
+        let vertex_distances = reference_index
+            .vertex_distances(other)
+            .into_iter()
+            .map(|d| d as f32)
+            .collect();
+        Self {
+            volume_change_percent: crate::metrics::volume_change_percent(reference, other),
+            mean_distance: 0.5 * (forth.mean + back.mean),
+            max_distance: forth.max.max(back.max),
+            vertex_rms: vertices.map(|v| v.rms),
+            barycenter_drift: vertices.map(|v| v.barycenter_drift),
+            vertex_distances: Arc::new(vertex_distances),
+        }
+    }
+}
+
 /// The latest faired result shown for the document.
 pub struct FairedResult {
     pub positions: Arc<Vec<[f32; 3]>>,
@@ -134,6 +320,12 @@ pub struct FairedResult {
     pub elapsed: Duration,
     /// Distinguishes results, so the viewport knows when to upload.
     pub serial: u64,
+    /// Against the document's mesh.
+    pub against_document: Option<Measures>,
+    /// Against the clean mesh, when noise was injected.
+    pub against_clean: Option<Measures>,
+    /// Seconds the measuring took on the worker.
+    pub measure_time: Duration,
 }
 
 /// One loaded mesh and everything derived from it.
@@ -141,7 +333,12 @@ pub struct Document {
     pub path: PathBuf,
     /// Bumped for every document; jobs for older documents are stale.
     pub generation: u64,
+    /// The document's mesh: as loaded, or as noise or an applied result made it.
     pub original: Arc<TriMesh>,
+    /// The mesh before noise was injected (the clean reference), when there is one.
+    pub clean: Option<Arc<TriMesh>>,
+    /// The document mesh measured against the clean mesh (same connectivity).
+    pub against_clean: Option<Measures>,
     pub report: LoadReport,
     pub load_time: Duration,
     /// Bounding box of the loaded mesh (min, max), for fitting the view.
@@ -170,6 +367,8 @@ impl Document {
             path,
             generation,
             original: Arc::new(original),
+            clean: None,
+            against_clean: None,
             report,
             load_time,
             bounds,
@@ -197,6 +396,100 @@ impl Document {
                 triangles: self.original.triangles.clone(),
             },
             _ => self.original.as_ref().clone(),
+        }
+    }
+}
+
+/// A document's content as undo and redo keep it: the meshes, and the hierarchy already built
+/// for them (so going back does not rebuild it).
+#[derive(Clone)]
+pub struct DocumentSnapshot {
+    pub path: PathBuf,
+    pub mesh: Arc<TriMesh>,
+    pub clean: Option<Arc<TriMesh>>,
+    pub against_clean: Option<Measures>,
+    pub report: LoadReport,
+    pub load_time: Duration,
+    pub level: usize,
+    pub export_path: String,
+    /// The hierarchy, its build time, and whether its M0 has the mesh's triangles.
+    pub hierarchy: Option<(Arc<Hierarchy>, Duration, bool)>,
+}
+
+fn mesh_bytes(mesh: &TriMesh) -> usize {
+    std::mem::size_of_val(mesh.positions.as_slice())
+        + std::mem::size_of_val(mesh.triangles.as_slice())
+}
+
+impl SizeInBytes for DocumentSnapshot {
+    fn size_in_bytes(&self) -> usize {
+        // Shared meshes are counted once per snapshot: an over-estimate, on the safe side.
+        mesh_bytes(&self.mesh)
+            + self.clean.as_deref().map_or(0, mesh_bytes)
+            + self
+                .hierarchy
+                .as_ref()
+                .map_or(0, |(h, _, _)| h.record_bytes() + mesh_bytes(h.base_mesh()))
+            + self
+                .against_clean
+                .as_ref()
+                .map_or(0, |m| m.vertex_distances.len() * 4)
+    }
+}
+
+impl Document {
+    /// What undo needs to bring this document back.
+    pub fn snapshot(&self) -> DocumentSnapshot {
+        DocumentSnapshot {
+            path: self.path.clone(),
+            mesh: self.original.clone(),
+            clean: self.clean.clone(),
+            against_clean: self.against_clean.clone(),
+            report: self.report.clone(),
+            load_time: self.load_time,
+            level: self.level,
+            export_path: self.export_path.clone(),
+            hierarchy: match &self.hierarchy {
+                HierarchyState::Ready {
+                    hierarchy,
+                    build_time,
+                    base_matches_original,
+                    ..
+                } => Some((hierarchy.clone(), *build_time, *base_matches_original)),
+                _ => None,
+            },
+        }
+    }
+
+    /// A document made from a snapshot; its hierarchy is ready when the snapshot kept one
+    /// (otherwise `Building`: the caller starts the build).
+    pub fn from_snapshot(snapshot: DocumentSnapshot, generation: u64) -> Self {
+        let bounds = bounds_of(&snapshot.mesh.positions);
+        let hierarchy = match snapshot.hierarchy {
+            Some((hierarchy, build_time, base_matches_original)) => HierarchyState::Ready {
+                levels: (0..hierarchy.level_count())
+                    .map(|l| hierarchy.level_info(l))
+                    .collect(),
+                base_matches_original,
+                hierarchy,
+                build_time,
+            },
+            None => HierarchyState::Building,
+        };
+        Self {
+            path: snapshot.path,
+            generation,
+            original: snapshot.mesh,
+            clean: snapshot.clean,
+            against_clean: snapshot.against_clean,
+            report: snapshot.report,
+            load_time: snapshot.load_time,
+            bounds,
+            hierarchy,
+            level: snapshot.level,
+            faired: None,
+            level_mesh: None,
+            export_path: snapshot.export_path,
         }
     }
 }

@@ -31,7 +31,12 @@ pub fn viridis_strip(width: usize) -> Vec<[u8; 4]> {
     (0..width)
         .map(|i| {
             let [r, g, b] = viridis(i as f32 / (width.max(2) - 1) as f32);
-            [(r * 255.0).round() as u8, (g * 255.0).round() as u8, (b * 255.0).round() as u8, 255]
+            [
+                (r * 255.0).round() as u8,
+                (g * 255.0).round() as u8,
+                (b * 255.0).round() as u8,
+                255,
+            ]
         })
         .collect()
 }
@@ -43,8 +48,15 @@ pub fn legend_ticks(max: f64, count: usize) -> Vec<f64> {
     }
     let raw = max / count as f64;
     let power = 10f64.powf(raw.log10().floor());
-    let step = [1.0, 2.0, 5.0, 10.0].into_iter().map(|m| m * power).find(|s| *s >= raw).unwrap_or(10.0 * power);
-    (0..).map(|i| i as f64 * step).take_while(|v| *v <= max * (1.0 + 1e-9)).collect()
+    let step = [1.0, 2.0, 5.0, 10.0]
+        .into_iter()
+        .map(|m| m * power)
+        .find(|s| *s >= raw)
+        .unwrap_or(10.0 * power);
+    (0..)
+        .map(|i| i as f64 * step)
+        .take_while(|v| *v <= max * (1.0 + 1e-9))
+        .collect()
 }
 
 #[cfg(test)]
@@ -52,14 +64,34 @@ mod tests {
     use super::*;
 
     fn relative_luminance([r, g, b]: [f32; 3]) -> f32 {
-        let lin = |c: f32| if c <= 0.04045 { c / 12.92 } else { ((c + 0.055) / 1.055).powf(2.4) };
+        let lin = |c: f32| {
+            if c <= 0.04045 {
+                c / 12.92
+            } else {
+                ((c + 0.055) / 1.055).powf(2.4)
+            }
+        };
         0.2126 * lin(r) + 0.7152 * lin(g) + 0.0722 * lin(b)
     }
 
     #[test]
     fn ends_match_the_keys_and_lightness_rises_monotonically() {
-        assert_eq!(viridis(0.0), [0x44 as f32 / 255.0, 0x01 as f32 / 255.0, 0x54 as f32 / 255.0]);
-        assert_eq!(viridis(1.0), [0xfd as f32 / 255.0, 0xe7 as f32 / 255.0, 0x25 as f32 / 255.0]);
+        assert_eq!(
+            viridis(0.0),
+            [
+                0x44 as f32 / 255.0,
+                0x01 as f32 / 255.0,
+                0x54 as f32 / 255.0
+            ]
+        );
+        assert_eq!(
+            viridis(1.0),
+            [
+                0xfd as f32 / 255.0,
+                0xe7 as f32 / 255.0,
+                0x25 as f32 / 255.0
+            ]
+        );
         assert_eq!(viridis(-3.0), viridis(0.0));
         assert_eq!(viridis(f32::NAN), viridis(0.0));
         let mut previous = -1.0;

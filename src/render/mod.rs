@@ -8,27 +8,47 @@
 //! headless tests. The renderer takes positions, triangles and optional per-vertex scalars and
 //! knows nothing of fairing.
 
+pub mod colormap;
 pub mod pipeline;
 
 pub use pipeline::{DrawParams, MeshRenderer};
 
 use egui_wgpu::wgpu;
 
-/// The app's handle on the renderer, which lives in egui_wgpu's callback resources so that the
-/// paint callback can reach it.
+/// Every viewport's renderer, in egui_wgpu's callback resources (one entry per type, so the
+/// renderers of several viewports share one list; a viewport knows its slot).
+#[derive(Default)]
+pub struct MeshRenderers(Vec<MeshRenderer>);
+
+/// The app's handle on one renderer (its mesh and offscreen image). Several viewports (before
+/// and after) each have their own.
 pub struct Viewport3d {
     state: egui_wgpu::RenderState,
     texture: Option<egui::TextureId>,
+    slot: usize,
 }
 
 impl Viewport3d {
-    /// Creates the pipelines on the render state's device.
+    /// Creates a renderer (pipelines, buffers, target) on the render state's device.
     pub fn new(state: &egui_wgpu::RenderState) -> Self {
         let renderer = MeshRenderer::new(&state.device);
-        state.renderer.write().callback_resources.insert(renderer);
+        let mut egui_renderer = state.renderer.write();
+        let resources = &mut egui_renderer.callback_resources;
+        if resources.get::<MeshRenderers>().is_none() {
+            resources.insert(MeshRenderers::default());
+        }
+        let slot = match resources.get_mut::<MeshRenderers>() {
+            Some(list) => {
+                list.0.push(renderer);
+                list.0.len() - 1
+            }
+            None => 0,
+        };
+        drop(egui_renderer);
         Self {
             state: state.clone(),
             texture: None,
+            slot,
         }
     }
 
@@ -36,7 +56,8 @@ impl Viewport3d {
         let mut egui_renderer = self.state.renderer.write();
         egui_renderer
             .callback_resources
-            .get_mut::<MeshRenderer>()
+            .get_mut::<MeshRenderers>()
+            .and_then(|list| list.0.get_mut(self.slot))
             .map(f)
     }
 
@@ -78,7 +99,23 @@ impl Viewport3d {
 
     /// Paints the viewport into `rect`: sizes the offscreen target to the rect's pixels, adds the
     /// paint callback that draws the mesh into it, and the image that shows it.
-    pub fn paint(&mut self, painter: &egui::Painter, rect: egui::Rect, mut params: DrawParams) {
+    pub fn paint(&mut self, painter: &egui::Painter, rect: egui::Rect, params: DrawParams) {
+        self.paint_part(painter, rect, rect, params);
+    }
+
+    /// Like [`Self::paint`], but shows only the part of the image inside `visible` (a part of
+    /// `rect`): the split view draws two renderers' images over one rect, each on its side.
+    pub fn paint_part(
+        &mut self,
+        painter: &egui::Painter,
+        rect: egui::Rect,
+        visible: egui::Rect,
+        mut params: DrawParams,
+    ) {
+        let visible = visible.intersect(rect);
+        if !visible.is_positive() {
+            return;
+        }
         let pixels_per_point = painter.ctx().pixels_per_point();
         let size = [
             ((rect.width() * pixels_per_point).round() as u32).max(1),
@@ -88,7 +125,11 @@ impl Viewport3d {
         {
             let device = &self.state.device;
             let mut egui_renderer = self.state.renderer.write();
-            let Some(renderer) = egui_renderer.callback_resources.get_mut::<MeshRenderer>() else {
+            let Some(renderer) = egui_renderer
+                .callback_resources
+                .get_mut::<MeshRenderers>()
+                .and_then(|list| list.0.get_mut(self.slot))
+            else {
                 return;
             };
             let recreated = renderer.ensure_target(device, size);
@@ -116,13 +157,22 @@ impl Viewport3d {
             return;
         };
         painter.add(egui_wgpu::Callback::new_paint_callback(
-            rect,
-            ViewportCallback { params },
+            visible,
+            ViewportCallback {
+                params,
+                slot: self.slot,
+            },
         ));
+        let uv = |p: egui::Pos2| {
+            egui::pos2(
+                (p.x - rect.min.x) / rect.width(),
+                (p.y - rect.min.y) / rect.height(),
+            )
+        };
         painter.image(
             texture,
-            rect,
-            egui::Rect::from_min_max(egui::pos2(0.0, 0.0), egui::pos2(1.0, 1.0)),
+            visible,
+            egui::Rect::from_min_max(uv(visible.min), uv(visible.max)),
             egui::Color32::WHITE,
         );
     }
@@ -140,6 +190,7 @@ impl Drop for Viewport3d {
 /// begins; the image shape that follows it shows the result.
 struct ViewportCallback {
     params: DrawParams,
+    slot: usize,
 }
 
 impl egui_wgpu::CallbackTrait for ViewportCallback {
@@ -151,7 +202,10 @@ impl egui_wgpu::CallbackTrait for ViewportCallback {
         egui_encoder: &mut wgpu::CommandEncoder,
         callback_resources: &mut egui_wgpu::CallbackResources,
     ) -> Vec<wgpu::CommandBuffer> {
-        if let Some(renderer) = callback_resources.get_mut::<MeshRenderer>() {
+        if let Some(renderer) = callback_resources
+            .get_mut::<MeshRenderers>()
+            .and_then(|list| list.0.get_mut(self.slot))
+        {
             renderer.render(device, queue, egui_encoder, &self.params);
         }
         Vec::new()
