@@ -5,7 +5,7 @@
 //! compare viewport images with reference snapshots (`UPDATE_SNAPSHOTS=1` rewrites them).
 #![cfg(feature = "gui")]
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::time::{Duration, Instant};
 
 use egui::accesskit::Role;
@@ -13,35 +13,8 @@ use egui_kittest::kittest::Queryable;
 use egui_kittest::{Harness, SnapshotOptions};
 use fairmesh::app::App;
 
-fn bunny() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/bunny00.obj")
-}
-
-fn harness_for(path: PathBuf) -> Harness<'static, App> {
-    Harness::builder()
-        .with_size(egui::vec2(1200.0, 800.0))
-        .wgpu()
-        .build_eframe(move |cc| App::new_for_test(cc, path))
-}
-
-/// Steps frames until every background job finished and its result was applied. The bound is
-/// generous (the real hierarchy of a 75k-face mesh in a debug build on a busy machine).
-fn settle(harness: &mut Harness<'_, App>) {
-    let deadline = Instant::now() + Duration::from_secs(300);
-    for _ in 0..200_000 {
-        harness.step();
-        if harness.state().is_settled() {
-            // One more frame: the results applied in the last one reach the viewport and labels.
-            harness.step();
-            return;
-        }
-        if Instant::now() > deadline {
-            break;
-        }
-        std::thread::sleep(Duration::from_millis(5));
-    }
-    panic!("the editor did not settle: {:?}", harness.state().status());
-}
+mod editor_common;
+use editor_common::{bunny, harness_for, settle};
 
 /// The viewport's pixels out of a full-window render.
 fn viewport_image(harness: &mut Harness<'_, App>) -> image::RgbaImage {

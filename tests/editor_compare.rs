@@ -5,41 +5,13 @@
 //! `UPDATE_SNAPSHOTS=1` rewrites them) and the export of the level chain.
 #![cfg(feature = "gui")]
 
-use std::path::{Path, PathBuf};
-use std::time::{Duration, Instant};
-
 use egui::accesskit::Role;
 use egui_kittest::kittest::Queryable;
 use egui_kittest::Harness;
 use fairmesh::app::{App, Command};
 
-fn bunny() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/bunny00.obj")
-}
-
-fn harness_for(path: PathBuf) -> Harness<'static, App> {
-    Harness::builder()
-        .with_size(egui::vec2(1200.0, 800.0))
-        .wgpu()
-        .build_eframe(move |cc| App::new_for_test(cc, path))
-}
-
-/// Steps frames until every background job finished and its result was applied.
-fn settle(harness: &mut Harness<'_, App>) {
-    let deadline = Instant::now() + Duration::from_secs(300);
-    for _ in 0..200_000 {
-        harness.step();
-        if harness.state().is_settled() {
-            harness.step();
-            return;
-        }
-        if Instant::now() > deadline {
-            break;
-        }
-        std::thread::sleep(Duration::from_millis(5));
-    }
-    panic!("the editor did not settle: {:?}", harness.state().status());
-}
+mod editor_common;
+use editor_common::{bunny, harness_for, settle};
 
 /// Loads the bunny, adds the default noise (sigma 0.3 of the mean edge, seed 1, along the
 /// normal) through the panel's button, and fairs from a middle level: M4 of the bunny's 19

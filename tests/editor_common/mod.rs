@@ -1,0 +1,39 @@
+//! What the editor's headless test files share: the bundled mesh, a harness running the real app
+//! on egui_kittest's wgpu renderer, and stepping frames until the background work is done.
+#![allow(dead_code)] // each test file uses its own subset
+
+use std::path::{Path, PathBuf};
+use std::time::{Duration, Instant};
+
+use egui_kittest::Harness;
+use fairmesh::app::App;
+
+pub fn bunny() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/bunny00.obj")
+}
+
+pub fn harness_for(path: PathBuf) -> Harness<'static, App> {
+    Harness::builder()
+        .with_size(egui::vec2(1200.0, 800.0))
+        .wgpu()
+        .build_eframe(move |cc| App::new_for_test(cc, path))
+}
+
+/// Steps frames until every background job finished and its result was applied. The bound is
+/// generous (the real hierarchy of a 75k-face mesh in a debug build on a busy machine).
+pub fn settle(harness: &mut Harness<'_, App>) {
+    let deadline = Instant::now() + Duration::from_secs(300);
+    for _ in 0..200_000 {
+        harness.step();
+        if harness.state().is_settled() {
+            // One more frame: the results applied in the last one reach the viewport and labels.
+            harness.step();
+            return;
+        }
+        if Instant::now() > deadline {
+            break;
+        }
+        std::thread::sleep(Duration::from_millis(5));
+    }
+    panic!("the editor did not settle: {:?}", harness.state().status());
+}
