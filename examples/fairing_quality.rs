@@ -19,44 +19,10 @@ use fairmesh::fairing::{
     fair, BoundaryMode, FairOptions, FairVariant, HcOptions, LaplacianOptions, MethodOptions,
     TaubinOptions,
 };
-use fairmesh::metrics::{mean_edge_length, signed_volume};
+use fairmesh::metrics::{closest_point_on_triangle, mean_edge_length, signed_volume};
 use fairmesh::noise::{add_noise, NoiseMode, NoiseOptions};
 use fairmesh::{Topology, TriMesh};
-use glam::DVec3;
 use std::path::PathBuf;
-
-/// Closest point to `p` on triangle (a, b, c) (Voronoi regions of the corners and edges).
-fn closest_on_triangle(p: DVec3, a: DVec3, b: DVec3, c: DVec3) -> DVec3 {
-    let (ab, ac, ap) = (b - a, c - a, p - a);
-    let (d1, d2) = (ab.dot(ap), ac.dot(ap));
-    if d1 <= 0.0 && d2 <= 0.0 {
-        return a;
-    }
-    let bp = p - b;
-    let (d3, d4) = (ab.dot(bp), ac.dot(bp));
-    if d3 >= 0.0 && d4 <= d3 {
-        return b;
-    }
-    let vc = d1 * d4 - d3 * d2;
-    if vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0 {
-        return a + ab * (d1 / (d1 - d3));
-    }
-    let cp = p - c;
-    let (d5, d6) = (ab.dot(cp), ac.dot(cp));
-    if d6 >= 0.0 && d5 <= d6 {
-        return c;
-    }
-    let vb = d5 * d2 - d1 * d6;
-    if vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0 {
-        return a + ac * (d2 / (d2 - d6));
-    }
-    let va = d3 * d6 - d5 * d4;
-    if va <= 0.0 && (d4 - d3) >= 0.0 && (d5 - d6) >= 0.0 {
-        return b + (c - b) * ((d4 - d3) / ((d4 - d3) + (d5 - d6)));
-    }
-    let denom = 1.0 / (va + vb + vc);
-    a + ab * (vb * denom) + ac * (vc * denom)
-}
 
 /// Faces within the 3-ring of every vertex (shared connectivity), computed once per mesh.
 fn local_faces(topology: &Topology, vertex_count: usize) -> Vec<Vec<u32>> {
@@ -103,7 +69,7 @@ fn one_side(from: &TriMesh, to: &TriMesh, faces: &[Vec<u32>]) -> (f64, f64) {
             .iter()
             .map(|&f| {
                 let [a, b, c] = to.triangle_points(f as usize);
-                (closest_on_triangle(p, a, b, c) - p).length()
+                (closest_point_on_triangle(p, a, b, c) - p).length()
             })
             .fold(f64::INFINITY, f64::min);
         sum += d;

@@ -14,33 +14,7 @@ use egui_kittest::{Harness, SnapshotOptions};
 use fairmesh::app::App;
 
 mod editor_common;
-use editor_common::{bunny, harness_for, settle};
-
-/// The viewport's pixels out of a full-window render.
-fn viewport_image(harness: &mut Harness<'_, App>) -> image::RgbaImage {
-    let full = harness.render().expect("the wgpu test renderer renders");
-    let rect = harness
-        .state()
-        .viewport_rect()
-        .expect("the viewport was drawn");
-    let scale = full.width() as f32 / 1200.0;
-    let (x, y) = (
-        (rect.min.x * scale).round() as u32,
-        (rect.min.y * scale).round() as u32,
-    );
-    let (w, h) = (
-        (rect.width() * scale).round() as u32,
-        (rect.height() * scale).round() as u32,
-    );
-    image::imageops::crop_imm(
-        &full,
-        x,
-        y,
-        w.min(full.width() - x),
-        h.min(full.height() - y),
-    )
-    .to_image()
-}
+use editor_common::{bunny, harness_for, settle, viewport_image};
 
 fn snapshot_options() -> SnapshotOptions {
     // Software rasterisers differ a little between versions: compare with a tolerance.

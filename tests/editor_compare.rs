@@ -11,7 +11,7 @@ use egui_kittest::Harness;
 use fairmesh::app::{App, Command};
 
 mod editor_common;
-use editor_common::{bunny, harness_for, settle};
+use editor_common::{bunny, harness_for, settle, viewport_image};
 
 /// Loads the bunny, adds the default noise (sigma 0.3 of the mean edge, seed 1, along the
 /// normal) through the panel's button, and fairs from a middle level: M4 of the bunny's 19
@@ -176,32 +176,6 @@ fn undo_restores_the_noisy_mesh_exactly_and_redo_brings_the_result_back() {
     // The hierarchy is ready again and a result is on record.
     let status = harness.state().status();
     assert!(status.hierarchy_ready && status.faired_serial.is_some());
-}
-
-/// The viewport's pixels out of a full-window render.
-fn viewport_image(harness: &mut Harness<'_, App>) -> image::RgbaImage {
-    let full = harness.render().expect("the wgpu test renderer renders");
-    let rect = harness
-        .state()
-        .viewport_rect()
-        .expect("the viewport was drawn");
-    let scale = full.width() as f32 / 1200.0;
-    let (x, y) = (
-        (rect.min.x * scale).round() as u32,
-        (rect.min.y * scale).round() as u32,
-    );
-    let (w, h) = (
-        (rect.width() * scale).round() as u32,
-        (rect.height() * scale).round() as u32,
-    );
-    image::imageops::crop_imm(
-        &full,
-        x,
-        y,
-        w.min(full.width() - x),
-        h.min(full.height() - y),
-    )
-    .to_image()
 }
 
 fn snapshot_options() -> egui_kittest::SnapshotOptions {

@@ -827,24 +827,10 @@ mod tests {
 
     /// A small irregular closed mesh: an octahedron subdivided irregularly, with bumps.
     fn irregular_sphere() -> TriMesh {
-        let mut positions: Vec<[f32; 3]> = vec![
-            [1.0, 0.0, 0.0],
-            [-1.0, 0.0, 0.0],
-            [0.0, 1.0, 0.0],
-            [0.0, -1.0, 0.0],
-            [0.0, 0.0, 1.0],
-            [0.0, 0.0, -1.0],
-        ];
-        let mut triangles: Vec<[u32; 3]> = vec![
-            [0, 2, 4],
-            [2, 1, 4],
-            [1, 3, 4],
-            [3, 0, 4],
-            [2, 0, 5],
-            [1, 2, 5],
-            [3, 1, 5],
-            [0, 3, 5],
-        ];
+        let TriMesh {
+            mut positions,
+            mut triangles,
+        } = crate::mesh::fixtures::octahedron(1.0);
         // Split some faces at their centre (1-to-3) to make valences irregular.
         let mut rng = Rng(12345);
         for round in 0..3 {

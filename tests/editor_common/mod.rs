@@ -1,5 +1,6 @@
 //! What the editor's headless test files share: the bundled mesh, a harness running the real app
-//! on egui_kittest's wgpu renderer, and stepping frames until the background work is done.
+//! on egui_kittest's wgpu renderer, stepping frames until the background work is done, and the
+//! viewport's pixels.
 #![allow(dead_code)] // each test file uses its own subset
 
 use std::path::{Path, PathBuf};
@@ -36,4 +37,30 @@ pub fn settle(harness: &mut Harness<'_, App>) {
         std::thread::sleep(Duration::from_millis(5));
     }
     panic!("the editor did not settle: {:?}", harness.state().status());
+}
+
+/// The viewport's pixels out of a full-window render (the harness is 1200 points wide).
+pub fn viewport_image(harness: &mut Harness<'_, App>) -> image::RgbaImage {
+    let full = harness.render().expect("the wgpu test renderer renders");
+    let rect = harness
+        .state()
+        .viewport_rect()
+        .expect("the viewport was drawn");
+    let scale = full.width() as f32 / 1200.0;
+    let (x, y) = (
+        (rect.min.x * scale).round() as u32,
+        (rect.min.y * scale).round() as u32,
+    );
+    let (w, h) = (
+        (rect.width() * scale).round() as u32,
+        (rect.height() * scale).round() as u32,
+    );
+    image::imageops::crop_imm(
+        &full,
+        x,
+        y,
+        w.min(full.width() - x),
+        h.min(full.height() - y),
+    )
+    .to_image()
 }
