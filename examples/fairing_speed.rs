@@ -118,8 +118,10 @@ fn main() {
         big_bandwidth / 1e9
     );
     let big_reordered = breadth_first_reordered(&big);
-    let meshes: [(&str, TriMesh); 3] = [
+    let bunny_reordered = breadth_first_reordered(&bunny);
+    let meshes: [(&str, TriMesh); 4] = [
         ("bunny00", bunny),
+        ("bunny00 BFS order", bunny_reordered),
         ("bunny00 x16", big),
         ("bunny00 x16 BFS order", big_reordered),
     ];

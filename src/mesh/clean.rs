@@ -13,7 +13,7 @@ use std::hash::{BuildHasherDefault, Hasher};
 /// A multiply-rotate hasher for position keys: SipHash's DoS resistance buys nothing here and
 /// costs a third of the weld time on large meshes.
 #[derive(Default)]
-struct PositionHasher(u64);
+pub(crate) struct PositionHasher(u64);
 
 impl Hasher for PositionHasher {
     fn finish(&self) -> u64 {

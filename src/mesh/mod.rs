@@ -6,14 +6,19 @@
 //! - [`weld`] and [`clean`]: merge vertices with identical positions, drop triangles that repeat a
 //!   vertex and vertices no triangle uses, keeping the first-occurrence order of the input so that
 //!   output files keep the input's vertex order.
+//! - [`breadth_first_order`]: a locality order for the gather kernels, which keep their own
+//!   internal numbering and map back on output.
 
 mod clean;
 #[cfg(test)]
 pub(crate) mod fixtures;
+mod reorder;
 mod subdivide;
 mod topology;
 
+pub(crate) use clean::PositionHasher;
 pub use clean::{clean, weld, CleanReport, WeldReport};
+pub use reorder::{breadth_first_order, inverse_permutation};
 pub use subdivide::subdivide_loop;
 pub use topology::{ComponentInfo, Topology};
 
