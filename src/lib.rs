@@ -29,12 +29,13 @@ pub mod render;
 pub use mesh::{Topology, TriMesh};
 
 /// Progress-and-cancel hook for long operations. `report` is called now and then with the fraction
-/// done, in `0.0..=1.0`; returning `false` asks the operation to stop as soon as it can.
-pub trait Progress {
+/// done, in `0.0..=1.0`; returning `false` asks the operation to stop as soon as it can. `Send`,
+/// so that operations can run their whole body on a worker of the rayon pool.
+pub trait Progress: Send {
     fn report(&mut self, fraction: f32) -> bool;
 }
 
-impl<F: FnMut(f32) -> bool> Progress for F {
+impl<F: FnMut(f32) -> bool + Send> Progress for F {
     fn report(&mut self, fraction: f32) -> bool {
         self(fraction)
     }

@@ -42,14 +42,21 @@
 //! optional (`fair_finest`; the paper's loop ends at the refinement).
 //!
 //! Speed: a [`MultiresWorkspace`] keeps, per level used so far, its connectivity (`TriMesh`
-//! triangles and `Topology`) and loop neighbours, built on first use; a run then only copies
-//! positions and calls the fairing per level, and allocates nothing but its result.
+//! triangles and `Topology`), loop neighbours, fan-ordered one-rings and fairing operator, built on
+//! first use; a run then only moves positions, and allocates nothing but its result. The whole run
+//! executes on a worker of the rayon pool (a run makes a dozen parallel calls per level, and each
+//! call issued from outside the pool is a cross-thread hand-off); passes over the coarse levels
+//! are not split below [`PARALLEL_GRAIN`] vertices. The per-level passes (Kobbelt step, vertex
+//! normals, low-pass filters) work in f32 SIMD points; the Kobbelt step takes every vertex's
+//! umbrella Laplacian once instead of once per adjacent split vertex, and closed fans give the
+//! vertex normals from their fan order (one gather per neighbour instead of three per face).
 
+use crate::fairing::constrained::FanRings;
 use crate::fairing::{BoundaryMode, ConstrainedFairing, FairOptions, FairVariant};
 use crate::hierarchy::Hierarchy;
 use crate::mesh::{Topology, TriMesh};
 use crate::Progress;
-use glam::DVec3;
+use glam::{DVec3, Vec3A};
 use rayon::prelude::*;
 
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -85,6 +92,10 @@ impl Default for MultiresOptions {
 
 const NONE: u32 = u32::MAX;
 
+/// Vertices per parallel work item at least: the coarse levels have a few hundred vertices, too
+/// few to share out.
+const PARALLEL_GRAIN: usize = 1024;
+
 /// Improved: 1-ring averages that low-pass a level fairing's normal displacement before it is
 /// taken back. Two kept most of the noise removal on noisy `bunny00` while taking back the
 /// shrinkage of `elephant`'s legs (one leaves part of the shrinkage, more remove less noise).
@@ -101,6 +112,8 @@ struct LevelData {
     /// Previous and next vertex along the boundary loop (`NONE` for interior vertices); empty when
     /// the level is closed.
     loop_neighbors: Vec<[u32; 2]>,
+    /// One-rings in fan order (closed fans), for the vertex normals of the shrinkage correction.
+    fans: FanRings,
     /// The precomputed fairing operator of this connectivity, for the variant and boundary mode
     /// it was made with.
     fairing: Option<ConstrainedFairing>,
@@ -113,16 +126,18 @@ pub struct MultiresWorkspace {
     levels: Vec<Option<LevelData>>,
     /// Working positions in the hierarchy's internal order (level i: the first V_i).
     positions: Vec<[f32; 3]>,
+    /// Umbrella Laplacian of every vertex of the level being refined, from the placed positions.
+    laplacians: Vec<Vec3A>,
     /// Per split vertex of the level being refined: Kobbelt displacement, then (Improved) the
     /// unit normal and the height that would restore the split's volume.
-    displacements: Vec<DVec3>,
+    displacements: Vec<Vec3A>,
     heights: Vec<(DVec3, f64, f64)>,
     /// Per vertex of the finer level: weighted sum of heights of adjacent split vertices, weights.
     height_sums: Vec<[f64; 2]>,
     /// Positions of the level before its fairing, vertex normals and areas, normal displacement
     /// of the fairing and its low-passed copy (Improved's shrinkage correction).
     before_fairing: Vec<[f32; 3]>,
-    normals: Vec<DVec3>,
+    normals: Vec<Vec3A>,
     normal_moves: Vec<[f64; 2]>,
     smoothed_moves: Vec<[f64; 2]>,
 }
@@ -156,10 +171,12 @@ impl MultiresWorkspace {
                 }
             }
         }
+        let fans = FanRings::new(&mesh.triangles, &topology);
         self.levels[level] = Some(LevelData {
             mesh,
             topology,
             loop_neighbors,
+            fans,
             fairing: None,
         });
     }
@@ -172,6 +189,18 @@ fn point(p: [f32; 3]) -> DVec3 {
 /// Returns M0's positions after fairing (M0's triangles are `hierarchy.base_mesh().triangles`),
 /// or `None` when `progress` cancelled the run.
 pub fn fair_multires(
+    hierarchy: &Hierarchy,
+    options: &MultiresOptions,
+    workspace: &mut MultiresWorkspace,
+    progress: &mut dyn Progress,
+) -> Option<Vec<[f32; 3]>> {
+    // A run makes a dozen small parallel calls per level. Issued from outside the pool, each one
+    // is handed to a worker and waited for (a futex round trip); from a worker they run in place
+    // or are stolen, so the whole run goes to the pool once.
+    rayon::scope(|_| fair_multires_on_worker(hierarchy, options, workspace, progress))
+}
+
+fn fair_multires_on_worker(
     hierarchy: &Hierarchy,
     options: &MultiresOptions,
     workspace: &mut MultiresWorkspace,
@@ -251,17 +280,13 @@ fn fair_level(workspace: &mut MultiresWorkspace, level: usize, options: &FairOpt
         ));
     }
     let n = data.mesh.positions.len();
-    data.mesh
-        .positions
-        .copy_from_slice(&workspace.positions[..n]);
     workspace.before_fairing.clear();
     workspace
         .before_fairing
         .extend_from_slice(&workspace.positions[..n]);
     if let Some(fairing) = data.fairing.as_mut() {
-        fairing.run(&mut data.mesh.positions, options);
+        fairing.run(&mut workspace.positions[..n], options);
     }
-    workspace.positions[..n].copy_from_slice(&data.mesh.positions);
     true
 }
 
@@ -283,39 +308,49 @@ fn remove_low_frequency_shrinkage(workspace: &mut MultiresWorkspace, level: usiz
     let n = data.mesh.positions.len();
     let topology = &data.topology;
     let triangles = &data.mesh.triangles;
-    let (face_offsets, vertex_faces) = topology.face_csr();
+    let (offsets, _) = topology.neighbor_csr();
+    let fans = &data.fans;
     let positions_now: &[[f32; 3]] = positions;
+    let before: &[[f32; 3]] = before_fairing;
+    let at = |v: u32| Vec3A::from_array(positions_now[v as usize]);
+    // Area-weighted vertex normals (twice the area: Σ over the fan of (a − x) × (b − x), from the
+    // fan order where the fan is closed, from the faces otherwise), unit normals, and the normal
+    // displacement weighted by the area.
     (0..n)
         .into_par_iter()
+        .with_min_len(PARALLEL_GRAIN)
         .map(|v| {
-            let mut sum = DVec3::ZERO;
-            for &f in &vertex_faces[face_offsets[v] as usize..face_offsets[v + 1] as usize] {
-                let [a, b, c] = triangles[f as usize].map(|u| point(positions_now[u as usize]));
-                sum += (b - a).cross(c - a);
-            }
-            sum
-        })
-        .collect_into_vec(normals);
-    let before: &[[f32; 3]] = before_fairing;
-    normals
-        .par_iter_mut()
-        .enumerate()
-        .map(|(v, normal)| {
-            let area = normal.length();
-            let unit = if area > 0.0 {
-                *normal / area
+            let centre = at(v as u32);
+            let mut normal = Vec3A::ZERO;
+            if fans.closed_fan[v] {
+                let fan = &fans.ring[offsets[v] as usize..offsets[v + 1] as usize];
+                let mut previous = at(fan[fan.len() - 1]) - centre;
+                for &u in fan {
+                    let current = at(u) - centre;
+                    normal += previous.cross(current);
+                    previous = current;
+                }
             } else {
-                DVec3::ZERO
+                for &f in topology.faces_of(v as u32) {
+                    let [a, b, c] = triangles[f as usize].map(at);
+                    normal += (b - a).cross(c - a);
+                }
+            }
+            let area = normal.length();
+            let unit = if area > 0.0 && area.is_finite() {
+                normal / area
+            } else {
+                Vec3A::ZERO
             };
-            *normal = unit;
-            let moved = point(positions_now[v]) - point(before[v]);
-            [moved.dot(unit) * area, area]
+            let moved = centre - Vec3A::from_array(before[v]);
+            (unit, [(moved.dot(unit) * area) as f64, area as f64])
         })
-        .collect_into_vec(normal_moves);
+        .unzip_into_vecs(normals, normal_moves);
     for _ in 0..SHRINKAGE_SMOOTHING_ROUNDS {
         let moves: &[[f64; 2]] = normal_moves;
         (0..n)
             .into_par_iter()
+            .with_min_len(PARALLEL_GRAIN)
             .map(|v| {
                 let mut sum = moves[v];
                 for &u in topology.neighbors(v as u32) {
@@ -329,16 +364,15 @@ fn remove_low_frequency_shrinkage(workspace: &mut MultiresWorkspace, level: usiz
             .collect_into_vec(smoothed_moves);
         std::mem::swap(normal_moves, smoothed_moves);
     }
-    let (moves, normals): (&[[f64; 2]], &[DVec3]) = (normal_moves, normals);
+    let (moves, normals): (&[[f64; 2]], &[Vec3A]) = (normal_moves, normals);
     positions[..n]
         .par_iter_mut()
+        .with_min_len(PARALLEL_GRAIN)
         .enumerate()
         .for_each(|(v, p)| {
             let [weighted, area] = moves[v];
             if area > 0.0 {
-                *p = (point(*p) - normals[v] * (weighted / area))
-                    .as_vec3()
-                    .to_array();
+                *p = (Vec3A::from_array(*p) - normals[v] * (weighted / area) as f32).to_array();
             }
         });
 }
@@ -355,6 +389,7 @@ fn refine_positions(
     let MultiresWorkspace {
         levels,
         positions,
+        laplacians,
         displacements,
         heights,
         height_sums,
@@ -388,44 +423,46 @@ fn refine_positions(
         });
     }
 
-    // One Kobbelt step for all, from the placed positions, applied together.
-    let laplacian = |v: usize, positions: &[[f32; 3]]| -> DVec3 {
-        if on_loop(v) {
-            let [a, b] = loops[v];
-            (point(positions[a as usize]) + point(positions[b as usize])) * 0.5
-                - point(positions[v])
-        } else {
-            let ring = topology.neighbors(v as u32);
-            ring.iter()
-                .map(|&u| point(positions[u as usize]))
-                .sum::<DVec3>()
-                / ring.len() as f64
-                - point(positions[v])
-        }
-    };
+    // One Kobbelt step for all, from the placed positions, applied together: the umbrella
+    // Laplacian of every vertex first (a split vertex needs its neighbours'), then the steps.
     {
         let placed: &[[f32; 3]] = positions;
+        let at = |v: u32| Vec3A::from_array(placed[v as usize]);
+        (0..fine_count)
+            .into_par_iter()
+            .with_min_len(PARALLEL_GRAIN)
+            .map(|v| {
+                if on_loop(v) {
+                    let [a, b] = loops[v];
+                    (at(a) + at(b)) * 0.5 - at(v as u32)
+                } else {
+                    let ring = topology.neighbors(v as u32);
+                    let sum: Vec3A = ring.iter().map(|&u| at(u)).sum();
+                    sum / ring.len().max(1) as f32 - at(v as u32)
+                }
+            })
+            .collect_into_vec(laplacians);
+    }
+    {
+        let laplacians: &[Vec3A] = laplacians;
         split
             .clone()
             .into_par_iter()
+            .with_min_len(PARALLEL_GRAIN)
             .map(|v| {
-                let own = laplacian(v, placed);
+                let own = laplacians[v];
                 let (sum, inverse_valences, n) = if on_loop(v) {
                     let [a, b] = loops[v];
-                    (
-                        laplacian(a as usize, placed) + laplacian(b as usize, placed),
-                        1.0,
-                        2.0,
-                    )
+                    (laplacians[a as usize] + laplacians[b as usize], 1.0, 2.0)
                 } else {
                     let ring = topology.neighbors(v as u32);
-                    let mut sum = DVec3::ZERO;
+                    let mut sum = Vec3A::ZERO;
                     let mut inverse_valences = 0.0;
                     for &u in ring {
-                        sum += laplacian(u as usize, placed);
-                        inverse_valences += 1.0 / topology.valence(u) as f64;
+                        sum += laplacians[u as usize];
+                        inverse_valences += 1.0 / topology.valence(u) as f32;
                     }
-                    (sum, inverse_valences, ring.len() as f64)
+                    (sum, inverse_valences, ring.len() as f32)
                 };
                 let l2 = sum / n - own;
                 let nu = 1.0 + inverse_valences / n;
@@ -436,7 +473,7 @@ fn refine_positions(
     positions[coarse_count..]
         .par_iter_mut()
         .zip(displacements.par_iter())
-        .for_each(|(p, d)| *p = (point(*p) + *d).as_vec3().to_array());
+        .for_each(|(p, d)| *p = (Vec3A::from_array(*p) + *d).to_array());
 
     if variant == MultiresVariant::Paper {
         return;

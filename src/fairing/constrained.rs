@@ -269,22 +269,11 @@ impl ConstrainedFairing {
         let triangles = &mesh.triangles;
         let is_boundary = topology.boundary_flags();
 
-        // One-rings, in fan order where possible. A closed fan has as many entries as the vertex
-        // has neighbours, so the rings share the topology's CSR offsets and are written in place.
         let ring_offsets = topology.neighbor_csr().0.to_vec();
-        let mut ring = vec![0u32; topology.neighbor_csr().1.len()];
-        let mut closed = vec![false; vertex_count];
-        split_by_offsets(&mut ring, &ring_offsets)
-            .into_par_iter()
-            .zip(closed.par_iter_mut())
-            .enumerate()
-            .for_each(|(v, (ring_v, closed_v))| {
-                let v = v as u32;
-                *closed_v = !is_boundary[v as usize] && closed_fan(v, topology, triangles, ring_v);
-                if !*closed_v {
-                    ring_v.copy_from_slice(topology.neighbors(v));
-                }
-            });
+        let FanRings {
+            ring,
+            closed_fan: closed,
+        } = FanRings::new(triangles, topology);
 
         let valence = |v: u32| topology.valence(v);
         let interior = |t: &[u32; 3]| {
@@ -641,7 +630,7 @@ impl ConstrainedFairing {
 }
 
 impl<I: Copy + Into<u32> + Sync> Stencil<'_, I> {
-    /// The anchors' contribution to every vertex's update, constant within a round (f64 sums).
+    /// The anchors' contribution to every vertex's update, constant within a round.
     fn anchor_terms(&self, anchors: &[Vec3A], terms: &mut [Vec3A]) {
         terms
             .par_chunks_mut(CHUNK)
@@ -650,17 +639,12 @@ impl<I: Copy + Into<u32> + Sync> Stencil<'_, I> {
                 let start = chunk * CHUNK;
                 for (i, term) in out.iter_mut().enumerate() {
                     let v = start + i;
-                    let w = self.self_weights[v][2] as f64;
-                    let mut sum = anchors[v].to_array().map(|x| w * x as f64);
+                    let mut sum = anchors[v] * self.self_weights[v][2];
                     let entries = self.offsets[v] as usize..self.offsets[v + 1] as usize;
                     for (&u, &row) in self.ring[entries.clone()].iter().zip(&self.index[entries]) {
-                        let w = self.rows[row.into() as usize][2] as f64;
-                        let p = anchors[u as usize];
-                        for k in 0..3 {
-                            sum[k] += w * p[k] as f64;
-                        }
+                        sum += anchors[u as usize] * self.rows[row.into() as usize][2];
                     }
-                    *term = Vec3A::from_array(sum.map(|s| s as f32));
+                    *term = sum;
                 }
             });
     }
@@ -832,6 +816,39 @@ fn umbrella_mean(x: &[Vec3A], ring: &[u32], inverse_valence: f32) -> Vec3A {
         even += x[*u as usize];
     }
     (even + odd) * inverse_valence
+}
+
+/// Every vertex's one-ring, in fan order where possible, sharing the topology's one-ring CSR
+/// offsets (a closed fan has as many entries as the vertex has neighbours).
+pub(crate) struct FanRings {
+    /// For a vertex with a closed, consistently oriented fan, its neighbours in fan order (faces
+    /// (v, ring[k], ring[k+1])); otherwise the topology's sorted neighbours.
+    pub ring: Vec<u32>,
+    pub closed_fan: Vec<bool>,
+}
+
+impl FanRings {
+    pub fn new(triangles: &[[u32; 3]], topology: &Topology) -> Self {
+        let (offsets, neighbors) = topology.neighbor_csr();
+        let is_boundary = topology.boundary_flags();
+        let mut ring = vec![0u32; neighbors.len()];
+        let mut closed = vec![false; offsets.len().saturating_sub(1)];
+        split_by_offsets(&mut ring, offsets)
+            .into_par_iter()
+            .zip(closed.par_iter_mut())
+            .enumerate()
+            .for_each(|(v, (ring_v, closed_v))| {
+                let v = v as u32;
+                *closed_v = !is_boundary[v as usize] && closed_fan(v, topology, triangles, ring_v);
+                if !*closed_v {
+                    ring_v.copy_from_slice(topology.neighbors(v));
+                }
+            });
+        FanRings {
+            ring,
+            closed_fan: closed,
+        }
+    }
 }
 
 /// Writes v's neighbours in fan order (faces (v, fan[k], fan[k+1])) into `fan` when v has a closed,

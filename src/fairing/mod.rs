@@ -16,32 +16,36 @@
 //! is already smooth, so vertices slide along the surface.
 //!
 //! [`FairVariant::NormalProjected`] (the default) computes exactly the paper's update x̃ (all
-//! vertices, Jacobi) and keeps only the component of each move x̃_v − x_v along the unit normal of
-//! v's updated fan (the area-weighted normal of the triangles around x̃_v); boundary vertices keep
-//! the part of the curve update orthogonal to the loop's tangent. Noise lies across the surface,
-//! so removing it needs only normal motion; the tangential part of the paper's update is the
-//! sliding. (Projecting on the normal of the previous iterate instead was measured worse: on the
-//! noisy sphere it changes the volume by 0.024% in the first iteration against the paper's 0.005%;
-//! the updated fan's normal gives 0.005%.)
+//! vertices, Jacobi) and keeps only the component of each move x̃_v − x_v along the normal of v's
+//! fan taken at the midpoints between the positions and their umbrella means; boundary vertices
+//! keep the part of the curve update orthogonal to the loop's tangent. Noise lies across the
+//! surface, so removing it needs only normal motion; the tangential part of the paper's update is
+//! the sliding. Which normal: the one that keeps the volume best is the volume gradient halfway
+//! along the move; the midpoint fan approximates it without a third pass over the mesh (the
+//! measurements of the other candidates are in [`constrained`]'s docs; the fan of the updated
+//! positions, used until November 2026, cost a third gather pass and measured about the same or
+//! slightly worse in every row of the table below).
 //!
-//! Measured with `examples/fairing_quality.rs` (10 iterations per round):
+//! Measured with `examples/fairing_quality.rs` (10 iterations per round; surface distances in
+//! mean edge lengths of the clean mesh):
 //! - Noise-free meshes, mean vertex move in mean edge lengths, paper → normal-projected:
-//!   `bunny00` 0.097 → 0.006, `elephant` 0.104 → 0.032, `mushroom_open` 0.005 → 0.0007.
-//!   Volume changes are the same for both (bunny −0.002%; elephant −0.33% for both: that loss is
-//!   the smoothing of the coarse mesh's thin legs and trunk, not sliding, and projection does not
-//!   remove it).
+//!   `bunny00` 0.097 → 0.006, `elephant` 0.105 → 0.032, `mushroom_open` 0.005 → 0.0007.
+//!   Volume changes are about the same for both (bunny −0.002%; elephant −0.33% and −0.32%: that
+//!   loss is the smoothing of the coarse mesh's thin legs and trunk, not sliding, and projection
+//!   does not remove it).
 //! - Noisy meshes (0.3 mean edge lengths along normals, seed 1; mean surface distance to the
-//!   clean mesh by `metrics::compare`, in mean edge lengths): about equal to the paper's at one
-//!   round (bunny 0.1024 against 0.1026, elephant 0.1007 against 0.1023, mushroom 0.1022 against
-//!   0.1018) and better at many rounds, where the paper's sliding accumulates (best settings:
-//!   bunny 0.0557 at 40 rounds against 0.0567 at 30; elephant 0.0872 against 0.0893 at 3;
-//!   mushroom 0.0427 against 0.0440 at 60). The vertex RMS to the clean mesh is much lower
-//!   (bunny, 20 rounds: 0.09 against 0.22) and keeps falling with rounds. Its volume drifts a
-//!   little more with many rounds on bunny (+0.03% at 40 rounds against −0.01%).
+//!   clean mesh by `metrics::compare`): about equal to the paper's at one round (bunny 0.1012
+//!   against 0.1015, elephant 0.0956 against 0.0976, mushroom 0.1042 against 0.1041) and better at
+//!   many rounds, where the paper's sliding accumulates (best: bunny 0.0549 at 40 rounds against
+//!   0.0566 at 30; elephant 0.0820 against 0.0841 at 3; mushroom 0.0460 at 60 against 0.0466). The
+//!   vertex RMS to the clean mesh is much lower (bunny, 20 rounds: 0.089 against 0.215) and keeps
+//!   falling with rounds. Its volume drifts a little more with many rounds on bunny (+0.024% at 40
+//!   rounds against −0.023%).
 //!
 //! So the default keeps vertices where they belong (texture coordinates, per-vertex attributes and
 //! triangle shapes stay meaningful, and rounds do not accumulate drift), is as close or closer to
-//! the clean surface, and costs one extra gather pass per iteration. [`FairVariant::Paper`] remains
+//! the clean surface, and costs a fan normal per vertex in the same two passes (on `bunny00` about
+//! 0.64 ms an iteration against the paper's 0.43, 2 threads). [`FairVariant::Paper`] remains
 //! available and is the faster of the two.
 //!
 //! Both variants use the paper's uniform weights, so the local matrices depend on the valence
@@ -82,7 +86,7 @@ impl BoundaryMode {
 pub enum FairVariant {
     /// The paper's operator exactly (uniform umbrella weights, eq 7, plain average).
     Paper,
-    /// The paper's update with only its component along the normal of the updated fan kept
+    /// The paper's update with only its component along the normal of the midpoint fan kept
     /// (boundary vertices: the component orthogonal to the loop tangent), so vertices no longer
     /// slide along the surface. The default; see the module docs for why.
     #[default]
