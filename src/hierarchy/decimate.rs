@@ -691,7 +691,11 @@ fn choose_collapse(
         }
         // Link condition: apart from the opposite vertices, no neighbour of v may be one of k.
         let neighbors = &scratch.neighbors;
-        let shared = |x: u32| x != opposite[0] && x != opposite[1] && neighbors.contains(&x);
+        // (Without early exits: this runs for every face of `k`, and exits would be unpredictable.)
+        let shared = |x: u32| {
+            let found = neighbors.iter().fold(false, |found, &y| found | (y == x));
+            found & (x != opposite[0]) & (x != opposite[1])
+        };
         let mut link_ok = true;
         let tetrahedron_check = !on_boundary && valence == 3;
         let single_triangle = on_boundary && valence == 2;
@@ -702,9 +706,7 @@ fn choose_collapse(
         };
         let mut faces_on_third_edge = 0;
         view.for_each_face_of(k, |a, b| {
-            if shared(a) || shared(b) {
-                link_ok = false;
-            }
+            link_ok &= !(shared(a) | shared(b));
             // The tetrahedron case: k's other faces already hold both opposite vertices.
             if tetrahedron_check
                 && (a == opposite[0] && b == opposite[1] || a == opposite[1] && b == opposite[0])
