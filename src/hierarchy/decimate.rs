@@ -31,19 +31,38 @@
 //!   faces form one consistently oriented fan); otherwise the build refuses with
 //!   `HierarchyError::Unsupported` naming the vertex.
 //!
-//! Speed. The pass state is flat arrays: the faces' corners, the fans of the level in CSR form
-//! (for every face `(v, a, b)` the pair `(a, b)` at `v`, built by a counting sort at the start of
-//! the pass), and one stamp per vertex (locked / removed in this pass). No face is rewritten
-//! during the pass: the removed vertices are independent, so their collapses touch disjoint face
-//! sets and compose as one simultaneous relabelling `v -> target[v]`, done after the pass (faces
-//! that degenerate are the removed ones). During the pass, a vertex that is not locked still has
-//! exactly its pass-start fan; the current faces of a collapse target `k` are its pass-start fan
-//! relabelled through this pass's removals (a face that degenerates is gone) plus the fans of the
-//! vertices collapsed into it, chained in `absorbed` lists. Visiting vertices in cost order jumps
-//! all over the mesh, so the build first renumbers vertices in Morton order of their positions
-//! (faces by their first corner), which keeps a vertex's neighbours near it in memory; ties in
-//! the visiting order and among equal cone volumes still go by M0's ids, so the result does not
-//! depend on this renumbering.
+//! Speed. Each level is a compact mesh: vertices `0..V`, faces `0..F`, positions and M0 ids in
+//! flat arrays. M0 enters in Morton order of its positions (faces by their first corner), since
+//! visiting in cost order jumps all over the mesh and this keeps a vertex's neighbours near it
+//! in memory; every later level keeps the order of the one below, so it stays local, and a pass
+//! only touches arrays of its own level's size. Ties in the visiting order and among equal cone
+//! volumes go by M0's ids, so the result does not depend on this ordering. A pass:
+//! - builds the fans of the level in CSR form (for every face `(v, a, b)` the pair `(a, b)` at
+//!   `v`, in face order) by a counting sort;
+//! - computes every vertex's cost and whether its fan is open, in parallel: min and max are
+//!   taken over squared lengths (square root and rounding to f32 are monotone, so they commute
+//!   with min and max), and a fan is open exactly when the sums of its `a`s and its `b`s differ
+//!   (see `visiting_order`);
+//! - sorts the vertices by cost with an LSD radix sort on the cost's bits;
+//! - visits them. No face is rewritten during the pass: the removed vertices are independent,
+//!   so their collapses touch disjoint face sets and compose as one simultaneous relabelling
+//!   `v -> target[v]`. A vertex that is not locked still has exactly its pass-start fan; the
+//!   current faces of a collapse target `k` are its pass-start fan relabelled through this pass's
+//!   removals (a face that degenerates is gone) plus the fans of the vertices collapsed into it,
+//!   chained in `absorbed` lists. The cone volume of every candidate is summed over all of `v`'s
+//!   faces in fan order (those that contain the candidate add an exact zero), and candidates
+//!   are taken least first rather than sorted, since the first is nearly always valid. The
+//!   fan and link checks compare without early exits, which would be mispredicted;
+//! - writes the next level: survivors keep their order, faces are relabelled, and those that
+//!   degenerate are the removed ones.
+//!
+//! Where the time goes (one thread): about half is the visits, which are sequential and wait on
+//! memory (a tried vertex costs about 900 cycles on bunny00 and 1400 on a 600k-vertex mesh, in
+//! roughly equal parts gathering its fan, summing the cones, the flip check and the link check);
+//! then costs and sorting (about 15%), fans and next level (15%), and M0's ordering, the input
+//! check and storing the result (15%). Software prefetching of the vertices ahead in the visiting
+//! order, and skipping the exact cone sums of candidates that an error-bounded estimate rules
+//! out, were tried and did not measurably help.
 
 use super::{HierarchyError, HierarchyOptions};
 use crate::mesh::TriMesh;
@@ -76,54 +95,48 @@ pub(super) fn build(
     options: &HierarchyOptions,
     progress: &mut dyn Progress,
 ) -> Result<BuildOutput, HierarchyError> {
-    let (local, vertex_of_local, face_of_local) = spatially_ordered(mesh);
-    let built =
-        build_ordered(&local, &vertex_of_local, options, progress).map_err(|e| match e {
-            BuildFailure::NonManifold(v) => HierarchyError::Unsupported(format!(
-                "the mesh is not an oriented 2-manifold at vertex {}: its faces do not form one \
+    passes(mesh, first_level(mesh), options, progress).map_err(|e| match e {
+        BuildFailure::NonManifold(v) => HierarchyError::Unsupported(format!(
+            "the mesh is not an oriented 2-manifold at vertex {v}: its faces do not form one \
              consistently oriented fan (an edge with more than two faces, two fans meeting at \
-             the vertex, or faces of opposite orientation)",
-                vertex_of_local[v]
-            )),
-            BuildFailure::Cancelled => HierarchyError::Cancelled,
-        })?;
-    // Back to M0's numbering.
-    let n = mesh.vertex_count();
-    let mut out = BuildOutput {
-        removed_in_pass: vec![NEVER; n],
-        target: vec![NEVER; n],
-        six_split_volume: vec![0.0; n],
-        face_removed_in_pass: vec![NEVER; mesh.face_count()],
-        pass_ms: built.pass_ms,
-    };
-    for (local_v, &v) in vertex_of_local.iter().enumerate() {
-        let v = v as usize;
-        out.removed_in_pass[v] = built.removed_in_pass[local_v];
-        let k = built.target[local_v];
-        out.target[v] = if k == NEVER {
-            NEVER
-        } else {
-            vertex_of_local[k as usize]
-        };
-        out.six_split_volume[v] = built.six_split_volume[local_v];
-    }
-    for (local_f, &f) in face_of_local.iter().enumerate() {
-        out.face_removed_in_pass[f as usize] = built.face_removed_in_pass[local_f];
-    }
-    Ok(out)
+             the vertex, or faces of opposite orientation)"
+        )),
+        BuildFailure::Cancelled => HierarchyError::Cancelled,
+    })
 }
 
 enum BuildFailure {
-    NonManifold(usize),
+    /// M0 id of a vertex whose faces are not one oriented fan.
+    NonManifold(u32),
     Cancelled,
 }
 
-/// The mesh with vertices in Morton order of their positions and faces in order of their first
-/// corner, so that the neighbours of a vertex are near it in memory (the passes visit vertices in
-/// cost order, which jumps all over the mesh). Returns it with the M0 ids of its vertices and
-/// faces.
-fn spatially_ordered(mesh: &TriMesh) -> (TriMesh, Vec<u32>, Vec<u32>) {
+/// One level during the build, compact: its vertices are `0..V` and its faces `0..F`. M0's
+/// vertices are put in Morton order of their positions and its faces in order of their first
+/// corner (see `first_level`), and a level keeps the order of the one below, so a pass only
+/// touches arrays of its level's size and a vertex's neighbours are near it in memory.
+#[derive(Default)]
+struct Level {
+    points: Vec<[f32; 3]>,
+    /// M0 id of each vertex: where its collapse is recorded, and ties in the visiting order and
+    /// among equal cone volumes go by it.
+    vertex_id: Vec<u32>,
+    corners: Vec<[u32; 3]>,
+    /// M0 id of each face.
+    face_id: Vec<u32>,
+}
+
+/// M0 as the first level: the vertices that some face uses (isolated ones are never removed) in
+/// Morton order of their positions (quantized to 10 bits per axis in M0's bounding box; ties by
+/// id), the faces in order of their first corner's place in that order (ties by id).
+fn first_level(mesh: &TriMesh) -> Level {
     let n = mesh.vertex_count();
+    let mut level_of = vec![NEVER; n];
+    for t in &mesh.triangles {
+        for &c in t {
+            level_of[c as usize] = 0;
+        }
+    }
     let (lo, hi) = crate::metrics::bounding_box(mesh).unwrap_or_default();
     let scale = (hi - lo).max_element().max(f64::MIN_POSITIVE);
     let spread = |x: u64| {
@@ -134,88 +147,98 @@ fn spatially_ordered(mesh: &TriMesh) -> (TriMesh, Vec<u32>, Vec<u32>) {
         x = (x | x << 4) & 0x030c30c3;
         (x | x << 2) & 0x09249249
     };
-    let mut keys: Vec<u64> = mesh
-        .positions
-        .par_iter()
-        .enumerate()
-        .map(|(v, p)| {
+    let mut keys: Vec<u64> = (0..n)
+        .into_par_iter()
+        .with_min_len(4096)
+        .filter(|&v| level_of[v] == 0)
+        .map(|v| {
+            let p = mesh.positions[v];
             let q = |c: usize| (((p[c] as f64 - lo[c]) / scale * 1023.0).clamp(0.0, 1023.0)) as u64;
             (spread(q(0)) | spread(q(1)) << 1 | spread(q(2)) << 2) << 32 | v as u64
         })
         .collect();
-    keys.par_sort_unstable();
-    let vertex_of_local: Vec<u32> = keys.iter().map(|&k| k as u32).collect();
-    let mut local_of = vec![0u32; n];
-    for (i, &v) in vertex_of_local.iter().enumerate() {
-        local_of[v as usize] = i as u32;
+    sort_by_high_half(&mut keys, &mut Vec::new());
+    let vertex_id: Vec<u32> = keys.iter().map(|&k| k as u32).collect();
+    drop(keys);
+    for (i, &v) in vertex_id.iter().enumerate() {
+        level_of[v as usize] = i as u32;
     }
-    let mut face_keys: Vec<u64> = mesh
-        .triangles
-        .par_iter()
-        .enumerate()
-        .map(|(f, t)| (local_of[t[0] as usize] as u64) << 32 | f as u64)
-        .collect();
-    face_keys.par_sort_unstable();
-    let face_of_local: Vec<u32> = face_keys.iter().map(|&k| k as u32).collect();
-    let local = TriMesh::new(
-        vertex_of_local
+    // Faces by a counting sort on their first corner's place (stable, so ties stay by id).
+    let mut starts = vec![0u32; vertex_id.len() + 1];
+    for t in &mesh.triangles {
+        starts[level_of[t[0] as usize] as usize + 1] += 1;
+    }
+    for i in 1..starts.len() {
+        starts[i] += starts[i - 1];
+    }
+    let mut face_id = vec![0u32; mesh.face_count()];
+    for (f, t) in mesh.triangles.iter().enumerate() {
+        let slot = &mut starts[level_of[t[0] as usize] as usize];
+        face_id[*slot as usize] = f as u32;
+        *slot += 1;
+    }
+    Level {
+        points: vertex_id
             .iter()
             .map(|&v| mesh.positions[v as usize])
             .collect(),
-        face_of_local
+        corners: face_id
             .iter()
-            .map(|&f| mesh.triangles[f as usize].map(|c| local_of[c as usize]))
+            .map(|&f| mesh.triangles[f as usize].map(|c| level_of[c as usize]))
             .collect(),
-    );
-    (local, vertex_of_local, face_of_local)
+        vertex_id,
+        face_id,
+    }
 }
 
-/// The passes on a mesh whose vertex `v` is M0's `original[v]` (ties in the visiting order and
-/// among equal cone volumes are broken by M0's ids, as if the build ran on M0's numbering).
-fn build_ordered(
+/// `mark` of a vertex that is neither removed nor locked in the current pass.
+const FREE: u32 = u32::MAX;
+/// `mark` of a neighbour of a vertex removed in the current pass.
+const LOCKED: u32 = u32::MAX - 1;
+
+/// The per-pass arrays, sized for the level and reused from pass to pass.
+#[derive(Default)]
+struct PassState {
+    /// The fans in CSR form: for every face `(v, a, b)` the pair `(a, b)` at `v`, in face order.
+    fan_offsets: Vec<u32>,
+    fans: Vec<[u32; 2]>,
+    cursor: Vec<u32>,
+    /// `(cost bits << 32) | vertex`, sorted into visiting order.
+    keys: Vec<u64>,
+    sort_buffer: Vec<u64>,
+    /// Whether the vertex's fan is open (it is on a boundary).
+    open: Vec<bool>,
+    /// `FREE`, `LOCKED`, or the collapse target of a vertex removed in this pass.
+    mark: Vec<u32>,
+    /// Vertices collapsed into a vertex during this pass, as linked lists.
+    absorbed_head: Vec<u32>,
+    absorbed_next: Vec<u32>,
+    /// Id in the next level of every vertex's image (its target's if removed).
+    label: Vec<u32>,
+}
+
+/// The passes, from M0 (given as its first level) up.
+fn passes(
     mesh: &TriMesh,
-    original: &[u32],
+    mut level: Level,
     options: &HierarchyOptions,
     progress: &mut dyn Progress,
 ) -> Result<BuildOutput, BuildFailure> {
     let n = mesh.vertex_count();
-    let face_count = mesh.face_count();
-    let points: &[[f32; 3]] = &mesh.positions;
-    let mut corners: Vec<[u32; 3]> = mesh.triangles.clone();
-
     let mut out = BuildOutput {
         removed_in_pass: vec![NEVER; n],
         target: vec![NEVER; n],
         six_split_volume: vec![0.0; n],
-        face_removed_in_pass: vec![NEVER; face_count],
+        face_removed_in_pass: vec![NEVER; mesh.face_count()],
         pass_ms: Vec::new(),
     };
-    let mut alive_faces: Vec<u32> = (0..face_count as u32).collect();
-    let mut referenced = vec![false; n];
-    for t in &mesh.triangles {
-        for &c in t {
-            referenced[c as usize] = true;
-        }
-    }
-    let mut alive_vertices: Vec<u32> = (0..n as u32).filter(|&v| referenced[v as usize]).collect();
-    drop(referenced);
-    let isolated = n - alive_vertices.len();
-
-    let mut fan_offsets = vec![0u32; n + 1];
-    let mut fans: Vec<[u32; 2]> = Vec::with_capacity(3 * face_count);
-    let mut cursor: Vec<u32> = vec![0; n];
-    let mut edge_min = vec![f32::INFINITY; n];
-    let mut edge_max = vec![0f32; n];
-    let mut keys: Vec<u64> = Vec::with_capacity(alive_vertices.len());
-    // `2 * stamp` while locked in the pass of that stamp, `2 * stamp + 1` once removed in it.
-    let mut state = vec![0u32; n];
-    let mut absorbed_head = vec![NEVER; n];
-    let mut absorbed_next = vec![NEVER; n];
+    let isolated = n - level.points.len();
+    let mut next = Level::default();
+    let mut state = PassState::default();
     let mut scratch = Scratch::default();
-
-    let start_vertices = alive_vertices.len() as f64;
+    let start_vertices = level.points.len() as f64;
     let goal = (start_vertices - options.min_vertices as f64).max(1.0);
-    let mut vertex_count = alive_vertices.len() + isolated;
+    let mut vertex_count = n;
     let mut visits = 0usize;
 
     for pass in 0..options.max_levels.max(1) as u32 {
@@ -225,82 +248,25 @@ fn build_ordered(
             break;
         }
         let started = Instant::now();
-        let stamp = pass + 1;
-
-        // Fans of the current level in CSR form: for each face (v, a, b) the pair (a, b) at v.
-        fan_offsets.fill(0);
-        for &f in &alive_faces {
-            for &c in &corners[f as usize] {
-                fan_offsets[c as usize + 1] += 1;
-            }
-        }
-        for v in 0..n {
-            fan_offsets[v + 1] += fan_offsets[v];
-        }
-        fans.clear();
-        fans.resize(fan_offsets[n] as usize, [0; 2]);
-        cursor.copy_from_slice(&fan_offsets[..n]);
-        for &f in &alive_faces {
-            let [x, y, z] = corners[f as usize];
-            for (v, pair) in [(x, [y, z]), (y, [z, x]), (z, [x, y])] {
-                let slot = &mut cursor[v as usize];
-                fans[*slot as usize] = pair;
-                *slot += 1;
-            }
-        }
+        let level_vertices = level.points.len();
+        build_fans(&level.corners, level_vertices, &mut state);
         if pass == 0 {
-            if let Some(v) = first_non_manifold_vertex(&fan_offsets, &fans) {
-                return Err(BuildFailure::NonManifold(v));
+            if let Some(v) = first_non_manifold_vertex(&state.fan_offsets, &state.fans) {
+                return Err(BuildFailure::NonManifold(level.vertex_id[v]));
             }
             if vertex_count <= options.min_vertices || options.max_levels == 0 {
                 break;
             }
         }
+        visiting_order(&level, options, &mut state);
 
-        // Costs on the current level.
-        for &v in &alive_vertices {
-            edge_min[v as usize] = f32::INFINITY;
-            edge_max[v as usize] = 0.0;
-        }
-        for &f in &alive_faces {
-            let t = corners[f as usize];
-            for i in 0..3 {
-                let (a, b) = (t[i] as usize, t[(i + 1) % 3] as usize);
-                let length = point(points, a as u32).distance(point(points, b as u32)) as f32;
-                edge_min[a] = edge_min[a].min(length);
-                edge_max[a] = edge_max[a].max(length);
-                edge_min[b] = edge_min[b].min(length);
-                edge_max[b] = edge_max[b].max(length);
-            }
-        }
-        keys.clear();
-        keys.extend(alive_vertices.iter().map(|&v| {
-            let cost = (options.alpha * edge_min[v as usize] as f64
-                + options.beta * edge_max[v as usize] as f64) as f32;
-            // Non-negative finite f32s order like their bit patterns.
-            let bits = if cost.is_finite() && cost >= 0.0 {
-                cost.to_bits()
-            } else {
-                f32::INFINITY.to_bits()
-            };
-            (bits as u64) << 32 | v as u64
-        }));
-        keys.par_sort_unstable();
-        // Equal costs go by M0's vertex id.
-        let mut run = 0;
-        while run < keys.len() {
-            let cost = keys[run] >> 32;
-            let end = run + keys[run..].partition_point(|&k| k >> 32 == cost);
-            if end - run > 1 {
-                keys[run..end].sort_unstable_by_key(|&k| original[k as u32 as usize]);
-            }
-            run = end;
-        }
-
-        let locked = 2 * stamp;
-        let removed_mark = 2 * stamp + 1;
+        state.mark.clear();
+        state.mark.resize(level_vertices, FREE);
+        state.absorbed_head.clear();
+        state.absorbed_head.resize(level_vertices, NEVER);
+        state.absorbed_next.resize(level_vertices, NEVER);
         let mut removed = 0usize;
-        for &key in &keys {
+        for &key in &state.keys {
             visits += 1;
             if visits.is_multiple_of(REPORT_EVERY) {
                 let done = (start_vertices - vertex_count as f64 + isolated as f64) / goal;
@@ -312,67 +278,217 @@ fn build_ordered(
                 break;
             }
             let v = key as u32;
-            if state[v as usize] >= locked {
+            if state.mark[v as usize] != FREE {
+                continue;
+            }
+            let open = state.open[v as usize];
+            if open && options.keep_boundary {
                 continue;
             }
             let view = PassView {
-                points,
-                fan_offsets: &fan_offsets,
-                fans: &fans,
-                state: &state,
-                target: &out.target,
-                absorbed_head: &absorbed_head,
-                absorbed_next: &absorbed_next,
-                locked,
+                points: &level.points,
+                fan_offsets: &state.fan_offsets,
+                fans: &state.fans,
+                mark: &state.mark,
+                absorbed_head: &state.absorbed_head,
+                absorbed_next: &state.absorbed_next,
             };
-            let Some((k, six_volume)) = choose_collapse(v, &view, original, options, &mut scratch)
+            let Some((k, six_volume)) =
+                choose_collapse(v, open, &view, &level.vertex_id, &mut scratch)
             else {
                 continue;
             };
 
-            // Perform v -> k: faces are relabelled after the pass (a pass's collapses touch
-            // disjoint face sets, so they compose as one simultaneous relabelling).
-            state[v as usize] = removed_mark;
+            // Perform v -> k: faces are relabelled when the next level is built (a pass's
+            // collapses touch disjoint face sets, so they compose as one simultaneous relabelling).
+            state.mark[v as usize] = k;
             for &x in &scratch.neighbors {
-                state[x as usize] = locked;
+                state.mark[x as usize] = LOCKED;
             }
-            absorbed_next[v as usize] = absorbed_head[k as usize];
-            absorbed_head[k as usize] = v;
-            out.removed_in_pass[v as usize] = pass;
-            out.target[v as usize] = k;
-            out.six_split_volume[v as usize] = six_volume as f32;
+            state.absorbed_next[v as usize] = state.absorbed_head[k as usize];
+            state.absorbed_head[k as usize] = v;
+            let id = level.vertex_id[v as usize] as usize;
+            out.removed_in_pass[id] = pass;
+            out.target[id] = level.vertex_id[k as usize];
+            out.six_split_volume[id] = six_volume as f32;
             vertex_count -= 1;
             removed += 1;
-        }
-
-        // Clear the absorbed lists of this pass.
-        for &key in &keys {
-            absorbed_head[key as u32 as usize] = NEVER;
         }
         if removed == 0 {
             break;
         }
-        // Relabel the faces of the removed vertices; those that degenerate disappear.
-        let (removed_in_pass, target) = (&out.removed_in_pass, &out.target);
-        let face_removed_in_pass = &mut out.face_removed_in_pass;
-        alive_faces.retain(|&f| {
-            let t = &mut corners[f as usize];
-            for c in t.iter_mut() {
-                if removed_in_pass[*c as usize] == pass {
-                    *c = target[*c as usize];
-                }
-            }
-            if t[0] == t[1] || t[1] == t[2] || t[0] == t[2] {
-                face_removed_in_pass[f as usize] = pass;
-                false
-            } else {
-                true
-            }
-        });
-        alive_vertices.retain(|&v| out.removed_in_pass[v as usize] == NEVER);
+        next_level(
+            &level,
+            &mut state,
+            pass,
+            &mut out.face_removed_in_pass,
+            &mut next,
+        );
+        std::mem::swap(&mut level, &mut next);
         out.pass_ms.push(started.elapsed().as_secs_f64() * 1e3);
     }
     Ok(out)
+}
+
+/// The fans of a level with `vertex_count` vertices in CSR form, by a counting sort of the
+/// faces' corners (a vertex's pairs come in face order).
+fn build_fans(corners: &[[u32; 3]], vertex_count: usize, state: &mut PassState) {
+    let offsets = &mut state.fan_offsets;
+    offsets.clear();
+    offsets.resize(vertex_count + 1, 0);
+    for t in corners {
+        for &c in t {
+            offsets[c as usize + 1] += 1;
+        }
+    }
+    for v in 0..vertex_count {
+        offsets[v + 1] += offsets[v];
+    }
+    state.fans.clear();
+    state.fans.resize(3 * corners.len(), [0; 2]);
+    state.cursor.clear();
+    state.cursor.extend_from_slice(&offsets[..vertex_count]);
+    for &[x, y, z] in corners {
+        for (v, pair) in [(x, [y, z]), (y, [z, x]), (z, [x, y])] {
+            let slot = &mut state.cursor[v as usize];
+            state.fans[*slot as usize] = pair;
+            *slot += 1;
+        }
+    }
+}
+
+/// The level's vertices in increasing cost (ties by M0 id) into `state.keys`, and which of them
+/// are on a boundary into `state.open`.
+fn visiting_order(level: &Level, options: &HierarchyOptions, state: &mut PassState) {
+    let vertex_count = level.points.len();
+    let (offsets, fans, points) = (&state.fan_offsets, &state.fans, &level.points);
+    state.keys.resize(vertex_count, 0);
+    state.open.resize(vertex_count, false);
+    state
+        .keys
+        .par_iter_mut()
+        .zip(state.open.par_iter_mut())
+        .enumerate()
+        .with_min_len(1024)
+        .for_each(|(v, (key, open))| {
+            let fan = &fans[offsets[v] as usize..offsets[v + 1] as usize];
+            // In a fan of a manifold level (checked on pass 0, kept by the collapse rules) the
+            // `a`s are distinct and so are the `b`s. A closed fan has the same `a`s as `b`s; an
+            // open one swaps its start (an `a` that is no `b`) for its end (a `b` that is no
+            // `a`, so a different vertex): the sums differ exactly when the fan is open.
+            let (sum_a, sum_b) = fan.iter().fold((0u32, 0u32), |(x, y), &[a, b]| {
+                (x.wrapping_add(a), y.wrapping_add(b))
+            });
+            *open = sum_a != sum_b;
+            // Squared lengths: the square root and the rounding to f32 are monotone, so they
+            // commute with min and max and only the two extremes need them.
+            let xv = point(points, v as u32);
+            let (mut shortest, mut longest) = (f64::INFINITY, 0f64);
+            let mut edge = |c: u32| {
+                let squared = xv.distance_squared(point(points, c));
+                shortest = shortest.min(squared);
+                longest = longest.max(squared);
+            };
+            for &[a, b] in fan {
+                edge(a);
+                if *open {
+                    edge(b);
+                }
+            }
+            let (shortest, longest) = (shortest.sqrt() as f32, longest.sqrt() as f32);
+            let cost = (options.alpha * shortest as f64 + options.beta * longest as f64) as f32;
+            // Non-negative finite f32s order like their bit patterns.
+            let bits = if cost.is_finite() && cost >= 0.0 {
+                cost.to_bits()
+            } else {
+                f32::INFINITY.to_bits()
+            };
+            *key = (bits as u64) << 32 | v as u64;
+        });
+    sort_by_high_half(&mut state.keys, &mut state.sort_buffer);
+    // Equal costs go by M0's vertex id (the sort left them by level id).
+    let keys = &mut state.keys;
+    let mut run = 0;
+    while run < keys.len() {
+        let cost = keys[run] >> 32;
+        let mut end = run + 1;
+        while end < keys.len() && keys[end] >> 32 == cost {
+            end += 1;
+        }
+        if end - run > 1 {
+            keys[run..end].sort_unstable_by_key(|&k| level.vertex_id[k as u32 as usize]);
+        }
+        run = end;
+    }
+}
+
+/// Stable LSD radix sort of `keys` by their upper 32 bits, a byte at a time (bytes that are the
+/// same in every key are skipped).
+fn sort_by_high_half(keys: &mut Vec<u64>, buffer: &mut Vec<u64>) {
+    let mut counts = [[0u32; 256]; 4];
+    for &k in keys.iter() {
+        for (digit, count) in counts.iter_mut().enumerate() {
+            count[(k >> (32 + 8 * digit)) as usize & 255] += 1;
+        }
+    }
+    buffer.resize(keys.len(), 0);
+    for (digit, count) in counts.iter().enumerate() {
+        if count.iter().any(|&c| c as usize == keys.len()) {
+            continue;
+        }
+        let mut starts = [0u32; 256];
+        let mut sum = 0;
+        for (start, &c) in starts.iter_mut().zip(count) {
+            *start = sum;
+            sum += c;
+        }
+        for &k in keys.iter() {
+            let slot = &mut starts[(k >> (32 + 8 * digit)) as usize & 255];
+            buffer[*slot as usize] = k;
+            *slot += 1;
+        }
+        std::mem::swap(keys, buffer);
+    }
+}
+
+/// The level after the pass's collapses: survivors keep their relative order, faces of removed
+/// vertices are relabelled to the targets, and those that degenerate disappear (recorded in
+/// `face_removed_in_pass`).
+fn next_level(
+    level: &Level,
+    state: &mut PassState,
+    pass: u32,
+    face_removed_in_pass: &mut [u32],
+    next: &mut Level,
+) {
+    next.points.clear();
+    next.vertex_id.clear();
+    next.corners.clear();
+    next.face_id.clear();
+    let (mark, label) = (&state.mark, &mut state.label);
+    label.clear();
+    label.resize(level.points.len(), NEVER);
+    for (v, &m) in mark.iter().enumerate() {
+        if m >= LOCKED {
+            label[v] = next.points.len() as u32;
+            next.points.push(level.points[v]);
+            next.vertex_id.push(level.vertex_id[v]);
+        }
+    }
+    for (v, &m) in mark.iter().enumerate() {
+        if m < LOCKED {
+            label[v] = label[m as usize];
+        }
+    }
+    for (t, &f) in level.corners.iter().zip(&level.face_id) {
+        let t = t.map(|c| label[c as usize]);
+        if t[0] == t[1] || t[1] == t[2] || t[0] == t[2] {
+            face_removed_in_pass[f as usize] = pass;
+        } else {
+            next.corners.push(t);
+            next.face_id.push(f);
+        }
+    }
 }
 
 #[inline]
@@ -386,45 +502,67 @@ fn point(points: &[[f32; 3]], v: u32) -> DVec3 {
 /// fan's start (an `a` that is no `b`, or any `a` when the fan is closed) must visit every face.
 fn first_non_manifold_vertex(fan_offsets: &[u32], fans: &[[u32; 2]]) -> Option<usize> {
     let n = fan_offsets.len() - 1;
-    (0..n).into_par_iter().find_first(|&v| {
-        let fan = &fans[fan_offsets[v] as usize..fan_offsets[v + 1] as usize];
-        if fan.is_empty() {
-            return false;
-        }
-        for i in 0..fan.len() {
-            for j in i + 1..fan.len() {
-                if fan[i][0] == fan[j][0] || fan[i][1] == fan[j][1] {
-                    return true;
-                }
-            }
-        }
-        let start = fan
-            .iter()
-            .position(|&[a, _]| !fan.iter().any(|&[_, b]| b == a))
-            .unwrap_or(0);
-        let mut current = start;
-        for step in 1..=fan.len() {
-            let b = fan[current][1];
-            match fan.iter().position(|&[a, _]| a == b) {
-                Some(next) if next == start => return step != fan.len(),
-                Some(next) => current = next,
-                None => return step != fan.len(),
-            }
-        }
-        true
-    })
+    (0..n)
+        .into_par_iter()
+        .with_min_len(1024)
+        .map_init(Vec::new, |next, v| {
+            let fan = &fans[fan_offsets[v] as usize..fan_offsets[v + 1] as usize];
+            (v, !is_one_fan(fan, next))
+        })
+        .find_first(|&(_, bad)| bad)
+        .map(|(v, _)| v)
 }
+
+/// Whether `fan` (the `(a, b)` of the faces `(v, a, b)` of one vertex) is one consistently
+/// oriented fan; `next` is scratch space. The comparisons are all made, without early exits, so
+/// that they compile to straight-line code.
+fn is_one_fan(fan: &[[u32; 2]], next: &mut Vec<usize>) -> bool {
+    let len = fan.len();
+    if len == 0 {
+        return true;
+    }
+    // Distinct `a`s and distinct `b`s; the face following each face (whose `a` is its `b`) and
+    // the start, a face whose `a` is no `b`.
+    let mut repeated = false;
+    let mut start = NONE;
+    next.clear();
+    for (i, &[a, b]) in fan.iter().enumerate() {
+        let mut follower = NONE;
+        let mut preceded = false;
+        for (j, &[c, d]) in fan.iter().enumerate() {
+            repeated |= j > i && (a == c || b == d);
+            follower = if c == b { j } else { follower };
+            preceded |= d == a;
+        }
+        next.push(follower);
+        start = if !preceded && start == NONE { i } else { start };
+    }
+    if repeated {
+        return false;
+    }
+    let start = if start == NONE { 0 } else { start };
+    let mut current = start;
+    for step in 1..=len {
+        match next[current] {
+            NONE => return step == len,
+            following if following == start => return step == len,
+            following => current = following,
+        }
+    }
+    false
+}
+
+/// No face (in `is_one_fan`).
+const NONE: usize = usize::MAX;
 
 /// Read-only view of the pass state for choosing a collapse.
 struct PassView<'a> {
     points: &'a [[f32; 3]],
     fan_offsets: &'a [u32],
     fans: &'a [[u32; 2]],
-    state: &'a [u32],
-    target: &'a [u32],
+    mark: &'a [u32],
     absorbed_head: &'a [u32],
     absorbed_next: &'a [u32],
-    locked: u32,
 }
 
 impl PassView<'_> {
@@ -433,11 +571,12 @@ impl PassView<'_> {
         &self.fans[self.fan_offsets[v as usize] as usize..self.fan_offsets[v as usize + 1] as usize]
     }
 
-    /// The current label of a vertex of the level's start: its target if removed in this pass.
+    /// The current label of a vertex of the level: its target if removed in this pass.
     #[inline]
     fn current(&self, c: u32) -> u32 {
-        if self.state[c as usize] == self.locked + 1 {
-            self.target[c as usize]
+        let m = self.mark[c as usize];
+        if m < LOCKED {
+            m
         } else {
             c
         }
@@ -476,12 +615,13 @@ struct Scratch {
     candidates: Vec<(f64, u32, f64)>,
 }
 
-/// The first valid collapse target of `v` in increasing cone volume, with its signed cone volume.
+/// The first valid collapse target of `v` (on a boundary if `on_boundary`) in increasing cone
+/// volume, with its signed cone volume.
 fn choose_collapse(
     v: u32,
+    on_boundary: bool,
     view: &PassView,
-    original: &[u32],
-    options: &HierarchyOptions,
+    m0_id: &[u32],
     scratch: &mut Scratch,
 ) -> Option<(u32, f64)> {
     let fan = view.fan(v);
@@ -489,22 +629,21 @@ fn choose_collapse(
         return None;
     }
     let p = |c: u32| point(view.points, c);
-    // Boundary: a fan edge v-a (a first in its face) that no face has as v-b opens the fan.
+    // An open fan starts with an edge v-a (a first in its face) that no face has as v-b and ends
+    // with one v-b that no face has as v-a.
     let mut fan_start = NEVER;
     let mut fan_end = NEVER;
-    for &[a, _] in fan {
-        if !fan.iter().any(|&[_, b]| b == a) {
-            fan_start = a;
+    if on_boundary {
+        for &[a, _] in fan {
+            if !fan.iter().any(|&[_, b]| b == a) {
+                fan_start = a;
+            }
         }
-    }
-    for &[_, b] in fan {
-        if !fan.iter().any(|&[a, _]| a == b) {
-            fan_end = b;
+        for &[_, b] in fan {
+            if !fan.iter().any(|&[a, _]| a == b) {
+                fan_end = b;
+            }
         }
-    }
-    let on_boundary = fan_start != NEVER;
-    if on_boundary && options.keep_boundary {
-        return None;
     }
     scratch.neighbors.clear();
     scratch.positions.clear();
@@ -517,27 +656,30 @@ fn choose_collapse(
     }
     let xv = p(v);
 
+    // Cone volumes, summed in fan order. A face that contains `k` adds exactly zero (one of its
+    // edge vectors from `k` is the zero vector), and the sum starts at +0 so it is never -0:
+    // adding that zero changes nothing, so no face needs to be skipped.
     scratch.candidates.clear();
     for &k in &scratch.neighbors {
         if on_boundary && k != fan_start && k != fan_end {
             continue;
         }
         let xk = p(k);
-        let mut cone = 0.0;
-        for (&[a, b], &[xa, xb]) in fan.iter().zip(&scratch.positions) {
-            if a != k && b != k {
-                cone += (xa - xk).cross(xb - xk).dot(xv - xk);
-            }
-        }
+        let cone = scratch.positions.iter().fold(0.0, |cone, &[xa, xb]| {
+            cone + (xa - xk).cross(xb - xk).dot(xv - xk)
+        });
         scratch.candidates.push((cone.abs(), k, cone));
     }
-    scratch.candidates.sort_unstable_by(|x, y| {
-        x.0.total_cmp(&y.0)
-            .then_with(|| original[x.1 as usize].cmp(&original[y.1 as usize]))
-    });
 
+    // Candidates in increasing (|cone|, M0 id): the first is nearly always valid, so take the
+    // least one at a time instead of sorting them.
     let valence = scratch.neighbors.len();
-    'candidate: for &(_, k, cone) in &scratch.candidates {
+    'candidate: while let Some(best) = (0..scratch.candidates.len()).min_by(|&x, &y| {
+        let (x, y) = (&scratch.candidates[x], &scratch.candidates[y]);
+        x.0.total_cmp(&y.0)
+            .then_with(|| m0_id[x.1 as usize].cmp(&m0_id[y.1 as usize]))
+    }) {
+        let (_, k, cone) = scratch.candidates.swap_remove(best);
         let xk = p(k);
         // No surviving face may flip or degenerate.
         let mut opposite = [NEVER; 2];
@@ -558,7 +700,11 @@ fn choose_collapse(
         }
         // Link condition: apart from the opposite vertices, no neighbour of v may be one of k.
         let neighbors = &scratch.neighbors;
-        let shared = |x: u32| x != opposite[0] && x != opposite[1] && neighbors.contains(&x);
+        // (Without early exits: this runs for every face of `k`, and exits would be unpredictable.)
+        let shared = |x: u32| {
+            let found = neighbors.iter().fold(false, |found, &y| found | (y == x));
+            found & (x != opposite[0]) & (x != opposite[1])
+        };
         let mut link_ok = true;
         let tetrahedron_check = !on_boundary && valence == 3;
         let single_triangle = on_boundary && valence == 2;
@@ -569,9 +715,7 @@ fn choose_collapse(
         };
         let mut faces_on_third_edge = 0;
         view.for_each_face_of(k, |a, b| {
-            if shared(a) || shared(b) {
-                link_ok = false;
-            }
+            link_ok &= !(shared(a) | shared(b));
             // The tetrahedron case: k's other faces already hold both opposite vertices.
             if tetrahedron_check
                 && (a == opposite[0] && b == opposite[1] || a == opposite[1] && b == opposite[0])

@@ -27,6 +27,7 @@ mod decimate;
 use crate::mesh::TriMesh;
 use crate::Progress;
 use decimate::NEVER;
+use rayon::prelude::*;
 use std::sync::atomic::{AtomicU64, Ordering};
 
 #[derive(Clone, Debug)]
@@ -339,13 +340,20 @@ pub fn build_hierarchy(
     };
     let level_vertices = level_sizes(&built.removed_in_pass);
     let level_faces = level_sizes(&built.face_removed_in_pass);
-    let positions = order.iter().map(|&v| mesh.positions[v as usize]).collect();
+    // Gathers in M0's order (parallel, as they mostly wait on memory).
+    let positions = order
+        .par_iter()
+        .with_min_len(4096)
+        .map(|&v| mesh.positions[v as usize])
+        .collect();
     let triangles = face_order
-        .iter()
+        .par_iter()
+        .with_min_len(4096)
         .map(|&f| mesh.triangles[f as usize].map(|c| rank[c as usize]))
         .collect();
     let target = order
-        .iter()
+        .par_iter()
+        .with_min_len(4096)
         .map(|&v| {
             let k = built.target[v as usize];
             if k == NEVER {
@@ -356,7 +364,8 @@ pub fn build_hierarchy(
         })
         .collect();
     let six_split_volume = order
-        .iter()
+        .par_iter()
+        .with_min_len(4096)
         .map(|&v| built.six_split_volume[v as usize])
         .collect();
     let mut level_ms = vec![setup_ms + finishing.elapsed().as_secs_f64() * 1e3];
