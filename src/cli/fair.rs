@@ -211,6 +211,8 @@ pub fn bench_rows(mesh: &fairmesh::TriMesh, topology: &fairmesh::Topology) -> Ve
     if mesh.positions.is_empty() {
         return Vec::new();
     }
+    // Iterations come in runs; time blocks of them, as a run gets them back to back.
+    const BLOCK: usize = 10;
     let mut rows = Vec::new();
     let precompute = median_ms(5, || {
         std::hint::black_box(ConstrainedFairing::new(
@@ -226,9 +228,11 @@ pub fn bench_rows(mesh: &fairmesh::TriMesh, topology: &fairmesh::Topology) -> Ve
         let positions = mesh.positions.clone();
         fairing.load(&positions);
         fairing.step();
-        let ms = median_ms(15, || {
-            fairing.step();
-        });
+        let ms = median_ms(7, || {
+            for _ in 0..BLOCK {
+                fairing.step();
+            }
+        }) / BLOCK as f64;
         rows.push((
             format!("fair: constrained iteration ({})", variant.name()),
             ms,
@@ -237,9 +241,11 @@ pub fn bench_rows(mesh: &fairmesh::TriMesh, topology: &fairmesh::Topology) -> Ve
     let stencil = UmbrellaStencil::new(topology, BoundaryMode::Curve);
     let positions = mesh.positions.clone();
     let mut next = positions.clone();
-    let ms = median_ms(15, || {
-        stencil.relax(&positions, &mut next, 0.5);
-    });
+    let ms = median_ms(7, || {
+        for _ in 0..BLOCK {
+            stencil.relax(&positions, &mut next, 0.5);
+        }
+    }) / BLOCK as f64;
     rows.push(("fair: Laplacian iteration".to_string(), ms));
     rows
 }
