@@ -150,14 +150,80 @@ impl MultiresWorkspace {
     /// Builds the connectivity of `level` if not yet cached (all levels up to the coarsest are
     /// cached after a run from the coarsest level).
     pub fn prepare(&mut self, hierarchy: &Hierarchy, level: usize) {
+        self.prepare_levels(hierarchy, level..=level, |_| None);
+    }
+
+    /// Builds every level a run from `options.start_level` (or from the coarsest level, with
+    /// `all`) needs, with the fairing operators of the levels it fairs, so that the runs after it
+    /// only fair. The editor calls this in the background once the hierarchy is built, so that
+    /// moving the level slider never waits for a level's set-up.
+    pub fn prepare_for(&mut self, hierarchy: &Hierarchy, options: &MultiresOptions, all: bool) {
+        let start = if all {
+            hierarchy.coarsest_level()
+        } else {
+            options.start_level.min(hierarchy.coarsest_level())
+        };
+        let fair_last = start == 0 || options.fair_finest;
+        let operator = (FairVariant::Paper, options.boundary);
+        let faired = move |level: usize| (level >= 1 || fair_last).then_some(operator);
+        self.prepare_levels(hierarchy, 0..=start, faired);
+    }
+
+    /// Builds the missing levels of `levels` in parallel (one level per task; each build is
+    /// parallel inside too), with a fairing operator where `operator(level)` names one.
+    fn prepare_levels(
+        &mut self,
+        hierarchy: &Hierarchy,
+        levels: std::ops::RangeInclusive<usize>,
+        operator: impl Fn(usize) -> Option<(FairVariant, BoundaryMode)> + Sync,
+    ) {
         if self.hierarchy_id != hierarchy.id() || self.levels.len() != hierarchy.level_count() {
             self.hierarchy_id = hierarchy.id();
             self.levels.clear();
             self.levels.resize_with(hierarchy.level_count(), || None);
         }
-        if self.levels[level].is_some() {
-            return;
+        let missing: Vec<usize> = levels
+            .filter(|&level| {
+                self.levels[level].as_ref().is_none_or(|data| {
+                    operator(level).is_some_and(|(variant, boundary)| {
+                        !data
+                            .fairing
+                            .as_ref()
+                            .is_some_and(|f| f.variant() == variant && f.boundary() == boundary)
+                    })
+                })
+            })
+            .collect();
+        let mut cached: Vec<Option<LevelData>> = missing
+            .iter()
+            .map(|&level| self.levels[level].take())
+            .collect();
+        let built: Vec<LevelData> = missing
+            .par_iter()
+            .zip(cached.par_iter_mut())
+            .map(|(&level, cached)| {
+                let mut data = cached
+                    .take()
+                    .unwrap_or_else(|| LevelData::build(hierarchy, level));
+                if let Some((variant, boundary)) = operator(level) {
+                    data.fairing = Some(ConstrainedFairing::new(
+                        &data.mesh,
+                        &data.topology,
+                        variant,
+                        boundary,
+                    ));
+                }
+                data
+            })
+            .collect();
+        for (level, data) in missing.into_iter().zip(built) {
+            self.levels[level] = Some(data);
         }
+    }
+}
+
+impl LevelData {
+    fn build(hierarchy: &Hierarchy, level: usize) -> Self {
         let mesh = hierarchy.level_mesh(level);
         let topology = Topology::build(&mesh);
         let mut loop_neighbors = Vec::new();
@@ -172,13 +238,13 @@ impl MultiresWorkspace {
             }
         }
         let fans = FanRings::new(&mesh.triangles, &topology);
-        self.levels[level] = Some(LevelData {
+        LevelData {
             mesh,
             topology,
             loop_neighbors,
             fans,
             fairing: None,
-        });
+        }
     }
 }
 
@@ -207,6 +273,7 @@ fn fair_multires_on_worker(
     progress: &mut dyn Progress,
 ) -> Option<Vec<[f32; 3]>> {
     let start = options.start_level.min(hierarchy.coarsest_level());
+    workspace.prepare_for(hierarchy, options, false);
     let fair_options = FairOptions {
         iterations: options.iterations,
         rounds: options.rounds.max(1),

@@ -699,6 +699,23 @@ impl App {
         }
     }
 
+    /// Sets up every level of a new hierarchy (connectivity and fairing operator) on the compute
+    /// worker, after the view's first fairing (already queued), so that moving the level slider
+    /// later never waits for a level's set-up (bunny00: about 0.2 s for all 20 levels; a
+    /// 1.2M-face mesh: a few seconds).
+    fn prepare_levels(&mut self, hierarchy: Arc<hierarchy::Hierarchy>, document: u64) {
+        let options = self.settings.multires_options(0);
+        let document_generation = self.document_generation.clone();
+        let workspace = self.workspace.clone();
+        self.compute.submit_latest("prepare levels", move || {
+            if !document_generation.is_current(document) {
+                return;
+            }
+            let mut workspace = workspace.lock().unwrap_or_else(PoisonError::into_inner);
+            workspace.prepare_for(&hierarchy, &options, true);
+        });
+    }
+
     fn request_fairing(
         &mut self,
         hierarchy: Arc<hierarchy::Hierarchy>,
@@ -1032,6 +1049,7 @@ impl App {
                             .map(|l| hierarchy.level_info(l))
                             .collect::<Vec<_>>();
                         current.level = current.level.min(levels.len().saturating_sub(1));
+                        let warm = hierarchy.clone();
                         current.hierarchy = HierarchyState::Ready {
                             base_matches_original,
                             hierarchy,
@@ -1039,6 +1057,7 @@ impl App {
                             build_time: elapsed,
                         };
                         self.refresh_view();
+                        self.prepare_levels(warm, document);
                     }
                     Err(HierarchyError::Cancelled) => {
                         current.hierarchy = HierarchyState::Failed("cancelled".into());
