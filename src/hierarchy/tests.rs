@@ -199,3 +199,39 @@ fn tetrahedron_is_not_collapsed_and_cancel_stops() {
         Err(HierarchyError::Cancelled)
     ));
 }
+
+#[test]
+fn same_hierarchy_on_one_thread_and_on_several() {
+    // Large enough that the parallel parts of a pass are split between threads.
+    let mut mesh = sphere(6);
+    for (i, p) in mesh.positions.iter_mut().enumerate() {
+        let bump = 1.0 + 0.01 * ((i * 7919 % 101) as f32 / 101.0);
+        *p = p.map(|c| c * bump);
+    }
+    let build_on = |threads: usize| {
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap()
+            .install(|| build_hierarchy(&mesh, &HierarchyOptions::default(), &mut NoProgress))
+            .unwrap()
+    };
+    let one = build_on(1);
+    assert!(one.level_count() > 3);
+    for threads in [2, 3] {
+        let several = build_on(threads);
+        assert_eq!(several.vertex_order(), one.vertex_order());
+        assert_eq!(several.level_count(), one.level_count());
+        for level in 0..one.level_count() {
+            assert_eq!(several.level_info(level), one.level_info(level));
+            assert_eq!(several.level_triangles(level), one.level_triangles(level));
+        }
+        for v in 0..mesh.vertex_count() as u32 {
+            assert_eq!(several.collapse_target(v), one.collapse_target(v));
+            assert_eq!(
+                several.six_split_volume(v).to_bits(),
+                one.six_split_volume(v).to_bits()
+            );
+        }
+    }
+}
