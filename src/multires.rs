@@ -56,7 +56,7 @@ use crate::fairing::{BoundaryMode, ConstrainedFairing, FairOptions, FairVariant}
 use crate::hierarchy::Hierarchy;
 use crate::mesh::{Topology, TriMesh};
 use crate::Progress;
-use glam::{DVec3, Vec3A};
+use glam::Vec3A;
 use rayon::prelude::*;
 
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -131,7 +131,7 @@ pub struct MultiresWorkspace {
     /// Per split vertex of the level being refined: Kobbelt displacement, then (Improved) the
     /// unit normal and the height that would restore the split's volume.
     displacements: Vec<Vec3A>,
-    heights: Vec<(DVec3, f64, f64)>,
+    heights: Vec<(Vec3A, f64, f64)>,
     /// Per vertex of the finer level: weighted sum of heights of adjacent split vertices, weights.
     height_sums: Vec<[f64; 2]>,
     /// Positions of the level before its fairing, vertex normals and areas, normal displacement
@@ -246,10 +246,6 @@ impl LevelData {
             fairing: None,
         }
     }
-}
-
-fn point(p: [f32; 3]) -> DVec3 {
-    DVec3::new(p[0] as f64, p[1] as f64, p[2] as f64)
 }
 
 /// Returns M0's positions after fairing (M0's triangles are `hierarchy.base_mesh().triangles`),
@@ -474,20 +470,21 @@ fn refine_positions(
     {
         let (coarse, fine) = positions.split_at_mut(coarse_count);
         let coarse: &[[f32; 3]] = coarse;
-        fine.par_iter_mut().enumerate().for_each(|(i, p)| {
-            let v = coarse_count + i;
-            let x = if on_loop(v) {
-                let [a, b] = loops[v];
-                (point(coarse[a as usize]) + point(coarse[b as usize])) * 0.5
-            } else {
-                let ring = topology.neighbors(v as u32);
-                ring.iter()
-                    .map(|&u| point(coarse[u as usize]))
-                    .sum::<DVec3>()
-                    / ring.len() as f64
-            };
-            *p = x.as_vec3().to_array();
-        });
+        let at = |v: u32| Vec3A::from_array(coarse[v as usize]);
+        fine.par_iter_mut()
+            .with_min_len(PARALLEL_GRAIN)
+            .enumerate()
+            .for_each(|(i, p)| {
+                let v = coarse_count + i;
+                let x = if on_loop(v) {
+                    let [a, b] = loops[v];
+                    (at(a) + at(b)) * 0.5
+                } else {
+                    let ring = topology.neighbors(v as u32);
+                    ring.iter().map(|&u| at(u)).sum::<Vec3A>() / ring.len().max(1) as f32
+                };
+                *p = x.to_array();
+            });
     }
 
     // One Kobbelt step for all, from the placed positions, applied together: the umbrella
@@ -551,15 +548,17 @@ fn refine_positions(
     let (face_offsets, vertex_faces) = topology.face_csr();
     {
         let placed: &[[f32; 3]] = positions;
+        let at = |v: u32| Vec3A::from_array(placed[v as usize]);
         split
             .clone()
             .into_par_iter()
+            .with_min_len(PARALLEL_GRAIN)
             .map(|v| {
                 let Some(k) = hierarchy.collapse_target(v as u32) else {
-                    return (DVec3::ZERO, 0.0, 0.0);
+                    return (Vec3A::ZERO, 0.0, 0.0);
                 };
-                let xk = point(placed[k as usize]);
-                let mut area = DVec3::ZERO;
+                let xk = at(k);
+                let mut area = Vec3A::ZERO;
                 for &f in &vertex_faces[face_offsets[v] as usize..face_offsets[v + 1] as usize] {
                     let t = triangles[f as usize];
                     if t.contains(&k) {
@@ -572,14 +571,15 @@ fn refine_positions(
                     } else {
                         (t[0], t[1])
                     };
-                    area += (point(placed[a as usize]) - xk).cross(point(placed[b as usize]) - xk);
+                    area += (at(a) - xk).cross(at(b) - xk);
                 }
                 let weight = area.length();
                 if weight <= 0.0 || !weight.is_finite() {
-                    return (DVec3::ZERO, 0.0, 0.0);
+                    return (Vec3A::ZERO, 0.0, 0.0);
                 }
                 let normal = area / weight;
-                let current = area.dot(point(placed[v]) - xk);
+                let current = area.dot(at(v as u32) - xk) as f64;
+                let weight = weight as f64;
                 let height = (hierarchy.six_split_volume(v as u32) as f64 - current) / weight;
                 (normal, height, weight)
             })
@@ -612,6 +612,6 @@ fn refine_positions(
         .par_iter_mut()
         .zip(heights.par_iter())
         .for_each(|(p, &(normal, height, _))| {
-            *p = (point(*p) + normal * height).as_vec3().to_array()
+            *p = (Vec3A::from_array(*p) + normal * height as f32).to_array()
         });
 }
