@@ -138,8 +138,8 @@ pub struct MultiresWorkspace {
     /// of the fairing and its low-passed copy (Improved's shrinkage correction).
     before_fairing: Vec<[f32; 3]>,
     normals: Vec<Vec3A>,
-    normal_moves: Vec<[f64; 2]>,
-    smoothed_moves: Vec<[f64; 2]>,
+    normal_moves: Vec<[f32; 2]>,
+    smoothed_moves: Vec<[f32; 2]>,
 }
 
 impl MultiresWorkspace {
@@ -406,11 +406,11 @@ fn remove_low_frequency_shrinkage(workspace: &mut MultiresWorkspace, level: usiz
                 Vec3A::ZERO
             };
             let moved = centre - Vec3A::from_array(before[v]);
-            (unit, [(moved.dot(unit) * area) as f64, area as f64])
+            (unit, [moved.dot(unit) * area, area])
         })
         .unzip_into_vecs(normals, normal_moves);
     for _ in 0..SHRINKAGE_SMOOTHING_ROUNDS {
-        let moves: &[[f64; 2]] = normal_moves;
+        let moves: &[[f32; 2]] = normal_moves;
         (0..n)
             .into_par_iter()
             .with_min_len(PARALLEL_GRAIN)
@@ -427,7 +427,7 @@ fn remove_low_frequency_shrinkage(workspace: &mut MultiresWorkspace, level: usiz
             .collect_into_vec(smoothed_moves);
         std::mem::swap(normal_moves, smoothed_moves);
     }
-    let (moves, normals): (&[[f64; 2]], &[Vec3A]) = (normal_moves, normals);
+    let (moves, normals): (&[[f32; 2]], &[Vec3A]) = (normal_moves, normals);
     positions[..n]
         .par_iter_mut()
         .with_min_len(PARALLEL_GRAIN)
@@ -435,7 +435,7 @@ fn remove_low_frequency_shrinkage(workspace: &mut MultiresWorkspace, level: usiz
         .for_each(|(v, p)| {
             let [weighted, area] = moves[v];
             if area > 0.0 {
-                *p = (Vec3A::from_array(*p) - normals[v] * (weighted / area) as f32).to_array();
+                *p = (Vec3A::from_array(*p) - normals[v] * (weighted / area)).to_array();
             }
         });
 }
@@ -586,27 +586,44 @@ fn refine_positions(
             .collect_into_vec(heights);
     }
     for _ in 0..HEIGHT_SMOOTHING_ROUNDS {
-        height_sums.clear();
-        height_sums.resize(fine_count, [0.0; 2]);
-        for (v, &(_, height, weight)) in split.clone().zip(heights.iter()) {
-            for &u in topology.neighbors(v as u32) {
-                let s = &mut height_sums[u as usize];
-                s[0] += height * weight;
-                s[1] += weight;
-            }
+        // Per vertex, the weighted heights of its adjacent split vertices (a gather over the
+        // sorted one-ring: the same sums, in the same order, as scattering from the split
+        // vertices).
+        {
+            let heights: &[(Vec3A, f64, f64)] = heights;
+            (0..fine_count)
+                .into_par_iter()
+                .with_min_len(PARALLEL_GRAIN)
+                .map(|u| {
+                    let mut sum = [0.0; 2];
+                    for &v in topology.neighbors(u as u32) {
+                        if let Some(&(_, height, weight)) =
+                            (v as usize).checked_sub(coarse_count).map(|i| &heights[i])
+                        {
+                            sum[0] += height * weight;
+                            sum[1] += weight;
+                        }
+                    }
+                    sum
+                })
+                .collect_into_vec(height_sums);
         }
         let sums: &[[f64; 2]] = height_sums;
-        heights.par_iter_mut().enumerate().for_each(|(i, entry)| {
-            let mut sum = [0.0; 2];
-            for &u in topology.neighbors((coarse_count + i) as u32) {
-                let s = sums[u as usize];
-                sum[0] += s[0];
-                sum[1] += s[1];
-            }
-            if sum[1] > 0.0 {
-                entry.1 = sum[0] / sum[1];
-            }
-        });
+        heights
+            .par_iter_mut()
+            .with_min_len(PARALLEL_GRAIN)
+            .enumerate()
+            .for_each(|(i, entry)| {
+                let mut sum = [0.0; 2];
+                for &u in topology.neighbors((coarse_count + i) as u32) {
+                    let s = sums[u as usize];
+                    sum[0] += s[0];
+                    sum[1] += s[1];
+                }
+                if sum[1] > 0.0 {
+                    entry.1 = sum[0] / sum[1];
+                }
+            });
     }
     positions[coarse_count..]
         .par_iter_mut()

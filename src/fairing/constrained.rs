@@ -198,6 +198,8 @@ pub struct ConstrainedFairing {
     boundary: BoundaryMode,
     /// Internal vertex i is the mesh's vertex `order[i]`.
     order: Vec<u32>,
+    /// The mesh's vertex v is internal vertex `internal[v]` (the inverse of `order`).
+    internal: Vec<u32>,
     /// One-ring of each vertex (internal numbering): in fan order (faces (v, ring[k], ring[k+1]))
     /// when the vertex has a closed, consistently oriented fan, otherwise the topology's sorted
     /// neighbours.
@@ -452,6 +454,7 @@ impl ConstrainedFairing {
             variant,
             boundary,
             order,
+            internal,
             ring_offsets: internal_offsets,
             ring: internal_ring,
             entry_weight_index,
@@ -551,9 +554,15 @@ impl ConstrainedFairing {
 
     /// Copies the current state into `positions` (the mesh's numbering).
     pub fn store(&self, positions: &mut [[f32; 3]]) {
-        for (state, &v) in self.workspace.current.iter().zip(&self.order) {
-            positions[v as usize] = state.to_array();
-        }
+        let (current, internal) = (&self.workspace.current, &self.internal);
+        positions
+            .par_chunks_mut(CHUNK)
+            .zip(internal.par_chunks(CHUNK))
+            .for_each(|(out, internal)| {
+                for (p, &i) in out.iter_mut().zip(internal) {
+                    *p = current[i as usize].to_array();
+                }
+            });
     }
 
     /// Re-imposes the constraints on the current state (the start of a new round).
