@@ -230,6 +230,14 @@ pub enum JobResult {
         level: usize,
         mesh: Arc<TriMesh>,
     },
+    /// The measures of the faired result with `serial`.
+    Measured {
+        document: u64,
+        serial: u64,
+        against_document: Option<Measures>,
+        against_clean: Option<Measures>,
+        measure_time: Duration,
+    },
     /// Noise was added to a copy of the document's mesh.
     Noised {
         document: u64,

@@ -233,6 +233,10 @@ pub struct App {
     workspace: Arc<Mutex<MultiresWorkspace>>,
     io: Worker,
     compute: Worker,
+    /// Measures faired results (surface distances need two BVHs per reference: 0.1-0.3 s on the
+    /// bunny), so that the compute worker hands each result to the view at once and is free for
+    /// the next slider value.
+    measure: Worker,
     jobs: JobCounter,
     results_tx: Sender<(JobResult, JobTicket)>,
     results_rx: Receiver<(JobResult, JobTicket)>,
@@ -279,6 +283,8 @@ impl App {
         let io = Worker::spawn("fairmesh-io").expect("cannot start the fairmesh-io thread");
         let compute =
             Worker::spawn("fairmesh-compute").expect("cannot start the fairmesh-compute thread");
+        let measure =
+            Worker::spawn("fairmesh-measure").expect("cannot start the fairmesh-measure thread");
         let file = options.file.unwrap_or_else(bundled_mesh_path);
         let mut app = Self {
             settings,
@@ -297,6 +303,7 @@ impl App {
             workspace: Arc::new(Mutex::new(MultiresWorkspace::default())),
             io,
             compute,
+            measure,
             jobs: JobCounter::default(),
             results_tx,
             results_rx,
@@ -728,7 +735,6 @@ impl App {
         let document_generation = self.document_generation.clone();
         let progress_out = self.fair_progress.clone();
         let workspace = self.workspace.clone();
-        let clean = self.document.as_ref().and_then(|d| d.clean.clone());
         let (tx, ctx, ticket) = (self.results_tx.clone(), self.ctx.clone(), self.jobs.start());
         self.fair_in_flight = true;
         self.fair_progress.set(0.0);
@@ -758,27 +764,16 @@ impl App {
                 }
             };
             let result = positions.map(|positions| {
-                let base = hierarchy.base_mesh();
-                let (volume_change, rms_displacement) = compare_to_base(base, &positions);
-                let elapsed = started.elapsed();
-                let measuring = Instant::now();
-                let faired = TriMesh {
-                    positions,
-                    triangles: base.triangles.clone(),
-                };
-                let against_document = Measures::of(base, &faired);
-                let against_clean = clean
-                    .as_deref()
-                    .filter(|_| document_generation.is_current(document))
-                    .map(|clean| Measures::of(clean, &faired));
+                let (volume_change, rms_displacement) =
+                    compare_to_base(hierarchy.base_mesh(), &positions);
                 Faired {
-                    positions: faired.positions,
+                    positions,
                     volume_change,
                     rms_displacement,
-                    elapsed,
-                    against_document: Some(against_document),
-                    against_clean,
-                    measure_time: measuring.elapsed(),
+                    elapsed: started.elapsed(),
+                    against_document: None,
+                    against_clean: None,
+                    measure_time: Duration::ZERO,
                 }
             });
             let message = JobResult::Faired {
@@ -786,6 +781,55 @@ impl App {
                 view,
                 level,
                 result,
+            };
+            Self::send_result(&tx, &ctx, message, ticket);
+        });
+    }
+
+    /// Measures the faired result `serial` against the document's mesh and the clean one on the
+    /// measuring worker (a newer result replaces a waiting request).
+    fn request_measures(&mut self, document: u64, serial: u64, positions: Arc<Vec<[f32; 3]>>) {
+        let Some(current) = self.document.as_ref().filter(|d| d.generation == document) else {
+            return;
+        };
+        let HierarchyState::Ready { hierarchy, .. } = &current.hierarchy else {
+            return;
+        };
+        let hierarchy = hierarchy.clone();
+        let clean = current.clean.clone();
+        let document_generation = self.document_generation.clone();
+        let (tx, ctx, ticket) = (self.results_tx.clone(), self.ctx.clone(), self.jobs.start());
+        self.measure.submit_latest("measure", move || {
+            if !document_generation.is_current(document) {
+                return;
+            }
+            let started = Instant::now();
+            let base = hierarchy.base_mesh();
+            let faired = TriMesh {
+                positions: positions.as_ref().clone(),
+                triangles: base.triangles.clone(),
+            };
+            let measure = || {
+                let against_document = Some(Measures::of(base, &faired));
+                let against_clean = clean
+                    .as_deref()
+                    .filter(|_| document_generation.is_current(document))
+                    .map(|clean| Measures::of(clean, &faired));
+                (against_document, against_clean)
+            };
+            // On one thread of its own, so that the next slider value's fairing keeps the whole
+            // rayon pool (sharing it doubled the time to the next result on the bunny).
+            let (against_document, against_clean) =
+                match rayon::ThreadPoolBuilder::new().num_threads(1).build() {
+                    Ok(pool) => pool.install(measure),
+                    Err(_) => measure(),
+                };
+            let message = JobResult::Measured {
+                document,
+                serial,
+                against_document,
+                against_clean,
+                measure_time: started.elapsed(),
             };
             Self::send_result(&tx, &ctx, message, ticket);
         });
@@ -1089,18 +1133,46 @@ impl App {
                 if let Some(faired) = result {
                     self.applied_view = view;
                     self.next_serial += 1;
+                    // The previous result's measures stay on screen until this one's arrive.
+                    let previous = current.faired.take();
+                    let positions = Arc::new(faired.positions);
                     current.faired = Some(FairedResult {
-                        positions: Arc::new(faired.positions),
+                        positions: positions.clone(),
                         level,
                         volume_change: faired.volume_change,
                         rms_displacement: faired.rms_displacement,
                         elapsed: faired.elapsed,
                         serial: self.next_serial,
-                        against_document: faired.against_document,
-                        against_clean: faired.against_clean,
+                        against_document: previous
+                            .as_ref()
+                            .and_then(|p| p.against_document.clone()),
+                        against_clean: previous.and_then(|p| p.against_clean),
                         measure_time: faired.measure_time,
+                        measures_pending: true,
                     });
+                    self.request_measures(document, self.next_serial, positions);
                 }
+            }
+            JobResult::Measured {
+                document,
+                serial,
+                against_document,
+                against_clean,
+                measure_time,
+            } => {
+                let Some(faired) = self
+                    .document
+                    .as_mut()
+                    .filter(|d| d.generation == document)
+                    .and_then(|d| d.faired.as_mut())
+                    .filter(|f| f.serial == serial)
+                else {
+                    return;
+                };
+                faired.against_document = against_document;
+                faired.against_clean = against_clean;
+                faired.measure_time = measure_time;
+                faired.measures_pending = false;
             }
             JobResult::LevelMesh {
                 document,

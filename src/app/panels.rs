@@ -491,7 +491,13 @@ fn controls(app: &mut App, ui: &mut egui::Ui) {
             ui.label(faired.map_or("–".into(), |f| seconds(f.elapsed)));
             ui.end_row();
             ui.label("Measuring");
-            ui.label(faired.map_or("–".into(), |f| seconds(f.measure_time)));
+            ui.label(faired.map_or("–".into(), |f| {
+                if f.measures_pending {
+                    "running…".into()
+                } else {
+                    seconds(f.measure_time)
+                }
+            }));
             ui.end_row();
         });
 

@@ -326,6 +326,9 @@ pub struct FairedResult {
     pub against_clean: Option<Measures>,
     /// Seconds the measuring took on the worker.
     pub measure_time: Duration,
+    /// The measures above are the previous result's, kept on screen (numbers and heat map)
+    /// until this result's own arrive from the measuring worker.
+    pub measures_pending: bool,
 }
 
 /// One loaded mesh and everything derived from it.
