@@ -1163,6 +1163,35 @@ mod tests {
     }
 
     #[test]
+    fn deduplicated_rows_map_back_to_every_row_with_either_index_width() {
+        let row = |i: usize| [i as f32, 0.5 * i as f32, -(i as f32), 0.0];
+        // Few distinct rows, repeated across the parallel chunks: two-byte indices.
+        let rows: Vec<[f32; 4]> = (0..200_000).map(|i| row(i % 37)).collect();
+        let (distinct, index) = deduplicate_rows(&rows);
+        assert_eq!(distinct.len(), 37);
+        // First appearance order.
+        assert!(distinct.iter().enumerate().all(|(i, d)| *d == row(i)));
+        let EntryWeightIndex::Narrow(index) = index else {
+            panic!("37 rows need no wide index");
+        };
+        assert!(rows
+            .iter()
+            .zip(&index)
+            .all(|(r, &i)| distinct[i as usize] == *r));
+        // More than 65536 distinct rows: four-byte indices.
+        let rows: Vec<[f32; 4]> = (0..150_000).map(|i| row((i * 7) % 70_001)).collect();
+        let (distinct, index) = deduplicate_rows(&rows);
+        assert_eq!(distinct.len(), 70_001);
+        let EntryWeightIndex::Wide(index) = index else {
+            panic!("70001 rows need a wide index");
+        };
+        assert!(rows
+            .iter()
+            .zip(&index)
+            .all(|(r, &i)| distinct[i as usize] == *r));
+    }
+
+    #[test]
     fn a_vertex_with_no_interior_triangle_keeps_its_position() {
         // A fan of 6 triangles around a centre: every triangle touches the boundary, so the centre
         // has no local solution and must stay (the pseudocode would move it to the origin).
