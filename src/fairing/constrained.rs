@@ -164,28 +164,20 @@ const VALENCE_SORTED_BLOCK: usize = 256;
 macro_rules! with_stencil {
     ($fairing:expr, |$stencil:ident| $body:expr) => {
         match &$fairing.entry_weight_index {
-            EntryWeightIndex::Narrow(index) => {
-                let $stencil = Stencil {
-                    offsets: &$fairing.ring_offsets,
-                    ring: &$fairing.ring,
-                    index,
-                    rows: &$fairing.entry_weights,
-                    self_weights: &$fairing.self_weights,
-                };
-                $body
-            }
-            EntryWeightIndex::Wide(index) => {
-                let $stencil = Stencil {
-                    offsets: &$fairing.ring_offsets,
-                    ring: &$fairing.ring,
-                    index,
-                    rows: &$fairing.entry_weights,
-                    self_weights: &$fairing.self_weights,
-                };
-                $body
-            }
+            EntryWeightIndex::Narrow(index) => with_stencil!(@with $fairing, index, $stencil, $body),
+            EntryWeightIndex::Wide(index) => with_stencil!(@with $fairing, index, $stencil, $body),
         }
     };
+    (@with $fairing:expr, $index:ident, $stencil:ident, $body:expr) => {{
+        let $stencil = Stencil {
+            offsets: &$fairing.ring_offsets,
+            ring: &$fairing.ring,
+            index: $index,
+            rows: &$fairing.entry_weights,
+            self_weights: &$fairing.self_weights,
+        };
+        $body
+    }};
 }
 
 /// Precomputed constrained fairing for one mesh connectivity, with its workspace buffers: build it
