@@ -42,8 +42,9 @@
 //! optional (`fair_finest`; the paper's loop ends at the refinement).
 //!
 //! Speed: a [`MultiresWorkspace`] keeps, per level used so far, its connectivity (`TriMesh`
-//! triangles and `Topology`), loop neighbours, fan-ordered one-rings and fairing operator, built on
-//! first use; a run then only moves positions, and allocates nothing but its result. The whole run
+//! triangles and `Topology`), loop neighbours, fan-ordered one-rings and fairing operator, built
+//! (levels in parallel) by the first run that needs them or by
+//! [`MultiresWorkspace::prepare_for`]; a run then only moves positions, and allocates nothing but its result. The whole run
 //! executes on a worker of the rayon pool (a run makes a dozen parallel calls per level, and each
 //! call issued from outside the pool is a cross-thread hand-off); passes over the coarse levels
 //! are not split below [`PARALLEL_GRAIN`] vertices. The per-level passes (Kobbelt step, vertex
@@ -105,7 +106,7 @@ const SHRINKAGE_SMOOTHING_ROUNDS: usize = 2;
 /// 1 is the best compromise (more rounds lose volume on `elephant` again and gain little).
 const HEIGHT_SMOOTHING_ROUNDS: usize = 1;
 
-/// Connectivity of one level, built on first use.
+/// Connectivity of one level, built by the first run that needs it.
 struct LevelData {
     mesh: TriMesh,
     topology: Topology,
@@ -147,12 +148,6 @@ impl MultiresWorkspace {
         Self::default()
     }
 
-    /// Builds the connectivity of `level` if not yet cached (all levels up to the coarsest are
-    /// cached after a run from the coarsest level).
-    pub fn prepare(&mut self, hierarchy: &Hierarchy, level: usize) {
-        self.prepare_levels(hierarchy, level..=level, |_| None);
-    }
-
     /// Builds every level a run from `options.start_level` (or from the coarsest level, with
     /// `all`) needs, with the fairing operators of the levels it fairs, so that the runs after it
     /// only fair. The editor calls this in the background once the hierarchy is built, so that
@@ -164,7 +159,8 @@ impl MultiresWorkspace {
             options.start_level.min(hierarchy.coarsest_level())
         };
         let fair_last = start == 0 || options.fair_finest;
-        let operator = (FairVariant::Paper, options.boundary);
+        let fair_options = level_fair_options(options);
+        let operator = (fair_options.variant, fair_options.boundary);
         let faired = move |level: usize| (level >= 1 || fair_last).then_some(operator);
         self.prepare_levels(hierarchy, 0..=start, faired);
     }
@@ -248,6 +244,21 @@ impl LevelData {
     }
 }
 
+/// The fairing options of every level of a run.
+fn level_fair_options(options: &MultiresOptions) -> FairOptions {
+    FairOptions {
+        iterations: options.iterations,
+        rounds: options.rounds.max(1),
+        boundary: options.boundary,
+        tolerance: 0.0,
+        // Both variants fair with the paper's operator: measured in multires, the
+        // normal-projected operator roughly doubles the normal error from coarse levels (noisy
+        // bunny00 from level 8: 22 degrees against 12) because the tangential part of the paper's
+        // update also evens out the coarse meshes the splits are placed on.
+        variant: FairVariant::Paper,
+    }
+}
+
 /// Returns M0's positions after fairing (M0's triangles are `hierarchy.base_mesh().triangles`),
 /// or `None` when `progress` cancelled the run.
 pub fn fair_multires(
@@ -269,18 +280,9 @@ fn fair_multires_on_worker(
     progress: &mut dyn Progress,
 ) -> Option<Vec<[f32; 3]>> {
     let start = options.start_level.min(hierarchy.coarsest_level());
+    // Every level this run touches, with the operators of those it fairs.
     workspace.prepare_for(hierarchy, options, false);
-    let fair_options = FairOptions {
-        iterations: options.iterations,
-        rounds: options.rounds.max(1),
-        boundary: options.boundary,
-        tolerance: 0.0,
-        // Both variants fair with the paper's operator: measured in multires, the
-        // normal-projected operator roughly doubles the normal error from coarse levels (noisy
-        // bunny00 from level 8: 22 degrees against 12) because the tangential part of the paper's
-        // update also evens out the coarse meshes the splits are placed on.
-        variant: FairVariant::Paper,
-    };
+    let fair_options = level_fair_options(options);
     let base_vertices = hierarchy.level_info(0).vertices;
     workspace.positions.clear();
     workspace
@@ -295,12 +297,10 @@ fn fair_multires_on_worker(
     let mut done = 0.0;
     let fair_last = start == 0 || options.fair_finest;
     for level in (1..=start).rev() {
-        workspace.prepare(hierarchy, level);
         let faired = fair_level(workspace, level, &fair_options);
         if faired && options.variant == MultiresVariant::Improved {
             remove_low_frequency_shrinkage(workspace, level);
         }
-        workspace.prepare(hierarchy, level - 1);
         refine_positions(hierarchy, workspace, level - 1, options.variant);
         done += hierarchy.level_info(level).vertices as f64;
         if !progress.report((done / total) as f32) {
@@ -308,7 +308,6 @@ fn fair_multires_on_worker(
         }
     }
     if fair_last {
-        workspace.prepare(hierarchy, 0);
         fair_level(workspace, 0, &fair_options);
         if !progress.report(1.0) {
             return None;
@@ -330,26 +329,16 @@ fn fair_level(workspace: &mut MultiresWorkspace, level: usize, options: &FairOpt
     if options.iterations == 0 || options.rounds == 0 || data.mesh.positions.is_empty() {
         return false;
     }
-    let fits = data
+    let fairing = data
         .fairing
-        .as_ref()
-        .is_some_and(|f| f.variant() == options.variant && f.boundary() == options.boundary);
-    if !fits {
-        data.fairing = Some(ConstrainedFairing::new(
-            &data.mesh,
-            &data.topology,
-            options.variant,
-            options.boundary,
-        ));
-    }
+        .as_mut()
+        .expect("prepare_for set up the operator of every level a run fairs");
     let n = data.mesh.positions.len();
     workspace.before_fairing.clear();
     workspace
         .before_fairing
         .extend_from_slice(&workspace.positions[..n]);
-    if let Some(fairing) = data.fairing.as_mut() {
-        fairing.run(&mut workspace.positions[..n], options);
-    }
+    fairing.run(&mut workspace.positions[..n], options);
     true
 }
 
