@@ -10,35 +10,16 @@ use std::time::{Duration, Instant};
 
 use egui::accesskit::Role;
 use egui_kittest::kittest::Queryable;
-use egui_kittest::{Harness, SnapshotOptions};
-use fairmesh::app::App;
+use egui_kittest::SnapshotOptions;
 
 mod editor_common;
-use editor_common::{bunny, harness_for, settle, viewport_image};
+use editor_common::{bunny, harness_for, retype, settle, viewport_image};
 
 fn snapshot_options() -> SnapshotOptions {
     // Software rasterisers differ a little between versions: compare with a tolerance.
     SnapshotOptions::new()
         .threshold(2.0)
         .max_failed_pixels(2500)
-}
-
-/// Replaces the text of the text field whose current value satisfies `which`.
-fn retype(harness: &mut Harness<'_, App>, which: impl Fn(&str) -> bool, text: &str) {
-    let field = harness
-        .get_all_by_role(Role::TextInput)
-        .find(|node| node.value().is_some_and(|v| which(&v)))
-        .expect("text field");
-    field.focus();
-    harness.step();
-    harness.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::A);
-    harness.step();
-    harness
-        .get_all_by_role(Role::TextInput)
-        .find(|node| node.is_focused())
-        .expect("focused text field")
-        .type_text(text);
-    harness.step();
 }
 
 #[test]

@@ -11,7 +11,7 @@ use egui_kittest::Harness;
 use fairmesh::app::{App, Command};
 
 mod editor_common;
-use editor_common::{bunny, harness_for, settle, viewport_image};
+use editor_common::{bunny, harness_for, retype, settle, viewport_image};
 
 /// Loads the bunny, adds the default noise (sigma 0.3 of the mean edge, seed 1, along the
 /// normal) through the panel's button, and fairs from a middle level: M4 of the bunny's 19
@@ -428,20 +428,11 @@ fn shortcuts_export_and_persisted_settings_round_trip() {
     let mut harness = harness_for(bunny());
     settle(&mut harness);
     let target = dir.path().join("shortcut.glb");
-    let field = harness
-        .get_all_by_role(Role::TextInput)
-        .find(|n| n.value().is_some_and(|v| v.ends_with("_faired.glb")))
-        .unwrap();
-    field.focus();
-    harness.step();
-    harness.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::A);
-    harness.step();
-    harness
-        .get_all_by_role(Role::TextInput)
-        .find(|n| n.is_focused())
-        .unwrap()
-        .type_text(&target.display().to_string());
-    harness.step();
+    retype(
+        &mut harness,
+        |v| v.ends_with("_faired.glb"),
+        &target.display().to_string(),
+    );
     harness.key_press(egui::Key::Escape);
     harness.step();
     harness.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::E);

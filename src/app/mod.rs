@@ -237,6 +237,10 @@ pub struct App {
     /// bunny), so that the compute worker hands each result to the view at once and is free for
     /// the next slider value.
     measure: Worker,
+    /// The measuring worker's own one-thread rayon pool (`None` if it could not be started: it
+    /// then shares the global pool), so that the next slider value's fairing keeps the global
+    /// pool (sharing it doubled the time to the next result on the bunny).
+    measure_pool: Option<Arc<rayon::ThreadPool>>,
     jobs: JobCounter,
     results_tx: Sender<(JobResult, JobTicket)>,
     results_rx: Receiver<(JobResult, JobTicket)>,
@@ -285,6 +289,12 @@ impl App {
             Worker::spawn("fairmesh-compute").expect("cannot start the fairmesh-compute thread");
         let measure =
             Worker::spawn("fairmesh-measure").expect("cannot start the fairmesh-measure thread");
+        let measure_pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(1)
+            .thread_name(|_| "fairmesh-measure-pool".into())
+            .build()
+            .ok()
+            .map(Arc::new);
         let file = options.file.unwrap_or_else(bundled_mesh_path);
         let mut app = Self {
             settings,
@@ -304,6 +314,7 @@ impl App {
             io,
             compute,
             measure,
+            measure_pool,
             jobs: JobCounter::default(),
             results_tx,
             results_rx,
@@ -797,6 +808,7 @@ impl App {
         };
         let hierarchy = hierarchy.clone();
         let clean = current.clean.clone();
+        let pool = self.measure_pool.clone();
         let document_generation = self.document_generation.clone();
         let (tx, ctx, ticket) = (self.results_tx.clone(), self.ctx.clone(), self.jobs.start());
         self.measure.submit_latest("measure", move || {
@@ -817,13 +829,10 @@ impl App {
                     .map(|clean| Measures::of(clean, &faired));
                 (against_document, against_clean)
             };
-            // On one thread of its own, so that the next slider value's fairing keeps the whole
-            // rayon pool (sharing it doubled the time to the next result on the bunny).
-            let (against_document, against_clean) =
-                match rayon::ThreadPoolBuilder::new().num_threads(1).build() {
-                    Ok(pool) => pool.install(measure),
-                    Err(_) => measure(),
-                };
+            let (against_document, against_clean) = match &pool {
+                Some(pool) => pool.install(measure),
+                None => measure(),
+            };
             let message = JobResult::Measured {
                 document,
                 serial,

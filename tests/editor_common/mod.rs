@@ -6,6 +6,8 @@
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
+use egui::accesskit::Role;
+use egui_kittest::kittest::Queryable;
 use egui_kittest::Harness;
 use fairmesh::app::App;
 
@@ -63,4 +65,22 @@ pub fn viewport_image(harness: &mut Harness<'_, App>) -> image::RgbaImage {
         h.min(full.height() - y),
     )
     .to_image()
+}
+
+/// Replaces the text of the text field whose current value satisfies `which`.
+pub fn retype(harness: &mut Harness<'_, App>, which: impl Fn(&str) -> bool, text: &str) {
+    let field = harness
+        .get_all_by_role(Role::TextInput)
+        .find(|node| node.value().is_some_and(|v| which(&v)))
+        .expect("text field");
+    field.focus();
+    harness.step();
+    harness.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::A);
+    harness.step();
+    harness
+        .get_all_by_role(Role::TextInput)
+        .find(|node| node.is_focused())
+        .expect("focused text field")
+        .type_text(text);
+    harness.step();
 }
