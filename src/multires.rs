@@ -113,8 +113,9 @@ struct LevelData {
     /// Previous and next vertex along the boundary loop (`NONE` for interior vertices); empty when
     /// the level is closed.
     loop_neighbors: Vec<[u32; 2]>,
-    /// One-rings in fan order (closed fans), for the vertex normals of the shrinkage correction.
-    fans: FanRings,
+    /// One-rings in fan order (closed fans), for the fairing operator and the vertex normals of
+    /// the shrinkage correction; only on levels that are faired.
+    fans: Option<FanRings>,
     /// The precomputed fairing operator of this connectivity, for the variant and boundary mode
     /// it was made with.
     fairing: Option<ConstrainedFairing>,
@@ -202,11 +203,15 @@ impl MultiresWorkspace {
                     .take()
                     .unwrap_or_else(|| LevelData::build(hierarchy, level));
                 if let Some((variant, boundary)) = operator(level) {
-                    data.fairing = Some(ConstrainedFairing::new(
-                        &data.mesh,
-                        &data.topology,
-                        variant,
-                        boundary,
+                    let LevelData {
+                        mesh,
+                        topology,
+                        fans,
+                        ..
+                    } = &mut data;
+                    let fans = fans.get_or_insert_with(|| FanRings::new(&mesh.triangles, topology));
+                    data.fairing = Some(ConstrainedFairing::with_fans(
+                        mesh, topology, fans, variant, boundary,
                     ));
                 }
                 data
@@ -233,12 +238,11 @@ impl LevelData {
                 }
             }
         }
-        let fans = FanRings::new(&mesh.triangles, &topology);
         LevelData {
             mesh,
             topology,
             loop_neighbors,
-            fans,
+            fans: None,
             fairing: None,
         }
     }
@@ -361,7 +365,10 @@ fn remove_low_frequency_shrinkage(workspace: &mut MultiresWorkspace, level: usiz
     let topology = &data.topology;
     let triangles = &data.mesh.triangles;
     let (offsets, _) = topology.neighbor_csr();
-    let fans = &data.fans;
+    let fans = data
+        .fans
+        .as_ref()
+        .expect("a faired level has its fan-ordered rings");
     let positions_now: &[[f32; 3]] = positions;
     let before: &[[f32; 3]] = before_fairing;
     let at = |v: u32| Vec3A::from_array(positions_now[v as usize]);

@@ -261,15 +261,24 @@ impl ConstrainedFairing {
         variant: FairVariant,
         boundary: BoundaryMode,
     ) -> Self {
+        let fans = FanRings::new(&mesh.triangles, topology);
+        Self::with_fans(mesh, topology, &fans, variant, boundary)
+    }
+
+    /// [`Self::new`] for a caller that already has the mesh's fan-ordered one-rings.
+    pub(crate) fn with_fans(
+        mesh: &TriMesh,
+        topology: &Topology,
+        fans: &FanRings,
+        variant: FairVariant,
+        boundary: BoundaryMode,
+    ) -> Self {
         let vertex_count = mesh.positions.len();
         let triangles = &mesh.triangles;
         let is_boundary = topology.boundary_flags();
 
         let ring_offsets = topology.neighbor_csr().0.to_vec();
-        let FanRings {
-            ring,
-            closed_fan: closed,
-        } = FanRings::new(triangles, topology);
+        let (ring, closed) = (&fans.ring, &fans.closed_fan);
 
         let valence = |v: u32| topology.valence(v);
         let interior = |t: &[u32; 3]| {
@@ -383,7 +392,7 @@ impl ConstrainedFairing {
         // Renumber for locality: internal vertex i is `order[i]`; every per-vertex array is
         // permuted and every one-ring entry moved with its vertex (its fan order and weights kept)
         // and relabelled.
-        let mut order = breadth_first_order(&ring_offsets, &ring);
+        let mut order = breadth_first_order(&ring_offsets, ring);
         for block in order.chunks_mut(VALENCE_SORTED_BLOCK) {
             block.sort_by_key(|&v| ring_offsets[v as usize + 1] - ring_offsets[v as usize]);
         }
@@ -413,7 +422,7 @@ impl ConstrainedFairing {
                 }
                 weights_out.copy_from_slice(&ring_weights[entries]);
             });
-        drop((ring, ring_weights));
+        drop(ring_weights);
         let (entry_weights, entry_weight_index) = deduplicate_rows(&internal_entry_weights);
         drop(internal_entry_weights);
         let self_weights = order.iter().map(|&v| self_weights[v as usize]).collect();
