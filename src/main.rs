@@ -8,8 +8,8 @@ use std::process::ExitCode;
 fn main() -> ExitCode {
     let args = cli::Cli::parse();
     let result = match args.command {
-        None => run_editor(None),
-        Some(cli::Command::Edit { file }) => run_editor(file),
+        None => run_editor(cli::EditArgs::default()),
+        Some(cli::Command::Edit(args)) => run_editor(args),
         Some(command) => cli::run(command),
     };
     match result {
@@ -22,12 +22,23 @@ fn main() -> ExitCode {
 }
 
 #[cfg(feature = "gui")]
-fn run_editor(file: Option<std::path::PathBuf>) -> anyhow::Result<()> {
-    fairmesh::app::run(file)
+fn run_editor(args: cli::EditArgs) -> anyhow::Result<()> {
+    let log_frames_over = match args.log_frames {
+        Some(ms) if ms.is_finite() && ms >= 0.0 => {
+            Some(std::time::Duration::from_secs_f64(ms / 1e3))
+        }
+        Some(ms) => anyhow::bail!("--log-frames needs a number of milliseconds >= 0, not {ms}"),
+        None => None,
+    };
+    fairmesh::app::run(fairmesh::app::AppOptions {
+        file: args.file,
+        log_frames_over,
+        ..Default::default()
+    })
 }
 
 #[cfg(not(feature = "gui"))]
-fn run_editor(_file: Option<std::path::PathBuf>) -> anyhow::Result<()> {
+fn run_editor(_args: cli::EditArgs) -> anyhow::Result<()> {
     anyhow::bail!(
         "this fairmesh was built without the editor (feature `gui`); use a subcommand, see --help"
     )

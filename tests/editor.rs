@@ -13,7 +13,8 @@ use egui_kittest::kittest::Queryable;
 use egui_kittest::SnapshotOptions;
 
 mod editor_common;
-use editor_common::{bunny, harness_for, retype, settle, viewport_image};
+use editor_common::{bunny, harness_for, harness_with, retype, settle, viewport_image};
+use fairmesh::app::AppOptions;
 
 fn snapshot_options() -> SnapshotOptions {
     // Software rasterisers differ a little between versions: compare with a tolerance.
@@ -271,6 +272,45 @@ fn viewport_snapshots() {
         "the wireframe changes the image ({differing} pixels)"
     );
     egui_kittest::image_snapshot_options(&wire, "viewport_bunny_wireframe", &snapshot_options());
+}
+
+/// The background upload path (used for big meshes) draws exactly what the in-frame path draws:
+/// the bunny with every mesh sent to the upload threads gives the same viewport images, shaded
+/// and with the wireframe (whose edges are then built on the upload thread too).
+#[test]
+fn background_uploads_draw_the_same_images() {
+    let mut images = Vec::new();
+    for async_upload_bytes in [None, Some(0)] {
+        let mut harness = harness_with(AppOptions {
+            file: Some(bunny()),
+            async_upload_bytes,
+            ..AppOptions::default()
+        });
+        settle(&mut harness);
+        harness.get_by_label("Original").click();
+        settle(&mut harness);
+        let shaded = viewport_image(&mut harness);
+        harness.key_press(egui::Key::W);
+        harness.step();
+        // The first image with the wireframe asks for the edges; in the background they land a
+        // moment later, and `settle` waits for them.
+        let first_wire = viewport_image(&mut harness);
+        settle(&mut harness);
+        let wire = viewport_image(&mut harness);
+        if async_upload_bytes.is_none() {
+            assert_eq!(first_wire, wire, "in-frame edges are there at once");
+        }
+        assert_ne!(shaded, wire, "the wireframe is drawn");
+        images.push((shaded, wire));
+    }
+    assert!(
+        images[0].0 == images[1].0,
+        "shaded images differ between the in-frame and background uploads"
+    );
+    assert!(
+        images[0].1 == images[1].1,
+        "wireframe images differ between the in-frame and background uploads"
+    );
 }
 
 /// Writes `mesh` as a minimal OBJ (the test needs a big file before `io::save` can be relied on).

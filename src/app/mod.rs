@@ -41,10 +41,14 @@ use state::{
     Settings, ViewMode,
 };
 
-use crate::render::{DrawParams, Viewport3d};
+use crate::render::{DrawParams, MeshSource, Viewport3d};
 
-/// Opens the editor window on `file`, or on the bundled bunny.
-pub fn run(file: Option<PathBuf>) -> anyhow::Result<()> {
+/// Opens the editor window on `options.file`, or on the bundled bunny.
+pub fn run(options: AppOptions) -> anyhow::Result<()> {
+    let app_options = AppOptions {
+        persistence: true,
+        ..options
+    };
     let options = eframe::NativeOptions {
         viewport: egui::ViewportBuilder::default()
             .with_title("fairmesh")
@@ -57,15 +61,7 @@ pub fn run(file: Option<PathBuf>) -> anyhow::Result<()> {
     eframe::run_native(
         "fairmesh",
         options,
-        Box::new(move |cc| {
-            Ok(Box::new(App::with_options(
-                cc,
-                AppOptions {
-                    file,
-                    persistence: true,
-                },
-            )))
-        }),
+        Box::new(move |cc| Ok(Box::new(App::with_options(cc, app_options)))),
     )
     .map_err(|error| anyhow::anyhow!("the editor window failed: {error}"))
 }
@@ -86,6 +82,12 @@ pub struct AppOptions {
     pub file: Option<PathBuf>,
     /// Read and write settings through eframe's storage (off in tests).
     pub persistence: bool,
+    /// Print every UI frame whose CPU time is over this to standard error, split into its parts
+    /// (`fairmesh edit --log-frames MS`: measures responsiveness in the real window).
+    pub log_frames_over: Option<Duration>,
+    /// Meshes of at least this many bytes (positions + triangles) upload to the GPU on the
+    /// viewports' upload threads; `None` keeps the renderer's default (4 MB). Tests set 0.
+    pub async_upload_bytes: Option<usize>,
 }
 
 /// Something the user asked for; applied after the frame's widgets are drawn.
@@ -160,12 +162,35 @@ pub struct FrameStats {
     /// That frame split into applying results, uploading to the GPU, and drawing widgets.
     pub max_while_busy_parts: [Duration; 3],
     pub frames: u64,
+    /// Frames over this are printed to standard error (`AppOptions::log_frames_over`).
+    log_over: Option<Duration>,
+    /// The main viewport's image count at the last frame (to tell whether it drew since).
+    images_seen: u64,
 }
 
 impl FrameStats {
     const WINDOW: usize = 240;
 
-    fn record(&mut self, elapsed: Duration, parts: [Duration; 3], busy: bool) {
+    /// Records one frame: its CPU time in `App::ui`, that split into applying results, uploading
+    /// and widgets, and the CPU time of the viewport's last offscreen draw (recorded in the
+    /// previous frame's paint callback, which runs after `App::ui` returns).
+    fn record(&mut self, elapsed: Duration, parts: [Duration; 3], render: Duration, busy: bool) {
+        if let Some(limit) = self.log_over {
+            if elapsed > limit || render > limit {
+                let ms = |d: Duration| d.as_secs_f64() * 1e3;
+                eprintln!(
+                    "frame {}: {:.1} ms UI CPU (results {:.1}, upload {:.1}, widgets {:.1}), \
+                     previous viewport draw {:.1} ms{}",
+                    self.frames,
+                    ms(elapsed),
+                    ms(parts[0]),
+                    ms(parts[1]),
+                    ms(parts[2]),
+                    ms(render),
+                    if busy { ", working" } else { "" }
+                );
+            }
+        }
         if self.recent.len() == Self::WINDOW {
             self.recent.pop_front();
         }
@@ -320,8 +345,9 @@ impl App {
             results_rx,
             dialog_open: false,
             ctx: cc.egui_ctx.clone(),
-            viewport: cc.wgpu_render_state.as_ref().map(Viewport3d::new),
-            viewport_before: cc.wgpu_render_state.as_ref().map(Viewport3d::new),
+            viewport: (cc.wgpu_render_state.as_ref()).map(|s| Viewport3d::new(s, &cc.egui_ctx)),
+            viewport_before: (cc.wgpu_render_state.as_ref())
+                .map(|s| Viewport3d::new(s, &cc.egui_ctx)),
             camera: OrbitCamera::default(),
             shown: None,
             shown_before: None,
@@ -333,10 +359,18 @@ impl App {
             open_path: file.display().to_string(),
             commands: Vec::new(),
             next_serial: 0,
-            frame_stats: FrameStats::default(),
+            frame_stats: FrameStats {
+                log_over: options.log_frames_over,
+                ..FrameStats::default()
+            },
             viewport_rect: None,
             history: History::new(HISTORY_BUDGET_BYTES),
         };
+        if let Some(bytes) = options.async_upload_bytes {
+            for viewport in [&app.viewport, &app.viewport_before].into_iter().flatten() {
+                viewport.set_async_upload_bytes(bytes);
+            }
+        }
         app.open(file);
         app
     }
@@ -347,7 +381,7 @@ impl App {
             cc,
             AppOptions {
                 file: Some(file.into()),
-                persistence: false,
+                ..AppOptions::default()
             },
         )
     }
@@ -359,7 +393,15 @@ impl App {
 
     /// No job running or waiting and every result applied.
     pub fn is_settled(&self) -> bool {
-        self.jobs.in_flight() == 0 && self.commands.is_empty()
+        self.jobs.in_flight() == 0 && self.commands.is_empty() && !self.upload_pending()
+    }
+
+    /// Whether a viewport's background upload of a big mesh has not landed yet.
+    fn upload_pending(&self) -> bool {
+        [&self.viewport, &self.viewport_before]
+            .into_iter()
+            .flatten()
+            .any(Viewport3d::upload_pending)
     }
 
     pub fn frame_stats(&self) -> &FrameStats {
@@ -881,18 +923,15 @@ impl App {
         let (positions, triangles_source) = match (&document.faired, &document.hierarchy) {
             (Some(faired), HierarchyState::Ready { hierarchy, .. }) => (
                 Some(faired.positions.clone()),
-                ExportTriangles::Base(hierarchy.clone()),
+                SharedMesh::Base(hierarchy.clone()),
             ),
-            _ => (None, ExportTriangles::Original(document.original.clone())),
+            _ => (None, SharedMesh::Mesh(document.original.clone())),
         };
         let (tx, ctx, ticket) = (self.results_tx.clone(), self.ctx.clone(), self.jobs.start());
         self.message = Some(format!("Exporting to {} …", path.display()));
         self.io.submit(move || {
             let started = Instant::now();
-            let source = match &triangles_source {
-                ExportTriangles::Base(hierarchy) => hierarchy.base_mesh(),
-                ExportTriangles::Original(mesh) => mesh.as_ref(),
-            };
+            let source = triangles_source.mesh();
             let mesh = match positions {
                 Some(positions) if positions.len() == source.positions.len() => TriMesh {
                     positions: positions.as_ref().clone(),
@@ -1404,31 +1443,40 @@ impl App {
                 shown.document == wanted.document
                     && shown.what.connectivity(matches) == wanted.what.connectivity(matches)
             });
-            let (positions, triangles): (&[[f32; 3]], &[[u32; 3]]) = match wanted.what {
-                ShownMesh::Original => (&document.original.positions, &document.original.triangles),
+            let source = match wanted.what {
+                ShownMesh::Original => ViewMesh {
+                    connectivity: SharedMesh::Mesh(document.original.clone()),
+                    positions: None,
+                },
                 ShownMesh::Faired { .. } => {
                     let Some(faired) = &document.faired else {
                         return;
                     };
-                    let triangles = match &base {
-                        Some((hierarchy, false)) => &hierarchy.base_mesh().triangles,
-                        _ => &document.original.triangles,
+                    let connectivity = match &base {
+                        Some((hierarchy, false)) => SharedMesh::Base(hierarchy.clone()),
+                        _ => SharedMesh::Mesh(document.original.clone()),
                     };
-                    (&faired.positions, triangles)
+                    ViewMesh {
+                        connectivity,
+                        positions: Some(faired.positions.clone()),
+                    }
                 }
                 ShownMesh::Level { .. } => {
                     let Some((_, mesh)) = &document.level_mesh else {
                         return;
                     };
-                    (&mesh.positions, &mesh.triangles)
+                    ViewMesh {
+                        connectivity: SharedMesh::Mesh(mesh.clone()),
+                        positions: None,
+                    }
                 }
             };
+            counts = Some((source.positions().len(), source.triangles().len()));
             if let Some(viewport) = viewport {
-                if !(same_connectivity && viewport.set_positions(positions)) {
-                    viewport.set_mesh(positions, triangles, None);
+                if !(same_connectivity && viewport.set_positions(source.positions())) {
+                    viewport.set_mesh(Arc::new(source), None);
                 }
             }
-            counts = Some((positions.len(), triangles.len()));
         }
         let mut heat_max = None;
         if let Some(reference) = wanted.heat {
@@ -1568,9 +1616,40 @@ fn heat_map_top(distances: &[f32]) -> f32 {
     value.max(0.0)
 }
 
-enum ExportTriangles {
+/// A mesh held by the document, shared with a worker or the renderer without copying it.
+#[derive(Clone)]
+enum SharedMesh {
+    /// The hierarchy's base mesh M0 (the connectivity faired results have).
     Base(Arc<hierarchy::Hierarchy>),
-    Original(Arc<TriMesh>),
+    Mesh(Arc<TriMesh>),
+}
+
+impl SharedMesh {
+    fn mesh(&self) -> &TriMesh {
+        match self {
+            Self::Base(hierarchy) => hierarchy.base_mesh(),
+            Self::Mesh(mesh) => mesh,
+        }
+    }
+}
+
+/// What the viewport shows: a mesh's triangles with its own positions or other ones (a faired
+/// result) over them.
+struct ViewMesh {
+    connectivity: SharedMesh,
+    positions: Option<Arc<Vec<[f32; 3]>>>,
+}
+
+impl MeshSource for ViewMesh {
+    fn positions(&self) -> &[[f32; 3]] {
+        match &self.positions {
+            Some(positions) => positions,
+            None => &self.connectivity.mesh().positions,
+        }
+    }
+    fn triangles(&self) -> &[[u32; 3]] {
+        &self.connectivity.mesh().triangles
+    }
 }
 
 /// Relative volume change and RMS vertex displacement of `positions` against `base`.
@@ -1629,8 +1708,22 @@ impl eframe::App for App {
             // Progress bars move without input events.
             ctx.request_repaint_after(Duration::from_millis(50));
         }
+        // The viewport's draw of the previous frame, if it drew a new image.
+        let render = match &self.viewport {
+            Some(viewport) => {
+                let images = viewport.images_drawn();
+                let drew = images != self.frame_stats.images_seen;
+                self.frame_stats.images_seen = images;
+                if drew {
+                    viewport.last_draw_time()
+                } else {
+                    Duration::ZERO
+                }
+            }
+            None => Duration::ZERO,
+        };
         self.frame_stats
-            .record(started.elapsed(), parts, busy || busy_before);
+            .record(started.elapsed(), parts, render, busy || busy_before);
     }
 
     fn save(&mut self, storage: &mut dyn eframe::Storage) {

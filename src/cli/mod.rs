@@ -23,10 +23,20 @@ pub struct Cli {
     pub command: Option<Command>,
 }
 
+#[derive(clap::Args, Debug, Default)]
+pub struct EditArgs {
+    /// The mesh to open; the bundled bunny when left out.
+    pub file: Option<PathBuf>,
+    /// Print every UI frame that takes more than MS milliseconds of CPU time to standard error,
+    /// split into its parts (applying results, uploading to the GPU, widgets, viewport draw).
+    #[arg(long, value_name = "MS")]
+    pub log_frames: Option<f64>,
+}
+
 #[derive(Subcommand, Debug)]
 pub enum Command {
     /// Open the editor on FILE (or on the bundled bunny).
-    Edit { file: Option<PathBuf> },
+    Edit(EditArgs),
     /// Print counts, topology and measures of a mesh.
     Info(basic::InfoArgs),
     /// Add seeded Gaussian noise to a mesh.

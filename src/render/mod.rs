@@ -11,9 +11,10 @@
 pub mod colormap;
 pub mod pipeline;
 
-pub use pipeline::{DrawParams, MeshRenderer};
+pub use pipeline::{DrawParams, MeshRenderer, MeshSource};
 
 use egui_wgpu::wgpu;
+use std::sync::Arc;
 
 /// Every viewport's renderer, in egui_wgpu's callback resources (one entry per type, so the
 /// renderers of several viewports share one list; a viewport knows its slot).
@@ -29,9 +30,11 @@ pub struct Viewport3d {
 }
 
 impl Viewport3d {
-    /// Creates a renderer (pipelines, buffers, target) on the render state's device.
-    pub fn new(state: &egui_wgpu::RenderState) -> Self {
-        let renderer = MeshRenderer::new(&state.device);
+    /// Creates a renderer (pipelines, buffers, target, upload thread) on the render state's
+    /// device; `ctx` repaints when a background upload lands.
+    pub fn new(state: &egui_wgpu::RenderState, ctx: &egui::Context) -> Self {
+        let ctx = ctx.clone();
+        let renderer = MeshRenderer::new(&state.device, Arc::new(move || ctx.request_repaint()));
         let mut egui_renderer = state.renderer.write();
         let resources = &mut egui_renderer.callback_resources;
         if resources.get::<MeshRenderers>().is_none() {
@@ -61,15 +64,23 @@ impl Viewport3d {
             .map(f)
     }
 
-    /// Uploads a mesh with new connectivity (slow for big meshes: call only when it changed).
-    pub fn set_mesh(
-        &self,
-        positions: &[[f32; 3]],
-        triangles: &[[u32; 3]],
-        scalars: Option<&[f32]>,
-    ) {
+    /// Shows a mesh with new connectivity (a big one uploads in the background: call only when
+    /// the connectivity changed, [`Self::set_positions`] otherwise).
+    pub fn set_mesh(&self, source: Arc<dyn MeshSource>, scalars: Option<&[f32]>) {
         let device = &self.state.device;
-        self.with_renderer(|r| r.set_mesh(device, positions, triangles, scalars));
+        self.with_renderer(|r| r.set_mesh(device, source, scalars));
+    }
+
+    /// Whether a background upload has not landed yet.
+    pub fn upload_pending(&self) -> bool {
+        let queue = &self.state.queue;
+        self.with_renderer(|r| r.upload_pending(queue))
+            .unwrap_or(false)
+    }
+
+    /// Meshes of at least `bytes` upload in the background (tests set 0 to exercise that path).
+    pub fn set_async_upload_bytes(&self, bytes: usize) {
+        self.with_renderer(|r| r.set_async_upload_bytes(bytes));
     }
 
     /// Moves the current mesh's vertices; `false` when the vertex count differs.
@@ -89,6 +100,11 @@ impl Viewport3d {
     /// Offscreen images drawn so far.
     pub fn images_drawn(&self) -> u64 {
         self.with_renderer(|r| r.images_drawn).unwrap_or(0)
+    }
+
+    /// CPU time of the last offscreen draw (see [`MeshRenderer::last_draw_time`]).
+    pub fn last_draw_time(&self) -> std::time::Duration {
+        self.with_renderer(|r| r.last_draw_time).unwrap_or_default()
     }
 
     /// Adapter name and backend, for the performance readout.

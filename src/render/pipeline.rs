@@ -5,8 +5,15 @@
 //! connectivity, [`MeshRenderer::set_positions`] when only the positions move), and the offscreen
 //! image is redrawn only when the view, the mesh or the target size changed, so a large mesh costs
 //! nothing per frame while nothing moves.
+//!
+//! New connectivity of a big mesh (4 MB of positions and triangles or more, ~170k faces) and its
+//! wireframe edges are filled into buffers on the renderer's own upload thread: for a 1.2M-face
+//! mesh that is ~30 ms of copying and page faults (positions, triangles) and ~20 ms (edges) that
+//! would otherwise stall one UI frame. The previous image stays until the upload lands.
 
 use bytemuck::{Pod, Zeroable};
+use std::sync::mpsc::{self, Receiver, Sender};
+use std::sync::{Arc, Mutex};
 use wgpu::util::DeviceExt;
 
 /// Format of the image the mesh is drawn into (and that egui then samples).
@@ -42,6 +49,17 @@ struct Uniforms {
     scalar_range: [f32; 4],
 }
 
+/// Mesh data the renderer may read on its upload thread (shared, never copied on the UI thread).
+pub trait MeshSource: Send + Sync + 'static {
+    fn positions(&self) -> &[[f32; 3]];
+    fn triangles(&self) -> &[[u32; 3]];
+}
+
+/// Meshes whose positions and triangles take fewer bytes than this are uploaded in the calling
+/// frame (under ~2 ms); larger ones on the renderer's upload thread, so that loading a 1M-face
+/// mesh does not stall the UI for the ~30 ms its buffers take to fill.
+pub const DEFAULT_ASYNC_UPLOAD_BYTES: usize = 4 << 20;
+
 /// GPU copies of one mesh.
 struct MeshBuffers {
     positions: wgpu::Buffer,
@@ -49,9 +67,211 @@ struct MeshBuffers {
     triangles: wgpu::Buffer,
     vertex_count: usize,
     index_count: u32,
-    /// Edge list for the wireframe, built on first use from `triangles_cpu`.
+    /// Edge list for the wireframe, built when first needed (on the upload thread for a big
+    /// mesh) from `source`'s triangles.
     lines: Option<(wgpu::Buffer, u32)>,
-    triangles_cpu: Vec<[u32; 3]>,
+    source: Arc<dyn MeshSource>,
+    /// Which [`MeshRenderer::set_mesh`] call this mesh answers.
+    generation: u64,
+}
+
+impl MeshBuffers {
+    fn create(
+        device: &wgpu::Device,
+        source: Arc<dyn MeshSource>,
+        scalars: Option<&[f32]>,
+        with_lines: bool,
+        generation: u64,
+    ) -> Self {
+        let positions = source.positions();
+        let triangles = source.triangles();
+        let positions_buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("fairmesh positions"),
+            contents: bytemuck::cast_slice(positions),
+            usage: wgpu::BufferUsages::VERTEX | wgpu::BufferUsages::COPY_DST,
+        });
+        let scalars_buffer = match scalars {
+            Some(s) if s.len() == positions.len() => {
+                device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                    label: Some("fairmesh scalars"),
+                    contents: bytemuck::cast_slice(s),
+                    usage: wgpu::BufferUsages::VERTEX | wgpu::BufferUsages::COPY_DST,
+                })
+            }
+            // wgpu zero-fills a buffer that is not mapped at creation.
+            _ => device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("fairmesh scalars"),
+                size: (positions.len() * 4) as u64,
+                usage: wgpu::BufferUsages::VERTEX | wgpu::BufferUsages::COPY_DST,
+                mapped_at_creation: false,
+            }),
+        };
+        let triangles_buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("fairmesh triangles"),
+            contents: bytemuck::cast_slice(triangles),
+            usage: wgpu::BufferUsages::INDEX,
+        });
+        let lines = with_lines.then(|| line_buffer(device, triangles));
+        Self {
+            positions: positions_buffer,
+            scalars: scalars_buffer,
+            triangles: triangles_buffer,
+            vertex_count: positions.len(),
+            index_count: (triangles.len() * 3) as u32,
+            lines,
+            source,
+            generation,
+        }
+    }
+}
+
+/// The wireframe's index buffer: each triangle's three edges as line segments (an edge shared by
+/// two triangles is drawn twice, which looks the same and needs no edge map).
+fn line_buffer(device: &wgpu::Device, triangles: &[[u32; 3]]) -> (wgpu::Buffer, u32) {
+    const BLOCK: usize = 4096;
+    let count = triangles.len() * 6;
+    let buffer = device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some("fairmesh wireframe edges"),
+        size: (count * 4) as u64,
+        usage: wgpu::BufferUsages::INDEX,
+        mapped_at_creation: true,
+    });
+    // The mapping is write-only (it may be write-combining memory): edges are built a block of
+    // triangles at a time in a small scratch array and copied in, with no full-size temporary.
+    let mut scratch = vec![0u32; BLOCK * 6];
+    match buffer.slice(..).get_mapped_range_mut() {
+        Ok(mut view) => {
+            for (block_index, block) in triangles.chunks(BLOCK).enumerate() {
+                let edges = &mut scratch[..block.len() * 6];
+                for (edge, &[a, b, c]) in edges.chunks_exact_mut(6).zip(block) {
+                    edge.copy_from_slice(&[a, b, b, c, c, a]);
+                }
+                let start = block_index * BLOCK * 6 * 4;
+                view.slice(start..start + edges.len() * 4)
+                    .copy_from_slice(bytemuck::cast_slice(edges));
+            }
+        }
+        // Cannot happen for a buffer mapped at creation; the wireframe is then just not drawn.
+        Err(_) => {
+            buffer.unmap();
+            return (buffer, 0);
+        }
+    }
+    buffer.unmap();
+    (buffer, count as u32)
+}
+
+/// Work for the upload thread.
+enum UploadJob {
+    Mesh {
+        generation: u64,
+        source: Arc<dyn MeshSource>,
+        scalars: Option<Vec<f32>>,
+        with_lines: bool,
+    },
+    Lines {
+        generation: u64,
+        source: Arc<dyn MeshSource>,
+    },
+}
+
+impl UploadJob {
+    fn generation(&self) -> u64 {
+        match self {
+            Self::Mesh { generation, .. } | Self::Lines { generation, .. } => *generation,
+        }
+    }
+}
+
+enum Uploaded {
+    Mesh(MeshBuffers),
+    Lines {
+        generation: u64,
+        lines: (wgpu::Buffer, u32),
+    },
+}
+
+/// The renderer's upload thread: fills buffers for big meshes off the UI thread. Only the newest
+/// generation's jobs in the queue are done; older ones are superseded.
+struct Uploader {
+    jobs: Option<Sender<UploadJob>>,
+    /// In a mutex only because egui_wgpu's callback resources must be `Sync`.
+    done: Mutex<Receiver<Uploaded>>,
+    thread: Option<std::thread::JoinHandle<()>>,
+}
+
+impl Uploader {
+    fn spawn(device: wgpu::Device, on_done: Arc<dyn Fn() + Send + Sync>) -> Option<Self> {
+        let (jobs_tx, jobs_rx) = mpsc::channel::<UploadJob>();
+        let (done_tx, done_rx) = mpsc::channel();
+        let thread = std::thread::Builder::new()
+            .name("fairmesh-upload".into())
+            .spawn(move || {
+                while let Ok(first) = jobs_rx.recv() {
+                    let mut batch = vec![first];
+                    batch.extend(jobs_rx.try_iter());
+                    let newest = batch.iter().map(UploadJob::generation).max();
+                    for job in batch {
+                        if Some(job.generation()) != newest {
+                            continue;
+                        }
+                        let uploaded = match job {
+                            UploadJob::Mesh {
+                                generation,
+                                source,
+                                scalars,
+                                with_lines,
+                            } => Uploaded::Mesh(MeshBuffers::create(
+                                &device,
+                                source,
+                                scalars.as_deref(),
+                                with_lines,
+                                generation,
+                            )),
+                            UploadJob::Lines { generation, source } => Uploaded::Lines {
+                                generation,
+                                lines: line_buffer(&device, source.triangles()),
+                            },
+                        };
+                        if done_tx.send(uploaded).is_err() {
+                            return;
+                        }
+                        on_done();
+                    }
+                }
+            })
+            .ok()?;
+        Some(Self {
+            jobs: Some(jobs_tx),
+            done: Mutex::new(done_rx),
+            thread: Some(thread),
+        })
+    }
+
+    /// Queues a job; gives it back when the thread is gone.
+    fn send(&self, job: UploadJob) -> Result<(), UploadJob> {
+        match &self.jobs {
+            Some(jobs) => jobs.send(job).map_err(|e| e.0),
+            None => Err(job),
+        }
+    }
+}
+
+impl Drop for Uploader {
+    fn drop(&mut self) {
+        // Closing the queue ends the thread after the job in hand.
+        self.jobs = None;
+        if let Some(thread) = self.thread.take() {
+            let _ = thread.join();
+        }
+    }
+}
+
+struct PendingMesh {
+    generation: u64,
+    vertex_count: usize,
+    /// Scalars set while the upload was in flight, written once it lands.
+    scalars: Option<Vec<f32>>,
 }
 
 struct Target {
@@ -73,10 +293,26 @@ pub struct MeshRenderer {
     drawn: Option<DrawParams>,
     /// Offscreen images drawn so far (for tests and the performance readout).
     pub images_drawn: u64,
+    uploader: Option<Uploader>,
+    /// Counts [`Self::set_mesh`] calls; an upload that lands for an older one is dropped.
+    generation: u64,
+    /// The upload in flight on the upload thread (the previous mesh stays on screen meanwhile).
+    pending: Option<PendingMesh>,
+    /// Generation of the mesh whose wireframe edges the upload thread is building.
+    lines_requested: Option<u64>,
+    /// Whether the last image had the wireframe (a big upload then builds its edges too).
+    wireframe: bool,
+    /// Meshes of at least this many bytes (positions + triangles) upload on the upload thread.
+    async_upload_bytes: usize,
+    /// CPU time of the last [`Self::render`] that drew (recording commands, building the
+    /// wireframe's edges on first use).
+    pub last_draw_time: std::time::Duration,
 }
 
 impl MeshRenderer {
-    pub fn new(device: &wgpu::Device) -> Self {
+    /// Pipelines on `device`, and an upload thread for big meshes that calls `on_upload_done`
+    /// (from that thread) whenever an upload lands, so the UI can repaint.
+    pub fn new(device: &wgpu::Device, on_upload_done: Arc<dyn Fn() + Send + Sync>) -> Self {
         let shader = device.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some("fairmesh mesh shader"),
             source: wgpu::ShaderSource::Wgsl(include_str!("../../shaders/mesh.wgsl").into()),
@@ -218,59 +454,124 @@ impl MeshRenderer {
             target: None,
             drawn: None,
             images_drawn: 0,
+            last_draw_time: std::time::Duration::ZERO,
+            // Without the thread (it failed to start) every upload happens in the calling frame.
+            uploader: Uploader::spawn(device.clone(), on_upload_done),
+            generation: 0,
+            pending: None,
+            lines_requested: None,
+            wireframe: false,
+            async_upload_bytes: DEFAULT_ASYNC_UPLOAD_BYTES,
         }
     }
 
-    /// Uploads a mesh with new connectivity. `scalars`, when given, has one value per vertex.
+    /// Meshes of at least `bytes` (positions + triangles) upload on the upload thread; 0 sends
+    /// every mesh there, `usize::MAX` none.
+    pub fn set_async_upload_bytes(&mut self, bytes: usize) {
+        self.async_upload_bytes = bytes;
+    }
+
+    /// Shows a mesh with new connectivity. `scalars`, when given, has one value per vertex.
+    ///
+    /// A small mesh is uploaded here; a big one on the upload thread, while the previous mesh
+    /// stays on screen (it appears in the first frame after the upload lands; see
+    /// [`Self::upload_pending`]).
     pub fn set_mesh(
         &mut self,
         device: &wgpu::Device,
-        positions: &[[f32; 3]],
-        triangles: &[[u32; 3]],
+        source: Arc<dyn MeshSource>,
         scalars: Option<&[f32]>,
     ) {
-        self.drawn = None;
-        if positions.is_empty() || triangles.is_empty() {
+        self.generation += 1;
+        self.pending = None;
+        self.lines_requested = None;
+        let (vertex_count, face_count) = (source.positions().len(), source.triangles().len());
+        if vertex_count == 0 || face_count == 0 {
             self.mesh = None;
+            self.drawn = None;
             return;
         }
-        let positions_buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-            label: Some("fairmesh positions"),
-            contents: bytemuck::cast_slice(positions),
-            usage: wgpu::BufferUsages::VERTEX | wgpu::BufferUsages::COPY_DST,
-        });
-        let zeros;
-        let scalars = match scalars {
-            Some(s) if s.len() == positions.len() => s,
-            _ => {
-                zeros = vec![0.0f32; positions.len()];
-                &zeros
+        let generation = self.generation;
+        let mut source = source;
+        if (vertex_count + face_count) * 12 >= self.async_upload_bytes {
+            if let Some(uploader) = &self.uploader {
+                let job = UploadJob::Mesh {
+                    generation,
+                    source,
+                    scalars: scalars.map(<[f32]>::to_vec),
+                    with_lines: self.wireframe,
+                };
+                match uploader.send(job) {
+                    Ok(()) => {
+                        self.pending = Some(PendingMesh {
+                            generation,
+                            vertex_count,
+                            scalars: None,
+                        });
+                        return;
+                    }
+                    Err(UploadJob::Mesh { source: back, .. }) => source = back,
+                    Err(UploadJob::Lines { .. }) => unreachable!("a mesh job comes back as one"),
+                }
             }
+        }
+        self.mesh = Some(MeshBuffers::create(
+            device, source, scalars, false, generation,
+        ));
+        self.drawn = None;
+    }
+
+    /// Takes in the uploads that landed since the last call (a stale one is dropped).
+    fn poll_uploads(&mut self, queue: &wgpu::Queue) {
+        let Some(uploader) = &self.uploader else {
+            return;
         };
-        let scalars_buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-            label: Some("fairmesh scalars"),
-            contents: bytemuck::cast_slice(scalars),
-            usage: wgpu::BufferUsages::VERTEX | wgpu::BufferUsages::COPY_DST,
-        });
-        let triangles_buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-            label: Some("fairmesh triangles"),
-            contents: bytemuck::cast_slice(triangles),
-            usage: wgpu::BufferUsages::INDEX,
-        });
-        self.mesh = Some(MeshBuffers {
-            positions: positions_buffer,
-            scalars: scalars_buffer,
-            triangles: triangles_buffer,
-            vertex_count: positions.len(),
-            index_count: (triangles.len() * 3) as u32,
-            lines: None,
-            triangles_cpu: triangles.to_vec(),
-        });
+        let landed: Vec<Uploaded> = match uploader.done.lock() {
+            Ok(done) => done.try_iter().collect(),
+            Err(poisoned) => poisoned.into_inner().try_iter().collect(),
+        };
+        for uploaded in landed {
+            match uploaded {
+                Uploaded::Mesh(buffers) => {
+                    if self
+                        .pending
+                        .as_ref()
+                        .is_some_and(|p| p.generation == buffers.generation)
+                    {
+                        if let Some(scalars) = self.pending.take().and_then(|p| p.scalars) {
+                            queue.write_buffer(&buffers.scalars, 0, bytemuck::cast_slice(&scalars));
+                        }
+                        self.mesh = Some(buffers);
+                        self.drawn = None;
+                    }
+                }
+                Uploaded::Lines { generation, lines } => {
+                    if self.lines_requested == Some(generation) {
+                        self.lines_requested = None;
+                    }
+                    if let Some(mesh) = self.mesh.as_mut().filter(|m| m.generation == generation) {
+                        mesh.lines = Some(lines);
+                        self.drawn = None;
+                    }
+                }
+            }
+        }
+    }
+
+    /// Whether an upload is still in flight (takes in those that landed first).
+    pub fn upload_pending(&mut self, queue: &wgpu::Queue) -> bool {
+        self.poll_uploads(queue);
+        self.pending.is_some() || self.lines_requested.is_some()
     }
 
     /// Moves the vertices of the current mesh; returns `false` (and changes nothing) when the
-    /// vertex count differs from the uploaded mesh's, in which case call [`Self::set_mesh`].
+    /// vertex count differs from the uploaded mesh's or a new mesh is still uploading, in which
+    /// case call [`Self::set_mesh`].
     pub fn set_positions(&mut self, queue: &wgpu::Queue, positions: &[[f32; 3]]) -> bool {
+        self.poll_uploads(queue);
+        if self.pending.is_some() {
+            return false;
+        }
         match &self.mesh {
             Some(mesh) if mesh.vertex_count == positions.len() => {
                 queue.write_buffer(&mesh.positions, 0, bytemuck::cast_slice(positions));
@@ -281,8 +582,17 @@ impl MeshRenderer {
         }
     }
 
-    /// Replaces the per-vertex scalars (one per vertex); `false` when the count does not match.
+    /// Replaces the per-vertex scalars (one per vertex) of the mesh on screen or, while one
+    /// uploads, of that one; `false` when the count does not match.
     pub fn set_scalars(&mut self, queue: &wgpu::Queue, scalars: &[f32]) -> bool {
+        self.poll_uploads(queue);
+        if let Some(pending) = &mut self.pending {
+            if pending.vertex_count != scalars.len() {
+                return false;
+            }
+            pending.scalars = Some(scalars.to_vec());
+            return true;
+        }
         match &self.mesh {
             Some(mesh) if mesh.vertex_count == scalars.len() => {
                 queue.write_buffer(&mesh.scalars, 0, bytemuck::cast_slice(scalars));
@@ -363,12 +673,15 @@ impl MeshRenderer {
         encoder: &mut wgpu::CommandEncoder,
         params: &DrawParams,
     ) -> bool {
+        self.poll_uploads(queue);
+        self.wireframe = params.wireframe;
         let Some(target) = &self.target else {
             return false;
         };
         if self.drawn.as_ref() == Some(params) || target.size != params.size {
             return false;
         }
+        let started = std::time::Instant::now();
         let uniforms = Uniforms {
             view_proj: params.view_proj,
             eye: [params.eye[0], params.eye[1], params.eye[2], 1.0],
@@ -389,18 +702,25 @@ impl MeshRenderer {
 
         if params.wireframe {
             if let Some(mesh) = &mut self.mesh {
-                if mesh.lines.is_none() {
-                    let edges: Vec<u32> = mesh
-                        .triangles_cpu
-                        .iter()
-                        .flat_map(|&[a, b, c]| [a, b, b, c, c, a])
-                        .collect();
-                    let buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                        label: Some("fairmesh wireframe edges"),
-                        contents: bytemuck::cast_slice(&edges),
-                        usage: wgpu::BufferUsages::INDEX,
-                    });
-                    mesh.lines = Some((buffer, edges.len() as u32));
+                if mesh.lines.is_none() && self.lines_requested != Some(mesh.generation) {
+                    // A big mesh's edges are built on the upload thread (the image shows the
+                    // mesh without them meanwhile); a small one's here.
+                    let bytes = (mesh.vertex_count + mesh.index_count as usize / 3) * 12;
+                    let job = UploadJob::Lines {
+                        generation: mesh.generation,
+                        source: mesh.source.clone(),
+                    };
+                    let sent = match &self.uploader {
+                        Some(uploader) if bytes >= self.async_upload_bytes => {
+                            uploader.send(job).is_ok()
+                        }
+                        _ => false,
+                    };
+                    if sent {
+                        self.lines_requested = Some(mesh.generation);
+                    } else {
+                        mesh.lines = Some(line_buffer(device, mesh.source.triangles()));
+                    }
                 }
             }
         }
@@ -453,6 +773,7 @@ impl MeshRenderer {
         }
         self.drawn = Some(*params);
         self.images_drawn += 1;
+        self.last_draw_time = started.elapsed();
         true
     }
 }

@@ -9,7 +9,7 @@ use std::time::{Duration, Instant};
 use egui::accesskit::Role;
 use egui_kittest::kittest::Queryable;
 use egui_kittest::Harness;
-use fairmesh::app::App;
+use fairmesh::app::{App, AppOptions};
 
 pub fn bunny() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/bunny00.obj")
@@ -20,6 +20,22 @@ pub fn harness_for(path: PathBuf) -> Harness<'static, App> {
         .with_size(egui::vec2(1200.0, 800.0))
         .wgpu()
         .build_eframe(move |cc| App::new_for_test(cc, path))
+}
+
+/// Like [`harness_for`], with the app's options (no persistence either way).
+pub fn harness_with(options: AppOptions) -> Harness<'static, App> {
+    Harness::builder()
+        .with_size(egui::vec2(1200.0, 800.0))
+        .wgpu()
+        .build_eframe(move |cc| {
+            App::with_options(
+                cc,
+                AppOptions {
+                    persistence: false,
+                    ..options
+                },
+            )
+        })
 }
 
 /// Steps frames until every background job finished and its result was applied. The bound is
