@@ -100,6 +100,32 @@ fn level_slider_refairs_and_updates_the_numbers() {
     }
 }
 
+/// Switching to the level view while a fairing runs: the fairing still finishes (its spinner
+/// goes), and the result it brings is measured once it has been on screen a moment.
+#[test]
+fn level_view_during_a_fairing_still_finishes_and_measures_it() {
+    let mut harness = harness_for(bunny());
+    settle(&mut harness);
+    let before = harness.state().status();
+    harness
+        .get_by_role_and_label(Role::Slider, "Start level")
+        .focus();
+    harness.step();
+    harness.key_press(egui::Key::ArrowRight);
+    harness.step();
+    harness.get_by_label("Level mesh").click();
+    settle(&mut harness);
+    let after = harness.state().status();
+    assert!(after.faired_serial > before.faired_serial);
+    assert!(
+        harness.query_by_label_contains("fairing …").is_none(),
+        "the fairing spinner is gone"
+    );
+    assert!(harness.query_by_label("running…").is_none());
+    let (against_document, _) = harness.state().faired_measures();
+    assert!(against_document.is_some());
+}
+
 #[test]
 fn exports_and_reloads_the_result() {
     let dir = tempfile::tempdir().unwrap();

@@ -255,6 +255,8 @@ pub struct App {
     hierarchy_progress: SharedProgress,
     fair_progress: SharedProgress,
     fair_in_flight: bool,
+    /// View generation of the newest fairing asked for.
+    fair_view: u64,
     workspace: Arc<Mutex<MultiresWorkspace>>,
     io: Worker,
     compute: Worker,
@@ -266,6 +268,9 @@ pub struct App {
     /// then shares the global pool), so that the next slider value's fairing keeps the global
     /// pool (sharing it doubled the time to the next result on the bunny).
     measure_pool: Option<Arc<rayon::ThreadPool>>,
+    /// The faired result to measure next (document, serial, positions, when it arrived); see
+    /// [`MEASURE_DELAY`].
+    measure_wanted: Option<(u64, u64, Arc<Vec<[f32; 3]>>, Instant)>,
     jobs: JobCounter,
     results_tx: Sender<(JobResult, JobTicket)>,
     results_rx: Receiver<(JobResult, JobTicket)>,
@@ -293,6 +298,13 @@ pub struct App {
     /// Earlier and later document states (noise, applied results, loading).
     history: History<DocumentSnapshot>,
 }
+
+/// A faired result is measured once it has been on screen this long with no fairing in flight:
+/// measuring takes a core for 0.1-0.3 s on the bunny (seconds on a 1M-face mesh), and while the
+/// slider is dragged it would compete with the next value's fairing (on a 2-core machine one
+/// slider step in ten then took 8 frames instead of 2-3). The numbers follow when the user
+/// pauses.
+const MEASURE_DELAY: Duration = Duration::from_millis(100);
 
 /// Memory the undo history may keep alive.
 const HISTORY_BUDGET_BYTES: usize = 1 << 30;
@@ -335,11 +347,13 @@ impl App {
             hierarchy_progress: SharedProgress::default(),
             fair_progress: SharedProgress::default(),
             fair_in_flight: false,
+            fair_view: 0,
             workspace: Arc::new(Mutex::new(MultiresWorkspace::default())),
             io,
             compute,
             measure,
             measure_pool,
+            measure_wanted: None,
             jobs: JobCounter::default(),
             results_tx,
             results_rx,
@@ -393,7 +407,10 @@ impl App {
 
     /// No job running or waiting and every result applied.
     pub fn is_settled(&self) -> bool {
-        self.jobs.in_flight() == 0 && self.commands.is_empty() && !self.upload_pending()
+        self.jobs.in_flight() == 0
+            && self.commands.is_empty()
+            && self.measure_wanted.is_none()
+            && !self.upload_pending()
     }
 
     /// Whether a viewport's background upload of a big mesh has not landed yet.
@@ -496,7 +513,26 @@ impl App {
     }
 
     fn busy(&self) -> bool {
-        self.jobs.in_flight() > 0
+        self.jobs.in_flight() > 0 || self.measure_wanted.is_some()
+    }
+
+    /// Hands the waiting result to the measuring worker once no fairing is in flight and it has
+    /// waited [`MEASURE_DELAY`]; until then asks for a frame when the delay is up.
+    fn start_waiting_measure(&mut self) {
+        let Some((_, _, _, arrived)) = &self.measure_wanted else {
+            return;
+        };
+        let waited = arrived.elapsed();
+        if self.fair_in_flight {
+            return;
+        }
+        if waited < MEASURE_DELAY {
+            self.ctx.request_repaint_after(MEASURE_DELAY - waited);
+            return;
+        }
+        if let Some((document, serial, positions, _)) = self.measure_wanted.take() {
+            self.request_measures(document, serial, positions);
+        }
     }
 
     fn send_result(
@@ -790,6 +826,7 @@ impl App {
         let workspace = self.workspace.clone();
         let (tx, ctx, ticket) = (self.results_tx.clone(), self.ctx.clone(), self.jobs.start());
         self.fair_in_flight = true;
+        self.fair_view = view;
         self.fair_progress.set(0.0);
         self.compute.submit_latest("fair", move || {
             if !document_generation.is_current(document) {
@@ -1167,7 +1204,9 @@ impl App {
                 level,
                 result,
             } => {
-                if self.view_generation.is_current(view) {
+                // The newest fairing asked for has answered (a view change to the level mesh
+                // since does not make it any less finished).
+                if view >= self.fair_view {
                     self.fair_in_flight = false;
                 }
                 let Some(current) = self.document.as_mut().filter(|d| d.generation == document)
@@ -1198,7 +1237,8 @@ impl App {
                         measure_time: faired.measure_time,
                         measures_pending: true,
                     });
-                    self.request_measures(document, self.next_serial, positions);
+                    self.measure_wanted =
+                        Some((document, self.next_serial, positions, Instant::now()));
                 }
             }
             JobResult::Measured {
@@ -1687,6 +1727,7 @@ impl eframe::App for App {
         // Busy at the start counts too: the frame that applies the last result is a working one.
         let busy_before = self.busy();
         self.poll_results();
+        self.start_waiting_measure();
         self.handle_global_input(&ctx);
         let results_done = Instant::now();
         // Upload before drawing, so the viewport draws what the panels describe.
