@@ -339,6 +339,56 @@ fn background_uploads_draw_the_same_images() {
     );
 }
 
+/// A mesh or wireframe too big for the GPU's buffers is not drawn, and the viewport says why
+/// (instead of wgpu's validation error ending the app). The bunny's triangles take 0.9 MB and
+/// its wireframe edges 1.8 MB: a 1 MB cap keeps the mesh and refuses the wireframe, 0.5 MB
+/// refuses both.
+#[test]
+fn meshes_too_big_for_the_gpu_buffers_are_refused_with_a_reason() {
+    let mut harness = harness_with(AppOptions {
+        file: Some(bunny()),
+        max_buffer_bytes: Some(1_000_000),
+        ..AppOptions::default()
+    });
+    settle(&mut harness);
+    let shaded = viewport_image(&mut harness);
+    assert!(harness.query_by_label_contains("Not drawn").is_none());
+    harness.key_press(egui::Key::W);
+    harness.step();
+    settle(&mut harness);
+    let wire = viewport_image(&mut harness);
+    // Below the notice at the top, the image is the shaded one: no wireframe.
+    let differing = (100..shaded.height())
+        .flat_map(|y| (0..shaded.width()).map(move |x| (x, y)))
+        .filter(|&(x, y)| shaded.get_pixel(x, y) != wire.get_pixel(x, y))
+        .count();
+    assert_eq!(
+        differing, 0,
+        "the wireframe was refused, the shaded mesh stays"
+    );
+    harness.get_by_label_contains(
+        "Not drawn: the wireframe of 75408 faces needs a 1.8 MB buffer; this GPU allows 1.0 MB",
+    );
+
+    let mut harness = harness_with(AppOptions {
+        file: Some(bunny()),
+        max_buffer_bytes: Some(500_000),
+        ..AppOptions::default()
+    });
+    settle(&mut harness);
+    harness.get_by_label_contains(
+        "Not drawn: the mesh of 75408 faces needs a 0.9 MB buffer; this GPU allows 0.5 MB",
+    );
+    let image = viewport_image(&mut harness);
+    let background = *image.get_pixel(3, 3);
+    let (w, h) = image.dimensions();
+    assert_eq!(
+        *image.get_pixel(w / 2, h / 2),
+        background,
+        "no mesh is drawn"
+    );
+}
+
 /// Writes `mesh` as a minimal OBJ (the test needs a big file before `io::save` can be relied on).
 fn write_obj(mesh: &fairmesh::TriMesh, path: &Path) {
     use std::io::Write;

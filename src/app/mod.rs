@@ -56,6 +56,7 @@ pub fn run(options: AppOptions) -> anyhow::Result<()> {
             .with_min_inner_size([640.0, 400.0])
             .with_drag_and_drop(true),
         renderer: eframe::Renderer::Wgpu,
+        wgpu_options: wgpu_configuration(),
         ..Default::default()
     };
     eframe::run_native(
@@ -64,6 +65,23 @@ pub fn run(options: AppOptions) -> anyhow::Result<()> {
         Box::new(move |cc| Ok(Box::new(App::with_options(cc, app_options)))),
     )
     .map_err(|error| anyhow::anyhow!("the editor window failed: {error}"))
+}
+
+/// eframe's wgpu set-up, asking for the largest buffers the adapter allows: wgpu's default
+/// limit (256 MiB per buffer) caps the wireframe at about 11M faces and the mesh at 22M, below
+/// what big scans have; real GPUs allow far more.
+fn wgpu_configuration() -> egui_wgpu::WgpuConfiguration {
+    let mut configuration = egui_wgpu::WgpuConfiguration::default();
+    if let egui_wgpu::WgpuSetup::CreateNew(setup) = &mut configuration.wgpu_setup {
+        let base = setup.device_descriptor.clone();
+        setup.device_descriptor = Arc::new(move |adapter| {
+            let mut descriptor = base(adapter);
+            let limits = &mut descriptor.required_limits;
+            limits.max_buffer_size = limits.max_buffer_size.max(adapter.limits().max_buffer_size);
+            descriptor
+        });
+    }
+    configuration
 }
 
 /// The bundled default mesh: `assets/bunny00.obj` beside the working directory or the source tree.
@@ -88,6 +106,9 @@ pub struct AppOptions {
     /// Meshes of at least this many bytes (positions + triangles) upload to the GPU on the
     /// viewports' upload threads; `None` keeps the renderer's default (4 MB). Tests set 0.
     pub async_upload_bytes: Option<usize>,
+    /// Caps the size of one GPU buffer below the device's limit (tests: what a small GPU does
+    /// with a mesh or wireframe too big for it).
+    pub max_buffer_bytes: Option<u64>,
 }
 
 /// Something the user asked for; applied after the frame's widgets are drawn.
@@ -380,9 +401,12 @@ impl App {
             viewport_rect: None,
             history: History::new(HISTORY_BUDGET_BYTES),
         };
-        if let Some(bytes) = options.async_upload_bytes {
-            for viewport in [&app.viewport, &app.viewport_before].into_iter().flatten() {
+        for viewport in [&app.viewport, &app.viewport_before].into_iter().flatten() {
+            if let Some(bytes) = options.async_upload_bytes {
                 viewport.set_async_upload_bytes(bytes);
+            }
+            if let Some(bytes) = options.max_buffer_bytes {
+                viewport.cap_buffer_size(bytes);
             }
         }
         app.open(file);

@@ -717,6 +717,21 @@ fn viewport(app: &mut App, ui: &mut egui::Ui) {
     if let (Some(top), Some(reference)) = (app.heat_top(), app.heat_reference()) {
         heat_legend(ui, rect, top, reference);
     }
+    let wireframe = app.settings.wireframe;
+    let problem = [&app.viewport, &app.viewport_before]
+        .into_iter()
+        .flatten()
+        .find_map(|viewport| viewport.problem(wireframe));
+    if let Some(problem) = problem {
+        let text = egui::RichText::new(format!("Not drawn: {problem}"))
+            .size(14.0)
+            .color(egui::Color32::from_rgb(240, 150, 90));
+        let area = egui::Rect::from_min_size(
+            rect.left_top() + egui::vec2(8.0, 32.0),
+            egui::vec2(rect.width() - 16.0, 20.0),
+        );
+        ui.put(area, egui::Label::new(text).selectable(false));
+    }
 }
 
 /// The compare and heat-map controls (top of the side panel, so they never take the viewport's room).

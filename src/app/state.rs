@@ -57,7 +57,7 @@ impl MethodSetting {
 
     pub fn label(self) -> &'static str {
         match self {
-            MethodSetting::Constrained => "Constrained (paper)",
+            MethodSetting::Constrained => "Constrained fairing",
             MethodSetting::Laplacian => "Laplacian",
             MethodSetting::Taubin => "Taubin λ|μ",
             MethodSetting::Hc => "HC Laplacian",

@@ -71,6 +71,17 @@ impl Viewport3d {
         self.with_renderer(|r| r.set_mesh(device, source, scalars));
     }
 
+    /// Why the mesh (or its wireframe, when on) is not drawn: too big for this GPU's buffers.
+    pub fn problem(&self, wireframe: bool) -> Option<String> {
+        self.with_renderer(|r| r.problem(wireframe)).flatten()
+    }
+
+    /// Uses at most `bytes` per GPU buffer (see [`MeshRenderer::cap_buffer_size`]).
+    pub fn cap_buffer_size(&self, bytes: u64) {
+        let device = &self.state.device;
+        self.with_renderer(|r| r.cap_buffer_size(device, bytes));
+    }
+
     /// Whether a background upload has not landed yet.
     pub fn upload_pending(&self) -> bool {
         let queue = &self.state.queue;

@@ -304,6 +304,9 @@ pub struct MeshRenderer {
     wireframe: bool,
     /// Meshes of at least this many bytes (positions + triangles) upload on the upload thread.
     async_upload_bytes: usize,
+    /// Why the last mesh set is not drawn (a buffer would exceed the device's `max_buffer_size`).
+    problem: Option<String>,
+    max_buffer_size: u64,
     /// CPU time of the last [`Self::render`] that drew (recording commands, building the
     /// wireframe's edges on first use).
     pub last_draw_time: std::time::Duration,
@@ -462,7 +465,48 @@ impl MeshRenderer {
             lines_requested: None,
             wireframe: false,
             async_upload_bytes: DEFAULT_ASYNC_UPLOAD_BYTES,
+            problem: None,
+            max_buffer_size: device.limits().max_buffer_size,
         }
+    }
+
+    /// Uses at most `bytes` per buffer, or the device's limit if that is lower (to see what a
+    /// smaller GPU would do; tests).
+    pub fn cap_buffer_size(&mut self, device: &wgpu::Device, bytes: u64) {
+        self.max_buffer_size = bytes.min(device.limits().max_buffer_size);
+    }
+
+    /// Why the mesh, or its wireframe when `wireframe` is on, is not shown (too big for the
+    /// device's buffers), if so.
+    pub fn problem(&self, wireframe: bool) -> Option<String> {
+        if self.problem.is_some() {
+            return self.problem.clone();
+        }
+        let faces = self.mesh.as_ref()?.index_count as usize / 3;
+        if wireframe {
+            self.too_big("the wireframe", faces * 24, faces)
+        } else {
+            None
+        }
+    }
+
+    /// `None` when a buffer of `bytes` fits the device, else the sentence saying it does not.
+    fn too_big(&self, what: &str, bytes: usize, faces: usize) -> Option<String> {
+        let megabytes = |bytes: u64| {
+            let mb = bytes as f64 / 1e6;
+            if mb < 10.0 {
+                format!("{mb:.1} MB")
+            } else {
+                format!("{mb:.0} MB")
+            }
+        };
+        (bytes as u64 > self.max_buffer_size).then(|| {
+            format!(
+                "{what} of {faces} faces needs a {} buffer; this GPU allows {}",
+                megabytes(bytes as u64),
+                megabytes(self.max_buffer_size)
+            )
+        })
     }
 
     /// Meshes of at least `bytes` (positions + triangles) upload on the upload thread; 0 sends
@@ -485,8 +529,11 @@ impl MeshRenderer {
         self.generation += 1;
         self.pending = None;
         self.lines_requested = None;
+        self.problem = None;
         let (vertex_count, face_count) = (source.positions().len(), source.triangles().len());
-        if vertex_count == 0 || face_count == 0 {
+        // Positions and triangles take 12 bytes per vertex and per face.
+        self.problem = self.too_big("the mesh", vertex_count.max(face_count) * 12, face_count);
+        if vertex_count == 0 || face_count == 0 || self.problem.is_some() {
             self.mesh = None;
             self.drawn = None;
             return;
@@ -499,7 +546,7 @@ impl MeshRenderer {
                     generation,
                     source,
                     scalars: scalars.map(<[f32]>::to_vec),
-                    with_lines: self.wireframe,
+                    with_lines: self.wireframe && face_count as u64 * 24 <= self.max_buffer_size,
                 };
                 match uploader.send(job) {
                     Ok(()) => {
@@ -702,10 +749,12 @@ impl MeshRenderer {
 
         if params.wireframe {
             if let Some(mesh) = &mut self.mesh {
-                if mesh.lines.is_none() && self.lines_requested != Some(mesh.generation) {
+                let faces = mesh.index_count as usize / 3;
+                let fits = faces as u64 * 24 <= self.max_buffer_size;
+                if fits && mesh.lines.is_none() && self.lines_requested != Some(mesh.generation) {
                     // A big mesh's edges are built on the upload thread (the image shows the
                     // mesh without them meanwhile); a small one's here.
-                    let bytes = (mesh.vertex_count + mesh.index_count as usize / 3) * 12;
+                    let bytes = (mesh.vertex_count + faces) * 12;
                     let job = UploadJob::Lines {
                         generation: mesh.generation,
                         source: mesh.source.clone(),
