@@ -292,14 +292,10 @@ impl Measures {
     pub fn of(reference: &TriMesh, other: &TriMesh) -> Self {
         let reference_index = crate::metrics::ClosestPointIndex::new(reference);
         let other_index = crate::metrics::ClosestPointIndex::new(other);
-        let forth = reference_index.distance_from(other);
+        let (forth, vertex_distances) = reference_index.distance_and_vertex_distances_from(other);
         let back = other_index.distance_from(reference);
         let vertices = crate::metrics::compare_vertices(reference, other);
-        let vertex_distances = reference_index
-            .vertex_distances(other)
-            .into_iter()
-            .map(|d| d as f32)
-            .collect();
+        let vertex_distances = vertex_distances.into_iter().map(|d| d as f32).collect();
         Self {
             volume_change_percent: crate::metrics::volume_change_percent(reference, other),
             mean_distance: 0.5 * (forth.mean + back.mean),
