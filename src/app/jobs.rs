@@ -3,7 +3,9 @@
 //!
 //! - [`Worker`] runs boxed jobs one after another on its own named thread. A job submitted with
 //!   [`Worker::submit_latest`] replaces any job of the same slot still waiting, so a slider being
-//!   dragged queues at most one fairing run behind the one in flight.
+//!   dragged queues at most one fairing run behind the one in flight. A job submitted with
+//!   [`Worker::submit_idle`] runs only when no other job waits: work for later (setting up the
+//!   hierarchy's levels) never delays what the user asked for by more than the idle job in hand.
 //! - [`Generation`] is a shared counter. A job remembers the value it was started under; when the
 //!   UI bumps the counter (a new file, a newer slider value) the job's progress hook sees the
 //!   change and cancels, and the UI ignores a result whose generation is not the current one.
@@ -27,6 +29,8 @@ type Job = Box<dyn FnOnce() + Send + 'static>;
 struct Queued {
     slot: Option<&'static str>,
     job: Job,
+    /// Runs only when no other job waits.
+    idle: bool,
 }
 
 #[derive(Default)]
@@ -71,6 +75,17 @@ impl Worker {
         self.lock().jobs.push_back(Queued {
             slot: None,
             job: Box::new(job),
+            idle: false,
+        });
+        self.shared.wake.notify_one();
+    }
+
+    /// Queues `job` to run when no other job waits (idle jobs run in the order submitted).
+    pub fn submit_idle(&self, job: impl FnOnce() + Send + 'static) {
+        self.lock().jobs.push_back(Queued {
+            slot: None,
+            job: Box::new(job),
+            idle: true,
         });
         self.shared.wake.notify_one();
     }
@@ -82,6 +97,7 @@ impl Worker {
         queue.jobs.push_back(Queued {
             slot: Some(slot),
             job: Box::new(job),
+            idle: false,
         });
         drop(queue);
         self.shared.wake.notify_one();
@@ -114,7 +130,9 @@ fn worker_loop(shared: &Shared) {
                 if queue.shutdown {
                     return;
                 }
-                if let Some(queued) = queue.jobs.pop_front() {
+                // The first job that is not idle, else the first idle one.
+                let next = queue.jobs.iter().position(|queued| !queued.idle);
+                if let Some(queued) = queue.jobs.remove(next.unwrap_or(0)) {
                     queue.running += 1;
                     break queued.job;
                 }
@@ -310,6 +328,28 @@ mod tests {
         release_tx.send(()).unwrap();
         assert_eq!(rx.recv_timeout(Duration::from_secs(5)).unwrap(), 4);
         assert!(rx.recv_timeout(Duration::from_millis(200)).is_err());
+    }
+
+    #[test]
+    fn idle_jobs_wait_for_every_other_job() {
+        let worker = Worker::spawn("fairmesh-test-idle").unwrap();
+        let (tx, rx) = mpsc::channel();
+        let (release_tx, release_rx) = mpsc::channel::<()>();
+        worker.submit(move || {
+            release_rx.recv_timeout(Duration::from_secs(5)).ok();
+        });
+        for name in ["idle 1", "idle 2"] {
+            let tx = tx.clone();
+            worker.submit_idle(move || tx.send(name).unwrap());
+        }
+        let tx2 = tx.clone();
+        worker.submit(move || tx2.send("normal").unwrap());
+        worker.submit_latest("fair", move || tx.send("latest").unwrap());
+        release_tx.send(()).unwrap();
+        let order: Vec<_> = (0..4)
+            .map(|_| rx.recv_timeout(Duration::from_secs(5)).unwrap())
+            .collect();
+        assert_eq!(order, ["normal", "latest", "idle 1", "idle 2"]);
     }
 
     #[test]
