@@ -60,12 +60,12 @@ struct Quality {
 fn one_side(from: &TriMesh, to: &TriMesh, faces: &[Vec<u32>]) -> (f64, f64) {
     let mut sum = 0.0;
     let mut max: f64 = 0.0;
-    for v in 0..from.positions.len() {
-        if faces[v].is_empty() {
+    for (v, near) in faces.iter().enumerate().take(from.positions.len()) {
+        if near.is_empty() {
             continue;
         }
         let p = from.point(v as u32);
-        let d = faces[v]
+        let d = near
             .iter()
             .map(|&f| {
                 let [a, b, c] = to.triangle_points(f as usize);

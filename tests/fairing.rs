@@ -422,7 +422,8 @@ fn equivariant_under_translation_rotation_and_scale() {
     let topology = Topology::build(&mesh);
     let (angle, axis) = (0.7f64, glam::DVec3::new(1.0, -2.0, 0.5).normalize());
     let rotation = glam::DQuat::from_axis_angle(axis, angle);
-    let transforms: [(&str, Box<dyn Fn(glam::DVec3) -> glam::DVec3>, f64); 3] = [
+    type Transform = Box<dyn Fn(glam::DVec3) -> glam::DVec3>;
+    let transforms: [(&str, Transform, f64); 3] = [
         (
             "translation",
             Box::new(|p| p + glam::DVec3::new(3.0, -1.5, 2.0)),

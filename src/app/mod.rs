@@ -291,9 +291,8 @@ pub struct App {
     /// then shares the global pool), so that the next slider value's fairing keeps the global
     /// pool (sharing it doubled the time to the next result on the bunny).
     measure_pool: Option<Arc<rayon::ThreadPool>>,
-    /// The faired result to measure next (document, serial, positions, when it arrived); see
-    /// [`MEASURE_DELAY`].
-    measure_wanted: Option<(u64, u64, Arc<Vec<[f32; 3]>>, Instant)>,
+    /// The faired result to measure next; see [`MEASURE_DELAY`].
+    measure_wanted: Option<MeasureRequest>,
     jobs: JobCounter,
     results_tx: Sender<(JobResult, JobTicket)>,
     results_rx: Receiver<(JobResult, JobTicket)>,
@@ -328,6 +327,15 @@ pub struct App {
 /// slider step in ten then took 8 frames instead of 2-3). The numbers follow when the user
 /// pauses.
 const MEASURE_DELAY: Duration = Duration::from_millis(100);
+
+/// A faired result waiting to be measured.
+struct MeasureRequest {
+    document: u64,
+    serial: u64,
+    positions: Arc<Vec<[f32; 3]>>,
+    /// When the result arrived.
+    arrived: Instant,
+}
 
 /// Memory the undo history may keep alive.
 const HISTORY_BUDGET_BYTES: usize = 1 << 30;
@@ -546,10 +554,10 @@ impl App {
     /// Hands the waiting result to the measuring worker once no fairing is in flight and it has
     /// waited [`MEASURE_DELAY`]; until then asks for a frame when the delay is up.
     fn start_waiting_measure(&mut self) {
-        let Some((_, _, _, arrived)) = &self.measure_wanted else {
+        let Some(request) = &self.measure_wanted else {
             return;
         };
-        let waited = arrived.elapsed();
+        let waited = request.arrived.elapsed();
         if self.fair_in_flight {
             return;
         }
@@ -557,8 +565,8 @@ impl App {
             self.ctx.request_repaint_after(MEASURE_DELAY - waited);
             return;
         }
-        if let Some((document, serial, positions, _)) = self.measure_wanted.take() {
-            self.request_measures(document, serial, positions);
+        if let Some(request) = self.measure_wanted.take() {
+            self.request_measures(request.document, request.serial, request.positions);
         }
     }
 
@@ -1272,8 +1280,12 @@ impl App {
                         measure_time: faired.measure_time,
                         measures_pending: true,
                     });
-                    self.measure_wanted =
-                        Some((document, self.next_serial, positions, Instant::now()));
+                    self.measure_wanted = Some(MeasureRequest {
+                        document,
+                        serial: self.next_serial,
+                        positions,
+                        arrived: Instant::now(),
+                    });
                 }
             }
             JobResult::Measured {

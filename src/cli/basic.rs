@@ -77,13 +77,7 @@ pub struct CompareArgs {
 }
 
 pub(crate) fn load(path: &Path, weld: bool) -> anyhow::Result<Loaded> {
-    Ok(io::load_with(
-        path,
-        &LoadOptions {
-            weld,
-            ..Default::default()
-        },
-    )?)
+    Ok(io::load_with(path, &LoadOptions { weld })?)
 }
 
 pub fn info(args: InfoArgs) -> anyhow::Result<()> {

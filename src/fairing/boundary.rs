@@ -127,8 +127,8 @@ impl BoundaryCurves {
                 }
             }
             let entry = &mut accumulator[slot as usize];
-            for c in 0..3 {
-                entry.0[c] += step[c];
+            for (sum, s) in entry.0.iter_mut().zip(step) {
+                *sum += s;
             }
             entry.1 += 1;
         }

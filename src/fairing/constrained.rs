@@ -139,6 +139,8 @@ pub fn invert3(a: &Matrix3) -> Option<Matrix3> {
     };
     let det = a[0][0] * cofactor(0, 0) + a[0][1] * cofactor(0, 1) + a[0][2] * cofactor(0, 2);
     let scale = a.iter().flatten().fold(0.0f64, |m, x| m.max(x.abs()));
+    // Negated on purpose: a NaN determinant (or scale) must count as singular too.
+    #[allow(clippy::neg_cmp_op_on_partial_ord)]
     if !(det.abs() > 1e-12 * scale * scale * scale) {
         return None;
     }
@@ -946,6 +948,7 @@ mod tests {
     }
 
     /// Solves the dense system `m·x = rhs` by Gaussian elimination with partial pivoting.
+    #[allow(clippy::needless_range_loop)] // rows and columns by index read like the textbook
     fn gauss_solve<const N: usize>(mut m: [[f64; N]; N], mut rhs: [f64; N]) -> [f64; N] {
         for col in 0..N {
             let pivot = (col..N)
@@ -1090,8 +1093,9 @@ mod tests {
                 let mut q = [0.0; 3];
                 for &u in topology.neighbors(t[r]) {
                     if !t.contains(&u) {
-                        for k in 0..3 {
-                            q[k] += point(mesh.positions[u as usize])[k] / n[r] as f64;
+                        let p = point(mesh.positions[u as usize]);
+                        for (qk, pk) in q.iter_mut().zip(p) {
+                            *qk += pk / n[r] as f64;
                         }
                     }
                 }
