@@ -49,11 +49,7 @@ fn level_slider_refairs_and_updates_the_numbers() {
     let before = harness.state().status();
     let top = before.level_count - 1;
 
-    harness
-        .get_by_role_and_label(Role::Slider, "Start level")
-        .focus();
-    harness.step();
-    harness.key_press(egui::Key::ArrowRight);
+    nudge_level_slider(&mut harness);
     settle(&mut harness);
     let after = harness.state().status();
     let expected = 1.min(top);
@@ -69,11 +65,7 @@ fn level_slider_refairs_and_updates_the_numbers() {
             .is_some());
         // The slider keeps working while results stream in: several steps, one settle.
         for _ in 0..3 {
-            harness
-                .get_by_role_and_label(Role::Slider, "Start level")
-                .focus();
-            harness.step();
-            harness.key_press(egui::Key::ArrowRight);
+            nudge_level_slider(&mut harness);
             harness.step();
         }
         settle(&mut harness);
@@ -107,11 +99,7 @@ fn level_view_during_a_fairing_still_finishes_and_measures_it() {
     let mut harness = harness_for(bunny());
     settle(&mut harness);
     let before = harness.state().status();
-    harness
-        .get_by_role_and_label(Role::Slider, "Start level")
-        .focus();
-    harness.step();
-    harness.key_press(egui::Key::ArrowRight);
+    nudge_level_slider(&mut harness);
     harness.step();
     harness.get_by_label("Level mesh").click();
     settle(&mut harness);
@@ -444,24 +432,11 @@ fn responsiveness() {
     // The first slider steps right after the hierarchy is ready: the levels' set-up job runs
     // then, and a step's fairing waits behind it on the compute worker.
     for step in 1..=3 {
-        harness
-            .get_by_role_and_label(Role::Slider, "Start level")
-            .focus();
-        harness.step();
-        let started = Instant::now();
-        harness.key_press(egui::Key::ArrowRight);
-        let mut frames = 0;
-        // This level's result (an earlier level's may still arrive first).
-        while harness.state().status().faired_level != Some(step) {
-            harness.step();
-            frames += 1;
-            std::thread::sleep(Duration::from_millis(16));
-            assert!(started.elapsed() < Duration::from_secs(300));
-        }
+        let (frames, elapsed) = slider_step_to_result(&mut harness, step);
         println!(
             "1.2M faces, slider to level {step} just after the hierarchy: new result after \
              {frames} frames ({:.0} ms)",
-            started.elapsed().as_secs_f64() * 1e3
+            elapsed.as_secs_f64() * 1e3
         );
     }
     drop(harness);
@@ -470,25 +445,41 @@ fn responsiveness() {
     settle(&mut harness);
     let top = harness.state().status().level_count - 1;
     for step in 1..=top.min(6) {
-        harness
-            .get_by_role_and_label(Role::Slider, "Start level")
-            .focus();
-        harness.step();
-        let started = Instant::now();
-        harness.key_press(egui::Key::ArrowRight);
-        let mut frames = 0;
-        loop {
-            harness.step();
-            frames += 1;
-            if harness.state().status().faired_level == Some(step) {
-                break;
-            }
-            assert!(started.elapsed() < Duration::from_secs(60));
-            std::thread::sleep(Duration::from_millis(16));
-        }
+        let (frames, elapsed) = slider_step_to_result(&mut harness, step);
         println!(
             "slider to level {step}: new result after {frames} frames ({:.0} ms)",
-            started.elapsed().as_secs_f64() * 1e3
+            elapsed.as_secs_f64() * 1e3
         );
+    }
+}
+
+/// Focuses the start-level slider (one frame) and presses the right arrow on it (taken in the
+/// next frame).
+fn nudge_level_slider(harness: &mut egui_kittest::Harness<'_, fairmesh::app::App>) {
+    harness
+        .get_by_role_and_label(Role::Slider, "Start level")
+        .focus();
+    harness.step();
+    harness.key_press(egui::Key::ArrowRight);
+}
+
+/// Moves the start-level slider one step right (to `level`) and steps 16 ms frames until the
+/// result for `level` is on record (an earlier level's may arrive first); the frames counted
+/// include the one that took the key press.
+fn slider_step_to_result(
+    harness: &mut egui_kittest::Harness<'_, fairmesh::app::App>,
+    level: usize,
+) -> (usize, Duration) {
+    let started = Instant::now();
+    nudge_level_slider(harness);
+    let mut frames = 0;
+    loop {
+        harness.step();
+        frames += 1;
+        if harness.state().status().faired_level == Some(level) {
+            return (frames, started.elapsed());
+        }
+        assert!(started.elapsed() < Duration::from_secs(300));
+        std::thread::sleep(Duration::from_millis(16));
     }
 }

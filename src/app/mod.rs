@@ -10,10 +10,13 @@
 //! - this file: [`App`], which applies commands after the frame, dispatches jobs, applies their
 //!   results, and keeps the viewport's GPU buffers in step with what should be shown.
 //!
-//! Two named worker threads: `fairmesh-io` (load, export) and `fairmesh-compute` (hierarchy,
-//! fairing, level meshes), so an export or the next file's loading never waits for a long
-//! hierarchy build. Loading another file cancels the hierarchy build and fairing of the previous
-//! one through their generation numbers.
+//! Named worker threads: `fairmesh-io` (load, export), `fairmesh-compute` (hierarchy, fairing,
+//! level meshes; the levels' set-up as idle jobs that any fairing overtakes) and
+//! `fairmesh-measure` (surface distances of a result, once the slider rests, on a one-thread
+//! pool of its own), so an export or the next file's loading never waits for a long hierarchy
+//! build and measuring never slows the next slider value. Each viewport's renderer has its own
+//! `fairmesh-upload` thread for big meshes. Loading another file cancels the hierarchy build and
+//! fairing of the previous one through their generation numbers.
 
 pub mod camera;
 pub mod history;
