@@ -504,20 +504,23 @@ pub fn default_export_path(input: &Path) -> PathBuf {
 
 /// Axis-aligned bounds of `positions` (zeros when empty).
 pub fn bounds_of(positions: &[[f32; 3]]) -> ([f32; 3], [f32; 3]) {
-    let mut lo = [f32::INFINITY; 3];
-    let mut hi = [f32::NEG_INFINITY; 3];
-    for p in positions {
-        for k in 0..3 {
-            if p[k].is_finite() {
-                lo[k] = lo[k].min(p[k]);
-                hi[k] = hi[k].max(p[k]);
-            }
-        }
-    }
-    if lo.iter().zip(&hi).any(|(l, h)| l > h) {
+    // Branch-free, non-finite coordinates left out one by one: the UI thread runs this for
+    // every document (600k vertices: 2.3 ms with a branch per coordinate).
+    use glam::Vec3A;
+    let (lo, hi) = positions
+        .iter()
+        .fold((Vec3A::INFINITY, Vec3A::NEG_INFINITY), |(lo, hi), &p| {
+            let p = Vec3A::from_array(p);
+            let finite = p.is_finite_mask();
+            (
+                lo.min(Vec3A::select(finite, p, Vec3A::INFINITY)),
+                hi.max(Vec3A::select(finite, p, Vec3A::NEG_INFINITY)),
+            )
+        });
+    if lo.cmpgt(hi).any() {
         return ([0.0; 3], [0.0; 3]);
     }
-    (lo, hi)
+    (lo.to_array(), hi.to_array())
 }
 
 #[cfg(test)]
