@@ -334,10 +334,25 @@ impl<'a> ClosestPointIndex<'a> {
         &self,
         from: &TriMesh,
     ) -> (SurfaceDistance, Vec<f64>) {
+        self.distance_and_vertex_distances_unless(from, &|| false)
+            .expect("never stopped")
+    }
+
+    /// [`Self::distance_and_vertex_distances_from`], giving up (`None`) once `stop` says so:
+    /// it is asked before every triangle's and vertex's queries, so a caller whose result went
+    /// stale (the editor, when the user moves on) gets its threads back within microseconds.
+    pub fn distance_and_vertex_distances_unless(
+        &self,
+        from: &TriMesh,
+        stop: &(dyn Fn() -> bool + Sync),
+    ) -> Option<(SurfaceDistance, Vec<f64>)> {
         let hinted = from.triangles.len() == self.mesh.triangles.len();
         let per_face: Vec<(f64, f64, f64)> = (0..from.triangles.len())
             .into_par_iter()
             .map(|t| {
+                if stop() {
+                    return (0.0, 0.0, 0.0);
+                }
                 let [a, b, c] = from.triangle_points(t);
                 let area = (b - a).cross(c - a).length() * 0.5;
                 let centroid = (a + b + c) / 3.0;
@@ -358,7 +373,18 @@ impl<'a> ClosestPointIndex<'a> {
                 (weighted, area, max)
             })
             .collect();
-        let vertex_distances = self.vertex_distances(from);
+        let vertex_distances: Vec<f64> = (0..from.positions.len() as u32)
+            .into_par_iter()
+            .map(|v| {
+                if stop() {
+                    return f64::NAN;
+                }
+                self.distance(from.point(v))
+            })
+            .collect();
+        if stop() {
+            return None;
+        }
         let vertex_max = vertex_distances.iter().copied().fold(0.0, f64::max);
         let (mut weighted, mut total_area, mut max) = (0.0, 0.0, vertex_max);
         for (w, a, m) in per_face {
@@ -374,7 +400,7 @@ impl<'a> ClosestPointIndex<'a> {
             },
             max,
         };
-        (distance, vertex_distances)
+        Some((distance, vertex_distances))
     }
 
     /// Distance from every vertex of `from` to this surface (for heat maps).
@@ -561,6 +587,30 @@ mod tests {
                 assert!((d2.sqrt() - brute).abs() < 1e-12, "query {i}, hint {hint}");
             }
         }
+    }
+
+    #[test]
+    fn a_stopped_distance_gives_up_and_an_unstopped_one_matches() {
+        let mesh = crate::mesh::subdivide_loop(&octahedron(1.0));
+        let mut bumpy = mesh.clone();
+        bumpy.positions[3][0] += 0.1;
+        let index = ClosestPointIndex::new(&mesh);
+        assert!(index
+            .distance_and_vertex_distances_unless(&bumpy, &|| true)
+            .is_none());
+        // Stopping after some queries (the counter is shared by the worker threads).
+        let asked = std::sync::atomic::AtomicUsize::new(0);
+        let stop_later = || asked.fetch_add(1, std::sync::atomic::Ordering::Relaxed) > 20;
+        assert!(index
+            .distance_and_vertex_distances_unless(&bumpy, &stop_later)
+            .is_none());
+        let (never, vertices) = index
+            .distance_and_vertex_distances_unless(&bumpy, &|| false)
+            .unwrap();
+        let plain = index.distance_from(&bumpy);
+        assert_eq!((never.mean, never.max), (plain.mean, plain.max));
+        assert!(never.max > 0.05);
+        assert_eq!(vertices, index.vertex_distances(&bumpy));
     }
 
     #[test]

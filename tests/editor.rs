@@ -114,6 +114,37 @@ fn level_view_during_a_fairing_still_finishes_and_measures_it() {
     assert!(against_document.is_some());
 }
 
+/// A result's measuring stops when the view moves on (here to the level mesh, which brings no
+/// new result) and is done again once things rest: the numbers end up being that result's.
+#[test]
+fn measuring_stops_when_the_view_moves_on_and_is_redone() {
+    let mut harness = harness_for(bunny());
+    settle(&mut harness);
+    nudge_level_slider(&mut harness);
+    let deadline = Instant::now() + Duration::from_secs(60);
+    while !harness.state().status().measuring {
+        harness.step();
+        std::thread::sleep(Duration::from_millis(2));
+        assert!(
+            Instant::now() < deadline,
+            "the new result is never measured"
+        );
+    }
+    let measured = harness.state().status().faired_serial;
+    harness.get_by_label("Level mesh").click();
+    settle(&mut harness);
+    let status = harness.state().status();
+    assert!(status.measures_stopped >= 1, "the measuring was stopped");
+    assert_eq!(status.faired_serial, measured, "no newer result came");
+    assert!(!status.measuring);
+    let (against_document, _) = harness.state().faired_measures();
+    assert!(against_document.is_some_and(|m| m.mean_distance > 0.0));
+    // The numbers panel shows them (back in the faired view).
+    harness.get_by_label("Faired").click();
+    settle(&mut harness);
+    assert!(harness.query_by_label("running…").is_none());
+}
+
 #[test]
 fn exports_and_reloads_the_result() {
     let dir = tempfile::tempdir().unwrap();

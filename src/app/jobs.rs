@@ -256,6 +256,13 @@ pub enum JobResult {
         against_clean: Option<Measures>,
         measure_time: Duration,
     },
+    /// Measuring the faired result `serial` stopped half way: the view moved on meanwhile. The
+    /// result is measured again once the slider rests, if it is still the one on screen.
+    MeasureStopped {
+        document: u64,
+        serial: u64,
+        positions: Arc<Vec<[f32; 3]>>,
+    },
     /// Noise was added to a copy of the document's mesh.
     Noised {
         document: u64,

@@ -258,6 +258,10 @@ pub struct AppStatus {
     pub faired_serial: Option<u64>,
     /// The start level of that result.
     pub faired_level: Option<usize>,
+    /// That result's measures are being computed on the measuring worker (not waiting).
+    pub measuring: bool,
+    /// Measurings given up because the view moved on (each is redone when the slider rests).
+    pub measures_stopped: u64,
     pub volume_change: Option<f64>,
     pub rms_displacement: Option<f64>,
     pub error: Option<String>,
@@ -296,6 +300,7 @@ pub struct App {
     measure_pool: Option<Arc<rayon::ThreadPool>>,
     /// The faired result to measure next; see [`MEASURE_DELAY`].
     measure_wanted: Option<MeasureRequest>,
+    measures_stopped: u64,
     jobs: JobCounter,
     results_tx: Sender<(JobResult, JobTicket)>,
     results_rx: Receiver<(JobResult, JobTicket)>,
@@ -388,6 +393,7 @@ impl App {
             measure,
             measure_pool,
             measure_wanted: None,
+            measures_stopped: 0,
             jobs: JobCounter::default(),
             results_tx,
             results_rx,
@@ -542,6 +548,8 @@ impl App {
             shown_faces: self.shown_counts.1,
             faired_serial: faired.map(|f| f.serial),
             faired_level: faired.map(|f| f.level),
+            measuring: faired.is_some_and(|f| f.measures_pending) && self.measure_wanted.is_none(),
+            measures_stopped: self.measures_stopped,
             volume_change: faired.map(|f| f.volume_change),
             rms_displacement: faired.map(|f| f.rms_displacement),
             error: self.error.clone(),
@@ -935,6 +943,11 @@ impl App {
         let clean = current.clean.clone();
         let pool = self.measure_pool.clone();
         let document_generation = self.document_generation.clone();
+        // A slider move, an option or a view change bumps the view generation: the result
+        // being measured is then about to be replaced, so measuring it stops and gives the
+        // cores to the next fairing.
+        let (view_generation, view) =
+            (self.view_generation.clone(), self.view_generation.current());
         let (tx, ctx, ticket) = (self.results_tx.clone(), self.ctx.clone(), self.jobs.start());
         self.measure.submit_latest("measure", move || {
             if !document_generation.is_current(document) {
@@ -946,24 +959,33 @@ impl App {
                 positions: positions.as_ref().clone(),
                 triangles: base.triangles.clone(),
             };
+            let stop =
+                || !view_generation.is_current(view) || !document_generation.is_current(document);
             let measure = || {
-                let against_document = Some(Measures::of(base, &faired));
-                let against_clean = clean
-                    .as_deref()
-                    .filter(|_| document_generation.is_current(document))
-                    .map(|clean| Measures::of(clean, &faired));
-                (against_document, against_clean)
+                let against_document = Measures::of_unless(base, &faired, &stop)?;
+                let against_clean = match clean.as_deref() {
+                    Some(clean) => Some(Measures::of_unless(clean, &faired, &stop)?),
+                    None => None,
+                };
+                Some((against_document, against_clean))
             };
-            let (against_document, against_clean) = match &pool {
+            let measured = match &pool {
                 Some(pool) => pool.install(measure),
                 None => measure(),
             };
-            let message = JobResult::Measured {
-                document,
-                serial,
-                against_document,
-                against_clean,
-                measure_time: started.elapsed(),
+            let message = match measured {
+                Some((against_document, against_clean)) => JobResult::Measured {
+                    document,
+                    serial,
+                    against_document: Some(against_document),
+                    against_clean,
+                    measure_time: started.elapsed(),
+                },
+                None => JobResult::MeasureStopped {
+                    document,
+                    serial,
+                    positions,
+                },
             };
             Self::send_result(&tx, &ctx, message, ticket);
         });
@@ -1311,6 +1333,28 @@ impl App {
                 faired.against_clean = against_clean;
                 faired.measure_time = measure_time;
                 faired.measures_pending = false;
+            }
+            JobResult::MeasureStopped {
+                document,
+                serial,
+                positions,
+            } => {
+                self.measures_stopped += 1;
+                let still_shown = self
+                    .document
+                    .as_ref()
+                    .filter(|d| d.generation == document)
+                    .and_then(|d| d.faired.as_ref())
+                    .is_some_and(|f| f.serial == serial);
+                // A newer result has its own request already; this one is measured again.
+                if still_shown && self.measure_wanted.is_none() {
+                    self.measure_wanted = Some(MeasureRequest {
+                        document,
+                        serial,
+                        positions,
+                        arrived: Instant::now(),
+                    });
+                }
             }
             JobResult::LevelMesh {
                 document,

@@ -290,20 +290,30 @@ pub struct Measures {
 impl Measures {
     /// `other` measured against `reference`.
     pub fn of(reference: &TriMesh, other: &TriMesh) -> Self {
+        Self::of_unless(reference, other, &|| false).expect("never stopped")
+    }
+
+    /// [`Self::of`], giving up (`None`) soon after `stop` says so.
+    pub fn of_unless(
+        reference: &TriMesh,
+        other: &TriMesh,
+        stop: &(dyn Fn() -> bool + Sync),
+    ) -> Option<Self> {
         let reference_index = crate::metrics::ClosestPointIndex::new(reference);
         let other_index = crate::metrics::ClosestPointIndex::new(other);
-        let (forth, vertex_distances) = reference_index.distance_and_vertex_distances_from(other);
-        let back = other_index.distance_from(reference);
+        let (forth, vertex_distances) =
+            reference_index.distance_and_vertex_distances_unless(other, stop)?;
+        let (back, _) = other_index.distance_and_vertex_distances_unless(reference, stop)?;
         let vertices = crate::metrics::compare_vertices(reference, other);
         let vertex_distances = vertex_distances.into_iter().map(|d| d as f32).collect();
-        Self {
+        Some(Self {
             volume_change_percent: crate::metrics::volume_change_percent(reference, other),
             mean_distance: 0.5 * (forth.mean + back.mean),
             max_distance: forth.max.max(back.max),
             vertex_rms: vertices.map(|v| v.rms),
             barycenter_drift: vertices.map(|v| v.barycenter_drift),
             vertex_distances: Arc::new(vertex_distances),
-        }
+        })
     }
 }
 
