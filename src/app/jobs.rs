@@ -19,12 +19,19 @@ use std::sync::{Arc, Condvar, Mutex, PoisonError};
 use std::time::Duration;
 
 use crate::hierarchy::{Hierarchy, HierarchyError};
-use crate::io::Loaded;
+use crate::io::LoadReport;
 use crate::TriMesh;
 
 use super::state::Measures;
 
 type Job = Box<dyn FnOnce() + Send + 'static>;
+
+/// A loaded mesh as the UI takes it: without the loader's topology, which the UI never uses;
+/// the io worker frees it (tens of megabytes for a 1M-face mesh) instead of the UI thread.
+pub struct LoadedMesh {
+    pub mesh: TriMesh,
+    pub report: LoadReport,
+}
 
 struct Queued {
     slot: Option<&'static str>,
@@ -225,7 +232,7 @@ pub enum JobResult {
     Loaded {
         load_generation: u64,
         path: PathBuf,
-        result: Result<Box<Loaded>, String>,
+        result: Result<Box<LoadedMesh>, String>,
         elapsed: Duration,
     },
     Hierarchy {

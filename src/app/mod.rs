@@ -37,7 +37,8 @@ use crate::{metrics, TriMesh};
 use camera::OrbitCamera;
 use history::History;
 use jobs::{
-    DialogPurpose, Faired, Generation, JobCounter, JobResult, JobTicket, SharedProgress, Worker,
+    DialogPurpose, Faired, Generation, JobCounter, JobResult, JobTicket, LoadedMesh,
+    SharedProgress, Worker,
 };
 use state::{
     CompareView, Document, DocumentSnapshot, FairedResult, HeatReference, HierarchyState, Measures,
@@ -763,15 +764,18 @@ impl App {
         self.io.submit(move || {
             let started = Instant::now();
             let result = crate::io::load(&path)
-                .map(Box::new)
-                .map_err(|error| error.to_string());
-            let result = result.and_then(|loaded| {
-                if loaded.mesh.triangles.is_empty() {
-                    Err(format!("{}: the file holds no triangles", path.display()))
-                } else {
-                    Ok(loaded)
-                }
-            });
+                .map_err(|error| error.to_string())
+                .and_then(|loaded| {
+                    if loaded.mesh.triangles.is_empty() {
+                        Err(format!("{}: the file holds no triangles", path.display()))
+                    } else {
+                        // The topology is dropped here, on the io worker.
+                        Ok(Box::new(LoadedMesh {
+                            mesh: loaded.mesh,
+                            report: loaded.report,
+                        }))
+                    }
+                });
             let message = JobResult::Loaded {
                 load_generation: generation,
                 path,
