@@ -185,6 +185,10 @@ impl UploadJob {
 
 enum Uploaded {
     Mesh(MeshBuffers),
+    /// Filling the buffers of `generation` panicked inside wgpu.
+    Failed {
+        generation: u64,
+    },
     Lines {
         generation: u64,
         lines: (wgpu::Buffer, u32),
@@ -215,7 +219,8 @@ impl Uploader {
                         if Some(job.generation()) != newest {
                             continue;
                         }
-                        let uploaded = match job {
+                        let generation = job.generation();
+                        let upload = std::panic::AssertUnwindSafe(|| match job {
                             UploadJob::Mesh {
                                 generation,
                                 source,
@@ -232,7 +237,11 @@ impl Uploader {
                                 generation,
                                 lines: line_buffer(&device, source.triangles()),
                             },
-                        };
+                        });
+                        // wgpu reports an error it cannot return (out of memory, say) by
+                        // panicking: the upload fails, the thread and the app go on.
+                        let uploaded = std::panic::catch_unwind(upload)
+                            .unwrap_or(Uploaded::Failed { generation });
                         if done_tx.send(uploaded).is_err() {
                             return;
                         }
@@ -304,8 +313,11 @@ pub struct MeshRenderer {
     wireframe: bool,
     /// Meshes of at least this many bytes (positions + triangles) upload on the upload thread.
     async_upload_bytes: usize,
-    /// Why the last mesh set is not drawn (a buffer would exceed the device's `max_buffer_size`).
+    /// Why the last mesh set is not drawn (a buffer would exceed the device's `max_buffer_size`,
+    /// or its upload failed).
     problem: Option<String>,
+    /// Building the current mesh's wireframe failed (not tried again for this mesh).
+    lines_failed: bool,
     max_buffer_size: u64,
     /// CPU time of the last [`Self::render`] that drew (recording commands, building the
     /// wireframe's edges on first use).
@@ -466,6 +478,7 @@ impl MeshRenderer {
             wireframe: false,
             async_upload_bytes: DEFAULT_ASYNC_UPLOAD_BYTES,
             problem: None,
+            lines_failed: false,
             max_buffer_size: device.limits().max_buffer_size,
         }
     }
@@ -483,10 +496,12 @@ impl MeshRenderer {
             return self.problem.clone();
         }
         let faces = self.mesh.as_ref()?.index_count as usize / 3;
-        if wireframe {
-            self.too_big("the wireframe", faces * 24, faces)
-        } else {
+        if !wireframe {
             None
+        } else if self.lines_failed {
+            Some("the GPU could not take the wireframe's buffer".into())
+        } else {
+            self.too_big("the wireframe", faces * 24, faces)
         }
     }
 
@@ -529,7 +544,7 @@ impl MeshRenderer {
         self.generation += 1;
         self.pending = None;
         self.lines_requested = None;
-        self.problem = None;
+        self.lines_failed = false;
         let (vertex_count, face_count) = (source.positions().len(), source.triangles().len());
         // Positions and triangles take 12 bytes per vertex and per face.
         self.problem = self.too_big("the mesh", vertex_count.max(face_count) * 12, face_count);
@@ -557,8 +572,13 @@ impl MeshRenderer {
                         });
                         return;
                     }
-                    Err(UploadJob::Mesh { source: back, .. }) => source = back,
-                    Err(UploadJob::Lines { .. }) => unreachable!("a mesh job comes back as one"),
+                    // The thread is gone (it panicked): upload here instead.
+                    Err(job) => {
+                        let UploadJob::Mesh { source: back, .. } = job else {
+                            return; // `send` gives back the job it was given: a mesh job
+                        };
+                        source = back;
+                    }
                 }
             }
         }
@@ -589,6 +609,23 @@ impl MeshRenderer {
                             queue.write_buffer(&buffers.scalars, 0, bytemuck::cast_slice(&scalars));
                         }
                         self.mesh = Some(buffers);
+                        self.drawn = None;
+                    }
+                }
+                Uploaded::Failed { generation } => {
+                    if self
+                        .pending
+                        .as_ref()
+                        .is_some_and(|p| p.generation == generation)
+                    {
+                        self.pending = None;
+                        self.mesh = None;
+                        self.drawn = None;
+                        self.problem = Some("the GPU could not take the mesh's buffers".into());
+                    }
+                    if self.lines_requested == Some(generation) {
+                        self.lines_requested = None;
+                        self.lines_failed = true;
                         self.drawn = None;
                     }
                 }
@@ -751,7 +788,11 @@ impl MeshRenderer {
             if let Some(mesh) = &mut self.mesh {
                 let faces = mesh.index_count as usize / 3;
                 let fits = faces as u64 * 24 <= self.max_buffer_size;
-                if fits && mesh.lines.is_none() && self.lines_requested != Some(mesh.generation) {
+                if fits
+                    && !self.lines_failed
+                    && mesh.lines.is_none()
+                    && self.lines_requested != Some(mesh.generation)
+                {
                     // A big mesh's edges are built on the upload thread (the image shows the
                     // mesh without them meanwhile); a small one's here.
                     let bytes = (mesh.vertex_count + faces) * 12;

@@ -1,0 +1,126 @@
+//! The mesh renderer's background uploads, driven directly on a software wgpu device (lavapipe or
+//! llvmpipe, as in the editor tests): the newest mesh wins over uploads still in flight, and an
+//! upload that panics inside the upload thread leaves a notice and a working renderer, not a
+//! mesh that never arrives.
+#![cfg(feature = "gui")]
+
+use std::sync::atomic::{AtomicUsize, Ordering};
+use std::sync::Arc;
+use std::time::{Duration, Instant};
+
+use egui_wgpu::wgpu;
+use fairmesh::render::{MeshRenderer, MeshSource};
+
+/// A grid of `n` × `n` quads (two triangles each) in the z = 0 plane.
+struct Grid {
+    positions: Vec<[f32; 3]>,
+    triangles: Vec<[u32; 3]>,
+    /// `triangles()` panics on this call (counting from 1), if set.
+    panic_on_call: Option<usize>,
+    calls: AtomicUsize,
+}
+
+impl Grid {
+    fn new(n: u32) -> Self {
+        let positions = (0..=n)
+            .flat_map(|y| (0..=n).map(move |x| [x as f32, y as f32, 0.0]))
+            .collect();
+        let index = |x: u32, y: u32| y * (n + 1) + x;
+        let triangles = (0..n)
+            .flat_map(|y| {
+                (0..n).flat_map(move |x| {
+                    [
+                        [index(x, y), index(x + 1, y), index(x + 1, y + 1)],
+                        [index(x, y), index(x + 1, y + 1), index(x, y + 1)],
+                    ]
+                })
+            })
+            .collect();
+        Self {
+            positions,
+            triangles,
+            panic_on_call: None,
+            calls: AtomicUsize::new(0),
+        }
+    }
+}
+
+impl MeshSource for Grid {
+    fn positions(&self) -> &[[f32; 3]] {
+        &self.positions
+    }
+    fn triangles(&self) -> &[[u32; 3]] {
+        let call = self.calls.fetch_add(1, Ordering::SeqCst) + 1;
+        if self.panic_on_call == Some(call) {
+            panic!("a failing upload (test)");
+        }
+        &self.triangles
+    }
+}
+
+fn device() -> (wgpu::Device, wgpu::Queue) {
+    let state = egui_kittest::wgpu::create_render_state(
+        egui_kittest::wgpu::default_wgpu_setup(),
+        Default::default(),
+    );
+    (state.device.clone(), state.queue.clone())
+}
+
+/// Polls until no upload is in flight (they take milliseconds here).
+fn wait_for_uploads(renderer: &mut MeshRenderer, queue: &wgpu::Queue) {
+    let deadline = Instant::now() + Duration::from_secs(60);
+    while renderer.upload_pending(queue) {
+        assert!(Instant::now() < deadline, "an upload never landed");
+        std::thread::sleep(Duration::from_millis(2));
+    }
+}
+
+#[test]
+fn the_newest_mesh_wins_over_uploads_in_flight() {
+    let (device, queue) = device();
+    let mut renderer = MeshRenderer::new(&device, Arc::new(|| {}));
+    renderer.set_async_upload_bytes(0);
+    let sizes = [120, 80, 7];
+    for n in sizes {
+        renderer.set_mesh(&device, Arc::new(Grid::new(n)), None);
+    }
+    wait_for_uploads(&mut renderer, &queue);
+    assert!(renderer.has_mesh());
+    // The mesh on screen is the last one: only its vertex count takes new positions.
+    let last = (sizes[2] as usize + 1).pow(2);
+    let first = (sizes[0] as usize + 1).pow(2);
+    assert!(!renderer.set_positions(&queue, &vec![[0.0; 3]; first]));
+    assert!(renderer.set_positions(&queue, &vec![[0.0; 3]; last]));
+
+    // A big mesh goes to the upload thread, then a small one is uploaded in the frame: the big
+    // one lands later and must not replace it.
+    renderer.set_mesh(&device, Arc::new(Grid::new(150)), None);
+    renderer.set_async_upload_bytes(usize::MAX);
+    renderer.set_mesh(&device, Arc::new(Grid::new(5)), None);
+    std::thread::sleep(Duration::from_millis(300));
+    wait_for_uploads(&mut renderer, &queue);
+    assert!(renderer.set_positions(&queue, &vec![[0.0; 3]; 36]));
+}
+
+#[test]
+fn a_failed_upload_leaves_a_notice_and_a_working_renderer() {
+    let (device, queue) = device();
+    let mut renderer = MeshRenderer::new(&device, Arc::new(|| {}));
+    renderer.set_async_upload_bytes(0);
+    // Call 1 is `set_mesh` counting faces on this thread; call 2 is on the upload thread.
+    let mut failing = Grid::new(20);
+    failing.panic_on_call = Some(2);
+    renderer.set_mesh(&device, Arc::new(failing), None);
+    wait_for_uploads(&mut renderer, &queue);
+    assert!(!renderer.has_mesh());
+    assert_eq!(
+        renderer.problem(false).as_deref(),
+        Some("the GPU could not take the mesh's buffers")
+    );
+    // The upload thread survived: the next mesh arrives, and the notice goes.
+    renderer.set_mesh(&device, Arc::new(Grid::new(20)), None);
+    wait_for_uploads(&mut renderer, &queue);
+    assert!(renderer.has_mesh());
+    assert_eq!(renderer.problem(false), None);
+    assert!(renderer.set_positions(&queue, &vec![[0.0; 3]; 21 * 21]));
+}
