@@ -149,16 +149,12 @@ impl MultiresWorkspace {
         Self::default()
     }
 
-    /// Builds every level a run from `options.start_level` (or from the coarsest level, with
-    /// `all`) needs, with the fairing operators of the levels it fairs, so that the runs after it
-    /// only fair. The editor calls this in the background once the hierarchy is built, so that
-    /// moving the level slider never waits for a level's set-up.
-    pub fn prepare_for(&mut self, hierarchy: &Hierarchy, options: &MultiresOptions, all: bool) {
-        let start = if all {
-            hierarchy.coarsest_level()
-        } else {
-            options.start_level.min(hierarchy.coarsest_level())
-        };
+    /// Builds every level a run from `options.start_level` needs, with the fairing operators of
+    /// the levels it fairs, so that the runs after it only fair. The editor calls this in the
+    /// background for each level once the hierarchy is built, so that moving the level slider
+    /// never waits for a level's set-up.
+    pub fn prepare_for(&mut self, hierarchy: &Hierarchy, options: &MultiresOptions) {
+        let start = options.start_level.min(hierarchy.coarsest_level());
         let fair_last = start == 0 || options.fair_finest;
         let fair_options = level_fair_options(options);
         let operator = (fair_options.variant, fair_options.boundary);
@@ -285,7 +281,7 @@ fn fair_multires_on_worker(
 ) -> Option<Vec<[f32; 3]>> {
     let start = options.start_level.min(hierarchy.coarsest_level());
     // Every level this run touches, with the operators of those it fairs.
-    workspace.prepare_for(hierarchy, options, false);
+    workspace.prepare_for(hierarchy, options);
     let fair_options = level_fair_options(options);
     let base_vertices = hierarchy.level_info(0).vertices;
     workspace.positions.clear();

@@ -82,7 +82,7 @@ fn the_newest_mesh_wins_over_uploads_in_flight() {
     renderer.set_async_upload_bytes(0);
     let sizes = [120, 80, 7];
     for n in sizes {
-        renderer.set_mesh(&device, Arc::new(Grid::new(n)), None);
+        renderer.set_mesh(&device, Arc::new(Grid::new(n)));
     }
     wait_for_uploads(&mut renderer, &queue);
     assert!(renderer.has_mesh());
@@ -94,9 +94,9 @@ fn the_newest_mesh_wins_over_uploads_in_flight() {
 
     // A big mesh goes to the upload thread, then a small one is uploaded in the frame: the big
     // one lands later and must not replace it.
-    renderer.set_mesh(&device, Arc::new(Grid::new(150)), None);
+    renderer.set_mesh(&device, Arc::new(Grid::new(150)));
     renderer.set_async_upload_bytes(usize::MAX);
-    renderer.set_mesh(&device, Arc::new(Grid::new(5)), None);
+    renderer.set_mesh(&device, Arc::new(Grid::new(5)));
     std::thread::sleep(Duration::from_millis(300));
     wait_for_uploads(&mut renderer, &queue);
     assert!(renderer.set_positions(&queue, &vec![[0.0; 3]; 36]));
@@ -110,7 +110,7 @@ fn a_failed_upload_leaves_a_notice_and_a_working_renderer() {
     // Call 1 is `set_mesh` counting faces on this thread; call 2 is on the upload thread.
     let mut failing = Grid::new(20);
     failing.panic_on_call = Some(2);
-    renderer.set_mesh(&device, Arc::new(failing), None);
+    renderer.set_mesh(&device, Arc::new(failing));
     wait_for_uploads(&mut renderer, &queue);
     assert!(!renderer.has_mesh());
     assert_eq!(
@@ -118,7 +118,7 @@ fn a_failed_upload_leaves_a_notice_and_a_working_renderer() {
         Some("the GPU could not take the mesh's buffers")
     );
     // The upload thread survived: the next mesh arrives, and the notice goes.
-    renderer.set_mesh(&device, Arc::new(Grid::new(20)), None);
+    renderer.set_mesh(&device, Arc::new(Grid::new(20)));
     wait_for_uploads(&mut renderer, &queue);
     assert!(renderer.has_mesh());
     assert_eq!(renderer.problem(false), None);

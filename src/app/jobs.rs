@@ -221,10 +221,6 @@ pub struct Faired {
     /// Root mean square of the vertex displacements against the loaded mesh (model units).
     pub rms_displacement: f64,
     pub elapsed: Duration,
-    /// The result measured against the document's mesh and against the clean mesh.
-    pub against_document: Option<Measures>,
-    pub against_clean: Option<Measures>,
-    pub measure_time: Duration,
 }
 
 /// A job's answer to the UI. Each carries the generation it was started under.
@@ -326,32 +322,34 @@ mod tests {
         assert_eq!(got[0].1.as_deref(), Some("fairmesh-test-worker"));
     }
 
+    /// A worker busy with a job that waits for the returned sender, so that the jobs submitted
+    /// next wait in the queue until the test releases it.
+    fn blocked_worker(name: &str) -> (Worker, mpsc::Sender<()>) {
+        let worker = Worker::spawn(name).unwrap();
+        let (release, released) = mpsc::channel::<()>();
+        worker.submit(move || {
+            released.recv_timeout(Duration::from_secs(5)).ok();
+        });
+        (worker, release)
+    }
+
     #[test]
     fn latest_slot_keeps_only_the_newest_waiting_job() {
-        let worker = Worker::spawn("fairmesh-test-coalesce").unwrap();
+        let (worker, release) = blocked_worker("fairmesh-test-coalesce");
         let (tx, rx) = mpsc::channel();
-        let (release_tx, release_rx) = mpsc::channel::<()>();
-        // Block the worker so the next jobs wait in the queue.
-        worker.submit(move || {
-            release_rx.recv_timeout(Duration::from_secs(5)).ok();
-        });
         for i in 0..5 {
             let tx = tx.clone();
             worker.submit_latest("fair", move || tx.send(i).unwrap());
         }
-        release_tx.send(()).unwrap();
+        release.send(()).unwrap();
         assert_eq!(rx.recv_timeout(Duration::from_secs(5)).unwrap(), 4);
         assert!(rx.recv_timeout(Duration::from_millis(200)).is_err());
     }
 
     #[test]
     fn idle_jobs_wait_for_every_other_job() {
-        let worker = Worker::spawn("fairmesh-test-idle").unwrap();
+        let (worker, release) = blocked_worker("fairmesh-test-idle");
         let (tx, rx) = mpsc::channel();
-        let (release_tx, release_rx) = mpsc::channel::<()>();
-        worker.submit(move || {
-            release_rx.recv_timeout(Duration::from_secs(5)).ok();
-        });
         for name in ["idle 1", "idle 2"] {
             let tx = tx.clone();
             worker.submit_idle(move || tx.send(name).unwrap());
@@ -359,7 +357,7 @@ mod tests {
         let tx2 = tx.clone();
         worker.submit(move || tx2.send("normal").unwrap());
         worker.submit_latest("fair", move || tx.send("latest").unwrap());
-        release_tx.send(()).unwrap();
+        release.send(()).unwrap();
         let order: Vec<_> = (0..4)
             .map(|_| rx.recv_timeout(Duration::from_secs(5)).unwrap())
             .collect();

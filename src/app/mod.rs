@@ -421,7 +421,7 @@ impl App {
             viewport_rect: None,
             history: History::new(HISTORY_BUDGET_BYTES),
         };
-        for viewport in [&app.viewport, &app.viewport_before].into_iter().flatten() {
+        for viewport in app.viewports() {
             if let Some(bytes) = options.async_upload_bytes {
                 viewport.set_async_upload_bytes(bytes);
             }
@@ -459,10 +459,14 @@ impl App {
 
     /// Whether a viewport's background upload of a big mesh has not landed yet.
     fn upload_pending(&self) -> bool {
+        self.viewports().any(Viewport3d::upload_pending)
+    }
+
+    /// The viewports there are (none without a wgpu render state).
+    fn viewports(&self) -> impl Iterator<Item = &Viewport3d> {
         [&self.viewport, &self.viewport_before]
             .into_iter()
             .flatten()
-            .any(Viewport3d::upload_pending)
     }
 
     pub fn frame_stats(&self) -> &FrameStats {
@@ -865,7 +869,7 @@ impl App {
                 let mut workspace = workspace.lock().unwrap_or_else(PoisonError::into_inner);
                 // Levels below `level` are there already (the first fairing or the jobs
                 // before this one): this builds `level` and its fairing operator.
-                workspace.prepare_for(&hierarchy, &options, false);
+                workspace.prepare_for(&hierarchy, &options);
             });
         }
     }
@@ -919,9 +923,6 @@ impl App {
                     volume_change,
                     rms_displacement,
                     elapsed: started.elapsed(),
-                    against_document: None,
-                    against_clean: None,
-                    measure_time: Duration::ZERO,
                 }
             });
             let message = JobResult::Faired {
@@ -1306,7 +1307,7 @@ impl App {
                             .as_ref()
                             .and_then(|p| p.against_document.clone()),
                         against_clean: previous.and_then(|p| p.against_clean),
-                        measure_time: faired.measure_time,
+                        measure_time: Duration::ZERO,
                         measures_pending: true,
                     });
                     self.measure_wanted = Some(MeasureRequest {
@@ -1612,7 +1613,7 @@ impl App {
             counts = Some((source.positions().len(), source.triangles().len()));
             if let Some(viewport) = viewport {
                 if !(same_connectivity && viewport.set_positions(source.positions())) {
-                    viewport.set_mesh(Arc::new(source), None);
+                    viewport.set_mesh(Arc::new(source));
                 }
             }
         }

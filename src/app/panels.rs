@@ -718,9 +718,8 @@ fn viewport(app: &mut App, ui: &mut egui::Ui) {
         heat_legend(ui, rect, top, reference);
     }
     let wireframe = app.settings.wireframe;
-    let problem = [&app.viewport, &app.viewport_before]
-        .into_iter()
-        .flatten()
+    let problem = app
+        .viewports()
         .find_map(|viewport| viewport.problem(wireframe));
     if let Some(problem) = problem {
         let text = egui::RichText::new(format!("Not drawn: {problem}"))

@@ -5,8 +5,8 @@
 //! the callback's `prepare` step, and that texture is shown as an ordinary egui image. So the
 //! mesh gets a depth buffer whatever egui's own render pass has (eframe without `depth_buffer`,
 //! or egui_kittest's single-sample pass with none), and the same code runs in the window and in
-//! headless tests. The renderer takes positions, triangles and optional per-vertex scalars and
-//! knows nothing of fairing.
+//! headless tests. The renderer takes positions, triangles and (through `set_scalars`)
+//! per-vertex scalars, and knows nothing of fairing.
 
 pub mod colormap;
 pub mod pipeline;
@@ -66,9 +66,9 @@ impl Viewport3d {
 
     /// Shows a mesh with new connectivity (a big one uploads in the background: call only when
     /// the connectivity changed, [`Self::set_positions`] otherwise).
-    pub fn set_mesh(&self, source: Arc<dyn MeshSource>, scalars: Option<&[f32]>) {
+    pub fn set_mesh(&self, source: Arc<dyn MeshSource>) {
         let device = &self.state.device;
-        self.with_renderer(|r| r.set_mesh(device, source, scalars));
+        self.with_renderer(|r| r.set_mesh(device, source));
     }
 
     /// Why the mesh (or its wireframe, when on) is not drawn: too big for this GPU's buffers.

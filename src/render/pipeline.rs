@@ -79,7 +79,6 @@ impl MeshBuffers {
     fn create(
         device: &wgpu::Device,
         source: Arc<dyn MeshSource>,
-        scalars: Option<&[f32]>,
         with_lines: bool,
         generation: u64,
     ) -> Self {
@@ -90,22 +89,14 @@ impl MeshBuffers {
             contents: bytemuck::cast_slice(positions),
             usage: wgpu::BufferUsages::VERTEX | wgpu::BufferUsages::COPY_DST,
         });
-        let scalars_buffer = match scalars {
-            Some(s) if s.len() == positions.len() => {
-                device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                    label: Some("fairmesh scalars"),
-                    contents: bytemuck::cast_slice(s),
-                    usage: wgpu::BufferUsages::VERTEX | wgpu::BufferUsages::COPY_DST,
-                })
-            }
-            // wgpu zero-fills a buffer that is not mapped at creation.
-            _ => device.create_buffer(&wgpu::BufferDescriptor {
-                label: Some("fairmesh scalars"),
-                size: (positions.len() * 4) as u64,
-                usage: wgpu::BufferUsages::VERTEX | wgpu::BufferUsages::COPY_DST,
-                mapped_at_creation: false,
-            }),
-        };
+        // Scalars come later through `set_scalars`; wgpu zero-fills a buffer that is not mapped
+        // at creation.
+        let scalars_buffer = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("fairmesh scalars"),
+            size: (positions.len() * 4) as u64,
+            usage: wgpu::BufferUsages::VERTEX | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
         let triangles_buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("fairmesh triangles"),
             contents: bytemuck::cast_slice(triangles),
@@ -166,7 +157,6 @@ enum UploadJob {
     Mesh {
         generation: u64,
         source: Arc<dyn MeshSource>,
-        scalars: Option<Vec<f32>>,
         with_lines: bool,
     },
     Lines {
@@ -224,14 +214,9 @@ impl Uploader {
                             UploadJob::Mesh {
                                 generation,
                                 source,
-                                scalars,
                                 with_lines,
                             } => Uploaded::Mesh(MeshBuffers::create(
-                                &device,
-                                source,
-                                scalars.as_deref(),
-                                with_lines,
-                                generation,
+                                &device, source, with_lines, generation,
                             )),
                             UploadJob::Lines { generation, source } => Uploaded::Lines {
                                 generation,
@@ -530,17 +515,12 @@ impl MeshRenderer {
         self.async_upload_bytes = bytes;
     }
 
-    /// Shows a mesh with new connectivity. `scalars`, when given, has one value per vertex.
+    /// Shows a mesh with new connectivity (its scalars zero until [`Self::set_scalars`]).
     ///
     /// A small mesh is uploaded here; a big one on the upload thread, while the previous mesh
     /// stays on screen (it appears in the first frame after the upload lands; see
     /// [`Self::upload_pending`]).
-    pub fn set_mesh(
-        &mut self,
-        device: &wgpu::Device,
-        source: Arc<dyn MeshSource>,
-        scalars: Option<&[f32]>,
-    ) {
+    pub fn set_mesh(&mut self, device: &wgpu::Device, source: Arc<dyn MeshSource>) {
         self.generation += 1;
         self.pending = None;
         self.lines_requested = None;
@@ -560,7 +540,6 @@ impl MeshRenderer {
                 let job = UploadJob::Mesh {
                     generation,
                     source,
-                    scalars: scalars.map(<[f32]>::to_vec),
                     with_lines: self.wireframe && face_count as u64 * 24 <= self.max_buffer_size,
                 };
                 match uploader.send(job) {
@@ -582,9 +561,7 @@ impl MeshRenderer {
                 }
             }
         }
-        self.mesh = Some(MeshBuffers::create(
-            device, source, scalars, false, generation,
-        ));
+        self.mesh = Some(MeshBuffers::create(device, source, false, generation));
         self.drawn = None;
     }
 
