@@ -31,6 +31,8 @@ type Job = Box<dyn FnOnce() + Send + 'static>;
 pub struct LoadedMesh {
     pub mesh: TriMesh,
     pub report: LoadReport,
+    /// The file the mesh came from, for writing it back on export.
+    pub source: Arc<crate::io::Source>,
 }
 
 struct Queued {
@@ -275,15 +277,17 @@ pub enum JobResult {
         /// The noisy mesh against the clean one.
         against_clean: Box<Measures>,
     },
+    /// The export was written; `Ok` holds what the output could not keep of the input.
     Exported {
         path: PathBuf,
-        result: Result<(), String>,
+        result: Result<Vec<String>, String>,
         elapsed: Duration,
     },
-    /// The level chain was written, one GLB per level.
+    /// The level chain was written, one GLB per level; `Ok` holds the files and what they could
+    /// not keep of the input.
     LevelsExported {
         folder: PathBuf,
-        result: Result<Vec<PathBuf>, String>,
+        result: Result<(Vec<PathBuf>, Vec<String>), String>,
         elapsed: Duration,
     },
     /// A file dialog closed; `None` when it was cancelled or no dialog could be shown.

@@ -777,6 +777,7 @@ impl App {
                         Ok(Box::new(LoadedMesh {
                             mesh: loaded.mesh,
                             report: loaded.report,
+                            source: loaded.source,
                         }))
                     }
                 });
@@ -1030,6 +1031,7 @@ impl App {
             return;
         }
         // The faired positions go with M0's triangles (the hierarchy's base mesh).
+        let file_source = document.source.clone();
         let (positions, triangles_source) = match (&document.faired, &document.hierarchy) {
             (Some(faired), HierarchyState::Ready { hierarchy, .. }) => (
                 Some(faired.positions.clone()),
@@ -1049,7 +1051,9 @@ impl App {
                 },
                 _ => source.clone(),
             };
-            let result = crate::io::save(&path, &mesh).map_err(|error| error.to_string());
+            let result = crate::io::save_with_source(&path, &mesh, &file_source)
+                .map(|report| report.warnings)
+                .map_err(|error| error.to_string());
             let message = JobResult::Exported {
                 path,
                 result,
@@ -1085,6 +1089,7 @@ impl App {
             return;
         };
         let hierarchy = hierarchy.clone();
+        let file_source = document.source.clone();
         let top = hierarchy.level_count().saturating_sub(1);
         let to = self.settings.levels_to.min(top);
         let from = self.settings.levels_from.min(to);
@@ -1105,11 +1110,27 @@ impl App {
                     (from..=to)
                         .map(|level| {
                             let path = folder.join(format!("{stem}_L{level:02}.glb"));
-                            crate::io::save(&path, &hierarchy.level_mesh(level))
-                                .map(|()| path)
-                                .map_err(|error| error.to_string())
+                            crate::io::save_with_source(
+                                &path,
+                                &hierarchy.level_mesh(level),
+                                &file_source,
+                            )
+                            .map(|report| (path, report.warnings))
+                            .map_err(|error| error.to_string())
                         })
                         .collect::<Result<Vec<_>, _>>()
+                })
+                .map(|written| {
+                    let mut warnings: Vec<String> = written
+                        .iter()
+                        .flat_map(|(_, w)| w.iter().cloned())
+                        .collect();
+                    // Every coarse level loses the same things: say it once.
+                    warnings.dedup();
+                    (
+                        written.into_iter().map(|(path, _)| path).collect(),
+                        warnings,
+                    )
                 });
             let message = JobResult::LevelsExported {
                 folder,
@@ -1216,6 +1237,7 @@ impl App {
                             export_path: state::default_export_path(&path).display().to_string(),
                             path,
                             mesh: Arc::new(loaded.mesh),
+                            source: loaded.source,
                             clean: None,
                             against_clean: None,
                             report: loaded.report,
@@ -1403,14 +1425,15 @@ impl App {
                 result,
                 elapsed,
             } => match result {
-                Ok(()) => {
+                Ok(warnings) => {
                     if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
                         self.settings.last_dir = Some(dir.to_path_buf());
                     }
                     self.message = Some(format!(
-                        "Exported to {} ({:.2} s)",
+                        "Exported to {} ({:.2} s){}",
                         path.display(),
-                        elapsed.as_secs_f64()
+                        elapsed.as_secs_f64(),
+                        notes(&warnings)
                     ));
                 }
                 Err(error) => {
@@ -1423,12 +1446,13 @@ impl App {
                 result,
                 elapsed,
             } => match result {
-                Ok(paths) => {
+                Ok((paths, warnings)) => {
                     self.message = Some(format!(
-                        "Exported {} levels to {} ({:.2} s)",
+                        "Exported {} levels to {} ({:.2} s){}",
                         paths.len(),
                         folder.display(),
-                        elapsed.as_secs_f64()
+                        elapsed.as_secs_f64(),
+                        notes(&warnings)
                     ));
                 }
                 Err(error) => {
@@ -1908,5 +1932,14 @@ mod tests {
         let (dv, rms) = compare_to_base(&mesh, &moved);
         assert!(dv.abs() < 1e-12, "translation keeps the volume");
         assert!((rms - 0.5).abs() < 1e-12);
+    }
+}
+
+/// What an export could not keep, as a note after its status message.
+fn notes(warnings: &[String]) -> String {
+    if warnings.is_empty() {
+        String::new()
+    } else {
+        format!(". Note: {}", warnings.join(". "))
     }
 }

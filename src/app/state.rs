@@ -360,6 +360,8 @@ pub struct Document {
     pub level_mesh: Option<(usize, Arc<TriMesh>)>,
     /// Where the export goes unless the user picks another place.
     pub export_path: String,
+    /// The file the mesh was loaded from: Export writes it back with the new positions.
+    pub source: Arc<crate::io::Source>,
 }
 
 impl Document {
@@ -372,7 +374,9 @@ impl Document {
     ) -> Self {
         let bounds = bounds_of(&original.positions);
         let export_path = default_export_path(&path).display().to_string();
+        let source = Arc::new(crate::io::Source::plain(&original));
         Self {
+            source,
             path,
             generation,
             original: Arc::new(original),
@@ -421,6 +425,7 @@ pub struct DocumentSnapshot {
     pub load_time: Duration,
     pub level: usize,
     pub export_path: String,
+    pub source: Arc<crate::io::Source>,
     /// The hierarchy, its build time, and whether its M0 has the mesh's triangles.
     pub hierarchy: Option<(Arc<Hierarchy>, Duration, bool)>,
 }
@@ -458,6 +463,7 @@ impl Document {
             load_time: self.load_time,
             level: self.level,
             export_path: self.export_path.clone(),
+            source: self.source.clone(),
             hierarchy: match &self.hierarchy {
                 HierarchyState::Ready {
                     hierarchy,
@@ -499,6 +505,7 @@ impl Document {
             faired: None,
             level_mesh: None,
             export_path: snapshot.export_path,
+            source: snapshot.source,
         }
     }
 }

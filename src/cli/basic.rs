@@ -87,6 +87,8 @@ pub fn info(args: InfoArgs) -> anyhow::Result<()> {
     let volume = closed.then(|| metrics::signed_volume(mesh));
     let bbox = metrics::bounding_box(mesh);
     let genus: Vec<Option<i64>> = topology.components.iter().map(|c| c.genus).collect();
+    // What the file holds beyond the mesh: kept when saving to the same format.
+    let contents = loaded.source.contents();
     let summary = json!({
         "file": args.file.display().to_string(),
         "vertices": mesh.vertex_count(),
@@ -111,6 +113,7 @@ pub fn info(args: InfoArgs) -> anyhow::Result<()> {
         "removed_degenerate_faces": report.removed_degenerate_faces,
         "removed_unreferenced_vertices": report.removed_unreferenced_vertices,
         "warnings": report.warnings,
+        "file_contents": contents,
     });
     if args.json {
         return super::emit(&format!("{}\n", serde_json::to_string_pretty(&summary)?));
@@ -168,6 +171,16 @@ pub fn info(args: InfoArgs) -> anyhow::Result<()> {
         "  removed             {} degenerate faces, {} unused vertices",
         report.removed_degenerate_faces, report.removed_unreferenced_vertices
     )?;
+    if !contents.is_empty() {
+        writeln!(
+            out,
+            "  also in the file    (kept when saving as {}):",
+            loaded.source.format()
+        )?;
+        for item in &contents {
+            writeln!(out, "    {item}")?;
+        }
+    }
     for warning in &report.warnings {
         writeln!(out, "  warning: {warning}")?;
     }
@@ -194,7 +207,7 @@ pub fn noise(args: NoiseArgs) -> anyhow::Result<()> {
             mode,
         },
     );
-    io::save(&args.output, &loaded.mesh)?;
+    super::save_kept(&args.output, &loaded.mesh, &loaded.source)?;
     eprintln!(
         "wrote {} (sigma {:.4e} model units, {:?}, seed {})",
         args.output.display(),
@@ -210,7 +223,7 @@ pub fn convert(args: ConvertArgs) -> anyhow::Result<()> {
     for _ in 0..args.subdivide {
         loaded.mesh = fairmesh::mesh::subdivide_loop(&loaded.mesh);
     }
-    io::save(&args.output, &loaded.mesh)?;
+    super::save_kept(&args.output, &loaded.mesh, &loaded.source)?;
     eprintln!(
         "wrote {} ({} vertices, {} faces)",
         args.output.display(),

@@ -135,7 +135,7 @@ impl FairArgs {
 
 pub fn run(args: FairArgs) -> anyhow::Result<()> {
     let loaded = fairmesh::io::load(&args.input)?;
-    let (mut mesh, topology) = (loaded.mesh, loaded.topology);
+    let (mut mesh, topology, source) = (loaded.mesh, loaded.topology, loaded.source);
     let options = args.method_options(fairmesh::metrics::mean_edge_length(&mesh));
     let volume_before = fairmesh::metrics::signed_volume(&mesh);
 
@@ -149,7 +149,7 @@ pub fn run(args: FairArgs) -> anyhow::Result<()> {
     } else {
         0.0
     };
-    fairmesh::io::save(&args.output, &mesh)?;
+    super::save_kept(&args.output, &mesh, &source)?;
 
     let method = options.method().name();
     let variant = match &options {

@@ -144,10 +144,18 @@ pub fn run_hierarchy(args: HierarchyArgs) -> anyhow::Result<()> {
             LevelFormat::Obj => "obj",
             LevelFormat::Glb => "glb",
         };
+        let mut lost = Vec::new();
         for level in 0..hierarchy.level_count() {
             let path = dir.join(format!("level_{level:02}.{extension}"));
-            io::save(&path, &hierarchy.level_mesh(level))
+            let mesh = hierarchy.level_mesh(level);
+            let report = io::save_with_source(&path, &mesh, &loaded.source)
                 .with_context(|| format!("writing level {level}"))?;
+            lost.extend(report.warnings);
+        }
+        // Every coarse level loses the same things: say it once.
+        lost.dedup();
+        for warning in lost {
+            eprintln!("warning: {}: {warning}", dir.display());
         }
     }
     let levels: Vec<_> = (0..hierarchy.level_count())
@@ -192,6 +200,7 @@ pub fn run_hierarchy(args: HierarchyArgs) -> anyhow::Result<()> {
 
 pub fn run_multires(args: MultiresArgs) -> anyhow::Result<()> {
     let loaded = super::basic::load(&args.input, true)?;
+    let source = loaded.source;
     let clean = loaded.mesh;
     let reference = match &args.reference {
         Some(path) => super::basic::load(path, true)?.mesh,
@@ -263,7 +272,7 @@ pub fn run_multires(args: MultiresArgs) -> anyhow::Result<()> {
         }
     }
     if let (Some(path), Some(result)) = (&args.output, &last) {
-        io::save(path, result).with_context(|| format!("writing {}", path.display()))?;
+        super::save_kept(path, result, &source)?;
     }
     if args.json {
         let value = if results.len() == 1 {

@@ -70,6 +70,20 @@ pub fn run(command: Command) -> anyhow::Result<()> {
     }
 }
 
+/// Saves `mesh` into what it was loaded from (see `fairmesh::io::save_with_source`) and prints, on
+/// stderr, what the output could not keep.
+pub(crate) fn save_kept(
+    path: &std::path::Path,
+    mesh: &fairmesh::TriMesh,
+    source: &fairmesh::io::Source,
+) -> anyhow::Result<()> {
+    let report = fairmesh::io::save_with_source(path, mesh, source)?;
+    for warning in &report.warnings {
+        eprintln!("warning: {}: {warning}", path.display());
+    }
+    Ok(())
+}
+
 /// Writes command output to stdout. A reader that closes the pipe early (`| head`) ends the output
 /// quietly instead of failing.
 pub fn emit(text: &str) -> anyhow::Result<()> {

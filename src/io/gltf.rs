@@ -26,6 +26,8 @@
 //! files first and renamed only when both are complete.
 
 use super::atomic;
+use super::gltf_writeback::{GltfSource, PrimitiveRead};
+use super::source::SourceData;
 use super::{IoError, Parsed};
 use crate::mesh::TriMesh;
 use ::gltf::accessor::{DataType, Dimensions};
@@ -50,6 +52,7 @@ pub(crate) fn parse(bytes: &[u8], path: &Path, base_dir: Option<&Path>) -> Resul
         warnings: Vec::new(),
         skipped_points: 0,
         skipped_lines: 0,
+        reads: Vec::new(),
     };
     let scene = document
         .default_scene()
@@ -85,10 +88,34 @@ pub(crate) fn parse(bytes: &[u8], path: &Path, base_dir: Option<&Path>) -> Resul
             reader.skipped_points, reader.skipped_lines
         ));
     }
+    let json = json_text(bytes)
+        .and_then(|text| serde_json::from_slice(text).ok())
+        .ok_or_else(|| IoError::invalid(path, "the glTF JSON cannot be read again"))?;
+    let SceneReader {
+        mesh,
+        warnings,
+        reads,
+        ..
+    } = reader;
+    let source = GltfSource {
+        json,
+        buffers: buffers.into_iter().map(Cow::into_owned).collect(),
+        reads,
+    };
     Ok(Parsed {
-        mesh: reader.mesh,
-        warnings: reader.warnings,
+        mesh,
+        warnings,
+        data: SourceData::Gltf(Box::new(source)),
     })
+}
+
+/// The JSON of a `.gltf` (the whole file) or of a GLB (its first chunk).
+fn json_text(bytes: &[u8]) -> Option<&[u8]> {
+    if !bytes.starts_with(b"glTF") {
+        return Some(bytes);
+    }
+    let length = u32::from_le_bytes(bytes.get(12..16)?.try_into().ok()?) as usize;
+    bytes.get(20..20usize.checked_add(length)?)
 }
 
 /// The GLB header's length, checked before the `gltf` crate sees it: gltf 1.4 subtracts the
@@ -282,7 +309,7 @@ fn decode_base64(text: &[u8]) -> Result<Vec<u8>, usize> {
 }
 
 /// Decode `%XX` escapes (UTF-8); `None` for a bad escape or invalid UTF-8.
-fn percent_decode(uri: &str) -> Option<String> {
+pub(crate) fn percent_decode(uri: &str) -> Option<String> {
     let bytes = uri.as_bytes();
     let mut out = Vec::with_capacity(bytes.len());
     let mut i = 0;
@@ -300,7 +327,7 @@ fn percent_decode(uri: &str) -> Option<String> {
 }
 
 /// Encode everything but unreserved characters, for a file name used as a URI.
-fn percent_encode(name: &str) -> String {
+pub(crate) fn percent_encode(name: &str) -> String {
     let mut out = String::with_capacity(name.len());
     for b in name.bytes() {
         if b.is_ascii_alphanumeric() || b"-_.~".contains(&b) {
@@ -319,6 +346,8 @@ struct SceneReader<'a> {
     warnings: Vec<String>,
     skipped_points: usize,
     skipped_lines: usize,
+    /// Which POSITION accessor elements became which parser vertices, for writing back.
+    reads: Vec<PrimitiveRead>,
 }
 
 fn local_matrix(node: &::gltf::Node) -> DMat4 {
@@ -506,6 +535,14 @@ impl SceneReader<'_> {
                 }
             }
             if self.mesh.triangles.len() > before {
+                self.reads.push(PrimitiveRead {
+                    accessor: position_accessor.index(),
+                    mesh: mesh.index(),
+                    node,
+                    raw_start: base as usize,
+                    count: positions.len(),
+                    world,
+                });
                 self.mesh.positions.extend_from_slice(&positions);
             }
         }

@@ -21,16 +21,22 @@
 mod atomic;
 mod error;
 mod gltf;
+mod gltf_writeback;
 mod obj;
 mod off;
 mod ply;
+mod source;
 mod stl;
 mod text;
 
 pub use error::{IoError, Location};
+pub use source::{SaveReport, Source};
 
 use crate::mesh::{self, Topology, TriMesh};
+use source::SourceData;
+use std::borrow::Cow;
 use std::path::{Path, PathBuf};
+use std::sync::Arc;
 
 /// A mesh file format, chosen from the file extension.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -123,20 +129,24 @@ pub struct LoadReport {
     pub warnings: Vec<String>,
 }
 
-/// A loaded, welded and cleaned mesh with its topology.
+/// A loaded, welded and cleaned mesh with its topology, and what it was read from.
 #[derive(Clone, Debug)]
 pub struct Loaded {
     pub mesh: TriMesh,
     pub topology: Topology,
     pub report: LoadReport,
+    /// The file the mesh came from, kept so that [`save_with_source`] writes it back with only
+    /// the positions (and what depends on them) changed.
+    pub source: Arc<Source>,
 }
 
-/// What a format parser hands back: the raw mesh (indices checked, positions finite) and
-/// warnings about what it skipped.
+/// What a format parser hands back: the raw mesh (indices checked, positions finite), warnings
+/// about what it skipped, and what of the file is kept for writing it back.
 #[derive(Debug)]
 pub(crate) struct Parsed {
     pub mesh: TriMesh,
     pub warnings: Vec<String>,
+    pub data: SourceData,
 }
 
 impl Parsed {
@@ -144,6 +154,7 @@ impl Parsed {
         Parsed {
             mesh,
             warnings: Vec::new(),
+            data: SourceData::Plain,
         }
     }
 }
@@ -161,7 +172,7 @@ pub fn load_with(path: &Path, options: &LoadOptions) -> Result<Loaded, IoError> 
         source,
     })?;
     let base_dir = path.parent().map(Path::to_path_buf);
-    load_bytes_impl(&bytes, format, path, base_dir.as_deref(), options)
+    load_bytes_impl(Cow::Owned(bytes), format, path, base_dir, options)
 }
 
 /// Parse a mesh from bytes in memory. `name` stands for the path in error messages (a file name,
@@ -173,28 +184,49 @@ pub fn load_from_bytes(
     name: &str,
     options: &LoadOptions,
 ) -> Result<Loaded, IoError> {
-    load_bytes_impl(bytes, format, Path::new(name), None, options)
+    load_bytes_impl(Cow::Borrowed(bytes), format, Path::new(name), None, options)
 }
 
 fn load_bytes_impl(
-    bytes: &[u8],
+    bytes: Cow<'_, [u8]>,
     format: Format,
     path: &Path,
-    base_dir: Option<&Path>,
+    base_dir: Option<PathBuf>,
     options: &LoadOptions,
 ) -> Result<Loaded, IoError> {
     if bytes.is_empty() {
         return Err(IoError::invalid(path, "the file is empty"));
     }
-    let parsed = match format {
-        Format::Obj => obj::parse(bytes, path)?,
-        Format::Gltf | Format::Glb => gltf::parse(bytes, path, base_dir)?,
-        Format::Ply => ply::parse(bytes, path)?,
-        Format::Stl => stl::parse(bytes, path)?,
-        Format::Off => off::parse(bytes, path)?,
+    let mut parsed = match format {
+        Format::Obj => obj::parse(&bytes, path)?,
+        Format::Gltf | Format::Glb => gltf::parse(&bytes, path, base_dir.as_deref())?,
+        Format::Ply => ply::parse(&bytes, path)?,
+        Format::Stl => stl::parse(&bytes, path)?,
+        Format::Off => off::parse(&bytes, path)?,
     };
     check_parsed(&parsed.mesh, path)?;
-    let mut loaded = finish(parsed.mesh, options);
+    // The text and PLY sources are the file itself: kept as read, not copied, when it came from
+    // a file.
+    match format {
+        Format::Obj => parsed.data = SourceData::Obj(bytes.into_owned()),
+        Format::Ply if ply::can_write_back(&bytes) => {
+            parsed.data = SourceData::Ply(bytes.into_owned())
+        }
+        _ => drop(bytes),
+    }
+    let raw_vertices = parsed.mesh.positions.len();
+    let (mut loaded, raw_to_welded) = finish_with_map(parsed.mesh, options);
+    loaded.source = Arc::new(Source {
+        format,
+        path: path.to_owned(),
+        base_dir,
+        raw_to_welded,
+        raw_vertices,
+        welded_vertices: loaded.mesh.positions.len(),
+        welded_triangles: loaded.mesh.triangles.len(),
+        triangle_fingerprint: loaded.source.triangle_fingerprint,
+        data: parsed.data,
+    });
     if loaded.mesh.triangles.is_empty() {
         return Err(IoError::invalid(
             path,
@@ -250,12 +282,34 @@ fn format_of(path: &Path) -> Result<Format, IoError> {
 /// Weld, clean and build the topology of a freshly parsed mesh. Indices must be in range and
 /// positions finite (every parser checks both). Non-manifold and inconsistently oriented input
 /// gets a warning in the report.
-pub fn finish(mut mesh: TriMesh, options: &LoadOptions) -> Loaded {
+pub fn finish(mesh: TriMesh, options: &LoadOptions) -> Loaded {
+    finish_with_map(mesh, options).0
+}
+
+/// [`finish`], also giving the map from the input's vertices to the welded ones (`u32::MAX` for
+/// a dropped vertex), `None` when they are the same.
+fn finish_with_map(mut mesh: TriMesh, options: &LoadOptions) -> (Loaded, Option<Vec<u32>>) {
     let mut report = LoadReport::default();
+    let mut map = None;
     if options.weld {
-        report.welded_vertices = mesh::weld(&mut mesh).merged_vertices;
+        let (welded, weld_map) = mesh::weld_with_map(&mut mesh);
+        report.welded_vertices = welded.merged_vertices;
+        if welded.merged_vertices > 0 {
+            map = Some(weld_map);
+        }
     }
-    let cleaned = mesh::clean(&mut mesh);
+    let (cleaned, clean_map) = mesh::clean_with_map(&mut mesh);
+    if let Some(clean_map) = clean_map {
+        map = Some(match map {
+            None => clean_map,
+            Some(mut map) => {
+                for v in &mut map {
+                    *v = clean_map[*v as usize];
+                }
+                map
+            }
+        });
+    }
     report.removed_degenerate_faces = cleaned.removed_degenerate_faces;
     report.removed_unreferenced_vertices = cleaned.removed_unreferenced_vertices;
     let topology = Topology::build(&mesh);
@@ -279,11 +333,16 @@ pub fn finish(mut mesh: TriMesh, options: &LoadOptions) -> Loaded {
             topology.inconsistent_edges
         ));
     }
-    Loaded {
-        mesh,
-        topology,
-        report,
-    }
+    let source = Arc::new(Source::plain(&mesh));
+    (
+        Loaded {
+            mesh,
+            topology,
+            report,
+            source,
+        },
+        map,
+    )
 }
 
 /// Save a mesh; the format comes from the extension. The write is atomic: on any error nothing
@@ -303,6 +362,52 @@ pub fn save_as(path: &Path, mesh: &TriMesh, format: Format) -> Result<(), IoErro
         Format::Stl => atomic::write(path, |w| stl::write(w, mesh)),
         Format::Off => atomic::write(path, |w| off::write(w, mesh)),
     }
+}
+
+/// Save `mesh` into what it was loaded from: to the same family of format (OBJ, PLY, glTF/GLB)
+/// the source file comes back with only the positions and what depends on them changed (see
+/// [`Source`]); to another format, or when `mesh` no longer has the source's connectivity (a
+/// level of the hierarchy, a subdivided copy), the mesh is written as it is and the report names
+/// what the output does not keep. The write is atomic, as with [`save`].
+pub fn save_with_source(
+    path: &Path,
+    mesh: &TriMesh,
+    source: &Source,
+) -> Result<SaveReport, IoError> {
+    let format = format_of(path)?;
+    check_writable(mesh, path)?;
+    let mut report = SaveReport::default();
+    let name = source.path.display();
+    if source.writes_back_as(format) && source.matches(mesh) {
+        match &source.data {
+            SourceData::Obj(bytes) => {
+                atomic::write(path, |w| obj::write_back(w, bytes, source, mesh))?
+            }
+            SourceData::Ply(bytes) => {
+                atomic::write(path, |w| ply::write_back(w, bytes, source, mesh))?
+            }
+            SourceData::Gltf(gltf) => {
+                gltf_writeback::write(path, format, gltf, source, mesh, &mut report)?
+            }
+            SourceData::Plain => save_as(path, mesh, format)?,
+        }
+        return Ok(report);
+    }
+    save_as(path, mesh, format)?;
+    let lost = source.contents();
+    if !lost.is_empty() {
+        let why = if source.writes_back_as(format) {
+            "the mesh no longer has its connectivity (a level of the hierarchy or a changed copy)"
+                .to_string()
+        } else {
+            format!("{format} cannot hold them")
+        };
+        report.warnings.push(format!(
+            "not kept from {name}, as {why}: {}",
+            lost.join("; ")
+        ));
+    }
+    Ok(report)
 }
 
 /// Refuse meshes that no reader could load back: no triangles, NaN/inf, indices out of range.

@@ -20,6 +20,7 @@
 //! Writing: `v x y z` with Rust's shortest round-trip float formatting (`{}`), so every f32 reads
 //! back bit for bit, and `f a b c` with 1-based indices.
 
+use super::source::{dvec, NormalTurns, Source};
 use super::text::{lines, non_finite_kind, quote, tokens};
 use super::{IoError, Parsed};
 use crate::mesh::TriMesh;
@@ -368,6 +369,213 @@ pub(crate) fn write(out: &mut dyn Write, mesh: &TriMesh) -> std::io::Result<()> 
         )?;
     }
     Ok(())
+}
+
+/// The parts of a line: its text without the line ending, and the ending (`\n`, `\r\n` or none).
+fn split_ending(line: &[u8]) -> (&[u8], &[u8]) {
+    let body = line.strip_suffix(b"\n").unwrap_or(line);
+    let body = body.strip_suffix(b"\r").unwrap_or(body);
+    line.split_at(body.len())
+}
+
+/// The position a `v` line gives (w divided out), as the reader reads it; `None` if unreadable.
+fn vertex_of<'a>(words: impl Iterator<Item = &'a [u8]>) -> Option<[f32; 3]> {
+    let mut values = [0f32; 6];
+    let mut count = 0;
+    for token in words {
+        *values.get_mut(count)? = super::text::parse_f32(token)?;
+        count += 1;
+    }
+    let p = [values[0], values[1], values[2]];
+    match count {
+        3 | 6 => Some(p),
+        4 if values[3] != 0.0 => Some(p.map(|c| c / values[3])),
+        _ => None,
+    }
+}
+
+/// The 0-based index an OBJ index token refers to, given how many items came before its line.
+fn resolve(token: &[u8], before: usize) -> Option<usize> {
+    let index = super::text::parse_i64(token)?;
+    match index {
+        i if i > 0 => usize::try_from(i - 1).ok(),
+        i if i < 0 => usize::try_from(before as i64 + i).ok(),
+        _ => None,
+    }
+}
+
+/// Write the OBJ `source` back with `mesh`'s positions: every line but the `v` lines of moved
+/// vertices and the `vn` lines of normals whose faces moved comes back byte for byte. A moved
+/// vertex is written `v x y z` (shortest round-trip floats; a w is folded in), followed by the
+/// line's vertex colour if it had one. Normals turn with their faces (see [`super::source`]).
+pub(crate) fn write_back(
+    out: &mut dyn Write,
+    bytes: &[u8],
+    source: &Source,
+    mesh: &TriMesh,
+) -> std::io::Result<()> {
+    // The file's own positions (as the reader read them), and each vertex's new position.
+    let mut before: Vec<[f32; 3]> = Vec::with_capacity(source.raw_vertices);
+    let mut normal_count = 0usize;
+    for line in bytes.split(|&b| b == b'\n') {
+        let mut words = tokens(line);
+        match words.next() {
+            Some(b"v") => before.push(vertex_of(words).unwrap_or([f32::NAN; 3])),
+            Some(b"vn") => normal_count += 1,
+            _ => {}
+        }
+    }
+    let after: Vec<[f32; 3]> = (0..before.len())
+        .map(|k| source.welded(k).map_or(before[k], |w| mesh.positions[w]))
+        .collect();
+    let moved = |k: usize| before[k] != after[k] && !before[k][0].is_nan();
+    let turns = (normal_count > 0 && (0..before.len()).any(moved))
+        .then(|| normal_turns(bytes, &before, &after, normal_count));
+
+    let mut vertex = 0usize;
+    let mut normal = 0usize;
+    for line in bytes.split_inclusive(|&b| b == b'\n') {
+        let (text, ending) = split_ending(line);
+        let mut words = tokens(text);
+        match words.next() {
+            Some(b"v") => {
+                let k = vertex;
+                vertex += 1;
+                if moved(k) {
+                    let [x, y, z] = after[k];
+                    write!(out, "v {x} {y} {z}")?;
+                    let rest: Vec<&[u8]> = words.collect();
+                    if rest.len() == 6 {
+                        // x y z r g b: keep the colour as written.
+                        for colour in &rest[3..] {
+                            out.write_all(b" ")?;
+                            out.write_all(colour)?;
+                        }
+                    }
+                    out.write_all(ending)?;
+                    continue;
+                }
+            }
+            Some(b"vn") => {
+                let k = normal;
+                normal += 1;
+                let turn = turns.as_ref().and_then(|t| t.turn(k));
+                if let (Some(turn), Some(n)) = (turn, vertex_of(words.take(3))) {
+                    let [x, y, z] = turn.normal(n);
+                    write!(out, "vn {x} {y} {z}")?;
+                    out.write_all(ending)?;
+                    continue;
+                }
+            }
+            _ => {}
+        }
+        out.write_all(line)?;
+    }
+    Ok(())
+}
+
+/// The turns of the `vn` normals: every face corner `v//vn` or `v/vt/vn` adds the area of its
+/// fan triangles to its normal.
+fn normal_turns(
+    bytes: &[u8],
+    before: &[[f32; 3]],
+    after: &[[f32; 3]],
+    normal_count: usize,
+) -> NormalTurns {
+    let mut turns = NormalTurns::new(normal_count);
+    let (mut vertices, mut normals) = (0usize, 0usize);
+    let mut corners: Vec<(usize, usize)> = Vec::with_capacity(8);
+    for line in bytes.split(|&b| b == b'\n') {
+        let mut words = tokens(line);
+        match words.next() {
+            Some(b"v") => vertices += 1,
+            Some(b"vn") => normals += 1,
+            Some(b"f") => {
+                corners.clear();
+                for corner in words {
+                    let mut parts = corner.split(|&b| b == b'/');
+                    let v = parts.next().and_then(|t| resolve(t, vertices));
+                    let n = parts.nth(1).and_then(|t| resolve(t, normals));
+                    match (v, n) {
+                        (Some(v), Some(n)) if v < before.len() => corners.push((v, n)),
+                        _ => {
+                            corners.clear();
+                            break;
+                        }
+                    }
+                }
+                for i in 1..corners.len().saturating_sub(1) {
+                    let fan = [corners[0], corners[i], corners[i + 1]];
+                    turns.add(
+                        fan.map(|(_, n)| n),
+                        fan.map(|(v, _)| dvec(before[v])),
+                        fan.map(|(v, _)| dvec(after[v])),
+                    );
+                }
+            }
+            _ => {}
+        }
+    }
+    turns
+}
+
+/// What an OBJ file holds beyond positions and triangles, in plain words.
+pub(crate) fn contents(bytes: &[u8]) -> Vec<String> {
+    let (mut uvs, mut normals, mut colours, mut polygons, mut groups, mut smoothing) =
+        (0usize, 0usize, 0usize, 0usize, 0usize, false);
+    let mut materials: Vec<String> = Vec::new();
+    let mut libraries: Vec<String> = Vec::new();
+    for line in bytes.split(|&b| b == b'\n') {
+        let mut words = tokens(line);
+        match words.next() {
+            Some(b"v") if words.by_ref().count() == 6 => colours += 1,
+            Some(b"vt") => uvs += 1,
+            Some(b"vn") => normals += 1,
+            Some(b"f") if words.by_ref().count() > 3 => polygons += 1,
+            Some(b"o" | b"g") => groups += 1,
+            Some(b"s") => smoothing = true,
+            Some(b"usemtl") => {
+                let name = String::from_utf8_lossy(words.next().unwrap_or_default()).into_owned();
+                if !materials.contains(&name) {
+                    materials.push(name);
+                }
+            }
+            Some(b"mtllib") => {
+                libraries.extend(words.map(|w| String::from_utf8_lossy(w).into_owned()))
+            }
+            _ => {}
+        }
+    }
+    let mut out = Vec::new();
+    if groups > 0 {
+        out.push(format!("{groups} object and group names (o, g)"));
+    }
+    if !materials.is_empty() || !libraries.is_empty() {
+        out.push(format!(
+            "{} materials ({}) from the material library {}",
+            materials.len(),
+            materials.join(", "),
+            libraries.join(", ")
+        ));
+    }
+    if uvs > 0 {
+        out.push(format!("texture coordinates ({uvs} vt)"));
+    }
+    if normals > 0 {
+        out.push(format!("normals ({normals} vn)"));
+    }
+    if smoothing {
+        out.push("smoothing groups (s)".into());
+    }
+    if colours > 0 {
+        out.push("vertex colours".into());
+    }
+    if polygons > 0 {
+        out.push(format!(
+            "{polygons} quads and polygons (written as triangles)"
+        ));
+    }
+    out
 }
 
 #[cfg(test)]

@@ -17,6 +17,7 @@
 //! Speed: binary vertex rows of fixed size are read with precomputed offsets; faces are read row by
 //! row without per-face allocation. ASCII rows are one per line (what every writer produces).
 
+use super::source::{dvec, NormalTurns, SmoothGroups, Source};
 use super::text::{lines, non_finite_kind, parse_f32, parse_f64, parse_i64, quote, tokens};
 use super::{IoError, Parsed};
 use crate::mesh::TriMesh;
@@ -772,6 +773,364 @@ pub(crate) fn write(out: &mut dyn Write, mesh: &TriMesh) -> std::io::Result<()> 
         }
     }
     out.write_all(&buffer)
+}
+
+/// Where the rows of the vertex element are, for writing a PLY back.
+enum VertexRows {
+    /// Binary rows of fixed size: the byte range of all of them and the row size.
+    Binary {
+        start: usize,
+        end: usize,
+        stride: usize,
+    },
+    /// ASCII: the 0-based index, among the body's non-empty lines, of the first vertex row.
+    Ascii { first_row: usize },
+}
+
+/// The byte length of a binary element's rows starting at `pos` (rows with lists are walked).
+fn binary_element_len<const BIG: bool>(
+    bytes: &[u8],
+    pos: usize,
+    element: &Element,
+) -> Option<usize> {
+    if let Some(stride) = element.fixed_row_size() {
+        return usize::try_from(element.count).ok()?.checked_mul(stride);
+    }
+    let mut at = pos;
+    for _ in 0..element.count {
+        for property in &element.properties {
+            match property {
+                Property::Scalar { kind, .. } => at = at.checked_add(kind.size())?,
+                Property::List { count, item, .. } => {
+                    let n = usize::try_from(read_int::<BIG>(*count, bytes.get(at..)?)?).ok()?;
+                    at = at
+                        .checked_add(count.size())?
+                        .checked_add(n.checked_mul(item.size())?)?;
+                }
+            }
+        }
+    }
+    (at <= bytes.len()).then_some(at - pos)
+}
+
+fn vertex_rows(bytes: &[u8], header: &Header, layout: &Layout) -> Option<VertexRows> {
+    let before = &header.elements[..layout.vertex_element];
+    match header.encoding {
+        Encoding::Ascii => Some(VertexRows::Ascii {
+            first_row: before
+                .iter()
+                .try_fold(0usize, |n, e| n.checked_add(usize::try_from(e.count).ok()?))?,
+        }),
+        encoding => {
+            let mut pos = header.body_start;
+            for element in before {
+                pos += match encoding {
+                    Encoding::BigEndian => binary_element_len::<true>(bytes, pos, element)?,
+                    _ => binary_element_len::<false>(bytes, pos, element)?,
+                };
+            }
+            let vertex = &header.elements[layout.vertex_element];
+            let stride = vertex.fixed_row_size()?;
+            let end = pos.checked_add(usize::try_from(vertex.count).ok()?.checked_mul(stride)?)?;
+            (end <= bytes.len()).then_some(VertexRows::Binary {
+                start: pos,
+                end,
+                stride,
+            })
+        }
+    }
+}
+
+/// Whether a PLY file can be written back with new positions (its header reads and, in binary,
+/// its vertex rows have a fixed size).
+pub(crate) fn can_write_back(bytes: &[u8]) -> bool {
+    let path = Path::new("");
+    parse_header(bytes, path)
+        .ok()
+        .and_then(|header| {
+            let layout = find_layout(&header, path).ok()?;
+            vertex_rows(bytes, &header, &layout)
+        })
+        .is_some()
+}
+
+/// Property indices of nx, ny, nz when the vertex element has all three as scalars.
+fn normal_properties(element: &Element) -> Option<[usize; 3]> {
+    let find = |axis: &[u8]| {
+        element
+            .properties
+            .iter()
+            .position(|p| matches!(p, Property::Scalar { name, .. } if name == axis))
+    };
+    Some([find(b"nx")?, find(b"ny")?, find(b"nz")?])
+}
+
+/// A value in a property's type and the file's byte order.
+fn encode(kind: Scalar, big: bool, value: f32, out: &mut [u8]) {
+    macro_rules! put {
+        ($v:expr) => {{
+            let v = $v;
+            let raw = if big {
+                v.to_be_bytes()
+            } else {
+                v.to_le_bytes()
+            };
+            out[..raw.len()].copy_from_slice(&raw);
+        }};
+    }
+    let whole = value.round() as f64;
+    match kind {
+        Scalar::F32 => put!(value),
+        Scalar::F64 => put!(value as f64),
+        Scalar::I8 => put!(whole.clamp(i8::MIN as f64, i8::MAX as f64) as i8),
+        Scalar::U8 => put!(whole.clamp(0.0, u8::MAX as f64) as u8),
+        Scalar::I16 => put!(whole.clamp(i16::MIN as f64, i16::MAX as f64) as i16),
+        Scalar::U16 => put!(whole.clamp(0.0, u16::MAX as f64) as u16),
+        Scalar::I32 => put!(whole.clamp(i32::MIN as f64, i32::MAX as f64) as i32),
+        Scalar::U32 => put!(whole.clamp(0.0, u32::MAX as f64) as u32),
+    }
+}
+
+/// A value as ASCII PLY text for a property's type.
+fn ascii_value(kind: Scalar, value: f32) -> String {
+    if kind.is_integer() {
+        format!("{}", value.round() as i64)
+    } else {
+        format!("{value}")
+    }
+}
+
+/// Write the PLY `source` back with `mesh`'s positions, in the file's own encoding: the header,
+/// every other element and every other property come back byte for byte; x, y, z of moved
+/// vertices are written in their declared types, and nx, ny, nz (when present) turn with their
+/// faces (see [`super::source`]).
+pub(crate) fn write_back(
+    out: &mut dyn Write,
+    bytes: &[u8],
+    source: &Source,
+    mesh: &TriMesh,
+) -> std::io::Result<()> {
+    let invalid =
+        |what: &str| std::io::Error::new(std::io::ErrorKind::InvalidData, what.to_string());
+    let path = Path::new("");
+    let header = parse_header(bytes, path).map_err(|e| invalid(&e.to_string()))?;
+    let layout = find_layout(&header, path).map_err(|e| invalid(&e.to_string()))?;
+    let rows = vertex_rows(bytes, &header, &layout)
+        .ok_or_else(|| invalid("the vertex rows cannot be located"))?;
+    let element = &header.elements[layout.vertex_element];
+    let normal_props = normal_properties(element);
+    let big = header.encoding == Encoding::BigEndian;
+
+    // The file's positions and faces, as the reader reads them.
+    let parsed = parse(bytes, path).map_err(|e| invalid(&e.to_string()))?;
+    let before = &parsed.mesh.positions;
+    let after: Vec<[f32; 3]> = (0..before.len())
+        .map(|k| source.welded(k).map_or(before[k], |w| mesh.positions[w]))
+        .collect();
+    // Slots for the normals (see `SmoothGroups`), read from the file when it has normals.
+    let slots: Option<Vec<usize>> = normal_props.filter(|_| before != &after).map(|props| {
+        let values = file_normals(bytes, &header, &rows, element, props);
+        let mut own = vec![glam::DVec3::ZERO; before.len()];
+        for t in &parsed.mesh.triangles {
+            let [a, b, c] = t.map(|v| dvec(before[v as usize]));
+            for v in t {
+                own[*v as usize] += (b - a).cross(c - a);
+            }
+        }
+        let mut groups = SmoothGroups::default();
+        (0..before.len())
+            .map(|k| {
+                let normal = values.get(k).copied().unwrap_or_default();
+                groups.slot_for(own[k], source.welded(k), normal)
+            })
+            .collect()
+    });
+    let turns = slots.as_ref().map(|slots| {
+        let mut turns = NormalTurns::new(before.len());
+        for t in &parsed.mesh.triangles {
+            let corners = t.map(|v| v as usize);
+            turns.add(
+                corners.map(|v| slots[v]),
+                corners.map(|v| dvec(before[v])),
+                corners.map(|v| dvec(after[v])),
+            );
+        }
+        turns
+    });
+
+    // The properties to rewrite in a row: (property index, value).
+    let changes = |k: usize, row_normal: &dyn Fn([usize; 3]) -> Option<[f32; 3]>| {
+        let mut list: Vec<(usize, f32)> = Vec::new();
+        if before[k] != after[k] {
+            list.extend(layout.xyz.iter().copied().zip(after[k]));
+        }
+        let turn = turns
+            .as_ref()
+            .zip(slots.as_ref())
+            .and_then(|(t, slots)| t.turn(slots[k]));
+        if let (Some(props), Some(turn)) = (normal_props, turn) {
+            if let Some(normal) = row_normal(props) {
+                list.extend(props.iter().copied().zip(turn.normal(normal)));
+            }
+        }
+        list
+    };
+    match rows {
+        VertexRows::Binary { start, end, stride } => {
+            let mut offsets = Vec::with_capacity(element.properties.len());
+            let mut offset = 0;
+            for property in &element.properties {
+                let Property::Scalar { kind, .. } = property else {
+                    return Err(invalid("the vertex rows have lists"));
+                };
+                offsets.push((offset, *kind));
+                offset += kind.size();
+            }
+            let mut body = bytes[start..end].to_vec();
+            for (k, row) in body.chunks_exact_mut(stride).enumerate().take(before.len()) {
+                let read = |p: usize| {
+                    let (at, kind) = offsets[p];
+                    if big {
+                        read_f32::<true>(kind, &row[at..])
+                    } else {
+                        read_f32::<false>(kind, &row[at..])
+                    }
+                };
+                let normal =
+                    |props: [usize; 3]| Some([read(props[0])?, read(props[1])?, read(props[2])?]);
+                for (p, value) in changes(k, &normal) {
+                    let (at, kind) = offsets[p];
+                    encode(kind, big, value, &mut row[at..]);
+                }
+            }
+            out.write_all(&bytes[..start])?;
+            out.write_all(&body)?;
+            out.write_all(&bytes[end..])
+        }
+        VertexRows::Ascii { first_row } => {
+            out.write_all(&bytes[..header.body_start])?;
+            let mut row = 0usize;
+            for line in bytes[header.body_start..].split_inclusive(|&b| b == b'\n') {
+                let text = line.strip_suffix(b"\n").unwrap_or(line);
+                let text = text.strip_suffix(b"\r").unwrap_or(text);
+                if tokens(text).next().is_none() {
+                    out.write_all(line)?;
+                    continue;
+                }
+                let k = row.wrapping_sub(first_row);
+                row += 1;
+                if k >= before.len() {
+                    out.write_all(line)?;
+                    continue;
+                }
+                let words: Vec<&[u8]> = tokens(text).collect();
+                let read = |p: usize| words.get(p).and_then(|t| parse_f32(t));
+                let normal =
+                    |props: [usize; 3]| Some([read(props[0])?, read(props[1])?, read(props[2])?]);
+                let list = changes(k, &normal);
+                if list.is_empty() {
+                    out.write_all(line)?;
+                    continue;
+                }
+                let mut fields: Vec<String> = words
+                    .iter()
+                    .map(|w| String::from_utf8_lossy(w).into_owned())
+                    .collect();
+                for (p, value) in list {
+                    if let (Some(field), Property::Scalar { kind, .. }) =
+                        (fields.get_mut(p), &element.properties[p])
+                    {
+                        *field = ascii_value(*kind, value);
+                    }
+                }
+                out.write_all(fields.join(" ").as_bytes())?;
+                out.write_all(&line[text.len()..])?;
+            }
+            Ok(())
+        }
+    }
+}
+
+/// The nx, ny, nz of every vertex row (zero where unreadable).
+fn file_normals(
+    bytes: &[u8],
+    header: &Header,
+    rows: &VertexRows,
+    element: &Element,
+    props: [usize; 3],
+) -> Vec<[f32; 3]> {
+    match *rows {
+        VertexRows::Binary { start, end, stride } => {
+            let mut offsets = [(0usize, Scalar::F32); 3];
+            let mut offset = 0;
+            for (p, property) in element.properties.iter().enumerate() {
+                if let Property::Scalar { kind, .. } = property {
+                    if let Some(axis) = props.iter().position(|&q| q == p) {
+                        offsets[axis] = (offset, *kind);
+                    }
+                    offset += kind.size();
+                }
+            }
+            let big = header.encoding == Encoding::BigEndian;
+            bytes[start..end]
+                .chunks_exact(stride)
+                .map(|row| {
+                    offsets.map(|(at, kind)| {
+                        if big {
+                            read_f32::<true>(kind, &row[at..])
+                        } else {
+                            read_f32::<false>(kind, &row[at..])
+                        }
+                        .unwrap_or(0.0)
+                    })
+                })
+                .collect()
+        }
+        VertexRows::Ascii { first_row } => lines(&bytes[header.body_start..])
+            .map(|(_, line)| line)
+            .filter(|line| tokens(line).next().is_some())
+            .skip(first_row)
+            .take(element.count as usize)
+            .map(|line| {
+                let words: Vec<&[u8]> = tokens(line).collect();
+                props.map(|p| words.get(p).and_then(|t| parse_f32(t)).unwrap_or(0.0))
+            })
+            .collect(),
+    }
+}
+
+/// What a PLY file holds beyond positions and triangles, in plain words.
+pub(crate) fn contents(bytes: &[u8]) -> Vec<String> {
+    let path = Path::new("");
+    let Ok(header) = parse_header(bytes, path) else {
+        return Vec::new();
+    };
+    let Ok(layout) = find_layout(&header, path) else {
+        return Vec::new();
+    };
+    let names = |element: &Element, skip: &[usize]| -> Vec<String> {
+        (0..element.properties.len())
+            .filter(|p| !skip.contains(p))
+            .map(|p| String::from_utf8_lossy(element.properties[p].name()).into_owned())
+            .collect()
+    };
+    let mut out = Vec::new();
+    let vertex = names(&header.elements[layout.vertex_element], &layout.xyz);
+    if !vertex.is_empty() {
+        out.push(format!("vertex properties {}", vertex.join(", ")));
+    }
+    if let Some(f) = layout.face_element {
+        let face = names(&header.elements[f], &[layout.face_list]);
+        if !face.is_empty() {
+            out.push(format!("face properties {}", face.join(", ")));
+        }
+    }
+    for (e, element) in header.elements.iter().enumerate() {
+        if e != layout.vertex_element && Some(e) != layout.face_element {
+            out.push(format!("{} {} elements", element.count, element.label()));
+        }
+    }
+    out
 }
 
 #[cfg(test)]

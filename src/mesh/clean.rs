@@ -59,6 +59,11 @@ fn position_key(p: &[f32; 3]) -> [u32; 3] {
 /// Merge vertices with bit-identical positions. Returns the report; `mesh` is rewritten in place.
 /// Triangle indices must be in range (loaders check that first).
 pub fn weld(mesh: &mut TriMesh) -> WeldReport {
+    weld_with_map(mesh).0
+}
+
+/// [`weld`], also giving the map from each input vertex to the vertex it became.
+pub(crate) fn weld_with_map(mesh: &mut TriMesh) -> (WeldReport, Vec<u32>) {
     let n = mesh.positions.len();
     let mut first_index: HashMap<[u32; 3], u32, BuildHasherDefault<PositionHasher>> =
         HashMap::with_capacity_and_hasher(n, Default::default());
@@ -79,13 +84,22 @@ pub fn weld(mesh: &mut TriMesh) -> WeldReport {
         }
         mesh.positions = kept;
     }
-    WeldReport {
-        merged_vertices: merged,
-    }
+    (
+        WeldReport {
+            merged_vertices: merged,
+        },
+        remap,
+    )
 }
 
 /// Remove triangles that repeat a vertex and vertices that no triangle uses.
 pub fn clean(mesh: &mut TriMesh) -> CleanReport {
+    clean_with_map(mesh).0
+}
+
+/// [`clean`], also giving the map from each input vertex to the vertex it became (`u32::MAX` for
+/// a removed vertex); `None` when no vertex was removed.
+pub(crate) fn clean_with_map(mesh: &mut TriMesh) -> (CleanReport, Option<Vec<u32>>) {
     let before_faces = mesh.triangles.len();
     mesh.triangles
         .retain(|&[a, b, c]| a != b && b != c && a != c);
@@ -98,6 +112,7 @@ pub fn clean(mesh: &mut TriMesh) -> CleanReport {
         }
     }
     let unused = used.iter().filter(|u| !**u).count();
+    let mut map = None;
     if unused > 0 {
         let mut remap = vec![u32::MAX; mesh.positions.len()];
         let mut next = 0u32;
@@ -113,11 +128,15 @@ pub fn clean(mesh: &mut TriMesh) -> CleanReport {
             *t = t.map(|v| remap[v as usize]);
         }
         mesh.positions = kept;
+        map = Some(remap);
     }
-    CleanReport {
-        removed_degenerate_faces,
-        removed_unreferenced_vertices: unused,
-    }
+    (
+        CleanReport {
+            removed_degenerate_faces,
+            removed_unreferenced_vertices: unused,
+        },
+        map,
+    )
 }
 
 #[cfg(test)]

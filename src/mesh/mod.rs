@@ -16,8 +16,8 @@ mod reorder;
 mod subdivide;
 mod topology;
 
-pub(crate) use clean::PositionHasher;
 pub use clean::{clean, weld, CleanReport, WeldReport};
+pub(crate) use clean::{clean_with_map, weld_with_map, PositionHasher};
 pub use reorder::{breadth_first_order, inverse_permutation};
 pub use subdivide::subdivide_loop;
 pub use topology::{ComponentInfo, Topology};

@@ -1,0 +1,869 @@
+//! Writing a glTF/GLB back with new positions and everything else as it was.
+//!
+//! What is kept: the whole JSON document (scenes, nodes with names, parents, TRS or matrix,
+//! meshes, primitives, materials, textures, images, samplers, cameras, skins, animations, morph
+//! targets, extensions and extras, in their order) and every byte of every buffer view, except the
+//! elements of POSITION accessors whose vertex moved, the NORMAL and TANGENT elements whose faces
+//! moved, and the POSITION accessors' `min`/`max`.
+//!
+//! How positions go back: the reader placed each primitive in world space through its node's
+//! world transform; a moved vertex goes back to the primitive's own space through the inverse of
+//! that transform (in f64). A vertex that did not move keeps its bytes. A mesh placed by two nodes
+//! with different transforms has one set of vertices in the file: it is written as faired in its
+//! first placement (scene order, depth first), and the save report says so.
+//!
+//! Normals and tangents turn with their faces, in the primitive's own space (see
+//! [`super::source`]); a tangent's w (handedness) is kept. Morph target deltas are kept as they
+//! are. Values are written in the accessor's own component type (floats, or normalized integers
+//! under KHR_mesh_quantization); integer `min`/`max` are in the accessor's integer type, as the
+//! specification asks.
+//!
+//! Buffers: all buffers are joined into one (each starting at a multiple of 16 bytes, buffer views
+//! moved accordingly), which becomes the GLB's BIN chunk or the `.gltf`'s `<stem>.bin`. Images
+//! stored in buffer views or as data: URIs stay inside the file; images that are external files are
+//! referenced, not copied: their URI is rewritten relative to the output's folder (unchanged when
+//! the output is beside the input).
+
+use super::atomic;
+use super::source::{dvec, NormalTurns, SaveReport, SmoothGroups, Source, Turn};
+use super::{Format, IoError};
+use crate::mesh::TriMesh;
+use glam::DMat4;
+use serde_json::{json, Value};
+use std::collections::{BTreeMap, BTreeSet};
+use std::io::Write;
+use std::path::{Component, Path, PathBuf};
+
+/// One primitive as the reader read it for one node: its POSITION accessor's elements became the
+/// parser vertices `raw_start..raw_start + count`, placed by `world`.
+#[derive(Clone, Debug)]
+pub(crate) struct PrimitiveRead {
+    pub accessor: usize,
+    pub mesh: usize,
+    pub node: Option<usize>,
+    pub raw_start: usize,
+    pub count: usize,
+    pub world: DMat4,
+}
+
+/// A glTF document as loaded: its JSON, its buffers and the primitive reads.
+#[derive(Debug)]
+pub(crate) struct GltfSource {
+    pub json: Value,
+    pub buffers: Vec<Vec<u8>>,
+    pub reads: Vec<PrimitiveRead>,
+}
+
+/// The bytes behind one accessor: buffer, offset of element 0, stride, component type and size,
+/// components per element, normalized, count.
+#[derive(Clone, Copy, Debug)]
+struct Layout {
+    buffer: usize,
+    start: usize,
+    stride: usize,
+    component: u64,
+    size: usize,
+    components: usize,
+    normalized: bool,
+    count: usize,
+}
+
+fn index(value: &Value, key: &str) -> Option<usize> {
+    value
+        .get(key)?
+        .as_u64()
+        .and_then(|v| usize::try_from(v).ok())
+}
+
+impl GltfSource {
+    fn array(&self, key: &str) -> &[Value] {
+        self.json
+            .get(key)
+            .and_then(Value::as_array)
+            .map_or(&[], Vec::as_slice)
+    }
+
+    /// The checked layout of accessor `a`, or why it cannot be used.
+    fn layout(&self, a: usize) -> Result<Layout, String> {
+        let accessor = self
+            .array("accessors")
+            .get(a)
+            .ok_or_else(|| format!("accessor {a} does not exist"))?;
+        if accessor.get("sparse").is_some() {
+            return Err(format!("accessor {a} is sparse"));
+        }
+        let view_index = index(accessor, "bufferView")
+            .ok_or_else(|| format!("accessor {a} has no buffer view"))?;
+        let view = self
+            .array("bufferViews")
+            .get(view_index)
+            .ok_or_else(|| format!("buffer view {view_index} does not exist"))?;
+        let buffer = index(view, "buffer").unwrap_or(usize::MAX);
+        let data = self
+            .buffers
+            .get(buffer)
+            .ok_or_else(|| format!("buffer view {view_index}: its buffer does not exist"))?;
+        let component = accessor
+            .get("componentType")
+            .and_then(Value::as_u64)
+            .unwrap_or(0);
+        let size = match component {
+            5120 | 5121 => 1,
+            5122 | 5123 => 2,
+            5125 | 5126 => 4,
+            other => return Err(format!("accessor {a}: component type {other}")),
+        };
+        let components = match accessor.get("type").and_then(Value::as_str) {
+            Some("SCALAR") => 1,
+            Some("VEC2") => 2,
+            Some("VEC3") => 3,
+            Some("VEC4") => 4,
+            other => return Err(format!("accessor {a}: type {other:?}")),
+        };
+        let element = size * components;
+        let stride = index(view, "byteStride").unwrap_or(element);
+        let count = index(accessor, "count").unwrap_or(0);
+        let view_start = index(view, "byteOffset").unwrap_or(0);
+        let view_len = index(view, "byteLength").unwrap_or(0);
+        let start = view_start
+            .checked_add(index(accessor, "byteOffset").unwrap_or(0))
+            .ok_or("offset overflows")?;
+        let needed = match count {
+            0 => 0,
+            n => (n - 1)
+                .checked_mul(stride)
+                .and_then(|b| b.checked_add(element))
+                .ok_or("size overflows")?,
+        };
+        let end = start.checked_add(needed).ok_or("size overflows")?;
+        if stride < element || end > view_start.saturating_add(view_len) || end > data.len() {
+            return Err(format!("accessor {a} runs past its buffer view"));
+        }
+        Ok(Layout {
+            buffer,
+            start,
+            stride,
+            component,
+            size,
+            components,
+            normalized: accessor
+                .get("normalized")
+                .and_then(Value::as_bool)
+                .unwrap_or(false),
+            count,
+        })
+    }
+
+    fn read(&self, layout: &Layout, element: usize, component: usize) -> f32 {
+        let at = layout.start + element * layout.stride + component * layout.size;
+        let bytes = &self.buffers[layout.buffer][at..at + layout.size];
+        decode(layout, bytes)
+    }
+
+    fn read3(&self, layout: &Layout, element: usize) -> [f32; 3] {
+        [0, 1, 2].map(|c| self.read(layout, element, c))
+    }
+
+    /// The indices of a primitive's triangles (strips and fans unrolled), in its own space.
+    fn triangles(&self, primitive: &Value, vertex_count: usize) -> Vec<[usize; 3]> {
+        let corners: Vec<usize> = match index(primitive, "indices") {
+            Some(a) => match self.layout(a) {
+                Ok(layout) if layout.components == 1 => (0..layout.count)
+                    .map(|k| self.read_index(&layout, k))
+                    .collect(),
+                _ => return Vec::new(),
+            },
+            None => (0..vertex_count).collect(),
+        };
+        let mode = primitive.get("mode").and_then(Value::as_u64).unwrap_or(4);
+        let mut triangles = Vec::with_capacity(corners.len() / 3);
+        match mode {
+            4 => triangles.extend(corners.chunks_exact(3).map(|c| [c[0], c[1], c[2]])),
+            5 => triangles.extend(corners.windows(3).enumerate().map(|(i, w)| {
+                if i % 2 == 0 {
+                    [w[0], w[1], w[2]]
+                } else {
+                    [w[0], w[2], w[1]]
+                }
+            })),
+            6 => {
+                if let Some((&first, rest)) = corners.split_first() {
+                    triangles.extend(rest.windows(2).map(|w| [w[0], w[1], first]));
+                }
+            }
+            _ => {}
+        }
+        triangles.retain(|t| t.iter().all(|&v| v < vertex_count));
+        triangles
+    }
+
+    fn read_index(&self, layout: &Layout, k: usize) -> usize {
+        let at = layout.start + k * layout.stride;
+        let b = &self.buffers[layout.buffer][at..at + layout.size];
+        match layout.size {
+            1 => b[0] as usize,
+            2 => u16::from_le_bytes([b[0], b[1]]) as usize,
+            _ => u32::from_le_bytes([b[0], b[1], b[2], b[3]]) as usize,
+        }
+    }
+
+    /// What the document holds beyond positions and triangles, in plain words.
+    pub(crate) fn contents(&self) -> Vec<String> {
+        let names = |key: &str| -> Vec<String> {
+            self.array(key)
+                .iter()
+                .enumerate()
+                .map(|(i, v)| match v.get("name").and_then(Value::as_str) {
+                    Some(name) => format!("'{name}'"),
+                    None => format!("#{i}"),
+                })
+                .collect()
+        };
+        let mut out = Vec::new();
+        let nodes = names("nodes");
+        if nodes.len() > 1 || self.array("nodes").iter().any(|n| n.get("name").is_some()) {
+            out.push(format!(
+                "the node tree ({} nodes: {})",
+                nodes.len(),
+                nodes.join(", ")
+            ));
+        }
+        for (key, what) in [
+            ("materials", "materials"),
+            ("textures", "textures"),
+            ("cameras", "cameras"),
+            ("skins", "skins"),
+            ("animations", "animations"),
+        ] {
+            let list = names(key);
+            if !list.is_empty() {
+                out.push(format!("{} {what} ({})", list.len(), list.join(", ")));
+            }
+        }
+        let mut attributes: Vec<String> = Vec::new();
+        let mut targets = 0;
+        for mesh in self.array("meshes") {
+            for primitive in mesh
+                .get("primitives")
+                .and_then(Value::as_array)
+                .map_or(&[][..], Vec::as_slice)
+            {
+                if let Some(map) = primitive.get("attributes").and_then(Value::as_object) {
+                    for name in map.keys() {
+                        if name != "POSITION" && !attributes.contains(name) {
+                            attributes.push(name.clone());
+                        }
+                    }
+                }
+                targets += primitive
+                    .get("targets")
+                    .and_then(Value::as_array)
+                    .map_or(0, Vec::len);
+            }
+        }
+        if !attributes.is_empty() {
+            attributes.sort();
+            out.push(format!("vertex attributes {}", attributes.join(", ")));
+        }
+        if targets > 0 {
+            out.push(format!("{targets} morph targets"));
+        }
+        if let Some(used) = self.json.get("extensionsUsed").and_then(Value::as_array) {
+            let used: Vec<&str> = used.iter().filter_map(Value::as_str).collect();
+            if !used.is_empty() {
+                out.push(format!("extensions {}", used.join(", ")));
+            }
+        }
+        out
+    }
+}
+
+fn decode(layout: &Layout, b: &[u8]) -> f32 {
+    macro_rules! get {
+        ($t:ty) => {
+            <$t>::from_le_bytes(b.try_into().unwrap_or_default())
+        };
+    }
+    let n = layout.normalized;
+    match layout.component {
+        5126 => get!(f32),
+        5120 if n => (get!(i8) as f32 / 127.0).max(-1.0),
+        5121 if n => get!(u8) as f32 / 255.0,
+        5122 if n => (get!(i16) as f32 / 32767.0).max(-1.0),
+        5123 if n => get!(u16) as f32 / 65535.0,
+        5125 if n => (get!(u32) as f64 / u32::MAX as f64) as f32,
+        5120 => get!(i8) as f32,
+        5121 => get!(u8) as f32,
+        5122 => get!(i16) as f32,
+        5123 => get!(u16) as f32,
+        _ => get!(u32) as f32,
+    }
+}
+
+/// The stored (integer) value for `value` in an integer component type.
+fn quantize(layout: &Layout, value: f32) -> f64 {
+    let scale = match (layout.normalized, layout.component) {
+        (false, _) => 1.0,
+        (true, 5120) => 127.0,
+        (true, 5121) => 255.0,
+        (true, 5122) => 32767.0,
+        (true, 5123) => 65535.0,
+        (true, _) => u32::MAX as f64,
+    };
+    let (lo, hi) = match layout.component {
+        5120 => (i8::MIN as f64, i8::MAX as f64),
+        5121 => (0.0, u8::MAX as f64),
+        5122 => (i16::MIN as f64, i16::MAX as f64),
+        5123 => (0.0, u16::MAX as f64),
+        _ => (0.0, u32::MAX as f64),
+    };
+    (value as f64 * scale).round().clamp(lo, hi)
+}
+
+fn encode(layout: &Layout, value: f32, out: &mut [u8]) {
+    if layout.component == 5126 {
+        out.copy_from_slice(&value.to_le_bytes());
+        return;
+    }
+    let q = quantize(layout, value);
+    match layout.component {
+        5120 => out.copy_from_slice(&(q as i8).to_le_bytes()),
+        5121 => out.copy_from_slice(&(q as u8).to_le_bytes()),
+        5122 => out.copy_from_slice(&(q as i16).to_le_bytes()),
+        5123 => out.copy_from_slice(&(q as u16).to_le_bytes()),
+        _ => out.copy_from_slice(&(q as u32).to_le_bytes()),
+    }
+}
+
+/// The new values of one POSITION accessor, in its own space; `None` where the vertex did not
+/// move.
+struct PositionEdit {
+    layout: Layout,
+    before: Vec<[f32; 3]>,
+    after: Vec<Option<[f32; 3]>>,
+    world: DMat4,
+    node: Option<usize>,
+    mesh: usize,
+}
+
+impl PositionEdit {
+    fn position(&self, k: usize) -> [f32; 3] {
+        self.after[k].unwrap_or(self.before[k])
+    }
+}
+
+fn node_label(json: &Value, node: Option<usize>) -> String {
+    match node {
+        None => "no node".into(),
+        Some(n) => match json
+            .get("nodes")
+            .and_then(|nodes| nodes.get(n))
+            .and_then(|node| node.get("name"))
+            .and_then(Value::as_str)
+        {
+            Some(name) => format!("node {n} '{name}'"),
+            None => format!("node {n}"),
+        },
+    }
+}
+
+fn mesh_label(json: &Value, mesh: usize) -> String {
+    match json
+        .get("meshes")
+        .and_then(|meshes| meshes.get(mesh))
+        .and_then(|m| m.get("name"))
+        .and_then(Value::as_str)
+    {
+        Some(name) => format!("mesh {mesh} '{name}'"),
+        None => format!("mesh {mesh}"),
+    }
+}
+
+/// Write `gltf` back to `path` (GLB or `.gltf` + `.bin`) with `mesh`'s positions.
+pub(crate) fn write(
+    path: &Path,
+    format: Format,
+    gltf: &GltfSource,
+    source: &Source,
+    mesh: &TriMesh,
+    report: &mut SaveReport,
+) -> Result<(), IoError> {
+    let fail = |message: String| IoError::Refused {
+        path: path.to_owned(),
+        message,
+    };
+    let edits = position_edits(gltf, source, mesh, report).map_err(&fail)?;
+    let mut buffers = gltf.buffers.clone();
+    // Normals turn from the file's own positions, before any is overwritten.
+    let mut json = gltf.json.clone();
+    let mut changed = turn_normals(gltf, source, &edits, &mut buffers, report);
+    for (&a, edit) in &edits {
+        for (k, after) in edit.after.iter().enumerate() {
+            if let Some(p) = after {
+                put(&mut buffers, &edit.layout, k, p);
+            }
+        }
+        changed.insert(a);
+    }
+    // Bounds of what changed: always for POSITION (the specification asks for them), for other
+    // accessors where the file had them.
+    for a in changed {
+        let Some(accessor) = json.get_mut("accessors").and_then(|list| list.get_mut(a)) else {
+            continue;
+        };
+        if !edits.contains_key(&a) && accessor.get("min").is_none() && accessor.get("max").is_none()
+        {
+            continue;
+        }
+        let Ok(layout) = gltf.layout(a) else { continue };
+        if let Some((min, max)) = bounds(&layout, &buffers) {
+            accessor["min"] = json!(min);
+            accessor["max"] = json!(max);
+        }
+    }
+    let bin = join_buffers(&mut json, buffers);
+    rewrite_image_uris(&mut json, source, path, report);
+    match format {
+        Format::Glb => atomic::write(path, |w| write_glb(w, &json, &bin)),
+        _ => {
+            let bin_path = super::gltf_bin_path(path);
+            let bin_name = bin_path
+                .file_name()
+                .map(|n| n.to_string_lossy().into_owned())
+                .unwrap_or_else(|| "mesh.bin".into());
+            if let Some(buffer) = json.get_mut("buffers").and_then(|b| b.get_mut(0)) {
+                buffer["uri"] = json!(super::gltf::percent_encode(&bin_name));
+            }
+            let text = serde_json::to_vec_pretty(&json).map_err(|e| IoError::Write {
+                path: path.to_owned(),
+                source: std::io::Error::other(e),
+            })?;
+            let staged_bin = (!bin.is_empty())
+                .then(|| atomic::stage(&bin_path, |w| w.write_all(&bin)))
+                .transpose()?;
+            let staged_json = atomic::stage(path, |w| w.write_all(&text))?;
+            if let Some(staged) = staged_bin {
+                staged.commit()?;
+            }
+            staged_json.commit()
+        }
+    }
+}
+
+/// The new positions of every POSITION accessor with a moved vertex, from the first read of each
+/// accessor; a later read that placed the same accessor differently is named in the report.
+fn position_edits(
+    gltf: &GltfSource,
+    source: &Source,
+    mesh: &TriMesh,
+    report: &mut SaveReport,
+) -> Result<BTreeMap<usize, PositionEdit>, String> {
+    let mut edits: BTreeMap<usize, PositionEdit> = BTreeMap::new();
+    let mut other_placements: BTreeMap<usize, Vec<Option<usize>>> = BTreeMap::new();
+    for read in &gltf.reads {
+        if let Some(edit) = edits.get(&read.accessor) {
+            if edit.world != read.world {
+                other_placements
+                    .entry(read.accessor)
+                    .or_default()
+                    .push(read.node);
+            }
+            continue;
+        }
+        let layout = gltf.layout(read.accessor)?;
+        if layout.components != 3 || layout.count != read.count {
+            return Err(format!(
+                "accessor {} no longer matches what was read from it",
+                read.accessor
+            ));
+        }
+        let before: Vec<[f32; 3]> = (0..layout.count).map(|k| gltf.read3(&layout, k)).collect();
+        let identity = read.world == DMat4::IDENTITY;
+        let inverse = read.world.inverse();
+        let invertible = identity || (read.world.determinant() != 0.0 && inverse.is_finite());
+        if !invertible {
+            report.warnings.push(format!(
+                "{} is placed by {} with a transform that flattens it: its vertices were not moved",
+                mesh_label(&gltf.json, read.mesh),
+                node_label(&gltf.json, read.node)
+            ));
+        }
+        let after = (0..layout.count)
+            .map(|k| {
+                let new = mesh.positions[source.welded(read.raw_start + k)?];
+                let placed = if identity {
+                    before[k]
+                } else {
+                    read.world
+                        .transform_point3(dvec(before[k]))
+                        .as_vec3()
+                        .to_array()
+                };
+                if placed == new || !invertible {
+                    return None;
+                }
+                let local = if identity {
+                    new
+                } else {
+                    inverse.transform_point3(dvec(new)).as_vec3().to_array()
+                };
+                local.iter().all(|c| c.is_finite()).then_some(local)
+            })
+            .collect();
+        edits.insert(
+            read.accessor,
+            PositionEdit {
+                layout,
+                before,
+                after,
+                world: read.world,
+                node: read.node,
+                mesh: read.mesh,
+            },
+        );
+    }
+    for (accessor, others) in other_placements {
+        let edit = &edits[&accessor];
+        let others: Vec<String> = others.iter().map(|&n| node_label(&gltf.json, n)).collect();
+        report.warnings.push(format!(
+            "{} is also placed by {} with another transform; the file holds its vertices once, so they are written as faired where {} places it (the first in the scene)",
+            mesh_label(&gltf.json, edit.mesh),
+            others.join(", "),
+            node_label(&gltf.json, edit.node)
+        ));
+    }
+    edits.retain(|_, edit| edit.after.iter().any(Option::is_some));
+    Ok(edits)
+}
+
+fn primitives(json: &Value) -> impl Iterator<Item = &Value> {
+    json.get("meshes")
+        .and_then(Value::as_array)
+        .into_iter()
+        .flatten()
+        .flat_map(|mesh| {
+            mesh.get("primitives")
+                .and_then(Value::as_array)
+                .into_iter()
+                .flatten()
+        })
+}
+
+fn attribute(primitive: &Value, name: &str) -> Option<usize> {
+    index(primitive.get("attributes")?, name)
+}
+
+/// Turn the NORMAL (and TANGENT) elements of every primitive whose faces moved. Normals of all
+/// accessors share slots by welded vertex and value ([`SmoothGroups`]), so a smooth normal split
+/// at a UV seam or between two primitives stays smooth.
+fn turn_normals(
+    gltf: &GltfSource,
+    source: &Source,
+    edits: &BTreeMap<usize, PositionEdit>,
+    buffers: &mut [Vec<u8>],
+    report: &mut SaveReport,
+) -> BTreeSet<usize> {
+    let touched: BTreeSet<usize> = primitives(&gltf.json)
+        .filter(|p| attribute(p, "POSITION").is_some_and(|a| edits.contains_key(&a)))
+        .filter_map(|p| attribute(p, "NORMAL"))
+        .collect();
+    let mut first_read: BTreeMap<usize, usize> = BTreeMap::new();
+    for read in &gltf.reads {
+        first_read.entry(read.accessor).or_insert(read.raw_start);
+    }
+    // Normal accessor -> its layout, its primitives' triangles with their position accessor, and
+    // its tangent accessors.
+    type Uses = Vec<(usize, Layout, Vec<[usize; 3]>)>;
+    let mut normals: BTreeMap<usize, (Layout, Uses, BTreeSet<usize>)> = BTreeMap::new();
+    for primitive in primitives(&gltf.json) {
+        let (Some(p), Some(n)) = (
+            attribute(primitive, "POSITION"),
+            attribute(primitive, "NORMAL"),
+        ) else {
+            continue;
+        };
+        if !touched.contains(&n) {
+            continue;
+        }
+        let (Ok(layout), Ok(positions)) = (gltf.layout(n), gltf.layout(p)) else {
+            report.warnings.push(format!(
+                "normal accessor {n} cannot be read: its normals were not turned"
+            ));
+            continue;
+        };
+        if layout.components != 3 || layout.count != positions.count {
+            report.warnings.push(format!(
+                "normal accessor {n} does not match its positions: its normals were not turned"
+            ));
+            continue;
+        }
+        let (_, uses, tangents) = normals
+            .entry(n)
+            .or_insert_with(|| (layout, Vec::new(), BTreeSet::new()));
+        uses.push((p, positions, gltf.triangles(primitive, positions.count)));
+        if let Some(t) = attribute(primitive, "TANGENT") {
+            tangents.insert(t);
+        }
+    }
+    let corners = |p: usize, positions: &Layout, t: [usize; 3]| match edits.get(&p) {
+        Some(edit) => (t.map(|v| edit.before[v]), t.map(|v| edit.position(v))),
+        None => {
+            let read = t.map(|v| gltf.read3(positions, v));
+            (read, read)
+        }
+    };
+    let mut groups = SmoothGroups::default();
+    let mut turns = NormalTurns::new(0);
+    let mut slotted: Vec<(usize, &Layout, Vec<usize>, &BTreeSet<usize>)> = Vec::new();
+    for (&n, (layout, uses, tangents)) in &normals {
+        let mut own = vec![glam::DVec3::ZERO; layout.count];
+        for (p, positions, triangles) in uses {
+            for &t in triangles {
+                let [a, b, c] = corners(*p, positions, t).0.map(dvec);
+                for v in t {
+                    own[v] += (b - a).cross(c - a);
+                }
+            }
+        }
+        let start = first_read.get(&uses[0].0).copied();
+        let slots: Vec<usize> = (0..layout.count)
+            .map(|k| {
+                let welded = start.and_then(|s| source.welded(s + k));
+                groups.slot_for(own[k], welded, gltf.read3(layout, k))
+            })
+            .collect();
+        for (p, positions, triangles) in uses {
+            for &t in triangles {
+                let (before, after) = corners(*p, positions, t);
+                turns.add(t.map(|v| slots[v]), before.map(dvec), after.map(dvec));
+            }
+        }
+        slotted.push((n, layout, slots, tangents));
+    }
+    let mut changed = BTreeSet::new();
+    for (n, layout, slots, tangents) in slotted {
+        let mut turned: Vec<(usize, Turn)> = Vec::new();
+        for (k, &slot) in slots.iter().enumerate() {
+            if let Some(turn) = turns.turn(slot) {
+                let normal = turn.normal(gltf.read3(layout, k));
+                put(buffers, layout, k, &normal);
+                turned.push((k, turn));
+            }
+        }
+        if !turned.is_empty() {
+            changed.insert(n);
+        }
+        for &t in tangents {
+            match gltf.layout(t) {
+                Ok(tangent) if tangent.components == 4 && tangent.count == layout.count => {
+                    for &(k, turn) in &turned {
+                        let direction = turn.direction(gltf.read3(&tangent, k));
+                        put(buffers, &tangent, k, &direction);
+                    }
+                    if !turned.is_empty() {
+                        changed.insert(t);
+                    }
+                }
+                _ => report.warnings.push(format!(
+                    "tangent accessor {t} does not match its normals: its tangents were not turned"
+                )),
+            }
+        }
+    }
+    changed
+}
+/// Per-component minimum and maximum of an accessor's stored values (integers for integer
+/// types, as the specification asks, not the normalized values); `None` when it is empty.
+fn bounds(layout: &Layout, buffers: &[Vec<u8>]) -> Option<(Vec<f64>, Vec<f64>)> {
+    if layout.count == 0 {
+        return None;
+    }
+    let raw = Layout {
+        normalized: false,
+        ..*layout
+    };
+    let mut min = vec![f64::INFINITY; layout.components];
+    let mut max = vec![f64::NEG_INFINITY; layout.components];
+    for k in 0..layout.count {
+        for c in 0..layout.components {
+            let at = layout.start + k * layout.stride + c * layout.size;
+            let value = decode(&raw, &buffers[layout.buffer][at..at + layout.size]) as f64;
+            min[c] = min[c].min(value);
+            max[c] = max[c].max(value);
+        }
+    }
+    Some((min, max))
+}
+
+/// Write the first three components of element `k`.
+fn put(buffers: &mut [Vec<u8>], layout: &Layout, k: usize, values: &[f32; 3]) {
+    for (c, value) in values.iter().enumerate() {
+        let at = layout.start + k * layout.stride + c * layout.size;
+        encode(
+            layout,
+            *value,
+            &mut buffers[layout.buffer][at..at + layout.size],
+        );
+    }
+}
+
+/// Join every buffer into one (each starting at a multiple of 16 bytes) and point the buffer
+/// views at it; returns the joined bytes.
+fn join_buffers(json: &mut Value, buffers: Vec<Vec<u8>>) -> Vec<u8> {
+    let declared: Vec<usize> = json
+        .get("buffers")
+        .and_then(Value::as_array)
+        .map(|list| {
+            list.iter()
+                .map(|b| index(b, "byteLength").unwrap_or(0))
+                .collect()
+        })
+        .unwrap_or_default();
+    let mut bin = Vec::with_capacity(buffers.iter().map(|b| b.len() + 16).sum());
+    let mut starts = Vec::with_capacity(buffers.len());
+    for (b, data) in buffers.iter().enumerate() {
+        while bin.len() % 16 != 0 {
+            bin.push(0);
+        }
+        starts.push(bin.len());
+        let length = declared
+            .get(b)
+            .copied()
+            .unwrap_or(data.len())
+            .min(data.len());
+        bin.extend_from_slice(&data[..length]);
+    }
+    if let Some(views) = json.get_mut("bufferViews").and_then(Value::as_array_mut) {
+        for view in views {
+            let buffer = index(view, "buffer").unwrap_or(0);
+            let offset = index(view, "byteOffset").unwrap_or(0);
+            let start = starts.get(buffer).copied().unwrap_or(0);
+            view["buffer"] = json!(0);
+            if start + offset > 0 {
+                view["byteOffset"] = json!(start + offset);
+            }
+        }
+    }
+    if let Some(root) = json.as_object_mut() {
+        if buffers.is_empty() {
+            root.remove("buffers");
+        } else {
+            let mut joined = serde_json::Map::new();
+            if let Some(name) = root
+                .get("buffers")
+                .and_then(|b| b.get(0))
+                .and_then(|b| b.get("name"))
+            {
+                joined.insert("name".into(), name.clone());
+            }
+            joined.insert("byteLength".into(), json!(bin.len()));
+            root.insert("buffers".into(), json!([joined]));
+        }
+    }
+    bin
+}
+
+/// Point external images (files beside the input) at the same files from the output's folder.
+fn rewrite_image_uris(json: &mut Value, source: &Source, output: &Path, report: &mut SaveReport) {
+    let Some(images) = json.get_mut("images").and_then(Value::as_array_mut) else {
+        return;
+    };
+    let out_dir = match output.parent() {
+        Some(dir) if !dir.as_os_str().is_empty() => dir.to_path_buf(),
+        _ => PathBuf::from("."),
+    };
+    for (i, image) in images.iter_mut().enumerate() {
+        let Some(uri) = image.get("uri").and_then(Value::as_str).map(str::to_owned) else {
+            continue;
+        };
+        if uri.starts_with("data:") {
+            continue;
+        }
+        let Some(base) = &source.base_dir else {
+            report.warnings.push(format!(
+                "image {i} refers to the file {uri:?}, which was not resolved (the input was read from memory): the reference is kept as it was"
+            ));
+            continue;
+        };
+        let Some(relative) = super::gltf::percent_decode(&uri) else {
+            continue;
+        };
+        let base = if base.as_os_str().is_empty() {
+            Path::new(".")
+        } else {
+            base.as_path()
+        };
+        let target = base.join(&relative);
+        let (Ok(target), Ok(out_dir)) = (target.canonicalize(), out_dir.canonicalize()) else {
+            report.warnings.push(format!(
+                "image {i} refers to {}, which does not exist: the reference is kept as it was",
+                base.join(&relative).display()
+            ));
+            continue;
+        };
+        let Some(path) = relative_path(&out_dir, &target) else {
+            report.warnings.push(format!(
+                "image {i} ({}) cannot be reached from the output's folder by a relative path: the reference is kept as it was",
+                target.display()
+            ));
+            continue;
+        };
+        let encoded: Vec<String> = path
+            .components()
+            .map(|c| match c {
+                Component::ParentDir => "..".to_string(),
+                other => super::gltf::percent_encode(&other.as_os_str().to_string_lossy()),
+            })
+            .collect();
+        let encoded = encoded.join("/");
+        if super::gltf::percent_decode(&encoded).as_deref() != Some(relative.as_str()) {
+            image["uri"] = json!(encoded);
+        }
+    }
+}
+
+/// The path from folder `from` to `to`, both absolute and canonical.
+fn relative_path(from: &Path, to: &Path) -> Option<PathBuf> {
+    let from: Vec<Component> = from.components().collect();
+    let to: Vec<Component> = to.components().collect();
+    if from.first() != to.first() {
+        return None;
+    }
+    let common = from.iter().zip(&to).take_while(|(a, b)| a == b).count();
+    let mut path = PathBuf::new();
+    for _ in common..from.len() {
+        path.push("..");
+    }
+    for c in &to[common..] {
+        path.push(c.as_os_str());
+    }
+    Some(path)
+}
+
+fn write_glb(out: &mut dyn Write, json: &Value, bin: &[u8]) -> std::io::Result<()> {
+    let mut text = serde_json::to_vec(json).map_err(std::io::Error::other)?;
+    while text.len() % 4 != 0 {
+        text.push(b' ');
+    }
+    let padded_bin = bin.len().div_ceil(4) * 4;
+    let total = 12 + 8 + text.len() + if bin.is_empty() { 0 } else { 8 + padded_bin };
+    let total = u32::try_from(total).map_err(|_| {
+        std::io::Error::new(
+            std::io::ErrorKind::InvalidInput,
+            "GLB files hold at most 4 GiB",
+        )
+    })?;
+    out.write_all(b"glTF")?;
+    out.write_all(&2u32.to_le_bytes())?;
+    out.write_all(&total.to_le_bytes())?;
+    out.write_all(&(text.len() as u32).to_le_bytes())?;
+    out.write_all(b"JSON")?;
+    out.write_all(&text)?;
+    if !bin.is_empty() {
+        out.write_all(&(padded_bin as u32).to_le_bytes())?;
+        out.write_all(b"BIN\0")?;
+        out.write_all(bin)?;
+        out.write_all(&[0u8; 3][..padded_bin - bin.len()])?;
+    }
+    Ok(())
+}

@@ -1,0 +1,357 @@
+//! What a mesh was read from, kept so that a faired mesh is written back with only its shape
+//! changed.
+//!
+//! Fairing, noise and multiresolution fairing move vertices and never change connectivity, so
+//! everything else a file holds (a glTF scene's nodes, materials, textures, UVs, colours; an
+//! OBJ's groups, materials, texture coordinates and polygons; a PLY's extra properties) can come
+//! through untouched. [`Source`] keeps:
+//! - the file itself (the OBJ or PLY bytes; for glTF the JSON document and its buffers), at most
+//!   the file's own size;
+//! - the map from the parser's vertices (an OBJ `v` line, a PLY vertex row, an element of a glTF
+//!   POSITION accessor as read for one node) to the welded vertices the algorithms work on;
+//! - a fingerprint of the welded triangles, so that a mesh with other connectivity (a level of
+//!   the hierarchy, a subdivided copy) is never written into the source by mistake.
+//!
+//! Saving to the same family of format (OBJ, PLY, glTF/GLB) writes the source back with the new
+//! positions and what depends on them: normals (and glTF tangents) are turned by the rotation
+//! that takes the vertex's area-weighted normal before the change to the one after (so split
+//! normals stay split, smooth ones stay smooth, and a file's own custom normals keep their
+//! character), and the glTF POSITION accessor's min/max are recomputed. A vertex that did not
+//! move keeps its bytes (or its text) exactly, and so does a normal whose faces did not move.
+//! Saving to another format writes the mesh as it is and names, in the [`SaveReport`], what that
+//! format cannot keep.
+
+use super::{gltf_writeback, Format};
+use crate::mesh::TriMesh;
+use glam::{DQuat, DVec3};
+use std::path::PathBuf;
+
+/// What a mesh was read from: kept by [`super::load`] in [`super::Loaded::source`], used by
+/// [`super::save_with_source`].
+#[derive(Debug)]
+pub struct Source {
+    pub(crate) format: Format,
+    /// The path (or the name given to `load_from_bytes`) of the input.
+    pub(crate) path: PathBuf,
+    /// The input's folder, where a glTF's external images live; `None` when loaded from memory.
+    pub(crate) base_dir: Option<PathBuf>,
+    /// Parser vertex -> welded vertex (`u32::MAX` where the vertex was dropped); `None` when the
+    /// welded vertices are the parser's, one for one.
+    pub(crate) raw_to_welded: Option<Vec<u32>>,
+    pub(crate) raw_vertices: usize,
+    pub(crate) welded_vertices: usize,
+    pub(crate) welded_triangles: usize,
+    pub(crate) triangle_fingerprint: u64,
+    pub(crate) data: SourceData,
+}
+
+/// The format-specific part of a [`Source`].
+#[derive(Debug)]
+pub(crate) enum SourceData {
+    /// Nothing beyond positions and triangles is kept (STL, OFF).
+    Plain,
+    /// The OBJ file's bytes.
+    Obj(Vec<u8>),
+    /// The PLY file's bytes.
+    Ply(Vec<u8>),
+    /// The glTF document, its buffers and which accessor elements became which vertices.
+    Gltf(Box<gltf_writeback::GltfSource>),
+}
+
+/// What saving did beyond writing the file: what could not be carried through, in plain words.
+#[derive(Clone, Debug, Default)]
+#[non_exhaustive]
+pub struct SaveReport {
+    pub warnings: Vec<String>,
+}
+
+impl Source {
+    /// A source that keeps nothing but the mesh (for meshes that come from no file).
+    pub fn plain(mesh: &TriMesh) -> Source {
+        Source {
+            format: Format::Ply,
+            path: PathBuf::new(),
+            base_dir: None,
+            raw_to_welded: None,
+            raw_vertices: mesh.positions.len(),
+            welded_vertices: mesh.positions.len(),
+            welded_triangles: mesh.triangles.len(),
+            triangle_fingerprint: fingerprint(&mesh.triangles),
+            data: SourceData::Plain,
+        }
+    }
+
+    /// The format the mesh was read from.
+    pub fn format(&self) -> Format {
+        self.format
+    }
+
+    /// Whether `mesh` has the connectivity of the mesh this source was loaded as (same vertex
+    /// count and the same triangles), so that its positions can be written back into the source.
+    pub fn matches(&self, mesh: &TriMesh) -> bool {
+        mesh.positions.len() == self.welded_vertices
+            && mesh.triangles.len() == self.welded_triangles
+            && fingerprint(&mesh.triangles) == self.triangle_fingerprint
+    }
+
+    /// What the file holds beyond positions and triangles, in plain words (for `info`, and for
+    /// saying what an output format cannot keep). Empty for a bare mesh.
+    pub fn contents(&self) -> Vec<String> {
+        match &self.data {
+            SourceData::Plain => Vec::new(),
+            SourceData::Obj(bytes) => super::obj::contents(bytes),
+            SourceData::Ply(bytes) => super::ply::contents(bytes),
+            SourceData::Gltf(gltf) => gltf.contents(),
+        }
+    }
+
+    /// The welded vertex that parser vertex `raw` became, if it was kept.
+    #[inline]
+    pub(crate) fn welded(&self, raw: usize) -> Option<usize> {
+        match &self.raw_to_welded {
+            None => Some(raw),
+            Some(map) => map
+                .get(raw)
+                .copied()
+                .filter(|&w| w != u32::MAX)
+                .map(|w| w as usize),
+        }
+    }
+
+    /// Whether writing `format` can carry the source through.
+    pub(crate) fn writes_back_as(&self, format: Format) -> bool {
+        match self.data {
+            SourceData::Plain => false,
+            SourceData::Obj(_) => format == Format::Obj,
+            SourceData::Ply(_) => format == Format::Ply,
+            SourceData::Gltf(_) => matches!(format, Format::Gltf | Format::Glb),
+        }
+    }
+}
+
+/// An order-dependent fingerprint of a triangle list (FNV-style mixing of the indices).
+pub(crate) fn fingerprint(triangles: &[[u32; 3]]) -> u64 {
+    let mut hash = 0xcbf2_9ce4_8422_2325u64 ^ triangles.len() as u64;
+    for t in triangles {
+        for &v in t {
+            hash = (hash ^ v as u64).wrapping_mul(0x0000_0100_0000_01b3);
+        }
+        hash = hash.rotate_left(7);
+    }
+    hash
+}
+
+/// How the normals of a file change when its vertices move. Each file normal (an OBJ `vn`, a PLY
+/// vertex's nx ny nz, an element of a glTF NORMAL accessor) belongs to a slot, and each slot
+/// gathers the area vectors of the faces that use it, before and after the move; the normal is
+/// then turned by the shortest rotation between the two sums. Normals whose faces did not move
+/// are left alone. An OBJ's slots are its `vn` lines (the file says which corners share a
+/// normal). A glTF or PLY normal has a slot of its own when it is the normal of its own faces (a
+/// flat-shaded triangle, a vertex nothing else shares), so flat parts stay flat per face; a normal
+/// that is not (it was smoothed over faces of other file vertices: a smooth normal split at a UV
+/// seam or a material boundary) shares its slot with the other normals of the same value on the
+/// same welded vertex ([`SmoothGroups`]), so the copies stay equal, while normals that differ
+/// there (a hard edge) stay apart.
+pub(crate) struct NormalTurns {
+    before: Vec<DVec3>,
+    after: Vec<DVec3>,
+    moved: Vec<bool>,
+}
+
+impl NormalTurns {
+    pub(crate) fn new(normals: usize) -> NormalTurns {
+        NormalTurns {
+            before: vec![DVec3::ZERO; normals],
+            after: vec![DVec3::ZERO; normals],
+            moved: vec![false; normals],
+        }
+    }
+
+    /// Add a triangle whose corners use the slots `slots`, with its corners' positions before
+    /// and after.
+    #[inline]
+    pub(crate) fn add(&mut self, slots: [usize; 3], before: [DVec3; 3], after: [DVec3; 3]) {
+        let area_before = (before[1] - before[0]).cross(before[2] - before[0]);
+        let area_after = (after[1] - after[0]).cross(after[2] - after[0]);
+        let moved = before != after;
+        for n in slots {
+            if n >= self.before.len() {
+                self.before.resize(n + 1, DVec3::ZERO);
+                self.after.resize(n + 1, DVec3::ZERO);
+                self.moved.resize(n + 1, false);
+            }
+            self.before[n] += area_before;
+            self.after[n] += area_after;
+            self.moved[n] |= moved;
+        }
+    }
+
+    /// The rotation for normal `n`, or `None` when it stays as it is.
+    pub(crate) fn turn(&self, n: usize) -> Option<Turn> {
+        if !*self.moved.get(n)? {
+            return None;
+        }
+        let after = self.after[n].normalize_or_zero();
+        if after == DVec3::ZERO {
+            return None;
+        }
+        let before = self.before[n].normalize_or_zero();
+        Some(if before == DVec3::ZERO {
+            Turn::Replace(after)
+        } else {
+            Turn::Rotate(DQuat::from_rotation_arc(before, after))
+        })
+    }
+}
+
+/// Slots for normals that turn together: one per (welded vertex, normal value); a normal on no
+/// welded vertex gets a slot of its own.
+#[derive(Default)]
+pub(crate) struct SmoothGroups {
+    slots: std::collections::HashMap<(usize, [u32; 3]), usize>,
+    next: usize,
+}
+
+impl SmoothGroups {
+    /// The slot of a file normal whose own faces (those of its file vertex) add up to the area
+    /// vector `own`, on welded vertex `welded`.
+    pub(crate) fn slot_for(
+        &mut self,
+        own: DVec3,
+        welded: Option<usize>,
+        normal: [f32; 3],
+    ) -> usize {
+        let own = own.normalize_or_zero();
+        let n = dvec(normal).normalize_or_zero();
+        if own != DVec3::ZERO && own.dot(n) > 0.99999 {
+            self.next += 1;
+            return self.next - 1;
+        }
+        self.slot(welded, normal)
+    }
+
+    pub(crate) fn slot(&mut self, welded: Option<usize>, normal: [f32; 3]) -> usize {
+        let fresh = self.next;
+        let slot = match welded {
+            Some(w) => *self
+                .slots
+                .entry((w, normal.map(f32::to_bits)))
+                .or_insert(fresh),
+            None => fresh,
+        };
+        if slot == fresh {
+            self.next += 1;
+        }
+        slot
+    }
+}
+
+/// What happens to one file normal.
+#[derive(Clone, Copy, Debug)]
+pub(crate) enum Turn {
+    /// Turned by the rotation of its faces.
+    Rotate(DQuat),
+    /// Its faces had no area before: it becomes their normal after.
+    Replace(DVec3),
+}
+
+impl Turn {
+    /// The turned normal (unit length when `normal` was), never NaN.
+    pub(crate) fn normal(self, normal: [f32; 3]) -> [f32; 3] {
+        let turned = match self {
+            Turn::Rotate(q) => q * DVec3::from_array(normal.map(f64::from)),
+            Turn::Replace(n) => n,
+        };
+        if turned.is_finite() {
+            turned.as_vec3().to_array()
+        } else {
+            normal
+        }
+    }
+
+    /// A direction that moves with the surface (a tangent), turned; its length is kept.
+    pub(crate) fn direction(self, direction: [f32; 3]) -> [f32; 3] {
+        match self {
+            Turn::Rotate(q) => {
+                let turned = q * DVec3::from_array(direction.map(f64::from));
+                if turned.is_finite() {
+                    turned.as_vec3().to_array()
+                } else {
+                    direction
+                }
+            }
+            Turn::Replace(_) => direction,
+        }
+    }
+}
+
+/// A point in f64.
+#[inline]
+pub(crate) fn dvec(p: [f32; 3]) -> DVec3 {
+    DVec3::from_array(p.map(f64::from))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn fingerprint_sees_order_and_values() {
+        let a = [[0, 1, 2], [2, 1, 3]];
+        let b = [[2, 1, 3], [0, 1, 2]];
+        let c = [[0, 1, 2], [2, 3, 1]];
+        assert_ne!(fingerprint(&a), fingerprint(&b));
+        assert_ne!(fingerprint(&a), fingerprint(&c));
+        assert_eq!(fingerprint(&a), fingerprint(&a.clone()));
+    }
+
+    #[test]
+    fn normals_turn_with_their_faces_and_unmoved_ones_stay() {
+        // Two triangles: one tilts by 90 degrees about the x axis, the other stays.
+        let mut turns = NormalTurns::new(3);
+        let flat = [DVec3::ZERO, DVec3::X, DVec3::Y];
+        let tilted = [DVec3::ZERO, DVec3::X, DVec3::Z];
+        turns.add([0, 0, 0], flat, tilted);
+        turns.add([1, 1, 1], flat, flat);
+        // A custom normal leaning 45 degrees from the face normal keeps its lean.
+        let lean = [0.0, (0.5f32).sqrt(), (0.5f32).sqrt()];
+        let turned = turns.turn(0).unwrap().normal(lean);
+        let expected = [0.0, -(0.5f32).sqrt(), (0.5f32).sqrt()];
+        for axis in 0..3 {
+            assert!((turned[axis] - expected[axis]).abs() < 1e-6, "{turned:?}");
+        }
+        assert!(turns.turn(1).is_none());
+        assert!(turns.turn(2).is_none(), "a normal no face uses stays");
+    }
+
+    #[test]
+    fn smooth_groups_join_equal_normals_on_one_vertex_only() {
+        let mut groups = SmoothGroups::default();
+        let up = [0.0, 0.0, 1.0];
+        let side = [1.0, 0.0, 0.0];
+        let a = groups.slot(Some(4), up);
+        assert_eq!(groups.slot(Some(4), up), a, "a seam copy shares its slot");
+        assert_ne!(groups.slot(Some(4), side), a, "a hard edge does not");
+        assert_ne!(groups.slot(Some(5), up), a, "another vertex does not");
+        let lone = groups.slot(None, up);
+        assert_ne!(groups.slot(None, up), lone);
+        // A normal that is its own faces' normal (flat shading) never shares.
+        let flat = groups.slot_for(DVec3::Z * 2.0, Some(4), up);
+        assert_ne!(flat, a);
+        assert_ne!(groups.slot_for(DVec3::Z, Some(4), up), flat);
+        // One smoothed over other faces does.
+        assert_eq!(groups.slot_for(DVec3::new(1.0, 0.0, 1.0), Some(4), up), a);
+    }
+
+    #[test]
+    fn a_normal_of_collapsed_faces_becomes_the_new_face_normal() {
+        let mut turns = NormalTurns::new(1);
+        let collapsed = [DVec3::ZERO, DVec3::X, DVec3::X * 2.0];
+        let opened = [DVec3::ZERO, DVec3::X, DVec3::Y];
+        turns.add([0, 0, 0], collapsed, opened);
+        assert_eq!(
+            turns.turn(0).unwrap().normal([1.0, 0.0, 0.0]),
+            [0.0, 0.0, 1.0]
+        );
+    }
+}

@@ -1,0 +1,611 @@
+//! Fairing an artist's file changes its shape and nothing else: real files made by other tools
+//! (`tests/data/roundtrip/`, see its README: trimesh, pygltflib, plyfile and a quad-mesh OBJ
+//! writer) are faired, written back with `io::save_with_source`, read again, and compared item
+//! by item with the input.
+
+use fairmesh::fairing::{self, Method, MethodOptions};
+use fairmesh::io::{self, Loaded};
+use fairmesh::TriMesh;
+use serde_json::Value;
+use std::collections::BTreeSet;
+use std::path::{Path, PathBuf};
+
+fn data(name: &str) -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+        .join("tests/data/roundtrip")
+        .join(name)
+}
+
+/// The mesh after the default constrained fairing.
+fn faired(loaded: &Loaded) -> TriMesh {
+    let mut mesh = loaded.mesh.clone();
+    fairing::fair(
+        &mut mesh,
+        &loaded.topology,
+        &MethodOptions::default_for(Method::Constrained),
+    );
+    assert_ne!(
+        mesh.positions, loaded.mesh.positions,
+        "fairing moved nothing"
+    );
+    mesh
+}
+
+// ---------------------------------------------------------------------------------------------
+// glTF, read here with serde_json and our own accessor walk (independent of the library).
+
+struct Gltf {
+    json: Value,
+    buffers: Vec<Vec<u8>>,
+}
+
+fn read_gltf(path: &Path) -> Gltf {
+    let bytes = std::fs::read(path).unwrap();
+    if bytes.starts_with(b"glTF") {
+        let json_len = u32::from_le_bytes(bytes[12..16].try_into().unwrap()) as usize;
+        let json: Value = serde_json::from_slice(&bytes[20..20 + json_len]).unwrap();
+        let rest = &bytes[20 + json_len..];
+        let bin = if rest.len() >= 8 {
+            let len = u32::from_le_bytes(rest[0..4].try_into().unwrap()) as usize;
+            assert_eq!(&rest[4..8], b"BIN\0");
+            rest[8..8 + len].to_vec()
+        } else {
+            Vec::new()
+        };
+        Gltf {
+            json,
+            buffers: vec![bin],
+        }
+    } else {
+        let json: Value = serde_json::from_slice(&bytes).unwrap();
+        let buffers = json["buffers"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|b| {
+                let uri = b["uri"].as_str().unwrap().replace("%20", " ");
+                std::fs::read(path.parent().unwrap().join(uri)).unwrap()
+            })
+            .collect();
+        Gltf { json, buffers }
+    }
+}
+
+impl Gltf {
+    /// The bytes of each element of accessor `a`.
+    fn elements(&self, a: usize) -> Vec<Vec<u8>> {
+        let accessor = &self.json["accessors"][a];
+        let view = &self.json["bufferViews"][accessor["bufferView"].as_u64().unwrap() as usize];
+        let size = match accessor["componentType"].as_u64().unwrap() {
+            5120 | 5121 => 1,
+            5122 | 5123 => 2,
+            _ => 4,
+        };
+        let n = match accessor["type"].as_str().unwrap() {
+            "SCALAR" => 1,
+            "VEC2" => 2,
+            "VEC3" => 3,
+            "VEC4" => 4,
+            "MAT4" => 16,
+            other => panic!("type {other}"),
+        };
+        let stride = view["byteStride"].as_u64().map_or(size * n, |s| s as usize);
+        let start = view["byteOffset"].as_u64().unwrap_or(0) as usize
+            + accessor["byteOffset"].as_u64().unwrap_or(0) as usize;
+        let buffer = &self.buffers[view["buffer"].as_u64().unwrap() as usize];
+        (0..accessor["count"].as_u64().unwrap() as usize)
+            .map(|k| buffer[start + k * stride..start + k * stride + size * n].to_vec())
+            .collect()
+    }
+
+    fn floats(&self, a: usize) -> Vec<Vec<f32>> {
+        assert_eq!(self.json["accessors"][a]["componentType"], 5126);
+        self.elements(a)
+            .iter()
+            .map(|e| {
+                e.chunks(4)
+                    .map(|c| f32::from_le_bytes(c.try_into().unwrap()))
+                    .collect()
+            })
+            .collect()
+    }
+
+    fn indices(&self, a: usize) -> Vec<usize> {
+        self.elements(a)
+            .iter()
+            .map(|e| match e.len() {
+                1 => e[0] as usize,
+                2 => u16::from_le_bytes([e[0], e[1]]) as usize,
+                _ => u32::from_le_bytes(e[..4].try_into().unwrap()) as usize,
+            })
+            .collect()
+    }
+
+    fn primitives(&self) -> Vec<&Value> {
+        self.json["meshes"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .flat_map(|m| m["primitives"].as_array().unwrap())
+            .collect()
+    }
+
+    /// Accessors of the attributes that fairing may change: POSITION, NORMAL, TANGENT.
+    fn changing_accessors(&self) -> BTreeSet<usize> {
+        self.primitives()
+            .iter()
+            .flat_map(|p| {
+                ["POSITION", "NORMAL", "TANGENT"]
+                    .into_iter()
+                    .filter_map(|name| p["attributes"][name].as_u64())
+            })
+            .map(|a| a as usize)
+            .collect()
+    }
+
+    fn attribute(&self, mesh_name: &str, name: &str) -> usize {
+        let mesh = self.json["meshes"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .find(|m| m["name"] == mesh_name)
+            .unwrap_or_else(|| panic!("no mesh {mesh_name}"));
+        mesh["primitives"][0]["attributes"][name].as_u64().unwrap() as usize
+    }
+}
+
+/// Everything but buffers, buffer view placement, POSITION bounds and external image URIs is
+/// the same JSON; every accessor outside POSITION/NORMAL/TANGENT has the same bytes; positions
+/// moved.
+fn assert_only_shape_changed(input: &Gltf, output: &Gltf, what: &str) {
+    let (a, b) = (
+        input.json.as_object().unwrap(),
+        output.json.as_object().unwrap(),
+    );
+    let skip = ["accessors", "bufferViews", "buffers", "images"];
+    let keys_a: Vec<&String> = a.keys().collect();
+    let keys_b: Vec<&String> = b.keys().collect();
+    assert_eq!(keys_a, keys_b, "{what}: top-level keys");
+    for key in a.keys().filter(|k| !skip.contains(&k.as_str())) {
+        assert_eq!(a[key], b[key], "{what}: {key}");
+    }
+    let strip = |v: &Value, keys: &[&str]| {
+        let mut v = v.clone();
+        for key in keys {
+            v.as_object_mut().unwrap().remove(*key);
+        }
+        v
+    };
+    let positions: BTreeSet<usize> = input
+        .primitives()
+        .iter()
+        .filter_map(|p| p["attributes"]["POSITION"].as_u64())
+        .map(|a| a as usize)
+        .collect();
+    let changing = input.changing_accessors();
+    let accessors = a["accessors"].as_array().unwrap();
+    assert_eq!(accessors.len(), b["accessors"].as_array().unwrap().len());
+    for (i, accessor) in accessors.iter().enumerate() {
+        let keys: &[&str] = if changing.contains(&i) {
+            &["min", "max"]
+        } else {
+            &[]
+        };
+        assert_eq!(
+            strip(accessor, keys),
+            strip(&b["accessors"][i], keys),
+            "{what}: accessor {i}"
+        );
+    }
+    for (i, view) in a["bufferViews"].as_array().unwrap().iter().enumerate() {
+        assert_eq!(
+            strip(view, &["buffer", "byteOffset"]),
+            strip(&b["bufferViews"][i], &["buffer", "byteOffset"]),
+            "{what}: buffer view {i}"
+        );
+    }
+    if let Some(images) = a.get("images") {
+        for (i, image) in images.as_array().unwrap().iter().enumerate() {
+            assert_eq!(
+                strip(image, &["uri"]),
+                strip(&b["images"][i], &["uri"]),
+                "{what}: image {i}"
+            );
+        }
+    }
+    for i in 0..accessors.len() {
+        if !changing.contains(&i) {
+            assert!(
+                input.elements(i) == output.elements(i),
+                "{what}: accessor {i} changed"
+            );
+        }
+    }
+    for &p in &positions {
+        assert!(
+            input.elements(p) != output.elements(p),
+            "{what}: positions of accessor {p} did not move"
+        );
+        // The bounds are those of the data.
+        let values = output.floats(p);
+        for c in 0..3 {
+            let lo = values.iter().map(|v| v[c]).fold(f32::INFINITY, f32::min);
+            let hi = values
+                .iter()
+                .map(|v| v[c])
+                .fold(f32::NEG_INFINITY, f32::max);
+            assert_eq!(b["accessors"][p]["min"][c].as_f64().unwrap() as f32, lo);
+            assert_eq!(b["accessors"][p]["max"][c].as_f64().unwrap() as f32, hi);
+        }
+    }
+}
+
+/// Reloading the output gives the faired mesh (up to the round trip through the node
+/// transforms, which is exact for untransformed nodes).
+fn assert_reloads_as(path: &Path, faired: &TriMesh, tolerance: f32) {
+    let reloaded = io::load(path).unwrap().mesh;
+    assert_eq!(reloaded.triangles, faired.triangles, "{}", path.display());
+    let worst = reloaded
+        .positions
+        .iter()
+        .zip(&faired.positions)
+        .flat_map(|(a, b)| (0..3).map(move |c| (a[c] - b[c]).abs()))
+        .fold(0.0f32, f32::max);
+    assert!(worst <= tolerance, "{}: off by {worst}", path.display());
+}
+
+fn validate(files: &[PathBuf]) {
+    let root = PathBuf::from(env!("CARGO_MANIFEST_DIR"));
+    assert!(
+        root.join("node_modules/gltf-validator").exists(),
+        "node_modules/gltf-validator is missing: run `npm ci` in the repository root"
+    );
+    let output = std::process::Command::new("node")
+        .arg(root.join("tests/gltf_validate.mjs"))
+        .args(files)
+        .output()
+        .expect("node must be installed to validate glTF output");
+    let stdout = String::from_utf8_lossy(&output.stdout);
+    assert!(
+        output.status.success(),
+        "validator: {stdout}\n{}",
+        String::from_utf8_lossy(&output.stderr)
+    );
+    assert_eq!(stdout.matches(" 0 errors").count(), files.len(), "{stdout}");
+}
+
+#[test]
+fn gltf_scenes_keep_everything_but_their_shape() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut outputs = Vec::new();
+    for name in ["scene.glb", "scene.gltf", "morph.glb", "skinned.glb"] {
+        let input_path = data(name);
+        let loaded = io::load(&input_path).unwrap();
+        let mesh = faired(&loaded);
+        let stem = name.replace('.', "_");
+        for ext in ["glb", "gltf"] {
+            let out = dir.path().join(format!("{stem}.{ext}"));
+            let report = io::save_with_source(&out, &mesh, &loaded.source).unwrap();
+            assert!(report.warnings.is_empty(), "{name}: {:?}", report.warnings);
+            let (input, output) = (read_gltf(&input_path), read_gltf(&out));
+            assert_only_shape_changed(&input, &output, &format!("{name} -> {ext}"));
+            assert_reloads_as(&out, &mesh, 2e-6);
+            outputs.push(out);
+        }
+    }
+    // The external texture of scene.gltf is referenced from the output's folder.
+    let text = std::fs::read_to_string(dir.path().join("scene_gltf.gltf")).unwrap();
+    let json: Value = serde_json::from_str(&text).unwrap();
+    let uri = json["images"][0]["uri"].as_str().unwrap();
+    assert!(
+        uri.ends_with("checker.png") && uri.starts_with(".."),
+        "{uri}"
+    );
+    assert_eq!(
+        std::fs::read(dir.path().join(uri)).unwrap(),
+        std::fs::read(data("checker.png")).unwrap()
+    );
+    validate(&outputs);
+}
+
+#[test]
+fn gltf_hard_edges_stay_flat_and_seams_stay_smooth() {
+    let dir = tempfile::tempdir().unwrap();
+    let loaded = io::load(&data("scene.glb")).unwrap();
+    let mesh = faired(&loaded);
+    let out = dir.path().join("scene.glb");
+    io::save_with_source(&out, &mesh, &loaded.source).unwrap();
+    let (input, output) = (read_gltf(&data("scene.glb")), read_gltf(&out));
+
+    // The block is flat-shaded (every triangle has its own corners): each corner's normal is its
+    // triangle's normal after fairing, as it was before.
+    let block = input.json["meshes"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|m| m["name"] == "block_mesh")
+        .unwrap();
+    let primitive = &block["primitives"][0];
+    let triangles = output.indices(primitive["indices"].as_u64().unwrap() as usize);
+    let p = output.floats(output.attribute("block_mesh", "POSITION"));
+    let n = output.floats(output.attribute("block_mesh", "NORMAL"));
+    let n_before = input.floats(input.attribute("block_mesh", "NORMAL"));
+    let mut tilted = 0;
+    for t in triangles.chunks(3) {
+        let [a, b, c] = [t[0], t[1], t[2]].map(|v| glam::Vec3::from_slice(&p[v]));
+        let face = (b - a).cross(c - a).normalize();
+        for &v in t {
+            let normal = glam::Vec3::from_slice(&n[v]);
+            assert!(normal.dot(face) > 0.99999, "corner {v}: {normal} vs {face}");
+            if glam::Vec3::from_slice(&n_before[v]).dot(normal) < 0.99999 {
+                tilted += 1;
+            }
+        }
+    }
+    assert!(tilted > 0, "no block normal turned");
+
+    // The ball's UV seam splits vertices with one smooth normal: the copies stay equal.
+    let ball_p = input.floats(input.attribute("ball_mesh", "POSITION"));
+    let ball_n_before = input.floats(input.attribute("ball_mesh", "NORMAL"));
+    let ball_n = output.floats(output.attribute("ball_mesh", "NORMAL"));
+    let mut seams = 0;
+    for i in 0..ball_p.len() {
+        for j in i + 1..ball_p.len() {
+            if ball_p[i] == ball_p[j] && ball_n_before[i] == ball_n_before[j] {
+                seams += 1;
+                assert_eq!(ball_n[i], ball_n[j], "seam copies {i} and {j} split");
+            }
+        }
+    }
+    assert!(seams > 10, "expected a UV seam, found {seams} copies");
+    assert!(ball_n != ball_n_before, "no ball normal turned");
+}
+
+#[test]
+fn an_unchanged_mesh_writes_every_byte_back() {
+    let dir = tempfile::tempdir().unwrap();
+    for name in ["textured.obj", "colored.ply", "colored_ascii.ply"] {
+        let loaded = io::load(&data(name)).unwrap();
+        let out = dir.path().join(name);
+        io::save_with_source(&out, &loaded.mesh, &loaded.source).unwrap();
+        assert!(
+            std::fs::read(&out).unwrap() == std::fs::read(data(name)).unwrap(),
+            "{name} changed although nothing moved"
+        );
+    }
+    for name in ["scene.glb", "morph.glb", "skinned.glb"] {
+        let loaded = io::load(&data(name)).unwrap();
+        let out = dir.path().join(name);
+        io::save_with_source(&out, &loaded.mesh, &loaded.source).unwrap();
+        let (input, output) = (read_gltf(&data(name)), read_gltf(&out));
+        for a in 0..input.json["accessors"].as_array().unwrap().len() {
+            assert!(
+                input.elements(a) == output.elements(a),
+                "{name}: accessor {a}"
+            );
+        }
+    }
+}
+
+#[test]
+fn obj_keeps_every_line_but_the_moved_vertices_and_their_normals() {
+    let dir = tempfile::tempdir().unwrap();
+    let loaded = io::load(&data("textured.obj")).unwrap();
+    let mesh = faired(&loaded);
+    let out = dir.path().join("textured.obj");
+    let report = io::save_with_source(&out, &mesh, &loaded.source).unwrap();
+    assert!(report.warnings.is_empty(), "{:?}", report.warnings);
+    let before = std::fs::read_to_string(data("textured.obj")).unwrap();
+    let after = std::fs::read_to_string(&out).unwrap();
+    let (before, after): (Vec<&str>, Vec<&str>) =
+        (before.lines().collect(), after.lines().collect());
+    assert_eq!(before.len(), after.len());
+    let (mut moved, mut turned) = (0, 0);
+    for (a, b) in before.iter().zip(&after) {
+        match a.split_whitespace().next() {
+            Some("v") => moved += usize::from(a != b),
+            Some("vn") => turned += usize::from(a != b),
+            _ => assert_eq!(a, b),
+        }
+    }
+    assert!(
+        moved > 300 && turned > 300,
+        "{moved} v, {turned} vn changed"
+    );
+    let quads = after
+        .iter()
+        .filter(|l| l.starts_with("f ") && l.split_whitespace().count() == 5)
+        .count();
+    assert_eq!(quads, 384);
+    // Positions read back bit for bit.
+    assert_reloads_as(&out, &mesh, 0.0);
+    // Each vn is still a unit normal close to its quad's corner normal.
+    let normals: Vec<glam::Vec3> = after
+        .iter()
+        .filter(|l| l.starts_with("vn "))
+        .map(|l| {
+            let v: Vec<f32> = l
+                .split_whitespace()
+                .skip(1)
+                .map(|t| t.parse().unwrap())
+                .collect();
+            glam::Vec3::from_slice(&v)
+        })
+        .collect();
+    assert!(normals.iter().all(|n| (n.length() - 1.0).abs() < 1e-5));
+}
+
+/// The vertex property types of a PLY header, in order.
+fn ply_vertex_properties(header: &str) -> Vec<(String, String)> {
+    let mut in_vertex = false;
+    let mut out = Vec::new();
+    for line in header.lines() {
+        let words: Vec<&str> = line.split_whitespace().collect();
+        match words.as_slice() {
+            ["element", name, _] => in_vertex = *name == "vertex",
+            ["property", kind, name] if in_vertex => out.push((kind.to_string(), name.to_string())),
+            _ => {}
+        }
+    }
+    out
+}
+
+#[test]
+fn ply_keeps_colours_quality_and_face_properties() {
+    let dir = tempfile::tempdir().unwrap();
+    for name in ["colored.ply", "colored_ascii.ply"] {
+        let loaded = io::load(&data(name)).unwrap();
+        let mesh = faired(&loaded);
+        let out = dir.path().join(name);
+        let report = io::save_with_source(&out, &mesh, &loaded.source).unwrap();
+        assert!(report.warnings.is_empty(), "{:?}", report.warnings);
+        assert_reloads_as(&out, &mesh, 0.0);
+        let (a, b) = (
+            std::fs::read(data(name)).unwrap(),
+            std::fs::read(&out).unwrap(),
+        );
+        let end = |bytes: &[u8]| {
+            bytes
+                .windows(11)
+                .position(|w| w == b"end_header\n")
+                .unwrap()
+                + 11
+        };
+        assert_eq!(a[..end(&a)], b[..end(&b)], "{name}: header");
+        let header = String::from_utf8_lossy(&a[..end(&a)]).into_owned();
+        let properties = ply_vertex_properties(&header);
+        let xyz: Vec<usize> = (0..properties.len())
+            .filter(|&p| ["x", "y", "z"].contains(&properties[p].1.as_str()))
+            .collect();
+        assert_eq!(xyz, vec![0, 1, 2]);
+        let vertices = loaded.mesh.positions.len();
+        if name.contains("ascii") {
+            let (la, lb): (Vec<&[u8]>, Vec<&[u8]>) = (
+                a[end(&a)..].split(|&c| c == b'\n').collect(),
+                b[end(&b)..].split(|&c| c == b'\n').collect(),
+            );
+            assert_eq!(la.len(), lb.len());
+            for (row, (x, y)) in la.iter().zip(&lb).enumerate() {
+                let tx: Vec<&[u8]> = x.split(|&c| c == b' ').filter(|t| !t.is_empty()).collect();
+                let ty: Vec<&[u8]> = y.split(|&c| c == b' ').filter(|t| !t.is_empty()).collect();
+                if row < vertices {
+                    assert_eq!(tx[3..], ty[3..], "{name}: vertex {row}");
+                } else {
+                    assert_eq!(x, y, "{name}: row {row}");
+                }
+            }
+        } else {
+            let size = |kind: &str| match kind {
+                "uchar" | "char" => 1,
+                "short" | "ushort" => 2,
+                "double" => 8,
+                _ => 4,
+            };
+            let stride: usize = properties.iter().map(|(k, _)| size(k)).sum();
+            let (ra, rb) = (&a[end(&a)..], &b[end(&b)..]);
+            assert_eq!(ra.len(), rb.len());
+            for row in 0..vertices {
+                let at = row * stride;
+                assert_eq!(
+                    ra[at + 12..at + stride],
+                    rb[at + 12..at + stride],
+                    "{name}: vertex {row}"
+                );
+            }
+            assert_eq!(
+                ra[vertices * stride..],
+                rb[vertices * stride..],
+                "{name}: faces"
+            );
+        }
+    }
+}
+
+#[test]
+fn other_formats_and_other_connectivity_say_what_is_not_kept() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = io::load(&data("scene.glb")).unwrap();
+    let report =
+        io::save_with_source(&dir.path().join("scene.obj"), &scene.mesh, &scene.source).unwrap();
+    let text = report.warnings.join("\n");
+    for item in [
+        "'root'",
+        "'ball'",
+        "'block'",
+        "'checker'",
+        "'paint'",
+        "TEXCOORD_0",
+        "COLOR_0",
+    ] {
+        assert!(text.contains(item), "{item} not named in: {text}");
+    }
+    assert!(text.contains("OBJ cannot hold"), "{text}");
+
+    let obj = io::load(&data("textured.obj")).unwrap();
+    let report = io::save_with_source(&dir.path().join("t.ply"), &obj.mesh, &obj.source).unwrap();
+    let text = report.warnings.join("\n");
+    for item in [
+        "texture coordinates",
+        "normals",
+        "checker",
+        "paint",
+        "quads",
+    ] {
+        assert!(text.contains(item), "{item} not named in: {text}");
+    }
+
+    // A mesh with other connectivity (a subdivided copy) is never written into the source.
+    let finer = fairmesh::mesh::subdivide_loop(&obj.mesh);
+    let out = dir.path().join("finer.obj");
+    let report = io::save_with_source(&out, &finer, &obj.source).unwrap();
+    assert!(
+        report
+            .warnings
+            .join("\n")
+            .contains("no longer has its connectivity"),
+        "{:?}",
+        report.warnings
+    );
+    assert_eq!(
+        io::load(&out).unwrap().mesh.triangles.len(),
+        finer.triangles.len()
+    );
+
+    // A bare mesh has nothing to lose.
+    let bare = io::load(&PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/data/elephant.obj"))
+        .unwrap();
+    let report = io::save_with_source(&dir.path().join("e.glb"), &bare.mesh, &bare.source).unwrap();
+    assert!(report.warnings.is_empty(), "{:?}", report.warnings);
+}
+
+#[test]
+fn a_mesh_placed_twice_is_written_from_its_first_placement_with_a_warning() {
+    let dir = tempfile::tempdir().unwrap();
+    // scene.gltf with a second node placing the ball mesh elsewhere.
+    let mut json: Value =
+        serde_json::from_slice(&std::fs::read(data("scene.gltf")).unwrap()).unwrap();
+    let nodes = json["nodes"].as_array_mut().unwrap();
+    nodes.push(serde_json::json!({"name": "ball_copy", "mesh": 0, "translation": [3.0, 0.0, 0.0]}));
+    let copy = nodes.len() - 1;
+    json["scenes"][0]["nodes"]
+        .as_array_mut()
+        .unwrap()
+        .push(copy.into());
+    let input = dir.path().join("twice.gltf");
+    std::fs::write(&input, serde_json::to_vec(&json).unwrap()).unwrap();
+    std::fs::copy(data("scene.bin"), dir.path().join("scene.bin")).unwrap();
+    std::fs::copy(data("checker.png"), dir.path().join("checker.png")).unwrap();
+
+    let loaded = io::load(&input).unwrap();
+    let mesh = faired(&loaded);
+    let out = dir.path().join("out.glb");
+    let report = io::save_with_source(&out, &mesh, &loaded.source).unwrap();
+    let text = report.warnings.join("\n");
+    assert!(
+        text.contains("'ball_mesh'") && text.contains("'ball_copy'") && text.contains("'ball'"),
+        "{text}"
+    );
+    // The image beside the input is referenced as it was (same folder).
+    let output = read_gltf(&out);
+    assert_eq!(output.json["images"][0]["uri"], "checker.png");
+}
