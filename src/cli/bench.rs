@@ -18,6 +18,48 @@ pub struct BenchArgs {
     pub subdivide: usize,
 }
 
+/// Saving a moved copy of the mesh in the input's format: written into the kept file
+/// (`io::save_with_source`) and as a bare mesh (`io::save`), to a temporary folder.
+fn save_rows(args: &BenchArgs, loaded: &io::Loaded) -> anyhow::Result<Vec<(String, f64)>> {
+    let Some(format) = io::Format::from_path(&args.input) else {
+        return Ok(Vec::new());
+    };
+    if matches!(format, io::Format::Off) {
+        return Ok(Vec::new());
+    }
+    // Every vertex moves (as after fairing), so every position and normal is written anew.
+    let mut moved = loaded.mesh.clone();
+    for p in &mut moved.positions {
+        *p = p.map(|c| c * 1.0001 + 1e-4);
+    }
+    let dir = tempfile_dir()?;
+    let path = dir.join(format!("bench.{}", format.extension()));
+    let mut result = Ok(());
+    let kept = median_ms(args.runs, || {
+        if let Err(e) = io::save_with_source(&path, &moved, &loaded.source) {
+            result = Err(e);
+        }
+    });
+    let bare = median_ms(args.runs, || {
+        if let Err(e) = io::save(&path, &moved) {
+            result = Err(e);
+        }
+    });
+    let _ = std::fs::remove_dir_all(&dir);
+    result?;
+    Ok(vec![
+        (format!("save {format}, keeping the input file's content"), kept),
+        (format!("save {format}, bare mesh"), bare),
+    ])
+}
+
+/// A fresh folder in the system's temporary directory.
+fn tempfile_dir() -> anyhow::Result<PathBuf> {
+    let dir = std::env::temp_dir().join(format!("fairmesh-bench-{}", std::process::id()));
+    std::fs::create_dir_all(&dir)?;
+    Ok(dir)
+}
+
 /// Median wall time of `runs` calls of `f`, in milliseconds.
 pub fn median_ms(runs: usize, mut f: impl FnMut()) -> f64 {
     let mut times: Vec<f64> = (0..runs.max(1))
@@ -38,6 +80,9 @@ pub fn run(args: BenchArgs) -> anyhow::Result<()> {
     });
     let mut loaded = io::load(&args.input)?;
     rows.push(("load + weld + clean + topology".into(), load_ms));
+    if args.subdivide == 0 {
+        rows.extend(save_rows(&args, &loaded)?);
+    }
     for _ in 0..args.subdivide {
         loaded.mesh = mesh::subdivide_loop(&loaded.mesh);
     }

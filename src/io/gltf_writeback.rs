@@ -20,9 +20,10 @@
 //!
 //! Buffers: all buffers are joined into one (each starting at a multiple of 16 bytes, buffer views
 //! moved accordingly), which becomes the GLB's BIN chunk or the `.gltf`'s `<stem>.bin`. Images
-//! stored in buffer views or as data: URIs stay inside the file; images that are external files are
-//! referenced, not copied: their URI is rewritten relative to the output's folder (unchanged when
-//! the output is beside the input).
+//! stored in buffer views or as data: URIs stay as they are. Images that are external files are
+//! copied: into the GLB's binary chunk (a GLB is one self-contained file), or, for a `.gltf`
+//! written to another folder, beside it (as `<stem>_<name>` if a different file of that name is
+//! already there); a `.gltf` written beside its input refers to the same files.
 
 use super::atomic;
 use super::source::{dvec, NormalTurns, SaveReport, SmoothGroups, Source, Turn};
@@ -32,7 +33,7 @@ use glam::DMat4;
 use serde_json::{json, Value};
 use std::collections::{BTreeMap, BTreeSet};
 use std::io::Write;
-use std::path::{Component, Path, PathBuf};
+use std::path::{Path, PathBuf};
 
 /// One primitive as the reader read it for one node: its POSITION accessor's elements became the
 /// parser vertices `raw_start..raw_start + count`, placed by `world`.
@@ -228,43 +229,48 @@ impl GltfSource {
                 nodes.join(", ")
             ));
         }
-        for (key, what) in [
-            ("materials", "materials"),
-            ("textures", "textures"),
-            ("cameras", "cameras"),
-            ("skins", "skins"),
-            ("animations", "animations"),
+        for (key, one, many) in [
+            ("materials", "material", "materials"),
+            ("textures", "texture", "textures"),
+            ("cameras", "camera", "cameras"),
+            ("skins", "skin", "skins"),
+            ("animations", "animation", "animations"),
         ] {
             let list = names(key);
             if !list.is_empty() {
+                let what = if list.len() == 1 { one } else { many };
                 out.push(format!("{} {what} ({})", list.len(), list.join(", ")));
             }
         }
         let mut attributes: Vec<String> = Vec::new();
         let mut targets = 0;
-        for mesh in self.array("meshes") {
-            for primitive in mesh
-                .get("primitives")
-                .and_then(Value::as_array)
-                .map_or(&[][..], Vec::as_slice)
-            {
-                if let Some(map) = primitive.get("attributes").and_then(Value::as_object) {
-                    for name in map.keys() {
-                        if name != "POSITION" && !attributes.contains(name) {
-                            attributes.push(name.clone());
-                        }
+        for primitive in primitives(&self.json) {
+            if let Some(map) = primitive.get("attributes").and_then(Value::as_object) {
+                for name in map.keys().filter(|n| *n != "POSITION") {
+                    let plain = if name == "NORMAL" {
+                        "normals".to_string()
+                    } else if name == "TANGENT" {
+                        "tangents".to_string()
+                    } else if name.starts_with("TEXCOORD") {
+                        format!("UVs ({name})")
+                    } else if name.starts_with("COLOR") {
+                        format!("vertex colours ({name})")
+                    } else if name.starts_with("JOINTS") || name.starts_with("WEIGHTS") {
+                        format!("skin weights ({name})")
+                    } else {
+                        name.clone()
+                    };
+                    if !attributes.contains(&plain) {
+                        attributes.push(plain);
                     }
                 }
-                targets += primitive
-                    .get("targets")
-                    .and_then(Value::as_array)
-                    .map_or(0, Vec::len);
             }
+            targets += primitive
+                .get("targets")
+                .and_then(Value::as_array)
+                .map_or(0, Vec::len);
         }
-        if !attributes.is_empty() {
-            attributes.sort();
-            out.push(format!("vertex attributes {}", attributes.join(", ")));
-        }
+        out.extend(attributes);
         if targets > 0 {
             out.push(format!("{targets} morph targets"));
         }
@@ -421,11 +427,15 @@ pub(crate) fn write(
             accessor["max"] = json!(max);
         }
     }
-    let bin = join_buffers(&mut json, buffers);
-    rewrite_image_uris(&mut json, source, path, report);
+    let mut bin = join_buffers(&mut json, buffers);
+    let images = external_images(&json, source, report);
     match format {
-        Format::Glb => atomic::write(path, |w| write_glb(w, &json, &bin)),
+        Format::Glb => {
+            embed_images(&mut json, &mut bin, images, report);
+            atomic::write(path, |w| write_glb(w, &json, &bin))
+        }
         _ => {
+            let copies = place_image_files(&mut json, images, path);
             let bin_path = super::gltf_bin_path(path);
             let bin_name = bin_path
                 .file_name()
@@ -441,7 +451,18 @@ pub(crate) fn write(
             let staged_bin = (!bin.is_empty())
                 .then(|| atomic::stage(&bin_path, |w| w.write_all(&bin)))
                 .transpose()?;
+            let mut staged_images = Vec::new();
+            for (from, to) in &copies {
+                let bytes = std::fs::read(from).map_err(|source| IoError::Read {
+                    path: from.clone(),
+                    source,
+                })?;
+                staged_images.push(atomic::stage(to, |w| w.write_all(&bytes))?);
+            }
             let staged_json = atomic::stage(path, |w| w.write_all(&text))?;
+            for staged in staged_images {
+                staged.commit()?;
+            }
             if let Some(staged) = staged_bin {
                 staged.commit()?;
             }
@@ -763,17 +784,17 @@ fn join_buffers(json: &mut Value, buffers: Vec<Vec<u8>>) -> Vec<u8> {
     bin
 }
 
-/// Point external images (files beside the input) at the same files from the output's folder.
-fn rewrite_image_uris(json: &mut Value, source: &Source, output: &Path, report: &mut SaveReport) {
-    let Some(images) = json.get_mut("images").and_then(Value::as_array_mut) else {
-        return;
-    };
-    let out_dir = match output.parent() {
-        Some(dir) if !dir.as_os_str().is_empty() => dir.to_path_buf(),
-        _ => PathBuf::from("."),
-    };
-    for (i, image) in images.iter_mut().enumerate() {
-        let Some(uri) = image.get("uri").and_then(Value::as_str).map(str::to_owned) else {
+/// The external image files of the document (`uri` that is not a data: URI), resolved against
+/// the input's folder; those that cannot be found are named in the report and left as they are.
+fn external_images(
+    json: &Value,
+    source: &Source,
+    report: &mut SaveReport,
+) -> Vec<(usize, PathBuf)> {
+    let mut found = Vec::new();
+    let images = json.get("images").and_then(Value::as_array);
+    for (i, image) in images.into_iter().flatten().enumerate() {
+        let Some(uri) = image.get("uri").and_then(Value::as_str) else {
             continue;
         };
         if uri.starts_with("data:") {
@@ -781,63 +802,150 @@ fn rewrite_image_uris(json: &mut Value, source: &Source, output: &Path, report: 
         }
         let Some(base) = &source.base_dir else {
             report.warnings.push(format!(
-                "image {i} refers to the file {uri:?}, which was not resolved (the input was read from memory): the reference is kept as it was"
+                "image {i} refers to the file {uri:?}, which cannot be found (the input was read from memory): the reference is kept as it was"
             ));
             continue;
         };
-        let Some(relative) = super::gltf::percent_decode(&uri) else {
-            continue;
-        };
-        let base = if base.as_os_str().is_empty() {
-            Path::new(".")
-        } else {
-            base.as_path()
-        };
-        let target = base.join(&relative);
-        let (Ok(target), Ok(out_dir)) = (target.canonicalize(), out_dir.canonicalize()) else {
-            report.warnings.push(format!(
-                "image {i} refers to {}, which does not exist: the reference is kept as it was",
-                base.join(&relative).display()
-            ));
-            continue;
-        };
-        let Some(path) = relative_path(&out_dir, &target) else {
-            report.warnings.push(format!(
-                "image {i} ({}) cannot be reached from the output's folder by a relative path: the reference is kept as it was",
-                target.display()
-            ));
-            continue;
-        };
-        let encoded: Vec<String> = path
-            .components()
-            .map(|c| match c {
-                Component::ParentDir => "..".to_string(),
-                other => super::gltf::percent_encode(&other.as_os_str().to_string_lossy()),
-            })
-            .collect();
-        let encoded = encoded.join("/");
-        if super::gltf::percent_decode(&encoded).as_deref() != Some(relative.as_str()) {
-            image["uri"] = json!(encoded);
+        let file = super::gltf::percent_decode(uri).map(|relative| base.join(relative));
+        match file {
+            Some(file) if file.is_file() => found.push((i, file)),
+            _ => report.warnings.push(format!(
+                "image {i} refers to {uri:?}, which is not beside the input: the reference is kept as it was"
+            )),
         }
+    }
+    found
+}
+
+/// The MIME type of an image, from its first bytes or else its extension.
+fn image_mime_type(bytes: &[u8], file: &Path) -> &'static str {
+    if bytes.starts_with(b"\x89PNG") {
+        return "image/png";
+    }
+    if bytes.starts_with(&[0xFF, 0xD8]) {
+        return "image/jpeg";
+    }
+    if bytes.get(8..12) == Some(b"WEBP") {
+        return "image/webp";
+    }
+    match file
+        .extension()
+        .map(|e| e.to_string_lossy().to_ascii_lowercase())
+        .as_deref()
+    {
+        Some("jpg" | "jpeg") => "image/jpeg",
+        Some("webp") => "image/webp",
+        Some("ktx2") => "image/ktx2",
+        _ => "image/png",
     }
 }
 
-/// The path from folder `from` to `to`, both absolute and canonical.
-fn relative_path(from: &Path, to: &Path) -> Option<PathBuf> {
-    let from: Vec<Component> = from.components().collect();
-    let to: Vec<Component> = to.components().collect();
-    if from.first() != to.first() {
-        return None;
+/// A GLB is self-contained: external images are copied into its binary chunk, each in a buffer
+/// view of its own.
+fn embed_images(
+    json: &mut Value,
+    bin: &mut Vec<u8>,
+    images: Vec<(usize, PathBuf)>,
+    report: &mut SaveReport,
+) {
+    for (i, file) in images {
+        let bytes = match std::fs::read(&file) {
+            Ok(bytes) => bytes,
+            Err(e) => {
+                report.warnings.push(format!(
+                    "image {i} ({}) cannot be read ({e}): the reference is kept as it was",
+                    file.display()
+                ));
+                continue;
+            }
+        };
+        while bin.len() % 4 != 0 {
+            bin.push(0);
+        }
+        let view = json!({"buffer": 0, "byteOffset": bin.len(), "byteLength": bytes.len()});
+        bin.extend_from_slice(&bytes);
+        let Some(root) = json.as_object_mut() else {
+            return;
+        };
+        let views = root
+            .entry("bufferViews")
+            .or_insert_with(|| json!([]))
+            .as_array_mut();
+        let Some(views) = views else { return };
+        views.push(view);
+        let view_index = views.len() - 1;
+        if let Some(image) = root.get_mut("images").and_then(|list| list.get_mut(i)) {
+            if let Some(image) = image.as_object_mut() {
+                image.remove("uri");
+                image.insert("bufferView".into(), json!(view_index));
+                if !image.contains_key("mimeType") {
+                    image.insert("mimeType".into(), json!(image_mime_type(&bytes, &file)));
+                }
+            }
+        }
     }
-    let common = from.iter().zip(&to).take_while(|(a, b)| a == b).count();
-    let mut path = PathBuf::new();
-    for _ in common..from.len() {
-        path.push("..");
+    set_buffer_length(json, bin.len());
+}
+
+fn set_buffer_length(json: &mut Value, length: usize) {
+    if length == 0 {
+        return;
     }
-    for c in &to[common..] {
-        path.push(c.as_os_str());
+    match json.get_mut("buffers").and_then(|b| b.get_mut(0)) {
+        Some(buffer) => buffer["byteLength"] = json!(length),
+        None => json["buffers"] = json!([{ "byteLength": length }]),
     }
-    Some(path)
+}
+
+/// A `.gltf` keeps its images as files beside it: those not already in the output's folder are
+/// copied there (as `<output stem>_<name>` when another file of that name is there) and the
+/// copies to make are returned; those in the same folder are referenced as they were.
+fn place_image_files(
+    json: &mut Value,
+    images: Vec<(usize, PathBuf)>,
+    output: &Path,
+) -> Vec<(PathBuf, PathBuf)> {
+    let out_dir = match output.parent() {
+        Some(dir) if !dir.as_os_str().is_empty() => dir.to_path_buf(),
+        _ => PathBuf::from("."),
+    };
+    let stem = output
+        .file_stem()
+        .map_or_else(|| "mesh".into(), |s| s.to_string_lossy().into_owned());
+    let same = |a: &Path, b: &Path| match (a.canonicalize(), b.canonicalize()) {
+        (Ok(a), Ok(b)) => a == b,
+        _ => false,
+    };
+    let mut copies: Vec<(PathBuf, PathBuf)> = Vec::new();
+    for (i, file) in images {
+        if file.parent().is_some_and(|dir| same(dir, &out_dir)) {
+            continue;
+        }
+        let name = file.file_name().map_or_else(
+            || format!("image{i}.png"),
+            |n| n.to_string_lossy().into_owned(),
+        );
+        let mut target = out_dir.join(&name);
+        let taken = |target: &Path| {
+            copies
+                .iter()
+                .any(|(from, to)| to == target && *from != file)
+                || (target.exists() && std::fs::read(target).ok() != std::fs::read(&file).ok())
+        };
+        if taken(&target) {
+            target = out_dir.join(format!("{stem}_{name}"));
+        }
+        let uri_name = target
+            .file_name()
+            .map_or_else(|| name.clone(), |n| n.to_string_lossy().into_owned());
+        if let Some(image) = json.get_mut("images").and_then(|list| list.get_mut(i)) {
+            image["uri"] = json!(super::gltf::percent_encode(&uri_name));
+        }
+        if !copies.iter().any(|(_, to)| *to == target) {
+            copies.push((file, target));
+        }
+    }
+    copies
 }
 
 fn write_glb(out: &mut dyn Write, json: &Value, bin: &[u8]) -> std::io::Result<()> {

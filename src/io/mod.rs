@@ -397,15 +397,13 @@ pub fn save_with_source(
     let lost = source.contents();
     if !lost.is_empty() {
         let why = if source.writes_back_as(format) {
-            "the mesh no longer has its connectivity (a level of the hierarchy or a changed copy)"
-                .to_string()
+            "the mesh no longer has its connectivity (a level of the hierarchy or a changed copy), so it is written as a bare mesh".to_string()
         } else {
-            format!("{format} cannot hold them")
+            format!("it is written as a bare {format} mesh")
         };
-        report.warnings.push(format!(
-            "not kept from {name}, as {why}: {}",
-            lost.join("; ")
-        ));
+        report
+            .warnings
+            .push(format!("{why}; not kept from {name}: {}", lost.join("; ")));
     }
     Ok(report)
 }
