@@ -152,8 +152,8 @@ fn exports_and_reloads_the_result() {
     settle(&mut harness);
     let loaded = harness.state().status();
 
-    // The default export name sits next to the input.
-    let default_export = bunny().with_file_name("bunny00_faired.glb");
+    // The default export name sits next to the input, in its format.
+    let default_export = bunny().with_file_name("bunny00_faired.obj");
     assert!(harness
         .get_all_by_role(Role::TextInput)
         .any(|node| node.value() == Some(default_export.display().to_string())));
@@ -161,7 +161,7 @@ fn exports_and_reloads_the_result() {
     let target = dir.path().join("bunny_faired.glb");
     retype(
         &mut harness,
-        |v| v.ends_with("_faired.glb"),
+        |v| v.ends_with("_faired.obj"),
         &target.display().to_string(),
     );
     harness
@@ -192,6 +192,50 @@ fn exports_and_reloads_the_result() {
     assert!(reloaded.error.is_none(), "{:?}", reloaded.error);
     assert_eq!(reloaded.shown_faces, loaded.shown_faces);
     assert_eq!(reloaded.shown_vertices, loaded.shown_vertices);
+}
+
+#[test]
+fn export_writes_an_artists_file_back_with_its_materials_groups_and_uvs() {
+    let dir = tempfile::tempdir().unwrap();
+    let data = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/roundtrip");
+    let input = dir.path().join("textured.obj");
+    std::fs::copy(data.join("textured.obj"), &input).unwrap();
+    let mut harness = harness_for(input.clone());
+    settle(&mut harness);
+    // The default export (Ctrl+E) keeps the input's format; nothing is lost, so no note.
+    harness.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::E);
+    settle(&mut harness);
+    let status = harness.state().status();
+    assert!(status.error.is_none(), "{:?}", status.error);
+    let message = status.message.unwrap_or_default();
+    assert!(message.starts_with("Exported to"), "{message}");
+    assert!(!message.contains("Note"), "{message}");
+    let before = std::fs::read_to_string(&input).unwrap();
+    let after = std::fs::read_to_string(dir.path().join("textured_faired.obj")).unwrap();
+    let kept = |text: &str| -> Vec<String> {
+        text.lines()
+            .filter(|l| !l.starts_with("v ") && !l.starts_with("vn "))
+            .map(str::to_owned)
+            .collect()
+    };
+    assert_eq!(kept(&before), kept(&after));
+    assert_ne!(before, after, "the faired shape was written");
+
+    // Exported as GLB, the editor says what GLB does not keep of the OBJ.
+    retype(
+        &mut harness,
+        |v| v.ends_with("_faired.obj"),
+        &dir.path().join("as.glb").display().to_string(),
+    );
+    harness
+        .get_by_role_and_label(Role::Button, "Export")
+        .click();
+    settle(&mut harness);
+    let message = harness.state().status().message.unwrap_or_default();
+    assert!(
+        message.contains("Note") && message.contains("texture coordinates"),
+        "{message}"
+    );
 }
 
 #[test]

@@ -430,7 +430,7 @@ fn shortcuts_export_and_persisted_settings_round_trip() {
     let target = dir.path().join("shortcut.glb");
     retype(
         &mut harness,
-        |v| v.ends_with("_faired.glb"),
+        |v| v.ends_with("_faired.obj"),
         &target.display().to_string(),
     );
     harness.key_press(egui::Key::Escape);

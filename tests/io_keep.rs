@@ -305,7 +305,10 @@ fn gltf_scenes_keep_everything_but_their_shape() {
     let texture = std::fs::read(data("checker.png")).unwrap();
     let gltf = read_gltf(&dir.path().join("scene_gltf.gltf"));
     assert_eq!(gltf.json["images"][0]["uri"], "checker.png");
-    assert_eq!(std::fs::read(dir.path().join("checker.png")).unwrap(), texture);
+    assert_eq!(
+        std::fs::read(dir.path().join("checker.png")).unwrap(),
+        texture
+    );
     let glb = read_gltf(&dir.path().join("scene_gltf.glb"));
     let image = &glb.json["images"][0];
     assert!(image.get("uri").is_none(), "{image}");

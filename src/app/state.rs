@@ -510,13 +510,16 @@ impl Document {
     }
 }
 
-/// `<stem>_faired.glb` next to `input`.
+/// `<stem>_faired.<extension>` next to `input`, in the input's format.
 pub fn default_export_path(input: &Path) -> PathBuf {
     let stem = input
         .file_stem()
         .map(|s| s.to_string_lossy().into_owned())
         .unwrap_or_else(|| "mesh".to_owned());
-    input.with_file_name(format!("{stem}_faired.glb"))
+    // The input's own format, so that the export keeps everything the file holds (materials,
+    // UVs, colours, the scene); GLB for a name with no known format.
+    let extension = crate::io::Format::from_path(input).map_or("glb", |f| f.extension());
+    input.with_file_name(format!("{stem}_faired.{extension}"))
 }
 
 /// Axis-aligned bounds of `positions` (zeros when empty).
@@ -545,10 +548,18 @@ mod tests {
     use super::*;
 
     #[test]
-    fn export_name_sits_next_to_the_input() {
+    fn export_name_sits_next_to_the_input_in_its_format() {
         assert_eq!(
             default_export_path(Path::new("/scans/bunny00.obj")),
-            PathBuf::from("/scans/bunny00_faired.glb")
+            PathBuf::from("/scans/bunny00_faired.obj")
+        );
+        assert_eq!(
+            default_export_path(Path::new("/art/scene.GLB")),
+            PathBuf::from("/art/scene_faired.glb")
+        );
+        assert_eq!(
+            default_export_path(Path::new("/art/dropped")),
+            PathBuf::from("/art/dropped_faired.glb")
         );
     }
 

@@ -48,7 +48,10 @@ fn save_rows(args: &BenchArgs, loaded: &io::Loaded) -> anyhow::Result<Vec<(Strin
     let _ = std::fs::remove_dir_all(&dir);
     result?;
     Ok(vec![
-        (format!("save {format}, keeping the input file's content"), kept),
+        (
+            format!("save {format}, keeping the input file's content"),
+            kept,
+        ),
         (format!("save {format}, bare mesh"), bare),
     ])
 }

@@ -97,9 +97,23 @@ pub(crate) fn parse(bytes: &[u8], path: &Path, base_dir: Option<&Path>) -> Resul
         reads,
         ..
     } = reader;
+    // Buffers read from elsewhere are owned already; the GLB's BIN chunk is taken, not copied.
+    let owned: Vec<Option<Vec<u8>>> = buffers
+        .into_iter()
+        .map(|b| match b {
+            Cow::Owned(data) => Some(data),
+            Cow::Borrowed(_) => None,
+        })
+        .collect();
+    let mut document = document;
+    let mut blob = document.blob.take();
+    let buffers = owned
+        .into_iter()
+        .map(|b| b.unwrap_or_else(|| blob.take().unwrap_or_default()))
+        .collect();
     let source = GltfSource {
         json,
-        buffers: buffers.into_iter().map(Cow::into_owned).collect(),
+        buffers,
         reads,
     };
     Ok(Parsed {

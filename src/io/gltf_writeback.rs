@@ -633,32 +633,28 @@ fn turn_normals(
             (read, read)
         }
     };
+    // Per element: the area sums of its faces before and after; then slots (see
+    // `SmoothGroups`), and the sums of each slot.
     let mut groups = SmoothGroups::default();
     let mut turns = NormalTurns::new(0);
     let mut slotted: Vec<(usize, &Layout, Vec<usize>, &BTreeSet<usize>)> = Vec::new();
     for (&n, (layout, uses, tangents)) in &normals {
-        let mut own = vec![glam::DVec3::ZERO; layout.count];
+        let mut elements = NormalTurns::new(layout.count);
         for (p, positions, triangles) in uses {
             for &t in triangles {
-                let [a, b, c] = corners(*p, positions, t).0.map(dvec);
-                for v in t {
-                    own[v] += (b - a).cross(c - a);
-                }
+                let (before, after) = corners(*p, positions, t);
+                elements.add(t, before.map(dvec), after.map(dvec));
             }
         }
         let start = first_read.get(&uses[0].0).copied();
         let slots: Vec<usize> = (0..layout.count)
             .map(|k| {
                 let welded = start.and_then(|s| source.welded(s + k));
-                groups.slot_for(own[k], welded, gltf.read3(layout, k))
+                let slot = groups.slot_for(elements.area_before(k), welded, gltf.read3(layout, k));
+                turns.merge_slot(slot, &elements, k);
+                slot
             })
             .collect();
-        for (p, positions, triangles) in uses {
-            for &t in triangles {
-                let (before, after) = corners(*p, positions, t);
-                turns.add(t.map(|v| slots[v]), before.map(dvec), after.map(dvec));
-            }
-        }
         slotted.push((n, layout, slots, tangents));
     }
     let mut changed = BTreeSet::new();

@@ -921,53 +921,53 @@ pub(crate) fn write_back(
     let normal_props = normal_properties(element);
     let big = header.encoding == Encoding::BigEndian;
 
-    // The file's positions and faces, as the reader reads them.
-    let parsed = parse(bytes, path).map_err(|e| invalid(&e.to_string()))?;
-    let before = &parsed.mesh.positions;
+    // The file's positions, as the reader reads them.
+    let before = &vertex_triples(bytes, &header, &rows, element, layout.xyz);
     let after: Vec<[f32; 3]> = (0..before.len())
         .map(|k| source.welded(k).map_or(before[k], |w| mesh.positions[w]))
         .collect();
-    // Slots for the normals (see `SmoothGroups`), read from the file when it has normals.
-    let slots: Option<Vec<usize>> = normal_props.filter(|_| before != &after).map(|props| {
-        let values = file_normals(bytes, &header, &rows, element, props);
-        let mut own = vec![glam::DVec3::ZERO; before.len()];
-        for t in &parsed.mesh.triangles {
-            let [a, b, c] = t.map(|v| dvec(before[v as usize]));
-            for v in t {
-                own[*v as usize] += (b - a).cross(c - a);
+    // The faces, only needed to turn normals.
+    let parsed = match normal_props {
+        Some(_) if before != &after => {
+            Some(parse(bytes, path).map_err(|e| invalid(&e.to_string()))?)
+        }
+        _ => None,
+    };
+    // Per vertex: the area sums of its faces before and after; then slots (see `SmoothGroups`)
+    // and the sums of each slot. Only when the file has normals.
+    let slotted: Option<(Vec<usize>, NormalTurns)> =
+        normal_props.zip(parsed.as_ref()).map(|(props, parsed)| {
+            let values = vertex_triples(bytes, &header, &rows, element, props);
+            let mut elements = NormalTurns::new(before.len());
+            for t in &parsed.mesh.triangles {
+                let corners = t.map(|v| v as usize);
+                elements.add(
+                    corners,
+                    corners.map(|v| dvec(before[v])),
+                    corners.map(|v| dvec(after[v])),
+                );
             }
-        }
-        let mut groups = SmoothGroups::default();
-        (0..before.len())
-            .map(|k| {
-                let normal = values.get(k).copied().unwrap_or_default();
-                groups.slot_for(own[k], source.welded(k), normal)
-            })
-            .collect()
-    });
-    let turns = slots.as_ref().map(|slots| {
-        let mut turns = NormalTurns::new(before.len());
-        for t in &parsed.mesh.triangles {
-            let corners = t.map(|v| v as usize);
-            turns.add(
-                corners.map(|v| slots[v]),
-                corners.map(|v| dvec(before[v])),
-                corners.map(|v| dvec(after[v])),
-            );
-        }
-        turns
-    });
-
+            let mut groups = SmoothGroups::default();
+            let mut turns = NormalTurns::new(0);
+            let slots = (0..before.len())
+                .map(|k| {
+                    let normal = values.get(k).copied().unwrap_or_default();
+                    let slot = groups.slot_for(elements.area_before(k), source.welded(k), normal);
+                    turns.merge_slot(slot, &elements, k);
+                    slot
+                })
+                .collect();
+            (slots, turns)
+        });
     // The properties to rewrite in a row: (property index, value).
     let changes = |k: usize, row_normal: &dyn Fn([usize; 3]) -> Option<[f32; 3]>| {
         let mut list: Vec<(usize, f32)> = Vec::new();
-        if before[k] != after[k] {
+        if before[k] != after[k] && after[k].iter().all(|c| c.is_finite()) {
             list.extend(layout.xyz.iter().copied().zip(after[k]));
         }
-        let turn = turns
+        let turn = slotted
             .as_ref()
-            .zip(slots.as_ref())
-            .and_then(|(t, slots)| t.turn(slots[k]));
+            .and_then(|(slots, turns)| turns.turn(slots[k]));
         if let (Some(props), Some(turn)) = (normal_props, turn) {
             if let Some(normal) = row_normal(props) {
                 list.extend(props.iter().copied().zip(turn.normal(normal)));
@@ -1051,8 +1051,9 @@ pub(crate) fn write_back(
     }
 }
 
-/// The nx, ny, nz of every vertex row (zero where unreadable).
-fn file_normals(
+/// Three scalar properties (x y z, or nx ny nz) of every vertex row, read as the reader reads
+/// coordinates (NaN where unreadable).
+fn vertex_triples(
     bytes: &[u8],
     header: &Header,
     rows: &VertexRows,
@@ -1081,7 +1082,7 @@ fn file_normals(
                         } else {
                             read_f32::<false>(kind, &row[at..])
                         }
-                        .unwrap_or(0.0)
+                        .unwrap_or(f32::NAN)
                     })
                 })
                 .collect()
@@ -1093,7 +1094,16 @@ fn file_normals(
             .take(element.count as usize)
             .map(|line| {
                 let words: Vec<&[u8]> = tokens(line).collect();
-                props.map(|p| words.get(p).and_then(|t| parse_f32(t)).unwrap_or(0.0))
+                props.map(|p| {
+                    let kind = match element.properties.get(p) {
+                        Some(Property::Scalar { kind, .. }) => *kind,
+                        _ => Scalar::F32,
+                    };
+                    words
+                        .get(p)
+                        .and_then(|t| ascii_coordinate(kind, t))
+                        .unwrap_or(f32::NAN)
+                })
             })
             .collect(),
     }

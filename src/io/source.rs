@@ -186,6 +186,23 @@ impl NormalTurns {
         }
     }
 
+    /// The sum of the area vectors of slot `n`'s faces before the move.
+    pub(crate) fn area_before(&self, n: usize) -> DVec3 {
+        self.before.get(n).copied().unwrap_or(DVec3::ZERO)
+    }
+
+    /// Add the sums of `from`'s slot `n` to this one's slot `slot`.
+    pub(crate) fn merge_slot(&mut self, slot: usize, from: &NormalTurns, n: usize) {
+        if slot >= self.before.len() {
+            self.before.resize(slot + 1, DVec3::ZERO);
+            self.after.resize(slot + 1, DVec3::ZERO);
+            self.moved.resize(slot + 1, false);
+        }
+        self.before[slot] += from.before[n];
+        self.after[slot] += from.after[n];
+        self.moved[slot] |= from.moved[n];
+    }
+
     /// The rotation for normal `n`, or `None` when it stays as it is.
     pub(crate) fn turn(&self, n: usize) -> Option<Turn> {
         if !*self.moved.get(n)? {
@@ -208,7 +225,11 @@ impl NormalTurns {
 /// welded vertex gets a slot of its own.
 #[derive(Default)]
 pub(crate) struct SmoothGroups {
-    slots: std::collections::HashMap<(usize, [u32; 3]), usize>,
+    slots: std::collections::HashMap<
+        (usize, [u32; 3]),
+        usize,
+        std::hash::BuildHasherDefault<crate::mesh::PositionHasher>,
+    >,
     next: usize,
 }
 
