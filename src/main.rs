@@ -33,6 +33,7 @@ fn run_editor(args: cli::EditArgs) -> anyhow::Result<()> {
     fairmesh::app::run(fairmesh::app::AppOptions {
         file: args.file,
         log_frames_over,
+        exit_when_settled: args.exit_when_settled,
         ..Default::default()
     })
 }

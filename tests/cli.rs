@@ -213,3 +213,53 @@ fn errors_name_the_file_and_exit_with_code_1() {
     assert_eq!(bad_sigma.status.code(), Some(1));
     assert!(!dir.path().join("x.obj").exists());
 }
+
+/// `@bunny` reads the bunny compiled into the binary: it works from a folder with no files.
+#[test]
+fn the_bundled_bunny_is_read_without_any_file() {
+    let empty = tempfile::tempdir().unwrap();
+    let out = Command::new(env!("CARGO_BIN_EXE_fairmesh"))
+        .args(["info", "@bunny", "--json"])
+        .current_dir(empty.path())
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let info: Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(info["vertices"], 37706);
+    assert_eq!(info["faces"], 75408);
+    // A real file of that name is still reachable as `./@bunny` (here it does not exist).
+    let out = Command::new(env!("CARGO_BIN_EXE_fairmesh"))
+        .args(["info", "./@bunny"])
+        .current_dir(empty.path())
+        .output()
+        .unwrap();
+    assert!(!out.status.success());
+}
+
+/// STL is written like the other formats, and reads back with the same triangles.
+#[test]
+fn convert_writes_stl() {
+    let dir = tempfile::tempdir().unwrap();
+    let stl = dir.path().join("bunny.stl");
+    let out = fairmesh(&[
+        "convert",
+        &data("bunny_npm.obj"),
+        "-o",
+        stl.to_str().unwrap(),
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let info = json_of(&["info", stl.to_str().unwrap(), "--json"]);
+    assert_eq!(info["vertices"], 1839);
+    assert_eq!(info["faces"], 3674);
+    let help = fairmesh(&["--help"]);
+    let help = String::from_utf8_lossy(&help.stdout);
+    assert!(help.contains(".stl .off, to read and to write"), "{help}");
+}

@@ -134,7 +134,7 @@ impl FairArgs {
 }
 
 pub fn run(args: FairArgs) -> anyhow::Result<()> {
-    let loaded = fairmesh::io::load(&args.input)?;
+    let loaded = super::basic::load(&args.input, true)?;
     let (mut mesh, topology) = (loaded.mesh, loaded.topology);
     let options = args.method_options(fairmesh::metrics::mean_edge_length(&mesh));
     let volume_before = fairmesh::metrics::signed_volume(&mesh);
