@@ -45,6 +45,21 @@ impl Default for NoiseOptions {
 }
 
 /// Adds noise in place; returns the absolute sigma used (model units).
+///
+/// ```
+/// use fairmesh::noise::{add_noise, NoiseMode, NoiseOptions};
+///
+/// let clean = fairmesh::bundled::load_bunny(&Default::default())?.mesh;
+/// let mut noisy = clean.clone();
+/// let options = NoiseOptions { sigma: 0.2, seed: 7, mode: NoiseMode::Normal };
+/// let sigma = add_noise(&mut noisy, &options);
+/// assert!(sigma > 0.0);
+/// // Seeded: the same seed gives the same mesh.
+/// let mut again = clean.clone();
+/// add_noise(&mut again, &options);
+/// assert_eq!(noisy.positions, again.positions);
+/// # Ok::<(), fairmesh::io::IoError>(())
+/// ```
 pub fn add_noise(mesh: &mut TriMesh, options: &NoiseOptions) -> f64 {
     let sigma = options.sigma.max(0.0) * metrics::mean_edge_length(mesh);
     if sigma == 0.0 || !sigma.is_finite() {

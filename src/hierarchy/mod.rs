@@ -286,6 +286,23 @@ impl LevelCursor {
     }
 }
 
+/// Builds the decimation hierarchy of `mesh` (section 4.1): M0 is `mesh`, each further level
+/// removes an independent set of vertices by volume-preserving half-edge collapses. `progress`
+/// may cancel the build ([`HierarchyError::Cancelled`]); a mesh that is not an oriented
+/// 2-manifold is refused ([`HierarchyError::Unsupported`]).
+///
+/// ```
+/// use fairmesh::hierarchy::{build_hierarchy, HierarchyOptions};
+///
+/// let mesh = fairmesh::bundled::load_bunny(&Default::default())?.mesh;
+/// let hierarchy = build_hierarchy(&mesh, &HierarchyOptions::default(), &mut fairmesh::NoProgress)?;
+/// assert_eq!(hierarchy.level_info(0).vertices, mesh.vertex_count());
+/// let coarsest = hierarchy.level_info(hierarchy.coarsest_level());
+/// assert!(coarsest.vertices < mesh.vertex_count() / 20);
+/// // Every level is a closed mesh again: V − E + F = 2, so F = 2V − 4.
+/// assert_eq!(coarsest.faces, 2 * coarsest.vertices - 4);
+/// # Ok::<(), Box<dyn std::error::Error>>(())
+/// ```
 pub fn build_hierarchy(
     mesh: &TriMesh,
     options: &HierarchyOptions,
