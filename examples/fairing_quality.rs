@@ -146,10 +146,7 @@ fn main() {
             fair(
                 &mut faired,
                 &topology,
-                &MethodOptions::Constrained(FairOptions {
-                    variant,
-                    ..Default::default()
-                }),
+                &MethodOptions::Constrained(FairOptions::default().with_variant(variant)),
             );
             let moves: Vec<f64> = clean
                 .positions
@@ -176,11 +173,10 @@ fn main() {
         let mut noisy = clean.clone();
         add_noise(
             &mut noisy,
-            &NoiseOptions {
-                sigma: 0.3,
-                seed: 1,
-                mode: NoiseMode::Normal,
-            },
+            &NoiseOptions::default()
+                .with_sigma(0.3)
+                .with_seed(1)
+                .with_mode(NoiseMode::Normal),
         );
         println!("\nNoise 0.3 mean edge lengths along normals (seed 1):\n");
         println!("| method | setting | surf mean | hausdorff | rms | normal ° | vol % |\n|---|---|---:|---:|---:|---:|---:|");
@@ -191,13 +187,14 @@ fn main() {
                 fair(
                     &mut faired,
                     &topology,
-                    &MethodOptions::Constrained(FairOptions {
-                        iterations: 10,
-                        rounds,
-                        variant,
-                        boundary: BoundaryMode::Curve,
-                        tolerance: 0.0,
-                    }),
+                    &MethodOptions::Constrained(
+                        FairOptions::default()
+                            .with_iterations(10)
+                            .with_rounds(rounds)
+                            .with_variant(variant)
+                            .with_boundary(BoundaryMode::Curve)
+                            .with_tolerance(0.0),
+                    ),
                 );
                 row(
                     &format!("constrained {}", variant.name()),

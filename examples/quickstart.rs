@@ -49,20 +49,14 @@ fn run() -> Result<(), Box<dyn std::error::Error>> {
     report("constrained fairing, 1 round", &clean, &once);
 
     let mut five = noisy.clone();
-    let options = FairOptions {
-        rounds: 5,
-        ..Default::default()
-    };
+    let options = FairOptions::default().with_rounds(5);
     fair_constrained(&mut five, &loaded.topology, &options);
     report("constrained fairing, 5 rounds", &clean, &five);
 
     // The hierarchy depends on the connectivity only, which noise leaves alone.
     let hierarchy = build_hierarchy(&noisy, &HierarchyOptions::default(), &mut NoProgress)?;
     let start_level = hierarchy.coarsest_level() / 2;
-    let options = MultiresOptions {
-        start_level,
-        ..Default::default()
-    };
+    let options = MultiresOptions::default().with_start_level(start_level);
     let mut workspace = MultiresWorkspace::default();
     let positions = fair_multires(&hierarchy, &options, &mut workspace, &mut NoProgress)
         .ok_or("multiresolution fairing was cancelled")?;

@@ -52,6 +52,25 @@
 //! # Ok::<(), fairmesh::io::IoError>(())
 //! ```
 
+/// `with_*` setters for an options struct. The options structs are `#[non_exhaustive]` (they will
+/// grow), so code outside the crate starts from `Default` and sets what it needs:
+/// `FairOptions::default().with_rounds(3)`.
+macro_rules! with_setters {
+    ($type:ident { $($setter:ident => $field:ident: $field_type:ty),* $(,)? }) => {
+        impl $type {
+            $(
+                #[doc = concat!("`self` with [`", stringify!($field), "`](Self::",
+                    stringify!($field), ") set to `value`.")]
+                #[must_use]
+                pub fn $setter(mut self, value: $field_type) -> Self {
+                    self.$field = value;
+                    self
+                }
+            )*
+        }
+    };
+}
+
 pub mod bundled;
 pub mod fairing;
 pub mod hierarchy;

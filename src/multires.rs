@@ -59,22 +59,39 @@ use glam::Vec3A;
 use rayon::prelude::*;
 
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[non_exhaustive]
 pub enum MultiresVariant {
     Paper,
     #[default]
     Improved,
 }
 
+/// Options of [`fair_multires`]; build them with `MultiresOptions::default()` and the `with_*`
+/// setters.
 #[derive(Clone, Debug)]
+#[non_exhaustive]
 pub struct MultiresOptions {
+    /// The level fairing starts from (0 is M0 itself); beyond the coarsest, the coarsest.
     pub start_level: usize,
+    /// Constrained fairing iterations per round on each level.
     pub iterations: usize,
+    /// Rounds per level (each re-anchors the constraints).
     pub rounds: usize,
+    /// How boundary vertices move on each level.
     pub boundary: BoundaryMode,
     /// Also fair M0 after the last refinement.
     pub fair_finest: bool,
     pub variant: MultiresVariant,
 }
+
+with_setters!(MultiresOptions {
+    with_start_level => start_level: usize,
+    with_iterations => iterations: usize,
+    with_rounds => rounds: usize,
+    with_boundary => boundary: BoundaryMode,
+    with_fair_finest => fair_finest: bool,
+    with_variant => variant: MultiresVariant,
+});
 
 impl Default for MultiresOptions {
     fn default() -> Self {
@@ -265,7 +282,7 @@ fn level_fair_options(options: &MultiresOptions) -> FairOptions {
 ///
 /// let mesh = fairmesh::bundled::load_bunny(&Default::default())?.mesh;
 /// let hierarchy = build_hierarchy(&mesh, &HierarchyOptions::default(), &mut NoProgress)?;
-/// let options = MultiresOptions { start_level: 8, ..Default::default() };
+/// let options = MultiresOptions::default().with_start_level(8);
 /// let mut workspace = MultiresWorkspace::default(); // keep it to run again cheaply
 /// let positions = fair_multires(&hierarchy, &options, &mut workspace, &mut NoProgress)
 ///     .expect("NoProgress never cancels");

@@ -193,11 +193,10 @@ pub fn noise(args: NoiseArgs) -> anyhow::Result<()> {
     };
     let absolute = noise::add_noise(
         &mut loaded.mesh,
-        &NoiseOptions {
-            sigma: args.sigma,
-            seed: args.seed,
-            mode,
-        },
+        &NoiseOptions::default()
+            .with_sigma(args.sigma)
+            .with_seed(args.seed)
+            .with_mode(mode),
     );
     io::save(&args.output, &loaded.mesh)?;
     eprintln!(

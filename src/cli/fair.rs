@@ -93,16 +93,17 @@ impl FairArgs {
             BoundaryArg::Fixed => BoundaryMode::Fixed,
         };
         match self.method {
-            MethodArg::Constrained => MethodOptions::Constrained(FairOptions {
-                iterations: self.iterations,
-                tolerance: self.tolerance * mean_edge_length,
-                rounds: self.rounds,
-                boundary,
-                variant: match self.variant {
-                    VariantArg::Paper => FairVariant::Paper,
-                    VariantArg::NormalProjected => FairVariant::NormalProjected,
-                },
-            }),
+            MethodArg::Constrained => MethodOptions::Constrained(
+                FairOptions::default()
+                    .with_iterations(self.iterations)
+                    .with_tolerance(self.tolerance * mean_edge_length)
+                    .with_rounds(self.rounds)
+                    .with_boundary(boundary)
+                    .with_variant(match self.variant {
+                        VariantArg::Paper => FairVariant::Paper,
+                        VariantArg::NormalProjected => FairVariant::NormalProjected,
+                    }),
+            ),
             MethodArg::Laplacian => {
                 let defaults = LaplacianOptions::default();
                 MethodOptions::Laplacian(LaplacianOptions {

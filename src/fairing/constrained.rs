@@ -925,7 +925,7 @@ fn split_by_offsets<'a, T>(data: &'a mut [T], offsets: &[u32]) -> Vec<&'a mut [T
 /// add_noise(&mut mesh, &NoiseOptions::default());
 /// let noisy = mesh.clone();
 ///
-/// let options = FairOptions { rounds: 3, ..Default::default() };
+/// let options = FairOptions::default().with_rounds(3);
 /// let report = fair_constrained(&mut mesh, &topology, &options);
 /// assert!(report.iterations_run > 0);
 /// // Smoother: the vertices moved, by less than the noise's size.

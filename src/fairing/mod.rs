@@ -47,6 +47,7 @@ pub use constrained::{fair_constrained, ConstrainedFairing};
 
 /// How boundary vertices of open meshes move.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[non_exhaustive]
 pub enum BoundaryMode {
     /// Each boundary loop is smoothed as a closed curve (section 3.3).
     #[default]
@@ -66,6 +67,7 @@ impl BoundaryMode {
 
 /// Which constrained operator.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[non_exhaustive]
 pub enum FairVariant {
     /// The paper's operator exactly (uniform umbrella weights, eq 7, plain average).
     Paper,
@@ -85,8 +87,10 @@ impl FairVariant {
     }
 }
 
-/// Options of [`fair_constrained`].
+/// Options of [`fair_constrained`]; build them with `FairOptions::default()` and the `with_*`
+/// setters.
 #[derive(Clone, Debug)]
+#[non_exhaustive]
 pub struct FairOptions {
     /// Iterations per round.
     pub iterations: usize,
@@ -94,9 +98,19 @@ pub struct FairOptions {
     pub tolerance: f64,
     /// Number of rounds; each round re-imposes the constraints on the current positions.
     pub rounds: usize,
+    /// How boundary vertices move.
     pub boundary: BoundaryMode,
+    /// The paper's update or its normal-projected form (the default).
     pub variant: FairVariant,
 }
+
+with_setters!(FairOptions {
+    with_iterations => iterations: usize,
+    with_tolerance => tolerance: f64,
+    with_rounds => rounds: usize,
+    with_boundary => boundary: BoundaryMode,
+    with_variant => variant: FairVariant,
+});
 
 impl Default for FairOptions {
     fn default() -> Self {
@@ -121,6 +135,7 @@ pub struct FairReport {
 
 /// The smoothing methods offered by the CLI and the editor.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[non_exhaustive]
 pub enum Method {
     /// Constrained fairing (the paper's method).
     #[default]
@@ -165,6 +180,7 @@ impl std::str::FromStr for Method {
 
 /// One method with its options.
 #[derive(Clone, Debug)]
+#[non_exhaustive]
 pub enum MethodOptions {
     Constrained(FairOptions),
     Laplacian(LaplacianOptions),

@@ -30,9 +30,14 @@ use decimate::NEVER;
 use rayon::prelude::*;
 use std::sync::atomic::{AtomicU64, Ordering};
 
+/// Options of [`build_hierarchy`]; build them with `HierarchyOptions::default()` and the
+/// `with_*` setters.
 #[derive(Clone, Debug)]
+#[non_exhaustive]
 pub struct HierarchyOptions {
+    /// Weight of the shortest incident edge in a vertex's removal cost (the paper's α).
     pub alpha: f64,
+    /// Weight of the longest incident edge in a vertex's removal cost (the paper's β).
     pub beta: f64,
     /// Stop when a level has fewer vertices than this.
     pub min_vertices: usize,
@@ -41,6 +46,14 @@ pub struct HierarchyOptions {
     /// Never collapse boundary vertices.
     pub keep_boundary: bool,
 }
+
+with_setters!(HierarchyOptions {
+    with_alpha => alpha: f64,
+    with_beta => beta: f64,
+    with_min_vertices => min_vertices: usize,
+    with_max_levels => max_levels: usize,
+    with_keep_boundary => keep_boundary: bool,
+});
 
 impl Default for HierarchyOptions {
     fn default() -> Self {
@@ -55,6 +68,7 @@ impl Default for HierarchyOptions {
 }
 
 #[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
 pub enum HierarchyError {
     #[error("hierarchy build cancelled")]
     Cancelled,
