@@ -45,7 +45,7 @@
 //! [`MultiresWorkspace::prepare_for`]; a run then only moves positions, and allocates nothing but its result. The whole run
 //! executes on a worker of the rayon pool (a run makes a dozen parallel calls per level, and each
 //! call issued from outside the pool is a cross-thread hand-off); passes over the coarse levels
-//! are not split below [`PARALLEL_GRAIN`] vertices. The per-level passes (Kobbelt step, vertex
+//! are not split below `PARALLEL_GRAIN` vertices. The per-level passes (Kobbelt step, vertex
 //! normals, low-pass filters) work in f32 SIMD points; the Kobbelt step takes every vertex's
 //! umbrella Laplacian once instead of once per adjacent split vertex, and closed fans give the
 //! vertex normals from their fan order (one gather per neighbour instead of three per face).

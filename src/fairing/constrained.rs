@@ -42,7 +42,7 @@
 //!
 //! # Speed
 //! - Locality: vertices are renumbered breadth-first over the one-rings (neighbours close in
-//!   memory), then sorted by valence within blocks of [`VALENCE_SORTED_BLOCK`] (the gather loops'
+//!   memory), then sorted by valence within blocks of `VALENCE_SORTED_BLOCK` (the gather loops'
 //!   exits become predictable); [`ConstrainedFairing::load`] and [`ConstrainedFairing::store`]
 //!   map between the mesh's numbering and this one.
 //! - Bytes: weight rows are deduplicated (a mesh has a few hundred distinct rows) and each entry

@@ -1,6 +1,6 @@
 //! Volume-preserving decimation hierarchy (paper section 4.1) and moving between its levels.
 //!
-//! [`build_hierarchy`] runs the passes of [`decimate`] (one pass per level, see that module for
+//! [`build_hierarchy`] runs the passes of `decimate.rs` (one pass per level, see that module for
 //! the cost, the independent set, the cone volume and the validity rules) and then stores the
 //! result in a form where every level is cheap to reach:
 //!
