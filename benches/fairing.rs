@@ -13,21 +13,9 @@ fn meshes() -> Vec<(&'static str, TriMesh)> {
         .expect("assets/bunny00.obj")
         .mesh;
     let mut big = fairmesh::mesh::subdivide_loop(&fairmesh::mesh::subdivide_loop(&bunny));
-    add_noise(
-        &mut big,
-        &NoiseOptions {
-            sigma: 0.3,
-            ..Default::default()
-        },
-    );
+    add_noise(&mut big, &NoiseOptions::default().with_sigma(0.3));
     let mut noisy_bunny = bunny;
-    add_noise(
-        &mut noisy_bunny,
-        &NoiseOptions {
-            sigma: 0.3,
-            ..Default::default()
-        },
-    );
+    add_noise(&mut noisy_bunny, &NoiseOptions::default().with_sigma(0.3));
     vec![("bunny00", noisy_bunny), ("bunny00_x16", big)]
 }
 

@@ -23,10 +23,7 @@ fn bench_mesh(c: &mut Criterion, name: &str, mesh: &TriMesh) {
     let mut workspace = MultiresWorkspace::new();
     let coarsest = hierarchy.coarsest_level();
     for (label, level) in [("coarsest", coarsest), ("middle", coarsest / 2)] {
-        let options = MultiresOptions {
-            start_level: level,
-            ..Default::default()
-        };
+        let options = MultiresOptions::default().with_start_level(level);
         // The first run builds the per-level connectivity into the workspace.
         fair_multires(&hierarchy, &options, &mut workspace, &mut NoProgress);
         c.bench_function(

@@ -4,7 +4,8 @@
 //! Also measures how far each variant moves the vertices of the noise-free mesh.
 //!
 //! Run: `cargo run --release --no-default-features --example fairing_quality [DATA_DIR]`
-//! (DATA_DIR defaults to `../shared/data`; meshes bunny00, elephant, mushroom_open).
+//! (meshes bunny00, elephant, mushroom_open: read from DATA_DIR when given, otherwise from the
+//! repository's `assets/` and `tests/data/`). `docs/measurements.md` holds the tables it printed.
 //!
 //! Measures (all lengths in mean edge lengths of the clean mesh):
 //! - `surf mean`, `hausdorff`: `metrics::compare` (surface distance both ways through a BVH).
@@ -22,7 +23,7 @@ use fairmesh::fairing::{
 use fairmesh::metrics::{closest_point_on_triangle, mean_edge_length, signed_volume};
 use fairmesh::noise::{add_noise, NoiseMode, NoiseOptions};
 use fairmesh::{Topology, TriMesh};
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 /// Faces within the 3-ring of every vertex (shared connectivity), computed once per mesh.
 fn local_faces(topology: &Topology, vertex_count: usize) -> Vec<Vec<u32>> {
@@ -107,12 +108,21 @@ fn row(name: &str, setting: &str, q: &Quality) {
 }
 
 fn main() {
-    let data_dir = std::env::args()
-        .nth(1)
-        .map(PathBuf::from)
-        .unwrap_or_else(|| PathBuf::from("../shared/data"));
+    let repository = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let data_dirs = match std::env::args().nth(1) {
+        Some(dir) => vec![PathBuf::from(dir)],
+        None => vec![repository.join("assets"), repository.join("tests/data")],
+    };
     for name in ["bunny00", "elephant", "mushroom_open"] {
-        let path = data_dir.join(format!("{name}.obj"));
+        let file = format!("{name}.obj");
+        let Some(path) = data_dirs
+            .iter()
+            .map(|d| d.join(&file))
+            .find(|p| p.is_file())
+        else {
+            eprintln!("{file} is in none of {data_dirs:?}");
+            std::process::exit(1);
+        };
         let loaded =
             fairmesh::io::load(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
         let (clean, topology) = (loaded.mesh, loaded.topology);
@@ -136,10 +146,7 @@ fn main() {
             fair(
                 &mut faired,
                 &topology,
-                &MethodOptions::Constrained(FairOptions {
-                    variant,
-                    ..Default::default()
-                }),
+                &MethodOptions::Constrained(FairOptions::default().with_variant(variant)),
             );
             let moves: Vec<f64> = clean
                 .positions
@@ -166,11 +173,10 @@ fn main() {
         let mut noisy = clean.clone();
         add_noise(
             &mut noisy,
-            &NoiseOptions {
-                sigma: 0.3,
-                seed: 1,
-                mode: NoiseMode::Normal,
-            },
+            &NoiseOptions::default()
+                .with_sigma(0.3)
+                .with_seed(1)
+                .with_mode(NoiseMode::Normal),
         );
         println!("\nNoise 0.3 mean edge lengths along normals (seed 1):\n");
         println!("| method | setting | surf mean | hausdorff | rms | normal ° | vol % |\n|---|---|---:|---:|---:|---:|---:|");
@@ -181,13 +187,14 @@ fn main() {
                 fair(
                     &mut faired,
                     &topology,
-                    &MethodOptions::Constrained(FairOptions {
-                        iterations: 10,
-                        rounds,
-                        variant,
-                        boundary: BoundaryMode::Curve,
-                        tolerance: 0.0,
-                    }),
+                    &MethodOptions::Constrained(
+                        FairOptions::default()
+                            .with_iterations(10)
+                            .with_rounds(rounds)
+                            .with_variant(variant)
+                            .with_boundary(BoundaryMode::Curve)
+                            .with_tolerance(0.0),
+                    ),
                 );
                 row(
                     &format!("constrained {}", variant.name()),

@@ -61,20 +61,8 @@ fn main() {
         .expect("assets/bunny00.obj")
         .mesh;
     let mut big = fairmesh::mesh::subdivide_loop(&fairmesh::mesh::subdivide_loop(&bunny));
-    add_noise(
-        &mut big,
-        &NoiseOptions {
-            sigma: 0.3,
-            ..Default::default()
-        },
-    );
-    add_noise(
-        &mut bunny,
-        &NoiseOptions {
-            sigma: 0.3,
-            ..Default::default()
-        },
-    );
+    add_noise(&mut big, &NoiseOptions::default().with_sigma(0.3));
+    add_noise(&mut bunny, &NoiseOptions::default().with_sigma(0.3));
     let threads = rayon::current_num_threads();
     let big_bandwidth = copy_bandwidth(256 << 20);
     println!("rayon threads: {threads}");

@@ -102,6 +102,22 @@ pub struct Comparison {
 }
 
 /// Compare `other` against `reference`.
+///
+/// ```
+/// use fairmesh::metrics::compare;
+///
+/// let reference = fairmesh::bundled::load_bunny(&Default::default())?.mesh;
+/// let mut shifted = reference.clone();
+/// for p in &mut shifted.positions {
+///     p[1] += 0.001; // move the whole mesh up
+/// }
+/// let comparison = compare(&reference, &shifted);
+/// let vertices = comparison.same_connectivity.expect("same triangles");
+/// assert!((vertices.rms - 0.001).abs() < 1e-5);
+/// assert!(comparison.mean_surface_distance <= 0.001 + 1e-5);
+/// assert!(comparison.volume_change_percent.unwrap().abs() < 1e-3);
+/// # Ok::<(), fairmesh::io::IoError>(())
+/// ```
 pub fn compare(reference: &TriMesh, other: &TriMesh) -> Comparison {
     let reference_index = ClosestPointIndex::new(reference);
     let other_index = ClosestPointIndex::new(other);

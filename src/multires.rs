@@ -5,7 +5,7 @@
 //! that level's fairing), then refine `M_i -> M_(i-1)` by the vertex splits of that level.
 //! Vertices that are not split keep their faired positions.
 //!
-//! Placing a split vertex (interpretations in `paper/NOTES.md`):
+//! Placing a split vertex (the reading of the paper is in the repository's `docs/paper.md`):
 //! - [`MultiresVariant::Paper`]: the vertex starts at the mean of its 1-ring in `M_(i-1)` (a
 //!   boundary vertex at the midpoint of its two loop neighbours), then takes one Kobbelt step
 //!   `x <- x - L²(x)/ν`, `L²(x_i) = (1/n_i) Σ_j L(x_j) - L(x_i)`, `ν = 1 + (1/n_i) Σ_j 1/n_j`,
@@ -15,28 +15,26 @@
 //! - [`MultiresVariant::Improved`]: two corrections of the drift the paper's recipe has on
 //!   clean meshes. (Both variants fair with the paper's operator, `FairVariant::Paper`: the
 //!   normal-projected one roughly doubled the normal error of multires from coarse levels.)
-//!   1. Shrinkage of the level fairings. Measured on clean `elephant` with exact split
-//!      placement, constrained fairing of a coarse level (a few hundred vertices, legs a few
-//!      edges around) loses 1-3% of the volume per level, even with one iteration: the local
-//!      solves keep triangle barycentres but the averaged result pulls strongly curved, coarsely
-//!      sampled parts inward, and the losses add up over the levels (-20% from the coarsest
-//!      level). Removing noise is a high-frequency normal motion; this shrinkage is a coherent
-//!      one. So after each level's fairing the normal displacement `h_v = (x_v - x_v^before) .
-//!      n_v` (area-weighted vertex normal) is low-passed by two area-weighted 1-ring averages and
+//!   1. Shrinkage of the level fairings. Constrained fairing of a coarse level (a few hundred
+//!      vertices, thin parts a few edges around) loses volume on every level, even with one
+//!      iteration: the local solves keep triangle barycentres but the averaged result pulls
+//!      strongly curved, coarsely sampled parts inward, and the losses add up over the levels.
+//!      Removing noise is a high-frequency normal motion; this shrinkage is a coherent one. So
+//!      after each level's fairing the normal displacement `h_v = (x_v - x_v^before) . n_v`
+//!      (area-weighted vertex normal) is low-passed by two area-weighted 1-ring averages and
 //!      that smooth part is taken back.
 //!   2. Split placement. After the paper's placement, a volume restoration: the build recorded,
 //!      for every collapse `v -> k`, the signed cone volume `c_v = A_v · (x_v - x_k)` of the
 //!      original geometry (`A_v = Σ (x_a - x_k) × (x_b - x_k)` over `v`'s faces `(v, a, b)` that
 //!      do not contain `k`): six times the volume the split adds back. The height
 //!      `t_v = (c_v - A_v · (x_v - x_k)) / |A_v|` along `A_v / |A_v|` would restore it exactly
-//!      (with no fairing, a clean mesh then keeps its volume exactly; the paper's placement
-//!      gains up to +1.9% on `elephant`). On a noisy mesh `t_v` also holds the vertex's own
-//!      noise, so it is low-passed before use: each split vertex takes the `|A|`-weighted mean of
-//!      the `t` of the split vertices within two rings of it (its own included).
+//!      (with no fairing, a clean mesh then keeps its volume exactly). On a noisy mesh `t_v` also
+//!      holds the vertex's own noise, so it is low-passed before use: each split vertex takes the
+//!      `|A|`-weighted mean of the `t` of the split vertices within two rings of it (its own
+//!      included).
 //!
-//!   Measured (issue notes): lower mean surface distance and volume drift than the paper's at
-//!   every start level; lower normal error on clean meshes, somewhat higher on noisy ones (the
-//!   corrections keep a little of the noise's low-frequency part).
+//!   The repository's `docs/measurements.md` has what these corrections gain over the paper's
+//!   recipe, level by level, and how to re-run the comparison.
 //!
 //! Start level 0 means single-level fairing of M0. Fairing M0 after the last refinement is
 //! optional (`fair_finest`; the paper's loop ends at the refinement).
@@ -47,7 +45,7 @@
 //! [`MultiresWorkspace::prepare_for`]; a run then only moves positions, and allocates nothing but its result. The whole run
 //! executes on a worker of the rayon pool (a run makes a dozen parallel calls per level, and each
 //! call issued from outside the pool is a cross-thread hand-off); passes over the coarse levels
-//! are not split below [`PARALLEL_GRAIN`] vertices. The per-level passes (Kobbelt step, vertex
+//! are not split below `PARALLEL_GRAIN` vertices. The per-level passes (Kobbelt step, vertex
 //! normals, low-pass filters) work in f32 SIMD points; the Kobbelt step takes every vertex's
 //! umbrella Laplacian once instead of once per adjacent split vertex, and closed fans give the
 //! vertex normals from their fan order (one gather per neighbour instead of three per face).
@@ -61,22 +59,39 @@ use glam::Vec3A;
 use rayon::prelude::*;
 
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[non_exhaustive]
 pub enum MultiresVariant {
     Paper,
     #[default]
     Improved,
 }
 
+/// Options of [`fair_multires`]; build them with `MultiresOptions::default()` and the `with_*`
+/// setters.
 #[derive(Clone, Debug)]
+#[non_exhaustive]
 pub struct MultiresOptions {
+    /// The level fairing starts from (0 is M0 itself); beyond the coarsest, the coarsest.
     pub start_level: usize,
+    /// Constrained fairing iterations per round on each level.
     pub iterations: usize,
+    /// Rounds per level (each re-anchors the constraints).
     pub rounds: usize,
+    /// How boundary vertices move on each level.
     pub boundary: BoundaryMode,
     /// Also fair M0 after the last refinement.
     pub fair_finest: bool,
     pub variant: MultiresVariant,
 }
+
+with_setters!(MultiresOptions {
+    with_start_level => start_level: usize,
+    with_iterations => iterations: usize,
+    with_rounds => rounds: usize,
+    with_boundary => boundary: BoundaryMode,
+    with_fair_finest => fair_finest: bool,
+    with_variant => variant: MultiresVariant,
+});
 
 impl Default for MultiresOptions {
     fn default() -> Self {
@@ -98,12 +113,10 @@ const NONE: u32 = u32::MAX;
 const PARALLEL_GRAIN: usize = 1024;
 
 /// Improved: 1-ring averages that low-pass a level fairing's normal displacement before it is
-/// taken back. Two kept most of the noise removal on noisy `bunny00` while taking back the
-/// shrinkage of `elephant`'s legs (one leaves part of the shrinkage, more remove less noise).
+/// taken back: fewer leave part of the shrinkage, more remove less noise (`docs/measurements.md`).
 const SHRINKAGE_SMOOTHING_ROUNDS: usize = 2;
-/// Improved: two-ring averages of the split heights. Measured on noisy `bunny00` and clean
-/// `elephant` with 0, 1, 2 and 4: 0 restores each vertex's noise (normal error +3 degrees),
-/// 1 is the best compromise (more rounds lose volume on `elephant` again and gain little).
+/// Improved: two-ring averages of the split heights: none restores each vertex's noise, more
+/// lose volume again (`docs/measurements.md`).
 const HEIGHT_SMOOTHING_ROUNDS: usize = 1;
 
 /// Connectivity of one level, built by the first run that needs it.
@@ -261,6 +274,24 @@ fn level_fair_options(options: &MultiresOptions) -> FairOptions {
 
 /// Returns M0's positions after fairing (M0's triangles are `hierarchy.base_mesh().triangles`),
 /// or `None` when `progress` cancelled the run.
+///
+/// ```
+/// use fairmesh::hierarchy::{build_hierarchy, HierarchyOptions};
+/// use fairmesh::multires::{fair_multires, MultiresOptions, MultiresWorkspace};
+/// use fairmesh::{NoProgress, TriMesh};
+///
+/// let mesh = fairmesh::bundled::load_bunny(&Default::default())?.mesh;
+/// let hierarchy = build_hierarchy(&mesh, &HierarchyOptions::default(), &mut NoProgress)?;
+/// let options = MultiresOptions::default().with_start_level(8);
+/// let mut workspace = MultiresWorkspace::default(); // keep it to run again cheaply
+/// let positions = fair_multires(&hierarchy, &options, &mut workspace, &mut NoProgress)
+///     .expect("NoProgress never cancels");
+/// let smooth = TriMesh::new(positions, mesh.triangles.clone());
+/// // Detail is gone, the volume is not.
+/// let change = fairmesh::metrics::volume_change_percent(&mesh, &smooth).unwrap();
+/// assert!(change.abs() < 1.0, "{change}%");
+/// # Ok::<(), Box<dyn std::error::Error>>(())
+/// ```
 pub fn fair_multires(
     hierarchy: &Hierarchy,
     options: &MultiresOptions,

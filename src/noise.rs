@@ -16,6 +16,7 @@ use rand::{Rng, SeedableRng};
 use rand_distr::{Distribution, Normal, StandardNormal};
 
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[non_exhaustive]
 pub enum NoiseMode {
     /// Random unit direction, Gaussian distance.
     Direction,
@@ -26,13 +27,23 @@ pub enum NoiseMode {
     Normal,
 }
 
+/// Options of [`add_noise`]; build them with `NoiseOptions::default()` and the `with_*` setters.
 #[derive(Clone, Debug, PartialEq)]
+#[non_exhaustive]
 pub struct NoiseOptions {
     /// Standard deviation as a fraction of the mean edge length.
     pub sigma: f64,
+    /// Seed of the generator: the same seed gives the same noise.
     pub seed: u64,
+    /// Which way vertices move.
     pub mode: NoiseMode,
 }
+
+with_setters!(NoiseOptions {
+    with_sigma => sigma: f64,
+    with_seed => seed: u64,
+    with_mode => mode: NoiseMode,
+});
 
 impl Default for NoiseOptions {
     fn default() -> Self {
@@ -45,6 +56,24 @@ impl Default for NoiseOptions {
 }
 
 /// Adds noise in place; returns the absolute sigma used (model units).
+///
+/// ```
+/// use fairmesh::noise::{add_noise, NoiseMode, NoiseOptions};
+///
+/// let clean = fairmesh::bundled::load_bunny(&Default::default())?.mesh;
+/// let mut noisy = clean.clone();
+/// let options = NoiseOptions::default()
+///     .with_sigma(0.2)
+///     .with_seed(7)
+///     .with_mode(NoiseMode::Normal);
+/// let sigma = add_noise(&mut noisy, &options);
+/// assert!(sigma > 0.0);
+/// // Seeded: the same seed gives the same mesh.
+/// let mut again = clean.clone();
+/// add_noise(&mut again, &options);
+/// assert_eq!(noisy.positions, again.positions);
+/// # Ok::<(), fairmesh::io::IoError>(())
+/// ```
 pub fn add_noise(mesh: &mut TriMesh, options: &NoiseOptions) -> f64 {
     let sigma = options.sigma.max(0.0) * metrics::mean_edge_length(mesh);
     if sigma == 0.0 || !sigma.is_finite() {

@@ -42,6 +42,20 @@ fn loads_the_bunny_builds_the_hierarchy_and_fairs() {
     harness.get_by_label("Hierarchy build");
 }
 
+/// With no file the editor opens the bunny compiled into the binary, not a file on disk: the
+/// document is named by the bare file name (no folder), so it cannot have come from `assets/`.
+#[test]
+fn no_file_opens_the_bundled_bunny() {
+    let mut harness = harness_with(AppOptions::default());
+    settle(&mut harness);
+    let status = harness.state().status();
+    assert!(status.error.is_none(), "{:?}", status.error);
+    assert_eq!(status.document.as_deref(), Some(Path::new("bunny00.obj")));
+    assert!(status.hierarchy_ready);
+    assert!(status.faired_serial.is_some(), "a first fairing ran");
+    assert!(status.shown_vertices > 30_000 && status.shown_faces > 70_000);
+}
+
 #[test]
 fn level_slider_refairs_and_updates_the_numbers() {
     let mut harness = harness_for(bunny());

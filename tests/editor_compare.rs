@@ -59,11 +59,10 @@ fn noise_keeps_the_clean_mesh_and_fairing_gets_closer_to_it() {
     let mut again = loaded.clone();
     fairmesh::noise::add_noise(
         &mut again,
-        &fairmesh::noise::NoiseOptions {
-            sigma: 0.3,
-            seed: 1,
-            mode: fairmesh::noise::NoiseMode::Normal,
-        },
+        &fairmesh::noise::NoiseOptions::default()
+            .with_sigma(0.3)
+            .with_seed(1)
+            .with_mode(fairmesh::noise::NoiseMode::Normal),
     );
     assert_eq!(again.positions, noisy.positions);
 

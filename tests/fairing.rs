@@ -134,11 +134,10 @@ fn hemisphere(levels: usize) -> TriMesh {
 fn noisy(mut mesh: TriMesh, sigma: f64, seed: u64) -> TriMesh {
     add_noise(
         &mut mesh,
-        &NoiseOptions {
-            sigma,
-            seed,
-            mode: NoiseMode::Normal,
-        },
+        &NoiseOptions::default()
+            .with_sigma(sigma)
+            .with_seed(seed)
+            .with_mode(NoiseMode::Normal),
     );
     mesh
 }
@@ -169,11 +168,9 @@ fn constrained_fairing_keeps_the_volume_of_a_noisy_sphere() {
             fair_constrained(
                 &mut faired,
                 &topology,
-                &FairOptions {
-                    iterations,
-                    variant,
-                    ..Default::default()
-                },
+                &FairOptions::default()
+                    .with_iterations(iterations)
+                    .with_variant(variant),
             );
             let change = relative_volume_change(&mesh, &faired);
             assert!(
@@ -211,10 +208,7 @@ fn constrained_fairing_removes_noise_from_the_sphere() {
         fair_constrained(
             &mut faired,
             &topology,
-            &FairOptions {
-                variant,
-                ..Default::default()
-            },
+            &FairOptions::default().with_variant(variant),
         );
         assert!(
             radius_error(&faired) < 0.7 * radius_error(&mesh),
@@ -235,12 +229,10 @@ fn tolerance_stops_early() {
         let report = fair_constrained(
             &mut faired,
             &topology,
-            &FairOptions {
-                iterations: 1000,
-                tolerance,
-                variant,
-                ..Default::default()
-            },
+            &FairOptions::default()
+                .with_iterations(1000)
+                .with_tolerance(tolerance)
+                .with_variant(variant),
         );
         assert!(report.iterations_run < 30, "{variant:?}: {report:?}");
         assert!(report.max_move < tolerance);
@@ -264,14 +256,8 @@ fn rounds_smooth_further_and_still_keep_the_volume() {
     let mut one = mesh.clone();
     let report_one = fair_constrained(&mut one, &topology, &FairOptions::default());
     let mut five = mesh.clone();
-    let report_five = fair_constrained(
-        &mut five,
-        &topology,
-        &FairOptions {
-            rounds: 5,
-            ..Default::default()
-        },
-    );
+    let report_five =
+        fair_constrained(&mut five, &topology, &FairOptions::default().with_rounds(5));
     assert_eq!(report_one.iterations_run, 10);
     assert_eq!(report_five.iterations_run, 50);
     assert!(roughness(&five) < roughness(&one));
@@ -307,10 +293,7 @@ fn open_hemisphere_boundary_neither_shrinks_nor_grows() {
     // towards the clean length, but the circle must not shrink: its mean radius stays.
     let full_noise = noisy(clean.clone(), 0.3, 2);
     for variant in VARIANTS {
-        let options = FairOptions {
-            variant,
-            ..Default::default()
-        };
+        let options = FairOptions::default().with_variant(variant);
         let mut faired = interior_noise.clone();
         fair_constrained(&mut faired, &topology, &options);
         let length_change = (loop_length(&faired, &boundary_loop) - clean_length) / clean_length;
@@ -393,13 +376,11 @@ fn noise_free_plane_stays_exactly_flat() {
             fair_constrained(
                 &mut faired,
                 &topology,
-                &FairOptions {
-                    iterations: 30,
-                    rounds: 3,
-                    boundary,
-                    variant,
-                    ..Default::default()
-                },
+                &FairOptions::default()
+                    .with_iterations(30)
+                    .with_rounds(3)
+                    .with_boundary(boundary)
+                    .with_variant(variant),
             );
             assert!(
                 faired.positions.iter().all(|p| p[2] == 0.0),
@@ -441,12 +422,10 @@ fn equivariant_under_translation_rotation_and_scale() {
         out
     };
     for variant in VARIANTS {
-        let options = FairOptions {
-            iterations: 10,
-            rounds: 2,
-            variant,
-            ..Default::default()
-        };
+        let options = FairOptions::default()
+            .with_iterations(10)
+            .with_rounds(2)
+            .with_variant(variant);
         let mut faired = mesh.clone();
         fair_constrained(&mut faired, &topology, &options);
         for (name, transform, scale) in &transforms {
@@ -471,17 +450,17 @@ fn bit_identical_for_one_and_two_threads() {
     let open = noisy(hemisphere(5), 0.3, 5);
     let all_methods = |boundary: BoundaryMode| {
         vec![
-            MethodOptions::Constrained(FairOptions {
-                rounds: 2,
-                boundary,
-                variant: FairVariant::Paper,
-                ..Default::default()
-            }),
-            MethodOptions::Constrained(FairOptions {
-                rounds: 2,
-                boundary,
-                ..Default::default()
-            }),
+            MethodOptions::Constrained(
+                FairOptions::default()
+                    .with_rounds(2)
+                    .with_boundary(boundary)
+                    .with_variant(FairVariant::Paper),
+            ),
+            MethodOptions::Constrained(
+                FairOptions::default()
+                    .with_rounds(2)
+                    .with_boundary(boundary),
+            ),
             MethodOptions::Laplacian(LaplacianOptions {
                 boundary,
                 ..Default::default()
@@ -574,10 +553,7 @@ fn baselines_run_and_respect_fixed_boundaries() {
     fair_constrained(
         &mut m,
         &topology,
-        &FairOptions {
-            boundary: BoundaryMode::Fixed,
-            ..Default::default()
-        },
+        &FairOptions::default().with_boundary(BoundaryMode::Fixed),
     );
     check(&m);
 }
@@ -594,10 +570,7 @@ fn normal_projection_stops_sliding_on_the_clean_bunny() {
         fair_constrained(
             &mut faired,
             &topology,
-            &FairOptions {
-                variant,
-                ..Default::default()
-            },
+            &FairOptions::default().with_variant(variant),
         );
         let mean_move = mesh
             .positions
@@ -628,6 +601,7 @@ fn normal_projection_stops_sliding_on_the_clean_bunny() {
 
 /// `fairmesh fair --json` end to end on a mesh shipped in the repository.
 #[test]
+#[cfg(feature = "cli")] // runs the binary
 fn cli_fair_writes_the_mesh_and_reports_json() {
     let directory = tempfile::tempdir().unwrap();
     let output = directory.path().join("faired.obj");

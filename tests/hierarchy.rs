@@ -130,11 +130,7 @@ fn noisy_bunny() -> (TriMesh, TriMesh) {
     let mut noisy = clean.clone();
     add_noise(
         &mut noisy,
-        &NoiseOptions {
-            sigma: 0.3,
-            seed: 1,
-            ..Default::default()
-        },
+        &NoiseOptions::default().with_sigma(0.3).with_seed(1),
     );
     (clean, noisy)
 }
@@ -146,11 +142,9 @@ fn multires_on_noisy_bunny_keeps_volume_and_beats_single_level_fairing() {
     let mut workspace = MultiresWorkspace::new();
     for variant in [MultiresVariant::Improved, MultiresVariant::Paper] {
         for level in 1..=4 {
-            let options = MultiresOptions {
-                start_level: level,
-                variant,
-                ..Default::default()
-            };
+            let options = MultiresOptions::default()
+                .with_start_level(level)
+                .with_variant(variant);
             let positions = fair_multires(&h, &options, &mut workspace, &mut NoProgress).unwrap();
             let result = TriMesh::new(positions, noisy.triangles.clone());
             let change = metrics::volume_change_percent(&noisy, &result).unwrap();
@@ -166,18 +160,13 @@ fn multires_on_noisy_bunny_keeps_volume_and_beats_single_level_fairing() {
     fair_constrained(
         &mut single,
         &Topology::build(&noisy),
-        &FairOptions {
-            iterations: 5,
-            ..Default::default()
-        },
+        &FairOptions::default().with_iterations(5),
     );
     let single_distance = metrics::compare(&clean, &single).mean_surface_distance;
     for variant in [MultiresVariant::Improved, MultiresVariant::Paper] {
-        let options = MultiresOptions {
-            start_level: 3,
-            variant,
-            ..Default::default()
-        };
+        let options = MultiresOptions::default()
+            .with_start_level(3)
+            .with_variant(variant);
         let positions = fair_multires(&h, &options, &mut workspace, &mut NoProgress).unwrap();
         let result = TriMesh::new(positions, noisy.triangles.clone());
         let distance = metrics::compare(&clean, &result).mean_surface_distance;
@@ -195,11 +184,9 @@ fn improved_variant_keeps_a_clean_elephant_from_shrinking() {
     let mut workspace = MultiresWorkspace::new();
     let coarsest = h.coarsest_level();
     let mut change = |variant| {
-        let options = MultiresOptions {
-            start_level: coarsest,
-            variant,
-            ..Default::default()
-        };
+        let options = MultiresOptions::default()
+            .with_start_level(coarsest)
+            .with_variant(variant);
         let positions = fair_multires(&h, &options, &mut workspace, &mut NoProgress).unwrap();
         metrics::volume_change_percent(&mesh, &TriMesh::new(positions, mesh.triangles.clone()))
             .unwrap()
@@ -218,10 +205,7 @@ fn multires_runs_again_with_the_same_result_and_can_be_cancelled() {
     let mesh = load("tests/data/mushroom_open.obj");
     let h = build(&mesh);
     let mut workspace = MultiresWorkspace::new();
-    let options = MultiresOptions {
-        start_level: h.coarsest_level() / 2,
-        ..Default::default()
-    };
+    let options = MultiresOptions::default().with_start_level(h.coarsest_level() / 2);
     let first = fair_multires(&h, &options, &mut workspace, &mut NoProgress).unwrap();
     let second = fair_multires(&h, &options, &mut workspace, &mut NoProgress).unwrap();
     assert_eq!(first, second);
@@ -247,12 +231,10 @@ fn improved_placement_alone_keeps_a_clean_mesh_volume_better_than_kobbelt() {
     let h = build(&mesh);
     let mut workspace = MultiresWorkspace::new();
     let mut change = |variant| {
-        let options = MultiresOptions {
-            start_level: 6,
-            iterations: 0,
-            variant,
-            ..Default::default()
-        };
+        let options = MultiresOptions::default()
+            .with_start_level(6)
+            .with_iterations(0)
+            .with_variant(variant);
         let positions = fair_multires(&h, &options, &mut workspace, &mut NoProgress).unwrap();
         metrics::volume_change_percent(&mesh, &TriMesh::new(positions, mesh.triangles.clone()))
             .unwrap()

@@ -88,25 +88,20 @@ fn wgpu_configuration() -> egui_wgpu::WgpuConfiguration {
     configuration
 }
 
-/// The bundled default mesh: `assets/bunny00.obj` beside the working directory or the source tree.
-pub fn bundled_mesh_path() -> PathBuf {
-    let relative = Path::new("assets").join("bunny00.obj");
-    if relative.is_file() {
-        return relative;
-    }
-    Path::new(env!("CARGO_MANIFEST_DIR")).join(relative)
-}
-
 /// How to start the app.
 #[derive(Clone, Debug, Default)]
 pub struct AppOptions {
-    /// The file to open; `None` opens the bundled bunny.
+    /// The file to open; `None` opens the bunny compiled into the binary ([`crate::bundled`]).
     pub file: Option<PathBuf>,
     /// Read and write settings through eframe's storage (off in tests).
     pub persistence: bool,
     /// Print every UI frame whose CPU time is over this to standard error, split into its parts
     /// (`fairmesh edit --log-frames MS`: measures responsiveness in the real window).
     pub log_frames_over: Option<Duration>,
+    /// Once the first mesh is loaded (or failed to) and every job is done, print one line about
+    /// it (stdout, or the error to stderr) and close the window. CI uses it to check that a
+    /// copied binary opens its bundled mesh in a real window (`fairmesh edit --exit-when-settled`).
+    pub exit_when_settled: bool,
     /// Meshes of at least this many bytes (positions + triangles) upload to the GPU on the
     /// viewports' upload threads; `None` keeps the renderer's default (4 MB). Tests set 0.
     pub async_upload_bytes: Option<usize>,
@@ -324,6 +319,8 @@ pub struct App {
     commands: Vec<Command>,
     next_serial: u64,
     frame_stats: FrameStats,
+    /// [`AppOptions::exit_when_settled`], until it has fired.
+    exit_when_settled: bool,
     /// Where the viewport was drawn in the last frame (points).
     viewport_rect: Option<egui::Rect>,
     /// Earlier and later document states (noise, applied results, loading).
@@ -372,7 +369,9 @@ impl App {
             .build()
             .ok()
             .map(Arc::new);
-        let file = options.file.unwrap_or_else(bundled_mesh_path);
+        let file = options
+            .file
+            .unwrap_or_else(|| PathBuf::from(crate::bundled::BUNNY_PSEUDO_PATH));
         let mut app = Self {
             settings,
             persistence: options.persistence,
@@ -418,6 +417,7 @@ impl App {
                 log_over: options.log_frames_over,
                 ..FrameStats::default()
             },
+            exit_when_settled: options.exit_when_settled,
             viewport_rect: None,
             history: History::new(HISTORY_BUDGET_BYTES),
         };
@@ -767,7 +767,16 @@ impl App {
         let (tx, ctx, ticket) = (self.results_tx.clone(), self.ctx.clone(), self.jobs.start());
         self.io.submit(move || {
             let started = Instant::now();
-            let result = crate::io::load(&path)
+            // The bundled bunny comes from the binary itself; it is named by its file name, so
+            // its default export is `bunny00_faired.glb` in the working directory.
+            let (path, loaded) = if crate::bundled::is_bunny_pseudo_path(&path) {
+                let loaded = crate::bundled::load_bunny(&crate::io::LoadOptions::default());
+                (PathBuf::from(crate::bundled::BUNNY_FILE_NAME), loaded)
+            } else {
+                let loaded = crate::io::load(&path);
+                (path, loaded)
+            };
+            let result = loaded
                 .map_err(|error| error.to_string())
                 .and_then(|loaded| {
                     if loaded.mesh.triangles.is_empty() {
@@ -1888,6 +1897,22 @@ impl eframe::App for App {
         };
         self.frame_stats
             .record(started.elapsed(), parts, render, busy || busy_before);
+        if self.exit_when_settled && !busy && self.is_settled() && self.loading.is_none() {
+            self.exit_when_settled = false;
+            let status = self.status();
+            match (&status.document, &status.error) {
+                (Some(path), None) => println!(
+                    "editor: {} loaded, {} levels, {} vertices and {} faces on screen",
+                    path.display(),
+                    status.level_count,
+                    status.shown_vertices,
+                    status.shown_faces
+                ),
+                (_, Some(error)) => eprintln!("editor: {error}"),
+                (None, None) => eprintln!("editor: no mesh was loaded"),
+            }
+            ctx.send_viewport_cmd(egui::ViewportCommand::Close);
+        }
     }
 
     fn save(&mut self, storage: &mut dyn eframe::Storage) {

@@ -53,7 +53,7 @@ pub struct NoiseArgs {
 pub struct ConvertArgs {
     /// Input mesh.
     pub input: PathBuf,
-    /// Output mesh; the format is chosen by its extension (.obj .gltf .glb .ply).
+    /// Output mesh; the format is chosen by its extension (.obj .gltf .glb .ply .stl .off).
     #[arg(short, long)]
     pub output: PathBuf,
     /// Keep vertices with identical positions apart (by default they are merged).
@@ -76,8 +76,13 @@ pub struct CompareArgs {
     pub json: bool,
 }
 
+/// Loads an input mesh; `@bunny` is the bunny compiled into the binary.
 pub(crate) fn load(path: &Path, weld: bool) -> anyhow::Result<Loaded> {
-    Ok(io::load_with(path, &LoadOptions { weld })?)
+    let options = LoadOptions { weld };
+    if fairmesh::bundled::is_bunny_pseudo_path(path) {
+        return Ok(fairmesh::bundled::load_bunny(&options)?);
+    }
+    Ok(io::load_with(path, &options)?)
 }
 
 pub fn info(args: InfoArgs) -> anyhow::Result<()> {
@@ -201,11 +206,10 @@ pub fn noise(args: NoiseArgs) -> anyhow::Result<()> {
     };
     let absolute = noise::add_noise(
         &mut loaded.mesh,
-        &NoiseOptions {
-            sigma: args.sigma,
-            seed: args.seed,
-            mode,
-        },
+        &NoiseOptions::default()
+            .with_sigma(args.sigma)
+            .with_seed(args.seed)
+            .with_mode(mode),
     );
     super::save_kept(&args.output, &loaded.mesh, &loaded.source)?;
     eprintln!(

@@ -2,7 +2,7 @@
 //! runs. Each part of the library adds its own rows (`fair::bench_rows`, `hierarchy::bench_rows`).
 
 use clap::Args;
-use fairmesh::{io, mesh, metrics, Topology};
+use fairmesh::{mesh, metrics, Topology};
 use std::path::PathBuf;
 use std::time::Instant;
 
@@ -79,9 +79,9 @@ pub fn median_ms(runs: usize, mut f: impl FnMut()) -> f64 {
 pub fn run(args: BenchArgs) -> anyhow::Result<()> {
     let mut rows: Vec<(String, f64)> = Vec::new();
     let load_ms = median_ms(args.runs, || {
-        let _ = io::load(&args.input);
+        let _ = super::basic::load(&args.input, true);
     });
-    let mut loaded = io::load(&args.input)?;
+    let mut loaded = super::basic::load(&args.input, true)?;
     rows.push(("load + weld + clean + topology".into(), load_ms));
     if args.subdivide == 0 {
         rows.extend(save_rows(&args, &loaded)?);

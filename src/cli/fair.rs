@@ -93,16 +93,17 @@ impl FairArgs {
             BoundaryArg::Fixed => BoundaryMode::Fixed,
         };
         match self.method {
-            MethodArg::Constrained => MethodOptions::Constrained(FairOptions {
-                iterations: self.iterations,
-                tolerance: self.tolerance * mean_edge_length,
-                rounds: self.rounds,
-                boundary,
-                variant: match self.variant {
-                    VariantArg::Paper => FairVariant::Paper,
-                    VariantArg::NormalProjected => FairVariant::NormalProjected,
-                },
-            }),
+            MethodArg::Constrained => MethodOptions::Constrained(
+                FairOptions::default()
+                    .with_iterations(self.iterations)
+                    .with_tolerance(self.tolerance * mean_edge_length)
+                    .with_rounds(self.rounds)
+                    .with_boundary(boundary)
+                    .with_variant(match self.variant {
+                        VariantArg::Paper => FairVariant::Paper,
+                        VariantArg::NormalProjected => FairVariant::NormalProjected,
+                    }),
+            ),
             MethodArg::Laplacian => {
                 let defaults = LaplacianOptions::default();
                 MethodOptions::Laplacian(LaplacianOptions {
@@ -134,7 +135,7 @@ impl FairArgs {
 }
 
 pub fn run(args: FairArgs) -> anyhow::Result<()> {
-    let loaded = fairmesh::io::load(&args.input)?;
+    let loaded = super::basic::load(&args.input, true)?;
     let (mut mesh, topology, source) = (loaded.mesh, loaded.topology, loaded.source);
     let options = args.method_options(fairmesh::metrics::mean_edge_length(&mesh));
     let volume_before = fairmesh::metrics::signed_volume(&mesh);

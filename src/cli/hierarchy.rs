@@ -34,13 +34,12 @@ pub struct BuildArgs {
 
 impl BuildArgs {
     fn options(&self) -> HierarchyOptions {
-        HierarchyOptions {
-            alpha: self.alpha,
-            beta: self.beta,
-            min_vertices: self.min_vertices,
-            max_levels: self.max_levels,
-            keep_boundary: self.keep_boundary,
-        }
+        HierarchyOptions::default()
+            .with_alpha(self.alpha)
+            .with_beta(self.beta)
+            .with_min_vertices(self.min_vertices)
+            .with_max_levels(self.max_levels)
+            .with_keep_boundary(self.keep_boundary)
     }
 }
 
@@ -210,11 +209,9 @@ pub fn run_multires(args: MultiresArgs) -> anyhow::Result<()> {
     if let Some(sigma) = args.noise {
         noise::add_noise(
             &mut input,
-            &NoiseOptions {
-                sigma,
-                seed: args.seed,
-                ..Default::default()
-            },
+            &NoiseOptions::default()
+                .with_sigma(sigma)
+                .with_seed(args.seed),
         );
     }
     let started = Instant::now();
@@ -225,20 +222,19 @@ pub fn run_multires(args: MultiresArgs) -> anyhow::Result<()> {
     let mut last = None;
     for &variant in &args.variant {
         for &level in &args.level {
-            let options = MultiresOptions {
-                start_level: level,
-                iterations: args.iterations,
-                rounds: args.rounds,
-                boundary: match args.boundary {
+            let options = MultiresOptions::default()
+                .with_start_level(level)
+                .with_iterations(args.iterations)
+                .with_rounds(args.rounds)
+                .with_boundary(match args.boundary {
                     BoundaryArg::Curve => BoundaryMode::Curve,
                     BoundaryArg::Fixed => BoundaryMode::Fixed,
-                },
-                fair_finest: args.fair_finest,
-                variant: match variant {
+                })
+                .with_fair_finest(args.fair_finest)
+                .with_variant(match variant {
                     VariantArg::Paper => MultiresVariant::Paper,
                     VariantArg::Improved => MultiresVariant::Improved,
-                },
-            };
+                });
             // The first run also builds the per-level connectivity; time a second run too.
             let started = Instant::now();
             let positions = fair_multires(&hierarchy, &options, &mut workspace, &mut NoProgress)
@@ -325,10 +321,7 @@ pub fn bench_rows(mesh: &TriMesh) -> Vec<(String, f64)> {
     let mut workspace = MultiresWorkspace::new();
     let coarsest = hierarchy.coarsest_level();
     for (name, level) in [("coarsest", coarsest), ("middle", coarsest / 2)] {
-        let options = MultiresOptions {
-            start_level: level,
-            ..Default::default()
-        };
+        let options = MultiresOptions::default().with_start_level(level);
         // Warm the workspace (per-level connectivity) once, then time.
         let _ = fair_multires(&hierarchy, &options, &mut workspace, &mut NoProgress);
         let ms = super::bench::median_ms(runs, || {

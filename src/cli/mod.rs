@@ -15,8 +15,9 @@ use std::path::PathBuf;
     about = "Remove noise and unwanted detail from triangle meshes without shrinking them.",
     long_about = "Remove noise and unwanted detail from triangle meshes without shrinking them \
 (constrained fairing, after Liu, Bao, Heng, Wong and Peng).\n\nWith no subcommand, opens the editor on \
-the bundled Stanford bunny. Formats are chosen by file extension: .obj .gltf .glb .ply .stl .off to read; \
-.obj .gltf .glb .ply to write."
+the bundled Stanford bunny. Formats are chosen by file extension: .obj .gltf .glb .ply .stl .off, \
+to read and to write. Wherever a mesh is read, `@bunny` names the bunny compiled into the binary \
+(a file of that name is `./@bunny`)."
 )]
 pub struct Cli {
     #[command(subcommand)]
@@ -31,6 +32,10 @@ pub struct EditArgs {
     /// split into its parts (applying results, uploading to the GPU, widgets, viewport draw).
     #[arg(long, value_name = "MS")]
     pub log_frames: Option<f64>,
+    /// Close the window once the mesh is loaded and all work is done, printing one line about it
+    /// (a smoke test of the editor in a real window; used by CI).
+    #[arg(long, hide = true)]
+    pub exit_when_settled: bool,
 }
 
 #[derive(Subcommand, Debug)]

@@ -1,5 +1,5 @@
 //! Baselines the constrained method is compared against (not from the paper's method; see the
-//! "Baselines" section of `paper/NOTES.md`):
+//! "Baselines" section of the repository's `docs/paper.md`):
 //! - Laplacian (umbrella) smoothing: x ← x + λ·(m − x), m the mean of the neighbours, λ = 0.5.
 //! - Taubin λ|μ smoothing: a λ = 0.5 step, then a μ = −0.53 step, per iteration (MeshLab's and
 //!   Open3D's defaults).

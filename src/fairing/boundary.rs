@@ -1,6 +1,6 @@
 //! Boundary curves (paper section 3.3): each boundary loop is faired as a closed curve.
 //!
-//! Interpretations (see `paper/NOTES.md`):
+//! Interpretations (see the repository's `docs/paper.md`):
 //! - The curve Laplacian of loop vertex p_i uses its two loop neighbours with weights ½, not its
 //!   mesh neighbours.
 //! - Each boundary edge (p_{i−1}, p_i), with loop neighbours p_{i−2} and p_{i+1}, solves the curve

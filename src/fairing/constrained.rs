@@ -1,7 +1,7 @@
 //! Constrained fairing (paper section 3.2): the local least-squares problem (6) of every interior
 //! triangle, solved in closed form (eq 7), averaged per vertex, iterated Jacobi-style.
 //!
-//! Interpretations (see `paper/NOTES.md`, which this follows):
+//! Interpretations (the repository's `docs/paper.md` gives the whole reading this follows):
 //! - Weights ω_ij = 1/n_i with n_i the number of distinct one-ring neighbours. For triangle
 //!   ⟨i, j, k⟩ the local energy is ‖AP − Q‖² with A = I − (ω between the three corners) and
 //!   q_i = Σ ω_ij x_j over the n_i − 2 neighbours of i that are not corners of the triangle.
@@ -36,15 +36,13 @@
 //! fan normal at the midpoint of the path. Pass 2 has, for every one-ring neighbour, its position
 //! and umbrella mean (gathered for the update anyway), but not its new position, so it takes the
 //! fan of the midpoints between the positions and their umbrella means, (x_u + m_u)/2: the
-//! neighbours' own moves approximated by a Laplacian step. Measured on the noisy sphere of the
-//! tests (volume change, 1 iteration / 5 or more): this fan 0.0093% / 0.0026%; the fan of the
-//! updated positions x̃ (which needs a third gather pass, 25% more time on `bunny00`) 0.0048% /
-//! 0.0031%; the fan of the positions x 0.024% / 0.0035%; the fan of the means m 0.015% / 0.011%;
-//! the paper's unprojected update 0.0050% / 0.0057%.
+//! neighbours' own moves approximated by a Laplacian step. Of the candidates measured (the fans of
+//! the updated positions, of the positions and of the means; `docs/measurements.md`) it keeps the
+//! volume about as well as the best and needs no third gather pass.
 //!
 //! # Speed
 //! - Locality: vertices are renumbered breadth-first over the one-rings (neighbours close in
-//!   memory), then sorted by valence within blocks of [`VALENCE_SORTED_BLOCK`] (the gather loops'
+//!   memory), then sorted by valence within blocks of `VALENCE_SORTED_BLOCK` (the gather loops'
 //!   exits become predictable); [`ConstrainedFairing::load`] and [`ConstrainedFairing::store`]
 //!   map between the mesh's numbering and this one.
 //! - Bytes: weight rows are deduplicated (a mesh has a few hundred distinct rows) and each entry
@@ -151,14 +149,13 @@ pub fn invert3(a: &Matrix3) -> Option<Matrix3> {
 
 /// Valences below this index a dense table of local operators; larger ones are computed on the fly.
 const TABLE_VALENCE: usize = 32;
-/// Vertices per parallel work item. Measured on `bunny00` (2 threads, one iteration, paper /
-/// normal-projected): 128: 0.42 / 0.54 ms, 256: 0.37 / 0.52, 512: 0.34 / 0.48, 1024: 0.40 / 0.60,
-/// 2048: 0.42 / 0.60, 4096: 0.42 / 0.62; on the 1.2M-face mesh 256 and 512 are also the best.
+/// Vertices per parallel work item: 256 and 512 were the fastest on meshes of 75k and 1.2M faces
+/// (`docs/measurements.md`).
 const CHUNK: usize = 512;
 /// The locality order is sorted by valence within blocks of this many vertices, so that the
-/// gather loops run the same trip count many times in a row and their exits are predicted: on
-/// `bunny00` (valences 3 to 12 mixed at random) this took one paper iteration from 1.07 to 0.65
-/// ms of CPU. Blocks of 64 to 512 measured alike; neighbours stay within a block of each other.
+/// gather loops run the same trip count many times in a row and their exits are predicted (about
+/// 40% less CPU time per iteration on a mesh of mixed valences; blocks of 64 to 512 measured
+/// alike, see `docs/measurements.md`). Neighbours stay within a block of each other.
 const VALENCE_SORTED_BLOCK: usize = 256;
 
 /// Evaluates `$body` with `$stencil` bound to `$fairing`'s one-ring stencil, whichever width its
@@ -917,6 +914,28 @@ fn split_by_offsets<'a, T>(data: &'a mut [T], offsets: &[u32]) -> Vec<&'a mut [T
 /// Constrained fairing of `mesh` in place (sections 3.2 and 3.3); `topology` must be built from
 /// `mesh`. Precomputes the operator (see [`ConstrainedFairing`] to reuse it) and runs
 /// `options.rounds` rounds of up to `options.iterations` iterations each.
+///
+/// ```
+/// use fairmesh::fairing::{fair_constrained, FairOptions};
+/// use fairmesh::metrics::signed_volume;
+/// use fairmesh::noise::{add_noise, NoiseOptions};
+///
+/// let loaded = fairmesh::bundled::load_bunny(&Default::default())?;
+/// let (mut mesh, topology) = (loaded.mesh, loaded.topology);
+/// add_noise(&mut mesh, &NoiseOptions::default());
+/// let noisy = mesh.clone();
+///
+/// let options = FairOptions::default().with_rounds(3);
+/// let report = fair_constrained(&mut mesh, &topology, &options);
+/// assert!(report.iterations_run > 0);
+/// // Smoother: the vertices moved, by less than the noise's size.
+/// let moved = mesh.positions.iter().zip(&noisy.positions).filter(|(a, b)| a != b).count();
+/// assert!(moved > mesh.vertex_count() / 2);
+/// // And without shrinkage: the volume stays within 0.1%.
+/// let change = signed_volume(&mesh) / signed_volume(&noisy) - 1.0;
+/// assert!(change.abs() < 1e-3, "{change}");
+/// # Ok::<(), fairmesh::io::IoError>(())
+/// ```
 pub fn fair_constrained(
     mesh: &mut TriMesh,
     topology: &Topology,

@@ -21,32 +21,15 @@
 //! keep the part of the curve update orthogonal to the loop's tangent. Noise lies across the
 //! surface, so removing it needs only normal motion; the tangential part of the paper's update is
 //! the sliding. Which normal: the one that keeps the volume best is the volume gradient halfway
-//! along the move; the midpoint fan approximates it without a third pass over the mesh (the
-//! measurements of the other candidates are in [`constrained`]'s docs; the fan of the updated
-//! positions, used until November 2026, cost a third gather pass and measured about the same or
-//! slightly worse in every row of the table below).
-//!
-//! Measured with `examples/fairing_quality.rs` (10 iterations per round; surface distances in
-//! mean edge lengths of the clean mesh):
-//! - Noise-free meshes, mean vertex move in mean edge lengths, paper → normal-projected:
-//!   `bunny00` 0.097 → 0.006, `elephant` 0.105 → 0.032, `mushroom_open` 0.005 → 0.0007.
-//!   Volume changes are about the same for both (bunny −0.002%; elephant −0.33% and −0.32%: that
-//!   loss is the smoothing of the coarse mesh's thin legs and trunk, not sliding, and projection
-//!   does not remove it).
-//! - Noisy meshes (0.3 mean edge lengths along normals, seed 1; mean surface distance to the
-//!   clean mesh by `metrics::compare`): about equal to the paper's at one round (bunny 0.1012
-//!   against 0.1015, elephant 0.0956 against 0.0976, mushroom 0.1042 against 0.1041) and better at
-//!   many rounds, where the paper's sliding accumulates (best: bunny 0.0549 at 40 rounds against
-//!   0.0566 at 30; elephant 0.0820 against 0.0841 at 3; mushroom 0.0460 at 60 against 0.0466). The
-//!   vertex RMS to the clean mesh is much lower (bunny, 20 rounds: 0.089 against 0.215) and keeps
-//!   falling with rounds. Its volume drifts a little more with many rounds on bunny (+0.024% at 40
-//!   rounds against −0.023%).
+//! along the move; the midpoint fan approximates it without a third pass over the mesh (see
+//! [`constrained`]).
 //!
 //! So the default keeps vertices where they belong (texture coordinates, per-vertex attributes and
-//! triangle shapes stay meaningful, and rounds do not accumulate drift), is as close or closer to
-//! the clean surface, and costs a fan normal per vertex in the same two passes (on `bunny00` about
-//! 0.64 ms an iteration against the paper's 0.43, 2 threads). [`FairVariant::Paper`] remains
-//! available and is the faster of the two.
+//! triangle shapes stay meaningful, and rounds do not accumulate drift), comes as close or closer
+//! to the clean surface, keeps the volume as well, and costs a fan normal per vertex in the same
+//! two passes. [`FairVariant::Paper`] remains available and is the faster of the two. The
+//! measurements behind this (`examples/fairing_quality.rs`) are in the repository's
+//! `docs/measurements.md`; `docs/paper.md` is the reading of the paper this follows.
 //!
 //! Both variants use the paper's uniform weights, so the local matrices depend on the valence
 //! triple alone and are precomputed once per topology.
@@ -64,6 +47,7 @@ pub use constrained::{fair_constrained, ConstrainedFairing};
 
 /// How boundary vertices of open meshes move.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[non_exhaustive]
 pub enum BoundaryMode {
     /// Each boundary loop is smoothed as a closed curve (section 3.3).
     #[default]
@@ -83,6 +67,7 @@ impl BoundaryMode {
 
 /// Which constrained operator.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[non_exhaustive]
 pub enum FairVariant {
     /// The paper's operator exactly (uniform umbrella weights, eq 7, plain average).
     Paper,
@@ -102,8 +87,10 @@ impl FairVariant {
     }
 }
 
-/// Options of [`fair_constrained`].
+/// Options of [`fair_constrained`]; build them with `FairOptions::default()` and the `with_*`
+/// setters.
 #[derive(Clone, Debug)]
+#[non_exhaustive]
 pub struct FairOptions {
     /// Iterations per round.
     pub iterations: usize,
@@ -111,9 +98,19 @@ pub struct FairOptions {
     pub tolerance: f64,
     /// Number of rounds; each round re-imposes the constraints on the current positions.
     pub rounds: usize,
+    /// How boundary vertices move.
     pub boundary: BoundaryMode,
+    /// The paper's update or its normal-projected form (the default).
     pub variant: FairVariant,
 }
+
+with_setters!(FairOptions {
+    with_iterations => iterations: usize,
+    with_tolerance => tolerance: f64,
+    with_rounds => rounds: usize,
+    with_boundary => boundary: BoundaryMode,
+    with_variant => variant: FairVariant,
+});
 
 impl Default for FairOptions {
     fn default() -> Self {
@@ -138,6 +135,7 @@ pub struct FairReport {
 
 /// The smoothing methods offered by the CLI and the editor.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[non_exhaustive]
 pub enum Method {
     /// Constrained fairing (the paper's method).
     #[default]
@@ -182,6 +180,7 @@ impl std::str::FromStr for Method {
 
 /// One method with its options.
 #[derive(Clone, Debug)]
+#[non_exhaustive]
 pub enum MethodOptions {
     Constrained(FairOptions),
     Laplacian(LaplacianOptions),

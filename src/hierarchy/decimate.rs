@@ -8,7 +8,7 @@
 //! `x_k` does not move, `v`'s faces that contain `k` disappear, `v` is replaced by `k` in the
 //! others. Positions never change during the build.
 //!
-//! Interpretations (see `paper/NOTES.md`):
+//! Interpretations (see the repository's `docs/paper.md`):
 //! - Cone volume of `v -> k`: `sum over v's faces (v, a, b), in their own orientation, of
 //!   ((x_a - x_k) x (x_b - x_k)) . (x_v - x_k)`; faces containing `k` add 0 (the paper's
 //!   "⊗" is a cross product). The signed value is six times the volume the matching vertex split
@@ -56,13 +56,9 @@
 //! - writes the next level: survivors keep their order, faces are relabelled, and those that
 //!   degenerate are the removed ones.
 //!
-//! Where the time goes (one thread): about half is the visits, which are sequential and wait on
-//! memory (a tried vertex costs about 900 cycles on bunny00 and 1400 on a 600k-vertex mesh, in
-//! roughly equal parts gathering its fan, summing the cones, the flip check and the link check);
-//! then costs and sorting (about 15%), fans and next level (15%), and M0's ordering, the input
-//! check and storing the result (15%). Software prefetching of the vertices ahead in the visiting
-//! order, and skipping the exact cone sums of candidates that an error-bounded estimate rules
-//! out, were tried and did not measurably help.
+//! About half of the build is the visits, which are sequential and wait on memory; prefetching and
+//! cheaper cone estimates were tried without a measurable gain (`docs/measurements.md` has the
+//! profile).
 
 use super::{HierarchyError, HierarchyOptions};
 use crate::mesh::TriMesh;

@@ -1,6 +1,6 @@
 //! Volume-preserving decimation hierarchy (paper section 4.1) and moving between its levels.
 //!
-//! [`build_hierarchy`] runs the passes of [`decimate`] (one pass per level, see that module for
+//! [`build_hierarchy`] runs the passes of `decimate.rs` (one pass per level, see that module for
 //! the cost, the independent set, the cone volume and the validity rules) and then stores the
 //! result in a form where every level is cheap to reach:
 //!
@@ -30,9 +30,14 @@ use decimate::NEVER;
 use rayon::prelude::*;
 use std::sync::atomic::{AtomicU64, Ordering};
 
+/// Options of [`build_hierarchy`]; build them with `HierarchyOptions::default()` and the
+/// `with_*` setters.
 #[derive(Clone, Debug)]
+#[non_exhaustive]
 pub struct HierarchyOptions {
+    /// Weight of the shortest incident edge in a vertex's removal cost (the paper's α).
     pub alpha: f64,
+    /// Weight of the longest incident edge in a vertex's removal cost (the paper's β).
     pub beta: f64,
     /// Stop when a level has fewer vertices than this.
     pub min_vertices: usize,
@@ -41,6 +46,14 @@ pub struct HierarchyOptions {
     /// Never collapse boundary vertices.
     pub keep_boundary: bool,
 }
+
+with_setters!(HierarchyOptions {
+    with_alpha => alpha: f64,
+    with_beta => beta: f64,
+    with_min_vertices => min_vertices: usize,
+    with_max_levels => max_levels: usize,
+    with_keep_boundary => keep_boundary: bool,
+});
 
 impl Default for HierarchyOptions {
     fn default() -> Self {
@@ -55,6 +68,7 @@ impl Default for HierarchyOptions {
 }
 
 #[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
 pub enum HierarchyError {
     #[error("hierarchy build cancelled")]
     Cancelled,
@@ -286,6 +300,23 @@ impl LevelCursor {
     }
 }
 
+/// Builds the decimation hierarchy of `mesh` (section 4.1): M0 is `mesh`, each further level
+/// removes an independent set of vertices by volume-preserving half-edge collapses. `progress`
+/// may cancel the build ([`HierarchyError::Cancelled`]); a mesh that is not an oriented
+/// 2-manifold is refused ([`HierarchyError::Unsupported`]).
+///
+/// ```
+/// use fairmesh::hierarchy::{build_hierarchy, HierarchyOptions};
+///
+/// let mesh = fairmesh::bundled::load_bunny(&Default::default())?.mesh;
+/// let hierarchy = build_hierarchy(&mesh, &HierarchyOptions::default(), &mut fairmesh::NoProgress)?;
+/// assert_eq!(hierarchy.level_info(0).vertices, mesh.vertex_count());
+/// let coarsest = hierarchy.level_info(hierarchy.coarsest_level());
+/// assert!(coarsest.vertices < mesh.vertex_count() / 20);
+/// // Every level is a closed mesh again: V − E + F = 2, so F = 2V − 4.
+/// assert_eq!(coarsest.faces, 2 * coarsest.vertices - 4);
+/// # Ok::<(), Box<dyn std::error::Error>>(())
+/// ```
 pub fn build_hierarchy(
     mesh: &TriMesh,
     options: &HierarchyOptions,
