@@ -1187,6 +1187,8 @@ impl App {
                             .add_filter("glTF", &["gltf"])
                             .add_filter("Wavefront OBJ", &["obj"])
                             .add_filter("PLY", &["ply"])
+                            .add_filter("STL", &["stl"])
+                            .add_filter("OFF", &["off"])
                             .save_file()
                     }
                 };

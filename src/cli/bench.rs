@@ -2,7 +2,7 @@
 //! runs. Each part of the library adds its own rows (`fair::bench_rows`, `hierarchy::bench_rows`).
 
 use clap::Args;
-use fairmesh::{mesh, metrics, Topology};
+use fairmesh::{io, mesh, metrics, Topology};
 use std::path::PathBuf;
 use std::time::Instant;
 

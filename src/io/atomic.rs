@@ -63,7 +63,7 @@ pub(crate) fn stage(
         committed: false,
     };
     let result = (|| {
-        let file = File::create(&staged.temp)?;
+        let file = File::create(&staged.temp).map_err(|e| explain_create_error(e, path))?;
         let mut writer = BufWriter::with_capacity(1 << 20, file);
         fill(&mut writer)?;
         let file = writer.into_inner().map_err(|e| e.into_error())?;
@@ -75,6 +75,25 @@ pub(crate) fn stage(
         source,
     })?;
     Ok(staged)
+}
+
+/// Say which folder is missing or not writable, instead of the bare OS message.
+fn explain_create_error(error: std::io::Error, path: &Path) -> std::io::Error {
+    let folder = match path.parent() {
+        Some(dir) if !dir.as_os_str().is_empty() => dir,
+        _ => Path::new("."),
+    };
+    let message = match error.kind() {
+        std::io::ErrorKind::NotFound if !folder.exists() => {
+            format!("the folder {} does not exist", folder.display())
+        }
+        std::io::ErrorKind::NotFound => format!("{} is not a folder", folder.display()),
+        std::io::ErrorKind::PermissionDenied => {
+            format!("no permission to write in the folder {}", folder.display())
+        }
+        _ => return error,
+    };
+    std::io::Error::new(error.kind(), message)
 }
 
 /// Write `path` atomically with `fill`, which writes the whole content.
@@ -107,6 +126,18 @@ mod tests {
         write(&path, |w| w.write_all(b"new")).unwrap();
         assert_eq!(std::fs::read(&path).unwrap(), b"new");
         assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1);
+
+        // A missing folder is named.
+        let nowhere = dir.path().join("no such folder").join("out.obj");
+        let err = write(&nowhere, |w| w.write_all(b"x"))
+            .unwrap_err()
+            .to_string();
+        assert!(
+            err.contains("the folder")
+                && err.contains("no such folder")
+                && err.contains("does not exist"),
+            "{err}"
+        );
 
         // A staged file dropped without commit disappears.
         let staged = stage(&dir.path().join("other.obj"), |w| w.write_all(b"x")).unwrap();

@@ -7,6 +7,7 @@ use std::path::{Path, PathBuf};
 
 /// Where in a file a problem is.
 #[derive(Clone, Debug, PartialEq, Eq)]
+#[non_exhaustive]
 pub enum Location {
     /// 1-based line number (text formats).
     Line(usize),
@@ -27,6 +28,7 @@ impl fmt::Display for Location {
 }
 
 #[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
 pub enum IoError {
     /// The file could not be opened or read.
     #[error("{}: cannot read the file: {source}", path.display())]

@@ -908,6 +908,41 @@ pub(crate) fn write_glb(out: &mut dyn Write, mesh: &TriMesh) -> std::io::Result<
     out.write_all(&bin)
 }
 
+/// A `.gltf` with its buffer embedded as a base64 data: URI, for writers that are not files.
+pub(crate) fn write_gltf_embedded(out: &mut dyn Write, mesh: &TriMesh) -> std::io::Result<()> {
+    let (mut root, bin) = build(mesh, None)?;
+    if let Some(buffer) = root.buffers.first_mut() {
+        buffer.uri = Some(format!(
+            "data:application/octet-stream;base64,{}",
+            encode_base64(&bin)
+        ));
+    }
+    let json_bytes = json::serialize::to_vec_pretty(&root).map_err(std::io::Error::other)?;
+    out.write_all(&json_bytes)
+}
+
+/// Standard base64 (RFC 4648) with padding.
+fn encode_base64(bytes: &[u8]) -> String {
+    const ALPHABET: &[u8; 64] = b"ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+    let mut out = String::with_capacity(bytes.len().div_ceil(3) * 4);
+    for chunk in bytes.chunks(3) {
+        let b = [
+            chunk[0],
+            *chunk.get(1).unwrap_or(&0),
+            *chunk.get(2).unwrap_or(&0),
+        ];
+        let bits = (b[0] as u32) << 16 | (b[1] as u32) << 8 | b[2] as u32;
+        for (i, shift) in [18, 12, 6, 0].into_iter().enumerate() {
+            if i <= chunk.len() {
+                out.push(ALPHABET[(bits >> shift & 63) as usize] as char);
+            } else {
+                out.push('=');
+            }
+        }
+    }
+    out
+}
+
 /// Write `path` (.gltf) and `<stem>.bin` beside it: both are staged, then renamed into place.
 pub(crate) fn write_gltf(path: &Path, mesh: &TriMesh) -> Result<(), IoError> {
     let bin_path = super::gltf_bin_path(path);
@@ -942,6 +977,21 @@ mod tests {
         assert_eq!(decode_base64(b"").unwrap(), b"");
         assert_eq!(decode_base64(b"aG!k"), Err(2));
         assert!(decode_base64(b"a").is_err());
+    }
+
+    #[test]
+    fn base64_round_trips() {
+        for text in [
+            &b""[..],
+            b"h",
+            b"hi",
+            b"hel",
+            b"hello world",
+            &[0, 255, 128, 7],
+        ] {
+            assert_eq!(decode_base64(encode_base64(text).as_bytes()).unwrap(), text);
+        }
+        assert_eq!(encode_base64(b"hello"), "aGVsbG8=");
     }
 
     #[test]

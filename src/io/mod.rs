@@ -14,7 +14,7 @@
 //! - After parsing, [`finish`] welds bit-identical positions (seams), drops degenerate triangles
 //!   and unused vertices and builds the topology; non-manifold or inconsistently oriented input is
 //!   loaded, with a warning in [`LoadReport::warnings`].
-//! - Writes are atomic ([`atomic`]): a temporary file beside the target is renamed into place, so a
+//! - Writes are atomic (`atomic.rs`): a temporary file beside the target is renamed into place, so a
 //!   failed export never leaves a partial file or damages an existing one. Meshes with non-finite
 //!   positions or out-of-range indices are refused before anything is written.
 
@@ -159,13 +159,23 @@ impl Parsed {
     }
 }
 
-/// Load a mesh, welded and cleaned, with default options.
-pub fn load(path: &Path) -> Result<Loaded, IoError> {
+/// Load a mesh, welded and cleaned, with default options; the format comes from the extension.
+///
+/// ```
+/// let path = concat!(env!("CARGO_MANIFEST_DIR"), "/assets/bunny00.obj");
+/// let loaded = fairmesh::io::load(path)?;
+/// assert_eq!(loaded.mesh.vertex_count(), 37_706);
+/// assert_eq!(loaded.mesh.face_count(), 75_408);
+/// assert!(loaded.topology.boundary_loops.is_empty()); // a closed mesh
+/// # Ok::<(), fairmesh::io::IoError>(())
+/// ```
+pub fn load(path: impl AsRef<Path>) -> Result<Loaded, IoError> {
     load_with(path, &LoadOptions::default())
 }
 
 /// Load a mesh; the format comes from the extension.
-pub fn load_with(path: &Path, options: &LoadOptions) -> Result<Loaded, IoError> {
+pub fn load_with(path: impl AsRef<Path>, options: &LoadOptions) -> Result<Loaded, IoError> {
+    let path = path.as_ref();
     let format = format_of(path)?;
     let bytes = std::fs::read(path).map_err(|source| IoError::Read {
         path: path.to_owned(),
@@ -185,6 +195,25 @@ pub fn load_from_bytes(
     options: &LoadOptions,
 ) -> Result<Loaded, IoError> {
     load_bytes_impl(Cow::Borrowed(bytes), format, Path::new(name), None, options)
+}
+
+/// Read a mesh in `format` from any reader (standard input, an archive entry, a socket). `name`
+/// stands for the path in error messages; as with [`load_from_bytes`], a glTF's external buffers
+/// cannot be resolved.
+pub fn load_from_reader(
+    mut reader: impl std::io::Read,
+    format: Format,
+    name: &str,
+    options: &LoadOptions,
+) -> Result<Loaded, IoError> {
+    let mut bytes = Vec::new();
+    reader
+        .read_to_end(&mut bytes)
+        .map_err(|source| IoError::Read {
+            path: PathBuf::from(name),
+            source,
+        })?;
+    load_bytes_impl(Cow::Owned(bytes), format, Path::new(name), None, options)
 }
 
 fn load_bytes_impl(
@@ -347,12 +376,14 @@ fn finish_with_map(mut mesh: TriMesh, options: &LoadOptions) -> (Loaded, Option<
 
 /// Save a mesh; the format comes from the extension. The write is atomic: on any error nothing
 /// is left behind and an existing file is unchanged. A `.gltf` also writes `<stem>.bin` beside it.
-pub fn save(path: &Path, mesh: &TriMesh) -> Result<(), IoError> {
+pub fn save(path: impl AsRef<Path>, mesh: &TriMesh) -> Result<(), IoError> {
+    let path = path.as_ref();
     save_as(path, mesh, format_of(path)?)
 }
 
 /// Save in an explicit format, whatever the extension.
-pub fn save_as(path: &Path, mesh: &TriMesh, format: Format) -> Result<(), IoError> {
+pub fn save_as(path: impl AsRef<Path>, mesh: &TriMesh, format: Format) -> Result<(), IoError> {
+    let path = path.as_ref();
     check_writable(mesh, path)?;
     match format {
         Format::Obj => atomic::write(path, |w| obj::write(w, mesh)),
@@ -364,16 +395,52 @@ pub fn save_as(path: &Path, mesh: &TriMesh, format: Format) -> Result<(), IoErro
     }
 }
 
+/// Write a mesh in `format` to any writer (standard output, a socket, a buffer in memory). A
+/// `.gltf` written this way embeds its buffer as a base64 data: URI (there is no folder for a
+/// `.bin`). Not atomic: the writer is the caller's. Errors name the output "the output".
+///
+/// ```
+/// use fairmesh::io::{write_to, Format};
+/// let triangle = fairmesh::TriMesh::new(vec![[0.0; 3], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]], vec![[0, 1, 2]]);
+/// let mut text = Vec::new();
+/// write_to(&mut text, &triangle, Format::Obj)?;
+/// assert!(String::from_utf8_lossy(&text).contains("f 1 2 3"));
+/// # Ok::<(), fairmesh::io::IoError>(())
+/// ```
+pub fn write_to(
+    mut writer: impl std::io::Write,
+    mesh: &TriMesh,
+    format: Format,
+) -> Result<(), IoError> {
+    let name = Path::new("the output");
+    check_writable(mesh, name)?;
+    let out: &mut dyn std::io::Write = &mut writer;
+    match format {
+        Format::Obj => obj::write(out, mesh),
+        Format::Glb => gltf::write_glb(out, mesh),
+        Format::Gltf => gltf::write_gltf_embedded(out, mesh),
+        Format::Ply => ply::write(out, mesh),
+        Format::Stl => stl::write(out, mesh),
+        Format::Off => off::write(out, mesh),
+    }
+    .and_then(|()| out.flush())
+    .map_err(|source| IoError::Write {
+        path: name.to_owned(),
+        source,
+    })
+}
+
 /// Save `mesh` into what it was loaded from: to the same family of format (OBJ, PLY, glTF/GLB)
 /// the source file comes back with only the positions and what depends on them changed (see
 /// [`Source`]); to another format, or when `mesh` no longer has the source's connectivity (a
 /// level of the hierarchy, a subdivided copy), the mesh is written as it is and the report names
 /// what the output does not keep. The write is atomic, as with [`save`].
 pub fn save_with_source(
-    path: &Path,
+    path: impl AsRef<Path>,
     mesh: &TriMesh,
     source: &Source,
 ) -> Result<SaveReport, IoError> {
+    let path = path.as_ref();
     let format = format_of(path)?;
     check_writable(mesh, path)?;
     let mut report = SaveReport::default();
