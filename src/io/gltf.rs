@@ -886,12 +886,23 @@ fn build(mesh: &TriMesh, uri: Option<String>) -> std::io::Result<(json::Root, Ve
 
 pub(crate) fn write_glb(out: &mut dyn Write, mesh: &TriMesh) -> std::io::Result<()> {
     let (root, bin) = build(mesh, None)?;
-    let mut json_bytes = json::serialize::to_vec(&root).map_err(std::io::Error::other)?;
+    let json_bytes = json::serialize::to_vec(&root).map_err(std::io::Error::other)?;
+    write_glb_container(out, json_bytes, &bin)
+}
+
+/// A GLB container: the header, the JSON chunk (padded with spaces) and, when `bin` is not empty,
+/// the BIN chunk (padded with zeros).
+pub(crate) fn write_glb_container(
+    out: &mut dyn Write,
+    mut json_bytes: Vec<u8>,
+    bin: &[u8],
+) -> std::io::Result<()> {
     while json_bytes.len() % 4 != 0 {
         json_bytes.push(b' ');
     }
-    let total = 12 + 8 + json_bytes.len() + 8 + bin.len();
-    let total = u32::try_from(total).map_err(|_| {
+    let padded_bin = bin.len().div_ceil(4) * 4;
+    let bin_chunk = if bin.is_empty() { 0 } else { 8 + padded_bin };
+    let total = u32::try_from(12 + 8 + json_bytes.len() + bin_chunk).map_err(|_| {
         std::io::Error::new(
             std::io::ErrorKind::InvalidInput,
             "GLB files hold at most 4 GiB",
@@ -903,9 +914,13 @@ pub(crate) fn write_glb(out: &mut dyn Write, mesh: &TriMesh) -> std::io::Result<
     out.write_all(&(json_bytes.len() as u32).to_le_bytes())?;
     out.write_all(b"JSON")?;
     out.write_all(&json_bytes)?;
-    out.write_all(&(bin.len() as u32).to_le_bytes())?;
-    out.write_all(b"BIN\0")?;
-    out.write_all(&bin)
+    if !bin.is_empty() {
+        out.write_all(&(padded_bin as u32).to_le_bytes())?;
+        out.write_all(b"BIN\0")?;
+        out.write_all(bin)?;
+        out.write_all(&[0u8; 3][..padded_bin - bin.len()])?;
+    }
+    Ok(())
 }
 
 /// A `.gltf` with its buffer embedded as a base64 data: URI, for writers that are not files.

@@ -945,29 +945,6 @@ fn place_image_files(
 }
 
 fn write_glb(out: &mut dyn Write, json: &Value, bin: &[u8]) -> std::io::Result<()> {
-    let mut text = serde_json::to_vec(json).map_err(std::io::Error::other)?;
-    while text.len() % 4 != 0 {
-        text.push(b' ');
-    }
-    let padded_bin = bin.len().div_ceil(4) * 4;
-    let total = 12 + 8 + text.len() + if bin.is_empty() { 0 } else { 8 + padded_bin };
-    let total = u32::try_from(total).map_err(|_| {
-        std::io::Error::new(
-            std::io::ErrorKind::InvalidInput,
-            "GLB files hold at most 4 GiB",
-        )
-    })?;
-    out.write_all(b"glTF")?;
-    out.write_all(&2u32.to_le_bytes())?;
-    out.write_all(&total.to_le_bytes())?;
-    out.write_all(&(text.len() as u32).to_le_bytes())?;
-    out.write_all(b"JSON")?;
-    out.write_all(&text)?;
-    if !bin.is_empty() {
-        out.write_all(&(padded_bin as u32).to_le_bytes())?;
-        out.write_all(b"BIN\0")?;
-        out.write_all(bin)?;
-        out.write_all(&[0u8; 3][..padded_bin - bin.len()])?;
-    }
-    Ok(())
+    let text = serde_json::to_vec(json).map_err(std::io::Error::other)?;
+    super::gltf::write_glb_container(out, text, bin)
 }
