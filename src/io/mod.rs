@@ -456,7 +456,7 @@ pub fn save_with_source(
             SourceData::Gltf(gltf) => {
                 gltf_writeback::write(path, format, gltf, source, mesh, &mut report)?
             }
-            SourceData::Plain => save_as(path, mesh, format)?,
+            SourceData::Plain | SourceData::Unkept(_) => save_as(path, mesh, format)?,
         }
         return Ok(report);
     }

@@ -50,6 +50,18 @@ pub(crate) fn parse(bytes: &[u8], path: &Path) -> Result<Parsed, IoError> {
     if rest.first() == Some(&&b"BINARY"[..]) {
         return Err(at_header("binary OFF is not supported".into()));
     }
+    // The per-vertex extras of COFF, NOFF, STOFF... are read past, not kept.
+    let mut extras = Vec::new();
+    if prefix.windows(2).any(|w| w == b"ST") {
+        extras.push("texture coordinates");
+    }
+    if prefix.contains(&b'C') {
+        extras.push("colours");
+    }
+    if prefix.contains(&b'N') {
+        extras.push("normals");
+    }
+    let variant = String::from_utf8_lossy(keyword).into_owned();
     let mut counts_line = header_line;
     if rest.is_empty() {
         let Some((n, line)) = rows.next() else {
@@ -179,6 +191,12 @@ pub(crate) fn parse(bytes: &[u8], path: &Path) -> Result<Parsed, IoError> {
         ));
     }
     let mut parsed = Parsed::new(mesh);
+    if !extras.is_empty() {
+        parsed.data = super::source::SourceData::Unkept(vec![format!(
+            "per-vertex {} ({variant})",
+            extras.join(", ")
+        )]);
+    }
     if short_faces > 0 {
         parsed.warnings.push(format!(
             "{short_faces} faces with fewer than 3 corners were skipped"
@@ -211,6 +229,27 @@ mod tests {
         let parsed = parse(text.as_bytes(), Path::new("q.off")).unwrap();
         assert_eq!(parsed.mesh.positions.len(), 4);
         assert_eq!(parsed.mesh.triangles, vec![[0, 1, 2], [0, 2, 3]]);
+    }
+
+    #[test]
+    fn vertex_colours_are_named_as_not_kept() {
+        let text =
+            b"COFF\n3 1 0\n0 0 0 255 0 0 255\n1 0 0 0 255 0 255\n0 1 0 0 0 255 255\n3 0 1 2\n";
+        let parsed = parse(text, Path::new("c.off")).unwrap();
+        match parsed.data {
+            super::super::source::SourceData::Unkept(items) => {
+                assert_eq!(items, vec!["per-vertex colours (COFF)".to_string()])
+            }
+            other => panic!("{other:?}"),
+        }
+        let plain = parse(
+            b"OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n",
+            Path::new("p.off"),
+        );
+        assert!(matches!(
+            plain.unwrap().data,
+            super::super::source::SourceData::Plain
+        ));
     }
 
     #[test]

@@ -50,6 +50,9 @@ pub struct Source {
 pub(crate) enum SourceData {
     /// Nothing beyond positions and triangles is kept (STL, OFF).
     Plain,
+    /// The file holds things no writer here carries (an STL's per-facet attribute bytes, an OFF's
+    /// colours): named, in plain words, so that saving says they were not kept.
+    Unkept(Vec<String>),
     /// The OBJ file's bytes.
     Obj(Vec<u8>),
     /// The PLY file's bytes.
@@ -99,6 +102,7 @@ impl Source {
     pub fn contents(&self) -> Vec<String> {
         match &self.data {
             SourceData::Plain => Vec::new(),
+            SourceData::Unkept(items) => items.clone(),
             SourceData::Obj(bytes) => super::obj::contents(bytes),
             SourceData::Ply(bytes) => super::ply::contents(bytes),
             SourceData::Gltf(gltf) => gltf.contents(),
@@ -121,7 +125,7 @@ impl Source {
     /// Whether writing `format` can carry the source through.
     pub(crate) fn writes_back_as(&self, format: Format) -> bool {
         match self.data {
-            SourceData::Plain => false,
+            SourceData::Plain | SourceData::Unkept(_) => false,
             SourceData::Obj(_) => format == Format::Obj,
             SourceData::Ply(_) => format == Format::Ply,
             SourceData::Gltf(_) => matches!(format, Format::Gltf | Format::Glb),

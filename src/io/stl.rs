@@ -118,6 +118,17 @@ fn read_binary(bytes: &[u8], path: &Path) -> Result<Parsed, IoError> {
             "no triangles: the binary STL header declares 0 triangles",
         ));
     }
+    // Some writers keep a colour per facet in its two attribute bytes; fairmesh writes zeros.
+    let coloured = body
+        .chunks_exact(RECORD)
+        .take(declared)
+        .filter(|record| record[48..50] != [0, 0])
+        .count();
+    if coloured > 0 {
+        parsed.data = super::source::SourceData::Unkept(vec![format!(
+            "the attribute bytes (colours, for some writers) of {coloured} facets"
+        )]);
+    }
     Ok(parsed)
 }
 
@@ -232,6 +243,28 @@ mod tests {
                 .starts_with("t.stl: byte 84: the file is truncated"),
             "{err}"
         );
+    }
+
+    #[test]
+    fn facet_attribute_bytes_are_named_as_not_kept() {
+        let mut bytes = vec![0u8; 80];
+        bytes.extend_from_slice(&2u32.to_le_bytes());
+        for colour in [[0u8, 0], [0x1f, 0x80]] {
+            bytes.extend_from_slice(&[0u8; 12]);
+            for p in [[0f32, 0., 0.], [1., 0., 0.], [0., 1., 0.]] {
+                for c in p {
+                    bytes.extend_from_slice(&c.to_le_bytes());
+                }
+            }
+            bytes.extend_from_slice(&colour);
+        }
+        let parsed = parse(&bytes, Path::new("c.stl")).unwrap();
+        match parsed.data {
+            super::super::source::SourceData::Unkept(items) => {
+                assert!(items[0].contains("of 1 facets"), "{items:?}")
+            }
+            other => panic!("{other:?}"),
+        }
     }
 
     #[test]
