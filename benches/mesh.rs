@@ -7,7 +7,7 @@ use std::hint::black_box;
 use std::path::Path;
 
 fn bunny() -> fairmesh::TriMesh {
-    io::load(&Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/bunny00.obj"))
+    io::load(Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/bunny00.obj"))
         .expect("bundled bunny loads")
         .mesh
 }

@@ -487,7 +487,7 @@ fn write_obj(mesh: &fairmesh::TriMesh, path: &Path) {
 fn responsiveness() {
     let dir = tempfile::tempdir().unwrap();
     let large = dir.path().join("bunny_x16.obj");
-    let base = fairmesh::io::load(&bunny()).unwrap().mesh;
+    let base = fairmesh::io::load(bunny()).unwrap().mesh;
     let big = fairmesh::mesh::subdivide_loop(&fairmesh::mesh::subdivide_loop(&base));
     write_obj(&big, &large);
     println!("large mesh: {} faces", big.face_count());

@@ -38,7 +38,7 @@ fn noise_keeps_the_clean_mesh_and_fairing_gets_closer_to_it() {
     let app = harness.state();
     let clean = app.clean_mesh().expect("the mesh before the noise is kept");
     let noisy = app.document_mesh().unwrap();
-    let loaded = fairmesh::io::load(&bunny()).unwrap().mesh;
+    let loaded = fairmesh::io::load(bunny()).unwrap().mesh;
     assert_eq!(
         clean.positions, loaded.positions,
         "the clean mesh is the loaded one"

@@ -9,7 +9,7 @@ use std::path::Path;
 
 fn load(path: &str) -> TriMesh {
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
-    fairmesh::io::load(&root.join(path)).unwrap().mesh
+    fairmesh::io::load(root.join(path)).unwrap().mesh
 }
 
 const MESHES: [&str; 4] = [

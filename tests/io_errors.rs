@@ -721,7 +721,7 @@ fn failed_export_leaves_existing_files_unchanged_and_nothing_behind() {
     assert_eq!(listing(dir.path()), expected);
 
     // A successful save replaces the file and leaves no temporary behind.
-    io::save(&dir.path().join("mesh.gltf"), &tetrahedron()).unwrap();
+    io::save(dir.path().join("mesh.gltf"), &tetrahedron()).unwrap();
     let mut with_bin = expected.clone();
     with_bin.push("mesh.bin".into());
     with_bin.sort();

@@ -323,7 +323,7 @@ fn gltf_scenes_keep_everything_but_their_shape() {
 #[test]
 fn gltf_hard_edges_stay_flat_and_seams_stay_smooth() {
     let dir = tempfile::tempdir().unwrap();
-    let loaded = io::load(&data("scene.glb")).unwrap();
+    let loaded = io::load(data("scene.glb")).unwrap();
     let mesh = faired(&loaded);
     let out = dir.path().join("scene.glb");
     io::save_with_source(&out, &mesh, &loaded.source).unwrap();
@@ -377,7 +377,7 @@ fn gltf_hard_edges_stay_flat_and_seams_stay_smooth() {
 fn an_unchanged_mesh_writes_every_byte_back() {
     let dir = tempfile::tempdir().unwrap();
     for name in ["textured.obj", "colored.ply", "colored_ascii.ply"] {
-        let loaded = io::load(&data(name)).unwrap();
+        let loaded = io::load(data(name)).unwrap();
         let out = dir.path().join(name);
         io::save_with_source(&out, &loaded.mesh, &loaded.source).unwrap();
         assert!(
@@ -386,7 +386,7 @@ fn an_unchanged_mesh_writes_every_byte_back() {
         );
     }
     for name in ["scene.glb", "morph.glb", "skinned.glb"] {
-        let loaded = io::load(&data(name)).unwrap();
+        let loaded = io::load(data(name)).unwrap();
         let out = dir.path().join(name);
         io::save_with_source(&out, &loaded.mesh, &loaded.source).unwrap();
         let (input, output) = (read_gltf(&data(name)), read_gltf(&out));
@@ -402,7 +402,7 @@ fn an_unchanged_mesh_writes_every_byte_back() {
 #[test]
 fn obj_keeps_every_line_but_the_moved_vertices_and_their_normals() {
     let dir = tempfile::tempdir().unwrap();
-    let loaded = io::load(&data("textured.obj")).unwrap();
+    let loaded = io::load(data("textured.obj")).unwrap();
     let mesh = faired(&loaded);
     let out = dir.path().join("textured.obj");
     let report = io::save_with_source(&out, &mesh, &loaded.source).unwrap();
@@ -466,7 +466,7 @@ fn ply_vertex_properties(header: &str) -> Vec<(String, String)> {
 fn ply_keeps_colours_quality_and_face_properties() {
     let dir = tempfile::tempdir().unwrap();
     for name in ["colored.ply", "colored_ascii.ply"] {
-        let loaded = io::load(&data(name)).unwrap();
+        let loaded = io::load(data(name)).unwrap();
         let mesh = faired(&loaded);
         let out = dir.path().join(name);
         let report = io::save_with_source(&out, &mesh, &loaded.source).unwrap();
@@ -536,9 +536,9 @@ fn ply_keeps_colours_quality_and_face_properties() {
 #[test]
 fn other_formats_and_other_connectivity_say_what_is_not_kept() {
     let dir = tempfile::tempdir().unwrap();
-    let scene = io::load(&data("scene.glb")).unwrap();
+    let scene = io::load(data("scene.glb")).unwrap();
     let report =
-        io::save_with_source(&dir.path().join("scene.obj"), &scene.mesh, &scene.source).unwrap();
+        io::save_with_source(dir.path().join("scene.obj"), &scene.mesh, &scene.source).unwrap();
     let text = report.warnings.join("\n");
     for item in [
         "'root'",
@@ -553,8 +553,8 @@ fn other_formats_and_other_connectivity_say_what_is_not_kept() {
     }
     assert!(text.contains("bare OBJ mesh"), "{text}");
 
-    let obj = io::load(&data("textured.obj")).unwrap();
-    let report = io::save_with_source(&dir.path().join("t.ply"), &obj.mesh, &obj.source).unwrap();
+    let obj = io::load(data("textured.obj")).unwrap();
+    let report = io::save_with_source(dir.path().join("t.ply"), &obj.mesh, &obj.source).unwrap();
     let text = report.warnings.join("\n");
     for item in [
         "texture coordinates",
@@ -584,9 +584,9 @@ fn other_formats_and_other_connectivity_say_what_is_not_kept() {
     );
 
     // A bare mesh has nothing to lose.
-    let bare = io::load(&PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/data/elephant.obj"))
+    let bare = io::load(PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/data/elephant.obj"))
         .unwrap();
-    let report = io::save_with_source(&dir.path().join("e.glb"), &bare.mesh, &bare.source).unwrap();
+    let report = io::save_with_source(dir.path().join("e.glb"), &bare.mesh, &bare.source).unwrap();
     assert!(report.warnings.is_empty(), "{:?}", report.warnings);
 }
 

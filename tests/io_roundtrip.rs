@@ -101,7 +101,7 @@ fn real_meshes_survive_obj_glb_obj_and_obj_ply_obj_bit_exactly() {
             }
         }
         // Topology survives too (elephant has genus 3, mushroom_open one hole).
-        let reloaded = io::load(&dir.path().join(format!("{name}.glb"))).unwrap();
+        let reloaded = io::load(dir.path().join(format!("{name}.glb"))).unwrap();
         assert_eq!(
             reloaded.topology.components[0].genus,
             original.topology.components[0].genus
@@ -115,11 +115,11 @@ fn real_meshes_survive_obj_glb_obj_and_obj_ply_obj_bit_exactly() {
 
 #[test]
 fn real_meshes_have_expected_topology() {
-    let elephant = io::load(&repo().join("tests/data/elephant.obj")).unwrap();
+    let elephant = io::load(repo().join("tests/data/elephant.obj")).unwrap();
     assert_eq!(elephant.mesh.vertex_count(), 2775);
     assert_eq!(elephant.mesh.face_count(), 5558);
     assert_eq!(elephant.topology.components[0].genus, Some(3));
-    let mushroom = io::load(&repo().join("tests/data/mushroom_open.obj")).unwrap();
+    let mushroom = io::load(repo().join("tests/data/mushroom_open.obj")).unwrap();
     assert_eq!(mushroom.topology.boundary_loops.len(), 1);
     assert!(
         mushroom.report.warnings.is_empty(),
@@ -419,7 +419,7 @@ fn seam_split_gltf_welds_into_one_closed_manifold() {
 
 #[test]
 fn elephant_with_every_corner_duplicated_welds_back() {
-    let elephant = io::load(&repo().join("tests/data/elephant.obj"))
+    let elephant = io::load(repo().join("tests/data/elephant.obj"))
         .unwrap()
         .mesh;
     let positions: Vec<[f32; 3]> = elephant
@@ -607,7 +607,7 @@ fn external_buffer_is_read_relative_to_the_gltf() {
 #[test]
 fn saved_gltf_writes_bin_beside_it_and_glb_is_self_contained() {
     let dir = tempfile::tempdir().unwrap();
-    let mesh = io::load(&repo().join("tests/data/bunny_npm.obj"))
+    let mesh = io::load(repo().join("tests/data/bunny_npm.obj"))
         .unwrap()
         .mesh;
     let path = dir.path().join("my bunny.gltf");
@@ -639,7 +639,7 @@ fn exported_gltf_and_glb_pass_the_khronos_validator() {
     let dir = tempfile::tempdir().unwrap();
     let mut files = Vec::new();
     for name in ["bunny_npm", "mushroom_open", "elephant"] {
-        let mesh = io::load(&repo().join(format!("tests/data/{name}.obj")))
+        let mesh = io::load(repo().join(format!("tests/data/{name}.obj")))
             .unwrap()
             .mesh;
         for ext in ["glb", "gltf"] {

@@ -1933,6 +1933,15 @@ impl Drop for App {
     }
 }
 
+/// What an export could not keep, as a note after its status message.
+fn notes(warnings: &[String]) -> String {
+    if warnings.is_empty() {
+        String::new()
+    } else {
+        format!(". Note: {}", warnings.join(". "))
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -1959,14 +1968,5 @@ mod tests {
         let (dv, rms) = compare_to_base(&mesh, &moved);
         assert!(dv.abs() < 1e-12, "translation keeps the volume");
         assert!((rms - 0.5).abs() < 1e-12);
-    }
-}
-
-/// What an export could not keep, as a note after its status message.
-fn notes(warnings: &[String]) -> String {
-    if warnings.is_empty() {
-        String::new()
-    } else {
-        format!(". Note: {}", warnings.join(". "))
     }
 }

@@ -897,7 +897,7 @@ pub(crate) fn write_glb_container(
     mut json_bytes: Vec<u8>,
     bin: &[u8],
 ) -> std::io::Result<()> {
-    while json_bytes.len() % 4 != 0 {
+    while !json_bytes.len().is_multiple_of(4) {
         json_bytes.push(b' ');
     }
     let padded_bin = bin.len().div_ceil(4) * 4;

@@ -855,7 +855,7 @@ fn embed_images(
                 continue;
             }
         };
-        while bin.len() % 4 != 0 {
+        while !bin.len().is_multiple_of(4) {
             bin.push(0);
         }
         let view = json!({"buffer": 0, "byteOffset": bin.len(), "byteLength": bytes.len()});
