@@ -33,7 +33,7 @@ git clone --quiet --no-hardlinks "$repo" "$clone"
 
 step "no file refers to anything outside the repository"
 if git -C "$clone" grep -n -I -e '\.\./shared' -e 'paper/NOTES' -- ':!scripts/check_clean_clone.sh'; then
-  echo "the files above refer to ../shared or paper/NOTES.md, which a clone does not have" >&2
+  echo "the files above refer to the folder beside the repository or to the paper notes there, which a clone does not have" >&2
   exit 1
 fi
 for file in README.md LICENSE-MIT LICENSE-APACHE NOTICE CHANGELOG.md docs/architecture.md \
