@@ -16,6 +16,15 @@ fn data(name: &str) -> PathBuf {
         .join(name)
 }
 
+/// Load `name` from the round-trip data, fair it and save it back into `out`: the loaded file, the
+/// faired mesh and the save report.
+fn fair_and_save(name: &str, out: &Path) -> (Loaded, TriMesh, io::SaveReport) {
+    let loaded = io::load(data(name)).unwrap();
+    let mesh = faired(&loaded);
+    let report = io::save_with_source(out, &mesh, &loaded.source).unwrap();
+    (loaded, mesh, report)
+}
+
 /// The mesh after the default constrained fairing.
 fn faired(loaded: &Loaded) -> TriMesh {
     let mut mesh = loaded.mesh.clone();
@@ -323,10 +332,8 @@ fn gltf_scenes_keep_everything_but_their_shape() {
 #[test]
 fn gltf_hard_edges_stay_flat_and_seams_stay_smooth() {
     let dir = tempfile::tempdir().unwrap();
-    let loaded = io::load(data("scene.glb")).unwrap();
-    let mesh = faired(&loaded);
     let out = dir.path().join("scene.glb");
-    io::save_with_source(&out, &mesh, &loaded.source).unwrap();
+    fair_and_save("scene.glb", &out);
     let (input, output) = (read_gltf(&data("scene.glb")), read_gltf(&out));
 
     // The block is flat-shaded (every triangle has its own corners): each corner's normal is its
@@ -402,10 +409,8 @@ fn an_unchanged_mesh_writes_every_byte_back() {
 #[test]
 fn obj_keeps_every_line_but_the_moved_vertices_and_their_normals() {
     let dir = tempfile::tempdir().unwrap();
-    let loaded = io::load(data("textured.obj")).unwrap();
-    let mesh = faired(&loaded);
     let out = dir.path().join("textured.obj");
-    let report = io::save_with_source(&out, &mesh, &loaded.source).unwrap();
+    let (_, mesh, report) = fair_and_save("textured.obj", &out);
     assert!(report.warnings.is_empty(), "{:?}", report.warnings);
     let before = std::fs::read_to_string(data("textured.obj")).unwrap();
     let after = std::fs::read_to_string(&out).unwrap();
@@ -466,10 +471,8 @@ fn ply_vertex_properties(header: &str) -> Vec<(String, String)> {
 fn ply_keeps_colours_quality_and_face_properties() {
     let dir = tempfile::tempdir().unwrap();
     for name in ["colored.ply", "colored_ascii.ply"] {
-        let loaded = io::load(data(name)).unwrap();
-        let mesh = faired(&loaded);
         let out = dir.path().join(name);
-        let report = io::save_with_source(&out, &mesh, &loaded.source).unwrap();
+        let (loaded, mesh, report) = fair_and_save(name, &out);
         assert!(report.warnings.is_empty(), "{:?}", report.warnings);
         assert_reloads_as(&out, &mesh, 0.0);
         let (a, b) = (

@@ -211,10 +211,8 @@ impl GltfSource {
     /// What the document holds beyond positions and triangles, in plain words.
     pub(crate) fn contents(&self) -> Vec<String> {
         let names = |key: &str| -> Vec<String> {
-            self.array(key)
-                .iter()
-                .enumerate()
-                .map(|(i, v)| match v.get("name").and_then(Value::as_str) {
+            (0..self.array(key).len())
+                .map(|i| match name_of(&self.json, key, i) {
                     Some(name) => format!("'{name}'"),
                     None => format!("#{i}"),
                 })
@@ -358,28 +356,25 @@ impl PositionEdit {
     }
 }
 
+/// The `name` of element `index` of the top-level array `key`, if it has one.
+fn name_of<'a>(json: &'a Value, key: &str, index: usize) -> Option<&'a str> {
+    json.get(key)?.get(index)?.get("name")?.as_str()
+}
+
+/// "node 3 'arm'" or "node 3" (or "no node").
 fn node_label(json: &Value, node: Option<usize>) -> String {
     match node {
         None => "no node".into(),
-        Some(n) => match json
-            .get("nodes")
-            .and_then(|nodes| nodes.get(n))
-            .and_then(|node| node.get("name"))
-            .and_then(Value::as_str)
-        {
+        Some(n) => match name_of(json, "nodes", n) {
             Some(name) => format!("node {n} '{name}'"),
             None => format!("node {n}"),
         },
     }
 }
 
+/// "mesh 0 'ball'" or "mesh 0".
 fn mesh_label(json: &Value, mesh: usize) -> String {
-    match json
-        .get("meshes")
-        .and_then(|meshes| meshes.get(mesh))
-        .and_then(|m| m.get("name"))
-        .and_then(Value::as_str)
-    {
+    match name_of(json, "meshes", mesh) {
         Some(name) => format!("mesh {mesh} '{name}'"),
         None => format!("mesh {mesh}"),
     }
@@ -400,8 +395,9 @@ pub(crate) fn write(
     };
     let edits = position_edits(gltf, source, mesh, report).map_err(&fail)?;
     let mut buffers = gltf.buffers.clone();
-    // Normals turn from the file's own positions, before any is overwritten.
     let mut json = gltf.json.clone();
+    // Normals turn from the file's own positions (read from `gltf`, never from `buffers`), so the
+    // order of these two steps does not matter.
     let mut changed = turn_normals(gltf, source, &edits, &mut buffers, report);
     for (&a, edit) in &edits {
         for (k, after) in edit.after.iter().enumerate() {
