@@ -327,12 +327,21 @@ fn fair_multires_on_worker(
         .max(1.0);
     let mut done = 0.0;
     let fair_last = start == 0 || options.fair_finest;
+    // Fixed boundary: M0's boundary vertices (internal ids, ascending) are put back at their own
+    // positions after every step that could move them (the shrinkage correction, the split
+    // placement), so that they are fixed at every level, not only on the levels' own boundaries.
+    let fixed: Vec<u32> = match options.boundary {
+        BoundaryMode::Fixed => original_boundary(hierarchy, workspace),
+        _ => Vec::new(),
+    };
     for level in (1..=start).rev() {
         let faired = fair_level(workspace, level, &fair_options);
         if faired && options.variant == MultiresVariant::Improved {
             remove_low_frequency_shrinkage(workspace, level);
+            restore_fixed(hierarchy, &mut workspace.positions, &fixed);
         }
         refine_positions(hierarchy, workspace, level - 1, options.variant);
+        restore_fixed(hierarchy, &mut workspace.positions, &fixed);
         done += hierarchy.level_info(level).vertices as f64;
         if !progress.report((done / total) as f32) {
             return None;
@@ -350,6 +359,28 @@ fn fair_multires_on_worker(
         result[hierarchy.original_vertex(v as u32) as usize] = *p;
     }
     Some(result)
+}
+
+/// M0's boundary vertices in the hierarchy's internal numbering, ascending.
+fn original_boundary(hierarchy: &Hierarchy, workspace: &MultiresWorkspace) -> Vec<u32> {
+    let data = workspace.levels[0]
+        .as_ref()
+        .expect("every run prepares M0, the level it refines to");
+    let flags = data.topology.boundary_flags();
+    (0..hierarchy.level_info(0).vertices as u32)
+        .filter(|&v| flags[v as usize])
+        .collect()
+}
+
+/// Puts the `fixed` vertices that the working positions hold back at their original positions.
+fn restore_fixed(hierarchy: &Hierarchy, positions: &mut [[f32; 3]], fixed: &[u32]) {
+    let original = hierarchy.level_positions(0);
+    for &v in fixed {
+        let Some(p) = positions.get_mut(v as usize) else {
+            continue;
+        };
+        *p = original[v as usize];
+    }
 }
 
 /// Fairs the working positions of `level`; false when there was nothing to do.
