@@ -220,7 +220,7 @@ impl MultiresWorkspace {
                     } = &mut data;
                     let fans = fans.get_or_insert_with(|| FanRings::new(&mesh.triangles, topology));
                     data.fairing = Some(ConstrainedFairing::with_fans(
-                        mesh, topology, fans, variant, boundary,
+                        mesh, topology, fans, variant, boundary, None,
                     ));
                 }
                 data
@@ -262,6 +262,9 @@ fn level_fair_options(options: &MultiresOptions) -> FairOptions {
     FairOptions {
         iterations: options.iterations,
         rounds: options.rounds.max(1),
+        strength: crate::fairing::Strength::Fixed,
+        creases: None,
+        tangential_relaxation: 0.0,
         boundary: options.boundary,
         tolerance: 0.0,
         // Both variants fair with the paper's operator: measured in multires, the

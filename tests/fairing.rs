@@ -159,6 +159,9 @@ fn loop_length(mesh: &TriMesh, boundary_loop: &[u32]) -> f64 {
 
 #[test]
 fn constrained_fairing_keeps_the_volume_of_a_noisy_sphere() {
+    // The operators alone (one round, no tangential relaxation, which changes the volume to second
+    // order; the default's volume is checked in
+    // `a_clean_mesh_is_left_alone_and_a_noisy_one_is_faired_by_default`).
     let mesh = noisy(icosphere(4), 0.3, 1);
     let topology = Topology::build(&mesh);
     assert!(topology.is_closed());
@@ -170,7 +173,9 @@ fn constrained_fairing_keeps_the_volume_of_a_noisy_sphere() {
                 &topology,
                 &FairOptions::default()
                     .with_iterations(iterations)
-                    .with_variant(variant),
+                    .with_rounds(1)
+                    .with_variant(variant)
+                    .with_tangential_relaxation(0.0),
             );
             let change = relative_volume_change(&mesh, &faired);
             assert!(
@@ -231,6 +236,8 @@ fn tolerance_stops_early() {
             &topology,
             &FairOptions::default()
                 .with_iterations(1000)
+                .with_rounds(1)
+                .with_tangential_relaxation(0.0)
                 .with_tolerance(tolerance)
                 .with_variant(variant),
         );
@@ -254,7 +261,7 @@ fn rounds_smooth_further_and_still_keep_the_volume() {
             .sum::<f64>()
     };
     let mut one = mesh.clone();
-    let report_one = fair_constrained(&mut one, &topology, &FairOptions::default());
+    let report_one = fair_constrained(&mut one, &topology, &FairOptions::default().with_rounds(1));
     let mut five = mesh.clone();
     let report_five =
         fair_constrained(&mut five, &topology, &FairOptions::default().with_rounds(5));
@@ -372,26 +379,29 @@ fn noise_free_plane_stays_exactly_flat() {
     let topology = Topology::build(&mesh);
     for variant in VARIANTS {
         for boundary in [BoundaryMode::Curve, BoundaryMode::Fixed] {
-            let mut faired = mesh.clone();
-            fair_constrained(
-                &mut faired,
-                &topology,
-                &FairOptions::default()
-                    .with_iterations(30)
-                    .with_rounds(3)
-                    .with_boundary(boundary)
-                    .with_variant(variant),
-            );
-            assert!(
-                faired.positions.iter().all(|p| p[2] == 0.0),
-                "{variant:?} {boundary:?}"
-            );
-            if variant == FairVariant::NormalProjected {
-                // Only normal motion: nothing in the plane moves.
-                let interior_moved = (0..mesh.positions.len())
-                    .filter(|&v| !topology.is_boundary_vertex(v as u32))
-                    .any(|v| faired.positions[v] != mesh.positions[v]);
-                assert!(!interior_moved);
+            for tangential in [0.0, fairmesh::fairing::DEFAULT_TANGENTIAL_RELAXATION] {
+                let mut faired = mesh.clone();
+                fair_constrained(
+                    &mut faired,
+                    &topology,
+                    &FairOptions::default()
+                        .with_iterations(30)
+                        .with_rounds(3)
+                        .with_boundary(boundary)
+                        .with_variant(variant)
+                        .with_tangential_relaxation(tangential),
+                );
+                assert!(
+                    faired.positions.iter().all(|p| p[2] == 0.0),
+                    "{variant:?} {boundary:?} tangential {tangential}"
+                );
+                if variant == FairVariant::NormalProjected && tangential == 0.0 {
+                    // Only normal motion: nothing in the plane moves.
+                    let interior_moved = (0..mesh.positions.len())
+                        .filter(|&v| !topology.is_boundary_vertex(v as u32))
+                        .any(|v| faired.positions[v] != mesh.positions[v]);
+                    assert!(!interior_moved);
+                }
             }
         }
     }
@@ -558,8 +568,9 @@ fn baselines_run_and_respect_fixed_boundaries() {
     check(&m);
 }
 
-/// On the noise-free bunny scan the normal-projected variant moves vertices less and changes the
-/// volume less than the paper's operator (the reason it is the default).
+/// On the noise-free bunny scan the normal projection (one round, no tangential relaxation, no
+/// creases: the operators alone) moves vertices less and changes the volume less than the paper's
+/// operator (the reason the default variant projects).
 #[test]
 fn normal_projection_stops_sliding_on_the_clean_bunny() {
     let loaded = fairmesh::io::load(std::path::Path::new("assets/bunny00.obj")).unwrap();
@@ -570,7 +581,11 @@ fn normal_projection_stops_sliding_on_the_clean_bunny() {
         fair_constrained(
             &mut faired,
             &topology,
-            &FairOptions::default().with_variant(variant),
+            &FairOptions::default()
+                .with_variant(variant)
+                .with_rounds(1)
+                .with_creases(None)
+                .with_tangential_relaxation(0.0),
         );
         let mean_move = mesh
             .positions
@@ -643,4 +658,143 @@ fn cli_fair_writes_the_mesh_and_reports_json() {
         let written = fairmesh::io::load(&output).unwrap();
         assert_eq!(written.mesh.face_count(), 4608);
     }
+}
+
+/// Distance from `p` to the nearest edge of the axis-aligned unit cube [0, 1]³.
+fn distance_to_cube_edge(p: [f32; 3]) -> f64 {
+    let p = p.map(|c| c as f64);
+    // An edge runs along axis a with the other two coordinates at 0 or 1.
+    (0..3)
+        .map(|a| {
+            let (b, c) = ((a + 1) % 3, (a + 2) % 3);
+            let along = p[a].clamp(0.0, 1.0) - p[a];
+            let db = p[b].abs().min((p[b] - 1.0).abs());
+            let dc = p[c].abs().min((p[c] - 1.0).abs());
+            (along * along + db * db + dc * dc).sqrt()
+        })
+        .fold(f64::INFINITY, f64::min)
+}
+
+#[test]
+fn a_noisy_cube_keeps_straight_edges_and_its_corners_with_creases() {
+    use fairmesh::fairing::{detect_creases, CreaseOptions, FeatureClass};
+    use fairmesh::mesh::shapes::cuboid;
+    let clean = cuboid([1.0, 1.0, 1.0], 0.05);
+    let topology = Topology::build(&clean);
+    let on_edge: Vec<usize> = (0..clean.vertex_count())
+        .filter(|&v| distance_to_cube_edge(clean.positions[v]) < 1e-6)
+        .collect();
+    let input = noisy(clean.clone(), 0.3, 5);
+
+    // Detection on the noisy cube (with the filtering the default picks for this noise) finds
+    // the eight corners and the twelve edges.
+    let estimate = fairmesh::fairing::estimate_noise(&input, &topology).unwrap();
+    let filtering = fairmesh::fairing::strength::normal_filtering_for(estimate);
+    let options = CreaseOptions::default().with_normal_filtering(filtering);
+    let creases = detect_creases(&input, &topology, &options);
+    let corners: Vec<usize> = (0..clean.vertex_count())
+        .filter(|&v| creases.class[v] == FeatureClass::Corner)
+        .collect();
+    assert_eq!(corners.len(), 8, "corners {corners:?}");
+    // Under noise of 0.3 edge lengths the crease lines may meet one vertex off the corner: each
+    // cube corner has one detected corner within one grid step (0.05) of it.
+    let at: Vec<[f32; 3]> = corners.iter().map(|&v| clean.positions[v]).collect();
+    for cube_corner in 0..8 {
+        let c = [cube_corner & 1, (cube_corner >> 1) & 1, cube_corner >> 2].map(|b| b as f32);
+        let near = at
+            .iter()
+            .filter(|p| (0..3).all(|k| (p[k] - c[k]).abs() <= 0.051))
+            .count();
+        assert_eq!(near, 1, "cube corner {c:?}: detected corners {at:?}");
+    }
+    // And nearly all of the edges of the cube's twelve edges, and few others.
+    let truth = detect_creases(&clean, &topology, &CreaseOptions::default()).edges;
+    assert_eq!(truth.len(), 12 * 20);
+    let found = creases.edges.iter().filter(|e| truth.contains(e)).count();
+    let extra = creases.edges.len() - found;
+    assert!(found * 10 >= truth.len() * 9, "{found} of {}", truth.len());
+    assert!(extra * 10 <= truth.len(), "{extra} extra crease edges");
+
+    let faired = |options: FairOptions| {
+        let mut mesh = input.clone();
+        let report = fair_constrained(&mut mesh, &topology, &options);
+        (mesh, report)
+    };
+    let (with, report) = faired(FairOptions::default());
+    let (without, _) = faired(FairOptions::default().with_creases(None));
+    // What `fair` did before creases, automatic strength and tangential relaxation.
+    let (previous, _) = faired(
+        FairOptions::default()
+            .with_rounds(1)
+            .with_creases(None)
+            .with_tangential_relaxation(0.0),
+    );
+    assert!(
+        report.rounds_run > 0 && report.crease_edges > 0,
+        "{report:?}"
+    );
+    // Corners stay where they are.
+    for &v in &corners {
+        assert_eq!(with.positions[v], input.positions[v], "corner {v}");
+    }
+    // Edges stay straight: edge vertices end close to the cube's edges, much closer than
+    // without creases (which rounds them).
+    let edge = mean_edge_length(&clean);
+    let mean_off_edge = |mesh: &TriMesh| {
+        on_edge
+            .iter()
+            .map(|&v| distance_to_cube_edge(mesh.positions[v]))
+            .sum::<f64>()
+            / on_edge.len() as f64
+            / edge
+    };
+    let (kept, rounded) = (mean_off_edge(&with), mean_off_edge(&without));
+    assert!(
+        kept < 0.5 * rounded,
+        "with creases {kept}, without {rounded}"
+    );
+    // And the faces keep their orientation: a lower mean normal error than without creases, and
+    // at most half of the previous default's.
+    let normal_error = |mesh: &TriMesh| {
+        fairmesh::metrics::compare_vertices(&clean, mesh)
+            .unwrap()
+            .normal_error_deg
+    };
+    let (error_with, error_without) = (normal_error(&with), normal_error(&without));
+    let error_previous = normal_error(&previous);
+    assert!(
+        error_with < 0.75 * error_without && error_with < 0.5 * error_previous,
+        "normal error with creases {error_with}°, without {error_without}°, previous default \
+         {error_previous}°"
+    );
+    // Still without shrinking.
+    assert!(relative_volume_change(&input, &with).abs() < 1e-3);
+}
+
+#[test]
+fn a_clean_mesh_is_left_alone_and_a_noisy_one_is_faired_by_default() {
+    let sphere = icosphere(4);
+    let topology = Topology::build(&sphere);
+    let mut clean = sphere.clone();
+    let report = fair_constrained(&mut clean, &topology, &FairOptions::default());
+    assert_eq!(report.rounds_run, 0, "{report:?}");
+    assert_eq!(clean, sphere);
+    assert!(report.noise_estimate.unwrap() < 0.04, "{report:?}");
+
+    let input = noisy(sphere.clone(), 0.3, 2);
+    let mut faired = input.clone();
+    let report = fair_constrained(&mut faired, &topology, &FairOptions::default());
+    let estimate = report.noise_estimate.unwrap();
+    assert!((0.2..0.4).contains(&estimate), "{report:?}");
+    assert!(report.rounds_run >= 1, "{report:?}");
+    let radius_error = |mesh: &TriMesh| {
+        mesh.positions
+            .iter()
+            .map(|p| ((p[0] * p[0] + p[1] * p[1] + p[2] * p[2]) as f64).sqrt() - 1.0)
+            .map(f64::abs)
+            .sum::<f64>()
+            / mesh.vertex_count() as f64
+    };
+    assert!(radius_error(&faired) < 0.3 * radius_error(&input));
+    assert!(relative_volume_change(&input, &faired) < 1e-3);
 }

@@ -15,6 +15,9 @@
 //! - The normal-projected variant keeps only the part of each boundary move orthogonal to the
 //!   loop's tangent (p_{i+1} − p_{i−1}), the curve's analogue of the surface's normal projection.
 
+/// A missing stencil entry (beyond the end of an open chain).
+const NONE: u32 = u32::MAX;
+
 /// A point type the curve operator reads and writes: plain `[f32; 3]` or a padded layout.
 pub trait CurvePoint: Copy {
     fn xyz(&self) -> [f32; 3];
@@ -35,7 +38,8 @@ impl CurvePoint for [f32; 3] {
 /// The boundary loops of a mesh, flattened for the curve operators.
 #[derive(Clone, Debug, Default)]
 pub struct BoundaryCurves {
-    /// Every loop occurrence of a boundary vertex: `[p_{i−2}, p_{i−1}, p_i, p_{i+1}, p_{i+2}]`.
+    /// Every loop occurrence of a boundary vertex: `[p_{i−2}, p_{i−1}, p_i, p_{i+1}, p_{i+2}]`
+    /// (`NONE` beyond the end of an open chain).
     stencils: Vec<[u32; 5]>,
     /// For each stencil, the index of its vertex in `vertices`.
     slot_of_stencil: Vec<u32>,
@@ -62,6 +66,47 @@ impl BoundaryCurves {
                     curves.vertices.push(v);
                 }
                 curves.stencils.push([at(-2), at(-1), v, at(1), at(2)]);
+                curves.slot_of_stencil.push(slot_of_vertex[v as usize]);
+            }
+        }
+        curves
+    }
+
+    /// Closed loops as in [`Self::new`] and open chains whose two ends stay fixed (crease chains
+    /// between corners, boundary loops cut at corners). A chain vertex takes the estimates of
+    /// those of its two edges whose outer neighbours exist (an edge next to an end has none
+    /// beyond the end); a chain of two edges has no such edge and stays as it is.
+    pub fn with_open_chains(
+        closed_loops: &[Vec<u32>],
+        open_chains: &[Vec<u32>],
+        vertex_count: usize,
+    ) -> Self {
+        let mut curves = Self::new(closed_loops, vertex_count);
+        let mut slot_of_vertex = vec![u32::MAX; vertex_count];
+        for (slot, &v) in curves.vertices.iter().enumerate() {
+            slot_of_vertex[v as usize] = slot as u32;
+        }
+        for chain in open_chains {
+            let n = chain.len();
+            for i in 1..n.saturating_sub(1) {
+                let at = |offset: isize| {
+                    let k = i as isize + offset;
+                    if (0..n as isize).contains(&k) {
+                        chain[k as usize]
+                    } else {
+                        NONE
+                    }
+                };
+                let stencil = [at(-2), at(-1), at(0), at(1), at(2)];
+                if stencil[0] == NONE && stencil[4] == NONE {
+                    continue;
+                }
+                let v = stencil[2];
+                if slot_of_vertex[v as usize] == u32::MAX {
+                    slot_of_vertex[v as usize] = curves.vertices.len() as u32;
+                    curves.vertices.push(v);
+                }
+                curves.stencils.push(stencil);
                 curves.slot_of_stencil.push(slot_of_vertex[v as usize]);
             }
         }
@@ -97,7 +142,13 @@ impl BoundaryCurves {
         accumulator.resize(self.vertices.len(), ([0.0; 3], 0));
         let point = |p: &P| p.xyz().map(|c| c as f64);
         for (stencil, &slot) in self.stencils.iter().zip(&self.slot_of_stencil) {
-            let [before2, before, v, after, after2] = stencil.map(|u| point(&previous[u as usize]));
+            // An open chain's stencil lacks p_{i−2} or p_{i+2} next to its ends: that edge's
+            // estimate is left out.
+            let (has_before2, has_after2) = (stencil[0] != NONE, stencil[4] != NONE);
+            let [before2, before, v, after, after2] = stencil.map(|u| match u {
+                NONE => [0.0; 3],
+                u => point(&previous[u as usize]),
+            });
             let anchor_before = point(&anchors[stencil[1] as usize]);
             let anchor_v = point(&anchors[stencil[2] as usize]);
             let anchor_after = point(&anchors[stencil[3] as usize]);
@@ -109,7 +160,11 @@ impl BoundaryCurves {
                 // Edge (p_i, p_{i+1}): p_i is its first vertex.
                 let d_after = 0.5 * ((anchor_v[c] + anchor_after[c]) - (before[c] + after2[c]));
                 let from_after = 2.0 * before[c] / 3.0 + after2[c] / 3.0 + d_after;
-                estimate[c] = 0.5 * (from_before + from_after);
+                estimate[c] = match (has_before2, has_after2) {
+                    (true, true) => 0.5 * (from_before + from_after),
+                    (true, false) => from_before,
+                    _ => from_after,
+                };
             }
             let mut step = [estimate[0] - v[0], estimate[1] - v[1], estimate[2] - v[2]];
             if normal_projected {

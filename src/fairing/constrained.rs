@@ -57,7 +57,11 @@
 //! does not accumulate; the tests check volume to 1e-4 relative and equivariance to f32 accuracy.
 
 use super::boundary::BoundaryCurves;
-use super::{BoundaryMode, FairOptions, FairReport, FairVariant};
+use super::creases::{detect_creases, Creases, FeatureClass};
+use super::strength::{
+    estimate_noise, normal_filtering_for, CLEAN_NOISE, MAX_AUTO_ROUNDS, MIN_NOISE_FALL, NOISE_LEFT,
+};
+use super::{BoundaryMode, FairOptions, FairReport, FairVariant, Strength};
 use crate::mesh::{breadth_first_order, inverse_permutation, PositionHasher, Topology, TriMesh};
 use glam::{Vec3A, Vec3Swizzles};
 use rayon::prelude::*;
@@ -212,6 +216,9 @@ pub struct ConstrainedFairing {
     /// Whether `ring` is a closed fan, so the vertex normal can be taken from it.
     closed_fan: Vec<bool>,
     curves: BoundaryCurves,
+    /// Normal-projected only: the weight of the tangential relaxation added to each move (0: none;
+    /// see [`Self::set_tangential_relaxation`]).
+    tangential: f32,
     /// Number of vertices that get at least one local solution.
     solved_vertices: usize,
     workspace: Workspace,
@@ -261,7 +268,22 @@ impl ConstrainedFairing {
         boundary: BoundaryMode,
     ) -> Self {
         let fans = FanRings::new(&mesh.triangles, topology);
-        Self::with_fans(mesh, topology, &fans, variant, boundary)
+        Self::with_fans(mesh, topology, &fans, variant, boundary, None)
+    }
+
+    /// [`Self::new`] with sharp creases kept: the surface on either side of a crease is faired
+    /// with the crease as its boundary, the crease chains are faired as curves (section 3.3's
+    /// edge-centre constraints, open chains between fixed ends), corners stay in place
+    /// ([`super::creases`]).
+    pub fn with_creases(
+        mesh: &TriMesh,
+        topology: &Topology,
+        variant: FairVariant,
+        boundary: BoundaryMode,
+        creases: &Creases,
+    ) -> Self {
+        let fans = FanRings::new(&mesh.triangles, topology);
+        Self::with_fans(mesh, topology, &fans, variant, boundary, Some(creases))
     }
 
     /// [`Self::new`] for a caller that already has the mesh's fan-ordered one-rings.
@@ -271,10 +293,22 @@ impl ConstrainedFairing {
         fans: &FanRings,
         variant: FairVariant,
         boundary: BoundaryMode,
+        creases: Option<&Creases>,
     ) -> Self {
         let vertex_count = mesh.positions.len();
         let triangles = &mesh.triangles;
-        let is_boundary = topology.boundary_flags();
+        let on_boundary = topology.boundary_flags();
+        // Crease vertices and corners bound the surface patches like boundary vertices do.
+        let with_features: Vec<bool>;
+        let is_boundary: &[bool] = match creases {
+            Some(creases) if !creases.is_empty() => {
+                with_features = (0..vertex_count)
+                    .map(|v| on_boundary[v] || creases.is_feature(v as u32))
+                    .collect();
+                &with_features
+            }
+            _ => on_boundary,
+        };
 
         let ring_offsets = topology.neighbor_csr().0.to_vec();
         let (ring, closed) = (&fans.ring, &fans.closed_fan);
@@ -425,7 +459,13 @@ impl ConstrainedFairing {
         let (entry_weights, entry_weight_index) = deduplicate_rows(&internal_entry_weights);
         drop(internal_entry_weights);
         let self_weights = order.iter().map(|&v| self_weights[v as usize]).collect();
-        let closed_fan = order.iter().map(|&v| closed[v as usize]).collect();
+        // A vertex with no local solution keeps its position: it gets neither the projection nor
+        // the tangential relaxation (corners of creases, vertices whose triangles all touch the
+        // boundary).
+        let closed_fan = order
+            .iter()
+            .map(|&v| closed[v as usize] && solved[v as usize])
+            .collect();
         let inverse_valence = order
             .iter()
             .map(|&v| match topology.valence(v) {
@@ -433,17 +473,7 @@ impl ConstrainedFairing {
                 n => 1.0 / n as f32,
             })
             .collect();
-        let curves = match boundary {
-            BoundaryMode::Curve => {
-                let loops: Vec<Vec<u32>> = topology
-                    .boundary_loops
-                    .iter()
-                    .map(|l| l.iter().map(|&v| internal[v as usize]).collect())
-                    .collect();
-                BoundaryCurves::new(&loops, vertex_count)
-            }
-            BoundaryMode::Fixed => BoundaryCurves::default(),
-        };
+        let curves = fairing_curves(topology, boundary, creases, &internal);
         let workspace = Workspace {
             current: vec![Vec3A::ZERO; vertex_count],
             anchors: vec![Vec3A::ZERO; vertex_count],
@@ -465,9 +495,24 @@ impl ConstrainedFairing {
             inverse_valence,
             closed_fan,
             curves,
+            tangential: 0.0,
             solved_vertices,
             workspace,
         }
+    }
+
+    /// Normal-projected variant: also move every vertex with a closed fan by `weight` times the
+    /// tangential part of its umbrella vector, each iteration (0, the initial value: not at all).
+    /// Noise that moved vertices along the surface (every scanner's noise has some) leaves
+    /// triangles jittered and skewed that the normal motion alone cannot even out; this evens
+    /// them out while keeping the vertices on the surface (a tangential move changes the volume
+    /// only to second order). The paper's variant ignores it.
+    pub fn set_tangential_relaxation(&mut self, weight: f32) {
+        self.tangential = if weight.is_finite() {
+            weight.clamp(0.0, 1.0)
+        } else {
+            0.0
+        };
     }
 
     pub fn variant(&self) -> FairVariant {
@@ -520,16 +565,23 @@ impl ConstrainedFairing {
             if round > 0 {
                 self.reanchor();
             }
-            for _ in 0..options.iterations {
-                report.max_move = self.step();
-                report.iterations_run += 1;
-                if report.max_move < options.tolerance {
-                    break;
-                }
-            }
+            self.run_round(options, &mut report);
         }
         self.store(positions);
         report
+    }
+
+    /// Up to `options.iterations` iterations from the current anchors (one round), counted in
+    /// `report`.
+    pub fn run_round(&mut self, options: &FairOptions, report: &mut FairReport) {
+        for _ in 0..options.iterations {
+            report.max_move = self.step();
+            report.iterations_run += 1;
+            if report.max_move < options.tolerance {
+                break;
+            }
+        }
+        report.rounds_run += 1;
     }
 
     /// Takes `positions` (the mesh's numbering) as the current state and imposes the constraints
@@ -612,6 +664,7 @@ impl ConstrainedFairing {
                 &ws.position_and_mean,
                 &ws.anchor_terms,
                 closed_fan,
+                self.tangential,
                 &mut ws.next
             ))
         } else {
@@ -619,6 +672,7 @@ impl ConstrainedFairing {
                 &ws.position_and_mean,
                 &ws.anchor_terms,
                 closed_fan,
+                0.0,
                 &mut ws.next
             ))
         };
@@ -669,6 +723,7 @@ impl<I: Copy + Into<u32> + Sync> Stencil<'_, I> {
         pairs: &[PositionAndMean],
         anchor_terms: &[Vec3A],
         closed_fan: &[bool],
+        tangential: f32,
         next: &mut [Vec3A],
     ) -> f32 {
         next.par_chunks_mut(CHUNK)
@@ -720,7 +775,14 @@ impl<I: Copy + Into<u32> + Sync> Stencil<'_, I> {
                     if PROJECT && closed_fan[v] {
                         let length_squared = normal.length_squared();
                         step = if length_squared > 0.0 && length_squared.is_finite() {
-                            normal * (normal.dot(step) / length_squared)
+                            let along = normal * (normal.dot(step) / length_squared);
+                            if tangential > 0.0 {
+                                let umbrella = m - p;
+                                let across = normal * (normal.dot(umbrella) / length_squared);
+                                along + (umbrella - across) * tangential
+                            } else {
+                                along
+                            }
                         } else {
                             Vec3A::ZERO
                         };
@@ -735,6 +797,54 @@ impl<I: Copy + Into<u32> + Sync> Stencil<'_, I> {
             })
             .reduce(|| 0.0f32, f32::max)
     }
+}
+
+/// The curves the curve operator moves (internal numbering): the boundary loops (when they are
+/// faired), cut into open chains at crease corners, and the crease chains.
+fn fairing_curves(
+    topology: &Topology,
+    boundary: BoundaryMode,
+    creases: Option<&Creases>,
+    internal: &[u32],
+) -> BoundaryCurves {
+    let mut closed: Vec<Vec<u32>> = Vec::new();
+    let mut open: Vec<Vec<u32>> = Vec::new();
+    let is_corner = |v: u32| creases.is_some_and(|c| c.class[v as usize] == FeatureClass::Corner);
+    if boundary == BoundaryMode::Curve {
+        for boundary_loop in &topology.boundary_loops {
+            match boundary_loop.iter().position(|&v| is_corner(v)) {
+                None => closed.push(boundary_loop.clone()),
+                Some(first) => {
+                    // Rotate so the loop starts at a corner, then cut at every corner.
+                    let n = boundary_loop.len();
+                    let mut chain = vec![boundary_loop[first]];
+                    for k in 1..=n {
+                        let v = boundary_loop[(first + k) % n];
+                        chain.push(v);
+                        if is_corner(v) {
+                            open.push(std::mem::replace(&mut chain, vec![v]));
+                        }
+                    }
+                }
+            }
+        }
+    }
+    if let Some(creases) = creases {
+        for chain in &creases.chains {
+            if chain.closed {
+                closed.push(chain.vertices.clone());
+            } else {
+                open.push(chain.vertices.clone());
+            }
+        }
+    }
+    let relabel = |curves: Vec<Vec<u32>>| -> Vec<Vec<u32>> {
+        curves
+            .into_iter()
+            .map(|c| c.iter().map(|&v| internal[v as usize]).collect())
+            .collect()
+    };
+    BoundaryCurves::with_open_chains(&relabel(closed), &relabel(open), internal.len())
 }
 
 /// The distinct rows of `rows` (compared bit for bit) in order of first appearance, and each
@@ -941,11 +1051,77 @@ pub fn fair_constrained(
     topology: &Topology,
     options: &FairOptions,
 ) -> FairReport {
-    if options.rounds == 0 || options.iterations == 0 || mesh.positions.is_empty() {
+    if options.iterations == 0 || mesh.positions.is_empty() {
         return FairReport::default();
     }
-    let mut fairing = ConstrainedFairing::new(mesh, topology, options.variant, options.boundary);
-    fairing.run(&mut mesh.positions, options)
+    if options.strength == Strength::Fixed && options.rounds == 0 {
+        return FairReport::default();
+    }
+    // The noise estimate decides the strength (automatic) and how much the normals are filtered
+    // before creases are detected (raw normals of a noisy mesh make creases of the noise).
+    let estimate = (options.strength == Strength::Auto || options.creases.is_some())
+        .then(|| estimate_noise(mesh, topology))
+        .flatten();
+    // Automatic strength: a clean mesh is left as it is.
+    let auto_noise = match options.strength {
+        Strength::Auto => match estimate {
+            Some(noise) if noise > CLEAN_NOISE => Some(noise),
+            _ => {
+                return FairReport {
+                    noise_estimate: estimate,
+                    ..FairReport::default()
+                }
+            }
+        },
+        _ => None,
+    };
+    let creases = options.creases.as_ref().map(|crease_options| {
+        let mut crease_options = crease_options.clone();
+        crease_options.normal_filtering = crease_options
+            .normal_filtering
+            .max(estimate.map_or(0, normal_filtering_for));
+        detect_creases(mesh, topology, &crease_options)
+    });
+    let mut fairing = match &creases {
+        Some(creases) => ConstrainedFairing::with_creases(
+            mesh,
+            topology,
+            options.variant,
+            options.boundary,
+            creases,
+        ),
+        None => ConstrainedFairing::new(mesh, topology, options.variant, options.boundary),
+    };
+    fairing.set_tangential_relaxation(options.tangential_relaxation as f32);
+    let mut report = match auto_noise {
+        None => fairing.run(&mut mesh.positions, options),
+        Some(noise) => {
+            // Round by round until the noise left is a small part of the input's (or no longer
+            // falls): see [`super::strength`].
+            let mut report = FairReport::default();
+            let target = noise * NOISE_LEFT;
+            let mut last = noise;
+            fairing.load(&mesh.positions);
+            for round in 0..MAX_AUTO_ROUNDS {
+                if round > 0 {
+                    fairing.reanchor();
+                }
+                fairing.run_round(options, &mut report);
+                fairing.store(&mut mesh.positions);
+                let Some(now) = estimate_noise(mesh, topology) else {
+                    break;
+                };
+                if now <= target || now > last * MIN_NOISE_FALL {
+                    break;
+                }
+                last = now;
+            }
+            report
+        }
+    };
+    report.noise_estimate = estimate;
+    report.crease_edges = creases.map_or(0, |c| c.edges.len());
+    report
 }
 
 #[cfg(test)]

@@ -37,6 +37,8 @@
 pub mod baseline;
 pub mod boundary;
 pub mod constrained;
+pub mod creases;
+pub mod strength;
 
 use crate::mesh::{Topology, TriMesh};
 
@@ -44,6 +46,8 @@ pub use baseline::{
     fair_hc, fair_laplacian, fair_taubin, HcOptions, LaplacianOptions, TaubinOptions,
 };
 pub use constrained::{fair_constrained, ConstrainedFairing};
+pub use creases::{detect_creases, CreaseOptions, Creases, FeatureClass};
+pub use strength::estimate_noise;
 
 /// How boundary vertices of open meshes move.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -96,21 +100,52 @@ pub struct FairOptions {
     pub iterations: usize,
     /// Stop a round when the largest vertex move is below this (model units); 0 disables.
     pub tolerance: f64,
-    /// Number of rounds; each round re-imposes the constraints on the current positions.
+    /// Number of rounds; each round re-imposes the constraints on the current positions. With
+    /// [`Strength::Auto`] the rounds are chosen from the mesh's noise instead.
     pub rounds: usize,
+    /// Whether `rounds` is used as given or chosen from the estimated noise (the default).
+    pub strength: Strength,
     /// How boundary vertices move.
     pub boundary: BoundaryMode,
     /// The paper's update or its normal-projected form (the default).
     pub variant: FairVariant,
+    /// Keep sharp creases ([`creases`]): `None` fairs every vertex alike, as the paper does.
+    /// The normals are filtered before detection at least as much as the estimated noise asks
+    /// for ([`strength::normal_filtering_for`]).
+    pub creases: Option<CreaseOptions>,
+    /// Normal-projected only: weight (0 to 1) of the tangential relaxation that evens out
+    /// triangles jittered along the surface ([`ConstrainedFairing::set_tangential_relaxation`]).
+    pub tangential_relaxation: f64,
 }
 
 with_setters!(FairOptions {
     with_iterations => iterations: usize,
     with_tolerance => tolerance: f64,
-    with_rounds => rounds: usize,
+    with_strength => strength: Strength,
     with_boundary => boundary: BoundaryMode,
     with_variant => variant: FairVariant,
+    with_creases => creases: Option<CreaseOptions>,
+    with_tangential_relaxation => tangential_relaxation: f64,
 });
+
+impl FairOptions {
+    /// `self` running exactly `rounds` rounds (a fixed strength).
+    #[must_use]
+    pub fn with_rounds(mut self, rounds: usize) -> Self {
+        self.rounds = rounds;
+        self.strength = Strength::Fixed;
+        self
+    }
+
+    /// The paper's method exactly: its operator, one round, every vertex alike (no creases).
+    pub fn paper() -> Self {
+        Self::default()
+            .with_variant(FairVariant::Paper)
+            .with_rounds(1)
+            .with_creases(None)
+            .with_tangential_relaxation(0.0)
+    }
+}
 
 impl Default for FairOptions {
     fn default() -> Self {
@@ -118,10 +153,28 @@ impl Default for FairOptions {
             iterations: 10,
             tolerance: 0.0,
             rounds: 1,
+            strength: Strength::Auto,
             boundary: BoundaryMode::Curve,
             variant: FairVariant::NormalProjected,
+            creases: Some(CreaseOptions::default()),
+            tangential_relaxation: DEFAULT_TANGENTIAL_RELAXATION,
         }
     }
+}
+
+/// The default [`FairOptions::tangential_relaxation`] (`docs/measurements.md`).
+pub const DEFAULT_TANGENTIAL_RELAXATION: f64 = 0.25;
+
+/// How many rounds constrained fairing runs.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[non_exhaustive]
+pub enum Strength {
+    /// Estimate the mesh's noise and run rounds until most of it is gone: none on a clean mesh
+    /// ([`strength`]).
+    #[default]
+    Auto,
+    /// Exactly [`FairOptions::rounds`] rounds.
+    Fixed,
 }
 
 /// What a fairing run did.
@@ -129,8 +182,15 @@ impl Default for FairOptions {
 pub struct FairReport {
     /// Iterations actually run, summed over rounds.
     pub iterations_run: usize,
+    /// Rounds run.
+    pub rounds_run: usize,
     /// Largest single-vertex move in the last iteration (model units).
     pub max_move: f64,
+    /// The input's estimated noise in mean edge lengths ([`strength::estimate_noise`]), when the
+    /// run estimated it ([`Strength::Auto`], or creases kept).
+    pub noise_estimate: Option<f64>,
+    /// Feature edges kept as creases (0 without creases).
+    pub crease_edges: usize,
 }
 
 /// The smoothing methods offered by the CLI and the editor.

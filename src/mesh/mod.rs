@@ -13,6 +13,7 @@ mod clean;
 #[cfg(test)]
 pub(crate) mod fixtures;
 mod reorder;
+pub mod shapes;
 mod subdivide;
 mod topology;
 

@@ -1,0 +1,199 @@
+//! CAD-like test shapes with sharp edges: prisms made by extruding a closed outline (a square, a
+//! circle, a gear, a D made of a half-disc on a rectangle), with evenly sampled sides and caps.
+//!
+//! Not part of the paper: the fairing's crease handling and its clean-mesh bounds are measured on
+//! these (the tests, `examples/fairing_quality.rs`), since scanned meshes have few sharp edges.
+//!
+//! A prism's side is a grid of `layers` rows between the two copies of the outline; each cap is a
+//! set of concentric copies of the outline shrunk towards its centroid (so the outline must be
+//! star-shaped about its centroid), joined by quads and a fan around the centre. Every triangle is
+//! oriented outwards; the mesh is closed, manifold and of genus 0.
+
+use super::TriMesh;
+use std::f64::consts::TAU;
+
+/// Extrudes `outline` (counter-clockwise, star-shaped about its centroid, in the xy plane) from
+/// z = 0 to z = `height`: `layers` rows of quads on the side, `rings` rings on each cap.
+pub fn extrusion(outline: &[[f64; 2]], height: f64, layers: usize, rings: usize) -> TriMesh {
+    let m = outline.len();
+    let (layers, rings) = (layers.max(1), rings.max(1));
+    let centre = outline
+        .iter()
+        .fold([0.0, 0.0], |s, p| [s[0] + p[0], s[1] + p[1]])
+        .map(|c| c / m as f64);
+    let mut positions: Vec<[f32; 3]> = Vec::new();
+    let mut triangles: Vec<[u32; 3]> = Vec::new();
+    let ring_at = |scale: f64, z: f64, positions: &mut Vec<[f32; 3]>| -> u32 {
+        let start = positions.len() as u32;
+        for p in outline {
+            let x = centre[0] + (p[0] - centre[0]) * scale;
+            let y = centre[1] + (p[1] - centre[1]) * scale;
+            positions.push([x as f32, y as f32, z as f32]);
+        }
+        start
+    };
+    // Quads between two rings a -> b (b above a, or b inside a on a cap), outward when `flip` is
+    // false for the side (counter-clockwise outline seen from outside).
+    let join = |a: u32, b: u32, flip: bool, triangles: &mut Vec<[u32; 3]>| {
+        for i in 0..m as u32 {
+            let j = (i + 1) % m as u32;
+            let (t1, t2) = ([a + i, a + j, b + j], [a + i, b + j, b + i]);
+            if flip {
+                triangles.push([t1[0], t1[2], t1[1]]);
+                triangles.push([t2[0], t2[2], t2[1]]);
+            } else {
+                triangles.push(t1);
+                triangles.push(t2);
+            }
+        }
+    };
+    let side: Vec<u32> = (0..=layers)
+        .map(|k| ring_at(1.0, height * k as f64 / layers as f64, &mut positions))
+        .collect();
+    for k in 0..layers {
+        join(side[k], side[k + 1], false, &mut triangles);
+    }
+    for (outer, z, top) in [(side[layers], height, true), (side[0], 0.0, false)] {
+        let mut previous = outer;
+        for r in 1..rings {
+            let ring = ring_at(1.0 - r as f64 / rings as f64, z, &mut positions);
+            // Seen from above, the outline runs counter-clockwise: a quad (outer i, outer j,
+            // inner j, inner i) faces up.
+            join(previous, ring, !top, &mut triangles);
+            previous = ring;
+        }
+        let c = positions.len() as u32;
+        positions.push([centre[0] as f32, centre[1] as f32, z as f32]);
+        for i in 0..m as u32 {
+            let j = (i + 1) % m as u32;
+            triangles.push(if top {
+                [previous + i, previous + j, c]
+            } else {
+                [previous + j, previous + i, c]
+            });
+        }
+    }
+    TriMesh::new(positions, triangles)
+}
+
+/// `count` points evenly spaced along the closed polyline `corners` (counter-clockwise), the
+/// corners themselves among them where the spacing allows (each side gets its share by length).
+pub fn resample_closed(corners: &[[f64; 2]], count: usize) -> Vec<[f64; 2]> {
+    let n = corners.len();
+    let length = |i: usize| {
+        let (a, b) = (corners[i], corners[(i + 1) % n]);
+        ((b[0] - a[0]).powi(2) + (b[1] - a[1]).powi(2)).sqrt()
+    };
+    let total: f64 = (0..n).map(length).sum();
+    let mut points = Vec::with_capacity(count);
+    for i in 0..n {
+        let (a, b) = (corners[i], corners[(i + 1) % n]);
+        let pieces = ((length(i) / total * count as f64).round() as usize).max(1);
+        for k in 0..pieces {
+            let t = k as f64 / pieces as f64;
+            points.push([a[0] + (b[0] - a[0]) * t, a[1] + (b[1] - a[1]) * t]);
+        }
+    }
+    points
+}
+
+/// A box of `size` (x, y, z) with sides sampled about every `spacing`.
+pub fn cuboid(size: [f64; 3], spacing: f64) -> TriMesh {
+    let square = [
+        [0.0, 0.0],
+        [size[0], 0.0],
+        [size[0], size[1]],
+        [0.0, size[1]],
+    ];
+    let perimeter = 2.0 * (size[0] + size[1]);
+    let outline = resample_closed(&square, (perimeter / spacing).round() as usize);
+    let layers = (size[2] / spacing).round() as usize;
+    let rings = (size[0].min(size[1]) / 2.0 / spacing).round() as usize;
+    extrusion(&outline, size[2], layers, rings)
+}
+
+/// A closed cylinder of `radius` and `height`, sampled about every `spacing`.
+pub fn cylinder(radius: f64, height: f64, spacing: f64) -> TriMesh {
+    let m = ((TAU * radius / spacing).round() as usize).max(3);
+    let outline: Vec<[f64; 2]> = (0..m)
+        .map(|i| {
+            let a = TAU * i as f64 / m as f64;
+            [radius * a.cos(), radius * a.sin()]
+        })
+        .collect();
+    let layers = (height / spacing).round() as usize;
+    extrusion(
+        &outline,
+        height,
+        layers,
+        (radius / spacing).round() as usize,
+    )
+}
+
+/// A spur gear: `teeth` trapezoidal teeth between `root` and `tip` radius, `height` thick.
+pub fn gear(teeth: usize, root: f64, tip: f64, height: f64, spacing: f64) -> TriMesh {
+    let mut corners = Vec::new();
+    for t in 0..teeth {
+        let a = TAU * t as f64 / teeth as f64;
+        let step = TAU / teeth as f64;
+        for (fraction, radius) in [(0.0, root), (0.2, tip), (0.45, tip), (0.65, root)] {
+            let angle = a + fraction * step;
+            corners.push([radius * angle.cos(), radius * angle.sin()]);
+        }
+    }
+    let perimeter: f64 = (0..corners.len())
+        .map(|i| {
+            let (a, b) = (corners[i], corners[(i + 1) % corners.len()]);
+            ((b[0] - a[0]).powi(2) + (b[1] - a[1]).powi(2)).sqrt()
+        })
+        .sum();
+    let outline = resample_closed(&corners, (perimeter / spacing).round() as usize);
+    let layers = (height / spacing).round() as usize;
+    extrusion(&outline, height, layers, (root / spacing).round() as usize)
+}
+
+/// A D-shaped prism: a half-disc of `radius` on a rectangle `2·radius` wide and `depth` deep,
+/// `height` thick: flat, sharp and smoothly curved regions side by side (like the fandisk).
+pub fn d_prism(radius: f64, depth: f64, height: f64, spacing: f64) -> TriMesh {
+    let arc_points = ((std::f64::consts::PI * radius / spacing).round() as usize).max(2);
+    let mut corners = vec![[-radius, -depth], [radius, -depth]];
+    for k in 0..=arc_points {
+        let a = std::f64::consts::PI * k as f64 / arc_points as f64;
+        corners.push([radius * a.cos(), radius * a.sin()]);
+    }
+    corners.dedup();
+    let perimeter = std::f64::consts::PI * radius + 2.0 * (radius + depth) + 2.0 * radius;
+    let outline = resample_closed(&corners, (perimeter / spacing).round() as usize);
+    let layers = (height / spacing).round() as usize;
+    extrusion(
+        &outline,
+        height,
+        layers,
+        (radius / spacing).round() as usize,
+    )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::mesh::Topology;
+
+    #[test]
+    fn shapes_are_closed_oriented_genus_zero_and_outward() {
+        for (name, mesh) in [
+            ("cuboid", cuboid([2.0, 1.0, 0.5], 0.1)),
+            ("cylinder", cylinder(1.0, 2.0, 0.15)),
+            ("gear", gear(12, 1.0, 1.3, 0.4, 0.06)),
+            ("d", d_prism(1.0, 0.8, 0.6, 0.1)),
+        ] {
+            let topology = Topology::build(&mesh);
+            assert!(topology.is_closed(), "{name}");
+            assert!(topology.is_oriented_manifold(), "{name}");
+            assert_eq!(topology.euler_characteristic(), 2, "{name}");
+            assert!(crate::metrics::signed_volume(&mesh) > 0.0, "{name}");
+        }
+        let size = [2.0, 1.0, 0.5];
+        let volume = crate::metrics::signed_volume(&cuboid(size, 0.1));
+        assert!((volume - 1.0).abs() < 1e-5, "cuboid volume {volume}");
+    }
+}
