@@ -1,5 +1,6 @@
-//! The command-line tool end to end: `info`, `noise`, `convert`, `compare` on the real meshes, and
-//! errors (exit code 1, the file named on stderr).
+//! The command-line tool end to end: `info`, `noise`, `convert`, `compare`, `fair` and `multires`
+//! on the real meshes, standard input and output (`-`), and errors (exit code 1, the file named
+//! on stderr).
 
 use serde_json::Value;
 use std::path::{Path, PathBuf};
@@ -212,4 +213,222 @@ fn errors_name_the_file_and_exit_with_code_1() {
     ]);
     assert_eq!(bad_sigma.status.code(), Some(1));
     assert!(!dir.path().join("x.obj").exists());
+}
+
+/// Runs `fairmesh args` with `stdin` on standard input.
+fn fairmesh_with_input(args: &[&str], stdin: &[u8]) -> Output {
+    use std::io::Write;
+    use std::process::Stdio;
+    let mut child = Command::new(env!("CARGO_BIN_EXE_fairmesh"))
+        .args(args)
+        .stdin(Stdio::piped())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("the fairmesh binary runs");
+    let mut pipe = child.stdin.take().unwrap();
+    let bytes = stdin.to_vec();
+    // Written from another thread: the child may fill its stdout before it has read all input.
+    let writer = std::thread::spawn(move || {
+        let _ = pipe.write_all(&bytes);
+    });
+    let out = child.wait_with_output().unwrap();
+    writer.join().unwrap();
+    out
+}
+
+const DISTANCE_FIELDS: [&str; 5] = [
+    "mean_surface_distance",
+    "mean_surface_distance_edges",
+    "hausdorff",
+    "normal_error_deg",
+    "rms",
+];
+
+#[test]
+fn multires_json_times_one_run_and_measures_only_when_asked() {
+    let dir = tempfile::tempdir().unwrap();
+    let output = dir.path().join("faired.obj");
+    let input = data("elephant.obj");
+    let args = [
+        "multires",
+        &input,
+        "-o",
+        output.to_str().unwrap(),
+        "--level",
+        "3",
+        "--json",
+    ];
+    let plain = json_of(&args);
+    assert!(plain["time_ms"].as_f64().unwrap() > 0.0);
+    assert!(plain["hierarchy_ms"].as_f64().unwrap() > 0.0);
+    assert_eq!(plain["level"], 3);
+    let volume = plain["volume_change_percent"].as_f64().unwrap();
+    assert!(volume.abs() < 1.0, "volume change {volume}%");
+    // One run: no second, separately timed run, and no distances nobody asked for.
+    assert!(plain.get("first_run_ms").is_none(), "{plain}");
+    for key in DISTANCE_FIELDS {
+        assert!(plain.get(key).is_none(), "{key} measured unasked: {plain}");
+    }
+    assert_eq!(fairmesh::io::load(&output).unwrap().mesh.face_count(), 5558);
+
+    let measured = json_of(&[&args[..], &["--measure"]].concat());
+    for key in DISTANCE_FIELDS {
+        let value = measured[key].as_f64().unwrap_or(f64::NAN);
+        assert!(value > 0.0 && value.is_finite(), "{key} = {value}");
+    }
+    // The fairing is deterministic, so the measured run gives the same volume change.
+    assert_eq!(
+        measured["volume_change_percent"],
+        plain["volume_change_percent"]
+    );
+
+    // The table has the distance columns only when measuring.
+    let text = fairmesh(&args[..args.len() - 1]);
+    assert!(text.status.success());
+    let text = String::from_utf8_lossy(&text.stdout);
+    assert!(
+        text.contains("volume %") && !text.contains("mean dist"),
+        "{text}"
+    );
+}
+
+#[test]
+fn fair_measures_distances_only_when_asked() {
+    let dir = tempfile::tempdir().unwrap();
+    let output = dir.path().join("faired.ply");
+    let input = data("mushroom_open.obj");
+    let args = ["fair", &input, "-o", output.to_str().unwrap(), "--json"];
+    let plain = json_of(&args);
+    assert!(plain["volume_change_percent"].is_number());
+    for key in ["mean_surface_distance", "hausdorff", "rms"] {
+        assert!(plain.get(key).is_none(), "{key} measured unasked: {plain}");
+    }
+    let measured = json_of(&[&args[..], &["--measure"]].concat());
+    for key in [
+        "mean_surface_distance",
+        "hausdorff",
+        "rms",
+        "normal_error_deg",
+    ] {
+        let value = measured[key].as_f64().unwrap_or(f64::NAN);
+        assert!(value > 0.0 && value.is_finite(), "{key} = {value}");
+    }
+}
+
+#[test]
+fn no_progress_line_when_stderr_is_not_a_terminal() {
+    let dir = tempfile::tempdir().unwrap();
+    let output = dir.path().join("faired.obj");
+    // Long enough that a progress line would be drawn (the bunny's hierarchy and fairing).
+    let out = fairmesh(&[
+        "multires",
+        &data("bunny00.obj"),
+        "-o",
+        output.to_str().unwrap(),
+        "--level",
+        "8",
+    ]);
+    assert!(out.status.success());
+    assert!(
+        out.stderr.is_empty(),
+        "stderr: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+}
+
+#[test]
+fn dash_reads_standard_input_and_writes_standard_output_in_the_named_format() {
+    let elephant = std::fs::read(data("elephant.obj")).unwrap();
+    let out = fairmesh_with_input(&["convert", "-", "-o", "-", "--format", "obj"], &elephant);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let mesh = fairmesh::io::load_from_bytes(
+        &out.stdout,
+        fairmesh::io::Format::Obj,
+        "stdout",
+        &Default::default(),
+    )
+    .unwrap()
+    .mesh;
+    assert_eq!((mesh.vertex_count(), mesh.face_count()), (2775, 5558));
+
+    // A PLY file in, binary PLY of the smoothed mesh out, the summary on stderr.
+    let dir = tempfile::tempdir().unwrap();
+    let ply = dir.path().join("elephant.ply");
+    assert!(fairmesh(&[
+        "convert",
+        &data("elephant.obj"),
+        "-o",
+        ply.to_str().unwrap()
+    ])
+    .status
+    .success());
+    let out = fairmesh_with_input(
+        &["fair", "-", "-o", "-", "--format", "ply"],
+        &std::fs::read(&ply).unwrap(),
+    );
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(out.stdout.starts_with(b"ply\n"));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("constrained"));
+    let faired = fairmesh::io::load_from_bytes(
+        &out.stdout,
+        fairmesh::io::Format::Ply,
+        "stdout",
+        &Default::default(),
+    )
+    .unwrap()
+    .mesh;
+    assert_eq!(faired.face_count(), 5558);
+    let original = fairmesh::io::load(&ply).unwrap().mesh;
+    assert_ne!(
+        faired.positions, original.positions,
+        "the mesh was smoothed"
+    );
+}
+
+#[test]
+fn dash_without_format_or_with_json_on_stdout_is_a_clear_error() {
+    let elephant = std::fs::read(data("elephant.obj")).unwrap();
+    let out = fairmesh_with_input(&["info", "-"], &elephant);
+    assert_eq!(out.status.code(), Some(1));
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        stderr.contains("standard input") && stderr.contains("--format"),
+        "stderr: {stderr}"
+    );
+
+    let out = fairmesh(&["fair", &data("elephant.obj"), "-o", "-"]);
+    assert_eq!(out.status.code(), Some(1));
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        stderr.contains("standard output") && stderr.contains("--format"),
+        "stderr: {stderr}"
+    );
+    assert!(out.stdout.is_empty());
+
+    let out = fairmesh(&[
+        "multires",
+        &data("elephant.obj"),
+        "-o",
+        "-",
+        "--format",
+        "obj",
+        "--json",
+    ]);
+    assert_eq!(out.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("--json"));
+    assert!(out.stdout.is_empty());
+
+    // Commands that read two meshes take files only.
+    let out = fairmesh(&["compare", "-", &data("elephant.obj")]);
+    assert_eq!(out.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("standard input"));
 }

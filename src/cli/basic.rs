@@ -19,6 +19,8 @@ pub struct InfoArgs {
     /// Keep vertices with identical positions apart (by default they are merged).
     #[arg(long)]
     pub no_weld: bool,
+    #[command(flatten)]
+    pub stdio: super::StdioFormat,
 }
 
 #[derive(Clone, Copy, Debug, ValueEnum)]
@@ -47,6 +49,8 @@ pub struct NoiseArgs {
     /// How vertices move.
     #[arg(long, value_enum, default_value_t = ModeArg::Normal)]
     pub mode: ModeArg,
+    #[command(flatten)]
+    pub stdio: super::StdioFormat,
 }
 
 #[derive(Args, Debug)]
@@ -63,6 +67,8 @@ pub struct ConvertArgs {
     /// e.g. `--subdivide 2` on the bundled bunny gives 1.2M faces.
     #[arg(long, default_value_t = 0)]
     pub subdivide: usize,
+    #[command(flatten)]
+    pub stdio: super::StdioFormat,
 }
 
 #[derive(Args, Debug)]
@@ -76,17 +82,52 @@ pub struct CompareArgs {
     pub json: bool,
 }
 
-/// Loads an input mesh; `@bunny` is the bunny compiled into the binary.
+/// Loads an input mesh; `@bunny` is the bunny compiled into the binary. `-` is refused (the
+/// command has no `--format`); see [`load_from`].
 pub(crate) fn load(path: &Path, weld: bool) -> anyhow::Result<Loaded> {
+    if super::is_stdio(path) {
+        anyhow::bail!("this command reads files only, not standard input (`-`)");
+    }
+    load_from(path, weld, None)
+}
+
+/// [`load_from`] with a progress line on a terminal (see `progress`).
+pub(crate) fn load_shown(
+    path: &Path,
+    weld: bool,
+    format: Option<super::FormatArg>,
+) -> anyhow::Result<Loaded> {
+    super::progress::Step::run(format!("loading {}", super::display_path(path)), || {
+        load_from(path, weld, format)
+    })
+}
+
+/// Loads an input mesh: a file, `@bunny` (the bunny compiled into the binary), or `-`, standard
+/// input in the format `format` names.
+pub(crate) fn load_from(
+    path: &Path,
+    weld: bool,
+    format: Option<super::FormatArg>,
+) -> anyhow::Result<Loaded> {
     let options = LoadOptions { weld };
     if fairmesh::bundled::is_bunny_pseudo_path(path) {
         return Ok(fairmesh::bundled::load_bunny(&options)?);
+    }
+    if super::is_stdio(path) {
+        let format = super::stdio_format(format, "reading from standard input")?;
+        let stdin = std::io::stdin().lock();
+        return Ok(io::load_from_reader(
+            stdin,
+            format,
+            "standard input",
+            &options,
+        )?);
     }
     Ok(io::load_with(path, &options)?)
 }
 
 pub fn info(args: InfoArgs) -> anyhow::Result<()> {
-    let loaded = load(&args.file, !args.no_weld)?;
+    let loaded = load_shown(&args.file, !args.no_weld, args.stdio.format)?;
     let (mesh, topology, report) = (&loaded.mesh, &loaded.topology, &loaded.report);
     let closed = topology.is_closed();
     let volume = closed.then(|| metrics::signed_volume(mesh));
@@ -198,7 +239,10 @@ pub fn noise(args: NoiseArgs) -> anyhow::Result<()> {
         "--sigma must be a finite number >= 0, got {}",
         args.sigma
     );
-    let mut loaded = load(&args.input, true)?;
+    if super::is_stdio(&args.output) {
+        super::stdio_format(args.stdio.format, "writing to standard output")?;
+    }
+    let mut loaded = load_shown(&args.input, true, args.stdio.format)?;
     let mode = match args.mode {
         ModeArg::Direction => NoiseMode::Direction,
         ModeArg::Iso => NoiseMode::Isotropic,
@@ -211,10 +255,15 @@ pub fn noise(args: NoiseArgs) -> anyhow::Result<()> {
             .with_seed(args.seed)
             .with_mode(mode),
     );
-    super::save_kept(&args.output, &loaded.mesh, &loaded.source)?;
+    super::save_kept(
+        &args.output,
+        &loaded.mesh,
+        &loaded.source,
+        args.stdio.format,
+    )?;
     eprintln!(
         "wrote {} (sigma {:.4e} model units, {:?}, seed {})",
-        args.output.display(),
+        super::display_path(&args.output),
         absolute,
         mode,
         args.seed
@@ -223,14 +272,22 @@ pub fn noise(args: NoiseArgs) -> anyhow::Result<()> {
 }
 
 pub fn convert(args: ConvertArgs) -> anyhow::Result<()> {
-    let mut loaded = load(&args.input, !args.no_weld)?;
+    if super::is_stdio(&args.output) {
+        super::stdio_format(args.stdio.format, "writing to standard output")?;
+    }
+    let mut loaded = load_shown(&args.input, !args.no_weld, args.stdio.format)?;
     for _ in 0..args.subdivide {
         loaded.mesh = fairmesh::mesh::subdivide_loop(&loaded.mesh);
     }
-    super::save_kept(&args.output, &loaded.mesh, &loaded.source)?;
+    super::save_kept(
+        &args.output,
+        &loaded.mesh,
+        &loaded.source,
+        args.stdio.format,
+    )?;
     eprintln!(
         "wrote {} ({} vertices, {} faces)",
-        args.output.display(),
+        super::display_path(&args.output),
         loaded.mesh.vertex_count(),
         loaded.mesh.face_count()
     );

@@ -44,7 +44,8 @@ pub enum VariantArg {
 pub struct FairArgs {
     /// Mesh to smooth (.obj .gltf .glb .ply .stl .off).
     pub input: PathBuf,
-    /// Where to write the smoothed mesh (format from the extension).
+    /// Where to write the smoothed mesh (format from the extension; `-`: standard output, with
+    /// --format).
     #[arg(short, long)]
     pub output: PathBuf,
     /// Smoothing method.
@@ -84,6 +85,12 @@ pub struct FairArgs {
     /// ...) instead of a sentence.
     #[arg(long)]
     pub json: bool,
+    /// Also measure the result against the input: two-way surface distance (mean and Hausdorff),
+    /// vertex RMS and normal error. Costs more than the fairing on large meshes.
+    #[arg(long)]
+    pub measure: bool,
+    #[command(flatten)]
+    pub stdio: super::StdioFormat,
 }
 
 impl FairArgs {
@@ -135,14 +142,25 @@ impl FairArgs {
 }
 
 pub fn run(args: FairArgs) -> anyhow::Result<()> {
-    let loaded = super::basic::load(&args.input, true)?;
+    anyhow::ensure!(
+        !(args.json && super::is_stdio(&args.output)),
+        "--json and `-o -` would both write to standard output: write the mesh to a file"
+    );
+    if super::is_stdio(&args.output) {
+        super::stdio_format(args.stdio.format, "writing to standard output")?;
+    }
+    let loaded = super::basic::load_shown(&args.input, true, args.stdio.format)?;
     let (mut mesh, topology, source) = (loaded.mesh, loaded.topology, loaded.source);
     let options = args.method_options(fairmesh::metrics::mean_edge_length(&mesh));
     let volume_before = fairmesh::metrics::signed_volume(&mesh);
+    // The input is kept only to measure against it.
+    let input = args.measure.then(|| mesh.clone());
 
+    let step = super::progress::Step::start("fairing");
     let start = Instant::now();
     let report = fairing::fair(&mut mesh, &topology, &options);
     let time_ms = start.elapsed().as_secs_f64() * 1e3;
+    drop(step);
 
     let volume_after = fairmesh::metrics::signed_volume(&mesh);
     let volume_change_percent = if volume_before != 0.0 {
@@ -150,7 +168,12 @@ pub fn run(args: FairArgs) -> anyhow::Result<()> {
     } else {
         0.0
     };
-    super::save_kept(&args.output, &mesh, &source)?;
+    super::save_kept(&args.output, &mesh, &source, args.stdio.format)?;
+    let measures = input.map(|input| {
+        super::progress::Step::run("measuring against the input", || {
+            fairmesh::metrics::compare(&input, &mesh)
+        })
+    });
 
     let method = options.method().name();
     let variant = match &options {
@@ -158,7 +181,7 @@ pub fn run(args: FairArgs) -> anyhow::Result<()> {
         _ => None,
     };
     if args.json {
-        let json = serde_json::json!({
+        let mut json = serde_json::json!({
             "method": method,
             "variant": variant,
             "input": args.input.display().to_string(),
@@ -171,27 +194,52 @@ pub fn run(args: FairArgs) -> anyhow::Result<()> {
             "volume_change_percent": volume_change_percent,
             "max_move": report.max_move,
         });
-        println!("{json}");
-    } else {
-        let closed_note = if topology.is_closed() {
-            ""
-        } else {
-            " (the mesh is open: volume is only indicative)"
-        };
-        println!(
-            "{}{}: {} iterations in {:.1} ms, volume change {:+.4}%{}, last largest move {:.3e}; \
-             wrote {}",
-            method,
-            variant.map(|v| format!(" ({v})")).unwrap_or_default(),
-            report.iterations_run,
-            time_ms,
-            volume_change_percent,
-            closed_note,
-            report.max_move,
-            args.output.display()
-        );
+        if let (Some(m), Some(map)) = (&measures, json.as_object_mut()) {
+            map.insert(
+                "mean_surface_distance".into(),
+                m.mean_surface_distance.into(),
+            );
+            map.insert("hausdorff".into(), m.hausdorff.into());
+            if let Some(c) = &m.same_connectivity {
+                map.insert("rms".into(), c.rms.into());
+                map.insert("normal_error_deg".into(), c.normal_error_deg.into());
+            }
+        }
+        return super::emit(&format!("{json}\n"));
     }
-    Ok(())
+    let closed_note = if topology.is_closed() {
+        ""
+    } else {
+        " (the mesh is open: volume is only indicative)"
+    };
+    let measured = measures
+        .map(|m| {
+            format!(
+                ", mean surface distance to the input {:.3e} (Hausdorff {:.3e})",
+                m.mean_surface_distance, m.hausdorff
+            )
+        })
+        .unwrap_or_default();
+    let sentence = format!(
+        "{}{}: {} iterations in {:.1} ms, volume change {:+.4}%{}, last largest move {:.3e}{}; \
+         wrote {}\n",
+        method,
+        variant.map(|v| format!(" ({v})")).unwrap_or_default(),
+        report.iterations_run,
+        time_ms,
+        volume_change_percent,
+        closed_note,
+        report.max_move,
+        measured,
+        super::display_path(&args.output)
+    );
+    if super::is_stdio(&args.output) {
+        // Standard output holds the mesh.
+        eprint!("{sentence}");
+        Ok(())
+    } else {
+        super::emit(&sentence)
+    }
 }
 
 /// Median time in milliseconds of `runs` calls of `work`.

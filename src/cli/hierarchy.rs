@@ -87,7 +87,8 @@ pub enum VariantArg {
 pub struct MultiresArgs {
     /// Input mesh.
     pub input: PathBuf,
-    /// Output mesh (format by extension); optional when only measuring.
+    /// Output mesh (format by extension; `-`: standard output, with --format); optional when
+    /// only timing or measuring.
     #[arg(short, long)]
     pub output: Option<PathBuf>,
     /// Start level(s): 0 is M0 (single-level fairing), larger is coarser and smoother. Several,
@@ -108,28 +109,40 @@ pub struct MultiresArgs {
     /// Placement of split vertices; several, comma separated, run one after another.
     #[arg(long, value_enum, value_delimiter = ',', default_value = "improved")]
     pub variant: Vec<VariantArg>,
-    /// Add seeded normal noise of this many mean edge lengths first, and measure the result
-    /// against the clean input.
+    /// Add seeded normal noise of this many mean edge lengths first (the volume change, and with
+    /// --measure the distances, are then taken against the clean input).
     #[arg(long)]
     pub noise: Option<f64>,
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
-    /// Measure the result against this mesh (default: the input, before any noise).
+    /// Measure each result against the input (before any noise): two-way surface distance (mean
+    /// and Hausdorff), vertex RMS and normal error. Costs more than the fairing on large meshes.
+    #[arg(long)]
+    pub measure: bool,
+    /// Measure the result against this mesh instead of the input (implies --measure).
     #[arg(long)]
     pub reference: Option<PathBuf>,
-    /// Print JSON instead of text.
+    /// Print JSON instead of text: the time of each run and of the hierarchy build, the volume
+    /// change, and with --measure the distances.
     #[arg(long)]
     pub json: bool,
+    #[command(flatten)]
+    pub stdio: super::StdioFormat,
     #[command(flatten)]
     pub build: BuildArgs,
 }
 
 fn build(mesh: &TriMesh, args: &BuildArgs) -> anyhow::Result<Hierarchy> {
-    Ok(build_hierarchy(mesh, &args.options(), &mut NoProgress)?)
+    let mut step = super::progress::Step::start("building the hierarchy");
+    Ok(build_hierarchy(mesh, &args.options(), &mut step)?)
 }
 
 pub fn run_hierarchy(args: HierarchyArgs) -> anyhow::Result<()> {
-    let mut loaded = super::basic::load(&args.input, true)?;
+    // (Its --format is the levels' format: it reads files only.)
+    let mut loaded =
+        super::progress::Step::run(format!("loading {}", args.input.display()), || {
+            super::basic::load(&args.input, true)
+        })?;
     for _ in 0..args.subdivide {
         loaded.mesh = fairmesh::mesh::subdivide_loop(&loaded.mesh);
     }
@@ -147,8 +160,10 @@ pub fn run_hierarchy(args: HierarchyArgs) -> anyhow::Result<()> {
         for level in 0..hierarchy.level_count() {
             let path = dir.join(format!("level_{level:02}.{extension}"));
             let mesh = hierarchy.level_mesh(level);
-            let report = io::save_with_source(&path, &mesh, &loaded.source)
-                .with_context(|| format!("writing level {level}"))?;
+            let report = super::progress::Step::run(format!("saving {}", path.display()), || {
+                io::save_with_source(&path, &mesh, &loaded.source)
+            })
+            .with_context(|| format!("writing level {level}"))?;
             lost.extend(report.warnings);
         }
         // Every coarse level loses the same things: say it once.
@@ -198,14 +213,31 @@ pub fn run_hierarchy(args: HierarchyArgs) -> anyhow::Result<()> {
 }
 
 pub fn run_multires(args: MultiresArgs) -> anyhow::Result<()> {
-    let loaded = super::basic::load(&args.input, true)?;
+    let to_stdout = args.output.as_deref().is_some_and(super::is_stdio);
+    anyhow::ensure!(
+        !(args.json && to_stdout),
+        "--json and `-o -` would both write to standard output: write the mesh to a file"
+    );
+    if to_stdout {
+        super::stdio_format(args.stdio.format, "writing to standard output")?;
+    }
+    let measure = args.measure || args.reference.is_some();
+    let loaded = super::basic::load_shown(&args.input, true, args.stdio.format)?;
     let source = loaded.source;
-    let clean = loaded.mesh;
-    let reference = match &args.reference {
-        Some(path) => super::basic::load(path, true)?.mesh,
-        None => clean.clone(),
+    drop(loaded.topology);
+    let mut input = loaded.mesh;
+    let reference_file = match &args.reference {
+        Some(path) => Some(super::basic::load_shown(path, true, None)?.mesh),
+        None => None,
     };
-    let mut input = clean.clone();
+    // Results are measured against the input before any noise: keep a copy only when the noise
+    // would change it and the distances are asked for.
+    let clean =
+        (measure && reference_file.is_none() && args.noise.is_some()).then(|| input.clone());
+    let clean_volume = match &reference_file {
+        Some(reference) => metrics::signed_volume(reference),
+        None => metrics::signed_volume(&input),
+    };
     if let Some(sigma) = args.noise {
         noise::add_noise(
             &mut input,
@@ -214,6 +246,7 @@ pub fn run_multires(args: MultiresArgs) -> anyhow::Result<()> {
                 .with_seed(args.seed),
         );
     }
+    let reference = measure.then(|| reference_file.as_ref().or(clean.as_ref()).unwrap_or(&input));
     let started = Instant::now();
     let hierarchy = build(&input, &args.build)?;
     let hierarchy_ms = started.elapsed().as_secs_f64() * 1e3;
@@ -235,40 +268,55 @@ pub fn run_multires(args: MultiresArgs) -> anyhow::Result<()> {
                     VariantArg::Paper => MultiresVariant::Paper,
                     VariantArg::Improved => MultiresVariant::Improved,
                 });
-            // The first run also builds the per-level connectivity; time a second run too.
-            let started = Instant::now();
-            let positions = fair_multires(&hierarchy, &options, &mut workspace, &mut NoProgress)
-                .context("multires fairing was cancelled")?;
-            let first_ms = started.elapsed().as_secs_f64() * 1e3;
-            let started = Instant::now();
-            let positions_again =
-                fair_multires(&hierarchy, &options, &mut workspace, &mut NoProgress)
-                    .context("multires fairing was cancelled")?;
-            let time_ms = started.elapsed().as_secs_f64() * 1e3;
-            debug_assert_eq!(positions, positions_again);
-            let result = TriMesh::new(positions, input.triangles.clone());
-            let comparison = metrics::compare(&reference, &result);
             let start = level.min(hierarchy.coarsest_level());
-            results.push(json!({
+            // One run, timed whole: with the per-level set-up a first run on this workspace does.
+            let mut step =
+                super::progress::Step::start(format!("multiresolution fairing from level {start}"));
+            let started = Instant::now();
+            let positions = fair_multires(&hierarchy, &options, &mut workspace, &mut step)
+                .context("multires fairing was cancelled")?;
+            let time_ms = started.elapsed().as_secs_f64() * 1e3;
+            drop(step);
+            let result = TriMesh::new(positions, input.triangles.clone());
+            let volume_change_percent = (clean_volume != 0.0).then(|| {
+                100.0 * (metrics::signed_volume(&result) - clean_volume) / clean_volume.abs()
+            });
+            let mut row = json!({
                 "level": start,
                 "level_vertices": hierarchy.level_info(start).vertices,
                 "variant": format!("{variant:?}").to_lowercase(),
                 "time_ms": time_ms,
-                "first_run_ms": first_ms,
                 "hierarchy_ms": hierarchy_ms,
-                "volume_change_percent": comparison.volume_change_percent,
-                "mean_surface_distance": comparison.mean_surface_distance,
-                "mean_surface_distance_edges":
-                    comparison.mean_surface_distance / metrics::mean_edge_length(&reference),
-                "hausdorff": comparison.hausdorff,
-                "normal_error_deg": comparison.same_connectivity.map(|c| c.normal_error_deg),
-                "rms": comparison.same_connectivity.map(|c| c.rms),
-            }));
+                "volume_change_percent": volume_change_percent,
+            });
+            if let (Some(reference), Some(map)) = (reference, row.as_object_mut()) {
+                let comparison = super::progress::Step::run("measuring the result", || {
+                    metrics::compare(reference, &result)
+                });
+                map.insert(
+                    "mean_surface_distance".into(),
+                    json!(comparison.mean_surface_distance),
+                );
+                map.insert(
+                    "mean_surface_distance_edges".into(),
+                    json!(comparison.mean_surface_distance / metrics::mean_edge_length(reference)),
+                );
+                map.insert("hausdorff".into(), json!(comparison.hausdorff));
+                map.insert(
+                    "normal_error_deg".into(),
+                    json!(comparison.same_connectivity.map(|c| c.normal_error_deg)),
+                );
+                map.insert(
+                    "rms".into(),
+                    json!(comparison.same_connectivity.map(|c| c.rms)),
+                );
+            }
+            results.push(row);
             last = Some(result);
         }
     }
     if let (Some(path), Some(result)) = (&args.output, &last) {
-        super::save_kept(path, result, &source)?;
+        super::save_kept(path, result, &source, args.stdio.format)?;
     }
     if args.json {
         let value = if results.len() == 1 {
@@ -279,31 +327,49 @@ pub fn run_multires(args: MultiresArgs) -> anyhow::Result<()> {
         return super::emit(&format!("{}\n", serde_json::to_string_pretty(&value)?));
     }
     let mut out = format!(
-        "{}: hierarchy of {} levels in {:.1} ms{}\nlevel  vertices  variant   time ms   volume %   mean dist (edges)  normal err deg\n",
+        "{}: hierarchy of {} levels in {:.1} ms{}\nlevel  vertices  variant   time ms   volume %{}\n",
         args.input.display(),
         hierarchy.level_count(),
         hierarchy_ms,
         match args.noise {
             Some(s) => format!(", noise {s} mean edge lengths (seed {})", args.seed),
             None => String::new(),
+        },
+        if measure {
+            "   mean dist (edges)  normal err deg"
+        } else {
+            ""
         }
     );
     for r in &results {
-        writeln!(
+        write!(
             out,
-            "{:>5} {:>9}  {:<8} {:>8.2} {:>+10.4} {:>18.5} {:>15.3}",
+            "{:>5} {:>9}  {:<8} {:>8.2} {:>+10.4}",
             r["level"],
             r["level_vertices"],
             r["variant"].as_str().unwrap_or(""),
             r["time_ms"].as_f64().unwrap_or(0.0),
             r["volume_change_percent"].as_f64().unwrap_or(f64::NAN),
-            r["mean_surface_distance_edges"]
-                .as_f64()
-                .unwrap_or(f64::NAN),
-            r["normal_error_deg"].as_f64().unwrap_or(f64::NAN),
         )?;
+        if measure {
+            write!(
+                out,
+                " {:>18.5} {:>15.3}",
+                r["mean_surface_distance_edges"]
+                    .as_f64()
+                    .unwrap_or(f64::NAN),
+                r["normal_error_deg"].as_f64().unwrap_or(f64::NAN),
+            )?;
+        }
+        out.push('\n');
     }
-    super::emit(&out)
+    if to_stdout {
+        // Standard output holds the mesh.
+        eprint!("{out}");
+        Ok(())
+    } else {
+        super::emit(&out)
+    }
 }
 
 /// Rows for `fairmesh bench`: (operation, milliseconds).

@@ -4,8 +4,9 @@ mod basic;
 mod bench;
 mod fair;
 mod hierarchy;
+mod progress;
 
-use clap::{Parser, Subcommand};
+use clap::{Parser, Subcommand, ValueEnum};
 use std::path::PathBuf;
 
 #[derive(Parser, Debug)]
@@ -17,7 +18,8 @@ use std::path::PathBuf;
 (constrained fairing, after Liu, Bao, Heng, Wong and Peng).\n\nWith no subcommand, opens the editor on \
 the bundled Stanford bunny. Formats are chosen by file extension: .obj .gltf .glb .ply .stl .off, \
 to read and to write. Wherever a mesh is read, `@bunny` names the bunny compiled into the binary \
-(a file of that name is `./@bunny`)."
+(a file of that name is `./@bunny`). Where a command reads or writes one mesh, `-` is standard \
+input or output, with --format naming the format."
 )]
 pub struct Cli {
     #[command(subcommand)]
@@ -75,18 +77,94 @@ pub fn run(command: Command) -> anyhow::Result<()> {
     }
 }
 
+/// The format of a mesh read from standard input or written to standard output (`-`).
+#[derive(Clone, Copy, Debug, ValueEnum, PartialEq, Eq)]
+pub enum FormatArg {
+    Obj,
+    Gltf,
+    Glb,
+    Ply,
+    Stl,
+    Off,
+}
+
+impl From<FormatArg> for fairmesh::io::Format {
+    fn from(format: FormatArg) -> Self {
+        use fairmesh::io::Format;
+        match format {
+            FormatArg::Obj => Format::Obj,
+            FormatArg::Gltf => Format::Gltf,
+            FormatArg::Glb => Format::Glb,
+            FormatArg::Ply => Format::Ply,
+            FormatArg::Stl => Format::Stl,
+            FormatArg::Off => Format::Off,
+        }
+    }
+}
+
+/// `--format`, for the commands that read or write one mesh.
+#[derive(clap::Args, Debug, Clone, Copy, Default)]
+pub struct StdioFormat {
+    /// Format of the mesh read from standard input or written to standard output, where the
+    /// input or the output is `-` (files are known by their extension).
+    #[arg(long, value_enum)]
+    pub format: Option<FormatArg>,
+}
+
+/// Whether `path` is `-`: standard input or output.
+pub(crate) fn is_stdio(path: &std::path::Path) -> bool {
+    path.as_os_str() == "-"
+}
+
+/// The format `--format` names for `-`, or an error saying it is needed.
+pub(crate) fn stdio_format(
+    format: Option<FormatArg>,
+    what: &str,
+) -> anyhow::Result<fairmesh::io::Format> {
+    format.map(Into::into).ok_or_else(|| {
+        anyhow::anyhow!(
+            "{what} (`-`) needs --format to name the mesh format (obj, gltf, glb, ply, stl or off)"
+        )
+    })
+}
+
 /// Saves `mesh` into what it was loaded from (see `fairmesh::io::save_with_source`) and prints, on
-/// stderr, what the output could not keep.
+/// stderr, what the output could not keep. `-` writes the bare mesh to standard output in the
+/// format `--format` names.
 pub(crate) fn save_kept(
     path: &std::path::Path,
     mesh: &fairmesh::TriMesh,
     source: &fairmesh::io::Source,
+    format: Option<FormatArg>,
 ) -> anyhow::Result<()> {
+    let _step = progress::Step::start(format!("saving {}", display_path(path)));
+    if is_stdio(path) {
+        let format = stdio_format(format, "writing to standard output")?;
+        let lost = source.contents();
+        let mut stdout = std::io::BufWriter::with_capacity(1 << 20, std::io::stdout().lock());
+        fairmesh::io::write_to(&mut stdout, mesh, format)?;
+        if !lost.is_empty() {
+            eprintln!(
+                "warning: standard output gets a bare {format} mesh; not kept from the input: {}",
+                lost.join("; ")
+            );
+        }
+        return Ok(());
+    }
     let report = fairmesh::io::save_with_source(path, mesh, source)?;
     for warning in &report.warnings {
         eprintln!("warning: {}: {warning}", path.display());
     }
     Ok(())
+}
+
+/// A path as messages show it: `-` is "standard input/output".
+pub(crate) fn display_path(path: &std::path::Path) -> String {
+    if is_stdio(path) {
+        "standard input/output (-)".into()
+    } else {
+        path.display().to_string()
+    }
 }
 
 /// Writes command output to stdout. A reader that closes the pipe early (`| head`) ends the output
