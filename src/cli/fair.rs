@@ -2,8 +2,8 @@
 //! baselines, and write the result; `bench_rows` gives `fairmesh bench` its fairing timings.
 use clap::{Args, ValueEnum};
 use fairmesh::fairing::{
-    self, baseline::UmbrellaStencil, BoundaryMode, ConstrainedFairing, FairOptions, FairVariant,
-    HcOptions, LaplacianOptions, MethodOptions, TaubinOptions,
+    self, baseline::UmbrellaStencil, BoundaryMode, ConstrainedFairing, CreaseOptions, FairOptions,
+    FairVariant, HcOptions, LaplacianOptions, MethodOptions, Strength, TaubinOptions,
 };
 use std::path::PathBuf;
 use std::time::Instant;
@@ -28,7 +28,7 @@ pub enum BoundaryArg {
     Fixed,
 }
 
-#[derive(Clone, Copy, Debug, ValueEnum)]
+#[derive(Clone, Copy, Debug, ValueEnum, PartialEq, Eq)]
 pub enum VariantArg {
     /// The paper's operator exactly (vertices may slide along the surface).
     Paper,
@@ -56,9 +56,22 @@ pub struct FairArgs {
     #[arg(long, default_value_t = 10)]
     pub iterations: usize,
     /// Constrained only: rounds; each round re-anchors the triangle centres at the current
-    /// positions, so more rounds smooth more (and drift further from the input).
-    #[arg(long, default_value_t = 1)]
-    pub rounds: usize,
+    /// positions, so more rounds smooth more (and drift further from the input). Without it the
+    /// noise is estimated and rounds run until most of it is gone (none on a clean mesh).
+    #[arg(long)]
+    pub rounds: Option<usize>,
+    /// Constrained only: edges where the surface folds by more than this many degrees are kept
+    /// sharp (faired along the crease; corners stay).
+    #[arg(long, default_value_t = fairmesh::fairing::creases::DEFAULT_CREASE_ANGLE,
+          conflicts_with = "no_creases")]
+    pub crease_angle: f64,
+    /// Constrained only: fair across sharp edges too, as the paper does.
+    #[arg(long)]
+    pub no_creases: bool,
+    /// Constrained normal-projected only: how much each iteration also evens out the triangles
+    /// along the surface (0 to 1; 0 moves vertices only along their normals).
+    #[arg(long, default_value_t = fairmesh::fairing::DEFAULT_TANGENTIAL_RELAXATION)]
+    pub tangential: f64,
     /// Constrained only: stop a round early once no vertex moves more than this many mean edge
     /// lengths in one iteration (0: always run all iterations).
     #[arg(long, default_value_t = 0.0)]
@@ -100,17 +113,30 @@ impl FairArgs {
             BoundaryArg::Fixed => BoundaryMode::Fixed,
         };
         match self.method {
-            MethodArg::Constrained => MethodOptions::Constrained(
-                FairOptions::default()
-                    .with_iterations(self.iterations)
-                    .with_tolerance(self.tolerance * mean_edge_length)
-                    .with_rounds(self.rounds)
-                    .with_boundary(boundary)
-                    .with_variant(match self.variant {
-                        VariantArg::Paper => FairVariant::Paper,
-                        VariantArg::NormalProjected => FairVariant::NormalProjected,
-                    }),
-            ),
+            MethodArg::Constrained => {
+                // `--variant paper` is the paper's method: one round, no creases, no tangential
+                // relaxation, unless those are asked for.
+                let paper = self.variant == VariantArg::Paper;
+                let mut options =
+                    FairOptions::default()
+                        .with_iterations(self.iterations)
+                        .with_tolerance(self.tolerance * mean_edge_length)
+                        .with_boundary(boundary)
+                        .with_tangential_relaxation(if paper { 0.0 } else { self.tangential })
+                        .with_creases((!self.no_creases && !paper).then(|| {
+                            CreaseOptions::default().with_angle_degrees(self.crease_angle)
+                        }))
+                        .with_variant(match self.variant {
+                            VariantArg::Paper => FairVariant::Paper,
+                            VariantArg::NormalProjected => FairVariant::NormalProjected,
+                        });
+                match self.rounds {
+                    Some(rounds) => options = options.with_rounds(rounds),
+                    None if paper => options = options.with_rounds(1),
+                    None => {}
+                }
+                MethodOptions::Constrained(options)
+            }
             MethodArg::Laplacian => {
                 let defaults = LaplacianOptions::default();
                 MethodOptions::Laplacian(LaplacianOptions {
@@ -190,6 +216,9 @@ pub fn run(args: FairArgs) -> anyhow::Result<()> {
             "faces": mesh.face_count(),
             "closed": topology.is_closed(),
             "iterations_run": report.iterations_run,
+            "rounds_run": report.rounds_run,
+            "noise_estimate": report.noise_estimate,
+            "crease_edges": report.crease_edges,
             "time_ms": time_ms,
             "volume_change_percent": volume_change_percent,
             "max_move": report.max_move,
@@ -220,9 +249,30 @@ pub fn run(args: FairArgs) -> anyhow::Result<()> {
             )
         })
         .unwrap_or_default();
+    // What the automatic strength and the creases decided, in words.
+    let strength = match (report.noise_estimate, &options) {
+        (Some(noise), MethodOptions::Constrained(o)) if o.strength == Strength::Auto => {
+            if report.rounds_run == 0 {
+                format!(
+                    "noise estimate {noise:.3} edge lengths: clean, left as it is (--rounds N \
+                     fairs anyway); "
+                )
+            } else {
+                format!(
+                    "noise estimate {noise:.3} edge lengths, {} rounds; ",
+                    report.rounds_run
+                )
+            }
+        }
+        _ => String::new(),
+    };
+    let creases = match report.crease_edges {
+        0 => String::new(),
+        n => format!("{n} crease edges kept sharp; "),
+    };
     let sentence = format!(
-        "{}{}: {} iterations in {:.1} ms, volume change {:+.4}%{}, last largest move {:.3e}{}; \
-         wrote {}\n",
+        "{}{}: {strength}{creases}{} iterations in {:.1} ms, volume change {:+.4}%{}, last \
+         largest move {:.3e}{}; wrote {}\n",
         method,
         variant.map(|v| format!(" ({v})")).unwrap_or_default(),
         report.iterations_run,
