@@ -157,18 +157,29 @@ pub(crate) fn fingerprint(triangles: &[[u32; 3]]) -> u64 {
 /// same welded vertex ([`SmoothGroups`]), so the copies stay equal, while normals that differ
 /// there (a hard edge) stay apart.
 pub(crate) struct NormalTurns {
-    before: Vec<DVec3>,
-    after: Vec<DVec3>,
-    moved: Vec<bool>,
+    /// Per slot, side by side so that adding a face touches one place per corner.
+    slots: Vec<SlotSums>,
+}
+
+#[derive(Clone, Copy, Default)]
+struct SlotSums {
+    before: DVec3,
+    after: DVec3,
+    moved: bool,
 }
 
 impl NormalTurns {
     pub(crate) fn new(normals: usize) -> NormalTurns {
         NormalTurns {
-            before: vec![DVec3::ZERO; normals],
-            after: vec![DVec3::ZERO; normals],
-            moved: vec![false; normals],
+            slots: vec![SlotSums::default(); normals],
         }
+    }
+
+    fn slot_mut(&mut self, n: usize) -> &mut SlotSums {
+        if n >= self.slots.len() {
+            self.slots.resize(n + 1, SlotSums::default());
+        }
+        &mut self.slots[n]
     }
 
     /// Add a triangle whose corners use the slots `slots`, with its corners' positions before
@@ -179,44 +190,38 @@ impl NormalTurns {
         let area_after = (after[1] - after[0]).cross(after[2] - after[0]);
         let moved = before != after;
         for n in slots {
-            if n >= self.before.len() {
-                self.before.resize(n + 1, DVec3::ZERO);
-                self.after.resize(n + 1, DVec3::ZERO);
-                self.moved.resize(n + 1, false);
-            }
-            self.before[n] += area_before;
-            self.after[n] += area_after;
-            self.moved[n] |= moved;
+            let sums = self.slot_mut(n);
+            sums.before += area_before;
+            sums.after += area_after;
+            sums.moved |= moved;
         }
     }
 
     /// The sum of the area vectors of slot `n`'s faces before the move.
     pub(crate) fn area_before(&self, n: usize) -> DVec3 {
-        self.before.get(n).copied().unwrap_or(DVec3::ZERO)
+        self.slots.get(n).map_or(DVec3::ZERO, |sums| sums.before)
     }
 
     /// Add the sums of `from`'s slot `n` to this one's slot `slot`.
     pub(crate) fn merge_slot(&mut self, slot: usize, from: &NormalTurns, n: usize) {
-        if slot >= self.before.len() {
-            self.before.resize(slot + 1, DVec3::ZERO);
-            self.after.resize(slot + 1, DVec3::ZERO);
-            self.moved.resize(slot + 1, false);
-        }
-        self.before[slot] += from.before[n];
-        self.after[slot] += from.after[n];
-        self.moved[slot] |= from.moved[n];
+        let add = from.slots.get(n).copied().unwrap_or_default();
+        let sums = self.slot_mut(slot);
+        sums.before += add.before;
+        sums.after += add.after;
+        sums.moved |= add.moved;
     }
 
     /// The rotation for normal `n`, or `None` when it stays as it is.
     pub(crate) fn turn(&self, n: usize) -> Option<Turn> {
-        if !*self.moved.get(n)? {
+        let sums = self.slots.get(n)?;
+        if !sums.moved {
             return None;
         }
-        let after = self.after[n].normalize_or_zero();
+        let after = sums.after.normalize_or_zero();
         if after == DVec3::ZERO {
             return None;
         }
-        let before = self.before[n].normalize_or_zero();
+        let before = sums.before.normalize_or_zero();
         Some(if before == DVec3::ZERO {
             Turn::Replace(after)
         } else {
@@ -229,7 +234,11 @@ impl NormalTurns {
 /// welded vertex gets a slot of its own.
 #[derive(Default)]
 pub(crate) struct SmoothGroups {
-    slots: std::collections::HashMap<
+    /// Per welded vertex, the slot of the first normal value seen there (most vertices have one):
+    /// looked up by index, with no hashing.
+    first: Vec<Option<(usize, [u32; 3])>>,
+    /// The slots of the further values on a vertex (hard edges).
+    others: std::collections::HashMap<
         (usize, [u32; 3]),
         usize,
         std::hash::BuildHasherDefault<crate::mesh::PositionHasher>,
@@ -249,25 +258,40 @@ impl SmoothGroups {
         let own = own.normalize_or_zero();
         let n = dvec(normal).normalize_or_zero();
         if own != DVec3::ZERO && own.dot(n) > 0.99999 {
-            self.next += 1;
-            return self.next - 1;
+            return self.fresh();
         }
         self.slot(welded, normal)
     }
 
     pub(crate) fn slot(&mut self, welded: Option<usize>, normal: [f32; 3]) -> usize {
-        let fresh = self.next;
-        let slot = match welded {
-            Some(w) => *self
-                .slots
-                .entry((w, normal.map(f32::to_bits)))
-                .or_insert(fresh),
-            None => fresh,
+        let Some(w) = welded else {
+            return self.fresh();
         };
-        if slot == fresh {
-            self.next += 1;
+        let bits = normal.map(f32::to_bits);
+        if w >= self.first.len() {
+            self.first.resize(w + 1, None);
         }
-        slot
+        match self.first[w] {
+            Some((slot, first_bits)) if first_bits == bits => slot,
+            Some(_) => match self.others.get(&(w, bits)) {
+                Some(&slot) => slot,
+                None => {
+                    let slot = self.fresh();
+                    self.others.insert((w, bits), slot);
+                    slot
+                }
+            },
+            None => {
+                let slot = self.fresh();
+                self.first[w] = Some((slot, bits));
+                slot
+            }
+        }
+    }
+
+    fn fresh(&mut self) -> usize {
+        self.next += 1;
+        self.next - 1
     }
 }
 
