@@ -26,6 +26,7 @@
 //! already there); a `.gltf` written beside its input refers to the same files.
 
 use super::atomic;
+use super::carry::{Gather, VertexAttributes};
 use super::source::{dvec, NormalTurns, SaveReport, SmoothGroups, Source, Turn};
 use super::{Format, IoError};
 use crate::mesh::TriMesh;
@@ -214,6 +215,64 @@ impl GltfSource {
                 .map(|b| u32::from_le_bytes([b[0], b[1], b[2], b[3]]) as usize)
                 .collect(),
         }
+    }
+
+    /// TEXCOORD_0 and COLOR_0 per welded vertex, for saving in another format: each read
+    /// primitive's elements go to the welded vertices its positions became.
+    pub(crate) fn vertex_attributes(&self, source: &Source) -> VertexAttributes {
+        let mut uvs = Gather::<2>::new(source.welded_vertices);
+        let mut colours = Gather::<4>::new(source.welded_vertices);
+        let (mut any_uv, mut any_colour) = (false, false);
+        for read in &self.reads {
+            let meshes = self.array("meshes");
+            let primitives = meshes
+                .get(read.mesh)
+                .and_then(|m| m.get("primitives"))
+                .and_then(Value::as_array)
+                .map_or(&[][..], Vec::as_slice);
+            let Some(primitive) = primitives
+                .iter()
+                .find(|p| attribute(p, "POSITION") == Some(read.accessor))
+            else {
+                continue;
+            };
+            let layout_of = |name: &str| {
+                attribute(primitive, name)
+                    .and_then(|a| self.layout(a).ok())
+                    .filter(|l| l.count == read.count)
+            };
+            if let Some(layout) = layout_of("TEXCOORD_0").filter(|l| l.components == 2) {
+                any_uv = true;
+                for k in 0..read.count {
+                    let uv = [self.read(&layout, k, 0), self.read(&layout, k, 1)];
+                    uvs.put(source.welded(read.raw_start + k), uv);
+                }
+            }
+            if let Some(layout) = layout_of("COLOR_0").filter(|l| l.components >= 3) {
+                any_colour = true;
+                for k in 0..read.count {
+                    let alpha = if layout.components == 4 {
+                        self.read(&layout, k, 3)
+                    } else {
+                        1.0
+                    };
+                    let [r, g, b] = self.read3(&layout, k);
+                    colours.put(source.welded(read.raw_start + k), [r, g, b, alpha]);
+                }
+            }
+        }
+        let mut out = VertexAttributes::default();
+        if any_uv {
+            let (values, merged) = uvs.finish();
+            out.uvs = Some(values);
+            out.uv_splits_merged = merged;
+        }
+        if any_colour {
+            let (values, merged) = colours.finish();
+            out.colours = Some(values);
+            out.colour_splits_merged = merged;
+        }
+        out
     }
 
     /// What the document holds beyond positions and triangles, in plain words.

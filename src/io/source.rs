@@ -21,6 +21,7 @@
 //! Saving to another format writes the mesh as it is and names, in the [`SaveReport`], what that
 //! format cannot keep.
 
+use super::carry::VertexAttributes;
 use super::{gltf_writeback, Format};
 use crate::mesh::TriMesh;
 use glam::{DQuat, DVec3};
@@ -53,6 +54,8 @@ pub(crate) enum SourceData {
     /// The file holds things no writer here carries (an STL's per-facet attribute bytes, an OFF's
     /// colours): named, in plain words, so that saving says they were not kept.
     Unkept(Vec<String>),
+    /// A binary STL's header text (written back into an STL) and what is not kept.
+    Stl(Box<super::stl::StlSource>),
     /// The OBJ file's bytes.
     Obj(Vec<u8>),
     /// The PLY file's bytes.
@@ -103,10 +106,51 @@ impl Source {
         match &self.data {
             SourceData::Plain => Vec::new(),
             SourceData::Unkept(items) => items.clone(),
+            SourceData::Stl(stl) => stl.contents(),
             SourceData::Obj(bytes) => super::obj::contents(bytes),
             SourceData::Ply(bytes) => super::ply::contents(bytes),
             SourceData::Gltf(gltf) => gltf.contents(),
         }
+    }
+
+    /// The file's UVs and vertex colours per welded vertex (see [`super::carry`]), for writing
+    /// another format.
+    pub(crate) fn vertex_attributes(&self) -> VertexAttributes {
+        match &self.data {
+            SourceData::Obj(bytes) => super::obj::vertex_attributes(bytes, self),
+            SourceData::Ply(bytes) => super::ply::vertex_attributes(bytes, self),
+            SourceData::Gltf(gltf) => gltf.vertex_attributes(self),
+            _ => VertexAttributes::default(),
+        }
+    }
+
+    /// [`Source::contents`] without what `carried` brought into the output.
+    pub(crate) fn contents_beyond(&self, carried: &VertexAttributes) -> Vec<String> {
+        let uvs = carried.uvs.is_some();
+        let colours = carried.colours.is_some();
+        let carried_property = |name: &str| {
+            (colours && matches!(name, "red" | "green" | "blue" | "alpha"))
+                || (uvs && matches!(name, "s" | "t" | "u" | "v" | "texture_u" | "texture_v"))
+        };
+        self.contents()
+            .into_iter()
+            .filter_map(|item| {
+                if (uvs
+                    && (item == "UVs (TEXCOORD_0)" || item.starts_with("texture coordinates (")))
+                    || (colours && (item == "vertex colours (COLOR_0)" || item == "vertex colours"))
+                {
+                    return None;
+                }
+                match item.strip_prefix("vertex properties ") {
+                    Some(list) => {
+                        let left: Vec<&str> =
+                            list.split(", ").filter(|p| !carried_property(p)).collect();
+                        (!left.is_empty()).then(|| format!("vertex properties {}", left.join(", ")))
+                    }
+                    None => Some(item),
+                }
+            })
+            .collect()
     }
 
     /// The welded vertex that parser vertex `raw` became, if it was kept.
@@ -126,6 +170,7 @@ impl Source {
     pub(crate) fn writes_back_as(&self, format: Format) -> bool {
         match self.data {
             SourceData::Plain | SourceData::Unkept(_) => false,
+            SourceData::Stl(_) => format == Format::Stl,
             SourceData::Obj(_) => format == Format::Obj,
             SourceData::Ply(_) => format == Format::Ply,
             SourceData::Gltf(_) => matches!(format, Format::Gltf | Format::Glb),
