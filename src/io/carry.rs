@@ -7,7 +7,8 @@
 //! became it. Where file vertices that were welded into one had different values (a UV seam, a
 //! colour border) the output cannot keep both, and the save report says how many vertices lost
 //! their split. Normals are not carried but recomputed by the writers from the moved mesh.
-//! Values that are not finite are never written: such a vertex gets zero (and is counted).
+//! Values that are not finite are never written: such a vertex gets zero. A vertex that had no
+//! value (a part of a glTF scene with no COLOR_0 beside one with colours) gets white, or UV 0 0.
 
 /// Per welded vertex: UVs and RGBA colours (0..1), each present when the source had them.
 #[derive(Debug, Default)]
@@ -54,9 +55,11 @@ pub(crate) struct Gather<const N: usize> {
 }
 
 impl<const N: usize> Gather<N> {
-    pub(crate) fn new(welded_vertices: usize) -> Self {
+    /// For `welded_vertices` vertices; those that get no value keep `fallback` (white for
+    /// colours, as glTF reads a primitive with no COLOR_0; zero for UVs).
+    pub(crate) fn new(welded_vertices: usize, fallback: [f32; N]) -> Self {
         Gather {
-            values: vec![[0.0; N]; welded_vertices],
+            values: vec![fallback; welded_vertices],
             set: vec![false; welded_vertices],
             merged: vec![false; welded_vertices],
         }

@@ -220,8 +220,8 @@ impl GltfSource {
     /// TEXCOORD_0 and COLOR_0 per welded vertex, for saving in another format: each read
     /// primitive's elements go to the welded vertices its positions became.
     pub(crate) fn vertex_attributes(&self, source: &Source) -> VertexAttributes {
-        let mut uvs = Gather::<2>::new(source.welded_vertices);
-        let mut colours = Gather::<4>::new(source.welded_vertices);
+        let mut uvs = Gather::<2>::new(source.welded_vertices, [0.0; 2]);
+        let mut colours = Gather::<4>::new(source.welded_vertices, [1.0; 4]);
         let (mut any_uv, mut any_colour) = (false, false);
         for read in &self.reads {
             let meshes = self.array("meshes");

@@ -424,8 +424,8 @@ fn resolve(token: &[u8], before: usize) -> Option<usize> {
 /// The vertex colours (`v x y z r g b`) and texture coordinates (`vt`, through the faces'
 /// `v/vt` corners) of an OBJ file, per welded vertex, for saving it in another format.
 pub(crate) fn vertex_attributes(bytes: &[u8], source: &Source) -> VertexAttributes {
-    let mut colours = Gather::<4>::new(source.welded_vertices);
-    let mut uvs = Gather::<2>::new(source.welded_vertices);
+    let mut colours = Gather::<4>::new(source.welded_vertices, [1.0; 4]);
+    let mut uvs = Gather::<2>::new(source.welded_vertices, [0.0; 2]);
     let (mut any_colour, mut any_uv) = (false, false);
     let mut vertices = 0usize;
     let mut texture_coordinates: Vec<[f32; 2]> = Vec::new();

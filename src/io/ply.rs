@@ -1148,7 +1148,7 @@ pub(crate) fn vertex_attributes(bytes: &[u8], source: &Source) -> VertexAttribut
                 scale(a),
             )
         });
-        let mut gather = Gather::<4>::new(source.welded_vertices);
+        let mut gather = Gather::<4>::new(source.welded_vertices, [1.0; 4]);
         for (k, c) in colours.iter().enumerate() {
             let alpha = alphas
                 .as_ref()
@@ -1168,7 +1168,7 @@ pub(crate) fn vertex_attributes(bytes: &[u8], source: &Source) -> VertexAttribut
     .into_iter()
     .find_map(|(u, v)| Some((find(u)?, find(v)?)));
     if let Some((u, v)) = uv {
-        let mut gather = Gather::<2>::new(source.welded_vertices);
+        let mut gather = Gather::<2>::new(source.welded_vertices, [0.0; 2]);
         for (k, uv) in vertex_triples(bytes, &header, &rows, element, [u, v, v])
             .iter()
             .enumerate()
