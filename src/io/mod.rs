@@ -433,9 +433,11 @@ pub fn write_to(
 
 /// Save `mesh` into what it was loaded from: to the same family of format (OBJ, PLY, glTF/GLB)
 /// the source file comes back with only the positions and what depends on them changed (see
-/// [`Source`]); to another format, or when `mesh` no longer has the source's connectivity (a
-/// level of the hierarchy, a subdivided copy), the mesh is written as it is and the report names
-/// what the output does not keep. The write is atomic, as with [`save`].
+/// [`Source`]); to another format, the mesh is written with the source's UVs and vertex colours
+/// where the format holds them (glTF, OBJ: one value per welded vertex); when `mesh` no longer
+/// has the source's connectivity (a level of the hierarchy, a subdivided copy), it is written
+/// bare. Either way the report names what the output does not keep. The write is atomic, as with
+/// [`save`].
 pub fn save_with_source(
     path: impl AsRef<Path>,
     mesh: &TriMesh,

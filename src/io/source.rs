@@ -18,8 +18,9 @@
 //! normals stay split, smooth ones stay smooth, and a file's own custom normals keep their
 //! character), and the glTF POSITION accessor's min/max are recomputed. A vertex that did not
 //! move keeps its bytes (or its text) exactly, and so does a normal whose faces did not move.
-//! Saving to another format writes the mesh as it is and names, in the [`SaveReport`], what that
-//! format cannot keep.
+//! Saving to another format writes the mesh with what that format can hold per vertex (UVs and
+//! vertex colours into glTF and OBJ, see [`super::carry`]) and names, in the [`SaveReport`],
+//! everything else it cannot keep.
 
 use super::carry::VertexAttributes;
 use super::{gltf_writeback, Format};

@@ -8,7 +8,8 @@
 //!
 //! STL stores three corners per triangle and shares nothing: every corner becomes its own vertex
 //! and welding (on by default) joins them. Facet normals are ignored on reading and written as the
-//! unit face normal (zero for a degenerate triangle).
+//! unit face normal (zero for a degenerate triangle). A binary file's 80-byte header text is kept
+//! ([`StlSource`]): written back when the mesh is saved as STL, named when saved as another format.
 
 use super::text::{lines, non_finite_kind, parse_f32, quote, tokens};
 use super::{IoError, Parsed};
