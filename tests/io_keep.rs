@@ -549,12 +549,13 @@ fn other_formats_and_other_connectivity_say_what_is_not_kept() {
         "'block'",
         "2 materials ('checker', 'paint')",
         "1 texture (",
-        "UVs (TEXCOORD_0)",
-        "vertex colours (COLOR_0)",
     ] {
         assert!(text.contains(item), "{item} not named in: {text}");
     }
-    assert!(text.contains("bare OBJ mesh"), "{text}");
+    assert!(
+        text.contains("as OBJ with its UVs and vertex colours"),
+        "{text}"
+    );
 
     let obj = io::load(data("textured.obj")).unwrap();
     let report = io::save_with_source(dir.path().join("t.ply"), &obj.mesh, &obj.source).unwrap();
@@ -625,4 +626,328 @@ fn a_mesh_placed_twice_is_written_from_its_first_placement_with_a_warning() {
     io::save_with_source(&out, &mesh, &loaded.source).unwrap();
     assert_eq!(read_gltf(&out).json["images"][0]["uri"], "checker.png");
     assert!(!dir.path().join("out_checker.png").exists());
+}
+
+// ---------------------------------------------------------------------------------------------
+// Saving into another format family: what the target can hold per vertex is carried.
+
+/// The `v` (with any colour), `vt` and `f` lines of an OBJ written by fairmesh.
+struct ObjLines {
+    vertices: Vec<Vec<f32>>,
+    uvs: Vec<[f32; 2]>,
+    /// Per face corner: (vertex, texture coordinate) 0-based.
+    corners: Vec<(usize, Option<usize>)>,
+}
+
+fn read_obj_lines(path: &Path) -> ObjLines {
+    let text = std::fs::read_to_string(path).unwrap();
+    let mut out = ObjLines {
+        vertices: Vec::new(),
+        uvs: Vec::new(),
+        corners: Vec::new(),
+    };
+    for line in text.lines() {
+        let mut words = line.split_whitespace();
+        let floats = |words: std::str::SplitWhitespace| -> Vec<f32> {
+            words.map(|w| w.parse::<f32>().unwrap()).collect()
+        };
+        match words.next() {
+            Some("v") => out.vertices.push(floats(words)),
+            Some("vt") => {
+                let uv = floats(words);
+                out.uvs.push([uv[0], uv[1]]);
+            }
+            Some("f") => out.corners.extend(words.map(|corner| {
+                let mut parts = corner.split('/');
+                let v = parts.next().unwrap().parse::<usize>().unwrap() - 1;
+                let t = parts
+                    .next()
+                    .filter(|t| !t.is_empty())
+                    .map(|t| t.parse::<usize>().unwrap() - 1);
+                (v, t)
+            })),
+            _ => {}
+        }
+    }
+    out
+}
+
+/// The world placement of each node of a glTF whose nodes carry matrices (trimesh writes them).
+fn node_worlds(json: &Value) -> Vec<glam::DMat4> {
+    let nodes = json["nodes"].as_array().unwrap();
+    let local = |n: usize| {
+        let m: Vec<f64> = nodes[n]["matrix"]
+            .as_array()
+            .map(|m| m.iter().map(|v| v.as_f64().unwrap()).collect())
+            .unwrap_or_else(|| glam::DMat4::IDENTITY.to_cols_array().to_vec());
+        assert!(nodes[n].get("translation").is_none() && nodes[n].get("rotation").is_none());
+        glam::DMat4::from_cols_slice(&m)
+    };
+    let mut world = vec![glam::DMat4::IDENTITY; nodes.len()];
+    let mut stack: Vec<(usize, glam::DMat4)> = json["scenes"][0]["nodes"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|n| (n.as_u64().unwrap() as usize, glam::DMat4::IDENTITY))
+        .collect();
+    while let Some((n, parent)) = stack.pop() {
+        world[n] = parent * local(n);
+        for child in nodes[n]["children"].as_array().into_iter().flatten() {
+            stack.push((child.as_u64().unwrap() as usize, world[n]));
+        }
+    }
+    world
+}
+
+/// The values of attribute `name` of every vertex of `input` (a glTF read independently), with
+/// the vertex's world position.
+fn placed_values(input: &Gltf, name: &str) -> Vec<([f32; 3], Vec<f32>)> {
+    let worlds = node_worlds(&input.json);
+    let mut out = Vec::new();
+    for (n, node) in input.json["nodes"].as_array().unwrap().iter().enumerate() {
+        let Some(mesh) = node["mesh"].as_u64() else {
+            continue;
+        };
+        for primitive in input.json["meshes"][mesh as usize]["primitives"]
+            .as_array()
+            .unwrap()
+        {
+            let Some(values) = primitive["attributes"][name].as_u64() else {
+                continue;
+            };
+            let positions =
+                input.floats(primitive["attributes"]["POSITION"].as_u64().unwrap() as usize);
+            let values = input.elements(values as usize);
+            let component = input.json["accessors"]
+                [primitive["attributes"][name].as_u64().unwrap() as usize]["componentType"]
+                .as_u64()
+                .unwrap();
+            for (p, value) in positions.iter().zip(values) {
+                let world = worlds[n]
+                    .transform_point3(glam::DVec3::new(p[0] as f64, p[1] as f64, p[2] as f64))
+                    .as_vec3()
+                    .to_array();
+                let value: Vec<f32> = match component {
+                    5126 => value
+                        .chunks(4)
+                        .map(|c| f32::from_le_bytes(c.try_into().unwrap()))
+                        .collect(),
+                    5121 => value.iter().map(|&b| b as f32 / 255.0).collect(),
+                    5123 => value
+                        .chunks(2)
+                        .map(|c| u16::from_le_bytes([c[0], c[1]]) as f32 / 65535.0)
+                        .collect(),
+                    other => panic!("component type {other}"),
+                };
+                out.push((world, value));
+            }
+        }
+    }
+    out
+}
+
+/// Whether `value` is (within `tolerance`) one of the values the input has at `position`.
+fn is_a_value_at(
+    placed: &[([f32; 3], Vec<f32>)],
+    position: [f32; 3],
+    value: &[f32],
+    tolerance: f32,
+) -> Option<bool> {
+    let near = |a: [f32; 3]| (0..3).all(|c| (a[c] - position[c]).abs() < 1e-5);
+    let mut candidates = placed.iter().filter(|(p, _)| near(*p)).peekable();
+    candidates.peek()?;
+    Some(candidates.any(|(_, v)| v.iter().zip(value).all(|(a, b)| (a - b).abs() <= tolerance)))
+}
+
+#[test]
+fn a_gltf_scene_saved_as_obj_keeps_its_uvs_and_colours() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("scene.obj");
+    let (loaded, mesh, report) = fair_and_save("scene.glb", &out);
+    let obj = read_obj_lines(&out);
+    assert_eq!(obj.vertices.len(), mesh.vertex_count());
+    assert_eq!(obj.uvs.len(), mesh.vertex_count(), "one vt per vertex");
+    for (v, t) in &obj.corners {
+        assert_eq!(Some(*v), *t, "each corner uses its vertex's vt");
+    }
+    let input = read_gltf(&data("scene.glb"));
+    let uvs = placed_values(&input, "TEXCOORD_0");
+    let colours = placed_values(&input, "COLOR_0");
+    let (mut checked_uvs, mut checked_colours) = (0, 0);
+    for (v, line) in obj.vertices.iter().enumerate() {
+        assert_eq!(line.len(), 6, "every v line has a colour");
+        assert!(line.iter().all(|c| c.is_finite()));
+        assert_eq!(&line[..3], &mesh.positions[v][..], "faired positions");
+        let before = loaded.mesh.positions[v];
+        if let Some(ok) = is_a_value_at(&uvs, before, &obj.uvs[v], 1e-6) {
+            assert!(
+                ok,
+                "vertex {v}: vt {:?} is not the input's UV there",
+                obj.uvs[v]
+            );
+            checked_uvs += 1;
+        }
+        match is_a_value_at(&colours, before, &line[3..6], 1e-6) {
+            Some(ok) => {
+                assert!(
+                    ok,
+                    "vertex {v}: colour {:?} is not the input's",
+                    &line[3..6]
+                );
+                checked_colours += 1;
+            }
+            // A part with no colours (the ball) is white, as glTF draws it, not black.
+            None => assert_eq!(&line[3..6], &[1.0, 1.0, 1.0], "vertex {v}"),
+        }
+    }
+    assert!(checked_uvs >= 400, "{checked_uvs} UVs checked");
+    assert!(checked_colours >= 300, "{checked_colours} colours checked");
+    // The reader reads it back as the faired mesh, with its texture coordinates and colours.
+    assert_reloads_as(&out, &mesh, 0.0);
+    let contents = io::load(&out).unwrap().source.contents().join("; ");
+    assert!(contents.contains("texture coordinates"), "{contents}");
+    assert!(contents.contains("vertex colours"), "{contents}");
+    // What OBJ cannot hold is named; what it holds is not.
+    let text = report.warnings.join("\n");
+    assert!(
+        text.contains("as OBJ with its UVs and vertex colours"),
+        "{text}"
+    );
+    for item in ["'root'", "2 materials ('checker', 'paint')", "normals"] {
+        assert!(text.contains(item), "{item} not named in: {text}");
+    }
+    assert!(
+        !text.contains("TEXCOORD_0") && !text.contains("COLOR_0"),
+        "{text}"
+    );
+}
+
+/// Per welded position (bit pattern) of an OBJ file read here: the texture coordinates its
+/// corners use.
+fn obj_uvs_by_position(path: &Path) -> std::collections::HashMap<[u32; 3], Vec<[f32; 2]>> {
+    let obj = read_obj_lines(path);
+    let mut out: std::collections::HashMap<[u32; 3], Vec<[f32; 2]>> = Default::default();
+    for (v, t) in obj.corners {
+        let p = &obj.vertices[v];
+        let key = [p[0], p[1], p[2]].map(f32::to_bits);
+        out.entry(key).or_default().push(obj.uvs[t.unwrap()]);
+    }
+    out
+}
+
+#[test]
+fn an_obj_saved_as_glb_keeps_its_uvs() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("textured.glb");
+    let (loaded, mesh, report) = fair_and_save("textured.obj", &out);
+    validate(std::slice::from_ref(&out));
+    assert_reloads_as(&out, &mesh, 0.0);
+    let output = read_gltf(&out);
+    let primitive = &output.json["meshes"][0]["primitives"][0];
+    let uvs = output.floats(primitive["attributes"]["TEXCOORD_0"].as_u64().unwrap() as usize);
+    assert_eq!(uvs.len(), mesh.vertex_count());
+    let input = obj_uvs_by_position(&data("textured.obj"));
+    let mut seams = 0;
+    for (v, uv) in uvs.iter().enumerate() {
+        assert!(uv.iter().all(|c| c.is_finite()));
+        let choices = &input[&loaded.mesh.positions[v].map(f32::to_bits)];
+        assert!(
+            choices.iter().any(|c| c[..] == uv[..]),
+            "vertex {v}: {uv:?} is not one of the input's {choices:?}"
+        );
+        if choices.iter().any(|c| c != &choices[0]) {
+            seams += 1;
+        }
+    }
+    // The quad sphere has UV seams: each seam vertex keeps one UV, and the report says how many.
+    assert!(seams > 0);
+    let text = report.warnings.join("\n");
+    assert!(
+        text.contains(&format!("the UV seams at {seams} vertices")),
+        "{text}"
+    );
+    for item in ["materials", "quads", "normals"] {
+        assert!(text.contains(item), "{item} not named in: {text}");
+    }
+}
+
+#[test]
+fn a_coloured_ply_saved_as_glb_keeps_its_colours() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("colored.glb");
+    let (loaded, mesh, report) = fair_and_save("colored_ascii.ply", &out);
+    validate(std::slice::from_ref(&out));
+    assert_reloads_as(&out, &mesh, 0.0);
+    // The input's rows, read here: x y z red green blue alpha quality.
+    let text = std::fs::read_to_string(data("colored_ascii.ply")).unwrap();
+    let body = text.split("end_header\n").nth(1).unwrap();
+    let mut input: std::collections::HashMap<[u32; 3], [f32; 4]> = Default::default();
+    for row in body.lines().take(1536) {
+        let v: Vec<f32> = row.split_whitespace().map(|w| w.parse().unwrap()).collect();
+        let colour = [v[3], v[4], v[5], v[6]].map(|c| c / 255.0);
+        input.insert([v[0], v[1], v[2]].map(f32::to_bits), colour);
+    }
+    let output = read_gltf(&out);
+    let primitive = &output.json["meshes"][0]["primitives"][0];
+    let colours = output.floats(primitive["attributes"]["COLOR_0"].as_u64().unwrap() as usize);
+    assert_eq!(colours.len(), mesh.vertex_count());
+    let mut translucent = 0;
+    for (v, colour) in colours.iter().enumerate() {
+        let expected = input[&loaded.mesh.positions[v].map(f32::to_bits)];
+        for c in 0..4 {
+            assert!(
+                (colour[c] - expected[c]).abs() < 1e-6,
+                "vertex {v}: {colour:?} vs {expected:?}"
+            );
+        }
+        translucent += usize::from(colour[3] < 1.0);
+    }
+    assert!(translucent > 0, "alpha carried");
+    let text = report.warnings.join("\n");
+    assert!(text.contains("with its vertex colours"), "{text}");
+    // The face colours have no place in glTF: named. The vertex colours are not.
+    assert!(text.contains("vertex properties quality;"), "{text}");
+    assert!(text.contains("face properties red, green, blue"), "{text}");
+}
+
+#[test]
+fn a_binary_stl_header_is_written_back_or_named() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut bytes = vec![0u8; 80];
+    let title = b"exported by SomeCAD 2024, units mm";
+    bytes[..title.len()].copy_from_slice(title);
+    let tetrahedron = [[0f32, 0., 0.], [1., 0., 0.], [0., 1., 0.], [0., 0., 1.]];
+    let faces = [[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]];
+    bytes.extend_from_slice(&(faces.len() as u32).to_le_bytes());
+    for face in faces {
+        bytes.extend_from_slice(&[0u8; 12]);
+        for v in face {
+            for c in tetrahedron[v] {
+                bytes.extend_from_slice(&c.to_le_bytes());
+            }
+        }
+        bytes.extend_from_slice(&[0, 0]);
+    }
+    let input = dir.path().join("part.stl");
+    std::fs::write(&input, &bytes).unwrap();
+    let loaded = io::load(&input).unwrap();
+    assert!(
+        loaded.source.contents().join(" ").contains("SomeCAD"),
+        "{:?}",
+        loaded.source.contents()
+    );
+    let mut moved = loaded.mesh.clone();
+    moved.positions[3][2] = 0.5;
+    let back = dir.path().join("back.stl");
+    let report = io::save_with_source(&back, &moved, &loaded.source).unwrap();
+    assert!(report.warnings.is_empty(), "{:?}", report.warnings);
+    let written = std::fs::read(&back).unwrap();
+    assert_eq!(written[..80], bytes[..80], "header kept");
+    assert_eq!(io::load(&back).unwrap().mesh.positions.len(), 4);
+    let report = io::save_with_source(dir.path().join("part.obj"), &moved, &loaded.source).unwrap();
+    let text = report.warnings.join("\n");
+    assert!(
+        text.contains("\"exported by SomeCAD 2024, units mm\""),
+        "{text}"
+    );
 }

@@ -26,6 +26,7 @@
 //! files first and renamed only when both are complete.
 
 use super::atomic;
+use super::carry::VertexAttributes;
 use super::gltf_writeback::{GltfSource, PrimitiveRead};
 use super::source::SourceData;
 use super::{IoError, Parsed};
@@ -741,6 +742,16 @@ pub(crate) fn unit_vertex_normals(mesh: &TriMesh) -> Vec<[f32; 3]> {
 /// The glTF document and its binary buffer for `mesh`. `uri` names the buffer file (`.gltf`),
 /// or is `None` for the GLB BIN chunk.
 fn build(mesh: &TriMesh, uri: Option<String>) -> std::io::Result<(json::Root, Vec<u8>)> {
+    build_with(mesh, uri, &VertexAttributes::default())
+}
+
+/// The document and binary buffer of a bare mesh, with TEXCOORD_0 and COLOR_0 where `extra`
+/// has them (one value per vertex of `mesh`; ignored otherwise).
+fn build_with(
+    mesh: &TriMesh,
+    uri: Option<String>,
+    extra: &VertexAttributes,
+) -> std::io::Result<(json::Root, Vec<u8>)> {
     use json::validation::{Checked::Valid, USize64};
     let too_big =
         || std::io::Error::new(std::io::ErrorKind::InvalidInput, "mesh too large for glTF");
@@ -749,9 +760,14 @@ fn build(mesh: &TriMesh, uri: Option<String>) -> std::io::Result<(json::Root, Ve
     let normals = unit_vertex_normals(mesh);
     let positions_len = n.checked_mul(12).ok_or_else(too_big)?;
     let indices_len = m.checked_mul(12).ok_or_else(too_big)?;
+    let uvs = extra.uvs.as_ref().filter(|uvs| uvs.len() == n);
+    let colours = extra.colours.as_ref().filter(|colours| colours.len() == n);
+    let uvs_len = if uvs.is_some() { n * 8 } else { 0 };
+    let colours_len = if colours.is_some() { n * 16 } else { 0 };
     let total = positions_len
         .checked_mul(2)
         .and_then(|b| b.checked_add(indices_len))
+        .and_then(|b| b.checked_add(uvs_len + colours_len))
         .filter(|&t| t <= u32::MAX as usize - 1024)
         .ok_or_else(too_big)?;
     let mut bin = Vec::with_capacity(total);
@@ -769,6 +785,12 @@ fn build(mesh: &TriMesh, uri: Option<String>) -> std::io::Result<(json::Root, Ve
         for v in t {
             bin.extend_from_slice(&v.to_le_bytes());
         }
+    }
+    for value in uvs.into_iter().flatten().flatten() {
+        bin.extend_from_slice(&value.to_le_bytes());
+    }
+    for value in colours.into_iter().flatten().flatten() {
+        bin.extend_from_slice(&value.to_le_bytes());
     }
     let mut min = [f32::INFINITY; 3];
     let mut max = [f32::NEG_INFINITY; 3];
@@ -849,13 +871,43 @@ fn build(mesh: &TriMesh, uri: Option<String>) -> std::io::Result<(json::Root, Ve
         json::accessor::Type::Scalar,
         None,
     ));
+    let mut attributes: std::collections::BTreeMap<_, _> = [
+        (Valid(json::mesh::Semantic::Positions), positions),
+        (Valid(json::mesh::Semantic::Normals), normals),
+    ]
+    .into_iter()
+    .collect();
+    let mut offset = 2 * positions_len + indices_len;
+    for (present, length, semantic, type_) in [
+        (
+            uvs.is_some(),
+            uvs_len,
+            json::mesh::Semantic::TexCoords(0),
+            json::accessor::Type::Vec2,
+        ),
+        (
+            colours.is_some(),
+            colours_len,
+            json::mesh::Semantic::Colors(0),
+            json::accessor::Type::Vec4,
+        ),
+    ] {
+        if !present {
+            continue;
+        }
+        let view = root.push(view(offset, length, json::buffer::Target::ArrayBuffer));
+        offset += length;
+        let values = root.push(accessor(
+            view,
+            n,
+            json::accessor::ComponentType::F32,
+            type_,
+            None,
+        ));
+        attributes.insert(Valid(semantic), values);
+    }
     let primitive = json::mesh::Primitive {
-        attributes: [
-            (Valid(json::mesh::Semantic::Positions), positions),
-            (Valid(json::mesh::Semantic::Normals), normals),
-        ]
-        .into_iter()
-        .collect(),
+        attributes,
         extensions: Default::default(),
         extras: Default::default(),
         indices: Some(indices),
@@ -885,7 +937,16 @@ fn build(mesh: &TriMesh, uri: Option<String>) -> std::io::Result<(json::Root, Ve
 }
 
 pub(crate) fn write_glb(out: &mut dyn Write, mesh: &TriMesh) -> std::io::Result<()> {
-    let (root, bin) = build(mesh, None)?;
+    write_glb_with(out, mesh, &VertexAttributes::default())
+}
+
+/// A GLB of `mesh` with the per-vertex UVs and colours of `extra`.
+pub(crate) fn write_glb_with(
+    out: &mut dyn Write,
+    mesh: &TriMesh,
+    extra: &VertexAttributes,
+) -> std::io::Result<()> {
+    let (root, bin) = build_with(mesh, None, extra)?;
     let json_bytes = json::serialize::to_vec(&root).map_err(std::io::Error::other)?;
     write_glb_container(out, json_bytes, &bin)
 }
@@ -960,15 +1021,26 @@ fn encode_base64(bytes: &[u8]) -> String {
 
 /// Write `path` (.gltf) and `<stem>.bin` beside it: both are staged, then renamed into place.
 pub(crate) fn write_gltf(path: &Path, mesh: &TriMesh) -> Result<(), IoError> {
+    write_gltf_with(path, mesh, &VertexAttributes::default())
+}
+
+/// [`write_gltf`] with the per-vertex UVs and colours of `extra`.
+pub(crate) fn write_gltf_with(
+    path: &Path,
+    mesh: &TriMesh,
+    extra: &VertexAttributes,
+) -> Result<(), IoError> {
     let bin_path = super::gltf_bin_path(path);
     let bin_name = bin_path
         .file_name()
         .map(|n| n.to_string_lossy().into_owned())
         .unwrap_or_else(|| "mesh.bin".into());
     let (root, bin) =
-        build(mesh, Some(percent_encode(&bin_name))).map_err(|source| IoError::Write {
-            path: path.to_owned(),
-            source,
+        build_with(mesh, Some(percent_encode(&bin_name)), extra).map_err(|source| {
+            IoError::Write {
+                path: path.to_owned(),
+                source,
+            }
         })?;
     let json_bytes = json::serialize::to_vec_pretty(&root).map_err(|e| IoError::Write {
         path: path.to_owned(),

@@ -26,10 +26,12 @@
 //! already there); a `.gltf` written beside its input refers to the same files.
 
 use super::atomic;
+use super::carry::{Gather, VertexAttributes};
 use super::source::{dvec, NormalTurns, SaveReport, SmoothGroups, Source, Turn};
 use super::{Format, IoError};
 use crate::mesh::TriMesh;
 use glam::DMat4;
+use rayon::prelude::*;
 use serde_json::{json, Value};
 use std::collections::{BTreeMap, BTreeSet};
 use std::io::Write;
@@ -169,9 +171,7 @@ impl GltfSource {
     fn triangles(&self, primitive: &Value, vertex_count: usize) -> Vec<[usize; 3]> {
         let corners: Vec<usize> = match index(primitive, "indices") {
             Some(a) => match self.layout(a) {
-                Ok(layout) if layout.components == 1 => (0..layout.count)
-                    .map(|k| self.read_index(&layout, k))
-                    .collect(),
+                Ok(layout) if layout.components == 1 => self.read_indices(&layout),
                 _ => return Vec::new(),
             },
             None => (0..vertex_count).collect(),
@@ -198,14 +198,81 @@ impl GltfSource {
         triangles
     }
 
-    fn read_index(&self, layout: &Layout, k: usize) -> usize {
-        let at = layout.start + k * layout.stride;
-        let b = &self.buffers[layout.buffer][at..at + layout.size];
-        match layout.size {
-            1 => b[0] as usize,
-            2 => u16::from_le_bytes([b[0], b[1]]) as usize,
-            _ => u32::from_le_bytes([b[0], b[1], b[2], b[3]]) as usize,
+    /// Every element of an index accessor (its layout checked), read straight from the bytes.
+    fn read_indices(&self, layout: &Layout) -> Vec<usize> {
+        let size = layout.size;
+        let bytes = &self.buffers[layout.buffer][layout.start..];
+        let elements = bytes
+            .chunks(layout.stride)
+            .take(layout.count)
+            .map(|element| &element[..size]);
+        match size {
+            1 => elements.map(|b| b[0] as usize).collect(),
+            2 => elements
+                .map(|b| u16::from_le_bytes([b[0], b[1]]) as usize)
+                .collect(),
+            _ => elements
+                .map(|b| u32::from_le_bytes([b[0], b[1], b[2], b[3]]) as usize)
+                .collect(),
         }
+    }
+
+    /// TEXCOORD_0 and COLOR_0 per welded vertex, for saving in another format: each read
+    /// primitive's elements go to the welded vertices its positions became.
+    pub(crate) fn vertex_attributes(&self, source: &Source) -> VertexAttributes {
+        let mut uvs = Gather::<2>::new(source.welded_vertices, [0.0; 2]);
+        let mut colours = Gather::<4>::new(source.welded_vertices, [1.0; 4]);
+        let (mut any_uv, mut any_colour) = (false, false);
+        for read in &self.reads {
+            let meshes = self.array("meshes");
+            let primitives = meshes
+                .get(read.mesh)
+                .and_then(|m| m.get("primitives"))
+                .and_then(Value::as_array)
+                .map_or(&[][..], Vec::as_slice);
+            let Some(primitive) = primitives
+                .iter()
+                .find(|p| attribute(p, "POSITION") == Some(read.accessor))
+            else {
+                continue;
+            };
+            let layout_of = |name: &str| {
+                attribute(primitive, name)
+                    .and_then(|a| self.layout(a).ok())
+                    .filter(|l| l.count == read.count)
+            };
+            if let Some(layout) = layout_of("TEXCOORD_0").filter(|l| l.components == 2) {
+                any_uv = true;
+                for k in 0..read.count {
+                    let uv = [self.read(&layout, k, 0), self.read(&layout, k, 1)];
+                    uvs.put(source.welded(read.raw_start + k), uv);
+                }
+            }
+            if let Some(layout) = layout_of("COLOR_0").filter(|l| l.components >= 3) {
+                any_colour = true;
+                for k in 0..read.count {
+                    let alpha = if layout.components == 4 {
+                        self.read(&layout, k, 3)
+                    } else {
+                        1.0
+                    };
+                    let [r, g, b] = self.read3(&layout, k);
+                    colours.put(source.welded(read.raw_start + k), [r, g, b, alpha]);
+                }
+            }
+        }
+        let mut out = VertexAttributes::default();
+        if any_uv {
+            let (values, merged) = uvs.finish();
+            out.uvs = Some(values);
+            out.uv_splits_merged = merged;
+        }
+        if any_colour {
+            let (values, merged) = colours.finish();
+            out.colours = Some(values);
+            out.colour_splits_merged = merged;
+        }
+        out
     }
 
     /// What the document holds beyond positions and triangles, in plain words.
@@ -394,15 +461,16 @@ pub(crate) fn write(
         message,
     };
     let edits = position_edits(gltf, source, mesh, report).map_err(&fail)?;
-    let mut buffers = gltf.buffers.clone();
     let mut json = gltf.json.clone();
-    // Normals turn from the file's own positions (read from `gltf`, never from `buffers`), so the
+    // The buffers are copied once, into the joined output buffer, and edited there.
+    let mut joined = join_buffers(&mut json, &gltf.buffers);
+    // Normals turn from the file's own positions (read from `gltf`, never from `joined`), so the
     // order of these two steps does not matter.
-    let mut changed = turn_normals(gltf, source, &edits, &mut buffers, report);
+    let mut changed = turn_normals(gltf, source, &edits, &mut joined, report);
     for (&a, edit) in &edits {
         for (k, after) in edit.after.iter().enumerate() {
             if let Some(p) = after {
-                put(&mut buffers, &edit.layout, k, p);
+                joined.put(&edit.layout, k, p);
             }
         }
         changed.insert(a);
@@ -418,12 +486,12 @@ pub(crate) fn write(
             continue;
         }
         let Ok(layout) = gltf.layout(a) else { continue };
-        if let Some((min, max)) = bounds(&layout, &buffers) {
+        if let Some((min, max)) = joined.bounds(&layout) {
             accessor["min"] = json!(min);
             accessor["max"] = json!(max);
         }
     }
-    let mut bin = join_buffers(&mut json, buffers);
+    let mut bin = joined.bytes;
     let images = external_images(&json, source, report);
     match format {
         Format::Glb => {
@@ -577,7 +645,7 @@ fn turn_normals(
     gltf: &GltfSource,
     source: &Source,
     edits: &BTreeMap<usize, PositionEdit>,
-    buffers: &mut [Vec<u8>],
+    joined: &mut Joined,
     report: &mut SaveReport,
 ) -> BTreeSet<usize> {
     let touched: BTreeSet<usize> = primitives(&gltf.json)
@@ -622,13 +690,6 @@ fn turn_normals(
             tangents.insert(t);
         }
     }
-    let corners = |p: usize, positions: &Layout, t: [usize; 3]| match edits.get(&p) {
-        Some(edit) => (t.map(|v| edit.before[v]), t.map(|v| edit.position(v))),
-        None => {
-            let read = t.map(|v| gltf.read3(positions, v));
-            (read, read)
-        }
-    };
     // Per element: the area sums of its faces before and after; then slots (see
     // `SmoothGroups`), and the sums of each slot.
     let mut groups = SmoothGroups::default();
@@ -637,9 +698,19 @@ fn turn_normals(
     for (&n, (layout, uses, tangents)) in &normals {
         let mut elements = NormalTurns::new(layout.count);
         for (p, positions, triangles) in uses {
-            for &t in triangles {
-                let (before, after) = corners(*p, positions, t);
-                elements.add(t, before.map(dvec), after.map(dvec));
+            match edits.get(p) {
+                Some(edit) => {
+                    for &t in triangles {
+                        let before = t.map(|v| dvec(edit.before[v]));
+                        elements.add(t, before, t.map(|v| dvec(edit.position(v))));
+                    }
+                }
+                None => {
+                    for &t in triangles {
+                        let unmoved = t.map(|v| dvec(gltf.read3(positions, v)));
+                        elements.add(t, unmoved, unmoved);
+                    }
+                }
             }
         }
         let start = first_read.get(&uses[0].0).copied();
@@ -655,13 +726,17 @@ fn turn_normals(
     }
     let mut changed = BTreeSet::new();
     for (n, layout, slots, tangents) in slotted {
-        let mut turned: Vec<(usize, Turn)> = Vec::new();
-        for (k, &slot) in slots.iter().enumerate() {
-            if let Some(turn) = turns.turn(slot) {
-                let normal = turn.normal(gltf.read3(layout, k));
-                put(buffers, layout, k, &normal);
-                turned.push((k, turn));
-            }
+        // The rotations are the costly part: worked out in parallel, written in order.
+        let turned: Vec<(usize, Turn, [f32; 3])> = slots
+            .par_iter()
+            .enumerate()
+            .filter_map(|(k, &slot)| {
+                let turn = turns.turn(slot)?;
+                Some((k, turn, turn.normal(gltf.read3(layout, k))))
+            })
+            .collect();
+        for (k, _, normal) in &turned {
+            joined.put(layout, *k, normal);
         }
         if !turned.is_empty() {
             changed.insert(n);
@@ -669,9 +744,9 @@ fn turn_normals(
         for &t in tangents {
             match gltf.layout(t) {
                 Ok(tangent) if tangent.components == 4 && tangent.count == layout.count => {
-                    for &(k, turn) in &turned {
+                    for &(k, turn, _) in &turned {
                         let direction = turn.direction(gltf.read3(&tangent, k));
-                        put(buffers, &tangent, k, &direction);
+                        joined.put(&tangent, k, &direction);
                     }
                     if !turned.is_empty() {
                         changed.insert(t);
@@ -685,44 +760,61 @@ fn turn_normals(
     }
     changed
 }
-/// Per-component minimum and maximum of an accessor's stored values (integers for integer
-/// types, as the specification asks, not the normalized values); `None` when it is empty.
-fn bounds(layout: &Layout, buffers: &[Vec<u8>]) -> Option<(Vec<f64>, Vec<f64>)> {
-    if layout.count == 0 {
-        return None;
+/// All buffers joined into one, and where each of them starts in it.
+struct Joined {
+    bytes: Vec<u8>,
+    /// Where each source buffer starts in `bytes`, and how many of its bytes were kept.
+    starts: Vec<(usize, usize)>,
+}
+
+impl Joined {
+    /// Where byte `at` of buffer `buffer` (as a layout of the source sees it) is in the joined
+    /// bytes, for `len` bytes; `None` past the end (a buffer longer than it declared).
+    fn range(&self, buffer: usize, at: usize, len: usize) -> Option<std::ops::Range<usize>> {
+        let &(start, kept) = self.starts.get(buffer)?;
+        (at + len <= kept).then_some(start + at..start + at + len)
     }
-    let raw = Layout {
-        normalized: false,
-        ..*layout
-    };
-    let mut min = vec![f64::INFINITY; layout.components];
-    let mut max = vec![f64::NEG_INFINITY; layout.components];
-    for k in 0..layout.count {
-        for c in 0..layout.components {
+
+    /// Per-component minimum and maximum of an accessor's stored values (integers for integer
+    /// types, as the specification asks, not the normalized values); `None` when it is empty.
+    fn bounds(&self, layout: &Layout) -> Option<(Vec<f64>, Vec<f64>)> {
+        if layout.count == 0 {
+            return None;
+        }
+        let raw = Layout {
+            normalized: false,
+            ..*layout
+        };
+        let mut min = vec![f64::INFINITY; layout.components];
+        let mut max = vec![f64::NEG_INFINITY; layout.components];
+        for k in 0..layout.count {
+            for c in 0..layout.components {
+                let at = layout.start + k * layout.stride + c * layout.size;
+                let Some(range) = self.range(layout.buffer, at, layout.size) else {
+                    continue;
+                };
+                let value = decode(&raw, &self.bytes[range]) as f64;
+                min[c] = min[c].min(value);
+                max[c] = max[c].max(value);
+            }
+        }
+        min.iter().all(|m| m.is_finite()).then_some((min, max))
+    }
+
+    /// Write the first three components of element `k`.
+    fn put(&mut self, layout: &Layout, k: usize, values: &[f32; 3]) {
+        for (c, value) in values.iter().enumerate() {
             let at = layout.start + k * layout.stride + c * layout.size;
-            let value = decode(&raw, &buffers[layout.buffer][at..at + layout.size]) as f64;
-            min[c] = min[c].min(value);
-            max[c] = max[c].max(value);
+            if let Some(range) = self.range(layout.buffer, at, layout.size) {
+                encode(layout, *value, &mut self.bytes[range]);
+            }
         }
     }
-    Some((min, max))
 }
 
-/// Write the first three components of element `k`.
-fn put(buffers: &mut [Vec<u8>], layout: &Layout, k: usize, values: &[f32; 3]) {
-    for (c, value) in values.iter().enumerate() {
-        let at = layout.start + k * layout.stride + c * layout.size;
-        encode(
-            layout,
-            *value,
-            &mut buffers[layout.buffer][at..at + layout.size],
-        );
-    }
-}
-
-/// Join every buffer into one (each starting at a multiple of 16 bytes) and point the buffer
-/// views at it; returns the joined bytes.
-fn join_buffers(json: &mut Value, buffers: Vec<Vec<u8>>) -> Vec<u8> {
+/// Join every buffer into one (each starting at a multiple of 16 bytes, cut to its declared
+/// length) and point the buffer views at it.
+fn join_buffers(json: &mut Value, buffers: &[Vec<u8>]) -> Joined {
     let declared: Vec<usize> = json
         .get("buffers")
         .and_then(Value::as_array)
@@ -738,19 +830,19 @@ fn join_buffers(json: &mut Value, buffers: Vec<Vec<u8>>) -> Vec<u8> {
         while bin.len() % 16 != 0 {
             bin.push(0);
         }
-        starts.push(bin.len());
         let length = declared
             .get(b)
             .copied()
             .unwrap_or(data.len())
             .min(data.len());
+        starts.push((bin.len(), length));
         bin.extend_from_slice(&data[..length]);
     }
     if let Some(views) = json.get_mut("bufferViews").and_then(Value::as_array_mut) {
         for view in views {
             let buffer = index(view, "buffer").unwrap_or(0);
             let offset = index(view, "byteOffset").unwrap_or(0);
-            let start = starts.get(buffer).copied().unwrap_or(0);
+            let start = starts.get(buffer).map_or(0, |&(start, _)| start);
             view["buffer"] = json!(0);
             if start + offset > 0 {
                 view["byteOffset"] = json!(start + offset);
@@ -773,7 +865,7 @@ fn join_buffers(json: &mut Value, buffers: Vec<Vec<u8>>) -> Vec<u8> {
             root.insert("buffers".into(), json!([joined]));
         }
     }
-    bin
+    Joined { bytes: bin, starts }
 }
 
 /// The external image files of the document (`uri` that is not a data: URI), resolved against

@@ -19,6 +19,7 @@
 //!   positions or out-of-range indices are refused before anything is written.
 
 mod atomic;
+mod carry;
 mod error;
 mod gltf;
 mod gltf_writeback;
@@ -432,9 +433,11 @@ pub fn write_to(
 
 /// Save `mesh` into what it was loaded from: to the same family of format (OBJ, PLY, glTF/GLB)
 /// the source file comes back with only the positions and what depends on them changed (see
-/// [`Source`]); to another format, or when `mesh` no longer has the source's connectivity (a
-/// level of the hierarchy, a subdivided copy), the mesh is written as it is and the report names
-/// what the output does not keep. The write is atomic, as with [`save`].
+/// [`Source`]); to another format, the mesh is written with the source's UVs and vertex colours
+/// where the format holds them (glTF, OBJ: one value per welded vertex); when `mesh` no longer
+/// has the source's connectivity (a level of the hierarchy, a subdivided copy), it is written
+/// bare. Either way the report names what the output does not keep. The write is atomic, as with
+/// [`save`].
 pub fn save_with_source(
     path: impl AsRef<Path>,
     mesh: &TriMesh,
@@ -445,6 +448,16 @@ pub fn save_with_source(
     check_writable(mesh, path)?;
     let mut report = SaveReport::default();
     let name = source.path.display();
+    if let (SourceData::Stl(stl), Format::Stl) = (&source.data, format) {
+        // STL keeps nothing per vertex: its header is written back whatever the connectivity.
+        atomic::write(path, |w| stl::write_with_header(w, mesh, &stl.header))?;
+        if !stl.unkept.is_empty() {
+            report
+                .warnings
+                .push(format!("not kept from {name}: {}", stl.unkept.join("; ")));
+        }
+        return Ok(report);
+    }
     if source.writes_back_as(format) && source.matches(mesh) {
         match &source.data {
             SourceData::Obj(bytes) => {
@@ -456,17 +469,35 @@ pub fn save_with_source(
             SourceData::Gltf(gltf) => {
                 gltf_writeback::write(path, format, gltf, source, mesh, &mut report)?
             }
-            SourceData::Plain | SourceData::Unkept(_) => save_as(path, mesh, format)?,
+            SourceData::Plain | SourceData::Unkept(_) | SourceData::Stl(_) => {
+                save_as(path, mesh, format)?
+            }
         }
         return Ok(report);
     }
-    save_as(path, mesh, format)?;
-    let lost = source.contents();
+    // Another format: what it can hold per vertex (UVs, colours) is carried when the mesh still
+    // has the source's vertices; the rest is named.
+    let carries = matches!(format, Format::Obj | Format::Glb | Format::Gltf);
+    let extra = if carries && !source.writes_back_as(format) && source.matches(mesh) {
+        source.vertex_attributes()
+    } else {
+        carry::VertexAttributes::default()
+    };
+    match format {
+        Format::Obj => atomic::write(path, |w| obj::write_with(w, mesh, &extra))?,
+        Format::Glb => atomic::write(path, |w| gltf::write_glb_with(w, mesh, &extra))?,
+        Format::Gltf => gltf::write_gltf_with(path, mesh, &extra)?,
+        _ => save_as(path, mesh, format)?,
+    }
+    let (kept, mut lost) = extra.describe();
+    lost.extend(source.contents_beyond(&extra));
     if !lost.is_empty() {
         let why = if source.writes_back_as(format) {
             "the mesh no longer has its connectivity (a level of the hierarchy or a changed copy), so it is written as a bare mesh".to_string()
-        } else {
+        } else if kept.is_empty() {
             format!("it is written as a bare {format} mesh")
+        } else {
+            format!("it is written as {format} with its {}", kept.join(" and "))
         };
         report
             .warnings

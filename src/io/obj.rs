@@ -20,6 +20,7 @@
 //! Writing: `v x y z` with Rust's shortest round-trip float formatting (`{}`), so every f32 reads
 //! back bit for bit, and `f a b c` with 1-based indices.
 
+use super::carry::{Gather, VertexAttributes};
 use super::source::{dvec, NormalTurns, Source};
 use super::text::{lines, non_finite_kind, quote, tokens};
 use super::{IoError, Parsed};
@@ -348,25 +349,41 @@ fn locate(bytes: &[u8], path: &Path) -> Option<IoError> {
 }
 
 pub(crate) fn write(out: &mut dyn Write, mesh: &TriMesh) -> std::io::Result<()> {
+    write_with(out, mesh, &VertexAttributes::default())
+}
+
+/// An OBJ of `mesh`, with the per-vertex colours of `extra` after each `v`'s x y z (RGB; alpha
+/// has no place in OBJ) and its UVs as one `vt` per vertex, referred to by the faces.
+pub(crate) fn write_with(
+    out: &mut dyn Write,
+    mesh: &TriMesh,
+    extra: &VertexAttributes,
+) -> std::io::Result<()> {
+    let n = mesh.positions.len();
+    let uvs = extra.uvs.as_ref().filter(|uvs| uvs.len() == n);
+    let colours = extra.colours.as_ref().filter(|colours| colours.len() == n);
     writeln!(out, "# written by fairmesh")?;
-    writeln!(
-        out,
-        "# {} vertices, {} triangles",
-        mesh.positions.len(),
-        mesh.triangles.len()
-    )?;
-    for [x, y, z] in &mesh.positions {
-        writeln!(out, "v {x} {y} {z}")?;
+    writeln!(out, "# {n} vertices, {} triangles", mesh.triangles.len())?;
+    for (v, [x, y, z]) in mesh.positions.iter().enumerate() {
+        match colours {
+            Some(colours) => {
+                let [r, g, b, _] = colours[v];
+                writeln!(out, "v {x} {y} {z} {r} {g} {b}")?
+            }
+            None => writeln!(out, "v {x} {y} {z}")?,
+        }
     }
-    for [a, b, c] in &mesh.triangles {
+    for [u, v] in uvs.into_iter().flatten() {
+        writeln!(out, "vt {u} {v}")?;
+    }
+    for triangle in &mesh.triangles {
         // u32 + 1 in u64: no overflow.
-        writeln!(
-            out,
-            "f {} {} {}",
-            *a as u64 + 1,
-            *b as u64 + 1,
-            *c as u64 + 1
-        )?;
+        let [a, b, c] = triangle.map(|v| v as u64 + 1);
+        if uvs.is_some() {
+            writeln!(out, "f {a}/{a} {b}/{b} {c}/{c}")?;
+        } else {
+            writeln!(out, "f {a} {b} {c}")?;
+        }
     }
     Ok(())
 }
@@ -402,6 +419,63 @@ fn resolve(token: &[u8], before: usize) -> Option<usize> {
         i if i < 0 => usize::try_from(before as i64 + i).ok(),
         _ => None,
     }
+}
+
+/// The vertex colours (`v x y z r g b`) and texture coordinates (`vt`, through the faces'
+/// `v/vt` corners) of an OBJ file, per welded vertex, for saving it in another format.
+pub(crate) fn vertex_attributes(bytes: &[u8], source: &Source) -> VertexAttributes {
+    let mut colours = Gather::<4>::new(source.welded_vertices, [1.0; 4]);
+    let mut uvs = Gather::<2>::new(source.welded_vertices, [0.0; 2]);
+    let (mut any_colour, mut any_uv) = (false, false);
+    let mut vertices = 0usize;
+    let mut texture_coordinates: Vec<[f32; 2]> = Vec::new();
+    for line in bytes.split(|&b| b == b'\n') {
+        let mut words = tokens(line);
+        match words.next() {
+            Some(b"v") => {
+                let values: Vec<f32> = words.filter_map(super::text::parse_f32).collect();
+                if values.len() == 6 {
+                    any_colour = true;
+                    let rgb = [values[3], values[4], values[5]].map(|c| c.clamp(0.0, 1.0));
+                    colours.put(source.welded(vertices), [rgb[0], rgb[1], rgb[2], 1.0]);
+                }
+                vertices += 1;
+            }
+            Some(b"vt") => {
+                let u = words.next().and_then(super::text::parse_f32).unwrap_or(0.0);
+                let v = words.next().and_then(super::text::parse_f32).unwrap_or(0.0);
+                texture_coordinates.push([u, v]);
+            }
+            Some(b"f") => {
+                for corner in words {
+                    let mut parts = corner.split(|&b| b == b'/');
+                    let vertex = parts.next().and_then(|t| resolve(t, vertices));
+                    let uv = parts
+                        .next()
+                        .filter(|t| !t.is_empty())
+                        .and_then(|t| resolve(t, texture_coordinates.len()))
+                        .and_then(|t| texture_coordinates.get(t));
+                    if let (Some(vertex), Some(uv)) = (vertex, uv) {
+                        any_uv = true;
+                        uvs.put(source.welded(vertex), *uv);
+                    }
+                }
+            }
+            _ => {}
+        }
+    }
+    let mut out = VertexAttributes::default();
+    if any_colour {
+        let (values, merged) = colours.finish();
+        out.colours = Some(values);
+        out.colour_splits_merged = merged;
+    }
+    if any_uv {
+        let (values, merged) = uvs.finish();
+        out.uvs = Some(values);
+        out.uv_splits_merged = merged;
+    }
+    out
 }
 
 /// Write the OBJ `source` back with `mesh`'s positions: every line but the `v` lines of moved

@@ -17,6 +17,7 @@
 //! Speed: binary vertex rows of fixed size are read with precomputed offsets; faces are read row by
 //! row without per-face allocation. ASCII rows are one per line (what every writer produces).
 
+use super::carry::{Gather, VertexAttributes};
 use super::source::{dvec, NormalTurns, SmoothGroups, Source};
 use super::text::{lines, non_finite_kind, parse_f32, parse_f64, parse_i64, quote, tokens};
 use super::{IoError, Parsed};
@@ -1107,6 +1108,78 @@ fn vertex_triples(
             })
             .collect(),
     }
+}
+
+/// The vertex colours (red green blue [alpha]) and UVs (s t, u v or texture_u texture_v) of a
+/// PLY file, per welded vertex, for saving it in another format.
+pub(crate) fn vertex_attributes(bytes: &[u8], source: &Source) -> VertexAttributes {
+    let path = Path::new("");
+    let mut out = VertexAttributes::default();
+    let Ok(header) = parse_header(bytes, path) else {
+        return out;
+    };
+    let Ok(layout) = find_layout(&header, path) else {
+        return out;
+    };
+    let Some(rows) = vertex_rows(bytes, &header, &layout) else {
+        return out;
+    };
+    let element = &header.elements[layout.vertex_element];
+    let find = |name: &[u8]| {
+        element
+            .properties
+            .iter()
+            .position(|p| matches!(p, Property::Scalar { name: n, .. } if n == name))
+    };
+    // Integer colours are 0..255 (0..65535 for 16 bits); float colours are 0..1.
+    let scale = |p: usize| match &element.properties[p] {
+        Property::Scalar {
+            kind: Scalar::U16, ..
+        } => 1.0 / 65535.0,
+        Property::Scalar { kind, .. } if kind.is_integer() => 1.0 / 255.0,
+        _ => 1.0,
+    };
+    let rgb = [b"red".as_slice(), b"green", b"blue"].map(find);
+    if let [Some(r), Some(g), Some(b)] = rgb {
+        let colours = vertex_triples(bytes, &header, &rows, element, [r, g, b]);
+        let alphas = find(b"alpha").map(|a| {
+            (
+                vertex_triples(bytes, &header, &rows, element, [a, a, a]),
+                scale(a),
+            )
+        });
+        let mut gather = Gather::<4>::new(source.welded_vertices, [1.0; 4]);
+        for (k, c) in colours.iter().enumerate() {
+            let alpha = alphas
+                .as_ref()
+                .map_or(1.0, |(values, scale)| values[k][0] * scale);
+            let rgba = [c[0] * scale(r), c[1] * scale(g), c[2] * scale(b), alpha];
+            gather.put(source.welded(k), rgba.map(|v| v.clamp(0.0, 1.0)));
+        }
+        let (values, merged) = gather.finish();
+        out.colours = Some(values);
+        out.colour_splits_merged = merged;
+    }
+    let uv = [
+        (b"s".as_slice(), b"t".as_slice()),
+        (b"u", b"v"),
+        (b"texture_u", b"texture_v"),
+    ]
+    .into_iter()
+    .find_map(|(u, v)| Some((find(u)?, find(v)?)));
+    if let Some((u, v)) = uv {
+        let mut gather = Gather::<2>::new(source.welded_vertices, [0.0; 2]);
+        for (k, uv) in vertex_triples(bytes, &header, &rows, element, [u, v, v])
+            .iter()
+            .enumerate()
+        {
+            gather.put(source.welded(k), [uv[0], uv[1]]);
+        }
+        let (values, merged) = gather.finish();
+        out.uvs = Some(values);
+        out.uv_splits_merged = merged;
+    }
+    out
 }
 
 /// What a PLY file holds beyond positions and triangles, in plain words.

@@ -18,9 +18,11 @@
 //! normals stay split, smooth ones stay smooth, and a file's own custom normals keep their
 //! character), and the glTF POSITION accessor's min/max are recomputed. A vertex that did not
 //! move keeps its bytes (or its text) exactly, and so does a normal whose faces did not move.
-//! Saving to another format writes the mesh as it is and names, in the [`SaveReport`], what that
-//! format cannot keep.
+//! Saving to another format writes the mesh with what that format can hold per vertex (UVs and
+//! vertex colours into glTF and OBJ, see [`super::carry`]) and names, in the [`SaveReport`],
+//! everything else it cannot keep.
 
+use super::carry::VertexAttributes;
 use super::{gltf_writeback, Format};
 use crate::mesh::TriMesh;
 use glam::{DQuat, DVec3};
@@ -53,6 +55,8 @@ pub(crate) enum SourceData {
     /// The file holds things no writer here carries (an STL's per-facet attribute bytes, an OFF's
     /// colours): named, in plain words, so that saving says they were not kept.
     Unkept(Vec<String>),
+    /// A binary STL's header text (written back into an STL) and what is not kept.
+    Stl(Box<super::stl::StlSource>),
     /// The OBJ file's bytes.
     Obj(Vec<u8>),
     /// The PLY file's bytes.
@@ -103,10 +107,51 @@ impl Source {
         match &self.data {
             SourceData::Plain => Vec::new(),
             SourceData::Unkept(items) => items.clone(),
+            SourceData::Stl(stl) => stl.contents(),
             SourceData::Obj(bytes) => super::obj::contents(bytes),
             SourceData::Ply(bytes) => super::ply::contents(bytes),
             SourceData::Gltf(gltf) => gltf.contents(),
         }
+    }
+
+    /// The file's UVs and vertex colours per welded vertex (see [`super::carry`]), for writing
+    /// another format.
+    pub(crate) fn vertex_attributes(&self) -> VertexAttributes {
+        match &self.data {
+            SourceData::Obj(bytes) => super::obj::vertex_attributes(bytes, self),
+            SourceData::Ply(bytes) => super::ply::vertex_attributes(bytes, self),
+            SourceData::Gltf(gltf) => gltf.vertex_attributes(self),
+            _ => VertexAttributes::default(),
+        }
+    }
+
+    /// [`Source::contents`] without what `carried` brought into the output.
+    pub(crate) fn contents_beyond(&self, carried: &VertexAttributes) -> Vec<String> {
+        let uvs = carried.uvs.is_some();
+        let colours = carried.colours.is_some();
+        let carried_property = |name: &str| {
+            (colours && matches!(name, "red" | "green" | "blue" | "alpha"))
+                || (uvs && matches!(name, "s" | "t" | "u" | "v" | "texture_u" | "texture_v"))
+        };
+        self.contents()
+            .into_iter()
+            .filter_map(|item| {
+                if (uvs
+                    && (item == "UVs (TEXCOORD_0)" || item.starts_with("texture coordinates (")))
+                    || (colours && (item == "vertex colours (COLOR_0)" || item == "vertex colours"))
+                {
+                    return None;
+                }
+                match item.strip_prefix("vertex properties ") {
+                    Some(list) => {
+                        let left: Vec<&str> =
+                            list.split(", ").filter(|p| !carried_property(p)).collect();
+                        (!left.is_empty()).then(|| format!("vertex properties {}", left.join(", ")))
+                    }
+                    None => Some(item),
+                }
+            })
+            .collect()
     }
 
     /// The welded vertex that parser vertex `raw` became, if it was kept.
@@ -126,6 +171,7 @@ impl Source {
     pub(crate) fn writes_back_as(&self, format: Format) -> bool {
         match self.data {
             SourceData::Plain | SourceData::Unkept(_) => false,
+            SourceData::Stl(_) => format == Format::Stl,
             SourceData::Obj(_) => format == Format::Obj,
             SourceData::Ply(_) => format == Format::Ply,
             SourceData::Gltf(_) => matches!(format, Format::Gltf | Format::Glb),
@@ -157,18 +203,29 @@ pub(crate) fn fingerprint(triangles: &[[u32; 3]]) -> u64 {
 /// same welded vertex ([`SmoothGroups`]), so the copies stay equal, while normals that differ
 /// there (a hard edge) stay apart.
 pub(crate) struct NormalTurns {
-    before: Vec<DVec3>,
-    after: Vec<DVec3>,
-    moved: Vec<bool>,
+    /// Per slot, side by side so that adding a face touches one place per corner.
+    slots: Vec<SlotSums>,
+}
+
+#[derive(Clone, Copy, Default)]
+struct SlotSums {
+    before: DVec3,
+    after: DVec3,
+    moved: bool,
 }
 
 impl NormalTurns {
     pub(crate) fn new(normals: usize) -> NormalTurns {
         NormalTurns {
-            before: vec![DVec3::ZERO; normals],
-            after: vec![DVec3::ZERO; normals],
-            moved: vec![false; normals],
+            slots: vec![SlotSums::default(); normals],
         }
+    }
+
+    fn slot_mut(&mut self, n: usize) -> &mut SlotSums {
+        if n >= self.slots.len() {
+            self.slots.resize(n + 1, SlotSums::default());
+        }
+        &mut self.slots[n]
     }
 
     /// Add a triangle whose corners use the slots `slots`, with its corners' positions before
@@ -179,44 +236,38 @@ impl NormalTurns {
         let area_after = (after[1] - after[0]).cross(after[2] - after[0]);
         let moved = before != after;
         for n in slots {
-            if n >= self.before.len() {
-                self.before.resize(n + 1, DVec3::ZERO);
-                self.after.resize(n + 1, DVec3::ZERO);
-                self.moved.resize(n + 1, false);
-            }
-            self.before[n] += area_before;
-            self.after[n] += area_after;
-            self.moved[n] |= moved;
+            let sums = self.slot_mut(n);
+            sums.before += area_before;
+            sums.after += area_after;
+            sums.moved |= moved;
         }
     }
 
     /// The sum of the area vectors of slot `n`'s faces before the move.
     pub(crate) fn area_before(&self, n: usize) -> DVec3 {
-        self.before.get(n).copied().unwrap_or(DVec3::ZERO)
+        self.slots.get(n).map_or(DVec3::ZERO, |sums| sums.before)
     }
 
     /// Add the sums of `from`'s slot `n` to this one's slot `slot`.
     pub(crate) fn merge_slot(&mut self, slot: usize, from: &NormalTurns, n: usize) {
-        if slot >= self.before.len() {
-            self.before.resize(slot + 1, DVec3::ZERO);
-            self.after.resize(slot + 1, DVec3::ZERO);
-            self.moved.resize(slot + 1, false);
-        }
-        self.before[slot] += from.before[n];
-        self.after[slot] += from.after[n];
-        self.moved[slot] |= from.moved[n];
+        let add = from.slots.get(n).copied().unwrap_or_default();
+        let sums = self.slot_mut(slot);
+        sums.before += add.before;
+        sums.after += add.after;
+        sums.moved |= add.moved;
     }
 
     /// The rotation for normal `n`, or `None` when it stays as it is.
     pub(crate) fn turn(&self, n: usize) -> Option<Turn> {
-        if !*self.moved.get(n)? {
+        let sums = self.slots.get(n)?;
+        if !sums.moved {
             return None;
         }
-        let after = self.after[n].normalize_or_zero();
+        let after = sums.after.normalize_or_zero();
         if after == DVec3::ZERO {
             return None;
         }
-        let before = self.before[n].normalize_or_zero();
+        let before = sums.before.normalize_or_zero();
         Some(if before == DVec3::ZERO {
             Turn::Replace(after)
         } else {
@@ -229,7 +280,11 @@ impl NormalTurns {
 /// welded vertex gets a slot of its own.
 #[derive(Default)]
 pub(crate) struct SmoothGroups {
-    slots: std::collections::HashMap<
+    /// Per welded vertex, the slot of the first normal value seen there (most vertices have one):
+    /// looked up by index, with no hashing.
+    first: Vec<Option<(usize, [u32; 3])>>,
+    /// The slots of the further values on a vertex (hard edges).
+    others: std::collections::HashMap<
         (usize, [u32; 3]),
         usize,
         std::hash::BuildHasherDefault<crate::mesh::PositionHasher>,
@@ -249,25 +304,40 @@ impl SmoothGroups {
         let own = own.normalize_or_zero();
         let n = dvec(normal).normalize_or_zero();
         if own != DVec3::ZERO && own.dot(n) > 0.99999 {
-            self.next += 1;
-            return self.next - 1;
+            return self.fresh();
         }
         self.slot(welded, normal)
     }
 
     pub(crate) fn slot(&mut self, welded: Option<usize>, normal: [f32; 3]) -> usize {
-        let fresh = self.next;
-        let slot = match welded {
-            Some(w) => *self
-                .slots
-                .entry((w, normal.map(f32::to_bits)))
-                .or_insert(fresh),
-            None => fresh,
+        let Some(w) = welded else {
+            return self.fresh();
         };
-        if slot == fresh {
-            self.next += 1;
+        let bits = normal.map(f32::to_bits);
+        if w >= self.first.len() {
+            self.first.resize(w + 1, None);
         }
-        slot
+        match self.first[w] {
+            Some((slot, first_bits)) if first_bits == bits => slot,
+            Some(_) => match self.others.get(&(w, bits)) {
+                Some(&slot) => slot,
+                None => {
+                    let slot = self.fresh();
+                    self.others.insert((w, bits), slot);
+                    slot
+                }
+            },
+            None => {
+                let slot = self.fresh();
+                self.first[w] = Some((slot, bits));
+                slot
+            }
+        }
+    }
+
+    fn fresh(&mut self) -> usize {
+        self.next += 1;
+        self.next - 1
     }
 }
 

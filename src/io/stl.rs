@@ -8,7 +8,8 @@
 //!
 //! STL stores three corners per triangle and shares nothing: every corner becomes its own vertex
 //! and welding (on by default) joins them. Facet normals are ignored on reading and written as the
-//! unit face normal (zero for a degenerate triangle).
+//! unit face normal (zero for a degenerate triangle). A binary file's 80-byte header text is kept
+//! ([`StlSource`]): written back when the mesh is saved as STL, named when saved as another format.
 
 use super::text::{lines, non_finite_kind, parse_f32, quote, tokens};
 use super::{IoError, Parsed};
@@ -124,10 +125,17 @@ fn read_binary(bytes: &[u8], path: &Path) -> Result<Parsed, IoError> {
         .take(declared)
         .filter(|record| record[48..50] != [0, 0])
         .count();
+    let mut unkept = Vec::new();
     if coloured > 0 {
-        parsed.data = super::source::SourceData::Unkept(vec![format!(
+        unkept.push(format!(
             "the attribute bytes (colours, for some writers) of {coloured} facets"
-        )]);
+        ));
+    }
+    let header: [u8; 80] = bytes[..80].try_into().unwrap_or([0; 80]);
+    if header_text(&header).is_some() {
+        parsed.data = super::source::SourceData::Stl(Box::new(StlSource { header, unkept }));
+    } else if !unkept.is_empty() {
+        parsed.data = super::source::SourceData::Unkept(unkept);
     }
     Ok(parsed)
 }
@@ -196,17 +204,55 @@ fn read_ascii(bytes: &[u8], path: &Path) -> Result<Parsed, IoError> {
     Ok(Parsed::new(mesh))
 }
 
+/// What a binary STL holds beyond its triangles: the 80-byte header, whose text (a title, the
+/// writing program, units) is written back when the mesh is saved as STL, and what is not kept.
+#[derive(Debug)]
+pub(crate) struct StlSource {
+    pub header: [u8; 80],
+    pub unkept: Vec<String>,
+}
+
+impl StlSource {
+    /// In plain words, for `info` and for saying what another format does not keep.
+    pub(crate) fn contents(&self) -> Vec<String> {
+        let mut out: Vec<String> = header_text(&self.header)
+            .map(|text| format!("the 80-byte STL header text {text:?}"))
+            .into_iter()
+            .collect();
+        out.extend(self.unkept.iter().cloned());
+        out
+    }
+}
+
+/// The text of a binary STL header (up to its first NUL, trimmed), when it says something other
+/// than what fairmesh itself writes there.
+fn header_text(header: &[u8; 80]) -> Option<String> {
+    let end = header.iter().position(|&b| b == 0).unwrap_or(header.len());
+    let text = String::from_utf8_lossy(&header[..end]).trim().to_string();
+    (!text.is_empty() && text != FAIRMESH_TITLE).then_some(text)
+}
+
+const FAIRMESH_TITLE: &str = "binary STL written by fairmesh";
+
 pub(crate) fn write(out: &mut dyn Write, mesh: &TriMesh) -> std::io::Result<()> {
+    let mut header = [b' '; 80];
+    header[..FAIRMESH_TITLE.len()].copy_from_slice(FAIRMESH_TITLE.as_bytes());
+    write_with_header(out, mesh, &header)
+}
+
+/// A binary STL with the given 80-byte header.
+pub(crate) fn write_with_header(
+    out: &mut dyn Write,
+    mesh: &TriMesh,
+    header: &[u8; 80],
+) -> std::io::Result<()> {
     let count = u32::try_from(mesh.triangles.len()).map_err(|_| {
         std::io::Error::new(
             std::io::ErrorKind::InvalidInput,
             "binary STL holds at most 2^32 - 1 triangles",
         )
     })?;
-    let mut header = [b' '; 80];
-    let title = b"binary STL written by fairmesh";
-    header[..title.len()].copy_from_slice(title);
-    out.write_all(&header)?;
+    out.write_all(header)?;
     out.write_all(&count.to_le_bytes())?;
     let mut record = [0u8; RECORD];
     for t in 0..mesh.triangles.len() {
