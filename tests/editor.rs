@@ -9,7 +9,7 @@ use std::path::Path;
 use std::time::{Duration, Instant};
 
 use egui::accesskit::Role;
-use egui_kittest::kittest::Queryable;
+use egui_kittest::kittest::{NodeT, Queryable};
 use egui_kittest::SnapshotOptions;
 
 mod editor_common;
@@ -464,6 +464,164 @@ fn meshes_too_big_for_the_gpu_buffers_are_refused_with_a_reason() {
         *image.get_pixel(w / 2, h / 2),
         background,
         "no mesh is drawn"
+    );
+}
+
+/// Undo and redo across an Open bring back the camera of the document they bring back: the
+/// view shows that mesh, not the place where the other one was (issue 13).
+#[test]
+fn undo_and_redo_across_open_bring_the_documents_camera_back() {
+    let dir = tempfile::tempdir().unwrap();
+    let far = dir.path().join("far.obj");
+    let mut mesh = fairmesh::io::load(bunny()).unwrap().mesh;
+    for p in &mut mesh.positions {
+        *p = [p[0] * 10.0 + 5.0, p[1] * 10.0, p[2] * 10.0 - 3.0];
+    }
+    write_obj(&mesh, &far);
+
+    let mut harness = harness_for(bunny());
+    settle(&mut harness);
+    // The user's own view of the bunny (zoomed in) is part of what comes back.
+    harness.hover_at(harness.state().viewport_rect().unwrap().center());
+    harness.event(egui::Event::MouseWheel {
+        unit: egui::MouseWheelUnit::Point,
+        delta: egui::vec2(0.0, 120.0),
+        phase: egui::TouchPhase::Move,
+        source: egui::MouseWheelSource::Unknown,
+        modifiers: egui::Modifiers::NONE,
+    });
+    for _ in 0..30 {
+        harness.step();
+    }
+    let bunny_camera = *harness.state().camera();
+    harness
+        .state_mut()
+        .push_command(fairmesh::app::Command::Open(far.clone()));
+    settle(&mut harness);
+    let far_camera = *harness.state().camera();
+    assert_ne!(far_camera.target, bunny_camera.target);
+
+    harness.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::Z);
+    settle(&mut harness);
+    assert_eq!(
+        harness.state().status().document.as_deref(),
+        Some(bunny().as_path())
+    );
+    assert_eq!(*harness.state().camera(), bunny_camera, "the bunny's view");
+
+    harness.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::Y);
+    settle(&mut harness);
+    assert_eq!(
+        harness.state().status().document.as_deref(),
+        Some(far.as_path())
+    );
+    assert_eq!(*harness.state().camera(), far_camera, "the far mesh's view");
+}
+
+/// After a slider step the new result is on screen at once while its distances are measured a
+/// moment later: until then the rows that still hold the previous result's numbers are greyed
+/// and say so (issue 13: they sat beside the fresh ones unmarked).
+#[test]
+fn numbers_of_the_previous_result_are_greyed_until_the_new_ones_arrive() {
+    let mut harness = harness_for(bunny());
+    settle(&mut harness);
+    let before = harness.state().status();
+    let (measures, _) = harness.state().faired_measures();
+    let old_mean = format!("{:.3e}", measures.unwrap().mean_distance);
+    assert!(!harness
+        .get_by_label(&old_mean)
+        .accesskit_node()
+        .is_disabled());
+
+    nudge_level_slider(&mut harness);
+    let deadline = Instant::now() + Duration::from_secs(120);
+    while harness.state().status().faired_serial == before.faired_serial {
+        harness.step();
+        std::thread::sleep(Duration::from_millis(2));
+        assert!(Instant::now() < deadline, "no new result came");
+    }
+    // The frame that took the new result drew the panel: its distances are not measured yet
+    // (measuring starts a moment after a result arrives).
+    let stale = harness.get_by_label(&old_mean).accesskit_node();
+    assert!(
+        stale.is_disabled(),
+        "the previous result's number is greyed"
+    );
+    assert!(
+        stale
+            .description()
+            .is_some_and(|d| d.contains("previous result")),
+        "{:?}",
+        stale.description()
+    );
+
+    settle(&mut harness);
+    let (measures, _) = harness.state().faired_measures();
+    let new_mean = format!("{:.3e}", measures.unwrap().mean_distance);
+    assert_ne!(new_mean, old_mean);
+    assert!(!harness
+        .get_by_label(&new_mean)
+        .accesskit_node()
+        .is_disabled());
+}
+
+/// At 800×600 every toolbar control is inside the window (the toolbar wraps), and a status
+/// message or an error does not move the controls under the pointer (issue 13).
+#[test]
+fn small_window_keeps_the_toolbar_and_messages_do_not_move_the_controls() {
+    let bunny = bunny();
+    let mut harness = egui_kittest::Harness::builder()
+        .with_size(egui::vec2(800.0, 600.0))
+        .wgpu()
+        .build_eframe(move |cc| fairmesh::app::App::new_for_test(cc, bunny));
+    settle(&mut harness);
+    for label in ["Level mesh", "Original", "Undo", "Redo"] {
+        let rect = harness.get_by_label(label).rect();
+        assert!(
+            rect.right() <= 800.0 && rect.bottom() <= 600.0,
+            "{label} at {rect:?}"
+        );
+    }
+    let fit = harness.get_by_label("Fit view (F)").rect();
+    let apply = harness
+        .get_by_role_and_label(Role::Button, "Apply result")
+        .rect();
+    harness
+        .state_mut()
+        .push_command(fairmesh::app::Command::Open("missing.obj".into()));
+    settle(&mut harness);
+    assert!(harness.state().status().error.is_some());
+    harness.get_by_label_contains("Could not open the file");
+    assert_eq!(harness.get_by_label("Fit view (F)").rect(), fit);
+    assert_eq!(
+        harness
+            .get_by_role_and_label(Role::Button, "Apply result")
+            .rect(),
+        apply
+    );
+}
+
+/// F fits the mesh into each half of the side-by-side view (narrower than tall), not only into
+/// the single view's height (issue 13: it cropped both meshes).
+#[test]
+fn fit_view_fits_the_side_by_side_halves() {
+    let mut harness = harness_for(bunny());
+    settle(&mut harness);
+    harness.get_by_label("Side by side").click();
+    harness.step();
+    harness.key_press(egui::Key::F);
+    harness.step();
+    harness.step();
+    let camera = *harness.state().camera();
+    let rect = harness.state().viewport_rect().unwrap();
+    let aspect = rect.width() / 2.0 / rect.height();
+    assert!(aspect < 1.0);
+    let half_width = camera.distance * (camera.fov_y * 0.5).tan() * aspect;
+    let half_height = camera.distance * (camera.fov_y * 0.5).tan();
+    assert!(
+        half_width >= camera.scene_radius && half_height >= camera.scene_radius,
+        "the bounding sphere (radius {}) fits in {half_width} × {half_height}",
+        camera.scene_radius
     );
 }
 

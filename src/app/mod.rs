@@ -610,10 +610,16 @@ impl App {
                 if let Some(document) = &mut self.document {
                     let top = document.level_count().unwrap_or(1).saturating_sub(1);
                     document.level = level.min(top);
+                    document.applied = false;
                 }
                 self.refresh_view();
             }
-            Command::Refair => self.refresh_view(),
+            Command::Refair => {
+                if let Some(document) = &mut self.document {
+                    document.applied = false;
+                }
+                self.refresh_view();
+            }
             Command::SetViewMode(mode) => {
                 self.settings.view_mode = mode;
                 self.refresh_view();
@@ -641,8 +647,17 @@ impl App {
     /// is rebuilt unless the snapshot kept one.
     fn install(&mut self, snapshot: DocumentSnapshot, record: Option<String>) {
         if let (Some(label), Some(current)) = (record, &self.document) {
-            self.history.record(label, current.snapshot());
+            let mut previous = current.snapshot();
+            previous.camera = Some(self.camera);
+            self.history.record(label, previous);
         }
+        // The camera follows the document: another file's comes back with it (undo and redo
+        // across an Open), or the view is fitted to it; the same file's keeps the user's view.
+        let other_file = self
+            .document
+            .as_ref()
+            .is_none_or(|current| current.path != snapshot.path);
+        let camera = snapshot.camera;
         let previous = self.document.take();
         // Freeing a big mesh and its hierarchy takes tens of milliseconds: not on the UI thread
         // (what the history keeps is shared, so this frees only what nobody else holds).
@@ -656,6 +671,12 @@ impl App {
         self.applied_view = 0;
         self.applied_level_view = 0;
         self.fair_in_flight = false;
+        if other_file {
+            match camera {
+                Some(camera) => self.camera = camera,
+                None => self.fit_view(),
+            }
+        }
         if needs_build {
             self.start_hierarchy();
         } else {
@@ -733,12 +754,20 @@ impl App {
         });
         snapshot.against_clean = faired.against_clean.clone();
         snapshot.hierarchy = None;
+        snapshot.applied = true;
         self.install(snapshot, Some(label.clone()));
         self.message = Some(format!("{label}: the result is now the document"));
     }
 
+    /// The current document as undo and redo keep it, with the view of it.
+    fn current_snapshot(&self) -> Option<DocumentSnapshot> {
+        let mut snapshot = self.document.as_ref()?.snapshot();
+        snapshot.camera = Some(self.camera);
+        Some(snapshot)
+    }
+
     fn undo(&mut self) {
-        let Some(current) = self.document.as_ref().map(Document::snapshot) else {
+        let Some(current) = self.current_snapshot() else {
             return;
         };
         let label = self.history.undo_label().map(str::to_owned);
@@ -749,7 +778,7 @@ impl App {
     }
 
     fn redo(&mut self) {
-        let Some(current) = self.document.as_ref().map(Document::snapshot) else {
+        let Some(current) = self.current_snapshot() else {
             return;
         };
         let label = self.history.redo_label().map(str::to_owned);
@@ -850,9 +879,12 @@ impl App {
         let hierarchy = hierarchy.clone();
         let level = document.level;
         let document_generation = document.generation;
+        let applied = document.applied;
         let view = self.view_generation.bump();
         match self.settings.view_mode {
             ViewMode::Level => self.request_level_mesh(hierarchy, document_generation, level, view),
+            // An applied result is shown as it is until a setting changes.
+            ViewMode::Faired | ViewMode::Original if applied => {}
             ViewMode::Faired | ViewMode::Original => {
                 self.request_fairing(hierarchy, document_generation, level, view)
             }
@@ -1208,8 +1240,19 @@ impl App {
             (ViewMode::Level, Some((_, mesh))) => state::bounds_of(&mesh.positions),
             _ => document.bounds,
         };
-        self.camera
-            .fit(glam::Vec3::from_array(lo), glam::Vec3::from_array(hi));
+        // Each side-by-side half is half the view's width.
+        let aspect = self.viewport_rect.map_or(1.0, |rect| {
+            let width = match self.settings.compare {
+                CompareView::SideBySide => rect.width() * 0.5,
+                CompareView::Single | CompareView::Split => rect.width(),
+            };
+            width / rect.height().max(1.0)
+        });
+        self.camera.fit(
+            glam::Vec3::from_array(lo),
+            glam::Vec3::from_array(hi),
+            aspect,
+        );
     }
 
     // ---- results --------------------------------------------------------------------------
@@ -1255,6 +1298,8 @@ impl App {
                             load_time: elapsed,
                             level: 0,
                             hierarchy: None,
+                            applied: false,
+                            camera: None,
                         };
                         self.install(snapshot, Some(format!("Open {name}")));
                         self.error = None;
@@ -1426,6 +1471,7 @@ impl App {
                 snapshot.clean = Some(clean);
                 snapshot.against_clean = Some(*against_clean);
                 snapshot.hierarchy = None;
+                snapshot.applied = false;
                 self.install(snapshot, Some(label.clone()));
                 self.message = Some(format!(
                     "{label}: the mesh before the noise is kept as the clean reference"

@@ -15,6 +15,7 @@ use crate::render::colormap::{legend_ticks, viridis_strip};
 
 pub fn show(app: &mut App, ui: &mut egui::Ui) {
     egui::Panel::top("fairmesh-toolbar").show(ui, |ui| toolbar(app, ui));
+    egui::Panel::bottom("fairmesh-status").show(ui, |ui| status_bar(app, ui));
     egui::Panel::right("fairmesh-controls")
         .resizable(true)
         .default_size(310.0)
@@ -26,7 +27,8 @@ pub fn show(app: &mut App, ui: &mut egui::Ui) {
 
 fn toolbar(app: &mut App, ui: &mut egui::Ui) {
     ui.add_space(4.0);
-    ui.horizontal(|ui| {
+    // Wraps in a narrow window, so that no control ends up off screen.
+    ui.horizontal_wrapped(|ui| {
         if ui
             .button("Open…")
             .on_hover_text("Pick a mesh file (Ctrl+O)")
@@ -96,6 +98,13 @@ fn toolbar(app: &mut App, ui: &mut egui::Ui) {
             ui.small(format!("undo: {label}"));
         }
     });
+    ui.add_space(2.0);
+}
+
+/// Loading, errors and messages, at the bottom of the window: their coming and going does not
+/// move the controls (a click meant for one button would hit another).
+fn status_bar(app: &mut App, ui: &mut egui::Ui) {
+    ui.add_space(2.0);
     if let Some(path) = &app.loading {
         ui.horizontal(|ui| {
             ui.spinner();
@@ -118,6 +127,10 @@ fn toolbar(app: &mut App, ui: &mut egui::Ui) {
     }
     if let Some(message) = &app.message {
         ui.colored_label(egui::Color32::from_rgb(140, 200, 140), message);
+    }
+    if app.loading.is_none() && app.error.is_none() && app.message.is_none() {
+        // The bar keeps its height when there is nothing to say.
+        ui.weak("Ready");
     }
     ui.add_space(2.0);
 }
@@ -324,6 +337,9 @@ fn controls(app: &mut App, ui: &mut egui::Ui) {
         });
     }
 
+    if document.applied {
+        ui.small("Showing the applied result as it is. Change the start level or an option to fair it again.");
+    }
     if ui
         .add_enabled(document.faired.is_some(), egui::Button::new("Apply result"))
         .on_hover_text("Make the faired result the document's mesh (undo with Ctrl+Z)")
@@ -437,11 +453,20 @@ fn controls(app: &mut App, ui: &mut egui::Ui) {
                         .map_or("–".into(), |v| format!("{v:.3e}"))
                 }),
             ];
+            // Until the result on screen is measured, these rows hold the previous result's
+            // numbers: greyed, and saying so, beside the fresh ones below.
+            let pending = faired.is_some_and(|f| f.measures_pending);
+            let value = |ui: &mut egui::Ui, text: String| {
+                let label = ui.add_enabled(!pending, egui::Label::new(text));
+                if pending {
+                    label.on_hover_text(PENDING_TIP);
+                }
+            };
             for (name, row) in rows {
                 ui.label(name);
-                ui.label(against_document.map_or("–".into(), row));
+                value(ui, against_document.map_or("–".into(), row));
                 if has_clean {
-                    ui.label(against_clean.map_or("–".into(), row));
+                    value(ui, against_clean.map_or("–".into(), row));
                 }
                 ui.end_row();
             }
@@ -864,6 +889,10 @@ fn tick_text(value: f64, spacing: f64) -> String {
     let decimals = (-spacing.log10().floor()).max(0.0) as usize;
     format!("{value:.decimals$}")
 }
+
+/// What a greyed number in the Numbers panel means.
+const PENDING_TIP: &str =
+    "From the previous result: the result on screen is being measured, its numbers follow";
 
 fn noise_mode_name(mode: NoiseMode) -> &'static str {
     match mode {

@@ -362,6 +362,9 @@ pub struct Document {
     pub export_path: String,
     /// The file the mesh was loaded from: Export writes it back with the new positions.
     pub source: Arc<crate::io::Source>,
+    /// The mesh is an applied result: it is shown and exported as it is, not faired again with
+    /// the settings that made it, until the user changes the start level or a fairing option.
+    pub applied: bool,
 }
 
 impl Document {
@@ -390,6 +393,7 @@ impl Document {
             faired: None,
             level_mesh: None,
             export_path,
+            applied: false,
         }
     }
 
@@ -428,6 +432,11 @@ pub struct DocumentSnapshot {
     pub source: Arc<crate::io::Source>,
     /// The hierarchy, its build time, and whether its M0 has the mesh's triangles.
     pub hierarchy: Option<(Arc<Hierarchy>, Duration, bool)>,
+    /// See [`Document::applied`].
+    pub applied: bool,
+    /// The view of this document when it was left (set by the app, which owns the camera), so
+    /// that undo and redo across an Open bring back the view with the mesh.
+    pub camera: Option<super::camera::OrbitCamera>,
 }
 
 fn mesh_bytes(mesh: &TriMesh) -> usize {
@@ -473,6 +482,8 @@ impl Document {
                 } => Some((hierarchy.clone(), *build_time, *base_matches_original)),
                 _ => None,
             },
+            applied: self.applied,
+            camera: None,
         }
     }
 
@@ -506,6 +517,7 @@ impl Document {
             level_mesh: None,
             export_path: snapshot.export_path,
             source: snapshot.source,
+            applied: snapshot.applied,
         }
     }
 }
