@@ -66,7 +66,7 @@ fn level_slider_refairs_and_updates_the_numbers() {
     nudge_level_slider(&mut harness);
     settle(&mut harness);
     let after = harness.state().status();
-    let expected = 1.min(top);
+    let expected = (before.level + 1).min(top);
     assert_eq!(after.level, expected);
     if top >= 1 {
         // Starting from a coarser level smooths more: a new result with other numbers.
@@ -84,7 +84,7 @@ fn level_slider_refairs_and_updates_the_numbers() {
         }
         settle(&mut harness);
         let last = harness.state().status();
-        assert_eq!(last.level, 4.min(top));
+        assert_eq!(last.level, (before.level + 4).min(top));
         assert!(last.faired_serial > after.faired_serial);
     }
     // Fair M0 too: another run, the same level.
@@ -337,7 +337,7 @@ fn viewport_snapshots() {
     let mut harness = harness_for(bunny());
     settle(&mut harness);
     // The loaded mesh, so the image does not depend on the fairing algorithm's details.
-    harness.get_by_label("Original").click();
+    harness.get_by_label("Input mesh").click();
     settle(&mut harness);
 
     let shaded = viewport_image(&mut harness);
@@ -391,7 +391,7 @@ fn background_uploads_draw_the_same_images() {
             ..AppOptions::default()
         });
         settle(&mut harness);
-        harness.get_by_label("Original").click();
+        harness.get_by_label("Input mesh").click();
         settle(&mut harness);
         let shaded = viewport_image(&mut harness);
         harness.key_press(egui::Key::W);
@@ -575,7 +575,7 @@ fn small_window_keeps_the_toolbar_and_messages_do_not_move_the_controls() {
         .wgpu()
         .build_eframe(move |cc| fairmesh::app::App::new_for_test(cc, bunny));
     settle(&mut harness);
-    for label in ["Level mesh", "Original", "Undo", "Redo"] {
+    for label in ["Level mesh", "Input mesh", "Undo", "Redo"] {
         let rect = harness.get_by_label(label).rect();
         assert!(
             rect.right() <= 800.0 && rect.bottom() <= 600.0,
@@ -623,6 +623,126 @@ fn fit_view_fits_the_side_by_side_halves() {
         "the bounding sphere (radius {}) fits in {half_width} × {half_height}",
         camera.scene_radius
     );
+}
+
+/// Every fairing control explains itself in its tooltip (read here as its accessible
+/// description); the ones a baseline method does not use are disabled and say why, and the
+/// numbers name the method instead of a start level it did not use (issue 13).
+#[test]
+fn fairing_controls_explain_themselves_and_say_why_they_are_off() {
+    let bunny = bunny();
+    // Tall enough that the whole side panel is on screen.
+    let mut harness = egui_kittest::Harness::builder()
+        .with_size(egui::vec2(1200.0, 1600.0))
+        .wgpu()
+        .build_eframe(move |cc| fairmesh::app::App::new_for_test(cc, bunny));
+    settle(&mut harness);
+    let description =
+        |harness: &egui_kittest::Harness<'_, fairmesh::app::App>, role: Role, label: &str| {
+            let node = harness.get_by_role_and_label(role, label);
+            let node = node.accesskit_node();
+            (node.description().unwrap_or_default(), node.is_disabled())
+        };
+    use fairmesh::app::panels::tips;
+    let controls = [
+        (Role::Slider, "Start level", tips::START_LEVEL),
+        (
+            Role::Slider,
+            "Iterations per level",
+            tips::ITERATIONS_PER_LEVEL,
+        ),
+        (Role::Slider, "Rounds", tips::ROUNDS),
+        (Role::CheckBox, "Fair M0 too", tips::FAIR_FINEST),
+        (Role::Button, "Apply result", tips::APPLY),
+    ];
+    for (role, label, tip) in controls {
+        let (text, disabled) = description(&harness, role, label);
+        assert_eq!(text, tip, "{label}");
+        assert!(!disabled, "{label}");
+    }
+    for (label, tip) in [
+        ("Method", tips::METHOD),
+        ("Boundary", tips::BOUNDARY),
+        ("Variant", tips::VARIANT),
+    ] {
+        let described = harness
+            .query_all_by(move |node| node.description().as_deref() == Some(tip))
+            .count();
+        assert_eq!(described, 1, "{label} has its tooltip");
+    }
+    let level = harness.state().status().level;
+    harness.get_by_label_contains(&format!("Result: Constrained fairing from M{level}"));
+
+    harness.get_by_label("Method").click();
+    for _ in 0..3 {
+        harness.step();
+    }
+    harness.get_by_label("Laplacian").click();
+    settle(&mut harness);
+    for (role, label) in [
+        (Role::Slider, "Start level"),
+        (Role::CheckBox, "Fair M0 too"),
+    ] {
+        let (text, disabled) = description(&harness, role, label);
+        assert!(disabled, "{label} is off for Laplacian");
+        assert!(
+            text.contains("Not used by Laplacian"),
+            "{label} says why: {text}"
+        );
+    }
+    harness.get_by_label_contains("Result: Laplacian, whole mesh");
+    assert!(harness.query_by_label_contains("from M").is_none());
+}
+
+/// A file opens at a middle start level (level 0 would show the input as the result), and at
+/// the level last chosen for it when it is opened again.
+#[test]
+fn a_file_opens_at_a_middle_level_then_at_the_last_one_chosen() {
+    let mut harness = harness_for(bunny());
+    settle(&mut harness);
+    let status = harness.state().status();
+    assert!(status.level_count >= 3);
+    assert_eq!(status.level, (status.level_count - 1) / 2);
+    assert_eq!(status.faired_level, Some(status.level));
+
+    harness
+        .state_mut()
+        .push_command(fairmesh::app::Command::SetLevel(2));
+    settle(&mut harness);
+    harness
+        .state_mut()
+        .push_command(fairmesh::app::Command::Open(bunny()));
+    settle(&mut harness);
+    let reopened = harness.state().status();
+    assert_eq!(reopened.level, 2);
+    assert_eq!(reopened.faired_level, Some(2));
+}
+
+/// Opening the Performance section does not widen the side panel (issue 13: it widened it for
+/// good, taking the viewport's room).
+#[test]
+fn performance_section_keeps_the_side_panel_width() {
+    let bunny = bunny();
+    let mut harness = egui_kittest::Harness::builder()
+        .with_size(egui::vec2(1200.0, 1600.0))
+        .wgpu()
+        .build_eframe(move |cc| fairmesh::app::App::new_for_test(cc, bunny));
+    settle(&mut harness);
+    let width = harness.state().viewport_rect().unwrap().width();
+    harness.get_by_label("Performance").click();
+    for _ in 0..10 {
+        harness.step();
+    }
+    assert!(
+        harness.query_by_label("UI frame (CPU)").is_some(),
+        "it opened"
+    );
+    assert_eq!(harness.state().viewport_rect().unwrap().width(), width);
+    harness.get_by_label("Performance").click();
+    for _ in 0..10 {
+        harness.step();
+    }
+    assert_eq!(harness.state().viewport_rect().unwrap().width(), width);
 }
 
 /// Writes `mesh` as a minimal OBJ (the test needs a big file before `io::save` can be relied on).

@@ -95,11 +95,11 @@ fn noise_keeps_the_clean_mesh_and_fairing_gets_closer_to_it() {
     assert!(against_noisy.max_distance >= against_noisy.mean_distance);
 
     // Both columns are on screen.
-    harness.get_by_label("noisy");
+    harness.get_by_label("input");
     harness.get_by_label("clean");
     harness.get_by_label("Mean distance");
     harness.get_by_label("Max distance");
-    harness.get_by_label("Vertex RMS");
+    harness.get_by_label("RMS displacement");
     harness.get_by_label("Barycenter drift");
     harness.get_by_label(&format!("{:.3e}", against_clean.mean_distance));
     harness.step();

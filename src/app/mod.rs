@@ -611,6 +611,8 @@ impl App {
                     let top = document.level_count().unwrap_or(1).saturating_sub(1);
                     document.level = level.min(top);
                     document.applied = false;
+                    self.settings
+                        .remember_start_level(&document.path, document.level);
                 }
                 self.refresh_view();
             }
@@ -746,7 +748,7 @@ impl App {
             self.error = Some("The faired result does not fit the mesh".into());
             return;
         }
-        let label = format!("Apply result (faired from M{})", faired.level);
+        let label = format!("Apply result ({})", faired.method.describe(faired.level));
         let mut snapshot = document.snapshot();
         snapshot.mesh = Arc::new(TriMesh {
             positions: faired.positions.as_ref().clone(),
@@ -756,7 +758,7 @@ impl App {
         snapshot.hierarchy = None;
         snapshot.applied = true;
         self.install(snapshot, Some(label.clone()));
-        self.message = Some(format!("{label}: the result is now the document"));
+        self.message = Some(format!("{label}: the result is now the input mesh"));
     }
 
     /// The current document as undo and redo keep it, with the view of it.
@@ -925,6 +927,7 @@ impl App {
     ) {
         let options = self.settings.multires_options(level);
         let baseline = self.settings.baseline_options();
+        let method = self.settings.method;
         let document_generation = self.document_generation.clone();
         let progress_out = self.fair_progress.clone();
         let workspace = self.workspace.clone();
@@ -965,6 +968,7 @@ impl App {
                     volume_change,
                     rms_displacement,
                     elapsed: started.elapsed(),
+                    method,
                 }
             });
             let message = JobResult::Faired {
@@ -1302,6 +1306,9 @@ impl App {
                             camera: None,
                         };
                         self.install(snapshot, Some(format!("Open {name}")));
+                        if let Some(document) = &mut self.document {
+                            document.pick_start_level = true;
+                        }
                         self.error = None;
                         self.fit_view();
                     }
@@ -1328,7 +1335,12 @@ impl App {
                         let levels = (0..hierarchy.level_count())
                             .map(|l| hierarchy.level_info(l))
                             .collect::<Vec<_>>();
-                        current.level = current.level.min(levels.len().saturating_sub(1));
+                        current.level = if current.pick_start_level {
+                            current.pick_start_level = false;
+                            self.settings.start_level_for(&current.path, levels.len())
+                        } else {
+                            current.level.min(levels.len().saturating_sub(1))
+                        };
                         let warm = hierarchy.clone();
                         current.hierarchy = HierarchyState::Ready {
                             base_matches_original,
@@ -1377,6 +1389,7 @@ impl App {
                     current.faired = Some(FairedResult {
                         positions: positions.clone(),
                         level,
+                        method: faired.method,
                         volume_change: faired.volume_change,
                         rms_displacement: faired.rms_displacement,
                         elapsed: faired.elapsed,
@@ -1474,7 +1487,7 @@ impl App {
                 snapshot.applied = false;
                 self.install(snapshot, Some(label.clone()));
                 self.message = Some(format!(
-                    "{label}: the mesh before the noise is kept as the clean reference"
+                    "{label}: the mesh before the noise is kept as the clean mesh"
                 ));
             }
             JobResult::Exported {
