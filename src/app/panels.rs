@@ -494,16 +494,14 @@ fn performance(app: &mut App, ui: &mut egui::Ui) {
                     ));
                     ui.end_row();
                     ui.label("max while working");
-                    ui.label(milliseconds(stats.max_while_busy));
-                    ui.end_row();
-                    ui.label("  results / upload / widgets");
                     let [results, upload, widgets] = stats.max_while_busy_parts;
-                    ui.label(format!(
-                        "{} / {} / {}",
-                        milliseconds(results),
-                        milliseconds(upload),
-                        milliseconds(widgets)
-                    ));
+                    ui.label(milliseconds(stats.max_while_busy))
+                        .on_hover_text(format!(
+                            "Results {}, upload {}, widgets {}",
+                            milliseconds(results),
+                            milliseconds(upload),
+                            milliseconds(widgets)
+                        ));
                     ui.end_row();
                     ui.label("frames");
                     ui.label(stats.frames.to_string());
@@ -512,11 +510,18 @@ fn performance(app: &mut App, ui: &mut egui::Ui) {
                         ui.label("viewport images");
                         ui.label(viewport.images_drawn().to_string());
                         ui.end_row();
-                        ui.label("adapter");
-                        ui.label(viewport.adapter_description());
-                        ui.end_row();
                     }
                 });
+            // Long adapter names wrap at the panel's width instead of widening it.
+            if let Some(viewport) = &app.viewport {
+                ui.add(
+                    egui::Label::new(
+                        egui::RichText::new(format!("Adapter: {}", viewport.adapter_description()))
+                            .small(),
+                    )
+                    .wrap(),
+                );
+            }
             if ui.button("Reset max").clicked() {
                 app.frame_stats.reset_busy_max();
             }
