@@ -598,28 +598,55 @@ fn small_window_keeps_the_toolbar_and_messages_do_not_move_the_controls() {
     );
 }
 
-/// F fits the mesh into each half of the side-by-side view (narrower than tall), not only into
-/// the single view's height (issue 13: it cropped both meshes).
+/// The side-by-side halves are narrower than tall: switching to them fits the mesh into each
+/// half (while the user has not moved the camera), and so does F (issue 13: both meshes were
+/// cropped and F did not fit them).
 #[test]
-fn fit_view_fits_the_side_by_side_halves() {
+fn side_by_side_halves_show_the_whole_mesh() {
     let mut harness = harness_for(bunny());
     settle(&mut harness);
+    let fits_the_halves = |harness: &egui_kittest::Harness<'_, fairmesh::app::App>| {
+        let camera = *harness.state().camera();
+        let rect = harness.state().viewport_rect().unwrap();
+        let aspect = rect.width() / 2.0 / rect.height();
+        assert!(aspect < 1.0);
+        let half_height = camera.distance * (camera.fov_y * 0.5).tan();
+        let half_width = half_height * aspect;
+        assert!(
+            half_width >= camera.scene_radius && half_height >= camera.scene_radius,
+            "the bounding sphere (radius {}) fits in {half_width} × {half_height}",
+            camera.scene_radius
+        );
+    };
     harness.get_by_label("Side by side").click();
     harness.step();
+    harness.step();
+    fits_the_halves(&harness);
+
+    // After an orbit, switching views keeps the user's camera; F fits again.
+    harness.get_by_label("Single").click();
+    harness.step();
+    let fitted = *harness.state().camera();
+    let centre = harness.state().viewport_rect().unwrap().center();
+    harness.hover_at(centre);
+    harness.step();
+    harness.drag_at(centre);
+    harness.step();
+    for i in 1..=4 {
+        harness.hover_at(centre + egui::vec2(15.0 * i as f32, 0.0));
+        harness.step();
+    }
+    harness.drop_at(centre + egui::vec2(60.0, 0.0));
+    harness.step();
+    let orbited = *harness.state().camera();
+    assert_ne!(orbited.yaw, fitted.yaw, "the drag orbited");
+    harness.get_by_label("Side by side").click();
+    harness.step();
+    assert_eq!(*harness.state().camera(), orbited);
     harness.key_press(egui::Key::F);
     harness.step();
     harness.step();
-    let camera = *harness.state().camera();
-    let rect = harness.state().viewport_rect().unwrap();
-    let aspect = rect.width() / 2.0 / rect.height();
-    assert!(aspect < 1.0);
-    let half_width = camera.distance * (camera.fov_y * 0.5).tan() * aspect;
-    let half_height = camera.distance * (camera.fov_y * 0.5).tan();
-    assert!(
-        half_width >= camera.scene_radius && half_height >= camera.scene_radius,
-        "the bounding sphere (radius {}) fits in {half_width} × {half_height}",
-        camera.scene_radius
-    );
+    fits_the_halves(&harness);
 }
 
 /// Every fairing control explains itself in its tooltip (read here as its accessible

@@ -47,7 +47,9 @@ use crate::TriMesh;
 use camera::OrbitCamera;
 use history::History;
 use jobs::{DialogPurpose, Generation, JobCounter, JobResult, JobTicket, SharedProgress, Worker};
-use state::{Document, DocumentSnapshot, HierarchyState, Measures, Settings, ViewMode};
+use state::{
+    CompareView, Document, DocumentSnapshot, HierarchyState, Measures, Settings, ViewMode,
+};
 
 use crate::render::Viewport3d;
 
@@ -206,6 +208,9 @@ pub struct App {
     viewport: Option<Viewport3d>,
     viewport_before: Option<Viewport3d>,
     camera: OrbitCamera,
+    /// The camera as the last fit left it: while the user has not moved it since, switching to
+    /// or from the side-by-side view fits it again (the halves are narrower than tall).
+    fitted_camera: Option<OrbitCamera>,
     shown: Option<Shown>,
     shown_before: Option<Shown>,
     /// Largest heat-map scalar uploaded per slot (the legend's and the colour map's top).
@@ -288,6 +293,7 @@ impl App {
             viewport_before: (cc.wgpu_render_state.as_ref())
                 .map(|s| Viewport3d::new(s, &cc.egui_ctx)),
             camera: OrbitCamera::default(),
+            fitted_camera: None,
             shown: None,
             shown_before: None,
             heat_max: [None; 2],
@@ -598,9 +604,16 @@ impl eframe::App for App {
         // Upload before drawing, so the viewport draws what the panels describe.
         self.sync_viewport();
         let upload_done = Instant::now();
+        let compare = self.settings.compare;
         panels::show(self, ui);
         for command in std::mem::take(&mut self.commands) {
             self.apply(command);
+        }
+        let side_by_side = |view| view == CompareView::SideBySide;
+        if side_by_side(self.settings.compare) != side_by_side(compare)
+            && self.fitted_camera == Some(self.camera)
+        {
+            self.fit_view();
         }
         let widgets_done = Instant::now();
         self.sync_viewport();

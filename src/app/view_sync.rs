@@ -332,5 +332,6 @@ impl App {
             glam::Vec3::from_array(hi),
             aspect,
         );
+        self.fitted_camera = Some(self.camera);
     }
 }
