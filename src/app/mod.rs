@@ -573,7 +573,7 @@ impl App {
                 noisy,
                 clean,
                 against_clean,
-            } => self.on_noised(document, label, noisy, clean, against_clean),
+            } => self.on_noised(document, label, noisy, clean, *against_clean),
             JobResult::Exported {
                 path,
                 result,

@@ -162,7 +162,7 @@ impl App {
         label: String,
         noisy: Arc<TriMesh>,
         clean: Arc<TriMesh>,
-        against_clean: Box<Measures>,
+        against_clean: Measures,
     ) {
         let Some(current) = self.document.as_ref().filter(|d| d.generation == document) else {
             return;
@@ -170,7 +170,7 @@ impl App {
         let mut snapshot = current.snapshot();
         snapshot.mesh = noisy;
         snapshot.clean = Some(clean);
-        snapshot.against_clean = Some(*against_clean);
+        snapshot.against_clean = Some(against_clean);
         snapshot.hierarchy = None;
         snapshot.applied = false;
         self.install(snapshot, Some(label.clone()));
