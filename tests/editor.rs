@@ -9,7 +9,7 @@ use std::path::Path;
 use std::time::{Duration, Instant};
 
 use egui::accesskit::Role;
-use egui_kittest::kittest::Queryable;
+use egui_kittest::kittest::{NodeT, Queryable};
 use egui_kittest::SnapshotOptions;
 
 mod editor_common;
@@ -36,7 +36,7 @@ fn loads_the_bunny_builds_the_hierarchy_and_fairs() {
     assert!(status.shown_vertices > 30_000 && status.shown_faces > 70_000);
     // Per-level counts and the numbers are on screen.
     harness.get_by_label("Level sizes");
-    assert!(harness.query_all_by_label("M0").next().is_some());
+    harness.get_by_label_contains(&format!("levels (M0 … M{})", status.level_count - 1));
     harness.get_by_label("Volume change");
     harness.get_by_label("RMS displacement");
     harness.get_by_label("Hierarchy build");
@@ -66,17 +66,14 @@ fn level_slider_refairs_and_updates_the_numbers() {
     nudge_level_slider(&mut harness);
     settle(&mut harness);
     let after = harness.state().status();
-    let expected = 1.min(top);
+    let expected = (before.level + 1).min(top);
     assert_eq!(after.level, expected);
     if top >= 1 {
         // Starting from a coarser level smooths more: a new result with other numbers.
         assert_ne!(after.faired_serial, before.faired_serial);
         assert_ne!(after.rms_displacement, before.rms_displacement);
         assert!(after.rms_displacement.is_some_and(|r| r > 0.0));
-        assert!(harness
-            .query_all_by_label(&format!("M{expected}"))
-            .next()
-            .is_some());
+        harness.get_by_label(&format!("Result: Constrained fairing from M{expected}"));
         // The slider keeps working while results stream in: several steps, one settle.
         for _ in 0..3 {
             nudge_level_slider(&mut harness);
@@ -84,7 +81,7 @@ fn level_slider_refairs_and_updates_the_numbers() {
         }
         settle(&mut harness);
         let last = harness.state().status();
-        assert_eq!(last.level, 4.min(top));
+        assert_eq!(last.level, (before.level + 4).min(top));
         assert!(last.faired_serial > after.faired_serial);
     }
     // Fair M0 too: another run, the same level.
@@ -337,7 +334,7 @@ fn viewport_snapshots() {
     let mut harness = harness_for(bunny());
     settle(&mut harness);
     // The loaded mesh, so the image does not depend on the fairing algorithm's details.
-    harness.get_by_label("Original").click();
+    harness.get_by_label("Input mesh").click();
     settle(&mut harness);
 
     let shaded = viewport_image(&mut harness);
@@ -391,7 +388,7 @@ fn background_uploads_draw_the_same_images() {
             ..AppOptions::default()
         });
         settle(&mut harness);
-        harness.get_by_label("Original").click();
+        harness.get_by_label("Input mesh").click();
         settle(&mut harness);
         let shaded = viewport_image(&mut harness);
         harness.key_press(egui::Key::W);
@@ -467,6 +464,311 @@ fn meshes_too_big_for_the_gpu_buffers_are_refused_with_a_reason() {
     );
 }
 
+/// Undo and redo across an Open bring back the camera of the document they bring back: the
+/// view shows that mesh, not the place where the other one was (issue 13).
+#[test]
+fn undo_and_redo_across_open_bring_the_documents_camera_back() {
+    let dir = tempfile::tempdir().unwrap();
+    let far = dir.path().join("far.obj");
+    let mut mesh = fairmesh::io::load(bunny()).unwrap().mesh;
+    for p in &mut mesh.positions {
+        *p = [p[0] * 10.0 + 5.0, p[1] * 10.0, p[2] * 10.0 - 3.0];
+    }
+    write_obj(&mesh, &far);
+
+    let mut harness = harness_for(bunny());
+    settle(&mut harness);
+    // The user's own view of the bunny (zoomed in) is part of what comes back.
+    harness.hover_at(harness.state().viewport_rect().unwrap().center());
+    harness.event(egui::Event::MouseWheel {
+        unit: egui::MouseWheelUnit::Point,
+        delta: egui::vec2(0.0, 120.0),
+        phase: egui::TouchPhase::Move,
+        source: egui::MouseWheelSource::Unknown,
+        modifiers: egui::Modifiers::NONE,
+    });
+    for _ in 0..30 {
+        harness.step();
+    }
+    let bunny_camera = *harness.state().camera();
+    harness
+        .state_mut()
+        .push_command(fairmesh::app::Command::Open(far.clone()));
+    settle(&mut harness);
+    let far_camera = *harness.state().camera();
+    assert_ne!(far_camera.target, bunny_camera.target);
+
+    harness.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::Z);
+    settle(&mut harness);
+    assert_eq!(
+        harness.state().status().document.as_deref(),
+        Some(bunny().as_path())
+    );
+    assert_eq!(*harness.state().camera(), bunny_camera, "the bunny's view");
+
+    harness.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::Y);
+    settle(&mut harness);
+    assert_eq!(
+        harness.state().status().document.as_deref(),
+        Some(far.as_path())
+    );
+    assert_eq!(*harness.state().camera(), far_camera, "the far mesh's view");
+}
+
+/// After a slider step the new result is on screen at once while its distances are measured a
+/// moment later: until then the rows that still hold the previous result's numbers are greyed
+/// and say so (issue 13: they sat beside the fresh ones unmarked).
+#[test]
+fn numbers_of_the_previous_result_are_greyed_until_the_new_ones_arrive() {
+    let mut harness = harness_for(bunny());
+    settle(&mut harness);
+    let before = harness.state().status();
+    let (measures, _) = harness.state().faired_measures();
+    let old_mean = format!("{:.3e}", measures.unwrap().mean_distance);
+    assert!(!harness
+        .get_by_label(&old_mean)
+        .accesskit_node()
+        .is_disabled());
+
+    nudge_level_slider(&mut harness);
+    let deadline = Instant::now() + Duration::from_secs(120);
+    while harness.state().status().faired_serial == before.faired_serial {
+        harness.step();
+        std::thread::sleep(Duration::from_millis(2));
+        assert!(Instant::now() < deadline, "no new result came");
+    }
+    // The frame that took the new result drew the panel: its distances are not measured yet
+    // (measuring starts a moment after a result arrives).
+    let stale = harness.get_by_label(&old_mean).accesskit_node();
+    assert!(
+        stale.is_disabled(),
+        "the previous result's number is greyed"
+    );
+    assert!(
+        stale
+            .description()
+            .is_some_and(|d| d.contains("previous result")),
+        "{:?}",
+        stale.description()
+    );
+
+    settle(&mut harness);
+    let (measures, _) = harness.state().faired_measures();
+    let new_mean = format!("{:.3e}", measures.unwrap().mean_distance);
+    assert_ne!(new_mean, old_mean);
+    assert!(!harness
+        .get_by_label(&new_mean)
+        .accesskit_node()
+        .is_disabled());
+}
+
+/// At 800×600 every toolbar control is inside the window (the toolbar wraps), and a status
+/// message or an error does not move the controls under the pointer (issue 13).
+#[test]
+fn small_window_keeps_the_toolbar_and_messages_do_not_move_the_controls() {
+    let bunny = bunny();
+    let mut harness = egui_kittest::Harness::builder()
+        .with_size(egui::vec2(800.0, 600.0))
+        .wgpu()
+        .build_eframe(move |cc| fairmesh::app::App::new_for_test(cc, bunny));
+    settle(&mut harness);
+    for label in ["Level mesh", "Input mesh", "Undo", "Redo"] {
+        let rect = harness.get_by_label(label).rect();
+        assert!(
+            rect.right() <= 800.0 && rect.bottom() <= 600.0,
+            "{label} at {rect:?}"
+        );
+    }
+    let fit = harness.get_by_label("Fit view (F)").rect();
+    let apply = harness
+        .get_by_role_and_label(Role::Button, "Apply result")
+        .rect();
+    harness
+        .state_mut()
+        .push_command(fairmesh::app::Command::Open("missing.obj".into()));
+    settle(&mut harness);
+    assert!(harness.state().status().error.is_some());
+    harness.get_by_label_contains("Could not open the file");
+    assert_eq!(harness.get_by_label("Fit view (F)").rect(), fit);
+    assert_eq!(
+        harness
+            .get_by_role_and_label(Role::Button, "Apply result")
+            .rect(),
+        apply
+    );
+}
+
+/// The side-by-side halves are narrower than tall: switching to them fits the mesh into each
+/// half (while the user has not moved the camera), and so does F (issue 13: both meshes were
+/// cropped and F did not fit them).
+#[test]
+fn side_by_side_halves_show_the_whole_mesh() {
+    let mut harness = harness_for(bunny());
+    settle(&mut harness);
+    let fits_the_halves = |harness: &egui_kittest::Harness<'_, fairmesh::app::App>| {
+        let camera = *harness.state().camera();
+        let rect = harness.state().viewport_rect().unwrap();
+        let aspect = rect.width() / 2.0 / rect.height();
+        assert!(aspect < 1.0);
+        let half_height = camera.distance * (camera.fov_y * 0.5).tan();
+        let half_width = half_height * aspect;
+        assert!(
+            half_width >= camera.scene_radius && half_height >= camera.scene_radius,
+            "the bounding sphere (radius {}) fits in {half_width} × {half_height}",
+            camera.scene_radius
+        );
+    };
+    harness.get_by_label("Side by side").click();
+    harness.step();
+    harness.step();
+    fits_the_halves(&harness);
+
+    // After an orbit, switching views keeps the user's camera; F fits again.
+    harness.get_by_label("Single").click();
+    harness.step();
+    let fitted = *harness.state().camera();
+    let centre = harness.state().viewport_rect().unwrap().center();
+    harness.hover_at(centre);
+    harness.step();
+    harness.drag_at(centre);
+    harness.step();
+    for i in 1..=4 {
+        harness.hover_at(centre + egui::vec2(15.0 * i as f32, 0.0));
+        harness.step();
+    }
+    harness.drop_at(centre + egui::vec2(60.0, 0.0));
+    harness.step();
+    let orbited = *harness.state().camera();
+    assert_ne!(orbited.yaw, fitted.yaw, "the drag orbited");
+    harness.get_by_label("Side by side").click();
+    harness.step();
+    assert_eq!(*harness.state().camera(), orbited);
+    harness.key_press(egui::Key::F);
+    harness.step();
+    harness.step();
+    fits_the_halves(&harness);
+}
+
+/// Every fairing control explains itself in its tooltip (read here as its accessible
+/// description); the ones a baseline method does not use are disabled and say why, and the
+/// numbers name the method instead of a start level it did not use (issue 13).
+#[test]
+fn fairing_controls_explain_themselves_and_say_why_they_are_off() {
+    let bunny = bunny();
+    // Tall enough that the whole side panel is on screen.
+    let mut harness = egui_kittest::Harness::builder()
+        .with_size(egui::vec2(1200.0, 1600.0))
+        .wgpu()
+        .build_eframe(move |cc| fairmesh::app::App::new_for_test(cc, bunny));
+    settle(&mut harness);
+    let description =
+        |harness: &egui_kittest::Harness<'_, fairmesh::app::App>, role: Role, label: &str| {
+            let node = harness.get_by_role_and_label(role, label);
+            let node = node.accesskit_node();
+            (node.description().unwrap_or_default(), node.is_disabled())
+        };
+    use fairmesh::app::panels::tips;
+    let controls = [
+        (Role::Slider, "Start level", tips::START_LEVEL),
+        (
+            Role::Slider,
+            "Iterations per level",
+            tips::ITERATIONS_PER_LEVEL,
+        ),
+        (Role::Slider, "Rounds", tips::ROUNDS),
+        (Role::CheckBox, "Fair M0 too", tips::FAIR_FINEST),
+        (Role::Button, "Apply result", tips::APPLY),
+    ];
+    for (role, label, tip) in controls {
+        let (text, disabled) = description(&harness, role, label);
+        assert_eq!(text, tip, "{label}");
+        assert!(!disabled, "{label}");
+    }
+    for (label, tip) in [
+        ("Method", tips::METHOD),
+        ("Boundary", tips::BOUNDARY),
+        ("Variant", tips::VARIANT),
+    ] {
+        let described = harness
+            .query_all_by(move |node| node.description().as_deref() == Some(tip))
+            .count();
+        assert_eq!(described, 1, "{label} has its tooltip");
+    }
+    let level = harness.state().status().level;
+    harness.get_by_label_contains(&format!("Result: Constrained fairing from M{level}"));
+
+    harness.get_by_label("Method").click();
+    for _ in 0..3 {
+        harness.step();
+    }
+    harness.get_by_label("Laplacian").click();
+    settle(&mut harness);
+    for (role, label) in [
+        (Role::Slider, "Start level"),
+        (Role::CheckBox, "Fair M0 too"),
+    ] {
+        let (text, disabled) = description(&harness, role, label);
+        assert!(disabled, "{label} is off for Laplacian");
+        assert!(
+            text.contains("Not used by Laplacian"),
+            "{label} says why: {text}"
+        );
+    }
+    harness.get_by_label_contains("Result: Laplacian, whole mesh");
+    assert!(harness.query_by_label_contains("from M").is_none());
+}
+
+/// A file opens at a middle start level (level 0 would show the input as the result), and at
+/// the level last chosen for it when it is opened again.
+#[test]
+fn a_file_opens_at_a_middle_level_then_at_the_last_one_chosen() {
+    let mut harness = harness_for(bunny());
+    settle(&mut harness);
+    let status = harness.state().status();
+    assert!(status.level_count >= 3);
+    assert_eq!(status.level, (status.level_count - 1) / 2);
+    assert_eq!(status.faired_level, Some(status.level));
+
+    harness
+        .state_mut()
+        .push_command(fairmesh::app::Command::SetLevel(2));
+    settle(&mut harness);
+    harness
+        .state_mut()
+        .push_command(fairmesh::app::Command::Open(bunny()));
+    settle(&mut harness);
+    let reopened = harness.state().status();
+    assert_eq!(reopened.level, 2);
+    assert_eq!(reopened.faired_level, Some(2));
+}
+
+/// Opening the Performance section does not widen the side panel (issue 13: it widened it for
+/// good, taking the viewport's room).
+#[test]
+fn performance_section_keeps_the_side_panel_width() {
+    let bunny = bunny();
+    let mut harness = egui_kittest::Harness::builder()
+        .with_size(egui::vec2(1200.0, 1600.0))
+        .wgpu()
+        .build_eframe(move |cc| fairmesh::app::App::new_for_test(cc, bunny));
+    settle(&mut harness);
+    let width = harness.state().viewport_rect().unwrap().width();
+    harness.get_by_label("Performance").click();
+    for _ in 0..10 {
+        harness.step();
+    }
+    assert!(
+        harness.query_by_label("UI frame (CPU)").is_some(),
+        "it opened"
+    );
+    assert_eq!(harness.state().viewport_rect().unwrap().width(), width);
+    harness.get_by_label("Performance").click();
+    for _ in 0..10 {
+        harness.step();
+    }
+    assert_eq!(harness.state().viewport_rect().unwrap().width(), width);
+}
+
 /// Writes `mesh` as a minimal OBJ (the test needs a big file before `io::save` can be relied on).
 fn write_obj(mesh: &fairmesh::TriMesh, path: &Path) {
     use std::io::Write;
@@ -521,10 +823,12 @@ fn responsiveness() {
     );
     // The first slider steps right after the hierarchy is ready: the levels' set-up job runs
     // then, and a step's fairing waits behind it on the compute worker.
-    for step in 1..=3 {
-        let (frames, elapsed) = slider_step_to_result(&mut harness, step);
+    // The file opens at a middle level; each step goes one level coarser.
+    let start = harness.state().status().level;
+    for level in start + 1..=start + 3 {
+        let (frames, elapsed) = slider_step_to_result(&mut harness, level);
         println!(
-            "1.2M faces, slider to level {step} just after the hierarchy: new result after \
+            "1.2M faces, slider to level {level} just after the hierarchy: new result after \
              {frames} frames ({:.0} ms)",
             elapsed.as_secs_f64() * 1e3
         );
@@ -534,10 +838,11 @@ fn responsiveness() {
     let mut harness = harness_for(bunny());
     settle(&mut harness);
     let top = harness.state().status().level_count - 1;
-    for step in 1..=top.min(6) {
-        let (frames, elapsed) = slider_step_to_result(&mut harness, step);
+    let start = harness.state().status().level;
+    for level in start + 1..=top.min(start + 6) {
+        let (frames, elapsed) = slider_step_to_result(&mut harness, level);
         println!(
-            "slider to level {step}: new result after {frames} frames ({:.0} ms)",
+            "slider to level {level}: new result after {frames} frames ({:.0} ms)",
             elapsed.as_secs_f64() * 1e3
         );
     }

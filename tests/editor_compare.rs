@@ -95,11 +95,11 @@ fn noise_keeps_the_clean_mesh_and_fairing_gets_closer_to_it() {
     assert!(against_noisy.max_distance >= against_noisy.mean_distance);
 
     // Both columns are on screen.
-    harness.get_by_label("noisy");
+    harness.get_by_label("input");
     harness.get_by_label("clean");
     harness.get_by_label("Mean distance");
     harness.get_by_label("Max distance");
-    harness.get_by_label("Vertex RMS");
+    harness.get_by_label("RMS displacement");
     harness.get_by_label("Barycenter drift");
     harness.get_by_label(&format!("{:.3e}", against_clean.mean_distance));
     harness.step();
@@ -175,6 +175,61 @@ fn undo_restores_the_noisy_mesh_exactly_and_redo_brings_the_result_back() {
     // The hierarchy is ready again and a result is on record.
     let status = harness.state().status();
     assert!(status.hierarchy_ready && status.faired_serial.is_some());
+}
+
+/// "Apply result" makes the result the document, and the view keeps showing exactly that mesh
+/// until a setting changes: the applied mesh is not faired again with the same settings, so
+/// Export writes the mesh the user applied (issue 13: it wrote a mesh faired twice).
+#[test]
+fn an_applied_result_stays_on_screen_and_is_what_export_writes() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut harness = noisy_bunny_faired_from_the_middle();
+    let result = harness.state().faired_positions().unwrap();
+    harness
+        .get_by_role_and_label(Role::Button, "Apply result")
+        .click();
+    settle(&mut harness);
+    let status = harness.state().status();
+    assert!(status.hierarchy_ready, "the applied mesh has its hierarchy");
+    assert_eq!(
+        status.faired_serial, None,
+        "the applied mesh is not faired again"
+    );
+    assert_eq!(
+        &harness.state().document_mesh().unwrap().positions,
+        result.as_ref()
+    );
+
+    let target = dir.path().join("applied.glb");
+    retype(
+        &mut harness,
+        |v| v.ends_with("_faired.obj"),
+        &target.display().to_string(),
+    );
+    harness.key_press(egui::Key::Escape);
+    harness.step();
+    harness.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::E);
+    settle(&mut harness);
+    let written = fairmesh::io::load(&target).unwrap().mesh;
+    assert_eq!(written.positions.len(), result.len());
+    let largest_move = written
+        .positions
+        .iter()
+        .zip(result.iter())
+        .flat_map(|(p, q)| (0..3).map(move |k| (p[k] - q[k]).abs()))
+        .fold(0.0f32, f32::max);
+    assert!(
+        largest_move == 0.0,
+        "the export is the applied mesh (a coordinate differs by {largest_move})"
+    );
+
+    // A changed setting fairs the new document again.
+    let level = harness.state().status().level;
+    harness
+        .state_mut()
+        .push_command(Command::SetLevel(level + 1));
+    settle(&mut harness);
+    assert!(harness.state().status().faired_serial.is_some());
 }
 
 fn snapshot_options() -> egui_kittest::SnapshotOptions {

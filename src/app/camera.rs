@@ -53,14 +53,18 @@ impl OrbitCamera {
         (right, up)
     }
 
-    /// Frames an axis-aligned box (min, max) from the current direction.
-    pub fn fit(&mut self, min: Vec3, max: Vec3) {
+    /// Frames an axis-aligned box (min, max) from the current direction in a view `aspect`
+    /// wide per unit height: the box's bounding sphere fits both the height and the width (a
+    /// side-by-side half is narrower than tall).
+    pub fn fit(&mut self, min: Vec3, max: Vec3, aspect: f32) {
         if !(min.is_finite() && max.is_finite()) {
             return;
         }
         self.target = (min + max) * 0.5;
         self.scene_radius = ((max - min).length() * 0.5).max(1e-6);
-        self.distance = self.scene_radius / (self.fov_y * 0.5).sin() * 1.05;
+        let half_fov_x = ((self.fov_y * 0.5).tan() * aspect.clamp(1e-3, 1e3)).atan();
+        let half_fov = (self.fov_y * 0.5).min(half_fov_x);
+        self.distance = self.scene_radius / half_fov.sin() * 1.05;
     }
 
     /// Rotates by a mouse drag of `delta` points.
@@ -134,7 +138,7 @@ mod tests {
     #[test]
     fn fit_puts_box_centre_in_view_centre() {
         let mut camera = OrbitCamera::default();
-        camera.fit(Vec3::new(-1.0, 2.0, 0.0), Vec3::new(1.0, 4.0, 2.0));
+        camera.fit(Vec3::new(-1.0, 2.0, 0.0), Vec3::new(1.0, 4.0, 2.0), 1.0);
         let centre = camera
             .view_proj(1.0)
             .project_point3(Vec3::new(0.0, 3.0, 1.0));
@@ -144,6 +148,23 @@ mod tests {
         for corner in [Vec3::new(-1.0, 2.0, 0.0), Vec3::new(1.0, 4.0, 2.0)] {
             let p = camera.view_proj(1.0).project_point3(corner);
             assert!(p.x.abs() <= 1.0 && p.y.abs() <= 1.0 && p.z > 0.0 && p.z < 1.0);
+        }
+    }
+
+    #[test]
+    fn fit_in_a_narrow_view_keeps_the_box_inside_its_width() {
+        let (min, max) = (Vec3::new(-1.0, -1.0, -1.0), Vec3::new(1.0, 1.0, 1.0));
+        for aspect in [0.4, 1.0, 2.5] {
+            let mut camera = OrbitCamera::default();
+            camera.fit(min, max, aspect);
+            for x in [-1.0, 1.0] {
+                for y in [-1.0, 1.0] {
+                    for z in [-1.0, 1.0] {
+                        let p = camera.view_proj(aspect).project_point3(Vec3::new(x, y, z));
+                        assert!(p.x.abs() <= 1.0 && p.y.abs() <= 1.0, "{aspect}: {p}");
+                    }
+                }
+            }
         }
     }
 

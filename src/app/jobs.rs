@@ -223,6 +223,8 @@ pub struct Faired {
     /// Root mean square of the vertex displacements against the loaded mesh (model units).
     pub rms_displacement: f64,
     pub elapsed: Duration,
+    /// The method that made it (a baseline ignores the start level).
+    pub method: super::state::MethodSetting,
 }
 
 /// A job's answer to the UI. Each carries the generation it was started under.

@@ -15,6 +15,7 @@ use crate::render::colormap::{legend_ticks, viridis_strip};
 
 pub fn show(app: &mut App, ui: &mut egui::Ui) {
     egui::Panel::top("fairmesh-toolbar").show(ui, |ui| toolbar(app, ui));
+    egui::Panel::bottom("fairmesh-status").show(ui, |ui| status_bar(app, ui));
     egui::Panel::right("fairmesh-controls")
         .resizable(true)
         .default_size(310.0)
@@ -26,7 +27,8 @@ pub fn show(app: &mut App, ui: &mut egui::Ui) {
 
 fn toolbar(app: &mut App, ui: &mut egui::Ui) {
     ui.add_space(4.0);
-    ui.horizontal(|ui| {
+    // Wraps in a narrow window, so that no control ends up off screen.
+    ui.horizontal_wrapped(|ui| {
         if ui
             .button("Open…")
             .on_hover_text("Pick a mesh file (Ctrl+O)")
@@ -63,9 +65,14 @@ fn toolbar(app: &mut App, ui: &mut egui::Ui) {
             .on_hover_text("Draw the edges over the faces (W)");
         ui.separator();
         let mut mode = app.settings.view_mode;
-        ui.selectable_value(&mut mode, ViewMode::Faired, "Faired");
-        ui.selectable_value(&mut mode, ViewMode::Level, "Level mesh");
-        ui.selectable_value(&mut mode, ViewMode::Original, "Original");
+        ui.selectable_value(&mut mode, ViewMode::Faired, "Faired")
+            .on_hover_text("Show the result of the fairing");
+        ui.selectable_value(&mut mode, ViewMode::Level, "Level mesh")
+            .on_hover_text("Show the coarse mesh of the start level, where the fairing begins");
+        ui.selectable_value(&mut mode, ViewMode::Original, "Input mesh")
+            .on_hover_text(
+                "Show the input mesh: as loaded, or as Add noise or Apply result left it",
+            );
         if mode != app.settings.view_mode {
             app.commands.push(Command::SetViewMode(mode));
         }
@@ -96,6 +103,13 @@ fn toolbar(app: &mut App, ui: &mut egui::Ui) {
             ui.small(format!("undo: {label}"));
         }
     });
+    ui.add_space(2.0);
+}
+
+/// Loading, errors and messages, at the bottom of the window: their coming and going does not
+/// move the controls (a click meant for one button would hit another).
+fn status_bar(app: &mut App, ui: &mut egui::Ui) {
+    ui.add_space(2.0);
     if let Some(path) = &app.loading {
         ui.horizontal(|ui| {
             ui.spinner();
@@ -118,6 +132,10 @@ fn toolbar(app: &mut App, ui: &mut egui::Ui) {
     }
     if let Some(message) = &app.message {
         ui.colored_label(egui::Color32::from_rgb(140, 200, 140), message);
+    }
+    if app.loading.is_none() && app.error.is_none() && app.message.is_none() {
+        // The bar keeps its height when there is nothing to say.
+        ui.weak("Ready");
     }
     ui.add_space(2.0);
 }
@@ -146,7 +164,7 @@ fn controls(app: &mut App, ui: &mut egui::Ui) {
     ui.label(name)
         .on_hover_text(document.path.display().to_string());
     ui.label(format!(
-        "Loaded: {} vertices, {} faces",
+        "Input mesh: {} vertices, {} faces",
         document.original.vertex_count(),
         document.original.face_count()
     ));
@@ -169,7 +187,7 @@ fn controls(app: &mut App, ui: &mut egui::Ui) {
 
     if let Some(clean) = &document.clean {
         ui.small(format!(
-            "Noisy; clean reference kept ({} vertices)",
+            "Noise added: the mesh before it is kept as the clean mesh ({} vertices)",
             clean.vertex_count()
         ));
     }
@@ -195,7 +213,10 @@ fn controls(app: &mut App, ui: &mut egui::Ui) {
         });
     if ui
         .button("Add noise")
-        .on_hover_text("Adds noise to the mesh; the mesh before it is kept as the clean reference")
+        .on_hover_text(
+            "Adds noise to the input mesh; the mesh before it is kept as the clean mesh, to \
+             measure how close the result gets to it",
+        )
         .clicked()
     {
         app.commands.push(Command::AddNoise);
@@ -249,88 +270,10 @@ fn controls(app: &mut App, ui: &mut egui::Ui) {
 
     ui.separator();
     ui.heading("Fairing");
-    let ready = document.level_count().is_some();
-    let mut level = document.level;
-    let slider = ui.add_enabled(
-        ready,
-        egui::Slider::new(&mut level, 0..=top_level).text("Start level"),
-    );
-    if slider.changed() {
-        app.commands.push(Command::SetLevel(level));
-    }
-    let before = app.settings.clone();
-    egui::ComboBox::from_label("Method")
-        .selected_text(app.settings.method.label())
-        .show_ui(ui, |ui| {
-            for method in MethodSetting::ALL {
-                ui.selectable_value(&mut app.settings.method, method, method.label());
-            }
-        });
-    let baseline = app.settings.method != MethodSetting::Constrained;
-    if baseline {
-        ui.small("A baseline smooths the mesh itself (no hierarchy): watch the volume change.");
-        ui.add(
-            egui::Slider::new(&mut app.settings.baseline_iterations, 1..=200).text("Iterations"),
-        );
-        if matches!(
-            app.settings.method,
-            MethodSetting::Laplacian | MethodSetting::Taubin
-        ) {
-            ui.add(egui::Slider::new(&mut app.settings.baseline_lambda, 0.05..=1.0).text("Lambda"));
-        }
-    } else {
-        ui.add(
-            egui::Slider::new(&mut app.settings.iterations, 1..=50).text("Iterations per level"),
-        );
-        ui.add(egui::Slider::new(&mut app.settings.rounds, 1..=10).text("Rounds"));
-    }
-    egui::ComboBox::from_label("Boundary")
-        .selected_text(match app.settings.boundary {
-            BoundarySetting::Curve => "Smooth as curve",
-            BoundarySetting::Fixed => "Fixed",
-        })
-        .show_ui(ui, |ui| {
-            ui.selectable_value(
-                &mut app.settings.boundary,
-                BoundarySetting::Curve,
-                "Smooth as curve",
-            );
-            ui.selectable_value(&mut app.settings.boundary, BoundarySetting::Fixed, "Fixed");
-        });
-    ui.checkbox(&mut app.settings.fair_finest, "Fair M0 too");
-    egui::ComboBox::from_label("Variant")
-        .selected_text(match app.settings.variant {
-            VariantSetting::Paper => "Paper",
-            VariantSetting::Improved => "Improved",
-        })
-        .show_ui(ui, |ui| {
-            ui.selectable_value(&mut app.settings.variant, VariantSetting::Paper, "Paper");
-            ui.selectable_value(
-                &mut app.settings.variant,
-                VariantSetting::Improved,
-                "Improved",
-            );
-        });
-    if app.settings.fairing_key() != before.fairing_key() {
-        app.commands.push(Command::Refair);
-    }
-    if app.fair_in_flight {
-        ui.horizontal(|ui| {
-            ui.spinner();
-            ui.label(format!(
-                "fairing … {:.0} %",
-                app.fair_progress.get() * 100.0
-            ));
-        });
-    }
-
-    if ui
-        .add_enabled(document.faired.is_some(), egui::Button::new("Apply result"))
-        .on_hover_text("Make the faired result the document's mesh (undo with Ctrl+Z)")
-        .clicked()
-    {
-        app.commands.push(Command::ApplyResult);
-    }
+    fairing_controls(app, ui, top_level);
+    let Some(document) = &app.document else {
+        return;
+    };
 
     ui.separator();
     ui.heading("Export");
@@ -411,17 +354,26 @@ fn controls(app: &mut App, ui: &mut egui::Ui) {
     let against_document = faired.and_then(|f| f.against_document.as_ref());
     let against_clean = faired.and_then(|f| f.against_clean.as_ref());
     let has_clean = document.clean.is_some();
+    let (lo, hi) = document.bounds;
+    let diagonal = ((0..3).map(|k| (hi[k] - lo[k]).powi(2)).sum::<f32>()).sqrt() as f64;
+    ui.label(match faired {
+        Some(f) => format!("Result: {}", f.method.describe(f.level)),
+        None => "Result: none yet".to_owned(),
+    });
     egui::Grid::new("fairmesh-measures")
         .num_columns(if has_clean { 3 } else { 2 })
         .striped(true)
         .show(ui, |ui| {
             ui.strong("Result vs.");
-            ui.strong(if has_clean { "noisy" } else { "loaded" });
+            ui.strong("input")
+                .on_hover_text("The input mesh: the mesh the result was smoothed from");
             if has_clean {
-                ui.strong("clean");
+                ui.strong("clean")
+                    .on_hover_text("The clean mesh: the input mesh before noise was added");
             }
             ui.end_row();
             type Row = fn(&Measures) -> String;
+            let percent = |v: f64| format!("{v:+.4} %");
             let rows: [(&str, Row); 5] = [
                 ("Volume change", |m| {
                     m.volume_change_percent
@@ -429,7 +381,7 @@ fn controls(app: &mut App, ui: &mut egui::Ui) {
                 }),
                 ("Mean distance", |m| format!("{:.3e}", m.mean_distance)),
                 ("Max distance", |m| format!("{:.3e}", m.max_distance)),
-                ("Vertex RMS", |m| {
+                ("RMS displacement", |m| {
                     m.vertex_rms.map_or("–".into(), |v| format!("{v:.3e}"))
                 }),
                 ("Barycenter drift", |m| {
@@ -437,18 +389,50 @@ fn controls(app: &mut App, ui: &mut egui::Ui) {
                         .map_or("–".into(), |v| format!("{v:.3e}"))
                 }),
             ];
+            // Volume change and RMS displacement against the input come with the result
+            // itself; the other numbers are measured a moment later. Until then they are the
+            // previous result's: greyed, and saying so.
+            let fresh = |name: &str| -> Option<(String, String)> {
+                let f = faired?;
+                match name {
+                    "Volume change" => Some((percent(f.volume_change * 100.0), String::new())),
+                    "RMS displacement" => Some((
+                        format!("{:.3e}", f.rms_displacement),
+                        format!(
+                            "{:.3} % of the bounding box diagonal",
+                            f.rms_displacement / diagonal.max(f64::MIN_POSITIVE) * 100.0
+                        ),
+                    )),
+                    _ => None,
+                }
+            };
+            let pending = faired.is_some_and(|f| f.measures_pending);
+            let value = |ui: &mut egui::Ui, text: String| {
+                let label = ui.add_enabled(!pending, egui::Label::new(text));
+                if pending {
+                    label.on_hover_text(PENDING_TIP);
+                }
+            };
             for (name, row) in rows {
                 ui.label(name);
-                ui.label(against_document.map_or("–".into(), row));
+                match fresh(name) {
+                    Some((text, tip)) if tip.is_empty() => {
+                        ui.label(text);
+                    }
+                    Some((text, tip)) => {
+                        ui.label(text).on_hover_text(tip);
+                    }
+                    None => value(ui, against_document.map_or("–".into(), row)),
+                }
                 if has_clean {
-                    ui.label(against_clean.map_or("–".into(), row));
+                    value(ui, against_clean.map_or("–".into(), row));
                 }
                 ui.end_row();
             }
-            if let Some(noisy) = &document.against_clean {
-                ui.label("Noisy vs. clean");
-                ui.label(format!("{:.3e}", noisy.mean_distance))
-                    .on_hover_text("mean surface distance of the noisy mesh from the clean one");
+            if let Some(noise) = &document.against_clean {
+                ui.label("Noise");
+                ui.label(format!("{:.3e}", noise.mean_distance))
+                    .on_hover_text("Mean distance of the input mesh from the clean mesh");
                 ui.end_row();
             }
         });
@@ -462,20 +446,6 @@ fn controls(app: &mut App, ui: &mut egui::Ui) {
             ui.end_row();
             ui.label("Shown faces");
             ui.label(app.shown_counts.1.to_string());
-            ui.end_row();
-            ui.label("RMS displacement");
-            let (lo, hi) = document.bounds;
-            let diagonal = ((0..3).map(|k| (hi[k] - lo[k]).powi(2)).sum::<f32>()).sqrt();
-            ui.label(faired.map_or("–".into(), |f| {
-                format!(
-                    "{:.3e} ({:.3} % of diagonal)",
-                    f.rms_displacement,
-                    f.rms_displacement / diagonal.max(f32::MIN_POSITIVE) as f64 * 100.0
-                )
-            }));
-            ui.end_row();
-            ui.label("Faired from");
-            ui.label(faired.map_or("–".into(), |f| format!("M{}", f.level)));
             ui.end_row();
             ui.label("Load time");
             ui.label(seconds(document.load_time));
@@ -524,16 +494,14 @@ fn performance(app: &mut App, ui: &mut egui::Ui) {
                     ));
                     ui.end_row();
                     ui.label("max while working");
-                    ui.label(milliseconds(stats.max_while_busy));
-                    ui.end_row();
-                    ui.label("  results / upload / widgets");
                     let [results, upload, widgets] = stats.max_while_busy_parts;
-                    ui.label(format!(
-                        "{} / {} / {}",
-                        milliseconds(results),
-                        milliseconds(upload),
-                        milliseconds(widgets)
-                    ));
+                    ui.label(milliseconds(stats.max_while_busy))
+                        .on_hover_text(format!(
+                            "Results {}, upload {}, widgets {}",
+                            milliseconds(results),
+                            milliseconds(upload),
+                            milliseconds(widgets)
+                        ));
                     ui.end_row();
                     ui.label("frames");
                     ui.label(stats.frames.to_string());
@@ -542,11 +510,18 @@ fn performance(app: &mut App, ui: &mut egui::Ui) {
                         ui.label("viewport images");
                         ui.label(viewport.images_drawn().to_string());
                         ui.end_row();
-                        ui.label("adapter");
-                        ui.label(viewport.adapter_description());
-                        ui.end_row();
                     }
                 });
+            // Long adapter names wrap at the panel's width instead of widening it.
+            if let Some(viewport) = &app.viewport {
+                ui.add(
+                    egui::Label::new(
+                        egui::RichText::new(format!("Adapter: {}", viewport.adapter_description()))
+                            .small(),
+                    )
+                    .wrap(),
+                );
+            }
             if ui.button("Reset max").clicked() {
                 app.frame_stats.reset_busy_max();
             }
@@ -617,7 +592,7 @@ fn viewport(app: &mut App, ui: &mut egui::Ui) {
     let after_name = match app.settings.view_mode {
         ViewMode::Faired => "After (faired)",
         ViewMode::Level => "Level mesh",
-        ViewMode::Original => "Document mesh",
+        ViewMode::Original => "Input mesh",
     };
     match app.settings.compare {
         CompareView::Single => {
@@ -751,7 +726,7 @@ fn view_bar(app: &mut App, ui: &mut egui::Ui) {
             app.settings.compare == CompareView::Single,
             egui::Button::selectable(app.show_before, "Before (B)"),
         )
-        .on_hover_text("Show the document's mesh instead of the result (B)")
+        .on_hover_text("Show the input mesh instead of the result (B)")
         .clicked()
         .then(|| app.show_before = !app.show_before);
         ui.checkbox(&mut app.settings.heat_map, "Heat map (H)")
@@ -764,11 +739,7 @@ fn view_bar(app: &mut App, ui: &mut egui::Ui) {
             ui.selectable_value(
                 &mut app.settings.heat_reference,
                 HeatReference::Document,
-                if has_clean {
-                    "noisy mesh"
-                } else {
-                    "loaded mesh"
-                },
+                "input mesh",
             );
             ui.add_enabled(
                 has_clean,
@@ -799,7 +770,7 @@ fn heat_legend(ui: &mut egui::Ui, viewport: egui::Rect, top: f32, reference: Hea
             .show(ui, |ui| {
                 let title = match reference {
                     HeatReference::Clean => "Distance to the clean mesh (model units)",
-                    HeatReference::Document => "Distance to the document mesh (model units)",
+                    HeatReference::Document => "Distance to the input mesh (model units)",
                 };
                 ui.label(
                     egui::RichText::new(title)
@@ -864,6 +835,173 @@ fn tick_text(value: f64, spacing: f64) -> String {
     let decimals = (-spacing.log10().floor()).max(0.0) as usize;
     format!("{value:.decimals$}")
 }
+
+/// The fairing section: start level, method and its options, Apply. Every control says in its
+/// tooltip what it does and when to change it; the ones the chosen method does not use are
+/// disabled and say why.
+fn fairing_controls(app: &mut App, ui: &mut egui::Ui, top_level: usize) {
+    let Some(document) = &app.document else {
+        return;
+    };
+    let ready = document.level_count().is_some();
+    let method = app.settings.method;
+    let not_for_baseline = (!method.uses_hierarchy()).then(|| {
+        format!(
+            "Not used by {}: it smooths the whole input mesh at once, without the hierarchy.",
+            method.label()
+        )
+    });
+    let level_off = match (&not_for_baseline, ready) {
+        (Some(why), _) => Some(why.clone()),
+        (None, false) => Some("Waiting for the hierarchy to be built.".to_owned()),
+        (None, true) => None,
+    };
+    let mut level = document.level;
+    let slider = ui.add_enabled(
+        level_off.is_none(),
+        egui::Slider::new(&mut level, 0..=top_level).text("Start level"),
+    );
+    if explain(slider, tips::START_LEVEL, level_off.as_deref()).changed() {
+        app.commands.push(Command::SetLevel(level));
+    }
+    let applied = document.applied;
+    let before = app.settings.clone();
+    let settings = &mut app.settings;
+    let combo = egui::ComboBox::from_label("Method")
+        .selected_text(settings.method.label())
+        .show_ui(ui, |ui| {
+            for method in MethodSetting::ALL {
+                ui.selectable_value(&mut settings.method, method, method.label());
+            }
+        });
+    explain(combo.response, tips::METHOD, None);
+    if method.uses_hierarchy() {
+        let iterations = ui
+            .add(egui::Slider::new(&mut settings.iterations, 1..=50).text("Iterations per level"));
+        explain(iterations, tips::ITERATIONS_PER_LEVEL, None);
+        let rounds = ui.add(egui::Slider::new(&mut settings.rounds, 1..=10).text("Rounds"));
+        explain(rounds, tips::ROUNDS, None);
+    } else {
+        ui.small("A baseline smooths the mesh itself (no hierarchy): watch the volume change.");
+        let iterations = ui
+            .add(egui::Slider::new(&mut settings.baseline_iterations, 1..=200).text("Iterations"));
+        explain(iterations, tips::BASELINE_ITERATIONS, None);
+        if matches!(method, MethodSetting::Laplacian | MethodSetting::Taubin) {
+            let lambda =
+                ui.add(egui::Slider::new(&mut settings.baseline_lambda, 0.05..=1.0).text("Lambda"));
+            explain(lambda, tips::LAMBDA, None);
+        }
+    }
+    let boundary = egui::ComboBox::from_label("Boundary")
+        .selected_text(match settings.boundary {
+            BoundarySetting::Curve => "Smooth as curve",
+            BoundarySetting::Fixed => "Fixed",
+        })
+        .show_ui(ui, |ui| {
+            ui.selectable_value(
+                &mut settings.boundary,
+                BoundarySetting::Curve,
+                "Smooth as curve",
+            );
+            ui.selectable_value(&mut settings.boundary, BoundarySetting::Fixed, "Fixed");
+        });
+    explain(boundary.response, tips::BOUNDARY, None);
+    let hierarchy_only = not_for_baseline.is_none();
+    let fair_finest = ui.add_enabled(
+        hierarchy_only,
+        egui::Checkbox::new(&mut settings.fair_finest, "Fair M0 too"),
+    );
+    explain(fair_finest, tips::FAIR_FINEST, not_for_baseline.as_deref());
+    let variant = ui.add_enabled_ui(hierarchy_only, |ui| {
+        egui::ComboBox::from_label("Variant")
+            .selected_text(match settings.variant {
+                VariantSetting::Paper => "Paper",
+                VariantSetting::Improved => "Improved",
+            })
+            .show_ui(ui, |ui| {
+                ui.selectable_value(&mut settings.variant, VariantSetting::Paper, "Paper");
+                ui.selectable_value(&mut settings.variant, VariantSetting::Improved, "Improved");
+            })
+            .response
+    });
+    explain(variant.inner, tips::VARIANT, not_for_baseline.as_deref());
+    if app.settings.fairing_key() != before.fairing_key() {
+        app.commands.push(Command::Refair);
+    }
+    if app.fair_in_flight {
+        ui.horizontal(|ui| {
+            ui.spinner();
+            ui.label(format!(
+                "fairing … {:.0} %",
+                app.fair_progress.get() * 100.0
+            ));
+        });
+    }
+    if applied {
+        ui.small(
+            "Showing the applied result as it is. Change the start level or an option to fair \
+             it again.",
+        );
+    }
+    let has_result = app.document.as_ref().is_some_and(|d| d.faired.is_some());
+    let apply = ui.add_enabled(has_result, egui::Button::new("Apply result"));
+    if explain(
+        apply,
+        tips::APPLY,
+        (!has_result).then_some("There is no result to apply yet."),
+    )
+    .clicked()
+    {
+        app.commands.push(Command::ApplyResult);
+    }
+}
+
+/// Shows `tip` on hover; when the control is disabled, shows `tip` and why it is off. The text
+/// is the control's accessible description either way (screen readers, tests).
+fn explain(response: egui::Response, tip: &str, off_because: Option<&str>) -> egui::Response {
+    match off_because {
+        Some(why) if !response.enabled() => {
+            let text = format!("{tip}\n\n{why}");
+            response
+                .on_hover_text(text.clone())
+                .on_disabled_hover_text(text)
+        }
+        _ => response.on_hover_text(tip),
+    }
+}
+
+/// The fairing controls' tooltips: what each does and when to change it, in plain words.
+pub mod tips {
+    pub const START_LEVEL: &str = "How coarse a version of the mesh the smoothing starts from \
+        (M0 is the mesh itself). Higher: smoother, bigger bumps go. Lower: more of the detail \
+        stays. Raise it until the noise is gone; lower it if wanted features melt away.";
+    pub const METHOD: &str = "Constrained fairing (the paper's method) smooths without \
+        shrinking the mesh. The others are classic smoothers to compare with: watch the volume \
+        change under Numbers.";
+    pub const ITERATIONS_PER_LEVEL: &str = "Smoothing passes on each level on the way back to \
+        full detail. More: a little smoother and slower. The start level matters far more: \
+        change this last.";
+    pub const ROUNDS: &str = "How often each level's smoothing starts over from where it got \
+        to. More: a little smoother and slower; 1 is usually enough.";
+    pub const BASELINE_ITERATIONS: &str = "Smoothing passes over the whole mesh. More: \
+        smoother, and (for Laplacian) more shrinkage.";
+    pub const LAMBDA: &str = "How far each pass moves a vertex towards its neighbours (0 to \
+        1). Higher: faster smoothing, more shrinkage.";
+    pub const BOUNDARY: &str = "What happens to open borders (holes, cut edges). Smooth as \
+        curve: the border line is smoothed too. Fixed: border vertices stay where they are; use \
+        it when the mesh must still meet another part.";
+    pub const FAIR_FINEST: &str = "Also smooth the full-detail mesh (M0) at the end. On: the \
+        finest noise goes too. Off: the finest detail stays as it was.";
+    pub const VARIANT: &str = "Paper: the method as published. Improved: two corrections that \
+        keep the shape from drifting and shrinking over the levels. Keep Improved unless you \
+        compare with the paper.";
+    pub const APPLY: &str = "Make the result the input mesh, to add noise to it, fair it \
+        again or export it as it is (undo with Ctrl+Z).";
+}
+
+/// What a greyed number in the Numbers panel means.
+const PENDING_TIP: &str =
+    "From the previous result: the result on screen is being measured, its numbers follow";
 
 fn noise_mode_name(mode: NoiseMode) -> &'static str {
     match mode {

@@ -63,6 +63,21 @@ impl MethodSetting {
             MethodSetting::Hc => "HC Laplacian",
         }
     }
+
+    /// Whether the method works over the hierarchy (start level, Fair M0, variant apply).
+    pub fn uses_hierarchy(self) -> bool {
+        self == MethodSetting::Constrained
+    }
+
+    /// What a result of this method from `start_level` is, in words ("from M4" means nothing
+    /// to a baseline, which smooths the whole input mesh).
+    pub fn describe(self, start_level: usize) -> String {
+        if self.uses_hierarchy() {
+            format!("{} from M{start_level}", self.label())
+        } else {
+            format!("{}, whole mesh", self.label())
+        }
+    }
 }
 
 /// What the viewport shows.
@@ -131,6 +146,9 @@ pub struct Settings {
     pub levels_folder: String,
     pub levels_from: usize,
     pub levels_to: usize,
+    /// The start level last chosen for each file, most recent last (at most
+    /// [`Settings::REMEMBERED_FILES`]): a file opens at the level the user left it at.
+    pub start_levels: Vec<(PathBuf, usize)>,
 }
 
 impl Default for Settings {
@@ -159,12 +177,38 @@ impl Default for Settings {
             levels_folder: String::new(),
             levels_from: 0,
             levels_to: usize::MAX,
+            start_levels: Vec::new(),
         }
     }
 }
 
 impl Settings {
     pub const STORAGE_KEY: &'static str = "fairmesh.settings";
+    pub const REMEMBERED_FILES: usize = 64;
+
+    /// The start level to open `path` at, with `level_count` levels: the one last chosen for
+    /// it, or a middle level (level 0 would show the input unchanged as the result).
+    pub fn start_level_for(&self, path: &Path, level_count: usize) -> usize {
+        let top = level_count.saturating_sub(1);
+        self.start_levels
+            .iter()
+            .rev()
+            .find(|(remembered, _)| remembered == path)
+            .map_or(top / 2, |&(_, level)| level)
+            .min(top)
+    }
+
+    /// Remembers `level` as the start level chosen for `path`.
+    pub fn remember_start_level(&mut self, path: &Path, level: usize) {
+        self.start_levels
+            .retain(|(remembered, _)| remembered != path);
+        self.start_levels.push((path.to_path_buf(), level));
+        let excess = self
+            .start_levels
+            .len()
+            .saturating_sub(Self::REMEMBERED_FILES);
+        self.start_levels.drain(..excess);
+    }
 
     /// The settings that change the fairing result (a change means: run again).
     #[allow(clippy::type_complexity)]
@@ -321,6 +365,7 @@ impl Measures {
 pub struct FairedResult {
     pub positions: Arc<Vec<[f32; 3]>>,
     pub level: usize,
+    pub method: MethodSetting,
     pub volume_change: f64,
     pub rms_displacement: f64,
     pub elapsed: Duration,
@@ -362,6 +407,12 @@ pub struct Document {
     pub export_path: String,
     /// The file the mesh was loaded from: Export writes it back with the new positions.
     pub source: Arc<crate::io::Source>,
+    /// The mesh is an applied result: it is shown and exported as it is, not faired again with
+    /// the settings that made it, until the user changes the start level or a fairing option.
+    pub applied: bool,
+    /// The file was just opened: once the hierarchy is ready, the start level is the one
+    /// remembered for the file, or a middle one.
+    pub pick_start_level: bool,
 }
 
 impl Document {
@@ -390,6 +441,8 @@ impl Document {
             faired: None,
             level_mesh: None,
             export_path,
+            applied: false,
+            pick_start_level: false,
         }
     }
 
@@ -428,6 +481,11 @@ pub struct DocumentSnapshot {
     pub source: Arc<crate::io::Source>,
     /// The hierarchy, its build time, and whether its M0 has the mesh's triangles.
     pub hierarchy: Option<(Arc<Hierarchy>, Duration, bool)>,
+    /// See [`Document::applied`].
+    pub applied: bool,
+    /// The view of this document when it was left (set by the app, which owns the camera), so
+    /// that undo and redo across an Open bring back the view with the mesh.
+    pub camera: Option<super::camera::OrbitCamera>,
 }
 
 fn mesh_bytes(mesh: &TriMesh) -> usize {
@@ -473,6 +531,8 @@ impl Document {
                 } => Some((hierarchy.clone(), *build_time, *base_matches_original)),
                 _ => None,
             },
+            applied: self.applied,
+            camera: None,
         }
     }
 
@@ -506,6 +566,8 @@ impl Document {
             level_mesh: None,
             export_path: snapshot.export_path,
             source: snapshot.source,
+            applied: snapshot.applied,
+            pick_start_level: false,
         }
     }
 }
@@ -576,6 +638,32 @@ mod tests {
         let partial: Settings = serde_json::from_str(r#"{"rounds": 3}"#).unwrap();
         assert_eq!(partial.rounds, 3);
         assert_eq!(partial.iterations, Settings::default().iterations);
+    }
+
+    #[test]
+    fn start_level_is_the_files_last_choice_or_a_middle_one() {
+        let mut settings = Settings::default();
+        let (bunny, scan) = (Path::new("/a/bunny.obj"), Path::new("/b/scan.ply"));
+        assert_eq!(settings.start_level_for(bunny, 20), 9);
+        assert_eq!(settings.start_level_for(bunny, 1), 0);
+        settings.remember_start_level(bunny, 3);
+        settings.remember_start_level(scan, 12);
+        settings.remember_start_level(bunny, 5);
+        assert_eq!(settings.start_level_for(bunny, 20), 5);
+        assert_eq!(
+            settings.start_level_for(scan, 8),
+            7,
+            "clamped to the levels there are"
+        );
+        for i in 0..Settings::REMEMBERED_FILES {
+            settings.remember_start_level(&PathBuf::from(format!("/c/{i}.obj")), 1);
+        }
+        assert_eq!(settings.start_levels.len(), Settings::REMEMBERED_FILES);
+        assert_eq!(
+            settings.start_level_for(bunny, 20),
+            9,
+            "the oldest are forgotten"
+        );
     }
 
     #[test]

@@ -1,0 +1,85 @@
+//! CPU time the UI thread spends per frame, for the Performance section and `--log-frames`.
+
+use std::collections::VecDeque;
+use std::time::Duration;
+
+/// CPU time the UI thread spent per frame, for the performance readout.
+#[derive(Default)]
+pub struct FrameStats {
+    recent: VecDeque<Duration>,
+    /// Longest frame while a background job was running.
+    pub max_while_busy: Duration,
+    /// That frame split into applying results, uploading to the GPU, and drawing widgets.
+    pub max_while_busy_parts: [Duration; 3],
+    pub frames: u64,
+    /// Frames over this are printed to standard error (`AppOptions::log_frames_over`).
+    pub(super) log_over: Option<Duration>,
+    /// The main viewport's image count at the last frame (to tell whether it drew since).
+    pub(super) images_seen: u64,
+}
+
+impl FrameStats {
+    const WINDOW: usize = 240;
+
+    /// Records one frame: its CPU time in `App::ui`, that split into applying results, uploading
+    /// and widgets, and the CPU time of the viewport's last offscreen draw (recorded in the
+    /// previous frame's paint callback, which runs after `App::ui` returns).
+    pub(super) fn record(
+        &mut self,
+        elapsed: Duration,
+        parts: [Duration; 3],
+        render: Duration,
+        busy: bool,
+    ) {
+        if let Some(limit) = self.log_over {
+            if elapsed > limit || render > limit {
+                let ms = |d: Duration| d.as_secs_f64() * 1e3;
+                eprintln!(
+                    "frame {}: {:.1} ms UI CPU (results {:.1}, upload {:.1}, widgets {:.1}), \
+                     previous viewport draw {:.1} ms{}",
+                    self.frames,
+                    ms(elapsed),
+                    ms(parts[0]),
+                    ms(parts[1]),
+                    ms(parts[2]),
+                    ms(render),
+                    if busy { ", working" } else { "" }
+                );
+            }
+        }
+        if self.recent.len() == Self::WINDOW {
+            self.recent.pop_front();
+        }
+        self.recent.push_back(elapsed);
+        if busy && elapsed > self.max_while_busy {
+            self.max_while_busy = elapsed;
+            self.max_while_busy_parts = parts;
+        }
+        self.frames += 1;
+    }
+
+    /// Frame statistics that print frames over `limit` to standard error.
+    pub(super) fn logging_over(limit: Option<Duration>) -> Self {
+        Self {
+            log_over: limit,
+            ..Self::default()
+        }
+    }
+
+    pub fn last(&self) -> Duration {
+        self.recent.back().copied().unwrap_or_default()
+    }
+    pub fn mean(&self) -> Duration {
+        if self.recent.is_empty() {
+            return Duration::ZERO;
+        }
+        self.recent.iter().sum::<Duration>() / self.recent.len() as u32
+    }
+    pub fn max(&self) -> Duration {
+        self.recent.iter().max().copied().unwrap_or_default()
+    }
+    pub fn reset_busy_max(&mut self) {
+        self.max_while_busy = Duration::ZERO;
+        self.max_while_busy_parts = [Duration::ZERO; 3];
+    }
+}

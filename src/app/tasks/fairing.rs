@@ -1,0 +1,247 @@
+//! Fairing the document from the start level (or a baseline method), and the level meshes of
+//! the level view, on the compute worker: launch and result.
+
+use std::sync::{Arc, PoisonError};
+use std::time::{Duration, Instant};
+
+use crate::app::jobs::{Faired, JobResult};
+use crate::app::state::{FairedResult, HierarchyState, ViewMode};
+use crate::app::tasks::measure::MeasureRequest;
+use crate::app::App;
+use crate::multires;
+use crate::{hierarchy, metrics, TriMesh};
+
+impl App {
+    /// Asks for what the current view mode needs at the current level and options.
+    pub(in crate::app) fn refresh_view(&mut self) {
+        let Some(document) = &self.document else {
+            return;
+        };
+        let HierarchyState::Ready { hierarchy, .. } = &document.hierarchy else {
+            return;
+        };
+        let hierarchy = hierarchy.clone();
+        let level = document.level;
+        let document_generation = document.generation;
+        let applied = document.applied;
+        let view = self.view_generation.bump();
+        match self.settings.view_mode {
+            ViewMode::Level => self.request_level_mesh(hierarchy, document_generation, level, view),
+            // An applied result is shown as it is until a setting changes.
+            ViewMode::Faired | ViewMode::Original if applied => {}
+            ViewMode::Faired | ViewMode::Original => {
+                self.request_fairing(hierarchy, document_generation, level, view)
+            }
+        }
+    }
+
+    pub(in crate::app) fn request_fairing(
+        &mut self,
+        hierarchy: Arc<hierarchy::Hierarchy>,
+        document: u64,
+        level: usize,
+        view: u64,
+    ) {
+        let options = self.settings.multires_options(level);
+        let baseline = self.settings.baseline_options();
+        let method = self.settings.method;
+        let document_generation = self.document_generation.clone();
+        let progress_out = self.fair_progress.clone();
+        let workspace = self.workspace.clone();
+        let (tx, ctx, ticket) = (self.results_tx.clone(), self.ctx.clone(), self.jobs.start());
+        self.fair_in_flight = true;
+        self.fair_view = view;
+        self.fair_progress.set(0.0);
+        self.compute.submit_latest("fair", move || {
+            if !document_generation.is_current(document) {
+                return;
+            }
+            let started = Instant::now();
+            // A newer slider value does not cancel this run: while dragging, finished runs are
+            // what keeps the view moving. Only a new document makes it pointless.
+            let mut progress = |fraction: f32| {
+                progress_out.set(fraction);
+                document_generation.is_current(document)
+            };
+            let positions = match &baseline {
+                // A baseline smooths the document's mesh itself; the level does not apply.
+                Some(method) => {
+                    let mut mesh = hierarchy.base_mesh().clone();
+                    let topology = crate::Topology::build(&mesh);
+                    crate::fairing::fair(&mut mesh, &topology, method);
+                    progress(1.0);
+                    Some(mesh.positions)
+                }
+                None => {
+                    let mut workspace = workspace.lock().unwrap_or_else(PoisonError::into_inner);
+                    multires::fair_multires(&hierarchy, &options, &mut workspace, &mut progress)
+                }
+            };
+            let result = positions.map(|positions| {
+                let (volume_change, rms_displacement) =
+                    compare_to_base(hierarchy.base_mesh(), &positions);
+                Faired {
+                    positions,
+                    volume_change,
+                    rms_displacement,
+                    elapsed: started.elapsed(),
+                    method,
+                }
+            });
+            let message = JobResult::Faired {
+                document,
+                view,
+                level,
+                result,
+            };
+            Self::send_result(&tx, &ctx, message, ticket);
+        });
+    }
+
+    pub(in crate::app) fn request_level_mesh(
+        &mut self,
+        hierarchy: Arc<hierarchy::Hierarchy>,
+        document: u64,
+        level: usize,
+        view: u64,
+    ) {
+        let document_generation = self.document_generation.clone();
+        let (tx, ctx, ticket) = (self.results_tx.clone(), self.ctx.clone(), self.jobs.start());
+        self.compute.submit_latest("level", move || {
+            if !document_generation.is_current(document) {
+                return;
+            }
+            let mesh = Arc::new(hierarchy.level_mesh(level));
+            let message = JobResult::LevelMesh {
+                document,
+                view,
+                level,
+                mesh,
+            };
+            Self::send_result(&tx, &ctx, message, ticket);
+        });
+    }
+
+    /// A fairing finished: its result goes on screen unless a newer one is there.
+    pub(in crate::app) fn on_faired(
+        &mut self,
+        document: u64,
+        view: u64,
+        level: usize,
+        result: Option<Faired>,
+    ) {
+        // The newest fairing asked for has answered (a view change to the level mesh
+        // since does not make it any less finished).
+        if view >= self.fair_view {
+            self.fair_in_flight = false;
+        }
+        let Some(current) = self.document.as_mut().filter(|d| d.generation == document) else {
+            return;
+        };
+        // Older than what is on screen: stale.
+        if view <= self.applied_view {
+            return;
+        }
+        if let Some(faired) = result {
+            self.applied_view = view;
+            self.next_serial += 1;
+            // The previous result's measures stay on screen until this one's arrive.
+            let previous = current.faired.take();
+            let positions = Arc::new(faired.positions);
+            current.faired = Some(FairedResult {
+                positions: positions.clone(),
+                level,
+                method: faired.method,
+                volume_change: faired.volume_change,
+                rms_displacement: faired.rms_displacement,
+                elapsed: faired.elapsed,
+                serial: self.next_serial,
+                against_document: previous.as_ref().and_then(|p| p.against_document.clone()),
+                against_clean: previous.and_then(|p| p.against_clean),
+                measure_time: Duration::ZERO,
+                measures_pending: true,
+            });
+            self.measure_wanted = Some(MeasureRequest {
+                document,
+                serial: self.next_serial,
+                positions,
+                arrived: Instant::now(),
+            });
+        }
+    }
+
+    /// A level mesh for the level view arrived.
+    pub(in crate::app) fn on_level_mesh(
+        &mut self,
+        document: u64,
+        view: u64,
+        level: usize,
+        mesh: Arc<TriMesh>,
+    ) {
+        let Some(current) = self.document.as_mut().filter(|d| d.generation == document) else {
+            return;
+        };
+        if view <= self.applied_level_view {
+            return;
+        }
+        self.applied_level_view = view;
+        current.level_mesh = Some((level, mesh));
+    }
+}
+
+/// Relative volume change and RMS vertex displacement of `positions` against `base`.
+fn compare_to_base(base: &TriMesh, positions: &[[f32; 3]]) -> (f64, f64) {
+    if positions.len() != base.positions.len() || positions.is_empty() {
+        return (f64::NAN, f64::NAN);
+    }
+    let before = metrics::signed_volume(base);
+    let after_mesh = TriMesh {
+        positions: positions.to_vec(),
+        triangles: base.triangles.clone(),
+    };
+    let after = metrics::signed_volume(&after_mesh);
+    let volume_change = if before.abs() > 0.0 {
+        (after - before) / before.abs()
+    } else {
+        f64::NAN
+    };
+    let sum_squared: f64 = positions
+        .iter()
+        .zip(&base.positions)
+        .map(|(p, q)| {
+            (0..3)
+                .map(|k| (p[k] as f64 - q[k] as f64).powi(2))
+                .sum::<f64>()
+        })
+        .sum();
+    (volume_change, (sum_squared / positions.len() as f64).sqrt())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn displacement_and_volume_of_identical_meshes_are_zero() {
+        let mesh = TriMesh::new(
+            vec![
+                [0.0, 0.0, 0.0],
+                [1.0, 0.0, 0.0],
+                [0.0, 1.0, 0.0],
+                [0.0, 0.0, 1.0],
+            ],
+            vec![[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]],
+        );
+        let (dv, rms) = compare_to_base(&mesh, &mesh.positions);
+        assert_eq!(dv, 0.0);
+        assert_eq!(rms, 0.0);
+        let moved: Vec<_> = mesh
+            .positions
+            .iter()
+            .map(|p| [p[0] + 0.5, p[1], p[2]])
+            .collect();
+        let (dv, rms) = compare_to_base(&mesh, &moved);
+        assert!(dv.abs() < 1e-12, "translation keeps the volume");
+        assert!((rms - 0.5).abs() < 1e-12);
+    }
+}
