@@ -146,7 +146,13 @@ fn main() {
             fair(
                 &mut faired,
                 &topology,
-                &MethodOptions::Constrained(FairOptions::default().with_variant(variant)),
+                &MethodOptions::Constrained(
+                    FairOptions::default()
+                        .with_variant(variant)
+                        .with_rounds(1)
+                        .with_creases(None)
+                        .with_tangential_relaxation(0.0),
+                ),
             );
             let moves: Vec<f64> = clean
                 .positions
@@ -192,6 +198,8 @@ fn main() {
                             .with_iterations(10)
                             .with_rounds(rounds)
                             .with_variant(variant)
+                            .with_creases(None)
+                            .with_tangential_relaxation(0.0)
                             .with_boundary(BoundaryMode::Curve)
                             .with_tolerance(0.0),
                     ),

@@ -45,8 +45,21 @@ fn run() -> Result<(), Box<dyn std::error::Error>> {
     report("noisy (0.3 mean edge lengths)", &clean, &noisy);
 
     let mut once = noisy.clone();
-    fair_constrained(&mut once, &loaded.topology, &FairOptions::default());
+    let options = FairOptions::default().with_rounds(1);
+    fair_constrained(&mut once, &loaded.topology, &options);
     report("constrained fairing, 1 round", &clean, &once);
+
+    // The default estimates the noise and picks the rounds itself.
+    let mut auto = noisy.clone();
+    let chosen = fair_constrained(&mut auto, &loaded.topology, &FairOptions::default());
+    report(
+        &format!(
+            "constrained fairing, default ({} rounds)",
+            chosen.rounds_run
+        ),
+        &clean,
+        &auto,
+    );
 
     let mut five = noisy.clone();
     let options = FairOptions::default().with_rounds(5);

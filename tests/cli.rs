@@ -298,7 +298,16 @@ fn fair_measures_distances_only_when_asked() {
     let dir = tempfile::tempdir().unwrap();
     let output = dir.path().join("faired.ply");
     let input = data("mushroom_open.obj");
-    let args = ["fair", &input, "-o", output.to_str().unwrap(), "--json"];
+    // One round asked for: the clean input would otherwise be left as it is (nothing to measure).
+    let args = [
+        "fair",
+        &input,
+        "-o",
+        output.to_str().unwrap(),
+        "--json",
+        "--rounds",
+        "1",
+    ];
     let plain = json_of(&args);
     assert!(plain["volume_change_percent"].is_number());
     for key in ["mean_surface_distance", "hausdorff", "rms"] {
@@ -368,7 +377,8 @@ fn dash_reads_standard_input_and_writes_standard_output_in_the_named_format() {
     .status
     .success());
     let out = fairmesh_with_input(
-        &["fair", "-", "-o", "-", "--format", "ply"],
+        // One round: the clean input would otherwise be left as it is.
+        &["fair", "-", "-o", "-", "--format", "ply", "--rounds", "1"],
         &std::fs::read(&ply).unwrap(),
     );
     assert!(
@@ -431,4 +441,49 @@ fn dash_without_format_or_with_json_on_stdout_is_a_clear_error() {
     let out = fairmesh(&["compare", "-", &data("elephant.obj")]);
     assert_eq!(out.status.code(), Some(1));
     assert!(String::from_utf8_lossy(&out.stderr).contains("standard input"));
+}
+
+#[test]
+fn fair_leaves_a_clean_mesh_alone_and_says_how_noisy_the_input_was() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = |name: &str| dir.path().join(name).to_string_lossy().into_owned();
+    let input = data("bunny00.obj");
+    // Clean: no round, the positions as they were.
+    let clean = json_of(&["fair", &input, "-o", &path("clean.obj"), "--json"]);
+    assert_eq!(clean["rounds_run"], 0, "{clean}");
+    let estimate = clean["noise_estimate"].as_f64().unwrap();
+    assert!(estimate < 0.04, "{clean}");
+    let before = fairmesh::io::load(&input).unwrap().mesh;
+    let after = fairmesh::io::load(path("clean.obj")).unwrap().mesh;
+    assert_eq!(before.positions, after.positions);
+    // Noisy: the estimate reads about the noise added, and rounds run until it is mostly gone.
+    let noisy = fairmesh(&["noise", &input, "-o", &path("noisy.obj"), "--sigma", "0.3"]);
+    assert!(noisy.status.success());
+    let faired = json_of(&["fair", &path("noisy.obj"), "-o", &path("f.obj"), "--json"]);
+    let estimate = faired["noise_estimate"].as_f64().unwrap();
+    assert!((0.2..0.4).contains(&estimate), "{faired}");
+    let rounds = faired["rounds_run"].as_u64().unwrap();
+    assert!((2..60).contains(&rounds), "{faired}");
+    // Explicit rounds are exactly what they say; the paper's variant is one round, no creases.
+    let two = json_of(&[
+        "fair",
+        &path("noisy.obj"),
+        "-o",
+        &path("2.obj"),
+        "--json",
+        "--rounds",
+        "2",
+    ]);
+    assert_eq!(two["rounds_run"], 2, "{two}");
+    let paper = json_of(&[
+        "fair",
+        &path("noisy.obj"),
+        "-o",
+        &path("p.obj"),
+        "--json",
+        "--variant",
+        "paper",
+    ]);
+    assert_eq!(paper["rounds_run"], 1, "{paper}");
+    assert_eq!(paper["crease_edges"], 0, "{paper}");
 }

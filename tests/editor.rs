@@ -232,7 +232,8 @@ fn export_writes_an_artists_file_back_with_its_materials_groups_and_uvs() {
     assert_eq!(kept(&before), kept(&after));
     assert_ne!(before, after, "the faired shape was written");
 
-    // Exported as GLB, the editor says what GLB does not keep of the OBJ.
+    // Exported as GLB, the editor says what it carried over (the UVs) and what GLB does not keep
+    // of the OBJ (its materials, among others).
     retype(
         &mut harness,
         |v| v.ends_with("_faired.obj"),
@@ -245,7 +246,9 @@ fn export_writes_an_artists_file_back_with_its_materials_groups_and_uvs() {
     assert!(dir.path().join("as.glb").is_file());
     let message = harness.state().status().message.unwrap_or_default();
     assert!(
-        message.contains("Note") && message.contains("texture coordinates"),
+        message.contains("Note")
+            && message.contains("with its UVs")
+            && message.contains("materials"),
         "{message}"
     );
 }
