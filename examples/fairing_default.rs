@@ -108,19 +108,23 @@ fn main() {
                 ),
                 &measure(&clean, &input, &faired, edge),
             );
-            for weight in [0.25, 0.5] {
-                let mut relaxed = input.clone();
-                let options = FairOptions::default().with_tangential_relaxation(weight);
-                let report = fair_constrained(&mut relaxed, &topology, &options);
-                print(
-                    &name,
-                    label,
-                    &format!("tangential {weight}: {} rounds", report.rounds_run),
-                    &measure(&clean, &input, &relaxed, edge),
-                );
-            }
+            let mut normal_only = input.clone();
+            let options = FairOptions::default().with_tangential_relaxation(0.0);
+            let report = fair_constrained(&mut normal_only, &topology, &options);
+            print(
+                &name,
+                label,
+                &format!(
+                    "default without tangential relaxation: {} rounds",
+                    report.rounds_run
+                ),
+                &measure(&clean, &input, &normal_only, edge),
+            );
             let mut old = input.clone();
-            let old_options = FairOptions::default().with_rounds(1).with_creases(None);
+            let old_options = FairOptions::default()
+                .with_rounds(1)
+                .with_creases(None)
+                .with_tangential_relaxation(0.0);
             fair_constrained(&mut old, &topology, &old_options);
             print(
                 &name,
@@ -129,7 +133,10 @@ fn main() {
                 &measure(&clean, &input, &old, edge),
             );
             if trace && mode.is_some() {
-                let options = FairOptions::default().with_rounds(1).with_creases(None);
+                let options = FairOptions::default()
+                    .with_rounds(1)
+                    .with_creases(None)
+                    .with_tangential_relaxation(0.0);
                 let mut fairing =
                     ConstrainedFairing::new(&input, &topology, options.variant, options.boundary);
                 let mut current = input.clone();

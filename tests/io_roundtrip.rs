@@ -749,3 +749,31 @@ fn readers_and_writers_round_trip_every_format_in_memory() {
     io::write_to(&mut text, &mesh, Format::Gltf).unwrap();
     assert!(String::from_utf8_lossy(&text).contains("data:application/octet-stream;base64,"));
 }
+
+#[test]
+fn triangles_facing_the_wrong_way_are_flipped_on_load_with_a_warning() {
+    // An octahedron (outward) with two faces written the other way round.
+    let text = "v 1 0 0\nv -1 0 0\nv 0 1 0\nv 0 -1 0\nv 0 0 1\nv 0 0 -1\n\
+                f 1 3 5\nf 3 2 5\nf 2 5 4\nf 4 1 5\nf 3 1 6\nf 2 3 6\nf 4 2 6\nf 6 4 1\n";
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("flipped.obj");
+    std::fs::write(&path, text).unwrap();
+    let loaded = fairmesh::io::load(&path).unwrap();
+    assert_eq!(loaded.topology.inconsistent_edges, 0);
+    assert!(
+        loaded
+            .report
+            .warnings
+            .iter()
+            .any(|w| w.contains("2 triangles faced the other way")),
+        "{:?}",
+        loaded.report.warnings
+    );
+    let volume = fairmesh::metrics::signed_volume(&loaded.mesh);
+    assert!((volume - 4.0 / 3.0).abs() < 1e-6, "volume {volume}");
+    // Written back, the file keeps its own faces: only positions change.
+    let out = dir.path().join("out.obj");
+    fairmesh::io::save_with_source(&out, &loaded.mesh, &loaded.source).unwrap();
+    let written = std::fs::read_to_string(&out).unwrap();
+    assert!(written.contains("f 2 5 4") && written.contains("f 6 4 1"));
+}

@@ -25,7 +25,7 @@
 //! - Feature edges that form small groups (fewer than [`CreaseOptions::min_edges`] edges joined at
 //!   their ends) are dropped, and so are groups that zigzag (more than one corner per two edges):
 //!   noise and single spikes of a scan make those, while a crease runs straight between a few
-//!   corners.
+//!   corners (for this test a corner is where the edges themselves turn sharply).
 //! - A crease vertex has exactly two feature edges whose crease directions (the cross product of
 //!   each edge's two filtered face normals: on a noisy crease the vertices zigzag, the faces on
 //!   either side do not) turn by less than [`CreaseOptions::corner_turn_degrees`]; any other vertex with feature edges is a corner (the
@@ -257,11 +257,14 @@ pub fn detect_creases(mesh: &TriMesh, topology: &Topology, options: &CreaseOptio
     let max_turn = options.corner_turn_degrees.to_radians().cos();
     let min_edges = options.min_edges;
     let edges = keep_groups(edges, vertex_count, None, |edges, _| edges >= min_edges);
-    let (_, _, class) = classify(topology, &edges, &directions, max_turn);
+    // The zigzag test turns by the edges' positions: noise that lines up into a fake crease
+    // zigzags there, while the faces' crease directions may still agree.
+    let (_, _, class) = classify(topology, &edges, Turn::Positions(mesh), max_turn);
     let edges = keep_groups(edges, vertex_count, Some(&class), |edges, corners| {
         2 * corners <= edges
     });
-    let (offsets, adjacent, class) = classify(topology, &edges, &directions, max_turn);
+    let (offsets, adjacent, class) =
+        classify(topology, &edges, Turn::Directions(&directions), max_turn);
     let feature_neighbors =
         |v: u32| &adjacent[offsets[v as usize] as usize..offsets[v as usize + 1] as usize];
 
@@ -327,11 +330,19 @@ pub fn detect_creases(mesh: &TriMesh, topology: &Topology, options: &CreaseOptio
     }
 }
 
+/// How the turn at a vertex with two feature edges is measured.
+enum Turn<'a> {
+    /// Between the edges themselves (from the vertex positions).
+    Positions(&'a TriMesh),
+    /// Between the edges' crease directions (from their faces' filtered normals).
+    Directions(&'a HashMap<[u32; 2], DVec3>),
+}
+
 /// The feature neighbours of every vertex (CSR offsets and entries) and every vertex's class.
 fn classify(
     topology: &Topology,
     edges: &[[u32; 2]],
-    directions: &HashMap<[u32; 2], DVec3>,
+    turn: Turn,
     max_turn: f64,
 ) -> (Vec<u32>, Vec<u32>, Vec<FeatureClass>) {
     let vertex_count = topology.vertex_count();
@@ -357,10 +368,20 @@ fn classify(
                 [] => FeatureClass::Smooth,
                 _ if topology.is_boundary_vertex(v as u32) => FeatureClass::Corner,
                 &[a, b] => {
-                    // The turn between the two edges' crease directions (their signs are arbitrary).
-                    let key = |u: u32| [u.min(v as u32), u.max(v as u32)];
-                    let (da, db) = (directions[&key(a)], directions[&key(b)]);
-                    if da.dot(db).abs() >= max_turn {
+                    let straight = match &turn {
+                        Turn::Positions(mesh) => {
+                            let x = mesh.point(v as u32);
+                            let incoming = (x - mesh.point(a)).normalize_or_zero();
+                            let outgoing = (mesh.point(b) - x).normalize_or_zero();
+                            incoming.dot(outgoing)
+                        }
+                        // The signs of crease directions are arbitrary.
+                        Turn::Directions(directions) => {
+                            let key = |u: u32| [u.min(v as u32), u.max(v as u32)];
+                            directions[&key(a)].dot(directions[&key(b)]).abs()
+                        }
+                    };
+                    if straight >= max_turn {
                         FeatureClass::Crease
                     } else {
                         FeatureClass::Corner

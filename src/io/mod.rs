@@ -342,7 +342,27 @@ fn finish_with_map(mut mesh: TriMesh, options: &LoadOptions) -> (Loaded, Option<
     }
     report.removed_degenerate_faces = cleaned.removed_degenerate_faces;
     report.removed_unreferenced_vertices = cleaned.removed_unreferenced_vertices;
-    let topology = Topology::build(&mesh);
+    let mut topology = Topology::build(&mesh);
+    if topology.inconsistent_edges > 0 {
+        // Neighbouring triangles facing opposite ways: orient each component consistently (the
+        // file itself keeps its own faces when it is written back; only positions change).
+        let oriented = mesh::orient_consistently(&mut mesh, &topology);
+        if oriented.flipped_faces > 0 {
+            report.warnings.push(format!(
+                "{} triangles faced the other way from their neighbours and were flipped, in {} \
+                 part(s), so that volume and normals mean something",
+                oriented.flipped_faces, oriented.reoriented_components
+            ));
+            topology = Topology::build(&mesh);
+        }
+        if oriented.non_orientable_components > 0 {
+            report.warnings.push(format!(
+                "{} part(s) cannot be oriented (like a Moebius strip): they are faired without \
+                 keeping to their normals, and their volume means nothing",
+                oriented.non_orientable_components
+            ));
+        }
+    }
     if !topology.non_manifold_edges.is_empty() {
         let [a, b] = topology.non_manifold_edges[0];
         report.warnings.push(format!(

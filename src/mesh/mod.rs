@@ -12,6 +12,7 @@
 mod clean;
 #[cfg(test)]
 pub(crate) mod fixtures;
+mod orient;
 mod reorder;
 pub mod shapes;
 mod subdivide;
@@ -19,6 +20,7 @@ mod topology;
 
 pub use clean::{clean, weld, CleanReport, WeldReport};
 pub(crate) use clean::{clean_with_map, weld_with_map, PositionHasher};
+pub use orient::{orient_consistently, OrientReport};
 pub use reorder::{breadth_first_order, inverse_permutation};
 pub use subdivide::subdivide_loop;
 pub use topology::{ComponentInfo, Topology};
