@@ -97,6 +97,14 @@ pub fn resample_closed(corners: &[[f64; 2]], count: usize) -> Vec<[f64; 2]> {
     points
 }
 
+/// [`extrusion`] of `outline` sampled about every `spacing`: as many side rows as fit in
+/// `height`, as many cap rings as fit in `cap_radius`.
+fn prism(outline: &[[f64; 2]], height: f64, spacing: f64, cap_radius: f64) -> TriMesh {
+    let layers = (height / spacing).round() as usize;
+    let rings = (cap_radius / spacing).round() as usize;
+    extrusion(outline, height, layers, rings)
+}
+
 /// A box of `size` (x, y, z) with sides sampled about every `spacing`.
 pub fn cuboid(size: [f64; 3], spacing: f64) -> TriMesh {
     let square = [
@@ -107,9 +115,7 @@ pub fn cuboid(size: [f64; 3], spacing: f64) -> TriMesh {
     ];
     let perimeter = 2.0 * (size[0] + size[1]);
     let outline = resample_closed(&square, (perimeter / spacing).round() as usize);
-    let layers = (size[2] / spacing).round() as usize;
-    let rings = (size[0].min(size[1]) / 2.0 / spacing).round() as usize;
-    extrusion(&outline, size[2], layers, rings)
+    prism(&outline, size[2], spacing, size[0].min(size[1]) / 2.0)
 }
 
 /// A closed cylinder of `radius` and `height`, sampled about every `spacing`.
@@ -121,13 +127,7 @@ pub fn cylinder(radius: f64, height: f64, spacing: f64) -> TriMesh {
             [radius * a.cos(), radius * a.sin()]
         })
         .collect();
-    let layers = (height / spacing).round() as usize;
-    extrusion(
-        &outline,
-        height,
-        layers,
-        (radius / spacing).round() as usize,
-    )
+    prism(&outline, height, spacing, radius)
 }
 
 /// A spur gear: `teeth` trapezoidal teeth between `root` and `tip` radius, `height` thick.
@@ -148,8 +148,7 @@ pub fn gear(teeth: usize, root: f64, tip: f64, height: f64, spacing: f64) -> Tri
         })
         .sum();
     let outline = resample_closed(&corners, (perimeter / spacing).round() as usize);
-    let layers = (height / spacing).round() as usize;
-    extrusion(&outline, height, layers, (root / spacing).round() as usize)
+    prism(&outline, height, spacing, root)
 }
 
 /// A D-shaped prism: a half-disc of `radius` on a rectangle `2·radius` wide and `depth` deep,
@@ -164,13 +163,7 @@ pub fn d_prism(radius: f64, depth: f64, height: f64, spacing: f64) -> TriMesh {
     corners.dedup();
     let perimeter = std::f64::consts::PI * radius + 2.0 * (radius + depth) + 2.0 * radius;
     let outline = resample_closed(&corners, (perimeter / spacing).round() as usize);
-    let layers = (height / spacing).round() as usize;
-    extrusion(
-        &outline,
-        height,
-        layers,
-        (radius / spacing).round() as usize,
-    )
+    prism(&outline, height, spacing, radius)
 }
 
 #[cfg(test)]
