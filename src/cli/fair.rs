@@ -60,12 +60,12 @@ pub struct FairArgs {
     /// noise is estimated and rounds run until most of it is gone (none on a clean mesh).
     #[arg(long)]
     pub rounds: Option<usize>,
-    /// Constrained only: edges where the surface folds by more than this many degrees are kept
-    /// sharp (faired along the crease; corners stay).
+    /// Constrained normal-projected only: edges where the surface folds by more than this many
+    /// degrees are kept sharp (faired along the crease; corners stay).
     #[arg(long, default_value_t = fairmesh::fairing::creases::DEFAULT_CREASE_ANGLE,
           conflicts_with = "no_creases")]
     pub crease_angle: f64,
-    /// Constrained only: fair across sharp edges too, as the paper does.
+    /// Constrained normal-projected only: fair across sharp edges too, as the paper does.
     #[arg(long)]
     pub no_creases: bool,
     /// Constrained normal-projected only: how much each iteration also evens out the triangles
@@ -114,26 +114,23 @@ impl FairArgs {
         };
         match self.method {
             MethodArg::Constrained => {
-                // `--variant paper` is the paper's method: one round, no creases, no tangential
-                // relaxation, unless those are asked for.
-                let paper = self.variant == VariantArg::Paper;
-                let mut options =
-                    FairOptions::default()
-                        .with_iterations(self.iterations)
-                        .with_tolerance(self.tolerance * mean_edge_length)
-                        .with_boundary(boundary)
-                        .with_tangential_relaxation(if paper { 0.0 } else { self.tangential })
-                        .with_creases((!self.no_creases && !paper).then(|| {
+                // `--variant paper` is the paper's method (`FairOptions::paper`): one round, no
+                // creases, no tangential relaxation; --crease-angle, --no-creases and
+                // --tangential do not apply to it, --rounds does.
+                let base = match self.variant {
+                    VariantArg::Paper => FairOptions::paper(),
+                    VariantArg::NormalProjected => FairOptions::default()
+                        .with_tangential_relaxation(self.tangential)
+                        .with_creases((!self.no_creases).then(|| {
                             CreaseOptions::default().with_angle_degrees(self.crease_angle)
-                        }))
-                        .with_variant(match self.variant {
-                            VariantArg::Paper => FairVariant::Paper,
-                            VariantArg::NormalProjected => FairVariant::NormalProjected,
-                        });
-                match self.rounds {
-                    Some(rounds) => options = options.with_rounds(rounds),
-                    None if paper => options = options.with_rounds(1),
-                    None => {}
+                        })),
+                };
+                let mut options = base
+                    .with_iterations(self.iterations)
+                    .with_tolerance(self.tolerance * mean_edge_length)
+                    .with_boundary(boundary);
+                if let Some(rounds) = self.rounds {
+                    options = options.with_rounds(rounds);
                 }
                 MethodOptions::Constrained(options)
             }

@@ -24,12 +24,24 @@
 //! along the move; the midpoint fan approximates it without a third pass over the mesh (see
 //! [`constrained`]).
 //!
-//! So the default keeps vertices where they belong (texture coordinates, per-vertex attributes and
-//! triangle shapes stay meaningful, and rounds do not accumulate drift), comes as close or closer
-//! to the clean surface, keeps the volume as well, and costs a fan normal per vertex in the same
-//! two passes. [`FairVariant::Paper`] remains available and is the faster of the two. The
+//! So the projection keeps vertices where they belong (texture coordinates, per-vertex attributes
+//! and triangle shapes stay meaningful, and rounds do not accumulate drift), comes as close or
+//! closer to the clean surface, keeps the volume as well, and costs a fan normal per vertex in the
+//! same two passes. [`FairVariant::Paper`] remains available and is the faster of the two. The
 //! measurements behind this (`examples/fairing_quality.rs`) are in the repository's
 //! `docs/measurements.md`; `docs/paper.md` is the reading of the paper this follows.
+//!
+//! # What the default adds to the projected operator
+//! [`FairOptions::default`] also
+//! - picks its number of rounds from the mesh's estimated noise and leaves a clean mesh as it is
+//!   ([`Strength::Auto`], [`strength`]);
+//! - keeps sharp creases as curves with fixed corners ([`creases`]);
+//! - adds a small tangential relaxation (weight [`DEFAULT_TANGENTIAL_RELAXATION`]) so that noise
+//!   that moved vertices along the surface comes out too. This one does move vertices along the
+//!   surface (unlike the projection alone); `with_tangential_relaxation(0.0)` turns it off.
+//!
+//! [`FairOptions::paper`] is the paper's method with none of these
+//! (`examples/fairing_default.rs` prints the table behind them).
 //!
 //! Both variants use the paper's uniform weights, so the local matrices depend on the valence
 //! triple alone and are precomputed once per topology.

@@ -4,9 +4,11 @@
 //! Not in the paper, which leaves the number of iterations to the user. Measured here: the
 //! iterations within a round hardly matter (a round settles after 5 to 10), the rounds do, and
 //! the best count differs from mesh to mesh (2, 5 and 40-60 rounds on three scans), while a clean
-//! mesh should not be touched at all. So the default measures the noise before and after every
-//! round and stops when the noise that is left has fallen to a fraction of what there was, or
-//! below what clean meshes show; a clean mesh gets no round at all.
+//! mesh should not be touched at all. So the default measures the noise before fairing (at or
+//! below [`CLEAN_NOISE`] it does nothing) and after every round, and stops once a round lowers the
+//! estimate by less than 10 % ([`MIN_NOISE_FALL`]; in the measurements this ends after 5 to 11
+//! rounds), once the estimate is below [`NOISE_LEFT`] of the input's, or after
+//! [`MAX_AUTO_ROUNDS`].
 //!
 //! The estimate, per vertex v with a closed fan: h_v = n_v · (m_v − x_v), the normal component of
 //! the umbrella vector (m_v the mean of v's neighbours, n_v the area-weighted normal). On a clean
@@ -74,8 +76,8 @@ pub fn estimate_noise(mesh: &TriMesh, topology: &Topology) -> Option<f64> {
     Some(1.4826 * *median / NOISE_GAIN / edge)
 }
 
-/// Below this estimate a mesh counts as clean and automatic fairing leaves it alone (mean edge
-/// lengths; clean scans and CAD parts measure 0.002 to 0.03, see `docs/measurements.md`).
+/// At or below this estimate a mesh counts as clean and automatic fairing leaves it alone (mean
+/// edge lengths; clean scans and CAD parts measure 0.000 to 0.035, see `docs/measurements.md`).
 pub const CLEAN_NOISE: f64 = 0.04;
 
 /// Automatic fairing stops once the estimate has fallen to this fraction of where it started.
@@ -87,7 +89,7 @@ pub const MIN_NOISE_FALL: f64 = 0.9;
 /// At most this many rounds in automatic mode.
 pub const MAX_AUTO_ROUNDS: usize = 60;
 
-/// Bilateral normal-filter passes crease detection gets for a mesh with this noise estimate: none
+/// Normal-filter passes crease detection gets for a mesh with this noise estimate: none
 /// for a clean mesh, more the noisier it is.
 pub fn normal_filtering_for(noise: f64) -> usize {
     if noise <= CLEAN_NOISE {
