@@ -439,9 +439,25 @@ fn box_distance_sq(node: &BvhNode, p: DVec3) -> f64 {
 }
 
 /// Closest point to `p` on triangle (a, b, c), by the Voronoi regions of its corners and edges.
+/// Degenerate triangles (two corners at one point, or all three on a line) give a point of the
+/// triangle too, never NaN.
 pub fn closest_point_on_triangle(p: DVec3, a: DVec3, b: DVec3, c: DVec3) -> DVec3 {
+    // The parameter along an edge; an edge of length zero has its one point at 0.
+    let ratio = |x: f64, y: f64| if y == 0.0 { 0.0 } else { x / y };
     let ab = b - a;
     let ac = c - a;
+    let scale = ab.length_squared().max(ac.length_squared());
+    if ab.cross(ac).length_squared() <= 1e-24 * scale * scale {
+        // No area: the closest point of its three edges.
+        let on_segment = |x: DVec3, y: DVec3| {
+            let e = y - x;
+            x + e * ratio((p - x).dot(e), e.length_squared()).clamp(0.0, 1.0)
+        };
+        return [on_segment(a, b), on_segment(b, c), on_segment(c, a)]
+            .into_iter()
+            .min_by(|x, y| (*x - p).length_squared().total_cmp(&(*y - p).length_squared()))
+            .unwrap_or(a);
+    }
     let ap = p - a;
     let d1 = ab.dot(ap);
     let d2 = ac.dot(ap);
@@ -456,7 +472,7 @@ pub fn closest_point_on_triangle(p: DVec3, a: DVec3, b: DVec3, c: DVec3) -> DVec
     }
     let vc = d1 * d4 - d3 * d2;
     if vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0 {
-        return a + ab * (d1 / (d1 - d3));
+        return a + ab * ratio(d1, d1 - d3);
     }
     let cp = p - c;
     let d5 = ab.dot(cp);
@@ -466,24 +482,13 @@ pub fn closest_point_on_triangle(p: DVec3, a: DVec3, b: DVec3, c: DVec3) -> DVec
     }
     let vb = d5 * d2 - d1 * d6;
     if vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0 {
-        return a + ac * (d2 / (d2 - d6));
+        return a + ac * ratio(d2, d2 - d6);
     }
     let va = d3 * d6 - d5 * d4;
     if va <= 0.0 && (d4 - d3) >= 0.0 && (d5 - d6) >= 0.0 {
-        return b + (c - b) * ((d4 - d3) / ((d4 - d3) + (d5 - d6)));
+        return b + (c - b) * ratio(d4 - d3, (d4 - d3) + (d5 - d6));
     }
     let denom = va + vb + vc;
-    if denom.abs() < f64::MIN_POSITIVE {
-        // Degenerate triangle: fall back to the closest of its edges' endpoints.
-        return [a, b, c]
-            .into_iter()
-            .min_by(|x, y| {
-                (*x - p)
-                    .length_squared()
-                    .total_cmp(&(*y - p).length_squared())
-            })
-            .unwrap_or(a);
-    }
     let v = vb / denom;
     let w = vc / denom;
     a + ab * v + ac * w
@@ -528,6 +533,22 @@ mod tests {
         );
         let on_hypotenuse = closest_point_on_triangle(DVec3::new(1.0, 1.0, 0.0), a, b, c);
         assert!((on_hypotenuse - DVec3::new(0.5, 0.5, 0.0)).length() < 1e-15);
+    }
+
+    #[test]
+    fn degenerate_triangles_give_a_point_on_them_not_nan() {
+        // Two corners at one point: the triangle is the segment a-c.
+        let (a, c) = (DVec3::ZERO, DVec3::X);
+        for p in [DVec3::new(0.5, 1.0, 0.0), DVec3::new(-1.0, 0.0, 2.0), DVec3::Y] {
+            for (x, y, z) in [(a, a, c), (a, c, a), (c, a, a)] {
+                let q = closest_point_on_triangle(p, x, y, z);
+                assert!(q.is_finite(), "{p} on ({x}, {y}, {z}) gave {q}");
+                let expected = DVec3::new(p.x.clamp(0.0, 1.0), 0.0, 0.0);
+                assert!((q - expected).length() < 1e-12, "{p}: {q} vs {expected}");
+            }
+        }
+        // All three corners at one point.
+        assert_eq!(closest_point_on_triangle(DVec3::Y, a, a, a), a);
     }
 
     #[test]

@@ -290,3 +290,69 @@ fn fixed_boundary_stays_fixed_in_multires_from_every_level() {
         }
     }
 }
+
+/// Mean surface distance from `reference` of multires from `level` of a hierarchy of `mesh`
+/// built with or without creases.
+fn multires_distance(reference: &TriMesh, mesh: &TriMesh, creases: bool, level: usize) -> f64 {
+    let mut options = HierarchyOptions::default();
+    if !creases {
+        options = options.with_creases(None);
+    }
+    let h = build_hierarchy(mesh, &options, &mut NoProgress).unwrap();
+    let positions = fair_multires(
+        &h,
+        &MultiresOptions::default().with_start_level(level),
+        &mut MultiresWorkspace::new(),
+        &mut NoProgress,
+    )
+    .unwrap();
+    let result = TriMesh::new(positions, mesh.triangles.clone());
+    metrics::compare(reference, &result).mean_surface_distance
+}
+
+#[test]
+fn a_coarse_level_of_a_box_keeps_its_edges_and_corners() {
+    let clean = fairmesh::mesh::shapes::cuboid([2.0, 1.0, 0.5], 0.05);
+    let h = build(&clean);
+    assert_eq!(h.level_creases(0).unwrap().counts().1, 8);
+    for level in [2, 4, h.coarsest_level()] {
+        let creases = h.level_creases(level).unwrap();
+        // The eight corners never collapse, the twelve edges stay chains between them.
+        assert_eq!(creases.counts().1, 8, "level {level}");
+        assert_eq!(creases.chains.len(), 12, "level {level}");
+        assert!(creases.chains.iter().all(|c| !c.closed));
+    }
+    // Multires from level 4 leaves a clean box nearly as it was; without creases it rounds the
+    // edges (measured: 0.0004 against 0.0115).
+    let kept = multires_distance(&clean, &clean, true, 4);
+    let rounded = multires_distance(&clean, &clean, false, 4);
+    assert!(kept < 0.2 * rounded, "{kept} vs {rounded} without creases");
+    // With noise, the creases help too (measured: 0.0048 against 0.0078).
+    let mut noisy = clean.clone();
+    add_noise(&mut noisy, &NoiseOptions::default().with_sigma(0.3));
+    let kept = multires_distance(&clean, &noisy, true, 4);
+    let rounded = multires_distance(&clean, &noisy, false, 4);
+    assert!(kept < 0.8 * rounded, "{kept} vs {rounded} without creases");
+}
+
+#[test]
+fn multires_of_a_noisy_gear_from_its_coarsest_level_leaves_no_face_without_area() {
+    // Its noisy creases zigzag and form small loops; both once made split vertices land on
+    // their neighbours (20 faces with no area from the coarsest level).
+    let mut gear = fairmesh::mesh::shapes::gear(12, 0.8, 1.0, 0.4, 0.04);
+    add_noise(&mut gear, &NoiseOptions::default().with_sigma(0.3));
+    let h = build(&gear);
+    assert!(h.crease_edge_count() > 0);
+    let mut workspace = MultiresWorkspace::new();
+    for variant in [MultiresVariant::Paper, MultiresVariant::Improved] {
+        let options = MultiresOptions::default()
+            .with_start_level(h.coarsest_level())
+            .with_variant(variant);
+        let positions = fair_multires(&h, &options, &mut workspace, &mut NoProgress).unwrap();
+        let result = TriMesh::new(positions, gear.triangles.clone());
+        let flat = (0..result.face_count())
+            .filter(|&f| result.face_normal(f).length() == 0.0)
+            .count();
+        assert_eq!(flat, 0, "{variant:?}");
+    }
+}

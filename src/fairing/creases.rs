@@ -229,25 +229,30 @@ pub fn detect_creases(mesh: &TriMesh, topology: &Topology, options: &CreaseOptio
     // crease however noisy the vertex positions are).
     let found: Vec<([u32; 2], DVec3)> = (0..vertex_count as u32)
         .into_par_iter()
+        .with_min_len(1024)
         .flat_map_iter(|v| {
+            // The faces of an edge v-u are among v's own: no other vertex's list is searched.
             let faces_v = topology.faces_of(v);
             let normals = &normals;
-            topology
-                .neighbors(v)
-                .iter()
-                .filter(move |&&u| u > v)
-                .filter_map(move |&u| {
-                    let mut shared = faces_v
-                        .iter()
-                        .filter(|f| topology.faces_of(u).binary_search(f).is_ok());
-                    let (Some(&a), Some(&b), None) = (shared.next(), shared.next(), shared.next())
-                    else {
-                        return None;
-                    };
-                    let (na, nb) = (normals[a as usize], normals[b as usize]);
-                    (na != DVec3::ZERO && nb != DVec3::ZERO && na.dot(nb) < threshold)
-                        .then(|| ([v, u], na.cross(nb).normalize_or_zero()))
-                })
+            faces_v.iter().enumerate().flat_map(move |(i, &f)| {
+                mesh.triangles[f as usize]
+                    .into_iter()
+                    .filter(move |&u| u > v)
+                    .filter_map(move |u| {
+                        // Each edge once: from the first of its faces in v's list.
+                        let has_u = |g: &u32| mesh.triangles[*g as usize].contains(&u);
+                        if faces_v[..i].iter().any(has_u) {
+                            return None;
+                        }
+                        let mut others = faces_v[i + 1..].iter().filter(|g| has_u(g));
+                        let (Some(&g), None) = (others.next(), others.next()) else {
+                            return None;
+                        };
+                        let (na, nb) = (normals[f as usize], normals[g as usize]);
+                        (na != DVec3::ZERO && nb != DVec3::ZERO && na.dot(nb) < threshold)
+                            .then(|| ([v, u], na.cross(nb).normalize_or_zero()))
+                    })
+            })
         })
         .collect();
     let edges: Vec<[u32; 2]> = found.iter().map(|&(e, _)| e).collect();
@@ -259,93 +264,115 @@ pub fn detect_creases(mesh: &TriMesh, topology: &Topology, options: &CreaseOptio
     let edges = keep_groups(edges, vertex_count, None, |edges, _| edges >= min_edges);
     // The zigzag test turns by the edges' positions: noise that lines up into a fake crease
     // zigzags there, while the faces' crease directions may still agree.
-    let (_, _, class) = classify(topology, &edges, Turn::Positions(mesh), max_turn);
+    let class = classify(topology, &edges, Turn::Positions(mesh), max_turn);
     let edges = keep_groups(edges, vertex_count, Some(&class), |edges, corners| {
         2 * corners <= edges
     });
-    let (offsets, adjacent, class) =
-        classify(topology, &edges, Turn::Directions(&directions), max_turn);
-    let feature_neighbors =
-        |v: u32| &adjacent[offsets[v as usize] as usize..offsets[v as usize + 1] as usize];
+    let class = classify(topology, &edges, Turn::Directions(&directions), max_turn);
+    Creases::from_classified(edges, class)
+}
 
-    // Chains: from every corner along each of its feature edges to the next corner, then the
-    // closed loops of crease vertices that remain.
-    let mut used = vec![false; adjacent.len()];
-    let slot = |from: u32, to: u32| -> usize {
-        let start = offsets[from as usize] as usize;
-        start
-            + feature_neighbors(from)
+impl Creases {
+    /// The creases given by their feature edges (each once, lower index first) and every
+    /// vertex's class: the chains are walked from the corners along the feature edges, then the
+    /// closed loops of crease vertices that remain. A vertex classed `Crease` must have exactly
+    /// two feature edges (one with another number is taken as a corner).
+    pub fn from_classified(edges: Vec<[u32; 2]>, mut class: Vec<FeatureClass>) -> Creases {
+        let vertex_count = class.len();
+        let (offsets, adjacent) = feature_neighbors(&edges, vertex_count);
+        let feature_neighbors =
+            |v: u32| &adjacent[offsets[v as usize] as usize..offsets[v as usize + 1] as usize];
+        for (v, c) in class.iter_mut().enumerate() {
+            let count = feature_neighbors(v as u32).len();
+            *c = match (*c, count) {
+                (_, 0) => FeatureClass::Smooth,
+                (FeatureClass::Crease, 2) => FeatureClass::Crease,
+                _ => FeatureClass::Corner,
+            };
+        }
+        let mut used = vec![false; adjacent.len()];
+        let slot = |from: u32, to: u32| -> usize {
+            let start = offsets[from as usize] as usize;
+            start
+                + feature_neighbors(from)
+                    .iter()
+                    .position(|&u| u == to)
+                    .expect("a feature edge is listed at both ends")
+        };
+        let walk = |start: u32, first: u32, used: &mut Vec<bool>| -> Option<Chain> {
+            if used[slot(start, first)] {
+                return None;
+            }
+            let mut vertices = vec![start];
+            let (mut previous, mut current) = (start, first);
+            loop {
+                used[slot(previous, current)] = true;
+                used[slot(current, previous)] = true;
+                if current == start {
+                    return Some(Chain {
+                        vertices,
+                        closed: true,
+                    });
+                }
+                vertices.push(current);
+                if class[current as usize] != FeatureClass::Crease {
+                    return Some(Chain {
+                        vertices,
+                        closed: false,
+                    });
+                }
+                let next = feature_neighbors(current)
+                    .iter()
+                    .copied()
+                    .find(|&u| u != previous)
+                    .expect("a crease vertex has two feature edges");
+                (previous, current) = (current, next);
+            }
+        };
+        let mut chains = Vec::new();
+        for v in 0..vertex_count as u32 {
+            if class[v as usize] == FeatureClass::Corner {
+                for &u in feature_neighbors(v) {
+                    chains.extend(walk(v, u, &mut used));
+                }
+            }
+        }
+        for v in 0..vertex_count as u32 {
+            if class[v as usize] == FeatureClass::Crease {
+                let first = feature_neighbors(v)[0];
+                chains.extend(walk(v, first, &mut used));
+            }
+        }
+        // A closed crease of a few vertices is no curve the section 3.3 constraints can fair (in
+        // multires from coarse levels its vertices were seen to run together, leaving faces with
+        // no area): it is held in place, as corners are, and its edges become chains between them.
+        if chains
+            .iter()
+            .any(|c| c.closed && c.vertices.len() < MIN_FAIRED_LOOP)
+        {
+            for chain in chains
                 .iter()
-                .position(|&u| u == to)
-                .expect("a feature edge is listed at both ends")
-    };
-    let walk = |start: u32, first: u32, used: &mut Vec<bool>| -> Option<Chain> {
-        if used[slot(start, first)] {
-            return None;
-        }
-        let mut vertices = vec![start];
-        let (mut previous, mut current) = (start, first);
-        loop {
-            used[slot(previous, current)] = true;
-            used[slot(current, previous)] = true;
-            if current == start {
-                return Some(Chain {
-                    vertices,
-                    closed: true,
-                });
+                .filter(|c| c.closed && c.vertices.len() < MIN_FAIRED_LOOP)
+            {
+                for &v in &chain.vertices {
+                    class[v as usize] = FeatureClass::Corner;
+                }
             }
-            vertices.push(current);
-            if class[current as usize] != FeatureClass::Crease {
-                return Some(Chain {
-                    vertices,
-                    closed: false,
-                });
-            }
-            let next = feature_neighbors(current)
-                .iter()
-                .copied()
-                .find(|&u| u != previous)
-                .expect("a crease vertex has two feature edges");
-            (previous, current) = (current, next);
+            return Creases::from_classified(edges, class);
         }
-    };
-    let mut chains = Vec::new();
-    for v in 0..vertex_count as u32 {
-        if class[v as usize] == FeatureClass::Corner {
-            for &u in feature_neighbors(v) {
-                chains.extend(walk(v, u, &mut used));
-            }
+        Creases {
+            class,
+            edges,
+            chains,
         }
-    }
-    for v in 0..vertex_count as u32 {
-        if class[v as usize] == FeatureClass::Crease {
-            let first = feature_neighbors(v)[0];
-            chains.extend(walk(v, first, &mut used));
-        }
-    }
-    Creases {
-        class,
-        edges,
-        chains,
     }
 }
 
-/// How the turn at a vertex with two feature edges is measured.
-enum Turn<'a> {
-    /// Between the edges themselves (from the vertex positions).
-    Positions(&'a TriMesh),
-    /// Between the edges' crease directions (from their faces' filtered normals).
-    Directions(&'a HashMap<[u32; 2], DVec3>),
-}
+/// Closed creases with fewer vertices than this are held in place.
+pub const MIN_FAIRED_LOOP: usize = 8;
 
-/// The feature neighbours of every vertex (CSR offsets and entries) and every vertex's class.
-fn classify(
-    topology: &Topology,
-    edges: &[[u32; 2]],
-    turn: Turn,
-    max_turn: f64,
-) -> (Vec<u32>, Vec<u32>, Vec<FeatureClass>) {
-    let vertex_count = topology.vertex_count();
+/// The feature neighbours of every vertex: CSR offsets and entries.
+fn feature_neighbors(edges: &[[u32; 2]], vertex_count: usize) -> (Vec<u32>, Vec<u32>) {
     let mut offsets = vec![0u32; vertex_count + 1];
     for e in edges {
         offsets[e[0] as usize + 1] += 1;
@@ -362,7 +389,27 @@ fn classify(
         adjacent[fill[b as usize] as usize] = a;
         fill[b as usize] += 1;
     }
-    let class = (0..vertex_count)
+    (offsets, adjacent)
+}
+
+/// How the turn at a vertex with two feature edges is measured.
+enum Turn<'a> {
+    /// Between the edges themselves (from the vertex positions).
+    Positions(&'a TriMesh),
+    /// Between the edges' crease directions (from their faces' filtered normals).
+    Directions(&'a HashMap<[u32; 2], DVec3>),
+}
+
+/// Every vertex's class, from its feature edges.
+fn classify(
+    topology: &Topology,
+    edges: &[[u32; 2]],
+    turn: Turn,
+    max_turn: f64,
+) -> Vec<FeatureClass> {
+    let vertex_count = topology.vertex_count();
+    let (offsets, adjacent) = feature_neighbors(edges, vertex_count);
+    (0..vertex_count)
         .map(
             |v| match &adjacent[offsets[v] as usize..offsets[v + 1] as usize] {
                 [] => FeatureClass::Smooth,
@@ -390,8 +437,7 @@ fn classify(
                 _ => FeatureClass::Corner,
             },
         )
-        .collect();
-    (offsets, adjacent, class)
+        .collect()
 }
 
 /// The feature edges whose group (edges joined at shared vertices) `keep(edges, corners)` accepts;

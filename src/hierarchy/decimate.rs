@@ -25,7 +25,15 @@
 //!   into them, which does not move them).
 //! - A pass stops removing once the level would drop below `min_vertices`; the build stops when a
 //!   pass removes nothing, the level has at most `min_vertices` vertices, or `max_levels` is
-//!   reached.
+//!   reached. A pass (after the first) that removes less than one vertex in 20 is dropped and ends
+//!   the build: only kept creases make such passes (see below).
+//! - Creases (`HierarchyOptions::creases`, not in the paper): a corner never collapses, a crease
+//!   vertex collapses only into one of its two neighbours along the crease (the crease then runs
+//!   from its other neighbour to that one), and not when those two neighbours are already joined
+//!   by an edge (a loop of three would close on itself; where a face holds the three, the split
+//!   would put the vertex back on their line and leave the face with no area). So every level
+//!   keeps M0's corners and its crease edges, relabelled, and a coarse level of a CAD part still
+//!   has its edges. Each vertex's crease neighbours are kept per level in `Level::crease`.
 //!
 //! - The input must be an oriented 2-manifold (checked on the first pass's fans: every vertex's
 //!   faces form one consistently oriented fan); otherwise the build refuses with
@@ -61,6 +69,7 @@
 //! profile).
 
 use super::{HierarchyError, HierarchyOptions};
+use crate::fairing::creases::{Creases, FeatureClass};
 use crate::mesh::TriMesh;
 use crate::Progress;
 use glam::DVec3;
@@ -83,15 +92,19 @@ pub(super) struct BuildOutput {
     pub pass_ms: Vec<f64>,
 }
 
+/// A pass that removes fewer than one vertex in this many ends the build, without its level.
+const MIN_PASS_SHARE: usize = 20;
+
 /// Visits between two progress reports.
 const REPORT_EVERY: usize = 4096;
 
 pub(super) fn build(
     mesh: &TriMesh,
+    creases: Option<&Creases>,
     options: &HierarchyOptions,
     progress: &mut dyn Progress,
 ) -> Result<BuildOutput, HierarchyError> {
-    passes(mesh, first_level(mesh), options, progress).map_err(|e| match e {
+    passes(mesh, first_level(mesh, creases), options, progress).map_err(|e| match e {
         BuildFailure::NonManifold(v) => HierarchyError::Unsupported(format!(
             "the mesh is not an oriented 2-manifold at vertex {v}: its faces do not form one \
              consistently oriented fan (an edge with more than two faces, two fans meeting at \
@@ -120,12 +133,21 @@ struct Level {
     corners: Vec<[u32; 3]>,
     /// M0 id of each face.
     face_id: Vec<u32>,
+    /// Per vertex when creases are kept (empty otherwise): [`NO_CREASE`], [`CORNER`], or the
+    /// two neighbours along its crease.
+    crease: Vec<[u32; 2]>,
 }
+
+/// `Level::crease` of a vertex on no crease.
+const NO_CREASE: [u32; 2] = [NEVER; 2];
+/// `Level::crease` of a corner, which never collapses.
+const CORNER: [u32; 2] = [NEVER - 1; 2];
 
 /// M0 as the first level: the vertices that some face uses (isolated ones are never removed) in
 /// Morton order of their positions (quantized to 10 bits per axis in M0's bounding box; ties by
-/// id), the faces in order of their first corner's place in that order (ties by id).
-fn first_level(mesh: &TriMesh) -> Level {
+/// id), the faces in order of their first corner's place in that order (ties by id); with the
+/// creases' classes and crease neighbours in the same order.
+fn first_level(mesh: &TriMesh, creases: Option<&Creases>) -> Level {
     let n = mesh.vertex_count();
     let mut level_of = vec![NEVER; n];
     for t in &mesh.triangles {
@@ -173,7 +195,29 @@ fn first_level(mesh: &TriMesh) -> Level {
         face_id[*slot as usize] = f as u32;
         *slot += 1;
     }
+    let crease = creases.map_or_else(Vec::new, |creases| {
+        let mut crease: Vec<[u32; 2]> = vertex_id
+            .iter()
+            .map(|&v| match creases.class[v as usize] {
+                FeatureClass::Smooth => NO_CREASE,
+                FeatureClass::Corner => CORNER,
+                FeatureClass::Crease => [NEVER; 2],
+            })
+            .collect();
+        for &[a, b] in &creases.edges {
+            let (a, b) = (level_of[a as usize], level_of[b as usize]);
+            for (x, y) in [(a, b), (b, a)] {
+                let slots = &mut crease[x as usize];
+                if *slots != CORNER {
+                    let free = if slots[0] == NEVER { 0 } else { 1 };
+                    slots[free] = y;
+                }
+            }
+        }
+        crease
+    });
     Level {
+        crease,
         points: vertex_id
             .iter()
             .map(|&v| mesh.positions[v as usize])
@@ -281,6 +325,22 @@ fn passes(
             if open && options.keep_boundary {
                 continue;
             }
+            // A crease vertex collapses only along its crease; a corner never. Nor when its crease
+            // neighbours are joined by an edge already: a loop of three would close on itself, and
+            // where a face holds the three (a noisy crease zigzags), the split would put the vertex
+            // back between the other two, on their line, and leave that face with no area.
+            let along = level.crease.get(v as usize).copied().unwrap_or(NO_CREASE);
+            if along == CORNER
+                || along != NO_CREASE
+                    && (level.crease[along[0] as usize].contains(&along[1])
+                        || state.fans[state.fan_offsets[v as usize] as usize
+                            ..state.fan_offsets[v as usize + 1] as usize]
+                            .iter()
+                            .any(|&[a, b]| along == [a, b] || along == [b, a]))
+            {
+                continue;
+            }
+            let along = (along != NO_CREASE).then_some(along);
             let view = PassView {
                 points: &level.points,
                 fan_offsets: &state.fan_offsets,
@@ -290,10 +350,21 @@ fn passes(
                 absorbed_next: &state.absorbed_next,
             };
             let Some((k, six_volume)) =
-                choose_collapse(v, open, &view, &level.vertex_id, &mut scratch)
+                choose_collapse(v, open, along, &view, &level.vertex_id, &mut scratch)
             else {
                 continue;
             };
+            if let Some([a, b]) = along {
+                // The crease now runs w - k.
+                let w = if k == a { b } else { a };
+                for (x, from, to) in [(k, v, w), (w, v, k)] {
+                    for slot in level.crease[x as usize].iter_mut() {
+                        if *slot == from {
+                            *slot = to;
+                        }
+                    }
+                }
+            }
 
             // Perform v -> k: faces are relabelled when the next level is built (a pass's
             // collapses touch disjoint face sets, so they compose as one simultaneous relabelling).
@@ -311,6 +382,22 @@ fn passes(
             removed += 1;
         }
         if removed == 0 {
+            break;
+        }
+        if removed * MIN_PASS_SHARE < level_vertices && pass > 0 && vertex_count > options.min_vertices
+        {
+            // A level that barely differs from the one below: left out, and the build ends (a
+            // last pass cut short by `min_vertices` is kept).
+            // (Kept creases make these: once the smooth parts are coarse, only crease vertices
+            // can still collapse, a few per pass, and multires from such levels lost volume.)
+            for (v, &m) in state.mark.iter().enumerate() {
+                if m < LOCKED {
+                    let id = level.vertex_id[v] as usize;
+                    out.removed_in_pass[id] = NEVER;
+                    out.target[id] = NEVER;
+                    out.six_split_volume[id] = 0.0;
+                }
+            }
             break;
         }
         next_level(
@@ -461,6 +548,7 @@ fn next_level(
     next.vertex_id.clear();
     next.corners.clear();
     next.face_id.clear();
+    next.crease.clear();
     let (mark, label) = (&state.mark, &mut state.label);
     label.clear();
     label.resize(level.points.len(), NEVER);
@@ -474,6 +562,16 @@ fn next_level(
     for (v, &m) in mark.iter().enumerate() {
         if m < LOCKED {
             label[v] = label[m as usize];
+        }
+    }
+    // Crease neighbours were moved to survivors as the collapses happened.
+    for (&c, &m) in level.crease.iter().zip(mark.iter()) {
+        if m >= LOCKED {
+            next.crease.push(if c == NO_CREASE || c == CORNER {
+                c
+            } else {
+                c.map(|u| label[u as usize])
+            });
         }
     }
     for (t, &f) in level.corners.iter().zip(&level.face_id) {
@@ -611,11 +709,12 @@ struct Scratch {
     candidates: Vec<(f64, u32, f64)>,
 }
 
-/// The first valid collapse target of `v` (on a boundary if `on_boundary`) in increasing cone
-/// volume, with its signed cone volume.
+/// The first valid collapse target of `v` (on a boundary if `on_boundary`; one of `along` when
+/// it is on a crease) in increasing cone volume, with its signed cone volume.
 fn choose_collapse(
     v: u32,
     on_boundary: bool,
+    along: Option<[u32; 2]>,
     view: &PassView,
     m0_id: &[u32],
     scratch: &mut Scratch,
@@ -658,6 +757,9 @@ fn choose_collapse(
     scratch.candidates.clear();
     for &k in &scratch.neighbors {
         if on_boundary && k != fan_start && k != fan_end {
+            continue;
+        }
+        if along.is_some_and(|along| !along.contains(&k)) {
             continue;
         }
         let xk = p(k);

@@ -19,12 +19,22 @@
 //!   from M0's corners. Both are exact: coarsening to the top and refining back gives M0's faces,
 //!   in M0's order once mapped back through [`Hierarchy::original_vertex`].
 //!
+//! Creases ([`HierarchyOptions::creases`], on by default; not in the paper): M0's creases are
+//! found as [`crate::fairing::detect_creases`] finds them (normals filtered as much as the noise
+//! estimate asks), corners never collapse and crease vertices collapse only along their crease
+//! (see `decimate.rs`), so every level's creases are M0's feature edges with their ends followed
+//! along `target` ([`Hierarchy::level_creases`]); multiresolution fairing fairs them as curves.
+//! The detection costs a topology, the noise estimate and the edge test (on the 1.2M-face mesh
+//! about 0.4 s, `docs/measurements.md`).
+//!
 //! Storage per M0 vertex: target 4 bytes, cone volume 4, the vertex order both ways 8, and the
 //! face order (about two faces per vertex) 8: 24 bytes, besides M0 itself in internal order.
 
 mod decimate;
 
-use crate::mesh::TriMesh;
+use crate::fairing::creases::{detect_creases, CreaseOptions, Creases, FeatureClass};
+use crate::fairing::strength::{estimate_noise, normal_filtering_for};
+use crate::mesh::{Topology, TriMesh};
 use crate::Progress;
 use decimate::NEVER;
 use rayon::prelude::*;
@@ -45,6 +55,11 @@ pub struct HierarchyOptions {
     pub max_levels: usize,
     /// Never collapse boundary vertices.
     pub keep_boundary: bool,
+    /// Keep sharp creases (found as [`crate::fairing::detect_creases`] finds them, with the
+    /// normals filtered as much as the mesh's noise estimate asks): a crease vertex collapses only
+    /// into one of its two neighbours along the crease, and corners never collapse, so every
+    /// level keeps M0's creases and corners ([`Hierarchy::level_creases`]). `None`: no creases.
+    pub creases: Option<CreaseOptions>,
 }
 
 with_setters!(HierarchyOptions {
@@ -53,6 +68,7 @@ with_setters!(HierarchyOptions {
     with_min_vertices => min_vertices: usize,
     with_max_levels => max_levels: usize,
     with_keep_boundary => keep_boundary: bool,
+    with_creases => creases: Option<CreaseOptions>,
 });
 
 impl Default for HierarchyOptions {
@@ -63,6 +79,7 @@ impl Default for HierarchyOptions {
             min_vertices: 100,
             max_levels: 64,
             keep_boundary: false,
+            creases: Some(CreaseOptions::default()),
         }
     }
 }
@@ -119,6 +136,10 @@ pub struct Hierarchy {
     level_faces: Vec<u32>,
     /// Milliseconds the pass building level `i` took (`level_ms[0]` is the setup of M0).
     level_ms: Vec<f64>,
+    /// M0's crease class of each internal vertex, and M0's feature edges in internal ids (both
+    /// empty when the build kept no creases).
+    feature_class: Vec<FeatureClass>,
+    crease_edges: Vec<[u32; 2]>,
 }
 
 impl Hierarchy {
@@ -211,11 +232,45 @@ impl Hierarchy {
     pub fn six_split_volume(&self, v: u32) -> f32 {
         self.six_split_volume[v as usize]
     }
+    /// The creases of `level` in its internal ids (`None` when the build kept none): M0's
+    /// feature edges with each end followed along its collapses to the level (a crease vertex
+    /// only ever collapses along its crease, so these are the level's own crease edges), and M0's
+    /// classes of the level's vertices.
+    pub fn level_creases(&self, level: usize) -> Option<Creases> {
+        if self.crease_edges.is_empty() {
+            return None;
+        }
+        let vertex_count = self.level_info(level).vertices as u32;
+        let resolve = |mut c: u32| {
+            while c >= vertex_count {
+                c = self.target[c as usize];
+            }
+            c
+        };
+        let mut edges: Vec<[u32; 2]> = self
+            .crease_edges
+            .iter()
+            .filter_map(|&[a, b]| {
+                let (a, b) = (resolve(a), resolve(b));
+                (a != b).then(|| [a.min(b), a.max(b)])
+            })
+            .collect();
+        edges.sort_unstable();
+        edges.dedup();
+        let class = self.feature_class[..vertex_count as usize].to_vec();
+        Some(Creases::from_classified(edges, class))
+    }
+    /// Number of M0's feature edges the build kept (0 without creases).
+    pub fn crease_edge_count(&self) -> usize {
+        self.crease_edges.len()
+    }
     /// Heap bytes of the collapse records (targets, cone volumes, vertex and face orders).
     pub fn record_bytes(&self) -> usize {
         4 * (self.target.len() + self.six_split_volume.len())
             + 4 * (self.order.len() + self.rank.len())
             + 4 * self.face_order.len()
+            + self.feature_class.len() * std::mem::size_of::<FeatureClass>()
+            + 8 * self.crease_edges.len()
     }
     pub(crate) fn id(&self) -> u64 {
         self.id
@@ -341,9 +396,21 @@ pub fn build_hierarchy(
             "face {f} {t:?} repeats a vertex or refers to a missing one"
         )));
     }
+    let creases = options
+        .creases
+        .as_ref()
+        .map(|crease_options| {
+            let topology = Topology::build(mesh);
+            let mut crease_options = crease_options.clone();
+            crease_options.normal_filtering = crease_options.normal_filtering.max(
+                estimate_noise(mesh, &topology).map_or(0, normal_filtering_for),
+            );
+            detect_creases(mesh, &topology, &crease_options)
+        })
+        .filter(|creases| !creases.is_empty());
     let setup_ms = started.elapsed().as_secs_f64() * 1e3;
 
-    let built = decimate::build(mesh, options, progress)?;
+    let built = decimate::build(mesh, creases.as_ref(), options, progress)?;
     let finishing = std::time::Instant::now();
     let passes = built.pass_ms.len();
 
@@ -399,6 +466,17 @@ pub fn build_hierarchy(
         .with_min_len(4096)
         .map(|&v| built.six_split_volume[v as usize])
         .collect();
+    let (feature_class, crease_edges) = match creases {
+        Some(creases) => (
+            order.iter().map(|&v| creases.class[v as usize]).collect(),
+            creases
+                .edges
+                .iter()
+                .map(|e| e.map(|c| rank[c as usize]))
+                .collect(),
+        ),
+        None => (Vec::new(), Vec::new()),
+    };
     let mut level_ms = vec![setup_ms + finishing.elapsed().as_secs_f64() * 1e3];
     level_ms.extend_from_slice(&built.pass_ms);
 
@@ -415,6 +493,8 @@ pub fn build_hierarchy(
         level_vertices,
         level_faces,
         level_ms,
+        feature_class,
+        crease_edges,
     })
 }
 
