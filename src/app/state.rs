@@ -298,6 +298,7 @@ impl Settings {
                 VariantSetting::Paper => MultiresVariant::Paper,
                 VariantSetting::Improved => MultiresVariant::Improved,
             },
+            mask: None,
         }
     }
 }
