@@ -41,7 +41,10 @@ fn check_only_painted_moved(before: &TriMesh, after: &[[f32; 3]], mask: &Mask) {
         }
     }
     let painted = mask.painted_count();
-    assert!(moved > painted * 9 / 10, "{moved} of {painted} painted moved");
+    assert!(
+        moved > painted * 9 / 10,
+        "{moved} of {painted} painted moved"
+    );
 }
 
 fn squared_distance(a: [f32; 3], b: [f32; 3]) -> f64 {
@@ -70,7 +73,10 @@ fn constrained_fairing_moves_only_the_painted_region_and_removes_its_noise() {
     fair_constrained(&mut whole, &topology, &FairOptions::default());
     let unmasked = error(&whole.positions);
     assert!(after < 0.95 * before, "{after} against {before}");
-    assert!(after < 1.05 * unmasked, "{after} against {unmasked} unmasked");
+    assert!(
+        after < 1.05 * unmasked,
+        "{after} against {unmasked} unmasked"
+    );
 }
 
 #[test]
