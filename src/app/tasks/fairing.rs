@@ -42,7 +42,11 @@ impl App {
         level: usize,
         view: u64,
     ) {
-        let options = self.settings.multires_options(level);
+        let mask = self.document.as_ref().and_then(|d| d.mask.clone());
+        let options = self
+            .settings
+            .multires_options(level)
+            .with_mask(mask.clone());
         let baseline = self.settings.baseline_options();
         let method = self.settings.method;
         let document_generation = self.document_generation.clone();
@@ -68,7 +72,12 @@ impl App {
                 Some(method) => {
                     let mut mesh = hierarchy.base_mesh().clone();
                     let topology = crate::Topology::build(&mesh);
-                    crate::fairing::fair(&mut mesh, &topology, method);
+                    match &mask {
+                        Some(mask) => {
+                            crate::fairing::fair_masked(&mut mesh, &topology, method, mask)
+                        }
+                        None => crate::fairing::fair(&mut mesh, &topology, method),
+                    };
                     progress(1.0);
                     Some(mesh.positions)
                 }
