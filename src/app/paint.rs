@@ -63,10 +63,11 @@ impl StoredMask {
     pub fn of(path: &Path, mask: &Mask) -> Option<StoredMask> {
         let mut runs: Vec<(u32, u32, u8)> = Vec::new();
         for (v, &w) in mask.weights().iter().enumerate() {
-            let level = (w.clamp(0.0, 1.0) * 255.0).round() as u8;
-            if level == 0 {
+            if w <= 0.0 {
                 continue;
             }
+            // A painted vertex stays painted, however faintly.
+            let level = ((w.min(1.0) * 255.0).round() as u8).max(1);
             match runs.last_mut() {
                 Some((start, count, last)) if *last == level && *start + *count == v as u32 => {
                     *count += 1
