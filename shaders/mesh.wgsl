@@ -73,7 +73,7 @@ fn fs_mesh(in: MeshOut, @builtin(front_facing) front: bool) -> @location(0) vec4
     var albedo = u.base_color.rgb;
     if (u.scalar_range.z > 1.5) {
         // The painted region in a warm orange, as strong as its weight.
-        albedo = mix(albedo, vec3<f32>(0.95, 0.28, 0.06), 0.7 * clamp(in.scalar, 0.0, 1.0));
+        albedo = mix(albedo, vec3<f32>(0.95, 0.28, 0.06), 0.5 * clamp(in.scalar, 0.0, 1.0));
     } else if (u.scalar_range.z > 0.5) {
         let span = max(u.scalar_range.y - u.scalar_range.x, 1e-20);
         albedo = viridis((in.scalar - u.scalar_range.x) / span);

@@ -251,6 +251,8 @@ pub struct App {
     paint_mode: bool,
     /// The mask's weights while a stroke is being painted.
     stroke: Option<Vec<f32>>,
+    /// Where the brush's last dab of the stroke was (screen points).
+    last_dab: Option<egui::Pos2>,
     /// Bumped with every change of the document's mask, so that its tint is uploaded again.
     mask_revision: u64,
 }
@@ -332,6 +334,7 @@ impl App {
             history: History::new(HISTORY_BUDGET_BYTES),
             paint_mode: false,
             stroke: None,
+            last_dab: None,
             mask_revision: 0,
         };
         for viewport in app.viewports() {

@@ -93,18 +93,29 @@ pub(super) fn viewport_brush(
     let pressed_here = response.is_pointer_button_down_on() && primary_down;
     match response.interact_pointer_pos().or(hover) {
         Some(cursor) if pressed_here && image.contains(cursor) => {
+            // Dabs every quarter radius from the last one, so a fast stroke leaves no gaps
+            // between the frames' cursor positions.
+            let from = app.last_dab.unwrap_or(cursor);
+            let spacing = (radius * 0.25).max(1.0);
+            let steps = ((cursor - from).length() / spacing).ceil().clamp(1.0, 64.0) as usize;
             let aspect = image.width() / image.height().max(1.0);
-            let view = BrushView {
-                view_proj: app.camera.view_proj(aspect),
-                eye: app.camera.eye(),
-                rect: image,
-                cursor,
-                radius,
-            };
             let erase = app.settings.paint.erase != shift;
-            app.commands.push(Command::Paint { view, erase });
+            for step in 1..=steps {
+                let view = BrushView {
+                    view_proj: app.camera.view_proj(aspect),
+                    eye: app.camera.eye(),
+                    rect: image,
+                    cursor: from.lerp(cursor, step as f32 / steps as f32),
+                    radius,
+                };
+                app.commands.push(Command::Paint { view, erase });
+            }
+            app.last_dab = Some(cursor);
         }
-        _ if !primary_down && app.stroke.is_some() => app.commands.push(Command::EndStroke),
+        _ if !primary_down && (app.stroke.is_some() || app.last_dab.is_some()) => {
+            app.last_dab = None;
+            app.commands.push(Command::EndStroke);
+        }
         _ => {}
     }
     true
