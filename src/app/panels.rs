@@ -271,7 +271,6 @@ fn controls(app: &mut App, ui: &mut egui::Ui) {
     ui.separator();
     ui.heading("Fairing");
     fairing_controls(app, ui, top_level);
-    super::paint_panel::section(app, ui);
     let Some(document) = &app.document else {
         return;
     };
@@ -472,6 +471,9 @@ fn controls(app: &mut App, ui: &mut egui::Ui) {
             ui.end_row();
         });
 
+    // Below Export and the numbers: a painting session is an occasional step, and the controls
+    // used on every file stay where they were.
+    super::paint_panel::section(app, ui);
     performance(app, ui);
 }
 
