@@ -94,10 +94,11 @@ pub(super) fn viewport_brush(
     match response.interact_pointer_pos().or(hover) {
         Some(cursor) if pressed_here && image.contains(cursor) => {
             // Dabs every quarter radius from the last one, so a fast stroke leaves no gaps
-            // between the frames' cursor positions.
+            // between the frames' cursor positions; at most 8 a frame (each dab tests every
+            // triangle: on a big mesh a frame must not pay for dozens).
             let from = app.last_dab.unwrap_or(cursor);
             let spacing = (radius * 0.25).max(1.0);
-            let steps = ((cursor - from).length() / spacing).ceil().clamp(1.0, 64.0) as usize;
+            let steps = ((cursor - from).length() / spacing).ceil().clamp(1.0, 8.0) as usize;
             let aspect = image.width() / image.height().max(1.0);
             let erase = app.settings.paint.erase != shift;
             for step in 1..=steps {
