@@ -9,6 +9,7 @@
 //! `softness` part of the radius, so the fairing fades out at the painted region's edge.
 
 use glam::{Mat4, Vec3, Vec4Swizzles};
+use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
 
@@ -217,7 +218,7 @@ pub fn brush_hits(
     let depth_slack = 0.5 * view.radius * world_per_point;
     let radius = view.radius.max(0.5);
     let candidates: Vec<(u32, f32)> = positions
-        .iter()
+        .par_iter()
         .enumerate()
         .filter_map(|(v, &p)| {
             let p = Vec3::from_array(p);
@@ -238,10 +239,11 @@ pub fn brush_hits(
     let normals = vertex_normals(positions, triangles, &candidates);
     candidates
         .into_iter()
-        .filter(|&(v, _)| {
-            let normal = normals.get(&v).copied().unwrap_or(Vec3::ZERO);
+        .zip(normals)
+        .filter(|&((v, _), normal)| {
             facing(normal, Vec3::from_array(positions[v as usize])) * picked_side >= 0.0
         })
+        .map(|(candidate, _)| candidate)
         .collect()
 }
 
@@ -251,23 +253,26 @@ fn triangle_normal(positions: &[[f32; 3]], t: &[u32; 3]) -> Vec3 {
     (corner(t[1]) - corner(t[0])).cross(corner(t[2]) - corner(t[0]))
 }
 
-/// Area-weighted vertex normals of the `candidates` only.
+/// Area-weighted vertex normals of the `candidates` only, in their order.
 fn vertex_normals(
     positions: &[[f32; 3]],
     triangles: &[[u32; 3]],
     candidates: &[(u32, f32)],
-) -> std::collections::HashMap<u32, Vec3> {
-    let mut normals: std::collections::HashMap<u32, Vec3> =
-        candidates.iter().map(|&(v, _)| (v, Vec3::ZERO)).collect();
+) -> Vec<Vec3> {
+    // Vertex -> its place among the candidates: a dense table, as every triangle is looked up.
+    let mut slot = vec![u32::MAX; positions.len()];
+    for (i, &(v, _)) in candidates.iter().enumerate() {
+        slot[v as usize] = i as u32;
+    }
+    let mut normals = vec![Vec3::ZERO; candidates.len()];
     for t in triangles {
-        if !t.iter().any(|v| normals.contains_key(v)) {
+        let slots = t.map(|v| slot.get(v as usize).copied().unwrap_or(u32::MAX));
+        if slots.iter().all(|&s| s == u32::MAX) {
             continue;
         }
         let normal = triangle_normal(positions, t);
-        for v in t {
-            if let Some(sum) = normals.get_mut(v) {
-                *sum += normal;
-            }
+        for s in slots.into_iter().filter(|&s| s != u32::MAX) {
+            normals[s as usize] += normal;
         }
     }
     normals
@@ -283,7 +288,7 @@ fn nearest_hit(
 ) -> Option<(f32, usize)> {
     let corner = |v: u32| positions.get(v as usize).map(|&p| Vec3::from_array(p));
     triangles
-        .iter()
+        .par_iter()
         .enumerate()
         .filter_map(|(index, t)| {
             let (a, b, c) = (corner(t[0])?, corner(t[1])?, corner(t[2])?);
@@ -301,7 +306,7 @@ fn nearest_hit(
             let t = e2.dot(q) * inv;
             (u >= 0.0 && w >= 0.0 && u + w <= 1.0 && t > 0.0).then_some((t, index))
         })
-        .min_by(|a, b| a.0.total_cmp(&b.0))
+        .min_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)))
 }
 
 #[cfg(test)]
