@@ -10,7 +10,8 @@ struct Uniforms {
     light_dir: vec4<f32>,
     base_color: vec4<f32>,
     wire_color: vec4<f32>,
-    // x: scalar mapped to blue, y: scalar mapped to red, z: 1 when scalars are shown.
+    // x: scalar mapped to blue, y: scalar mapped to red, z: 1 when scalars are a heat map, 2
+    // when they are a mask (0 to 1) tinted over the base colour.
     scalar_range: vec4<f32>,
 };
 
@@ -70,7 +71,10 @@ fn fs_mesh(in: MeshOut, @builtin(front_facing) front: bool) -> @location(0) vec4
         normal = -normal;
     }
     var albedo = u.base_color.rgb;
-    if (u.scalar_range.z > 0.5) {
+    if (u.scalar_range.z > 1.5) {
+        // The painted region in a warm orange, as strong as its weight.
+        albedo = mix(albedo, vec3<f32>(0.95, 0.28, 0.06), 0.5 * clamp(in.scalar, 0.0, 1.0));
+    } else if (u.scalar_range.z > 0.5) {
         let span = max(u.scalar_range.y - u.scalar_range.x, 1e-20);
         albedo = viridis((in.scalar - u.scalar_range.x) / span);
     }
@@ -81,7 +85,7 @@ fn fs_mesh(in: MeshOut, @builtin(front_facing) front: bool) -> @location(0) vec4
     let key = max(dot(normal, u.light_dir.xyz), 0.0);
     let fill = max(dot(normal, to_eye), 0.0);
     var shade = 0.08 + 0.72 * key + 0.25 * fill;
-    if (u.scalar_range.z > 0.5) {
+    if (u.scalar_range.z > 0.5 && u.scalar_range.z < 1.5) {
         // Flatter lighting for the heat map, so its colours read as the legend shows them.
         shade = 0.55 + 0.3 * key + 0.2 * fill;
     }

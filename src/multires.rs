@@ -51,7 +51,9 @@
 //! vertex normals from their fan order (one gather per neighbour instead of three per face).
 
 use crate::fairing::constrained::FanRings;
-use crate::fairing::{BoundaryMode, ConstrainedFairing, Creases, FairOptions, FairVariant};
+use crate::fairing::{
+    BoundaryMode, ConstrainedFairing, Creases, FairOptions, FairVariant, Mask,
+};
 use crate::hierarchy::Hierarchy;
 use crate::mesh::{Topology, TriMesh};
 use crate::Progress;
@@ -82,6 +84,11 @@ pub struct MultiresOptions {
     /// Also fair M0 after the last refinement.
     pub fair_finest: bool,
     pub variant: MultiresVariant,
+    /// Where to fair ([`crate::fairing::mask`]), one weight per M0 vertex in the base mesh's
+    /// numbering: the run fairs the whole mesh and blends the result back by the weights, so
+    /// weight-0 vertices keep their positions exactly. A mask that does not fit M0 leaves the
+    /// mesh unchanged.
+    pub mask: Option<Mask>,
 }
 
 with_setters!(MultiresOptions {
@@ -91,6 +98,7 @@ with_setters!(MultiresOptions {
     with_boundary => boundary: BoundaryMode,
     with_fair_finest => fair_finest: bool,
     with_variant => variant: MultiresVariant,
+    with_mask => mask: Option<Mask>,
 });
 
 impl Default for MultiresOptions {
@@ -102,6 +110,7 @@ impl Default for MultiresOptions {
             boundary: BoundaryMode::Curve,
             fair_finest: false,
             variant: MultiresVariant::Improved,
+            mask: None,
         }
     }
 }
@@ -229,6 +238,7 @@ impl MultiresWorkspace {
                         variant,
                         boundary,
                         creases.as_ref(),
+                        &[],
                     ));
                 }
                 data
@@ -291,6 +301,7 @@ fn level_fair_options(options: &MultiresOptions) -> FairOptions {
         tangential_relaxation: 0.0,
         boundary: options.boundary,
         tolerance: 0.0,
+        mask: None,
         // Both variants fair with the paper's operator: measured in multires, the
         // normal-projected operator roughly doubles the normal error from coarse levels (noisy
         // bunny00 from level 8: 22 degrees against 12) because the tangential part of the paper's
@@ -328,7 +339,18 @@ pub fn fair_multires(
     // A run makes a dozen small parallel calls per level. Issued from outside the pool, each one
     // is handed to a worker and waited for (a futex round trip); from a worker they run in place
     // or are stolen, so the whole run goes to the pool once.
-    rayon::scope(|_| fair_multires_on_worker(hierarchy, options, workspace, progress))
+    let original = &hierarchy.base_mesh().positions;
+    if let Some(mask) = &options.mask {
+        if mask.check_fits(original.len()).is_err() || mask.painted_count() == 0 {
+            return progress.report(1.0).then(|| original.clone());
+        }
+    }
+    let mut result =
+        rayon::scope(|_| fair_multires_on_worker(hierarchy, options, workspace, progress))?;
+    if let Some(mask) = &options.mask {
+        mask.blend(original, &mut result);
+    }
+    Some(result)
 }
 
 fn fair_multires_on_worker(

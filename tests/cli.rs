@@ -487,3 +487,194 @@ fn fair_leaves_a_clean_mesh_alone_and_says_how_noisy_the_input_was() {
     assert_eq!(paper["rounds_run"], 1, "{paper}");
     assert_eq!(paper["crease_edges"], 0, "{paper}");
 }
+
+/// The `v` lines of an OBJ file, in the file's order.
+fn obj_vertices(path: &Path) -> Vec<[f32; 3]> {
+    std::fs::read_to_string(path)
+        .unwrap()
+        .lines()
+        .filter_map(|line| line.strip_prefix("v "))
+        .map(|rest| {
+            let xyz: Vec<f32> = rest
+                .split_whitespace()
+                .map(|t| t.parse().unwrap())
+                .collect();
+            [xyz[0], xyz[1], xyz[2]]
+        })
+        .collect()
+}
+
+/// A noisy copy of the open mushroom in `dir`, a vertex list (0-based, in the file's order) of
+/// its 800 highest vertices (a compact region), with a comment and a blank line, and whether
+/// each vertex is in the list.
+fn noisy_mushroom_and_mask(dir: &Path) -> (PathBuf, PathBuf, Vec<bool>) {
+    let noisy = dir.join("noisy.obj");
+    let noise = fairmesh(&[
+        "noise",
+        &data("mushroom_open.obj"),
+        "-o",
+        noisy.to_str().unwrap(),
+        "--sigma",
+        "0.3",
+    ]);
+    assert!(noise.status.success());
+    let vertices = obj_vertices(&noisy);
+    let mut by_height: Vec<usize> = (0..vertices.len()).collect();
+    by_height.sort_by(|&a, &b| vertices[b][1].total_cmp(&vertices[a][1]));
+    let mut in_mask = vec![false; vertices.len()];
+    let mut list = String::from("# the top of the cap\n\n");
+    for &v in &by_height[..800] {
+        in_mask[v] = true;
+        list.push_str(&format!("{v}\n"));
+    }
+    let mask = dir.join("region.txt");
+    std::fs::write(&mask, list).unwrap();
+    (noisy, mask, in_mask)
+}
+
+/// The vertices in the mask moved (most of them), the others kept their exact positions.
+fn check_only_the_masked_moved(before: &[[f32; 3]], after: &[[f32; 3]], in_mask: &[bool]) {
+    assert_eq!(before.len(), after.len());
+    let masked = in_mask.iter().filter(|&&m| m).count();
+    let moved = (0..before.len())
+        .filter(|&v| in_mask[v] && before[v] != after[v])
+        .count();
+    assert!(
+        moved > masked * 9 / 10,
+        "only {moved} of {masked} masked vertices moved"
+    );
+    for v in (0..before.len()).filter(|&v| !in_mask[v]) {
+        assert_eq!(
+            before[v], after[v],
+            "vertex {v} is not in the mask but moved"
+        );
+    }
+}
+
+#[test]
+fn fair_and_multires_with_a_mask_move_only_the_listed_vertices() {
+    let dir = tempfile::tempdir().unwrap();
+    let (noisy, mask, in_mask) = noisy_mushroom_and_mask(dir.path());
+    let before = obj_vertices(&noisy);
+    let faired = dir.path().join("faired.obj");
+    let (noisy_arg, mask_arg) = (noisy.to_str().unwrap(), mask.to_str().unwrap());
+    let report = json_of(&[
+        "fair",
+        noisy_arg,
+        "-o",
+        faired.to_str().unwrap(),
+        "--rounds",
+        "2",
+        "--mask",
+        mask_arg,
+        "--json",
+    ]);
+    assert_eq!(report["masked_vertices"], 800);
+    check_only_the_masked_moved(&before, &obj_vertices(&faired), &in_mask);
+
+    let multires = dir.path().join("multires.obj");
+    for falloff in ["0", "2"] {
+        let out = fairmesh(&[
+            "multires",
+            noisy_arg,
+            "-o",
+            multires.to_str().unwrap(),
+            "--level",
+            "4",
+            "--mask",
+            mask_arg,
+            "--mask-falloff",
+            falloff,
+        ]);
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        check_only_the_masked_moved(&before, &obj_vertices(&multires), &in_mask);
+    }
+}
+
+#[test]
+fn mask_indices_are_the_input_files_even_where_loading_welds_vertices() {
+    // Every vertex written twice; triangles alternate between the copies, so loading welds
+    // vertex v and v + n into one. The mask names second copies only.
+    let dir = tempfile::tempdir().unwrap();
+    let (noisy, _, in_mask) = noisy_mushroom_and_mask(dir.path());
+    let text = std::fs::read_to_string(&noisy).unwrap();
+    let vertices: Vec<&str> = text.lines().filter(|l| l.starts_with("v ")).collect();
+    let n = vertices.len();
+    let mut doubled: String = vertices
+        .iter()
+        .chain(&vertices)
+        .map(|l| format!("{l}\n"))
+        .collect();
+    for (k, face) in text.lines().filter(|l| l.starts_with("f ")).enumerate() {
+        let offset = if k % 2 == 0 { 0 } else { n };
+        let corners: Vec<String> = face[2..]
+            .split_whitespace()
+            .map(|c| (c.split('/').next().unwrap().parse::<usize>().unwrap() + offset).to_string())
+            .collect();
+        doubled.push_str(&format!("f {}\n", corners.join(" ")));
+    }
+    let input = dir.path().join("doubled.obj");
+    std::fs::write(&input, doubled).unwrap();
+    let mask = dir.path().join("second_copies.txt");
+    let list: String = (0..n)
+        .filter(|&v| in_mask[v])
+        .map(|v| format!("{}\n", v + n))
+        .collect();
+    std::fs::write(&mask, list).unwrap();
+    let output = dir.path().join("faired.obj");
+    let out = fairmesh(&[
+        "fair",
+        input.to_str().unwrap(),
+        "-o",
+        output.to_str().unwrap(),
+        "--rounds",
+        "2",
+        "--mask",
+        mask.to_str().unwrap(),
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let (before, after) = (obj_vertices(&input), obj_vertices(&output));
+    // Both copies of a welded vertex are written with its one faired position.
+    check_only_the_masked_moved(&before[..n], &after[..n], &in_mask);
+    check_only_the_masked_moved(&before[n..], &after[n..], &in_mask);
+    assert_eq!(after[..n], after[n..]);
+}
+
+#[test]
+fn a_bad_mask_names_the_file_and_the_line() {
+    let dir = tempfile::tempdir().unwrap();
+    let output = dir.path().join("out.obj");
+    let input = data("mushroom_open.obj");
+    for (content, wanted) in [
+        ("1\n2\n99999\n", "line 3: vertex 99999 is out of range"),
+        ("1\n# fine\nfive\n", "line 3: `five` is not a vertex index"),
+    ] {
+        let mask = dir.path().join("bad.txt");
+        std::fs::write(&mask, content).unwrap();
+        for command in ["fair", "multires"] {
+            let out = fairmesh(&[
+                command,
+                &input,
+                "-o",
+                output.to_str().unwrap(),
+                "--mask",
+                mask.to_str().unwrap(),
+            ]);
+            assert_eq!(out.status.code(), Some(1));
+            let stderr = String::from_utf8_lossy(&out.stderr);
+            assert!(
+                stderr.contains("bad.txt") && stderr.contains(wanted),
+                "{stderr}"
+            );
+        }
+    }
+    assert!(!output.exists(), "nothing is written when the mask is bad");
+}

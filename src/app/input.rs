@@ -55,14 +55,21 @@ impl App {
             return;
         }
         let plain = |i: &egui::InputState, key| i.key_pressed(key) && i.modifiers.is_none();
-        let (fit, wire, before, heat) = ctx.input(|i| {
+        let (fit, wire, before, heat, paint) = ctx.input(|i| {
             (
                 plain(i, egui::Key::F),
                 plain(i, egui::Key::W),
                 plain(i, egui::Key::B),
                 plain(i, egui::Key::H),
+                plain(i, egui::Key::P),
             )
         });
+        if paint {
+            self.paint_mode = !self.paint_mode;
+            if !self.paint_mode {
+                self.commands.push(Command::EndStroke);
+            }
+        }
         if fit {
             self.commands.push(Command::FitView);
         }

@@ -11,7 +11,9 @@
 //! - `view_sync.rs`: keeps the viewports' GPU buffers in step with what should be shown;
 //! - [`panels`]: the widgets; they emit [`Command`]s, applied after the frame;
 //! - `input.rs`: shortcuts and dropped files; `frame_stats.rs`: the UI thread's frame times;
-//! - [`camera`]: the orbit camera; [`history`]: undo and redo.
+//! - [`camera`]: the orbit camera; [`history`]: undo and redo;
+//! - [`paint`]: the brush that paints where to fair (`tasks/mask.rs` applies its strokes,
+//!   `paint_panel.rs` holds its controls and its handling in the viewport).
 //!
 //! Named worker threads: `fairmesh-io` (load, export), `fairmesh-compute` (hierarchy, fairing,
 //! level meshes; the levels' set-up as idle jobs that any fairing overtakes) and
@@ -26,6 +28,8 @@ mod frame_stats;
 pub mod history;
 mod input;
 pub mod jobs;
+pub mod paint;
+mod paint_panel;
 pub mod panels;
 pub mod state;
 mod tasks;
@@ -141,6 +145,18 @@ pub enum Command {
     Redo,
     /// Write the levels of the hierarchy (the settings' range) as GLB files into a folder.
     ExportLevels,
+    /// One dab of the brush (the first of a stroke records an undo step); `erase` lowers the
+    /// mask instead of raising it.
+    Paint {
+        view: paint::BrushView,
+        erase: bool,
+    },
+    /// The stroke ended: remember the mask and fair with it.
+    EndStroke,
+    /// Forget the mask: fair the whole mesh.
+    ClearMask,
+    /// Paint what was unpainted and the other way round.
+    InvertMask,
 }
 
 /// A summary of the app's state, for tests and the status line.
@@ -229,8 +245,16 @@ pub struct App {
     exit_when_settled: bool,
     /// Where the viewport was drawn in the last frame (points).
     viewport_rect: Option<egui::Rect>,
-    /// Earlier and later document states (noise, applied results, loading).
+    /// Earlier and later document states (noise, applied results, loading, mask changes).
     history: History<DocumentSnapshot>,
+    /// The left button paints the mask instead of orbiting.
+    paint_mode: bool,
+    /// The mask's weights while a stroke is being painted.
+    stroke: Option<Vec<f32>>,
+    /// Where the brush's last dab of the stroke was (screen points).
+    last_dab: Option<egui::Pos2>,
+    /// Bumped with every change of the document's mask, so that its tint is uploaded again.
+    mask_revision: u64,
 }
 
 /// Memory the undo history may keep alive.
@@ -308,6 +332,10 @@ impl App {
             exit_when_settled: options.exit_when_settled,
             viewport_rect: None,
             history: History::new(HISTORY_BUDGET_BYTES),
+            paint_mode: false,
+            stroke: None,
+            last_dab: None,
+            mask_revision: 0,
         };
         for viewport in app.viewports() {
             if let Some(bytes) = options.async_upload_bytes {
@@ -510,6 +538,12 @@ impl App {
             Command::Undo => self.undo(),
             Command::Redo => self.redo(),
             Command::ExportLevels => self.export_levels(),
+            Command::Paint { view, erase } => self.paint_dab(&view, erase),
+            Command::EndStroke => self.end_stroke(),
+            Command::ClearMask => self.change_mask("Clear mask", |_| None),
+            Command::InvertMask => {
+                self.change_mask("Invert mask", |mask| mask.map(|m| m.inverted()))
+            }
         }
     }
 

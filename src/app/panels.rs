@@ -471,6 +471,9 @@ fn controls(app: &mut App, ui: &mut egui::Ui) {
             ui.end_row();
         });
 
+    // Below Export and the numbers: a painting session is an occasional step, and the controls
+    // used on every file stay where they were.
+    super::paint_panel::section(app, ui);
     performance(app, ui);
 }
 
@@ -554,12 +557,18 @@ fn viewport(app: &mut App, ui: &mut egui::Ui) {
             app.settings.split = ((x - rect.left()) / rect.width().max(1.0)).clamp(0.02, 0.98);
         }
     }
+    let painting = !divider_dragged && super::paint_panel::viewport_brush(app, ui, &response, rect);
+    // While painting, the middle button turns the view instead of the left.
+    let orbit_button = match painting {
+        true => egui::PointerButton::Middle,
+        false => egui::PointerButton::Primary,
+    };
     if !divider_dragged {
-        if response.dragged_by(egui::PointerButton::Primary) {
+        if response.dragged_by(orbit_button) {
             app.camera.orbit(response.drag_delta());
         }
         if response.dragged_by(egui::PointerButton::Secondary)
-            || response.dragged_by(egui::PointerButton::Middle)
+            || (!painting && response.dragged_by(egui::PointerButton::Middle))
         {
             app.camera.pan(response.drag_delta(), rect.height());
         }
@@ -685,13 +694,18 @@ fn viewport(app: &mut App, ui: &mut egui::Ui) {
     painter.text(
         rect.left_bottom() + egui::vec2(8.0, -8.0),
         egui::Align2::LEFT_BOTTOM,
-        "Left drag: orbit · right/middle drag: pan · scroll: zoom · F: fit · W: wireframe · B: before/after",
+        if painting {
+            "Painting: left drag paints (Shift: erase) · middle drag: orbit · right drag: pan · P: stop painting"
+        } else {
+            "Left drag: orbit · right/middle drag: pan · scroll: zoom · F: fit · W: wireframe · B: before/after · P: paint"
+        },
         egui::FontId::proportional(12.0),
         egui::Color32::from_gray(150),
     );
     if let (Some(top), Some(reference)) = (app.heat_top(), app.heat_reference()) {
         heat_legend(ui, rect, top, reference);
     }
+    super::paint_panel::brush_outline(app, ui, rect);
     let wireframe = app.settings.wireframe;
     let problem = app
         .viewports()
@@ -995,6 +1009,23 @@ pub mod tips {
     pub const VARIANT: &str = "Paper: the method as published. Improved: two corrections that \
         keep the shape from drifting and shrinking over the levels. Keep Improved unless you \
         compare with the paper.";
+    pub const PAINT: &str = "Paint where to fair (P). On: the left button paints on the mesh \
+        instead of turning the view (middle drag turns it, right drag pans). Only the painted \
+        part is smoothed; the rest keeps its exact shape.";
+    pub const BRUSH_ADD: &str = "The brush marks the part to smooth.";
+    pub const BRUSH_ERASE: &str = "The brush unmarks what it touches, so it keeps its shape \
+        (on a mesh with no mask yet: protects it while the rest is smoothed). Hold Shift to \
+        erase for a moment.";
+    pub const BRUSH_RADIUS: &str = "Size of the brush on screen, in points. Zoom in to paint \
+        finer detail.";
+    pub const BRUSH_SOFTNESS: &str = "How much of the brush's edge fades out. Higher: the \
+        smoothing blends gently into the untouched part; 0: a hard edge.";
+    pub const SHOW_MASK: &str = "Tint the painted part orange on the mesh (it replaces the \
+        heat map while shown).";
+    pub const CLEAR_MASK: &str = "Remove the paint: the whole mesh is smoothed again (undo \
+        with Ctrl+Z).";
+    pub const INVERT_MASK: &str = "Smooth what was left alone and keep what was painted \
+        (undo with Ctrl+Z).";
     pub const APPLY: &str = "Make the result the input mesh, to add noise to it, fair it \
         again or export it as it is (undo with Ctrl+Z).";
 }

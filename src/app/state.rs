@@ -11,7 +11,9 @@ use std::time::Duration;
 
 use serde::{Deserialize, Serialize};
 
-use crate::fairing::{BoundaryMode, HcOptions, LaplacianOptions, MethodOptions, TaubinOptions};
+use crate::fairing::{
+    BoundaryMode, HcOptions, LaplacianOptions, Mask, MethodOptions, TaubinOptions,
+};
 use crate::hierarchy::{Hierarchy, LevelInfo};
 use crate::io::LoadReport;
 use crate::multires::{MultiresOptions, MultiresVariant};
@@ -149,6 +151,8 @@ pub struct Settings {
     /// The start level last chosen for each file, most recent last (at most
     /// [`Settings::REMEMBERED_FILES`]): a file opens at the level the user left it at.
     pub start_levels: Vec<(PathBuf, usize)>,
+    /// The brush, and the mask last painted on each file.
+    pub paint: super::paint::PaintSettings,
 }
 
 impl Default for Settings {
@@ -178,6 +182,7 @@ impl Default for Settings {
             levels_from: 0,
             levels_to: usize::MAX,
             start_levels: Vec::new(),
+            paint: Default::default(),
         }
     }
 }
@@ -298,6 +303,7 @@ impl Settings {
                 VariantSetting::Paper => MultiresVariant::Paper,
                 VariantSetting::Improved => MultiresVariant::Improved,
             },
+            mask: None,
         }
     }
 }
@@ -413,6 +419,8 @@ pub struct Document {
     /// The file was just opened: once the hierarchy is ready, the start level is the one
     /// remembered for the file, or a middle one.
     pub pick_start_level: bool,
+    /// Where to fair (painted with the brush): `None` fairs the whole mesh.
+    pub mask: Option<Mask>,
 }
 
 impl Document {
@@ -443,6 +451,7 @@ impl Document {
             export_path,
             applied: false,
             pick_start_level: false,
+            mask: None,
         }
     }
 
@@ -486,6 +495,8 @@ pub struct DocumentSnapshot {
     /// The view of this document when it was left (set by the app, which owns the camera), so
     /// that undo and redo across an Open bring back the view with the mesh.
     pub camera: Option<super::camera::OrbitCamera>,
+    /// See [`Document::mask`].
+    pub mask: Option<Mask>,
 }
 
 fn mesh_bytes(mesh: &TriMesh) -> usize {
@@ -506,6 +517,7 @@ impl SizeInBytes for DocumentSnapshot {
                 .against_clean
                 .as_ref()
                 .map_or(0, |m| m.vertex_distances.len() * 4)
+            + self.mask.as_ref().map_or(0, |m| m.len() * 4)
     }
 }
 
@@ -533,6 +545,7 @@ impl Document {
             },
             applied: self.applied,
             camera: None,
+            mask: self.mask.clone(),
         }
     }
 
@@ -568,6 +581,7 @@ impl Document {
             source: snapshot.source,
             applied: snapshot.applied,
             pick_start_level: false,
+            mask: snapshot.mask,
         }
     }
 }

@@ -17,6 +17,8 @@ pub(in crate::app) struct Shown {
     pub(in crate::app) what: ShownMesh,
     /// The heat map's reference, when the heat map is on.
     pub(in crate::app) heat: Option<HeatReference>,
+    /// The painted mask's revision, when it is tinted over the mesh (instead of a heat map).
+    pub(in crate::app) mask: Option<u64>,
 }
 
 /// The two viewports: the main one (the view mode's mesh: the result, a level, the original)
@@ -121,12 +123,15 @@ impl App {
     /// one the document's mesh.
     pub(super) fn wanted_mesh(&self, slot: Slot) -> Option<Shown> {
         let document = self.document.as_ref()?;
-        let heat = self.heat_reference();
+        let mask = self.mask_tint();
+        // The tint and the heat map share the mesh's scalars: the mask wins while it is shown.
+        let heat = self.heat_reference().filter(|_| mask.is_none());
         if slot == Slot::Before {
             return Some(Shown {
                 document: document.generation,
                 what: ShownMesh::Original,
                 heat,
+                mask,
             });
         }
         let previous = self
@@ -146,10 +151,12 @@ impl App {
                 None => previous.unwrap_or(ShownMesh::Original),
             },
         };
+        let mask = mask.filter(|_| !matches!(what, ShownMesh::Level { .. }));
         Some(Shown {
             document: document.generation,
             what,
             heat,
+            mask,
         })
     }
 
@@ -270,6 +277,11 @@ impl App {
                 }
             }
         }
+        if wanted.mask.is_some() {
+            if let (Some(mask), Some(viewport)) = (&document.mask, viewport) {
+                viewport.set_scalars(mask.weights());
+            }
+        }
         self.heat_max[slot as usize] = heat_max;
         match slot {
             Slot::Main => {
@@ -301,12 +313,18 @@ impl App {
         let aspect = rect.width() / rect.height().max(1.0);
         let top = self.heat_top();
         let scalar_range = self.heat_max[slot as usize].and(top).map(|top| [0.0, top]);
+        let shown = match slot {
+            Slot::Main => self.shown,
+            Slot::Before => self.shown_before,
+        };
+        let mask_tint = scalar_range.is_none() && shown.is_some_and(|s| s.mask.is_some());
         DrawParams {
             view_proj: self.camera.view_proj(aspect).to_cols_array_2d(),
             eye: self.camera.eye().to_array(),
             light_dir: self.camera.light_dir().to_array(),
             wireframe: self.settings.wireframe,
             scalar_range,
+            mask_tint,
             size: [0, 0],
         }
     }

@@ -40,6 +40,7 @@ pub enum VariantArg {
 #[command(after_help = "Examples:\n  \
     fairmesh fair noisy.obj -o smooth.obj\n  \
     fairmesh fair noisy.obj -o smoother.obj --rounds 5\n  \
+    fairmesh fair scan.obj -o fixed.obj --mask region.txt --mask-falloff 3\n  \
     fairmesh fair noisy.obj -o taubin.obj --method taubin --iterations 20 --json")]
 pub struct FairArgs {
     /// Mesh to smooth (.obj .gltf .glb .ply .stl .off).
@@ -104,6 +105,8 @@ pub struct FairArgs {
     pub measure: bool,
     #[command(flatten)]
     pub stdio: super::StdioFormat,
+    #[command(flatten)]
+    pub mask: super::mask::MaskArgs,
 }
 
 impl FairArgs {
@@ -175,13 +178,17 @@ pub fn run(args: FairArgs) -> anyhow::Result<()> {
     let loaded = super::basic::load_shown(&args.input, true, args.stdio.format)?;
     let (mut mesh, topology, source) = (loaded.mesh, loaded.topology, loaded.source);
     let options = args.method_options(fairmesh::metrics::mean_edge_length(&mesh));
+    let mask = super::mask::load_for(&args.mask, &source, &mesh, Some(&topology))?;
     let volume_before = fairmesh::metrics::signed_volume(&mesh);
     // The input is kept only to measure against it.
     let input = args.measure.then(|| mesh.clone());
 
     let step = super::progress::Step::start("fairing");
     let start = Instant::now();
-    let report = fairing::fair(&mut mesh, &topology, &options);
+    let report = match &mask {
+        Some(mask) => fairing::fair_masked(&mut mesh, &topology, &options, mask),
+        None => fairing::fair(&mut mesh, &topology, &options),
+    };
     let time_ms = start.elapsed().as_secs_f64() * 1e3;
     drop(step);
 
@@ -219,6 +226,7 @@ pub fn run(args: FairArgs) -> anyhow::Result<()> {
             "time_ms": time_ms,
             "volume_change_percent": volume_change_percent,
             "max_move": report.max_move,
+            "masked_vertices": mask.as_ref().map(|m| m.painted_count()),
         });
         if let (Some(m), Some(map)) = (&measures, json.as_object_mut()) {
             map.insert(
@@ -268,10 +276,11 @@ pub fn run(args: FairArgs) -> anyhow::Result<()> {
         n => format!("{n} crease edges kept sharp; "),
     };
     let sentence = format!(
-        "{}{}: {strength}{creases}{} iterations in {:.1} ms, volume change {:+.4}%{}, last \
+        "{}{}: {}{strength}{creases}{} iterations in {:.1} ms, volume change {:+.4}%{}, last \
          largest move {:.3e}{}; wrote {}\n",
         method,
         variant.map(|v| format!(" ({v})")).unwrap_or_default(),
+        super::mask::describe(mask.as_ref()),
         report.iterations_run,
         time_ms,
         volume_change_percent,

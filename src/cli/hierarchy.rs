@@ -130,6 +130,8 @@ pub struct MultiresArgs {
     pub stdio: super::StdioFormat,
     #[command(flatten)]
     pub build: BuildArgs,
+    #[command(flatten)]
+    pub mask: super::mask::MaskArgs,
 }
 
 fn build(mesh: &TriMesh, args: &BuildArgs) -> anyhow::Result<Hierarchy> {
@@ -224,6 +226,7 @@ pub fn run_multires(args: MultiresArgs) -> anyhow::Result<()> {
     let measure = args.measure || args.reference.is_some();
     let loaded = super::basic::load_shown(&args.input, true, args.stdio.format)?;
     let source = loaded.source;
+    let mask = super::mask::load_for(&args.mask, &source, &loaded.mesh, Some(&loaded.topology))?;
     drop(loaded.topology);
     let mut input = loaded.mesh;
     let reference_file = match &args.reference {
@@ -264,6 +267,7 @@ pub fn run_multires(args: MultiresArgs) -> anyhow::Result<()> {
                     BoundaryArg::Fixed => BoundaryMode::Fixed,
                 })
                 .with_fair_finest(args.fair_finest)
+                .with_mask(mask.clone())
                 .with_variant(match variant {
                     VariantArg::Paper => MultiresVariant::Paper,
                     VariantArg::Improved => MultiresVariant::Improved,

@@ -4,6 +4,7 @@ mod basic;
 mod bench;
 mod fair;
 mod hierarchy;
+mod mask;
 mod progress;
 
 use clap::{Parser, Subcommand, ValueEnum};

@@ -268,7 +268,7 @@ impl ConstrainedFairing {
         boundary: BoundaryMode,
     ) -> Self {
         let fans = FanRings::new(&mesh.triangles, topology);
-        Self::with_fans(mesh, topology, &fans, variant, boundary, None)
+        Self::with_fans(mesh, topology, &fans, variant, boundary, None, &[])
     }
 
     /// [`Self::new`] with sharp creases kept: the surface on either side of a crease is faired
@@ -283,10 +283,12 @@ impl ConstrainedFairing {
         creases: &Creases,
     ) -> Self {
         let fans = FanRings::new(&mesh.triangles, topology);
-        Self::with_fans(mesh, topology, &fans, variant, boundary, Some(creases))
+        Self::with_fans(mesh, topology, &fans, variant, boundary, Some(creases), &[])
     }
 
-    /// [`Self::new`] for a caller that already has the mesh's fan-ordered one-rings.
+    /// [`Self::new`] for a caller that already has the mesh's fan-ordered one-rings; `creases`
+    /// kept as in [`Self::with_creases`]; the vertices flagged in `pinned` (empty: none) held
+    /// where they are, like fixed boundary vertices ([`super::mask`]).
     pub(crate) fn with_fans(
         mesh: &TriMesh,
         topology: &Topology,
@@ -294,20 +296,26 @@ impl ConstrainedFairing {
         variant: FairVariant,
         boundary: BoundaryMode,
         creases: Option<&Creases>,
+        pinned: &[bool],
     ) -> Self {
         let vertex_count = mesh.positions.len();
         let triangles = &mesh.triangles;
         let on_boundary = topology.boundary_flags();
-        // Crease vertices and corners bound the surface patches like boundary vertices do.
+        // Crease vertices and corners, and pinned vertices, bound the surface patches like
+        // boundary vertices do: they get no local solution and their triangles are not solved.
         let with_features: Vec<bool>;
-        let is_boundary: &[bool] = match creases {
-            Some(creases) if !creases.is_empty() => {
-                with_features = (0..vertex_count)
-                    .map(|v| on_boundary[v] || creases.is_feature(v as u32))
-                    .collect();
-                &with_features
-            }
-            _ => on_boundary,
+        let creases = creases.filter(|c| !c.is_empty());
+        let is_boundary: &[bool] = if creases.is_some() || !pinned.is_empty() {
+            with_features = (0..vertex_count)
+                .map(|v| {
+                    on_boundary[v]
+                        || creases.is_some_and(|c| c.is_feature(v as u32))
+                        || pinned.get(v).copied().unwrap_or(false)
+                })
+                .collect();
+            &with_features
+        } else {
+            on_boundary
         };
 
         let ring_offsets = topology.neighbor_csr().0.to_vec();
@@ -1057,6 +1065,13 @@ pub fn fair_constrained(
     if options.strength == Strength::Fixed && options.rounds == 0 {
         return FairReport::default();
     }
+    // A mask that does not fit, or pins everything: nothing may move.
+    if let Some(mask) = &options.mask {
+        if mask.check_fits(mesh.positions.len()).is_err() || mask.painted_count() == 0 {
+            return FairReport::default();
+        }
+    }
+    let original = options.mask.as_ref().map(|_| mesh.positions.clone());
     // The noise estimate decides the strength (automatic) and how much the normals are filtered
     // before creases are detected (raw normals of a noisy mesh make creases of the noise).
     let estimate = (options.strength == Strength::Auto || options.creases.is_some())
@@ -1082,16 +1097,22 @@ pub fn fair_constrained(
             .max(estimate.map_or(0, normal_filtering_for));
         detect_creases(mesh, topology, &crease_options)
     });
-    let mut fairing = match &creases {
-        Some(creases) => ConstrainedFairing::with_creases(
-            mesh,
-            topology,
-            options.variant,
-            options.boundary,
-            creases,
-        ),
-        None => ConstrainedFairing::new(mesh, topology, options.variant, options.boundary),
-    };
+    let pinned = options
+        .mask
+        .as_ref()
+        .map(|mask| mask.pinned_flags())
+        .unwrap_or_default();
+    let fans = FanRings::new(&mesh.triangles, topology);
+    let mut fairing = ConstrainedFairing::with_fans(
+        mesh,
+        topology,
+        &fans,
+        options.variant,
+        options.boundary,
+        creases.as_ref(),
+        &pinned,
+    );
+    drop(fans);
     fairing.set_tangential_relaxation(options.tangential_relaxation as f32);
     let mut report = match auto_noise {
         None => fairing.run(&mut mesh.positions, options),
@@ -1119,6 +1140,11 @@ pub fn fair_constrained(
             report
         }
     };
+    // The operator held the pinned vertices; the blend fades the rest by their weights (and
+    // puts back pinned boundary vertices, which the boundary curves may have moved).
+    if let (Some(mask), Some(original)) = (&options.mask, &original) {
+        mask.blend(original, &mut mesh.positions);
+    }
     report.noise_estimate = estimate;
     report.crease_edges = creases.map_or(0, |c| c.edges.len());
     report

@@ -50,6 +50,7 @@ pub mod baseline;
 pub mod boundary;
 pub mod constrained;
 pub mod creases;
+pub mod mask;
 pub mod strength;
 
 use crate::mesh::{Topology, TriMesh};
@@ -59,6 +60,7 @@ pub use baseline::{
 };
 pub use constrained::{fair_constrained, ConstrainedFairing};
 pub use creases::{detect_creases, CreaseOptions, Creases, FeatureClass};
+pub use mask::{Mask, MaskError};
 pub use strength::estimate_noise;
 
 /// How boundary vertices of open meshes move.
@@ -128,6 +130,10 @@ pub struct FairOptions {
     /// Normal-projected only: weight (0 to 1) of the tangential relaxation that evens out
     /// triangles jittered along the surface ([`ConstrainedFairing::set_tangential_relaxation`]).
     pub tangential_relaxation: f64,
+    /// Where to fair ([`mask`]): `None` fairs every vertex; with a mask, weight-0 vertices are
+    /// held like fixed boundary vertices and the rest blended by their weights. A mask that does
+    /// not fit the mesh leaves it unchanged.
+    pub mask: Option<Mask>,
 }
 
 with_setters!(FairOptions {
@@ -138,6 +144,7 @@ with_setters!(FairOptions {
     with_variant => variant: FairVariant,
     with_creases => creases: Option<CreaseOptions>,
     with_tangential_relaxation => tangential_relaxation: f64,
+    with_mask => mask: Option<Mask>,
 });
 
 impl FairOptions {
@@ -170,6 +177,7 @@ impl Default for FairOptions {
             variant: FairVariant::NormalProjected,
             creases: Some(CreaseOptions::default()),
             tangential_relaxation: DEFAULT_TANGENTIAL_RELAXATION,
+            mask: None,
         }
     }
 }
@@ -289,4 +297,27 @@ pub fn fair(mesh: &mut TriMesh, topology: &Topology, options: &MethodOptions) ->
         MethodOptions::Taubin(o) => fair_taubin(mesh, topology, o),
         MethodOptions::Hc(o) => fair_hc(mesh, topology, o),
     }
+}
+
+/// [`fair`] changing the mesh only where `mask` allows ([`mask`]): constrained fairing holds the
+/// weight-0 vertices like fixed boundary vertices ([`FairOptions::mask`]); the baselines smooth
+/// the whole mesh and the result is blended back by the weights. Either way weight-0 vertices
+/// keep their positions exactly. A mask that does not fit the mesh leaves it unchanged.
+pub fn fair_masked(
+    mesh: &mut TriMesh,
+    topology: &Topology,
+    options: &MethodOptions,
+    mask: &Mask,
+) -> FairReport {
+    if mask.check_fits(mesh.positions.len()).is_err() {
+        return FairReport::default();
+    }
+    if let MethodOptions::Constrained(o) = options {
+        let masked = o.clone().with_mask(Some(mask.clone()));
+        return fair_constrained(mesh, topology, &masked);
+    }
+    let original = mesh.positions.clone();
+    let report = fair(mesh, topology, options);
+    mask.blend(&original, &mut mesh.positions);
+    report
 }

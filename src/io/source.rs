@@ -154,6 +154,20 @@ impl Source {
             .collect()
     }
 
+    /// How many vertices the file holds, in its own order (before welding and clean-up).
+    pub fn file_vertex_count(&self) -> usize {
+        self.raw_vertices
+    }
+
+    /// The loaded (welded) vertex that the file's vertex `file_vertex` (0-based, in the file's
+    /// order) became; `None` when it is out of range or was dropped (unused by any triangle).
+    pub fn loaded_vertex(&self, file_vertex: usize) -> Option<usize> {
+        if file_vertex >= self.raw_vertices {
+            return None;
+        }
+        self.welded(file_vertex)
+    }
+
     /// The welded vertex that parser vertex `raw` became, if it was kept.
     #[inline]
     pub(crate) fn welded(&self, raw: usize) -> Option<usize> {

@@ -34,6 +34,8 @@ pub struct DrawParams {
     pub wireframe: bool,
     /// Scalars mapped to the heat map's two ends; `None` draws the plain base colour.
     pub scalar_range: Option<[f32; 2]>,
+    /// Without a heat map: the scalars are a mask (0 to 1), tinted over the base colour.
+    pub mask_tint: bool,
     /// Target size in physical pixels.
     pub size: [u32; 2],
 }
@@ -754,9 +756,10 @@ impl MeshRenderer {
             ],
             base_color: [0.62, 0.56, 0.48, 1.0],
             wire_color: [0.02, 0.03, 0.05, 1.0],
-            scalar_range: match params.scalar_range {
-                Some([lo, hi]) => [lo, hi, 1.0, 0.0],
-                None => [0.0, 1.0, 0.0, 0.0],
+            scalar_range: match (params.scalar_range, params.mask_tint) {
+                (Some([lo, hi]), _) => [lo, hi, 1.0, 0.0],
+                (None, true) => [0.0, 1.0, 2.0, 0.0],
+                (None, false) => [0.0, 1.0, 0.0, 0.0],
             },
         };
         queue.write_buffer(&self.uniform_buffer, 0, bytemuck::bytes_of(&uniforms));

@@ -35,6 +35,10 @@ impl App {
         let document = Document::from_snapshot(snapshot, generation);
         let needs_build = matches!(document.hierarchy, HierarchyState::Building);
         self.document = Some(document);
+        // Undo and redo may bring back another mask: it is the file's mask from now on.
+        self.stroke = None;
+        self.mask_revision += 1;
+        self.remember_mask();
         self.applied_view = 0;
         self.applied_level_view = 0;
         self.fair_in_flight = false;

@@ -11,6 +11,9 @@ use crate::app::App;
 use crate::multires;
 use crate::{hierarchy, metrics, TriMesh};
 
+/// Rings of vertices over which a painted mask always fades out at its edge.
+const MASK_EDGE_RINGS: usize = 3;
+
 impl App {
     /// Asks for what the current view mode needs at the current level and options.
     pub(in crate::app) fn refresh_view(&mut self) {
@@ -42,7 +45,8 @@ impl App {
         level: usize,
         view: u64,
     ) {
-        let options = self.settings.multires_options(level);
+        let mask = self.document.as_ref().and_then(|d| d.mask.clone());
+        let mut options = self.settings.multires_options(level);
         let baseline = self.settings.baseline_options();
         let method = self.settings.method;
         let document_generation = self.document_generation.clone();
@@ -63,12 +67,25 @@ impl App {
                 progress_out.set(fraction);
                 document_generation.is_current(document)
             };
+            // A few rings of fade inside the painted region's edge, whatever the brush left: where
+            // the brush stopped at a silhouette the mask drops from 1 to 0 at once, and the
+            // result would show a step there.
+            let mask = mask.map(|mask| {
+                let topology = crate::Topology::build(hierarchy.base_mesh());
+                mask.with_falloff(&topology, MASK_EDGE_RINGS)
+            });
+            options.mask = mask.clone();
             let positions = match &baseline {
                 // A baseline smooths the document's mesh itself; the level does not apply.
                 Some(method) => {
                     let mut mesh = hierarchy.base_mesh().clone();
                     let topology = crate::Topology::build(&mesh);
-                    crate::fairing::fair(&mut mesh, &topology, method);
+                    match &mask {
+                        Some(mask) => {
+                            crate::fairing::fair_masked(&mut mesh, &topology, method, mask)
+                        }
+                        None => crate::fairing::fair(&mut mesh, &topology, method),
+                    };
                     progress(1.0);
                     Some(mesh.positions)
                 }

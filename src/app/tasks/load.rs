@@ -122,7 +122,13 @@ impl App {
                     .file_name()
                     .map(|n| n.to_string_lossy().into_owned())
                     .unwrap_or_else(|| path.display().to_string());
+                // The mask last painted on this file comes back with it.
+                let mask = self
+                    .settings
+                    .paint
+                    .mask_for(&path, loaded.mesh.positions.len());
                 let snapshot = DocumentSnapshot {
+                    mask,
                     export_path: state::default_export_path(&path).display().to_string(),
                     path,
                     mesh: Arc::new(loaded.mesh),

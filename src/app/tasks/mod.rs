@@ -6,4 +6,5 @@ pub mod export;
 pub mod fairing;
 pub mod hierarchy;
 pub mod load;
+pub mod mask;
 pub mod measure;

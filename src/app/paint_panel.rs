@@ -1,0 +1,156 @@
+//! The "Paint where to fair" controls of the side panel, and the brush in the viewport: while
+//! painting, the left button emits [`Command::Paint`] dabs (one stroke per press) and the brush's
+//! outline follows the cursor.
+
+use super::paint::BrushView;
+use super::panels::tips;
+use super::state::{CompareView, ViewMode};
+use super::{App, Command};
+
+/// The side panel's section: paint mode, brush, mask tint, clear and invert.
+pub(super) fn section(app: &mut App, ui: &mut egui::Ui) {
+    ui.separator();
+    ui.heading("Paint where to fair");
+    let level_view = app.settings.view_mode == ViewMode::Level;
+    let paint = ui
+        .add_enabled(
+            !level_view,
+            egui::Checkbox::new(&mut app.paint_mode, "Paint (P)"),
+        )
+        .on_hover_text(tips::PAINT)
+        .on_disabled_hover_text(format!(
+            "{}\n\nThe level view shows a coarse mesh: switch to Faired to paint.",
+            tips::PAINT
+        ));
+    if paint.changed() && !app.paint_mode {
+        app.commands.push(Command::EndStroke);
+    }
+    let brush = &mut app.settings.paint;
+    ui.horizontal(|ui| {
+        ui.selectable_value(&mut brush.erase, false, "Add")
+            .on_hover_text(tips::BRUSH_ADD);
+        ui.selectable_value(&mut brush.erase, true, "Erase")
+            .on_hover_text(tips::BRUSH_ERASE);
+    });
+    ui.add(egui::Slider::new(&mut brush.radius, 4.0..=200.0).text("Brush radius (pt)"))
+        .on_hover_text(tips::BRUSH_RADIUS);
+    ui.add(egui::Slider::new(&mut brush.softness, 0.0..=1.0).text("Soft edge"))
+        .on_hover_text(tips::BRUSH_SOFTNESS);
+    ui.checkbox(&mut brush.show_mask, "Show mask")
+        .on_hover_text(tips::SHOW_MASK);
+    let mask = app.document.as_ref().and_then(|d| d.mask.as_ref());
+    ui.horizontal(|ui| {
+        let has_mask = mask.is_some();
+        let clear = ui
+            .add_enabled(has_mask, egui::Button::new("Clear mask"))
+            .on_hover_text(tips::CLEAR_MASK)
+            .on_disabled_hover_text(format!("{}\n\nNothing is painted.", tips::CLEAR_MASK));
+        if clear.clicked() {
+            app.commands.push(Command::ClearMask);
+        }
+        let invert = ui
+            .add_enabled(has_mask, egui::Button::new("Invert mask"))
+            .on_hover_text(tips::INVERT_MASK)
+            .on_disabled_hover_text(format!("{}\n\nNothing is painted.", tips::INVERT_MASK));
+        if invert.clicked() {
+            app.commands.push(Command::InvertMask);
+        }
+    });
+    match mask {
+        Some(mask) => ui.small(format!(
+            "Painted: {} of {} vertices are smoothed; the rest keeps its shape",
+            mask.painted_count(),
+            mask.len()
+        )),
+        None => ui.small("Nothing painted: the whole mesh is smoothed"),
+    };
+}
+
+/// The brush in the viewport: emits dabs while the left button is down on the view in paint
+/// mode and ends the stroke on release. Returns whether the left button belongs to the brush
+/// (so it does not orbit).
+pub(super) fn viewport_brush(
+    app: &mut App,
+    ui: &egui::Ui,
+    response: &egui::Response,
+    rect: egui::Rect,
+) -> bool {
+    if !app.paint_mode || app.settings.view_mode == ViewMode::Level {
+        if app.stroke.is_some() {
+            app.commands.push(Command::EndStroke);
+        }
+        return false;
+    }
+    let image = painted_image(app, rect);
+    let (primary_down, shift, hover) = ui.input(|i| {
+        (
+            i.pointer.primary_down(),
+            i.modifiers.shift,
+            i.pointer.hover_pos(),
+        )
+    });
+    let radius = app.settings.paint.radius;
+    let pressed_here = response.is_pointer_button_down_on() && primary_down;
+    match response.interact_pointer_pos().or(hover) {
+        Some(cursor) if pressed_here && image.contains(cursor) => {
+            // Dabs every quarter radius from the last one, so a fast stroke leaves no gaps
+            // between the frames' cursor positions; at most 8 a frame (each dab tests every
+            // triangle: on a big mesh a frame must not pay for dozens).
+            let from = app.last_dab.unwrap_or(cursor);
+            let spacing = (radius * 0.25).max(1.0);
+            let steps = ((cursor - from).length() / spacing).ceil().clamp(1.0, 8.0) as usize;
+            let aspect = image.width() / image.height().max(1.0);
+            let erase = app.settings.paint.erase != shift;
+            for step in 1..=steps {
+                let view = BrushView {
+                    view_proj: app.camera.view_proj(aspect),
+                    eye: app.camera.eye(),
+                    rect: image,
+                    cursor: from.lerp(cursor, step as f32 / steps as f32),
+                    radius,
+                };
+                app.commands.push(Command::Paint { view, erase });
+            }
+            app.last_dab = Some(cursor);
+        }
+        _ if !primary_down && (app.stroke.is_some() || app.last_dab.is_some()) => {
+            app.last_dab = None;
+            app.commands.push(Command::EndStroke);
+        }
+        _ => {}
+    }
+    true
+}
+
+/// The image the brush paints on: the result's, the right half side by side, the whole view
+/// otherwise.
+fn painted_image(app: &App, rect: egui::Rect) -> egui::Rect {
+    match app.settings.compare {
+        CompareView::SideBySide => rect.split_left_right_at_fraction(0.5).1,
+        CompareView::Single | CompareView::Split => rect,
+    }
+}
+
+/// The brush's outline at the cursor (and its hard inner part), over the drawn mesh; orange
+/// adds, blue erases.
+pub(super) fn brush_outline(app: &App, ui: &egui::Ui, rect: egui::Rect) {
+    if !app.paint_mode || app.settings.view_mode == ViewMode::Level {
+        return;
+    }
+    let (shift, hover) = ui.input(|i| (i.modifiers.shift, i.pointer.hover_pos()));
+    let Some(cursor) = hover.filter(|p| painted_image(app, rect).contains(*p)) else {
+        return;
+    };
+    let brush = &app.settings.paint;
+    let colour = if brush.erase != shift {
+        egui::Color32::from_rgb(120, 190, 255)
+    } else {
+        egui::Color32::from_rgb(255, 150, 60)
+    };
+    let painter = ui.painter_at(rect);
+    painter.circle_stroke(cursor, brush.radius, egui::Stroke::new(1.5, colour));
+    let inner = brush.radius * (1.0 - brush.softness.clamp(0.0, 1.0));
+    if inner > 1.0 {
+        painter.circle_stroke(cursor, inner, egui::Stroke::new(0.8, colour));
+    }
+}
