@@ -26,6 +26,7 @@ mod gltf_writeback;
 mod obj;
 mod off;
 mod ply;
+mod scene;
 mod source;
 mod stl;
 mod text;
@@ -495,35 +496,96 @@ pub fn save_with_source(
         }
         return Ok(report);
     }
-    // Another format: what it can hold per vertex (UVs, colours) is carried when the mesh still
-    // has the source's vertices; the rest is named.
-    let carries = matches!(format, Format::Obj | Format::Glb | Format::Gltf);
-    let extra = if carries && !source.writes_back_as(format) && source.matches(mesh) {
+    let name = name.to_string();
+    let carries = !source.writes_back_as(format) && source.matches(mesh);
+    // A glTF scene or an OBJ into OBJ or glTF: its parts, materials, UVs, normals and colours.
+    if carries && matches!(format, Format::Obj | Format::Glb | Format::Gltf) {
+        if let Some(mut scene) = source.scene(mesh) {
+            let mut merged_colours = 0;
+            match format {
+                Format::Obj => obj::write_scene(path, &scene, mesh, &mut merged_colours)?,
+                _ => gltf::write_scene(path, format == Format::Glb, &mut scene, mesh)?,
+            }
+            let mut lost = source.contents_beyond_scene(&scene, format);
+            if merged_colours > 0 {
+                lost.push(format!(
+                    "the colour borders at {merged_colours} vertices (an OBJ vertex keeps one colour; the first was kept)"
+                ));
+            }
+            lost.append(&mut scene.warnings);
+            if !lost.is_empty() {
+                report.warnings.push(format!(
+                    "it is written as {format} with its {}; not kept from {name}: {}",
+                    and_list(&scene.carried()),
+                    lost.join("; ")
+                ));
+            }
+            return Ok(report);
+        }
+    }
+    // Otherwise what the format can hold per vertex (UVs, colours; normals into PLY) is carried
+    // when the mesh still has the source's vertices; the rest is named.
+    let extra = if carries
+        && matches!(
+            format,
+            Format::Obj | Format::Glb | Format::Gltf | Format::Ply
+        ) {
         source.vertex_attributes()
     } else {
         carry::VertexAttributes::default()
     };
+    let (mut kept, mut lost) = extra.describe();
+    let mut beyond = source.contents_beyond(&extra);
     match format {
         Format::Obj => atomic::write(path, |w| obj::write_with(w, mesh, &extra))?,
         Format::Glb => atomic::write(path, |w| gltf::write_glb_with(w, mesh, &extra))?,
         Format::Gltf => gltf::write_gltf_with(path, mesh, &extra)?,
+        Format::Ply if carries => {
+            // Normals, when the file had them, are recomputed from the faired shape: one per
+            // vertex, so the split ones (hard edges) become smooth; how many is said.
+            let had_normals = beyond
+                .iter()
+                .any(|item| item == "normals" || item.starts_with("normals ("));
+            let normals = had_normals.then(|| gltf::unit_vertex_normals(mesh));
+            atomic::write(path, |w| {
+                ply::write_with(w, mesh, &extra, normals.as_deref())
+            })?;
+            if had_normals {
+                kept.push("normals (recomputed)");
+                beyond.retain(|item| item != "normals" && !item.starts_with("normals ("));
+                let split = source.split_normal_vertices(mesh);
+                if split > 0 {
+                    lost.push(format!(
+                        "the split normals (hard edges, seams) at {split} vertices: a PLY vertex holds one normal, recomputed smooth from the faired shape"
+                    ));
+                }
+            }
+        }
         _ => save_as(path, mesh, format)?,
     }
-    let (kept, mut lost) = extra.describe();
-    lost.extend(source.contents_beyond(&extra));
+    lost.extend(beyond);
     if !lost.is_empty() {
         let why = if source.writes_back_as(format) {
             "the mesh no longer has its connectivity (a level of the hierarchy or a changed copy), so it is written as a bare mesh".to_string()
         } else if kept.is_empty() {
             format!("it is written as a bare {format} mesh")
         } else {
-            format!("it is written as {format} with its {}", kept.join(" and "))
+            format!("it is written as {format} with its {}", and_list(&kept))
         };
         report
             .warnings
             .push(format!("{why}; not kept from {name}: {}", lost.join("; ")));
     }
     Ok(report)
+}
+
+/// "a", "a and b", "a, b and c".
+fn and_list(items: &[&str]) -> String {
+    match items {
+        [] => String::new(),
+        [one] => one.to_string(),
+        [rest @ .., last] => format!("{} and {last}", rest.join(", ")),
+    }
 }
 
 /// Refuse meshes that no reader could load back: no triangles, NaN/inf, indices out of range.
