@@ -1287,3 +1287,87 @@ fn a_binary_stl_header_is_written_back_or_named() {
         "{text}"
     );
 }
+
+#[test]
+fn a_coarse_level_keeps_names_materials_and_the_kept_vertices_uvs_and_colours() {
+    use fairmesh::hierarchy::{build_hierarchy, HierarchyOptions};
+    let dir = tempfile::tempdir().unwrap();
+    let loaded = io::load(data("scene.glb")).unwrap();
+    let hierarchy = build_hierarchy(
+        &loaded.mesh,
+        &HierarchyOptions::default(),
+        &mut fairmesh::NoProgress,
+    )
+    .unwrap();
+    let level = (hierarchy.coarsest_level() / 2).max(1);
+    let mesh = hierarchy.level_mesh(level);
+    assert!(mesh.vertex_count() < loaded.mesh.vertex_count() / 2);
+    let (vertex_origin, face_origin) = hierarchy.level_origins(level);
+    let derivation = io::Derivation {
+        base: hierarchy.base_mesh(),
+        vertex_origin: &vertex_origin,
+        face_origin: &face_origin,
+    };
+    let glb = dir.path().join("level.glb");
+    let obj = dir.path().join("level.obj");
+    let report = io::save_derived_with_source(&glb, &mesh, &derivation, &loaded.source).unwrap();
+    io::save_derived_with_source(&obj, &mesh, &derivation, &loaded.source).unwrap();
+    validate(std::slice::from_ref(&glb));
+    assert_same_surface(&glb, &mesh);
+    assert_same_surface(&obj, &mesh);
+    let input = read_gltf(&data("scene.glb"));
+    let uvs = placed_values(&input, "TEXCOORD_0");
+    let colours = placed_values(&input, "COLOR_0");
+    let output = read_gltf(&glb);
+    let json = &output.json;
+    let names: BTreeSet<&str> = json["nodes"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|n| n["name"].as_str().unwrap())
+        .collect();
+    assert_eq!(names, BTreeSet::from(["ball", "block"]));
+    let mut checked = (0, 0);
+    for node in json["nodes"].as_array().unwrap() {
+        let m = &json["meshes"][node["mesh"].as_u64().unwrap() as usize];
+        let primitive = &m["primitives"][0];
+        let material = &json["materials"][primitive["material"].as_u64().unwrap() as usize];
+        let attributes = &primitive["attributes"];
+        let positions = output.floats(attributes["POSITION"].as_u64().unwrap() as usize);
+        let texcoords = output.floats(attributes["TEXCOORD_0"].as_u64().unwrap() as usize);
+        let rgba = output.floats(attributes["COLOR_0"].as_u64().unwrap() as usize);
+        for k in 0..positions.len() {
+            let p = [positions[k][0], positions[k][1], positions[k][2]];
+            if node["name"] == "ball" {
+                assert_eq!(material["name"], "checker");
+                assert!(material["pbrMetallicRoughness"]["baseColorTexture"].is_object());
+                assert_eq!(is_a_value_at(&uvs, p, &texcoords[k], 1e-6), Some(true));
+                checked.0 += 1;
+            } else {
+                assert_eq!(material["name"], "paint");
+                assert_eq!(is_a_value_at(&colours, p, &rgba[k], 1e-6), Some(true));
+                checked.1 += 1;
+            }
+        }
+    }
+    assert!(checked.0 > 50 && checked.1 > 50, "{checked:?}");
+    let text = report.warnings.join("\n");
+    for item in [
+        "a coarser level has fewer vertices",
+        "with the names, materials, textures, UVs, normals and vertex colours of the kept vertices",
+        "recomputed, smooth",
+        "the node tree",
+    ] {
+        assert!(text.contains(item), "{item} not in: {text}");
+    }
+    let obj_text = std::fs::read_to_string(&obj).unwrap();
+    for line in [
+        "mtllib level.mtl",
+        "o ball",
+        "usemtl checker",
+        "o block",
+        "usemtl paint",
+    ] {
+        assert!(obj_text.contains(line), "{line}");
+    }
+}

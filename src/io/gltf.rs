@@ -1180,7 +1180,7 @@ pub(crate) fn write_scene(
         meshes.push(mesh_json);
         let mut node = json!({ "mesh": meshes.len() - 1 });
         match (&part.object, &part.group) {
-            (Some(object), Some(group)) => {
+            (Some(object), Some(group)) if scene.groups_under_objects => {
                 node["name"] = json!(group);
                 nodes.push(node);
                 let child = nodes.len() - 1;

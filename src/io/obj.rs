@@ -498,7 +498,10 @@ fn rest_of<'a>(words: impl Iterator<Item = &'a [u8]>) -> Option<String> {
 /// [`super::scene`]). Normals turn with their faces to `mesh`'s positions, slot by `vn` line as
 /// in [`write_back`].
 pub(crate) fn scene(bytes: &[u8], source: &Source, mesh: &TriMesh) -> Scene {
-    let mut scene = Scene::default();
+    let mut scene = Scene {
+        groups_under_objects: true,
+        ..Scene::default()
+    };
     let mut positions: Vec<[f32; 3]> = Vec::with_capacity(source.raw_vertices);
     let mut colours: Vec<Option<[f32; 3]>> = Vec::with_capacity(source.raw_vertices);
     let mut uvs: Vec<[f32; 2]> = Vec::new();

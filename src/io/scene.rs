@@ -21,6 +21,7 @@
 
 use super::source::{dvec, NormalTurns, SmoothGroups};
 use crate::mesh::TriMesh;
+use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 
 /// A source's structure, for writing it in another format.
@@ -32,6 +33,9 @@ pub(crate) struct Scene {
     pub colours: bool,
     pub normals: bool,
     pub parts: Vec<Part>,
+    /// Whether parts are groups of named objects (an OBJ's `g`s under its `o`s): a glTF gets a
+    /// node per object over a node per group. Otherwise (a glTF's nodes) a part is one node.
+    pub groups_under_objects: bool,
     pub materials: Vec<Material>,
     /// What could not be read while building the scene (a missing `.mtl`, an unreadable image).
     pub warnings: Vec<String>,
@@ -237,6 +241,138 @@ impl Scene {
             out.push("vertex colours");
         }
         out
+    }
+
+    /// The scene of a mesh derived from this one's welded mesh `base` by removing vertices (a
+    /// coarse level of the hierarchy): `mesh`'s vertex `j` is base vertex `vertex_origin[j]`, its
+    /// triangle `i` what is left of base triangle `face_origin[i]`. Each triangle stays in its
+    /// base triangle's part and material; a corner whose vertex survived keeps its file vertex
+    /// (UV, colour); a corner moved onto another vertex by a collapse takes that vertex's file
+    /// vertex in the same material (or its first). Normals are left to be recomputed (they are
+    /// zero here: see [`Scene::fill_missing_normals`]). The number of level triangles whose base
+    /// triangle was not found (they go to an unnamed part) comes back too.
+    pub(crate) fn derive(
+        &self,
+        base: &TriMesh,
+        mesh: &TriMesh,
+        vertex_origin: &[u32],
+        face_origin: &[u32],
+    ) -> (Scene, usize) {
+        let canonical = |t: [u32; 3]| {
+            let k = (0..3).min_by_key(|&k| t[k]).unwrap_or(0);
+            [t[k], t[(k + 1) % 3], t[(k + 2) % 3]]
+        };
+        // Base triangle (welded corners) -> (part, primitive, file corners); a triangle the
+        // loader turned over (to orient the mesh consistently) is found reversed.
+        let mut by_triangle: HashMap<[u32; 3], (usize, usize, [u32; 3])> = HashMap::new();
+        let mut in_primitive: HashMap<(u32, usize, usize), u32> = HashMap::new();
+        let mut first_any = vec![u32::MAX; base.positions.len()];
+        for (p, part) in self.parts.iter().enumerate() {
+            for (q, primitive) in part.primitives.iter().enumerate() {
+                for &t in &primitive.triangles {
+                    let welded = t.map(|v| self.vertices[v as usize].welded);
+                    by_triangle.entry(canonical(welded)).or_insert((p, q, t));
+                    by_triangle
+                        .entry(canonical([welded[0], welded[2], welded[1]]))
+                        .or_insert((p, q, t));
+                    for k in 0..3 {
+                        in_primitive.entry((welded[k], p, q)).or_insert(t[k]);
+                        if let Some(first) = first_any.get_mut(welded[k] as usize) {
+                            if *first == u32::MAX {
+                                *first = t[k];
+                            }
+                        }
+                    }
+                }
+            }
+        }
+        let mut derived = Scene {
+            uvs: self.uvs,
+            colours: self.colours,
+            normals: self.normals,
+            groups_under_objects: self.groups_under_objects,
+            parts: self
+                .parts
+                .iter()
+                .map(|part| Part {
+                    object: part.object.clone(),
+                    group: part.group.clone(),
+                    primitives: part
+                        .primitives
+                        .iter()
+                        .map(|p| Primitive {
+                            material: p.material,
+                            triangles: Vec::new(),
+                        })
+                        .collect(),
+                })
+                .collect(),
+            materials: self
+                .materials
+                .iter()
+                .map(|m| Material {
+                    name: m.name.clone(),
+                    base_colour: m.base_colour,
+                    metallic: m.metallic,
+                    roughness: m.roughness,
+                    texture: m.texture.clone(),
+                })
+                .collect(),
+            ..Scene::default()
+        };
+        let mut unplaced = Primitive::default();
+        let mut index: HashMap<(u32, u32), u32> = HashMap::new();
+        let mut vertex_of = |file: u32, level: u32, vertices: &mut Vec<SceneVertex>| {
+            *index.entry((file, level)).or_insert_with(|| {
+                let mut vertex = self
+                    .vertices
+                    .get(file as usize)
+                    .copied()
+                    .unwrap_or_else(|| SceneVertex::new(None, [0.0; 3]));
+                vertex.welded = level;
+                vertex.normal = [0.0; 3];
+                vertex.slot = usize::MAX;
+                vertices.push(vertex);
+                (vertices.len() - 1) as u32
+            })
+        };
+        for (i, t) in mesh.triangles.iter().enumerate() {
+            let origin = face_origin
+                .get(i)
+                .and_then(|&f| base.triangles.get(f as usize))
+                .and_then(|&b| by_triangle.get(&canonical(b)));
+            let base_of = |v: u32| vertex_origin.get(v as usize).copied().unwrap_or(u32::MAX);
+            let corners = t.map(|level| {
+                let b = base_of(level);
+                let file = match origin {
+                    Some(&(p, q, corners)) => corners
+                        .into_iter()
+                        .find(|&c| self.vertices[c as usize].welded == b)
+                        .or_else(|| in_primitive.get(&(b, p, q)).copied()),
+                    None => None,
+                }
+                .or_else(|| first_any.get(b as usize).copied())
+                .unwrap_or(u32::MAX);
+                vertex_of(file, level, &mut derived.vertices)
+            });
+            match origin {
+                Some(&(p, q, _)) => derived.parts[p].primitives[q].triangles.push(corners),
+                None => unplaced.triangles.push(corners),
+            }
+        }
+        let unplaced_count = unplaced.triangles.len();
+        if unplaced_count > 0 {
+            derived.parts.push(Part {
+                primitives: vec![unplaced],
+                ..Part::default()
+            });
+        }
+        for part in &mut derived.parts {
+            part.primitives.retain(|p| !p.triangles.is_empty());
+        }
+        derived.parts.retain(|p| !p.primitives.is_empty());
+        derived.fill_missing_normals(mesh);
+        (derived, unplaced_count)
     }
 
     /// How many triangles in all.
