@@ -1371,3 +1371,29 @@ fn a_coarse_level_keeps_names_materials_and_the_kept_vertices_uvs_and_colours() 
         assert!(obj_text.contains(line), "{line}");
     }
 }
+
+#[test]
+fn non_finite_uvs_normals_and_colours_never_reach_another_format() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = dir.path().join("bad.obj");
+    std::fs::write(
+        &input,
+        "v 0 0 0 nan 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nvt nan inf\nvt 0.5 0.5\nvn nan 0 0\nvn 0 0 1\n\
+         f 1/1/1 3/2/2 2/2/2\nf 1/1/1 2/2/2 4/2/2\nf 1/2/1 4/2/2 3/2/2\nf 2/2/2 3/2/2 4/1/1\n",
+    )
+    .unwrap();
+    let loaded = io::load(&input).unwrap();
+    let mut moved = loaded.mesh.clone();
+    moved.positions[3][2] = 1.5;
+    let out = dir.path().join("bad.glb");
+    io::save_with_source(&out, &moved, &loaded.source).unwrap();
+    validate(std::slice::from_ref(&out));
+    let output = read_gltf(&out);
+    for primitive in output.primitives() {
+        for (_, a) in primitive["attributes"].as_object().unwrap() {
+            for value in output.floats(a.as_u64().unwrap() as usize) {
+                assert!(value.iter().all(|c| c.is_finite()), "{value:?}");
+            }
+        }
+    }
+}

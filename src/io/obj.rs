@@ -523,16 +523,28 @@ pub(crate) fn scene(bytes: &[u8], source: &Source, mesh: &TriMesh) -> Scene {
                 positions.push(vertex_of(values.iter().copied()).unwrap_or([f32::NAN; 3]));
                 colours.push((values.len() == 6).then(|| {
                     [3, 4, 5].map(|i| {
-                        super::text::parse_f32(values[i]).map_or(1.0, |c| c.clamp(0.0, 1.0))
+                        super::text::parse_f32(values[i])
+                            .filter(|c| c.is_finite())
+                            .map_or(1.0, |c| c.clamp(0.0, 1.0))
                     })
                 }));
             }
             Some(b"vt") => {
-                let u = words.next().and_then(super::text::parse_f32).unwrap_or(0.0);
-                let v = words.next().and_then(super::text::parse_f32).unwrap_or(0.0);
-                uvs.push([u, v]);
+                // Never a NaN in the output: what is not a finite number becomes 0.
+                let mut number = || {
+                    words
+                        .next()
+                        .and_then(super::text::parse_f32)
+                        .filter(|c| c.is_finite())
+                        .unwrap_or(0.0)
+                };
+                uvs.push([number(), number()]);
             }
-            Some(b"vn") => normals.push(vertex_of(words.take(3)).unwrap_or([0.0; 3])),
+            Some(b"vn") => normals.push(
+                vertex_of(words.take(3))
+                    .filter(|n| n.iter().all(|c| c.is_finite()))
+                    .unwrap_or([0.0; 3]),
+            ),
             Some(b"o") => {
                 object = rest_of(words);
                 current = None;
