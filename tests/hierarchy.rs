@@ -291,13 +291,17 @@ fn fixed_boundary_stays_fixed_in_multires_from_every_level() {
     }
 }
 
+fn build_with_creases(mesh: &TriMesh) -> Hierarchy {
+    let options = HierarchyOptions::default()
+        .with_creases(Some(fairmesh::fairing::CreaseOptions::default()));
+    build_hierarchy(mesh, &options, &mut NoProgress).unwrap()
+}
+
 /// Mean surface distance from `reference` of multires from `level` of a hierarchy of `mesh`
 /// built with or without creases.
 fn multires_distance(reference: &TriMesh, mesh: &TriMesh, creases: bool, level: usize) -> f64 {
-    let mut options = HierarchyOptions::default();
-    if !creases {
-        options = options.with_creases(None);
-    }
+    let options = HierarchyOptions::default()
+        .with_creases(creases.then(fairmesh::fairing::CreaseOptions::default));
     let h = build_hierarchy(mesh, &options, &mut NoProgress).unwrap();
     let positions = fair_multires(
         &h,
@@ -313,7 +317,7 @@ fn multires_distance(reference: &TriMesh, mesh: &TriMesh, creases: bool, level: 
 #[test]
 fn a_coarse_level_of_a_box_keeps_its_edges_and_corners() {
     let clean = fairmesh::mesh::shapes::cuboid([2.0, 1.0, 0.5], 0.05);
-    let h = build(&clean);
+    let h = build_with_creases(&clean);
     assert_eq!(h.level_creases(0).unwrap().counts().1, 8);
     for level in [2, 4, h.coarsest_level()] {
         let creases = h.level_creases(level).unwrap();
@@ -341,7 +345,7 @@ fn multires_of_a_noisy_gear_from_its_coarsest_level_leaves_no_face_without_area(
     // their neighbours (20 faces with no area from the coarsest level).
     let mut gear = fairmesh::mesh::shapes::gear(12, 0.8, 1.0, 0.4, 0.04);
     add_noise(&mut gear, &NoiseOptions::default().with_sigma(0.3));
-    let h = build(&gear);
+    let h = build_with_creases(&gear);
     assert!(h.crease_edge_count() > 0);
     let mut workspace = MultiresWorkspace::new();
     for variant in [MultiresVariant::Paper, MultiresVariant::Improved] {

@@ -19,7 +19,7 @@
 //!   from M0's corners. Both are exact: coarsening to the top and refining back gives M0's faces,
 //!   in M0's order once mapped back through [`Hierarchy::original_vertex`].
 //!
-//! Creases ([`HierarchyOptions::creases`], on by default; not in the paper): M0's creases are
+//! Creases ([`HierarchyOptions::creases`], off by default for now; not in the paper): M0's creases are
 //! found as [`crate::fairing::detect_creases`] finds them (normals filtered as much as the noise
 //! estimate asks), corners never collapse and crease vertices collapse only along their crease
 //! (see `decimate.rs`), so every level's creases are M0's feature edges with their ends followed
@@ -79,7 +79,7 @@ impl Default for HierarchyOptions {
             min_vertices: 100,
             max_levels: 64,
             keep_boundary: false,
-            creases: Some(CreaseOptions::default()),
+            creases: None,
         }
     }
 }
