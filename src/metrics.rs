@@ -455,7 +455,11 @@ pub fn closest_point_on_triangle(p: DVec3, a: DVec3, b: DVec3, c: DVec3) -> DVec
         };
         return [on_segment(a, b), on_segment(b, c), on_segment(c, a)]
             .into_iter()
-            .min_by(|x, y| (*x - p).length_squared().total_cmp(&(*y - p).length_squared()))
+            .min_by(|x, y| {
+                (*x - p)
+                    .length_squared()
+                    .total_cmp(&(*y - p).length_squared())
+            })
             .unwrap_or(a);
     }
     let ap = p - a;
@@ -539,7 +543,11 @@ mod tests {
     fn degenerate_triangles_give_a_point_on_them_not_nan() {
         // Two corners at one point: the triangle is the segment a-c.
         let (a, c) = (DVec3::ZERO, DVec3::X);
-        for p in [DVec3::new(0.5, 1.0, 0.0), DVec3::new(-1.0, 0.0, 2.0), DVec3::Y] {
+        for p in [
+            DVec3::new(0.5, 1.0, 0.0),
+            DVec3::new(-1.0, 0.0, 2.0),
+            DVec3::Y,
+        ] {
             for (x, y, z) in [(a, a, c), (a, c, a), (c, a, a)] {
                 let q = closest_point_on_triangle(p, x, y, z);
                 assert!(q.is_finite(), "{p} on ({x}, {y}, {z}) gave {q}");

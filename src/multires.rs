@@ -51,9 +51,7 @@
 //! vertex normals from their fan order (one gather per neighbour instead of three per face).
 
 use crate::fairing::constrained::FanRings;
-use crate::fairing::{
-    BoundaryMode, ConstrainedFairing, Creases, FairOptions, FairVariant, Mask,
-};
+use crate::fairing::{BoundaryMode, ConstrainedFairing, Creases, FairOptions, FairVariant, Mask};
 use crate::hierarchy::Hierarchy;
 use crate::mesh::{Topology, TriMesh};
 use crate::Progress;

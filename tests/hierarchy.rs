@@ -292,8 +292,8 @@ fn fixed_boundary_stays_fixed_in_multires_from_every_level() {
 }
 
 fn build_with_creases(mesh: &TriMesh) -> Hierarchy {
-    let options = HierarchyOptions::default()
-        .with_creases(Some(fairmesh::fairing::CreaseOptions::default()));
+    let options =
+        HierarchyOptions::default().with_creases(Some(fairmesh::fairing::CreaseOptions::default()));
     build_hierarchy(mesh, &options, &mut NoProgress).unwrap()
 }
 

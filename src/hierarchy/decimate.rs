@@ -384,7 +384,9 @@ fn passes(
         if removed == 0 {
             break;
         }
-        if removed * MIN_PASS_SHARE < level_vertices && pass > 0 && vertex_count > options.min_vertices
+        if removed * MIN_PASS_SHARE < level_vertices
+            && pass > 0
+            && vertex_count > options.min_vertices
         {
             // A level that barely differs from the one below: left out, and the build ends (a
             // last pass cut short by `min_vertices` is kept).

@@ -402,9 +402,9 @@ pub fn build_hierarchy(
         .map(|crease_options| {
             let topology = Topology::build(mesh);
             let mut crease_options = crease_options.clone();
-            crease_options.normal_filtering = crease_options.normal_filtering.max(
-                estimate_noise(mesh, &topology).map_or(0, normal_filtering_for),
-            );
+            crease_options.normal_filtering = crease_options
+                .normal_filtering
+                .max(estimate_noise(mesh, &topology).map_or(0, normal_filtering_for));
             detect_creases(mesh, &topology, &crease_options)
         })
         .filter(|creases| !creases.is_empty());
