@@ -678,3 +678,39 @@ fn a_bad_mask_names_the_file_and_the_line() {
     }
     assert!(!output.exists(), "nothing is written when the mask is bad");
 }
+
+#[test]
+fn hierarchy_keeps_a_boxs_edges_only_when_asked() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("box.obj");
+    let cuboid = fairmesh::mesh::shapes::cuboid([2.0, 1.0, 0.5], 0.1);
+    fairmesh::io::save(&path, &cuboid).unwrap();
+    let file = path.to_str().unwrap();
+    let plain = json_of(&["hierarchy", file, "--json"]);
+    assert_eq!(
+        plain["crease_edges"], 0,
+        "the paper's hierarchy has no creases"
+    );
+    // A 2 × 1 × 0.5 box sampled every 0.1: its top and bottom outlines have 60 edges each, its
+    // four upright edges 5 each.
+    let kept = json_of(&["hierarchy", file, "--json", "--keep-creases"]);
+    assert_eq!(kept["crease_edges"], 140, "{kept}");
+    let angle = json_of(&["hierarchy", file, "--json", "--crease-angle", "100"]);
+    assert_eq!(angle["crease_edges"], 0, "the box folds by 90 degrees only");
+    let output = dir.path().join("out.obj");
+    let out = fairmesh(&[
+        "multires",
+        file,
+        "-o",
+        output.to_str().unwrap(),
+        "--crease-angle",
+        "200",
+    ]);
+    assert_eq!(out.status.code(), Some(1));
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        stderr.contains("--crease-angle") && stderr.contains("200"),
+        "{stderr}"
+    );
+    assert!(!output.exists(), "nothing is written");
+}

@@ -881,3 +881,47 @@ fn slider_step_to_result(
         std::thread::sleep(Duration::from_millis(16));
     }
 }
+
+#[test]
+fn keep_sharp_edges_keeps_a_boxs_edges_in_the_hierarchy_and_draws_them_while_pointed_at() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("box.obj");
+    fairmesh::io::save(&path, &fairmesh::mesh::shapes::cuboid([2.0, 1.0, 0.5], 0.1)).unwrap();
+    let mut harness = harness_for(path);
+    settle(&mut harness);
+    let status = harness.state().status();
+    assert!(status.hierarchy_ready);
+    assert_eq!(status.sharp_edges_kept, 0, "off by default");
+    let levels_without = status.level_count;
+
+    harness
+        .get_by_role_and_label(Role::CheckBox, "Keep sharp edges")
+        .click();
+    settle(&mut harness);
+    let status = harness.state().status();
+    assert!(status.hierarchy_ready, "the hierarchy was built again");
+    // The box's two outlines (60 edges each) and four upright edges (5 each).
+    assert_eq!(status.sharp_edges_kept, 140);
+    assert!(status.faired_serial.is_some(), "and the view fairs with it");
+    assert!(
+        status.level_count >= levels_without,
+        "kept edges never make the hierarchy shorter"
+    );
+
+    // Pointing at the control draws the kept edges the camera sees (a box shows at most three
+    // faces, so some edges are behind it).
+    harness
+        .get_by_role_and_label(Role::CheckBox, "Keep sharp edges")
+        .hover();
+    harness.step();
+    harness.step();
+    let drawn = harness.state().status().sharp_edges_drawn;
+    assert!(drawn > 40 && drawn < 140, "{drawn} edges drawn");
+
+    harness
+        .get_by_role_and_label(Role::CheckBox, "Keep sharp edges")
+        .click();
+    settle(&mut harness);
+    assert_eq!(harness.state().status().sharp_edges_kept, 0);
+    assert!(!harness.state().settings().keep_sharp_edges);
+}

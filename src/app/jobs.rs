@@ -22,6 +22,7 @@ use crate::hierarchy::{Hierarchy, HierarchyError};
 use crate::io::LoadReport;
 use crate::TriMesh;
 
+use super::sharp_edges::SharpEdgeLines;
 use super::state::Measures;
 
 type Job = Box<dyn FnOnce() + Send + 'static>;
@@ -239,7 +240,7 @@ pub enum JobResult {
         document: u64,
         hierarchy: u64,
         /// The hierarchy, and whether its M0 has the loaded mesh's triangles.
-        result: Result<(Arc<Hierarchy>, bool), HierarchyError>,
+        result: Result<(Arc<Hierarchy>, bool, Arc<SharpEdgeLines>), HierarchyError>,
         elapsed: Duration,
     },
     Faired {

@@ -31,6 +31,7 @@ pub mod jobs;
 pub mod paint;
 mod paint_panel;
 pub mod panels;
+mod sharp_edges;
 pub mod state;
 mod tasks;
 mod view_sync;
@@ -182,6 +183,10 @@ pub struct AppStatus {
     pub error: Option<String>,
     pub message: Option<String>,
     pub images_drawn: u64,
+    /// Sharp edges the current hierarchy keeps (0 without "Keep sharp edges").
+    pub sharp_edges_kept: usize,
+    /// Sharp edges drawn over the mesh in the last frame (while their controls are pointed at).
+    pub sharp_edges_drawn: usize,
 }
 
 pub struct App {
@@ -255,6 +260,13 @@ pub struct App {
     last_dab: Option<egui::Pos2>,
     /// Bumped with every change of the document's mask, so that its tint is uploaded again.
     mask_revision: u64,
+    /// The sharp-edge settings the current hierarchy was asked for (see
+    /// [`Settings::hierarchy_key`]): a change builds it again.
+    hierarchy_built_with: (bool, u64),
+    /// Draw the kept sharp edges over the mesh until then (their controls are hovered or were
+    /// just changed).
+    sharp_edges_shown_until: Option<std::time::Instant>,
+    sharp_edges_drawn: usize,
 }
 
 /// Memory the undo history may keep alive.
@@ -336,6 +348,9 @@ impl App {
             stroke: None,
             last_dab: None,
             mask_revision: 0,
+            hierarchy_built_with: (false, 0),
+            sharp_edges_shown_until: None,
+            sharp_edges_drawn: 0,
         };
         for viewport in app.viewports() {
             if let Some(bytes) = options.async_upload_bytes {
@@ -476,6 +491,11 @@ impl App {
             error: self.error.clone(),
             message: self.message.clone(),
             images_drawn: self.viewport.as_ref().map_or(0, Viewport3d::images_drawn),
+            sharp_edges_kept: document.map_or(0, |d| match &d.hierarchy {
+                HierarchyState::Ready { hierarchy, .. } => hierarchy.crease_edge_count(),
+                _ => 0,
+            }),
+            sharp_edges_drawn: self.sharp_edges_drawn,
         }
     }
 

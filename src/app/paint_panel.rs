@@ -124,7 +124,7 @@ pub(super) fn viewport_brush(
 
 /// The image the brush paints on: the result's, the right half side by side, the whole view
 /// otherwise.
-fn painted_image(app: &App, rect: egui::Rect) -> egui::Rect {
+pub(super) fn painted_image(app: &App, rect: egui::Rect) -> egui::Rect {
     match app.settings.compare {
         CompareView::SideBySide => rect.split_left_right_at_fraction(0.5).1,
         CompareView::Single | CompareView::Split => rect,

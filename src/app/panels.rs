@@ -7,7 +7,7 @@ use std::path::PathBuf;
 
 use super::state::{
     BoundarySetting, CompareView, HeatReference, HierarchyState, Measures, MethodSetting,
-    VariantSetting, ViewMode,
+    VariantSetting, ViewMode, MAX_SHARP_EDGE_ANGLE, MIN_SHARP_EDGE_ANGLE,
 };
 use super::{App, Command, Slot};
 use crate::noise::NoiseMode;
@@ -267,6 +267,7 @@ fn controls(app: &mut App, ui: &mut egui::Ui) {
                 });
         }
     }
+    sharp_edge_controls(app, ui);
 
     ui.separator();
     ui.heading("Fairing");
@@ -706,6 +707,7 @@ fn viewport(app: &mut App, ui: &mut egui::Ui) {
         heat_legend(ui, rect, top, reference);
     }
     super::paint_panel::brush_outline(app, ui, rect);
+    sharp_edge_overlay(app, ui, rect);
     let wireframe = app.settings.wireframe;
     let problem = app
         .viewports()
@@ -984,8 +986,115 @@ fn explain(response: egui::Response, tip: &str, off_because: Option<&str>) -> eg
     }
 }
 
+/// "Keep sharp edges" and its angle (the hierarchy is built again when either changes; while
+/// they are hovered or just changed, the kept edges are drawn over the mesh).
+fn sharp_edge_controls(app: &mut App, ui: &mut egui::Ui) {
+    let Some(document) = &app.document else {
+        return;
+    };
+    let not_for_baseline = (!app.settings.method.uses_hierarchy()).then(|| {
+        format!(
+            "Not used by {}: it smooths the whole mesh at once, across sharp edges too.",
+            app.settings.method.label()
+        )
+    });
+    let kept = match &document.hierarchy {
+        HierarchyState::Ready { hierarchy, .. } => Some(hierarchy.crease_edge_count()),
+        _ => None,
+    };
+    let before = app.settings.hierarchy_key();
+    let enabled = not_for_baseline.is_none();
+    let keep = ui.add_enabled(
+        enabled,
+        egui::Checkbox::new(&mut app.settings.keep_sharp_edges, "Keep sharp edges"),
+    );
+    let keep = explain(keep, tips::KEEP_SHARP_EDGES, not_for_baseline.as_deref());
+    let angle = ui.add_enabled(
+        enabled && app.settings.keep_sharp_edges,
+        egui::Slider::new(
+            &mut app.settings.sharp_edge_angle,
+            MIN_SHARP_EDGE_ANGLE..=MAX_SHARP_EDGE_ANGLE,
+        )
+        .suffix("°")
+        .fixed_decimals(0)
+        .text("Sharp edge angle"),
+    );
+    let angle = explain(angle, tips::SHARP_EDGE_ANGLE, not_for_baseline.as_deref());
+    let now = std::time::Instant::now();
+    if keep.hovered() || angle.hovered() || angle.dragged() {
+        app.sharp_edges_shown_until = Some(now + SHARP_EDGES_LINGER);
+    }
+    // The hierarchy is built again when the angle is let go (not at every step of a drag).
+    let settled = !angle.dragged();
+    if settled && app.settings.hierarchy_key() != app.hierarchy_built_with {
+        app.hierarchy_built_with = app.settings.hierarchy_key();
+        app.sharp_edges_shown_until = Some(now + SHARP_EDGES_LINGER);
+        app.commands.push(Command::RebuildHierarchy);
+    } else if app.settings.hierarchy_key() != before {
+        ui.ctx().request_repaint();
+    }
+    if app.settings.keep_sharp_edges && enabled {
+        match kept {
+            Some(0) => ui.small("No sharp edges found at this angle"),
+            Some(edges) => ui.small(format!(
+                "{edges} sharp edges kept (drawn in cyan while you point here)"
+            )),
+            None => ui.small("Finding sharp edges…"),
+        };
+    }
+}
+
+/// How long the kept sharp edges stay drawn after the pointer leaves their controls.
+const SHARP_EDGES_LINGER: std::time::Duration = std::time::Duration::from_millis(1500);
+
+/// Draws the kept sharp edges over the result's image while [`sharp_edge_controls`] asks for it.
+fn sharp_edge_overlay(app: &mut App, ui: &egui::Ui, rect: egui::Rect) {
+    app.sharp_edges_drawn = 0;
+    let Some(until) = app.sharp_edges_shown_until else {
+        return;
+    };
+    let now = std::time::Instant::now();
+    if now > until || app.settings.view_mode == ViewMode::Level {
+        return;
+    }
+    ui.ctx().request_repaint_after(until - now);
+    let Some(document) = &app.document else {
+        return;
+    };
+    let HierarchyState::Ready { sharp_edges, .. } = &document.hierarchy else {
+        return;
+    };
+    let faired = document.faired.as_ref().map(|f| f.positions.clone());
+    let shows_before = app.show_before && app.settings.compare == CompareView::Single;
+    let positions: &[[f32; 3]] = match (&faired, shows_before) {
+        (Some(faired), false) => faired,
+        _ => &document.original.positions,
+    };
+    let image = super::paint_panel::painted_image(app, rect);
+    let aspect = image.width() / image.height().max(1.0);
+    let segments = sharp_edges.segments(
+        positions,
+        app.camera.view_proj(aspect),
+        app.camera.eye(),
+        image,
+    );
+    app.sharp_edges_drawn = segments.len();
+    let painter = ui.painter_at(image);
+    let stroke = egui::Stroke::new(2.0, egui::Color32::from_rgb(60, 230, 255));
+    for segment in segments {
+        painter.line_segment(segment, stroke);
+    }
+}
+
 /// The fairing controls' tooltips: what each does and when to change it, in plain words.
 pub mod tips {
+    pub const KEEP_SHARP_EDGES: &str = "Keep the mesh's sharp edges (the edges of a machined \
+        part, a fold, a rim) sharp: the coarse levels keep them and the smoothing runs along them, \
+        not across them. Turn it off for organic shapes if smoothing leaves ridges where there \
+        should be none.";
+    pub const SHARP_EDGE_ANGLE: &str = "How sharply the surface must fold at an edge for the edge \
+        to be kept sharp. Lower: more edges are kept (gentle folds too). Higher: only the sharpest. \
+        The kept edges are drawn over the mesh while you point here.";
     pub const START_LEVEL: &str = "How coarse a version of the mesh the smoothing starts from \
         (M0 is the mesh itself). Higher: smoother, bigger bumps go. Lower: more of the detail \
         stays. Raise it until the noise is gone; lower it if wanted features melt away.";

@@ -11,16 +11,18 @@ use std::time::Duration;
 
 use serde::{Deserialize, Serialize};
 
+use crate::fairing::creases::{CreaseOptions, DEFAULT_CREASE_ANGLE};
 use crate::fairing::{
     BoundaryMode, HcOptions, LaplacianOptions, Mask, MethodOptions, TaubinOptions,
 };
-use crate::hierarchy::{Hierarchy, LevelInfo};
+use crate::hierarchy::{Hierarchy, HierarchyOptions, LevelInfo};
 use crate::io::LoadReport;
 use crate::multires::{MultiresOptions, MultiresVariant};
 use crate::noise::{NoiseMode, NoiseOptions};
 use crate::TriMesh;
 
 use super::history::SizeInBytes;
+use super::sharp_edges::SharpEdgeLines;
 
 /// Boundary handling, as stored in the settings.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
@@ -116,6 +118,10 @@ pub enum CompareView {
     SideBySide,
 }
 
+/// The range of the sharp-edge angle the editor offers, in degrees.
+pub const MIN_SHARP_EDGE_ANGLE: f64 = 10.0;
+pub const MAX_SHARP_EDGE_ANGLE: f64 = 90.0;
+
 /// Settings that persist between runs.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(default)]
@@ -153,6 +159,11 @@ pub struct Settings {
     pub start_levels: Vec<(PathBuf, usize)>,
     /// The brush, and the mask last painted on each file.
     pub paint: super::paint::PaintSettings,
+    /// Keep sharp edges: the hierarchy keeps them on every level and the fairing smooths along
+    /// them, not across them.
+    pub keep_sharp_edges: bool,
+    /// An edge is sharp when the surface folds there by more than this many degrees.
+    pub sharp_edge_angle: f64,
 }
 
 impl Default for Settings {
@@ -183,6 +194,8 @@ impl Default for Settings {
             levels_to: usize::MAX,
             start_levels: Vec::new(),
             paint: Default::default(),
+            keep_sharp_edges: HierarchyOptions::default().creases.is_some(),
+            sharp_edge_angle: DEFAULT_CREASE_ANGLE,
         }
     }
 }
@@ -288,6 +301,25 @@ impl Settings {
         }
     }
 
+    /// The settings that change the hierarchy (a change means: build it again).
+    pub fn hierarchy_key(&self) -> (bool, u64) {
+        (self.keep_sharp_edges, self.sharp_edge_angle.to_bits())
+    }
+
+    /// The hierarchy these settings ask for (the angle clamped to a sane range).
+    pub fn hierarchy_options(&self) -> HierarchyOptions {
+        let angle = if self.sharp_edge_angle.is_finite() {
+            self.sharp_edge_angle
+                .clamp(MIN_SHARP_EDGE_ANGLE, MAX_SHARP_EDGE_ANGLE)
+        } else {
+            DEFAULT_CREASE_ANGLE
+        };
+        HierarchyOptions::default().with_creases(
+            self.keep_sharp_edges
+                .then(|| CreaseOptions::default().with_angle_degrees(angle)),
+        )
+    }
+
     /// The multires options these settings give for `start_level`.
     pub fn multires_options(&self, start_level: usize) -> MultiresOptions {
         MultiresOptions {
@@ -318,6 +350,8 @@ pub enum HierarchyState {
         /// M0 has the loaded mesh's triangles (so faired positions can replace the loaded ones
         /// on the GPU without new connectivity).
         base_matches_original: bool,
+        /// The sharp edges the hierarchy keeps, to draw over the mesh.
+        sharp_edges: Arc<SharpEdgeLines>,
     },
     Failed(String),
 }
@@ -489,7 +523,7 @@ pub struct DocumentSnapshot {
     pub export_path: String,
     pub source: Arc<crate::io::Source>,
     /// The hierarchy, its build time, and whether its M0 has the mesh's triangles.
-    pub hierarchy: Option<(Arc<Hierarchy>, Duration, bool)>,
+    pub hierarchy: Option<(Arc<Hierarchy>, Duration, bool, Arc<SharpEdgeLines>)>,
     /// See [`Document::applied`].
     pub applied: bool,
     /// The view of this document when it was left (set by the app, which owns the camera), so
@@ -509,10 +543,9 @@ impl SizeInBytes for DocumentSnapshot {
         // Shared meshes are counted once per snapshot: an over-estimate, on the safe side.
         mesh_bytes(&self.mesh)
             + self.clean.as_deref().map_or(0, mesh_bytes)
-            + self
-                .hierarchy
-                .as_ref()
-                .map_or(0, |(h, _, _)| h.record_bytes() + mesh_bytes(h.base_mesh()))
+            + self.hierarchy.as_ref().map_or(0, |(h, _, _, _)| {
+                h.record_bytes() + mesh_bytes(h.base_mesh())
+            })
             + self
                 .against_clean
                 .as_ref()
@@ -539,8 +572,14 @@ impl Document {
                     hierarchy,
                     build_time,
                     base_matches_original,
+                    sharp_edges,
                     ..
-                } => Some((hierarchy.clone(), *build_time, *base_matches_original)),
+                } => Some((
+                    hierarchy.clone(),
+                    *build_time,
+                    *base_matches_original,
+                    sharp_edges.clone(),
+                )),
                 _ => None,
             },
             applied: self.applied,
@@ -554,14 +593,17 @@ impl Document {
     pub fn from_snapshot(snapshot: DocumentSnapshot, generation: u64) -> Self {
         let bounds = bounds_of(&snapshot.mesh.positions);
         let hierarchy = match snapshot.hierarchy {
-            Some((hierarchy, build_time, base_matches_original)) => HierarchyState::Ready {
-                levels: (0..hierarchy.level_count())
-                    .map(|l| hierarchy.level_info(l))
-                    .collect(),
-                base_matches_original,
-                hierarchy,
-                build_time,
-            },
+            Some((hierarchy, build_time, base_matches_original, sharp_edges)) => {
+                HierarchyState::Ready {
+                    levels: (0..hierarchy.level_count())
+                        .map(|l| hierarchy.level_info(l))
+                        .collect(),
+                    base_matches_original,
+                    hierarchy,
+                    build_time,
+                    sharp_edges,
+                }
+            }
             None => HierarchyState::Building,
         };
         Self {

@@ -260,6 +260,20 @@ impl Hierarchy {
         let class = self.feature_class[..vertex_count as usize].to_vec();
         Some(Creases::from_classified(edges, class))
     }
+    /// M0's feature edges the build kept, in M0's own vertex ids (the input mesh's), lower id
+    /// first; empty without creases.
+    pub fn crease_edges(&self) -> Vec<[u32; 2]> {
+        let mut edges: Vec<[u32; 2]> = self
+            .crease_edges
+            .iter()
+            .map(|&[a, b]| {
+                let (a, b) = (self.original_vertex(a), self.original_vertex(b));
+                [a.min(b), a.max(b)]
+            })
+            .collect();
+        edges.sort_unstable();
+        edges
+    }
     /// Number of M0's feature edges the build kept (0 without creases).
     pub fn crease_edge_count(&self) -> usize {
         self.crease_edges.len()

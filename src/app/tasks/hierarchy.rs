@@ -5,12 +5,14 @@ use std::sync::{Arc, PoisonError};
 use std::time::{Duration, Instant};
 
 use crate::app::jobs::JobResult;
+use crate::app::sharp_edges::SharpEdgeLines;
 use crate::app::state::HierarchyState;
 use crate::app::App;
-use crate::hierarchy::{self, HierarchyError, HierarchyOptions};
+use crate::hierarchy::{self, HierarchyError};
 
 impl App {
     pub(in crate::app) fn start_hierarchy(&mut self) {
+        self.hierarchy_built_with = self.settings.hierarchy_key();
         let Some(document) = &mut self.document else {
             return;
         };
@@ -18,6 +20,7 @@ impl App {
         document.hierarchy = HierarchyState::Building;
         self.hierarchy_progress.set(0.0);
         let mesh = document.original.clone();
+        let options = self.settings.hierarchy_options();
         let document_generation = document.generation;
         let hierarchy_generation = self.hierarchy_generation.clone();
         let progress_out = self.hierarchy_progress.clone();
@@ -31,14 +34,16 @@ impl App {
                 progress_out.set(fraction);
                 hierarchy_generation.is_current(generation)
             };
-            let result =
-                hierarchy::build_hierarchy(&mesh, &HierarchyOptions::default(), &mut progress).map(
-                    |built| {
-                        // Compared here, not on the UI thread (millions of triangles).
-                        let matches = built.base_mesh().triangles == mesh.triangles;
-                        (Arc::new(built), matches)
-                    },
-                );
+            let result = hierarchy::build_hierarchy(&mesh, &options, &mut progress).map(|built| {
+                // Compared here, not on the UI thread (millions of triangles).
+                let matches = built.base_mesh().triangles == mesh.triangles;
+                let sharp_edges = if matches {
+                    SharpEdgeLines::new(&mesh, built.crease_edges())
+                } else {
+                    SharpEdgeLines::default()
+                };
+                (Arc::new(built), matches, Arc::new(sharp_edges))
+            });
             let message = JobResult::Hierarchy {
                 document: document_generation,
                 hierarchy: generation,
@@ -83,7 +88,7 @@ impl App {
         &mut self,
         document: u64,
         hierarchy: u64,
-        result: Result<(Arc<hierarchy::Hierarchy>, bool), HierarchyError>,
+        result: Result<(Arc<hierarchy::Hierarchy>, bool, Arc<SharpEdgeLines>), HierarchyError>,
         elapsed: Duration,
     ) {
         if !self.hierarchy_generation.is_current(hierarchy) {
@@ -93,7 +98,7 @@ impl App {
             return;
         };
         match result {
-            Ok((hierarchy, base_matches_original)) => {
+            Ok((hierarchy, base_matches_original, sharp_edges)) => {
                 let levels = (0..hierarchy.level_count())
                     .map(|l| hierarchy.level_info(l))
                     .collect::<Vec<_>>();
@@ -106,6 +111,7 @@ impl App {
                 let warm = hierarchy.clone();
                 current.hierarchy = HierarchyState::Ready {
                     base_matches_original,
+                    sharp_edges,
                     hierarchy,
                     levels,
                     build_time: elapsed,
