@@ -1134,6 +1134,46 @@ fn an_obj_saved_as_gltf_keeps_groups_materials_uvs_and_normals() {
     }
 }
 
+/// An OBJ saved as glTF loads back vertex for vertex: the vertex `i` that was saved is the vertex
+/// `i` that is loaded (the editor shows, compares and exports by vertex index), even when the
+/// faces first use the vertices in another order and a UV seam splits one of them in the file.
+#[test]
+fn an_obj_saved_as_gltf_loads_back_in_its_own_vertex_order() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = dir.path().join("order.obj");
+    // A tetrahedron, outward facing; the faces first use its vertices in the order 4 2 3 1, and
+    // vertex 4 has two UVs (a seam).
+    std::fs::write(
+        &input,
+        "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\n\
+         vt 0 0\nvt 1 0\nvt 0 1\nvt 1 1\n\
+         f 4/4 2/2 3/3\nf 4/1 3/3 1/1\nf 4/4 1/1 2/2\nf 1/1 3/3 2/2\n",
+    )
+    .unwrap();
+    let loaded = io::load(&input).unwrap();
+    assert_eq!(loaded.mesh.positions[0], [0.0, 0.0, 0.0], "OBJ order");
+    assert_eq!(loaded.mesh.positions[3], [0.0, 0.0, 1.0], "OBJ order");
+    // Moved as fairing moves them: every vertex somewhere else.
+    let mut moved = loaded.mesh.clone();
+    for (v, p) in moved.positions.iter_mut().enumerate() {
+        *p = p.map(|c| c * 1.5 + 0.25 * v as f32);
+    }
+    for name in ["order.glb", "order.gltf"] {
+        let out = dir.path().join(name);
+        let report = io::save_with_source(&out, &moved, &loaded.source).unwrap();
+        let json = read_gltf(&out).json;
+        let attributes = &json["meshes"][0]["primitives"][0]["attributes"];
+        assert!(
+            attributes.get("TEXCOORD_0").is_some(),
+            "{name}: the UVs are carried ({:?})",
+            report.warnings
+        );
+        let back = io::load(&out).unwrap().mesh;
+        assert_eq!(back.positions, moved.positions, "{name}");
+        assert_eq!(back.triangles, moved.triangles, "{name}");
+    }
+}
+
 #[test]
 fn gltf_and_obj_saved_as_ply_keep_colours_uvs_and_normals_and_name_the_rest() {
     let dir = tempfile::tempdir().unwrap();

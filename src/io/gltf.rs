@@ -1061,7 +1061,9 @@ pub(crate) fn write_gltf_with(
 /// an object and a group name hangs under a node named by the object (an OBJ's `o` over its `g`s);
 /// materials with pbrMetallicRoughness from the base colour, metallic, roughness and base colour
 /// texture. A GLB embeds every image; a `.gltf` refers to image files beside it (copied there,
-/// or written out when the source held them inside) and to `<stem>.bin`.
+/// or written out when the source held them inside) and to `<stem>.bin`. Each primitive's
+/// vertices follow `mesh`'s vertex order, so that a one-part, one-material file loads back as
+/// `mesh` itself, vertex for vertex (several parts load back part by part).
 pub(crate) fn write_scene(
     path: &Path,
     glb: bool,
@@ -1104,16 +1106,29 @@ pub(crate) fn write_scene(
     for part in &scene.parts {
         let mut primitives = Vec::new();
         for primitive in &part.primitives {
+            // The primitive's file vertices in the order of the welded vertices they became (a
+            // vertex's seam copies in file order): read back and welded, a file with one part and
+            // one material gives the mesh's own vertex order, so the vertex `i` that was saved
+            // is the vertex `i` that is loaded. In the order of first use (the faces' order) the
+            // vertices would come back shuffled.
             let mut used: Vec<u32> = Vec::new();
-            let mut indices: Vec<u32> = Vec::with_capacity(primitive.triangles.len() * 3);
             for &v in primitive.triangles.iter().flatten() {
                 let slot = &mut local[v as usize];
                 if *slot == u32::MAX {
-                    *slot = used.len() as u32;
+                    *slot = 0;
                     used.push(v);
                 }
-                indices.push(*slot);
             }
+            used.sort_unstable_by_key(|&v| (scene.vertices[v as usize].welded, v));
+            for (k, &v) in used.iter().enumerate() {
+                local[v as usize] = k as u32;
+            }
+            let indices: Vec<u32> = primitive
+                .triangles
+                .iter()
+                .flatten()
+                .map(|&v| local[v as usize])
+                .collect();
             for &v in &used {
                 local[v as usize] = u32::MAX;
             }
