@@ -670,10 +670,12 @@ fn read_materials(
     }
     let mut found = vec![false; names.len()];
     let mut unkept: Vec<String> = Vec::new();
+    // The libraries that could not be read, each with why.
+    let mut unread: Vec<String> = Vec::new();
     for library in libraries {
         let Some(base) = &source.base_dir else {
-            warnings.push(format!(
-                "the material library {library} (the input was read from memory, so it cannot be found)"
+            unread.push(format!(
+                "{library} (the input was read from memory, so it cannot be found)"
             ));
             continue;
         };
@@ -681,10 +683,13 @@ fn read_materials(
         let text = match std::fs::read(&file) {
             Ok(text) => text,
             Err(e) => {
-                warnings.push(format!(
-                    "the material library {} ({e}): its materials are written white",
-                    file.display()
-                ));
+                let why = if e.kind() == std::io::ErrorKind::NotFound {
+                    let obj = source.path.file_name().unwrap_or_default();
+                    format!("not found beside {}", Path::new(obj).display())
+                } else {
+                    format!("{} cannot be read: {e}", file.display())
+                };
+                unread.push(format!("{library} ({why})"));
                 continue;
             }
         };
@@ -763,12 +768,27 @@ fn read_materials(
         .filter(|(_, found)| !**found)
         .map(|(name, _)| name.as_str())
         .collect();
-    if !missing.is_empty() && !libraries.is_empty() {
+    let quoted: Vec<String> = missing.iter().map(|name| format!("'{name}'")).collect();
+    let quoted: Vec<&str> = quoted.iter().map(String::as_str).collect();
+    if unread.len() == libraries.len() && !unread.is_empty() {
+        // Nothing defines the materials: said once, with why.
         warnings.push(format!(
-            "the definition of material(s) {} (not in {}): written white",
-            missing.join(", "),
-            libraries.join(", ")
+            "the material {} {}, so the materials {} are written white, without their colours and textures",
+            if unread.len() == 1 { "library" } else { "libraries" },
+            unread.join(" and "),
+            super::and_list(&quoted)
         ));
+    } else {
+        for library in &unread {
+            warnings.push(format!("the material library {library}"));
+        }
+        if !missing.is_empty() && !libraries.is_empty() {
+            warnings.push(format!(
+                "the definition of material(s) {} (not in {}): written white",
+                missing.join(", "),
+                libraries.join(", ")
+            ));
+        }
     }
     if !unkept.is_empty() {
         warnings.push(format!(
