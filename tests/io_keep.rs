@@ -544,7 +544,7 @@ fn other_formats_and_other_connectivity_say_what_is_not_kept() {
     let dir = tempfile::tempdir().unwrap();
     let scene = io::load(data("scene.glb")).unwrap();
     let report =
-        io::save_with_source(dir.path().join("scene.obj"), &scene.mesh, &scene.source).unwrap();
+        io::save_with_source(dir.path().join("scene.stl"), &scene.mesh, &scene.source).unwrap();
     let text = report.warnings.join("\n");
     for item in [
         "'root'",
@@ -552,23 +552,23 @@ fn other_formats_and_other_connectivity_say_what_is_not_kept() {
         "'block'",
         "2 materials ('checker', 'paint')",
         "1 texture (",
+        "normals",
+        "UVs (TEXCOORD_0)",
+        "vertex colours (COLOR_0)",
     ] {
         assert!(text.contains(item), "{item} not named in: {text}");
     }
-    assert!(
-        text.contains("as OBJ with its UVs and vertex colours"),
-        "{text}"
-    );
+    assert!(text.contains("as a bare STL mesh"), "{text}");
 
     let obj = io::load(data("textured.obj")).unwrap();
     let report = io::save_with_source(dir.path().join("t.ply"), &obj.mesh, &obj.source).unwrap();
     let text = report.warnings.join("\n");
     for item in [
-        "texture coordinates",
-        "normals",
+        "the UV seams at",
         "checker",
         "paint",
         "quads",
+        "smoothing groups",
     ] {
         assert!(text.contains(item), "{item} not named in: {text}");
     }
@@ -633,47 +633,6 @@ fn a_mesh_placed_twice_is_written_from_its_first_placement_with_a_warning() {
 
 // ---------------------------------------------------------------------------------------------
 // Saving into another format family: what the target can hold per vertex is carried.
-
-/// The `v` (with any colour), `vt` and `f` lines of an OBJ written by fairmesh.
-struct ObjLines {
-    vertices: Vec<Vec<f32>>,
-    uvs: Vec<[f32; 2]>,
-    /// Per face corner: (vertex, texture coordinate) 0-based.
-    corners: Vec<(usize, Option<usize>)>,
-}
-
-fn read_obj_lines(path: &Path) -> ObjLines {
-    let text = std::fs::read_to_string(path).unwrap();
-    let mut out = ObjLines {
-        vertices: Vec::new(),
-        uvs: Vec::new(),
-        corners: Vec::new(),
-    };
-    for line in text.lines() {
-        let mut words = line.split_whitespace();
-        let floats = |words: std::str::SplitWhitespace| -> Vec<f32> {
-            words.map(|w| w.parse::<f32>().unwrap()).collect()
-        };
-        match words.next() {
-            Some("v") => out.vertices.push(floats(words)),
-            Some("vt") => {
-                let uv = floats(words);
-                out.uvs.push([uv[0], uv[1]]);
-            }
-            Some("f") => out.corners.extend(words.map(|corner| {
-                let mut parts = corner.split('/');
-                let v = parts.next().unwrap().parse::<usize>().unwrap() - 1;
-                let t = parts
-                    .next()
-                    .filter(|t| !t.is_empty())
-                    .map(|t| t.parse::<usize>().unwrap() - 1);
-                (v, t)
-            })),
-            _ => {}
-        }
-    }
-    out
-}
 
 /// The world placement of each node of a glTF whose nodes carry matrices (trimesh writes them).
 fn node_worlds(json: &Value) -> Vec<glam::DMat4> {
@@ -762,114 +721,528 @@ fn is_a_value_at(
     Some(candidates.any(|(_, v)| v.iter().zip(value).all(|(a, b)| (a - b).abs() <= tolerance)))
 }
 
+/// An OBJ read here, with its structure: per face, the `o`, `g` and `usemtl` in force and its
+/// corners (v, vt, vn) 0-based.
+struct ObjScene {
+    vertices: Vec<Vec<f32>>,
+    uvs: Vec<[f32; 2]>,
+    normals: Vec<[f32; 3]>,
+    mtllib: Option<String>,
+    faces: Vec<ObjFace>,
+}
+
+struct ObjFace {
+    object: Option<String>,
+    group: Option<String>,
+    material: Option<String>,
+    corners: Vec<(usize, Option<usize>, Option<usize>)>,
+}
+
+fn read_obj_scene(path: &Path) -> ObjScene {
+    let text = std::fs::read_to_string(path).unwrap();
+    let mut out = ObjScene {
+        vertices: Vec::new(),
+        uvs: Vec::new(),
+        normals: Vec::new(),
+        mtllib: None,
+        faces: Vec::new(),
+    };
+    let (mut object, mut group, mut material) = (None, None, None);
+    for line in text.lines() {
+        let mut words = line.split_whitespace();
+        let floats = |words: std::str::SplitWhitespace| -> Vec<f32> {
+            words.map(|w| w.parse::<f32>().unwrap()).collect()
+        };
+        let index = |t: Option<&str>| {
+            t.filter(|t| !t.is_empty())
+                .map(|t| t.parse::<usize>().unwrap() - 1)
+        };
+        match words.next() {
+            Some("v") => out.vertices.push(floats(words)),
+            Some("vt") => {
+                let uv = floats(words);
+                out.uvs.push([uv[0], uv[1]]);
+            }
+            Some("vn") => {
+                let n = floats(words);
+                out.normals.push([n[0], n[1], n[2]]);
+            }
+            Some("mtllib") => out.mtllib = words.next().map(String::from),
+            Some("o") => object = words.next().map(String::from),
+            Some("g") => group = words.next().map(String::from),
+            Some("usemtl") => material = words.next().map(String::from),
+            Some("f") => out.faces.push(ObjFace {
+                object: object.clone(),
+                group: group.clone(),
+                material: material.clone(),
+                corners: words
+                    .map(|corner| {
+                        let mut parts = corner.split('/');
+                        let v = index(parts.next()).unwrap();
+                        (v, index(parts.next()), index(parts.next()))
+                    })
+                    .collect(),
+            }),
+            _ => {}
+        }
+    }
+    out
+}
+
+/// An MTL read here: per material, its statements (keyword -> rest of line).
+fn read_mtl(path: &Path) -> std::collections::BTreeMap<String, Vec<(String, String)>> {
+    let text = std::fs::read_to_string(path).unwrap();
+    let mut out: std::collections::BTreeMap<String, Vec<(String, String)>> = Default::default();
+    let mut current = None;
+    for line in text.lines() {
+        let line = line.trim();
+        if line.starts_with('#') || line.is_empty() {
+            continue;
+        }
+        let (keyword, rest) = line.split_once(' ').unwrap_or((line, ""));
+        if keyword == "newmtl" {
+            current = Some(rest.to_string());
+            out.entry(rest.to_string()).or_default();
+        } else if let Some(m) = &current {
+            out.get_mut(m)
+                .unwrap()
+                .push((keyword.to_string(), rest.to_string()));
+        }
+    }
+    out
+}
+
+fn mtl_value<'a>(statements: &'a [(String, String)], keyword: &str) -> Option<&'a str> {
+    statements
+        .iter()
+        .find(|(k, _)| k == keyword)
+        .map(|(_, v)| v.as_str())
+}
+
+/// The output has the faired mesh's surface: the same triangles between the same positions
+/// (whatever the order of its vertices and triangles, and its split vertices).
+fn assert_same_surface(path: &Path, faired: &TriMesh) {
+    let reloaded = io::load(path).unwrap().mesh;
+    let index: std::collections::HashMap<[u32; 3], u32> = faired
+        .positions
+        .iter()
+        .enumerate()
+        .map(|(v, p)| (p.map(f32::to_bits), v as u32))
+        .collect();
+    assert_eq!(
+        index.len(),
+        faired.positions.len(),
+        "faired positions repeat"
+    );
+    let canonical = |t: [u32; 3]| {
+        let k = (0..3).min_by_key(|&k| t[k]).unwrap();
+        [t[k], t[(k + 1) % 3], t[(k + 2) % 3]]
+    };
+    let mut got: Vec<[u32; 3]> = reloaded
+        .triangles
+        .iter()
+        .map(|t| canonical(t.map(|v| index[&reloaded.positions[v as usize].map(f32::to_bits)])))
+        .collect();
+    let mut expected: Vec<[u32; 3]> = faired.triangles.iter().map(|&t| canonical(t)).collect();
+    got.sort_unstable();
+    expected.sort_unstable();
+    assert_eq!(got, expected, "{}", path.display());
+}
+
 #[test]
-fn a_gltf_scene_saved_as_obj_keeps_its_uvs_and_colours() {
+fn a_gltf_scene_saved_as_obj_keeps_names_materials_uvs_colours_and_split_normals() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("scene.obj");
     let (loaded, mesh, report) = fair_and_save("scene.glb", &out);
-    let obj = read_obj_lines(&out);
-    assert_eq!(obj.vertices.len(), mesh.vertex_count());
-    assert_eq!(obj.uvs.len(), mesh.vertex_count(), "one vt per vertex");
-    for (v, t) in &obj.corners {
-        assert_eq!(Some(*v), *t, "each corner uses its vertex's vt");
+    let obj = read_obj_scene(&out);
+    assert_eq!(obj.vertices.len(), mesh.vertex_count(), "one v per vertex");
+    assert_same_surface(&out, &mesh);
+
+    // Names and materials: node names as `o`, mesh names as `g`, one `usemtl` per primitive.
+    let mut parts = BTreeSet::new();
+    for face in &obj.faces {
+        parts.insert((
+            face.object.clone().unwrap(),
+            face.group.clone().unwrap(),
+            face.material.clone().unwrap(),
+        ));
     }
+    let expected: BTreeSet<(String, String, String)> = [
+        ("ball", "ball_mesh", "checker"),
+        ("block", "block_mesh", "paint"),
+    ]
+    .iter()
+    .map(|(a, b, c)| (a.to_string(), b.to_string(), c.to_string()))
+    .collect();
+    assert_eq!(parts, expected);
+    assert_eq!(obj.mtllib.as_deref(), Some("scene.mtl"));
+    let mtl = read_mtl(&dir.path().join("scene.mtl"));
+    assert_eq!(mtl.keys().collect::<Vec<_>>(), ["checker", "paint"]);
+    let kd: Vec<f32> = mtl_value(&mtl["paint"], "Kd")
+        .unwrap()
+        .split(' ')
+        .map(|v| v.parse().unwrap())
+        .collect();
     let input = read_gltf(&data("scene.glb"));
+    let factor = &input.json["materials"][1]["pbrMetallicRoughness"]["baseColorFactor"];
+    for c in 0..3 {
+        assert_eq!(kd[c], factor[c].as_f64().unwrap() as f32);
+    }
+    assert!(mtl_value(&mtl["paint"], "map_Kd").is_none());
+    // The GLB's embedded image is written out beside the .mtl, byte for byte.
+    let texture = mtl_value(&mtl["checker"], "map_Kd").unwrap();
+    assert_eq!(
+        std::fs::read(dir.path().join(texture)).unwrap(),
+        std::fs::read(data("checker.png")).unwrap()
+    );
+
+    // UVs and colours: each corner has the input's UV at its place; seams stay split.
     let uvs = placed_values(&input, "TEXCOORD_0");
     let colours = placed_values(&input, "COLOR_0");
-    let (mut checked_uvs, mut checked_colours) = (0, 0);
-    for (v, line) in obj.vertices.iter().enumerate() {
-        assert_eq!(line.len(), 6, "every v line has a colour");
-        assert!(line.iter().all(|c| c.is_finite()));
-        assert_eq!(&line[..3], &mesh.positions[v][..], "faired positions");
-        let before = loaded.mesh.positions[v];
-        if let Some(ok) = is_a_value_at(&uvs, before, &obj.uvs[v], 1e-6) {
-            assert!(
-                ok,
-                "vertex {v}: vt {:?} is not the input's UV there",
-                obj.uvs[v]
-            );
-            checked_uvs += 1;
-        }
-        match is_a_value_at(&colours, before, &line[3..6], 1e-6) {
-            Some(ok) => {
-                assert!(
-                    ok,
-                    "vertex {v}: colour {:?} is not the input's",
-                    &line[3..6]
-                );
-                checked_colours += 1;
+    let mut uvs_at: Vec<BTreeSet<[u32; 2]>> = vec![BTreeSet::new(); mesh.vertex_count()];
+    let mut checked = 0;
+    for face in &obj.faces {
+        for &(v, t, n) in &face.corners {
+            let uv = obj.uvs[t.unwrap()];
+            assert!(n.is_some(), "every corner has a normal");
+            let before = loaded.mesh.positions[v];
+            if face.material.as_deref() == Some("checker") {
+                assert_eq!(is_a_value_at(&uvs, before, &uv, 1e-6), Some(true), "{uv:?}");
+                uvs_at[v].insert(uv.map(f32::to_bits));
+                checked += 1;
             }
-            // A part with no colours (the ball) is white, as glTF draws it, not black.
+        }
+    }
+    assert!(checked >= 2000, "{checked}");
+    let seams = uvs_at.iter().filter(|set| set.len() > 1).count();
+    assert!(seams >= 10, "the ball's UV seam is kept split: {seams}");
+    for (v, line) in obj.vertices.iter().enumerate() {
+        assert_eq!(line.len(), 6);
+        assert_eq!(&line[..3], &mesh.positions[v][..], "faired positions");
+        match is_a_value_at(&colours, loaded.mesh.positions[v], &line[3..6], 1e-6) {
+            Some(ok) => assert!(ok, "vertex {v}: colour {:?}", &line[3..6]),
             None => assert_eq!(&line[3..6], &[1.0, 1.0, 1.0], "vertex {v}"),
         }
     }
-    assert!(checked_uvs >= 400, "{checked_uvs} UVs checked");
-    assert!(checked_colours >= 300, "{checked_colours} colours checked");
-    // The reader reads it back as the faired mesh, with its texture coordinates and colours.
-    assert_reloads_as(&out, &mesh, 0.0);
+
+    // Normals: the block's hard edges stay split (each corner has its faired face's normal);
+    // the ball's seam copies share one smooth normal.
+    let mut ball_normals: Vec<BTreeSet<[u32; 3]>> = vec![BTreeSet::new(); mesh.vertex_count()];
+    let mut block_corners = 0;
+    for face in &obj.faces {
+        let [a, b, c] = [0, 1, 2].map(|k| glam::Vec3::from(mesh.positions[face.corners[k].0]));
+        let normal_of_face = (b - a).cross(c - a).normalize();
+        for &(v, _, n) in &face.corners {
+            let normal = glam::Vec3::from(obj.normals[n.unwrap()]);
+            assert!((normal.length() - 1.0).abs() < 1e-5);
+            if face.object.as_deref() == Some("block") {
+                assert!(
+                    normal.dot(normal_of_face) > 0.99999,
+                    "{normal} vs {normal_of_face}"
+                );
+                block_corners += 1;
+            } else {
+                ball_normals[v].insert(normal.to_array().map(f32::to_bits));
+            }
+        }
+    }
+    assert_eq!(block_corners, 768 * 3);
+    assert!(
+        ball_normals.iter().all(|set| set.len() <= 1),
+        "a ball seam split"
+    );
+
+    // Our reader and the report: what OBJ holds is not named as lost.
     let contents = io::load(&out).unwrap().source.contents().join("; ");
-    assert!(contents.contains("texture coordinates"), "{contents}");
-    assert!(contents.contains("vertex colours"), "{contents}");
-    // What OBJ cannot hold is named; what it holds is not.
+    for item in [
+        "object and group names",
+        "2 materials (checker, paint)",
+        "texture coordinates",
+        "normals",
+        "vertex colours",
+    ] {
+        assert!(contents.contains(item), "{item}: {contents}");
+    }
     let text = report.warnings.join("\n");
     assert!(
-        text.contains("as OBJ with its UVs and vertex colours"),
+        text.contains(
+            "as OBJ with its names, materials, textures, UVs, normals and vertex colours"
+        ),
         "{text}"
     );
-    for item in ["'root'", "2 materials ('checker', 'paint')", "normals"] {
-        assert!(text.contains(item), "{item} not named in: {text}");
-    }
     assert!(
-        !text.contains("TEXCOORD_0") && !text.contains("COLOR_0"),
+        text.contains("the node tree's hierarchy and transforms"),
         "{text}"
     );
+    for item in [
+        "2 materials",
+        "1 texture",
+        "TEXCOORD_0",
+        "COLOR_0",
+        "normals;",
+    ] {
+        assert!(!text.contains(item), "{item} named as lost: {text}");
+    }
 }
 
-/// Per welded position (bit pattern) of an OBJ file read here: the texture coordinates its
-/// corners use.
-fn obj_uvs_by_position(path: &Path) -> std::collections::HashMap<[u32; 3], Vec<[f32; 2]>> {
-    let obj = read_obj_lines(path);
-    let mut out: std::collections::HashMap<[u32; 3], Vec<[f32; 2]>> = Default::default();
-    for (v, t) in obj.corners {
-        let p = &obj.vertices[v];
-        let key = [p[0], p[1], p[2]].map(f32::to_bits);
-        out.entry(key).or_default().push(obj.uvs[t.unwrap()]);
+/// Per (group, input position bits) of the input OBJ: the UVs its corners use.
+fn obj_uvs_by_group(path: &Path) -> std::collections::HashMap<(String, [u32; 3]), Vec<[f32; 2]>> {
+    let obj = read_obj_scene(path);
+    let mut out: std::collections::HashMap<(String, [u32; 3]), Vec<[f32; 2]>> = Default::default();
+    for face in &obj.faces {
+        for &(v, t, _) in &face.corners {
+            let p = &obj.vertices[v];
+            let key = [p[0], p[1], p[2]].map(f32::to_bits);
+            out.entry((face.group.clone().unwrap(), key))
+                .or_default()
+                .push(obj.uvs[t.unwrap()]);
+        }
     }
     out
 }
 
 #[test]
-fn an_obj_saved_as_glb_keeps_its_uvs() {
+fn an_obj_saved_as_gltf_keeps_groups_materials_uvs_and_normals() {
     let dir = tempfile::tempdir().unwrap();
-    let out = dir.path().join("textured.glb");
-    let (loaded, mesh, report) = fair_and_save("textured.obj", &out);
-    validate(std::slice::from_ref(&out));
-    assert_reloads_as(&out, &mesh, 0.0);
-    let output = read_gltf(&out);
-    let primitive = &output.json["meshes"][0]["primitives"][0];
-    let uvs = output.floats(primitive["attributes"]["TEXCOORD_0"].as_u64().unwrap() as usize);
-    assert_eq!(uvs.len(), mesh.vertex_count());
-    let input = obj_uvs_by_position(&data("textured.obj"));
-    let mut seams = 0;
-    for (v, uv) in uvs.iter().enumerate() {
-        assert!(uv.iter().all(|c| c.is_finite()));
-        let choices = &input[&loaded.mesh.positions[v].map(f32::to_bits)];
-        assert!(
-            choices.iter().any(|c| c[..] == uv[..]),
-            "vertex {v}: {uv:?} is not one of the input's {choices:?}"
-        );
-        if choices.iter().any(|c| c != &choices[0]) {
-            seams += 1;
+    let glb = dir.path().join("textured.glb");
+    let (loaded, mesh, report) = fair_and_save("textured.obj", &glb);
+    let gltf = dir.path().join("sub/textured.gltf");
+    std::fs::create_dir(dir.path().join("sub")).unwrap();
+    io::save_with_source(&gltf, &mesh, &loaded.source).unwrap();
+    validate(&[glb.clone(), gltf.clone()]);
+    let texture = std::fs::read(data("textured.png")).unwrap();
+    let input = obj_uvs_by_group(&data("textured.obj"));
+    let welded_of: std::collections::HashMap<[u32; 3], usize> = mesh
+        .positions
+        .iter()
+        .enumerate()
+        .map(|(v, p)| (p.map(f32::to_bits), v))
+        .collect();
+    let smooth = {
+        let mut sums = vec![glam::Vec3::ZERO; mesh.vertex_count()];
+        for t in &mesh.triangles {
+            let [a, b, c] = t.map(|v| glam::Vec3::from(mesh.positions[v as usize]));
+            for &v in t {
+                sums[v as usize] += (b - a).cross(c - a);
+            }
         }
+        sums.iter().map(|s| s.normalize()).collect::<Vec<_>>()
+    };
+    for path in [&glb, &gltf] {
+        assert_same_surface(path, &mesh);
+        let output = read_gltf(path);
+        let json = &output.json;
+        // The `o` is a node over one node and mesh per `g`; one primitive per material.
+        let nodes = json["nodes"].as_array().unwrap();
+        let root = json["scenes"][0]["nodes"][0].as_u64().unwrap() as usize;
+        assert_eq!(json["scenes"][0]["nodes"].as_array().unwrap().len(), 1);
+        assert_eq!(nodes[root]["name"], "quadsphere");
+        let children: Vec<&str> = nodes[root]["children"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|c| {
+                nodes[c.as_u64().unwrap() as usize]["name"]
+                    .as_str()
+                    .unwrap()
+            })
+            .collect();
+        assert_eq!(children, ["px", "nx", "py", "ny", "pz", "nz"]);
+        let materials = json["materials"].as_array().unwrap();
+        let material_names: Vec<&str> = materials
+            .iter()
+            .map(|m| m["name"].as_str().unwrap())
+            .collect();
+        assert_eq!(material_names, ["paint", "checker"]);
+        let paint = &materials[0]["pbrMetallicRoughness"];
+        assert_eq!(
+            paint["baseColorFactor"],
+            serde_json::json!([0.8, 0.25, 0.15, 1.0])
+        );
+        assert!(paint.get("baseColorTexture").is_none());
+        let checker = &materials[1]["pbrMetallicRoughness"];
+        let t = checker["baseColorTexture"]["index"].as_u64().unwrap() as usize;
+        let image = &json["images"][json["textures"][t]["source"].as_u64().unwrap() as usize];
+        let image_bytes = match image["uri"].as_str() {
+            // A .gltf refers to a copy of the texture beside it.
+            Some(uri) => std::fs::read(path.parent().unwrap().join(uri)).unwrap(),
+            // A GLB embeds it.
+            None => {
+                let view = &json["bufferViews"][image["bufferView"].as_u64().unwrap() as usize];
+                let start = view["byteOffset"].as_u64().unwrap_or(0) as usize;
+                let length = view["byteLength"].as_u64().unwrap() as usize;
+                output.buffers[0][start..start + length].to_vec()
+            }
+        };
+        assert_eq!(image_bytes, texture, "{}", path.display());
+        let mut triangles = 0;
+        let mut normal_at: Vec<Option<Vec<f32>>> = vec![None; mesh.vertex_count()];
+        for node in &nodes[root]["children"].as_array().unwrap()[..] {
+            let node = &nodes[node.as_u64().unwrap() as usize];
+            let group = node["name"].as_str().unwrap();
+            let m = &json["meshes"][node["mesh"].as_u64().unwrap() as usize];
+            assert_eq!(m["name"], group);
+            let primitives = m["primitives"].as_array().unwrap();
+            assert_eq!(primitives.len(), 1);
+            // textured.obj: py and ny use `checker`, the other sides `paint`.
+            let expected = if group == "py" || group == "ny" { 1 } else { 0 };
+            assert_eq!(primitives[0]["material"], expected, "{group}");
+            let attributes = &primitives[0]["attributes"];
+            let positions = output.floats(attributes["POSITION"].as_u64().unwrap() as usize);
+            let uvs = output.floats(attributes["TEXCOORD_0"].as_u64().unwrap() as usize);
+            let normals = output.floats(attributes["NORMAL"].as_u64().unwrap() as usize);
+            triangles += output
+                .indices(primitives[0]["indices"].as_u64().unwrap() as usize)
+                .len()
+                / 3;
+            for k in 0..positions.len() {
+                let v = welded_of
+                    [&[positions[k][0], positions[k][1], positions[k][2]].map(f32::to_bits)];
+                let before = loaded.mesh.positions[v].map(f32::to_bits);
+                let choices = &input[&(group.to_string(), before)];
+                assert!(
+                    choices.iter().all(|c| c[..] == uvs[k][..]),
+                    "{group} vertex {k}: {:?} is not the group's UV {choices:?}",
+                    uvs[k]
+                );
+                // Smooth normals stay smooth across the groups and follow the faired shape.
+                let normal = glam::Vec3::from_slice(&normals[k]);
+                assert!((normal.length() - 1.0).abs() < 1e-5);
+                assert!(normal.dot(smooth[v]) > 0.99, "{normal} vs {}", smooth[v]);
+                match &normal_at[v] {
+                    None => normal_at[v] = Some(normals[k].clone()),
+                    Some(n) => assert_eq!(n, &normals[k], "split smooth normal at {v}"),
+                }
+            }
+        }
+        assert_eq!(triangles, mesh.face_count());
     }
-    // The quad sphere has UV seams: each seam vertex keeps one UV, and the report says how many.
-    assert!(seams > 0);
     let text = report.warnings.join("\n");
     assert!(
-        text.contains(&format!("the UV seams at {seams} vertices")),
+        text.contains("as GLB with its names, materials, textures, UVs and normals"),
         "{text}"
     );
-    for item in ["materials", "quads", "normals"] {
+    let lost = text.split("not kept from").nth(1).unwrap();
+    assert!(lost.contains("quads"), "{text}");
+    for item in [
+        "materials",
+        "texture coordinates",
+        "normals",
+        "object and group",
+    ] {
+        assert!(!lost.contains(item), "{item} named as lost: {text}");
+    }
+}
+
+/// An OBJ saved as glTF loads back vertex for vertex: the vertex `i` that was saved is the vertex
+/// `i` that is loaded (the editor shows, compares and exports by vertex index), even when the
+/// faces first use the vertices in another order and a UV seam splits one of them in the file.
+#[test]
+fn an_obj_saved_as_gltf_loads_back_in_its_own_vertex_order() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = dir.path().join("order.obj");
+    // A tetrahedron, outward facing; the faces first use its vertices in the order 4 2 3 1, and
+    // vertex 4 has two UVs (a seam).
+    std::fs::write(
+        &input,
+        "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\n\
+         vt 0 0\nvt 1 0\nvt 0 1\nvt 1 1\n\
+         f 4/4 2/2 3/3\nf 4/1 3/3 1/1\nf 4/4 1/1 2/2\nf 1/1 3/3 2/2\n",
+    )
+    .unwrap();
+    let loaded = io::load(&input).unwrap();
+    assert_eq!(loaded.mesh.positions[0], [0.0, 0.0, 0.0], "OBJ order");
+    assert_eq!(loaded.mesh.positions[3], [0.0, 0.0, 1.0], "OBJ order");
+    // Moved as fairing moves them: every vertex somewhere else.
+    let mut moved = loaded.mesh.clone();
+    for (v, p) in moved.positions.iter_mut().enumerate() {
+        *p = p.map(|c| c * 1.5 + 0.25 * v as f32);
+    }
+    for name in ["order.glb", "order.gltf"] {
+        let out = dir.path().join(name);
+        let report = io::save_with_source(&out, &moved, &loaded.source).unwrap();
+        let json = read_gltf(&out).json;
+        let attributes = &json["meshes"][0]["primitives"][0]["attributes"];
+        assert!(
+            attributes.get("TEXCOORD_0").is_some(),
+            "{name}: the UVs are carried ({:?})",
+            report.warnings
+        );
+        let back = io::load(&out).unwrap().mesh;
+        assert_eq!(back.positions, moved.positions, "{name}");
+        assert_eq!(back.triangles, moved.triangles, "{name}");
+    }
+}
+
+#[test]
+fn gltf_and_obj_saved_as_ply_keep_colours_uvs_and_normals_and_name_the_rest() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("scene.ply");
+    let (loaded, mesh, report) = fair_and_save("scene.glb", &out);
+    assert_reloads_as(&out, &mesh, 0.0);
+    let reloaded = io::load(&out).unwrap();
+    let contents = reloaded.source.contents().join("; ");
+    assert!(
+        contents.contains("vertex properties nx, ny, nz, s, t, red, green, blue, alpha"),
+        "{contents}"
+    );
+    // The PLY's own values, read here: x y z nx ny nz s t (floats) r g b a (bytes).
+    let bytes = std::fs::read(&out).unwrap();
+    let body = bytes
+        .windows(11)
+        .position(|w| w == b"end_header\n")
+        .unwrap()
+        + 11;
+    let input = read_gltf(&data("scene.glb"));
+    let colours = placed_values(&input, "COLOR_0");
+    let uvs = placed_values(&input, "TEXCOORD_0");
+    let normals = mesh.vertex_normals();
+    let (mut coloured, mut textured) = (0, 0);
+    for v in 0..mesh.vertex_count() {
+        let row = &bytes[body + v * 36..body + (v + 1) * 36];
+        let f = |k: usize| f32::from_le_bytes(row[4 * k..4 * k + 4].try_into().unwrap());
+        assert_eq!([f(0), f(1), f(2)], mesh.positions[v]);
+        let n = glam::Vec3::new(f(3), f(4), f(5));
+        assert!(
+            n.dot(normals[v].normalize().as_vec3()) > 0.9999,
+            "recomputed normal"
+        );
+        let before = loaded.mesh.positions[v];
+        if let Some(ok) = is_a_value_at(&uvs, before, &[f(6), f(7)], 1e-6) {
+            assert!(ok);
+            textured += 1;
+        }
+        let rgba: Vec<f32> = row[32..36].iter().map(|&c| c as f32 / 255.0).collect();
+        if let Some(ok) = is_a_value_at(&colours, before, &rgba, 0.5 / 255.0) {
+            assert!(ok, "vertex {v}: {rgba:?}");
+            coloured += 1;
+        }
+    }
+    assert!(textured >= 400 && coloured >= 300, "{textured} {coloured}");
+    let text = report.warnings.join("\n");
+    assert!(
+        text.contains("as PLY with its UVs, vertex colours and normals (recomputed)"),
+        "{text}"
+    );
+    for item in [
+        "the node tree",
+        "2 materials",
+        "1 texture",
+        "the split normals (hard edges, seams) at ",
+    ] {
+        assert!(text.contains(item), "{item} not named in: {text}");
+    }
+
+    let out = dir.path().join("textured.ply");
+    let (_, mesh, report) = fair_and_save("textured.obj", &out);
+    assert_reloads_as(&out, &mesh, 0.0);
+    let contents = io::load(&out).unwrap().source.contents().join("; ");
+    assert!(
+        contents.contains("vertex properties nx, ny, nz, s, t"),
+        "{contents}"
+    );
+    let text = report.warnings.join("\n");
+    for item in ["materials", "object and group names", "the UV seams at"] {
         assert!(text.contains(item), "{item} not named in: {text}");
     }
 }
@@ -953,4 +1326,114 @@ fn a_binary_stl_header_is_written_back_or_named() {
         text.contains("\"exported by SomeCAD 2024, units mm\""),
         "{text}"
     );
+}
+
+#[test]
+fn a_coarse_level_keeps_names_materials_and_the_kept_vertices_uvs_and_colours() {
+    use fairmesh::hierarchy::{build_hierarchy, HierarchyOptions};
+    let dir = tempfile::tempdir().unwrap();
+    let loaded = io::load(data("scene.glb")).unwrap();
+    let hierarchy = build_hierarchy(
+        &loaded.mesh,
+        &HierarchyOptions::default(),
+        &mut fairmesh::NoProgress,
+    )
+    .unwrap();
+    let level = (hierarchy.coarsest_level() / 2).max(1);
+    let mesh = hierarchy.level_mesh(level);
+    assert!(mesh.vertex_count() < loaded.mesh.vertex_count() / 2);
+    let (vertex_origin, face_origin) = hierarchy.level_origins(level);
+    let derivation = io::Derivation {
+        base: hierarchy.base_mesh(),
+        vertex_origin: &vertex_origin,
+        face_origin: &face_origin,
+    };
+    let glb = dir.path().join("level.glb");
+    let obj = dir.path().join("level.obj");
+    let report = io::save_derived_with_source(&glb, &mesh, &derivation, &loaded.source).unwrap();
+    io::save_derived_with_source(&obj, &mesh, &derivation, &loaded.source).unwrap();
+    validate(std::slice::from_ref(&glb));
+    assert_same_surface(&glb, &mesh);
+    assert_same_surface(&obj, &mesh);
+    let input = read_gltf(&data("scene.glb"));
+    let uvs = placed_values(&input, "TEXCOORD_0");
+    let colours = placed_values(&input, "COLOR_0");
+    let output = read_gltf(&glb);
+    let json = &output.json;
+    let names: BTreeSet<&str> = json["nodes"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|n| n["name"].as_str().unwrap())
+        .collect();
+    assert_eq!(names, BTreeSet::from(["ball", "block"]));
+    let mut checked = (0, 0);
+    for node in json["nodes"].as_array().unwrap() {
+        let m = &json["meshes"][node["mesh"].as_u64().unwrap() as usize];
+        let primitive = &m["primitives"][0];
+        let material = &json["materials"][primitive["material"].as_u64().unwrap() as usize];
+        let attributes = &primitive["attributes"];
+        let positions = output.floats(attributes["POSITION"].as_u64().unwrap() as usize);
+        let texcoords = output.floats(attributes["TEXCOORD_0"].as_u64().unwrap() as usize);
+        let rgba = output.floats(attributes["COLOR_0"].as_u64().unwrap() as usize);
+        for k in 0..positions.len() {
+            let p = [positions[k][0], positions[k][1], positions[k][2]];
+            if node["name"] == "ball" {
+                assert_eq!(material["name"], "checker");
+                assert!(material["pbrMetallicRoughness"]["baseColorTexture"].is_object());
+                assert_eq!(is_a_value_at(&uvs, p, &texcoords[k], 1e-6), Some(true));
+                checked.0 += 1;
+            } else {
+                assert_eq!(material["name"], "paint");
+                assert_eq!(is_a_value_at(&colours, p, &rgba[k], 1e-6), Some(true));
+                checked.1 += 1;
+            }
+        }
+    }
+    assert!(checked.0 > 50 && checked.1 > 50, "{checked:?}");
+    let text = report.warnings.join("\n");
+    for item in [
+        "a coarser level has fewer vertices",
+        "with the names, materials, textures, UVs, normals and vertex colours of the kept vertices",
+        "recomputed, smooth",
+        "the node tree",
+    ] {
+        assert!(text.contains(item), "{item} not in: {text}");
+    }
+    let obj_text = std::fs::read_to_string(&obj).unwrap();
+    for line in [
+        "mtllib level.mtl",
+        "o ball",
+        "usemtl checker",
+        "o block",
+        "usemtl paint",
+    ] {
+        assert!(obj_text.contains(line), "{line}");
+    }
+}
+
+#[test]
+fn non_finite_uvs_normals_and_colours_never_reach_another_format() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = dir.path().join("bad.obj");
+    std::fs::write(
+        &input,
+        "v 0 0 0 nan 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nvt nan inf\nvt 0.5 0.5\nvn nan 0 0\nvn 0 0 1\n\
+         f 1/1/1 3/2/2 2/2/2\nf 1/1/1 2/2/2 4/2/2\nf 1/2/1 4/2/2 3/2/2\nf 2/2/2 3/2/2 4/1/1\n",
+    )
+    .unwrap();
+    let loaded = io::load(&input).unwrap();
+    let mut moved = loaded.mesh.clone();
+    moved.positions[3][2] = 1.5;
+    let out = dir.path().join("bad.glb");
+    io::save_with_source(&out, &moved, &loaded.source).unwrap();
+    validate(std::slice::from_ref(&out));
+    let output = read_gltf(&out);
+    for primitive in output.primitives() {
+        for (_, a) in primitive["attributes"].as_object().unwrap() {
+            for value in output.floats(a.as_u64().unwrap() as usize) {
+                assert!(value.iter().all(|c| c.is_finite()), "{value:?}");
+            }
+        }
+    }
 }

@@ -185,8 +185,14 @@ pub fn run_hierarchy(args: HierarchyArgs) -> anyhow::Result<()> {
         for level in 0..hierarchy.level_count() {
             let path = dir.join(format!("level_{level:02}.{extension}"));
             let mesh = hierarchy.level_mesh(level);
+            let (vertex_origin, face_origin) = hierarchy.level_origins(level);
+            let derivation = io::Derivation {
+                base: hierarchy.base_mesh(),
+                vertex_origin: &vertex_origin,
+                face_origin: &face_origin,
+            };
             let report = super::progress::Step::run(format!("saving {}", path.display()), || {
-                io::save_with_source(&path, &mesh, &loaded.source)
+                io::save_derived_with_source(&path, &mesh, &derivation, &loaded.source)
             })
             .with_context(|| format!("writing level {level}"))?;
             lost.extend(report.warnings);

@@ -183,6 +183,22 @@ impl Hierarchy {
             self.level_triangles(level),
         )
     }
+    /// Where [`Hierarchy::level_mesh`]`(level)` comes from in M0: per vertex the M0 vertex, per
+    /// triangle the M0 triangle it is what is left of (for keeping a file's UVs, colours and
+    /// materials on a coarse level, see `io::save_derived_with_source`).
+    pub fn level_origins(&self, level: usize) -> (Vec<u32>, Vec<u32>) {
+        if self.level_vertices.is_empty() {
+            return (
+                (0..self.base.vertex_count() as u32).collect(),
+                (0..self.base.face_count() as u32).collect(),
+            );
+        }
+        let info = self.level_info(level);
+        (
+            self.order[..info.vertices].to_vec(),
+            self.face_order[..info.faces].to_vec(),
+        )
+    }
     /// M0 positions of the vertices of `level`, in internal order.
     pub fn level_positions(&self, level: usize) -> &[[f32; 3]] {
         &self.positions[..self.level_info(level).vertices]

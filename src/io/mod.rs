@@ -26,6 +26,7 @@ mod gltf_writeback;
 mod obj;
 mod off;
 mod ply;
+mod scene;
 mod source;
 mod stl;
 mod text;
@@ -495,35 +496,237 @@ pub fn save_with_source(
         }
         return Ok(report);
     }
-    // Another format: what it can hold per vertex (UVs, colours) is carried when the mesh still
-    // has the source's vertices; the rest is named.
-    let carries = matches!(format, Format::Obj | Format::Glb | Format::Gltf);
-    let extra = if carries && !source.writes_back_as(format) && source.matches(mesh) {
+    let name = name.to_string();
+    let carries = !source.writes_back_as(format) && source.matches(mesh);
+    // A glTF scene or an OBJ into OBJ or glTF: its parts, materials, UVs, normals and colours.
+    if carries && matches!(format, Format::Obj | Format::Glb | Format::Gltf) {
+        if let Some(mut scene) = source.scene(mesh) {
+            let mut merged_colours = 0;
+            match format {
+                Format::Obj => obj::write_scene(path, &scene, mesh, &mut merged_colours)?,
+                _ => gltf::write_scene(path, format == Format::Glb, &mut scene, mesh)?,
+            }
+            let mut lost = source.contents_beyond_scene(&scene, format);
+            if merged_colours > 0 {
+                lost.push(format!(
+                    "the colour borders at {merged_colours} vertices (an OBJ vertex keeps one colour; the first was kept)"
+                ));
+            }
+            lost.append(&mut scene.warnings);
+            if !lost.is_empty() {
+                report.warnings.push(format!(
+                    "it is written as {format} with its {}; not kept from {name}: {}",
+                    and_list(&scene.carried()),
+                    lost.join("; ")
+                ));
+            }
+            return Ok(report);
+        }
+    }
+    // Otherwise what the format can hold per vertex (UVs, colours; normals into PLY) is carried
+    // when the mesh still has the source's vertices; the rest is named.
+    let extra = if carries
+        && matches!(
+            format,
+            Format::Obj | Format::Glb | Format::Gltf | Format::Ply
+        ) {
         source.vertex_attributes()
     } else {
         carry::VertexAttributes::default()
     };
+    let (mut kept, mut lost) = extra.describe();
+    let mut beyond = source.contents_beyond(&extra);
     match format {
         Format::Obj => atomic::write(path, |w| obj::write_with(w, mesh, &extra))?,
         Format::Glb => atomic::write(path, |w| gltf::write_glb_with(w, mesh, &extra))?,
         Format::Gltf => gltf::write_gltf_with(path, mesh, &extra)?,
+        Format::Ply if carries => {
+            // Normals, when the file had them, are recomputed from the faired shape: one per
+            // vertex, so the split ones (hard edges) become smooth; how many is said.
+            let had_normals = beyond
+                .iter()
+                .any(|item| item == "normals" || item.starts_with("normals ("));
+            let normals = had_normals.then(|| gltf::unit_vertex_normals(mesh));
+            atomic::write(path, |w| {
+                ply::write_with(w, mesh, &extra, normals.as_deref())
+            })?;
+            if had_normals {
+                kept.push("normals (recomputed)");
+                beyond.retain(|item| item != "normals" && !item.starts_with("normals ("));
+                let split = source.split_normal_vertices(mesh);
+                if split > 0 {
+                    lost.push(format!(
+                        "the split normals (hard edges, seams) at {split} vertices: a PLY vertex holds one normal, recomputed smooth from the faired shape"
+                    ));
+                }
+            }
+        }
         _ => save_as(path, mesh, format)?,
     }
-    let (kept, mut lost) = extra.describe();
-    lost.extend(source.contents_beyond(&extra));
+    lost.extend(beyond);
     if !lost.is_empty() {
         let why = if source.writes_back_as(format) {
             "the mesh no longer has its connectivity (a level of the hierarchy or a changed copy), so it is written as a bare mesh".to_string()
         } else if kept.is_empty() {
             format!("it is written as a bare {format} mesh")
         } else {
-            format!("it is written as {format} with its {}", kept.join(" and "))
+            format!("it is written as {format} with its {}", and_list(&kept))
         };
         report
             .warnings
             .push(format!("{why}; not kept from {name}: {}", lost.join("; ")));
     }
     Ok(report)
+}
+
+/// Where a mesh derived from a loaded one by removing vertices (a coarse level of the
+/// hierarchy) came from, for [`save_derived_with_source`].
+#[derive(Clone, Copy, Debug)]
+pub struct Derivation<'a> {
+    /// The mesh it was derived from, with the loaded connectivity (its positions do not matter).
+    pub base: &'a TriMesh,
+    /// Per vertex of the derived mesh: the vertex of `base` it is.
+    pub vertex_origin: &'a [u32],
+    /// Per triangle of the derived mesh: the triangle of `base` it is what is left of.
+    pub face_origin: &'a [u32],
+}
+
+/// Save a mesh derived from the loaded one by removing vertices (a coarse level of the
+/// hierarchy), keeping what can be kept per surviving vertex: into OBJ or glTF, from a glTF or
+/// OBJ source, its part names, materials (and textures), and the UVs and colours of the kept
+/// vertices (a corner moved onto another vertex takes that vertex's UV in the same material);
+/// into OBJ, glTF or PLY from any source, the UVs and colours of the kept vertices. Normals are
+/// recomputed, smooth, from the coarse shape. The report names what is not kept (split normals,
+/// morph targets, the node tree's transforms, ...). A derivation that does not fit `mesh` or
+/// `source` is written as [`save_with_source`] writes it (bare, with the report saying so).
+pub fn save_derived_with_source(
+    path: impl AsRef<Path>,
+    mesh: &TriMesh,
+    derivation: &Derivation<'_>,
+    source: &Source,
+) -> Result<SaveReport, IoError> {
+    let path = path.as_ref();
+    let format = format_of(path)?;
+    let fits = derivation.vertex_origin.len() == mesh.positions.len()
+        && derivation.face_origin.len() == mesh.triangles.len()
+        && source.matches(derivation.base)
+        && derivation
+            .vertex_origin
+            .iter()
+            .all(|&v| (v as usize) < derivation.base.positions.len());
+    if !fits || (source.matches(mesh) && mesh.positions.len() == derivation.base.positions.len()) {
+        return save_with_source(path, mesh, source);
+    }
+    check_writable(mesh, path)?;
+    let mut report = SaveReport::default();
+    let name = source.path.display().to_string();
+    let why = "a coarser level has fewer vertices";
+    let mut lost: Vec<String> = Vec::new();
+    let kept: Vec<&str>;
+    let scene = matches!(format, Format::Obj | Format::Glb | Format::Gltf)
+        .then(|| source.scene(derivation.base))
+        .flatten();
+    if let Some(scene) = scene {
+        let (mut derived, unplaced) = scene.derive(
+            derivation.base,
+            mesh,
+            derivation.vertex_origin,
+            derivation.face_origin,
+        );
+        let mut merged_colours = 0;
+        match format {
+            Format::Obj => obj::write_scene(path, &derived, mesh, &mut merged_colours)?,
+            _ => gltf::write_scene(path, format == Format::Glb, &mut derived, mesh)?,
+        }
+        kept = derived.carried();
+        if unplaced > 0 {
+            lost.push(format!(
+                "the part and material of {unplaced} triangles (their source triangle was not found)"
+            ));
+        }
+        if merged_colours > 0 {
+            lost.push(format!(
+                "the colour borders at {merged_colours} vertices (an OBJ vertex keeps one colour; the first was kept)"
+            ));
+        }
+        if scene.normals {
+            lost.push("the file's own normals and their split (hard edges): they are recomputed, smooth, from the coarse shape".into());
+        }
+        let mut contents = source.contents_beyond_scene(&scene, format);
+        if format != Format::Obj {
+            for item in &mut contents {
+                if item.starts_with("the node tree") {
+                    *item = format!("{item}: its hierarchy and transforms (each part becomes one node, names kept, transforms baked into the positions)");
+                }
+            }
+        }
+        lost.extend(contents);
+        lost.extend(scene.warnings);
+    } else {
+        let full = source.vertex_attributes();
+        let pick = |values: &[[f32; 2]]| -> Vec<[f32; 2]> {
+            derivation
+                .vertex_origin
+                .iter()
+                .map(|&v| values[v as usize])
+                .collect()
+        };
+        let extra = carry::VertexAttributes {
+            uvs: full.uvs.as_deref().map(pick),
+            colours: full.colours.as_ref().map(|values| {
+                derivation
+                    .vertex_origin
+                    .iter()
+                    .map(|&v| values[v as usize])
+                    .collect()
+            }),
+            uv_splits_merged: full.uv_splits_merged,
+            colour_splits_merged: full.colour_splits_merged,
+        };
+        let (carried, mut merged) = extra.describe();
+        match format {
+            Format::Obj => atomic::write(path, |w| obj::write_with(w, mesh, &extra))?,
+            Format::Glb => atomic::write(path, |w| gltf::write_glb_with(w, mesh, &extra))?,
+            Format::Gltf => gltf::write_gltf_with(path, mesh, &extra)?,
+            Format::Ply => atomic::write(path, |w| ply::write_with(w, mesh, &extra, None))?,
+            _ => save_as(path, mesh, format)?,
+        }
+        let holds = matches!(
+            format,
+            Format::Obj | Format::Glb | Format::Gltf | Format::Ply
+        );
+        kept = if holds { carried } else { Vec::new() };
+        if holds {
+            lost.append(&mut merged);
+            lost.extend(source.contents_beyond(&extra));
+        } else {
+            lost.extend(source.contents());
+        }
+    }
+    if !lost.is_empty() {
+        let how = if kept.is_empty() {
+            format!("it is written as a bare {format} mesh")
+        } else {
+            format!(
+                "it is written as {format} with the {} of the kept vertices",
+                and_list(&kept)
+            )
+        };
+        report.warnings.push(format!(
+            "{why}: {how}; not kept from {name}: {}",
+            lost.join("; ")
+        ));
+    }
+    Ok(report)
+}
+
+/// "a", "a and b", "a, b and c".
+fn and_list(items: &[&str]) -> String {
+    match items {
+        [] => String::new(),
+        [one] => one.to_string(),
+        [rest @ .., last] => format!("{} and {last}", rest.join(", ")),
+    }
 }
 
 /// Refuse meshes that no reader could load back: no triangles, NaN/inf, indices out of range.

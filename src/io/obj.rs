@@ -20,12 +20,18 @@
 //! Writing: `v x y z` with Rust's shortest round-trip float formatting (`{}`), so every f32 reads
 //! back bit for bit, and `f a b c` with 1-based indices.
 
+use super::atomic;
 use super::carry::{Gather, VertexAttributes};
+use super::scene::{
+    image_file_name, image_mime_type, Image, ImageData, Material, Part, Primitive, Scene,
+    SceneVertex,
+};
 use super::source::{dvec, NormalTurns, Source};
 use super::text::{lines, non_finite_kind, quote, tokens};
 use super::{IoError, Parsed};
 use crate::mesh::TriMesh;
 use rayon::prelude::*;
+use std::collections::HashMap;
 use std::io::Write;
 use std::path::Path;
 
@@ -476,6 +482,473 @@ pub(crate) fn vertex_attributes(bytes: &[u8], source: &Source) -> VertexAttribut
         out.uv_splits_merged = merged;
     }
     out
+}
+
+/// The rest of a line after its keyword (`o`, `g`, `usemtl`, `mtllib`, `map_Kd`), words joined by
+/// one space; `None` when empty.
+fn rest_of<'a>(words: impl Iterator<Item = &'a [u8]>) -> Option<String> {
+    let words: Vec<String> = words
+        .map(|w| String::from_utf8_lossy(w).into_owned())
+        .collect();
+    (!words.is_empty()).then(|| words.join(" "))
+}
+
+/// The OBJ's parts (one per `o`/`g` pair), materials (from its `mtllib` files, read beside it),
+/// and file vertices (one per distinct `v/vt/vn` corner), for saving in another format (see
+/// [`super::scene`]). Normals turn with their faces to `mesh`'s positions, slot by `vn` line as
+/// in [`write_back`].
+pub(crate) fn scene(bytes: &[u8], source: &Source, mesh: &TriMesh) -> Scene {
+    let mut scene = Scene {
+        groups_under_objects: true,
+        ..Scene::default()
+    };
+    let mut positions: Vec<[f32; 3]> = Vec::with_capacity(source.raw_vertices);
+    let mut colours: Vec<Option<[f32; 3]>> = Vec::with_capacity(source.raw_vertices);
+    let mut uvs: Vec<[f32; 2]> = Vec::new();
+    let mut normals: Vec<[f32; 3]> = Vec::new();
+    let mut libraries: Vec<String> = Vec::new();
+    let mut material_names: Vec<String> = Vec::new();
+    let mut corner_vertex: HashMap<(usize, usize, usize), u32> = HashMap::new();
+    let mut parts: HashMap<(Option<String>, Option<String>), usize> = HashMap::new();
+    let (mut object, mut group, mut material): (Option<String>, Option<String>, Option<usize>) =
+        (None, None, None);
+    // The part and primitive faces go to, until an `o`, `g` or `usemtl` changes it.
+    let mut current: Option<(usize, usize)> = None;
+    let mut corners: Vec<u32> = Vec::with_capacity(8);
+    for line in bytes.split(|&b| b == b'\n') {
+        let mut words = tokens(line);
+        match words.next() {
+            Some(b"v") => {
+                let values: Vec<&[u8]> = words.collect();
+                positions.push(vertex_of(values.iter().copied()).unwrap_or([f32::NAN; 3]));
+                colours.push((values.len() == 6).then(|| {
+                    [3, 4, 5].map(|i| {
+                        super::text::parse_f32(values[i])
+                            .filter(|c| c.is_finite())
+                            .map_or(1.0, |c| c.clamp(0.0, 1.0))
+                    })
+                }));
+            }
+            Some(b"vt") => {
+                // Never a NaN in the output: what is not a finite number becomes 0.
+                let mut number = || {
+                    words
+                        .next()
+                        .and_then(super::text::parse_f32)
+                        .filter(|c| c.is_finite())
+                        .unwrap_or(0.0)
+                };
+                uvs.push([number(), number()]);
+            }
+            Some(b"vn") => normals.push(
+                vertex_of(words.take(3))
+                    .filter(|n| n.iter().all(|c| c.is_finite()))
+                    .unwrap_or([0.0; 3]),
+            ),
+            Some(b"o") => {
+                object = rest_of(words);
+                current = None;
+            }
+            Some(b"g") => {
+                group = rest_of(words);
+                current = None;
+            }
+            Some(b"usemtl") => {
+                material = rest_of(words).map(|name| {
+                    material_names
+                        .iter()
+                        .position(|m| *m == name)
+                        .unwrap_or_else(|| {
+                            material_names.push(name);
+                            material_names.len() - 1
+                        })
+                });
+                current = None;
+            }
+            Some(b"mtllib") => libraries.extend(rest_of(words)),
+            Some(b"f") => {
+                corners.clear();
+                for corner in words {
+                    let mut parts = corner.split(|&b| b == b'/');
+                    let v = parts.next().and_then(|t| resolve(t, positions.len()));
+                    let vt = parts
+                        .next()
+                        .filter(|t| !t.is_empty())
+                        .and_then(|t| resolve(t, uvs.len()))
+                        .filter(|&t| t < uvs.len());
+                    let vn = parts
+                        .next()
+                        .filter(|t| !t.is_empty())
+                        .and_then(|t| resolve(t, normals.len()))
+                        .filter(|&n| n < normals.len());
+                    let Some(v) = v.filter(|&v| v < positions.len()) else {
+                        corners.clear();
+                        break;
+                    };
+                    let key = (v, vt.unwrap_or(usize::MAX), vn.unwrap_or(usize::MAX));
+                    let index = *corner_vertex.entry(key).or_insert_with(|| {
+                        let mut vertex = SceneVertex::new(source.welded(v), positions[v]);
+                        if let Some(t) = vt {
+                            vertex.uv = uvs[t];
+                        }
+                        if let Some([r, g, b]) = colours[v] {
+                            vertex.colour = [r, g, b, 1.0];
+                        }
+                        if let Some(n) = vn {
+                            vertex.normal = normals[n];
+                            vertex.slot = n;
+                        }
+                        scene.vertices.push(vertex);
+                        (scene.vertices.len() - 1) as u32
+                    });
+                    scene.uvs |= vt.is_some();
+                    scene.normals |= vn.is_some();
+                    scene.colours |= colours[v].is_some();
+                    corners.push(index);
+                }
+                if corners.len() < 3 {
+                    continue;
+                }
+                let (part, primitive) = *current.get_or_insert_with(|| {
+                    let key = (object.clone(), group.clone());
+                    let part = *parts.entry(key).or_insert_with(|| {
+                        scene.parts.push(Part {
+                            object: object.clone(),
+                            group: group.clone(),
+                            primitives: Vec::new(),
+                        });
+                        scene.parts.len() - 1
+                    });
+                    let primitives = &mut scene.parts[part].primitives;
+                    let primitive = primitives
+                        .iter()
+                        .position(|p| p.material == material)
+                        .unwrap_or_else(|| {
+                            primitives.push(Primitive {
+                                material,
+                                triangles: Vec::new(),
+                            });
+                            primitives.len() - 1
+                        });
+                    (part, primitive)
+                });
+                let triangles = &mut scene.parts[part].primitives[primitive].triangles;
+                for i in 1..corners.len() - 1 {
+                    triangles.push([corners[0], corners[i], corners[i + 1]]);
+                }
+            }
+            _ => {}
+        }
+    }
+    scene.materials = read_materials(&material_names, &libraries, source, &mut scene.warnings);
+    scene.drop_degenerate();
+    scene.turn_normals(mesh);
+    scene
+}
+
+/// The materials `names` as the `.mtl` files `libraries` (beside the OBJ) define them: Kd and d
+/// (or Tr) as the base colour, Pm and Pr, and map_Kd (resolved beside the `.mtl`). A material
+/// or file that cannot be found is named in `warnings` and gets a white base colour.
+fn read_materials(
+    names: &[String],
+    libraries: &[String],
+    source: &Source,
+    warnings: &mut Vec<String>,
+) -> Vec<Material> {
+    let mut materials: Vec<Material> = names
+        .iter()
+        .map(|name| Material {
+            name: name.clone(),
+            base_colour: [1.0; 4],
+            metallic: 0.0,
+            roughness: 1.0,
+            texture: None,
+        })
+        .collect();
+    if names.is_empty() {
+        return materials;
+    }
+    let mut found = vec![false; names.len()];
+    let mut unkept: Vec<String> = Vec::new();
+    // The libraries that could not be read, each with why.
+    let mut unread: Vec<String> = Vec::new();
+    for library in libraries {
+        let Some(base) = &source.base_dir else {
+            unread.push(format!(
+                "{library} (the input was read from memory, so it cannot be found)"
+            ));
+            continue;
+        };
+        let file = base.join(library);
+        let text = match std::fs::read(&file) {
+            Ok(text) => text,
+            Err(e) => {
+                let why = if e.kind() == std::io::ErrorKind::NotFound {
+                    let obj = source.path.file_name().unwrap_or_default();
+                    format!("not found beside {}", Path::new(obj).display())
+                } else {
+                    format!("{} cannot be read: {e}", file.display())
+                };
+                unread.push(format!("{library} ({why})"));
+                continue;
+            }
+        };
+        let folder = file.parent().map(Path::to_path_buf).unwrap_or_default();
+        let mut current: Option<usize> = None;
+        for line in text.split(|&b| b == b'\n') {
+            let mut words = tokens(line);
+            let Some(keyword) = words.next() else {
+                continue;
+            };
+            if keyword == b"newmtl" {
+                current = rest_of(words).and_then(|name| names.iter().position(|n| *n == name));
+                if let Some(m) = current {
+                    found[m] = true;
+                }
+                continue;
+            }
+            let Some(m) = current else { continue };
+            let material = &mut materials[m];
+            let words: Vec<&[u8]> = words.collect();
+            let numbers: Vec<f32> = words
+                .iter()
+                .map_while(|w| super::text::parse_f32(w))
+                .filter(|v| v.is_finite())
+                .collect();
+            match keyword {
+                b"Kd" if numbers.len() >= 3 => {
+                    material.base_colour[..3].copy_from_slice(&numbers[..3]);
+                }
+                b"d" if !numbers.is_empty() => material.base_colour[3] = numbers[0],
+                b"Tr" if !numbers.is_empty() => material.base_colour[3] = 1.0 - numbers[0],
+                b"Pm" if !numbers.is_empty() => material.metallic = numbers[0],
+                b"Pr" if !numbers.is_empty() => material.roughness = numbers[0],
+                b"map_Kd" => {
+                    // Options (-s 1 1 1, -clamp on, ...) come first; the file name is last.
+                    let Some(name) = words
+                        .last()
+                        .map(|w| String::from_utf8_lossy(w).into_owned())
+                    else {
+                        continue;
+                    };
+                    let image = folder.join(name.replace('\\', "/"));
+                    if image.is_file() {
+                        material.texture = Some(Image {
+                            name: image_file_name(
+                                &image.file_name().map_or_else(
+                                    || name.clone(),
+                                    |n| n.to_string_lossy().into_owned(),
+                                ),
+                                image_mime_type(&[], &image),
+                            ),
+                            data: ImageData::File(image),
+                        });
+                    } else {
+                        warnings.push(format!(
+                            "the texture {name} of material '{}' (not found beside {})",
+                            material.name,
+                            file.display()
+                        ));
+                    }
+                }
+                b"Ka" | b"Ks" | b"Ke" | b"Ns" | b"Ni" | b"illum" | b"Tf" => {}
+                other if other.starts_with(b"map_") || other == b"bump" || other == b"norm" => {
+                    let what = format!("'{}' {}", material.name, String::from_utf8_lossy(other));
+                    if !unkept.contains(&what) {
+                        unkept.push(what);
+                    }
+                }
+                _ => {}
+            }
+        }
+    }
+    let missing: Vec<&str> = names
+        .iter()
+        .zip(&found)
+        .filter(|(_, found)| !**found)
+        .map(|(name, _)| name.as_str())
+        .collect();
+    let quoted: Vec<String> = missing.iter().map(|name| format!("'{name}'")).collect();
+    let quoted: Vec<&str> = quoted.iter().map(String::as_str).collect();
+    if unread.len() == libraries.len() && !unread.is_empty() {
+        // Nothing defines the materials: said once, with why.
+        warnings.push(format!(
+            "the material {} {}, so the materials {} are written white, without their colours and textures",
+            if unread.len() == 1 { "library" } else { "libraries" },
+            unread.join(" and "),
+            super::and_list(&quoted)
+        ));
+    } else {
+        for library in &unread {
+            warnings.push(format!("the material library {library}"));
+        }
+        if !missing.is_empty() && !libraries.is_empty() {
+            warnings.push(format!(
+                "the definition of material(s) {} (not in {}): written white",
+                missing.join(", "),
+                libraries.join(", ")
+            ));
+        }
+    }
+    if !unkept.is_empty() {
+        warnings.push(format!(
+            "material maps other than the diffuse map ({})",
+            unkept.join(", ")
+        ));
+    }
+    materials
+}
+
+/// An OBJ of `scene` at `path`, with a `.mtl` beside it (`<stem>.mtl`) when it has materials and
+/// their textures copied or written beside it (see [`Scene::place_images`]): `v` per welded
+/// vertex of `mesh` (with the vertex colour when the source had them), `vt` and `vn` per distinct
+/// value, `o`, `g` and `usemtl` per part and material. Every file is staged and renamed into
+/// place only when all are complete.
+pub(crate) fn write_scene(
+    path: &Path,
+    scene: &Scene,
+    mesh: &TriMesh,
+    merged_colours: &mut usize,
+) -> Result<(), IoError> {
+    let mtl_path = path.with_extension("mtl");
+    let mtl_name = mtl_path.file_name().map_or_else(
+        || "materials.mtl".into(),
+        |n| n.to_string_lossy().into_owned(),
+    );
+    let placed = scene.place_images(path);
+    let used = |v: &&SceneVertex| v.welded != u32::MAX;
+    // One colour per `v` line: the first file vertex's.
+    let colours = scene.colours.then(|| {
+        let mut gather = Gather::<4>::new(mesh.positions.len(), [1.0; 4]);
+        for vertex in scene.vertices.iter().filter(used) {
+            gather.put(Some(vertex.welded as usize), vertex.colour);
+        }
+        let (values, merged) = gather.finish();
+        *merged_colours = merged;
+        values
+    });
+    // Distinct values, numbered in first use.
+    fn numbered<const N: usize>(
+        values: impl Iterator<Item = [f32; N]>,
+    ) -> (Vec<[f32; N]>, HashMap<[u32; N], usize>) {
+        let mut list = Vec::new();
+        let mut index = HashMap::new();
+        for value in values {
+            index.entry(value.map(f32::to_bits)).or_insert_with(|| {
+                list.push(value);
+                list.len() - 1
+            });
+        }
+        (list, index)
+    }
+    let (uv_list, uv_index) = numbered(scene.vertices.iter().filter(used).map(|v| v.uv));
+    let (normal_list, normal_index) =
+        numbered(scene.vertices.iter().filter(used).map(|v| v.normal));
+    let name_token = |name: &str| name.split_whitespace().collect::<Vec<_>>().join("_");
+
+    let write_obj = |out: &mut dyn Write| -> std::io::Result<()> {
+        writeln!(out, "# written by fairmesh")?;
+        writeln!(
+            out,
+            "# {} vertices, {} triangles",
+            mesh.positions.len(),
+            scene.triangle_count()
+        )?;
+        if !scene.materials.is_empty() {
+            writeln!(out, "mtllib {mtl_name}")?;
+        }
+        for (v, [x, y, z]) in mesh.positions.iter().enumerate() {
+            match &colours {
+                Some(colours) => {
+                    let [r, g, b, _] = colours[v];
+                    writeln!(out, "v {x} {y} {z} {r} {g} {b}")?
+                }
+                None => writeln!(out, "v {x} {y} {z}")?,
+            }
+        }
+        if scene.uvs {
+            for [u, v] in &uv_list {
+                writeln!(out, "vt {u} {v}")?;
+            }
+        }
+        if scene.normals {
+            for [x, y, z] in &normal_list {
+                writeln!(out, "vn {x} {y} {z}")?;
+            }
+        }
+        let mut last_object: Option<&str> = None;
+        for part in &scene.parts {
+            if let Some(object) = part.object.as_deref() {
+                if last_object != Some(object) {
+                    writeln!(out, "o {object}")?;
+                    last_object = Some(object);
+                }
+            }
+            if let Some(group) = &part.group {
+                writeln!(out, "g {}", name_token(group))?;
+            }
+            for primitive in &part.primitives {
+                if let Some(m) = primitive.material {
+                    writeln!(out, "usemtl {}", name_token(&scene.materials[m].name))?;
+                }
+                for t in &primitive.triangles {
+                    out.write_all(b"f")?;
+                    for &corner in t {
+                        let vertex = &scene.vertices[corner as usize];
+                        let v = vertex.welded as u64 + 1;
+                        let vt = uv_index
+                            .get(&vertex.uv.map(f32::to_bits))
+                            .map_or(1, |i| i + 1);
+                        let vn = normal_index
+                            .get(&vertex.normal.map(f32::to_bits))
+                            .map_or(1, |i| i + 1);
+                        match (scene.uvs, scene.normals) {
+                            (true, true) => write!(out, " {v}/{vt}/{vn}")?,
+                            (true, false) => write!(out, " {v}/{vt}")?,
+                            (false, true) => write!(out, " {v}//{vn}")?,
+                            (false, false) => write!(out, " {v}")?,
+                        }
+                    }
+                    out.write_all(b"\n")?;
+                }
+            }
+        }
+        Ok(())
+    };
+    let write_mtl = |out: &mut dyn Write| -> std::io::Result<()> {
+        writeln!(out, "# written by fairmesh")?;
+        for (m, material) in scene.materials.iter().enumerate() {
+            let [r, g, b, a] = material.base_colour;
+            writeln!(out, "\nnewmtl {}", name_token(&material.name))?;
+            writeln!(out, "Kd {r} {g} {b}")?;
+            writeln!(out, "d {a}")?;
+            writeln!(out, "Pm {}", material.metallic)?;
+            writeln!(out, "Pr {}", material.roughness)?;
+            if let Some(Some(image)) = placed.get(m) {
+                writeln!(out, "map_Kd {}", image.uri_name)?;
+            }
+        }
+        Ok(())
+    };
+    let mut staged = Vec::new();
+    for (target, data) in placed.iter().flatten().filter_map(|p| p.write.as_ref()) {
+        let bytes = data.bytes().map_err(|source| IoError::Read {
+            path: match data {
+                ImageData::File(file) => file.clone(),
+                ImageData::Bytes(_) => target.clone(),
+            },
+            source,
+        })?;
+        staged.push(atomic::stage(target, |w| w.write_all(&bytes))?);
+    }
+    if !scene.materials.is_empty() {
+        staged.push(atomic::stage(&mtl_path, write_mtl)?);
+    }
+    staged.push(atomic::stage(path, write_obj)?);
+    for file in staged {
+        file.commit()?;
+    }
+    Ok(())
 }
 
 /// Write the OBJ `source` back with `mesh`'s positions: every line but the `v` lines of moved

@@ -23,6 +23,7 @@
 //! everything else it cannot keep.
 
 use super::carry::VertexAttributes;
+use super::scene::Scene;
 use super::{gltf_writeback, Format};
 use crate::mesh::TriMesh;
 use glam::{DQuat, DVec3};
@@ -123,6 +124,72 @@ impl Source {
             SourceData::Gltf(gltf) => gltf.vertex_attributes(self),
             _ => VertexAttributes::default(),
         }
+    }
+
+    /// The file's parts, materials and file vertices (see [`super::scene`]) for writing another
+    /// format, with normals turned to `mesh`'s positions; `None` for a format with no structure
+    /// to carry (PLY, STL, OFF).
+    pub(crate) fn scene(&self, mesh: &TriMesh) -> Option<Scene> {
+        match &self.data {
+            SourceData::Obj(bytes) => Some(super::obj::scene(bytes, self, mesh)),
+            SourceData::Gltf(gltf) => Some(gltf.scene(self, mesh)),
+            _ => None,
+        }
+    }
+
+    /// How many welded vertices have file vertices with different normals (hard edges, split
+    /// seams); 0 for a file with no normals or no structure.
+    pub(crate) fn split_normal_vertices(&self, mesh: &TriMesh) -> usize {
+        let Some(scene) = self.scene(mesh).filter(|s| s.normals) else {
+            return 0;
+        };
+        let mut first: Vec<Option<[f32; 3]>> = vec![None; mesh.positions.len()];
+        let mut split = vec![false; mesh.positions.len()];
+        for part in &scene.parts {
+            for primitive in &part.primitives {
+                for &v in primitive.triangles.iter().flatten() {
+                    let vertex = &scene.vertices[v as usize];
+                    let w = vertex.welded as usize;
+                    match first[w] {
+                        None => first[w] = Some(vertex.normal),
+                        Some(n) if n != vertex.normal => split[w] = true,
+                        Some(_) => {}
+                    }
+                }
+            }
+        }
+        split.iter().filter(|&&s| s).count()
+    }
+
+    /// [`Source::contents`] without what `scene` brings into `format` (OBJ or glTF); the node
+    /// tree, written into an OBJ, is named for what it loses (its hierarchy and transforms).
+    pub(crate) fn contents_beyond_scene(&self, scene: &Scene, format: Format) -> Vec<String> {
+        let numbered = |item: &str, what: &str| {
+            item.starts_with(|c: char| c.is_ascii_digit())
+                && (item.contains(&format!(" {what} (")) || item.contains(&format!(" {what}s (")))
+        };
+        self.contents()
+            .into_iter()
+            .filter_map(|item| {
+                let carried = (scene.normals && (item == "normals" || item.starts_with("normals (")))
+                    || (scene.uvs
+                        && (item == "UVs (TEXCOORD_0)" || item.starts_with("texture coordinates (")))
+                    || (scene.colours
+                        && (item == "vertex colours (COLOR_0)" || item == "vertex colours"))
+                    || item.ends_with("object and group names (o, g)")
+                    || (!scene.materials.is_empty()
+                        && (numbered(&item, "material") || numbered(&item, "texture")));
+                if carried {
+                    return None;
+                }
+                if item.starts_with("the node tree") && format == Format::Obj {
+                    return Some(
+                        "the node tree's hierarchy and transforms (node names became `o` names and mesh names `g` names; the transforms are baked into the positions)".into(),
+                    );
+                }
+                Some(item)
+            })
+            .collect()
     }
 
     /// [`Source::contents`] without what `carried` brought into the output.

@@ -99,9 +99,16 @@ impl App {
                     (from..=to)
                         .map(|level| {
                             let path = folder.join(format!("{stem}_L{level:02}.glb"));
-                            crate::io::save_with_source(
+                            let (vertex_origin, face_origin) = hierarchy.level_origins(level);
+                            let derivation = crate::io::Derivation {
+                                base: hierarchy.base_mesh(),
+                                vertex_origin: &vertex_origin,
+                                face_origin: &face_origin,
+                            };
+                            crate::io::save_derived_with_source(
                                 &path,
                                 &hierarchy.level_mesh(level),
+                                &derivation,
                                 &file_source,
                             )
                             .map(|report| (path, report.warnings))
