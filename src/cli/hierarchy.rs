@@ -349,8 +349,9 @@ pub fn run_multires(args: MultiresArgs) -> anyhow::Result<()> {
         write!(
             out,
             "{:>5} {:>9}  {:<8} {:>8.2} {:>+10.4}",
-            r["level"],
-            r["level_vertices"],
+            // as numbers: a JSON value ignores the column width
+            r["level"].as_u64().unwrap_or(0),
+            r["level_vertices"].as_u64().unwrap_or(0),
             r["variant"].as_str().unwrap_or(""),
             r["time_ms"].as_f64().unwrap_or(0.0),
             r["volume_change_percent"].as_f64().unwrap_or(f64::NAN),
