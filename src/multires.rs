@@ -42,7 +42,10 @@
 //! Speed: a [`MultiresWorkspace`] keeps, per level used so far, its connectivity (`TriMesh`
 //! triangles and `Topology`), loop neighbours, fan-ordered one-rings and fairing operator, built
 //! (levels in parallel) by the first run that needs them or by
-//! [`MultiresWorkspace::prepare_for`]; a run then only moves positions, and allocates nothing but its result. The whole run
+//! [`MultiresWorkspace::prepare_for`]; a run then only moves positions, and allocates nothing but its result.
+//! [`MultiresWorkspace::for_one_run`] keeps instead only the level a run is at (built when the run
+//! reaches it, freed when it leaves it): about a third of the memory for a single run (the
+//! command line), at the cost of building levels one after another. The whole run
 //! executes on a worker of the rayon pool (a run makes a dozen parallel calls per level, and each
 //! call issued from outside the pool is a cross-thread hand-off); passes over the coarse levels
 //! are not split below `PARALLEL_GRAIN` vertices. The per-level passes (Kobbelt step, vertex
@@ -147,6 +150,9 @@ struct LevelData {
 #[derive(Default)]
 pub struct MultiresWorkspace {
     hierarchy_id: u64,
+    /// Build each level when a run reaches it and free it when the run leaves it
+    /// ([`Self::for_one_run`]).
+    release_levels: bool,
     levels: Vec<Option<LevelData>>,
     /// Working positions in the hierarchy's internal order (level i: the first V_i).
     positions: Vec<[f32; 3]>,
@@ -169,6 +175,22 @@ pub struct MultiresWorkspace {
 impl MultiresWorkspace {
     pub fn new() -> Self {
         Self::default()
+    }
+
+    /// A workspace for a single run: it builds each level's connectivity and fairing operator
+    /// when the run reaches the level and frees them when the run moves to the next finer one,
+    /// so that at most two levels are held at a time instead of every level from the start
+    /// level down. The result is the same; a second run builds every level again.
+    pub fn for_one_run() -> Self {
+        Self {
+            release_levels: true,
+            ..Self::default()
+        }
+    }
+
+    /// How many levels' connectivity the workspace holds now.
+    pub fn levels_held(&self) -> usize {
+        self.levels.iter().filter(|level| level.is_some()).count()
     }
 
     /// Builds every level a run from `options.start_level` needs, with the fairing operators of
@@ -358,9 +380,16 @@ fn fair_multires_on_worker(
     progress: &mut dyn Progress,
 ) -> Option<Vec<[f32; 3]>> {
     let start = options.start_level.min(hierarchy.coarsest_level());
-    // Every level this run touches, with the operators of those it fairs.
-    workspace.prepare_for(hierarchy, options);
     let fair_options = level_fair_options(options);
+    let operator = (fair_options.variant, fair_options.boundary);
+    let release = workspace.release_levels;
+    if release {
+        // M0's connectivity only (its boundary is needed now, its operator at the end).
+        workspace.prepare_levels(hierarchy, 0..=0, |_| None);
+    } else {
+        // Every level this run touches, with the operators of those it fairs.
+        workspace.prepare_for(hierarchy, options);
+    }
     let base_vertices = hierarchy.level_info(0).vertices;
     workspace.positions.clear();
     workspace
@@ -382,10 +411,17 @@ fn fair_multires_on_worker(
         _ => Vec::new(),
     };
     for level in (1..=start).rev() {
+        if release {
+            workspace.prepare_levels(hierarchy, level..=level, |_| Some(operator));
+        }
         let faired = fair_level(workspace, level, &fair_options);
         if faired && options.variant == MultiresVariant::Improved {
             remove_low_frequency_shrinkage(workspace, level);
             restore_fixed(hierarchy, &mut workspace.positions, &fixed);
+        }
+        if release {
+            workspace.levels[level] = None;
+            workspace.prepare_levels(hierarchy, level - 1..=level - 1, |_| None);
         }
         refine_positions(hierarchy, workspace, level - 1, options.variant);
         restore_fixed(hierarchy, &mut workspace.positions, &fixed);
@@ -395,10 +431,16 @@ fn fair_multires_on_worker(
         }
     }
     if fair_last {
+        if release {
+            workspace.prepare_levels(hierarchy, 0..=0, |_| Some(operator));
+        }
         fair_level(workspace, 0, &fair_options);
         if !progress.report(1.0) {
             return None;
         }
+    }
+    if release {
+        workspace.levels[0] = None;
     }
     debug_assert_eq!(workspace.positions.len(), base_vertices);
     let mut result = vec![[0f32; 3]; base_vertices];

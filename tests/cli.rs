@@ -387,7 +387,9 @@ fn dash_reads_standard_input_and_writes_standard_output_in_the_named_format() {
         String::from_utf8_lossy(&out.stderr)
     );
     assert!(out.stdout.starts_with(b"ply\n"));
-    assert!(String::from_utf8_lossy(&out.stderr).contains("constrained"));
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(stderr.contains("constrained"));
+    assert!(stderr.contains("wrote standard output"), "{stderr}");
     let faired = fairmesh::io::load_from_bytes(
         &out.stdout,
         fairmesh::io::Format::Ply,

@@ -360,3 +360,40 @@ fn multires_of_a_noisy_gear_from_its_coarsest_level_leaves_no_face_without_area(
         assert_eq!(flat, 0, "{variant:?}");
     }
 }
+
+#[test]
+fn a_workspace_for_one_run_gives_the_same_result_and_keeps_no_level() {
+    use fairmesh::fairing::{BoundaryMode, CreaseOptions};
+    // An open mesh (boundary loops), and one with creases kept by the hierarchy.
+    let mushroom = load("tests/data/mushroom_open.obj");
+    let elephant = load("tests/data/elephant.obj");
+    let hierarchies = [
+        build(&mushroom),
+        build_hierarchy(
+            &elephant,
+            &HierarchyOptions::default().with_creases(Some(CreaseOptions::default())),
+            &mut NoProgress,
+        )
+        .unwrap(),
+    ];
+    for h in &hierarchies {
+        let mut kept = MultiresWorkspace::new();
+        for variant in [MultiresVariant::Improved, MultiresVariant::Paper] {
+            for boundary in [BoundaryMode::Curve, BoundaryMode::Fixed] {
+                for (level, fair_finest) in [(0, false), (1, true), (h.coarsest_level() / 2, false)]
+                {
+                    let options = MultiresOptions::default()
+                        .with_start_level(level)
+                        .with_variant(variant)
+                        .with_boundary(boundary)
+                        .with_fair_finest(fair_finest);
+                    let expected = fair_multires(h, &options, &mut kept, &mut NoProgress).unwrap();
+                    let mut one_run = MultiresWorkspace::for_one_run();
+                    let got = fair_multires(h, &options, &mut one_run, &mut NoProgress).unwrap();
+                    assert_eq!(got, expected, "{variant:?} {boundary:?} from level {level}");
+                    assert_eq!(one_run.levels_held(), 0);
+                }
+            }
+        }
+    }
+}

@@ -97,7 +97,7 @@ pub(crate) fn load_shown(
     weld: bool,
     format: Option<super::FormatArg>,
 ) -> anyhow::Result<Loaded> {
-    super::progress::Step::run(format!("loading {}", super::display_path(path)), || {
+    super::progress::Step::run(format!("loading {}", super::display_input(path)), || {
         load_from(path, weld, format)
     })
 }
@@ -263,7 +263,7 @@ pub fn noise(args: NoiseArgs) -> anyhow::Result<()> {
     )?;
     eprintln!(
         "wrote {} (sigma {:.4e} model units, {:?}, seed {})",
-        super::display_path(&args.output),
+        super::display_output(&args.output),
         absolute,
         mode,
         args.seed
@@ -287,7 +287,7 @@ pub fn convert(args: ConvertArgs) -> anyhow::Result<()> {
     )?;
     eprintln!(
         "wrote {} ({} vertices, {} faces)",
-        super::display_path(&args.output),
+        super::display_output(&args.output),
         loaded.mesh.vertex_count(),
         loaded.mesh.face_count()
     );

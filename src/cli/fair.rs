@@ -287,7 +287,7 @@ pub fn run(args: FairArgs) -> anyhow::Result<()> {
         closed_note,
         report.max_move,
         measured,
-        super::display_path(&args.output)
+        super::display_output(&args.output)
     );
     if super::is_stdio(&args.output) {
         // Standard output holds the mesh.

@@ -138,7 +138,7 @@ pub(crate) fn save_kept(
     source: &fairmesh::io::Source,
     format: Option<FormatArg>,
 ) -> anyhow::Result<()> {
-    let _step = progress::Step::start(format!("saving {}", display_path(path)));
+    let _step = progress::Step::start(format!("saving {}", display_output(path)));
     if is_stdio(path) {
         let format = stdio_format(format, "writing to standard output")?;
         let lost = source.contents();
@@ -159,10 +159,19 @@ pub(crate) fn save_kept(
     Ok(())
 }
 
-/// A path as messages show it: `-` is "standard input/output".
-pub(crate) fn display_path(path: &std::path::Path) -> String {
+/// An input path as messages show it: `-` is "standard input".
+pub(crate) fn display_input(path: &std::path::Path) -> String {
     if is_stdio(path) {
-        "standard input/output (-)".into()
+        "standard input (-)".into()
+    } else {
+        path.display().to_string()
+    }
+}
+
+/// An output path as messages show it: `-` is "standard output".
+pub(crate) fn display_output(path: &std::path::Path) -> String {
+    if is_stdio(path) {
+        "standard output (-)".into()
     } else {
         path.display().to_string()
     }
