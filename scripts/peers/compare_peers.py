@@ -1,0 +1,162 @@
+#!/usr/bin/env python3
+"""fairmesh's default `fair` against the smoothers users would pick instead, on meshes nobody
+tuned fairmesh for.
+
+For each mesh and noise mode: `fairmesh noise` (sigma 0.3 mean edge lengths, seed 1), then
+`fairmesh fair` with its defaults (no flags), and each peer at every iteration count of a scan;
+each result is measured with `fairmesh compare CLEAN RESULT --json` (one metric for all: mean
+surface distance both ways, in mean edge lengths of the clean mesh; mean face-normal error in
+degrees; volume change against the clean mesh in percent). A peer's row is its best iteration
+count by mean distance, picked knowing the clean mesh (an advantage no user has).
+
+Peers (those installed are run): trimesh (Taubin, Humphrey, Laplacian), PyMeshLab (Taubin,
+HC Laplacian), Open3D (Taubin). Install them in a virtual environment:
+    python3 -m venv venv && venv/bin/pip install -r scripts/peers/requirements.txt
+
+Run from the repository root after `cargo build --release`:
+    venv/bin/python scripts/peers/compare_peers.py MESH [MESH ...] [--modes normal,iso]
+Prints a Markdown table per mesh and noise mode.
+"""
+
+import argparse
+import json
+import os
+import subprocess
+import sys
+import tempfile
+
+import numpy as np
+import trimesh
+
+FAIRMESH = os.environ.get("FAIRMESH", "target/release/fairmesh")
+ITERATIONS = [1, 2, 5, 10, 20, 50, 100, 200]
+
+
+def run(*args):
+    out = subprocess.run([FAIRMESH, *args], capture_output=True, text=True)
+    if out.returncode != 0:
+        sys.exit(f"fairmesh {' '.join(args)} failed: {out.stderr.strip()}")
+    return out.stdout
+
+
+def measure(clean, result):
+    m = json.loads(run("compare", clean, result, "--json"))
+    edge = m["reference_mean_edge_length"]
+    return {
+        "mean": m["mean_surface_distance"] / edge,
+        "hausdorff": m["hausdorff"] / edge,
+        "normal": m.get("normal_error_deg"),
+        "volume": m["volume_change_percent"],
+    }
+
+
+def load(path):
+    # process=False keeps fairmesh's vertex order (the noisy file is already welded).
+    return trimesh.load(path, process=False, force="mesh")
+
+
+def peers():
+    """(name, function(vertices, faces, iterations) -> vertices) for the installed peers."""
+    found = []
+
+    def trimesh_filter(kind):
+        def smooth(v, f, k):
+            mesh = trimesh.Trimesh(v.copy(), f, process=False)
+            if kind == "taubin":
+                trimesh.smoothing.filter_taubin(mesh, lamb=0.5, nu=0.53, iterations=k)
+            elif kind == "humphrey":
+                trimesh.smoothing.filter_humphrey(mesh, alpha=0.1, beta=0.5, iterations=k)
+            else:
+                trimesh.smoothing.filter_laplacian(mesh, lamb=0.5, iterations=k)
+            return np.asarray(mesh.vertices)
+
+        return smooth
+
+    found += [
+        ("trimesh Taubin", trimesh_filter("taubin")),
+        ("trimesh Humphrey", trimesh_filter("humphrey")),
+        ("trimesh Laplacian", trimesh_filter("laplacian")),
+    ]
+    try:
+        import pymeshlab
+
+        def meshlab(kind):
+            def smooth(v, f, k):
+                ms = pymeshlab.MeshSet()
+                ms.add_mesh(pymeshlab.Mesh(v, f))
+                if kind == "taubin":
+                    ms.apply_coord_taubin_smoothing(stepsmoothnum=k)
+                else:
+                    for _ in range(k):
+                        ms.apply_coord_hc_laplacian_smoothing()
+                return ms.current_mesh().vertex_matrix()
+
+            return smooth
+
+        found += [("PyMeshLab Taubin", meshlab("taubin")), ("PyMeshLab HC", meshlab("hc"))]
+    except ImportError:
+        print("(PyMeshLab not installed: skipped)", file=sys.stderr)
+    try:
+        import open3d as o3d
+
+        def open3d_taubin(v, f, k):
+            mesh = o3d.geometry.TriangleMesh(
+                o3d.utility.Vector3dVector(v), o3d.utility.Vector3iVector(f)
+            )
+            return np.asarray(mesh.filter_smooth_taubin(number_of_iterations=k).vertices)
+
+        found.append(("Open3D Taubin", open3d_taubin))
+    except ImportError:
+        print("(Open3D not installed: skipped)", file=sys.stderr)
+    return found
+
+
+def row(name, setting, m):
+    normal = "-" if m["normal"] is None else f"{m['normal']:.1f}"
+    return (
+        f"| {name} | {setting} | {m['mean']:.4f} | {m['hausdorff']:.3f} | {normal} "
+        f"| {m['volume']:+.3f} |"
+    )
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    parser.add_argument("meshes", nargs="+")
+    parser.add_argument("--modes", default="normal,iso")
+    args = parser.parse_args()
+    smoothers = peers()
+    with tempfile.TemporaryDirectory() as tmp:
+        for path in args.meshes:
+            clean = os.path.join(tmp, "clean.ply")
+            run("convert", path, "-o", clean)
+            for mode in args.modes.split(","):
+                noisy = os.path.join(tmp, "noisy.ply")
+                run("noise", clean, "-o", noisy, "--sigma", "0.3", "--seed", "1", "--mode", mode)
+                print(f"\n{os.path.basename(path)}, noise 0.3 mean edge lengths, mode {mode}\n")
+                print("| smoother | setting | mean dist | Hausdorff | normal ° | volume % |")
+                print("|---|---|---:|---:|---:|---:|")
+                print(row("noisy input", "", measure(clean, noisy)))
+                ours = os.path.join(tmp, "ours.ply")
+                report = json.loads(run("fair", noisy, "-o", ours, "--json"))
+                setting = (
+                    f"default (noise {report['noise_estimate']:.3f}, "
+                    f"{report['rounds_run']} rounds, {report['crease_edges']} crease edges)"
+                )
+                print(row("fairmesh fair", setting, measure(clean, ours)), flush=True)
+                mesh = load(noisy)
+                v = np.asarray(mesh.vertices, dtype=np.float64)
+                f = np.asarray(mesh.faces, dtype=np.int32)
+                out = os.path.join(tmp, "peer.ply")
+                for name, smooth in smoothers:
+                    best = None
+                    for k in ITERATIONS:
+                        trimesh.Trimesh(smooth(v, f, k), f, process=False).export(out)
+                        m = measure(clean, out)
+                        if best is None or m["mean"] < best[1]["mean"]:
+                            best = (k, m)
+                    print(row(name, f"best of {ITERATIONS}: {best[0]} iterations", best[1]),
+                          flush=True)
+
+
+if __name__ == "__main__":
+    main()
