@@ -31,12 +31,15 @@ use super::scene::{
     image_file_name, image_mime_type, Image, ImageData, Material, Part, Primitive, Scene,
     SceneVertex,
 };
-use super::source::{dvec, NormalTurns, SaveReport, SmoothGroups, Source, Turn};
+use super::source::{
+    dvec, is_own_normal, NormalTurns, SaveReport, SlotSums, SmoothGroups, Source, Turn,
+};
 use super::{Format, IoError};
 use crate::mesh::TriMesh;
-use glam::{DMat3, DMat4};
+use glam::{DMat3, DMat4, DVec3};
 use rayon::prelude::*;
 use serde_json::{json, Value};
+use std::borrow::Cow;
 use std::collections::{BTreeMap, BTreeSet};
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -171,6 +174,24 @@ impl GltfSource {
 
     fn read3(&self, layout: &Layout, element: usize) -> [f32; 3] {
         [0, 1, 2].map(|c| self.read(layout, element, c))
+    }
+
+    /// The first three components of every element ([`Self::read3`] of each), read straight
+    /// from the bytes for plain floats.
+    fn read3_all(&self, layout: &Layout) -> Vec<[f32; 3]> {
+        if layout.component != 5126 || layout.count == 0 {
+            return (0..layout.count).map(|k| self.read3(layout, k)).collect();
+        }
+        let bytes = &self.buffers[layout.buffer][layout.start..];
+        let float = |b: &[u8], c: usize| {
+            f32::from_le_bytes([b[4 * c], b[4 * c + 1], b[4 * c + 2], b[4 * c + 3]])
+        };
+        (0..layout.count)
+            .map(|k| {
+                let b = &bytes[k * layout.stride..k * layout.stride + 12];
+                [float(b, 0), float(b, 1), float(b, 2)]
+            })
+            .collect()
     }
 
     /// The indices of a primitive's triangles (strips and fans unrolled), in its own space.
@@ -696,12 +717,6 @@ struct PositionEdit {
     mesh: usize,
 }
 
-impl PositionEdit {
-    fn position(&self, k: usize) -> [f32; 3] {
-        self.after[k].unwrap_or(self.before[k])
-    }
-}
-
 /// The `name` of element `index` of the top-level array `key`, if it has one.
 fn name_of<'a>(json: &'a Value, key: &str, index: usize) -> Option<&'a str> {
     json.get(key)?.get(index)?.get("name")?.as_str()
@@ -841,7 +856,7 @@ fn position_edits(
                 read.accessor
             ));
         }
-        let before: Vec<[f32; 3]> = (0..layout.count).map(|k| gltf.read3(&layout, k)).collect();
+        let before = gltf.read3_all(&layout);
         let identity = read.world == DMat4::IDENTITY;
         let inverse = read.world.inverse();
         let invertible = identity || (read.world.determinant() != 0.0 && inverse.is_finite());
@@ -853,6 +868,7 @@ fn position_edits(
             ));
         }
         let after = (0..layout.count)
+            .into_par_iter()
             .map(|k| {
                 let new = mesh.positions[source.welded(read.raw_start + k)?];
                 let placed = if identity {
@@ -969,65 +985,88 @@ fn turn_normals(
             tangents.insert(t);
         }
     }
-    // Per element: the area sums of its faces before and after; then slots (see
-    // `SmoothGroups`), and the sums of each slot.
+    // Per element: the area sums of its faces before and after (gathered in parallel, each
+    // element adding its faces in the order of the triangles, as a serial pass would); then slots
+    // (see `SmoothGroups`): a normal that is its own faces' normal has a slot of its own, and the
+    // others share the sums of their slot, kept in `shared`.
     let mut groups = SmoothGroups::default();
-    let mut turns = NormalTurns::new(0);
-    let mut slotted: Vec<(usize, &Layout, Vec<usize>, &BTreeSet<usize>)> = Vec::new();
+    let mut shared = NormalTurns::new(0);
+    let mut slotted: Vec<(usize, &Layout, Vec<[f32; 3]>, Vec<Sums>, &BTreeSet<usize>)> = Vec::new();
     for (&n, (layout, uses, tangents)) in &normals {
-        let mut elements = NormalTurns::new(layout.count);
-        for (p, positions, triangles) in uses {
-            match edits.get(p) {
-                Some(edit) => {
-                    for &t in triangles {
-                        let before = t.map(|v| dvec(edit.before[v]));
-                        elements.add(t, before, t.map(|v| dvec(edit.position(v))));
-                    }
-                }
-                None => {
-                    for &t in triangles {
-                        let unmoved = t.map(|v| dvec(gltf.read3(positions, v)));
-                        elements.add(t, unmoved, unmoved);
-                    }
-                }
-            }
-        }
-        let start = first_read.get(&uses[0].0).copied();
-        let slots: Vec<usize> = (0..layout.count)
-            .map(|k| {
-                let welded = start.and_then(|s| source.welded(s + k));
-                let slot = groups.slot_for(elements.area_before(k), welded, gltf.read3(layout, k));
-                turns.merge_slot(slot, &elements, k);
-                slot
+        let faces: Vec<FaceUse> = uses
+            .iter()
+            .map(|(p, positions, triangles)| match edits.get(p) {
+                Some(edit) => FaceUse {
+                    triangles,
+                    before: Cow::Borrowed(edit.before.as_slice()),
+                    after: Some(edit.after.as_slice()),
+                },
+                None => FaceUse {
+                    triangles,
+                    before: Cow::Owned(gltf.read3_all(positions)),
+                    after: None,
+                },
             })
             .collect();
-        slotted.push((n, layout, slots, tangents));
+        let elements = element_sums(&faces, layout.count);
+        let values = gltf.read3_all(layout);
+        let own: Vec<bool> = elements
+            .par_iter()
+            .zip(&values)
+            .map(|(sums, &normal)| is_own_normal(sums.area_before(), normal))
+            .collect();
+        let start = first_read.get(&uses[0].0).copied();
+        let sums: Vec<Sums> = (0..layout.count)
+            .map(|k| {
+                if own[k] {
+                    // What `SmoothGroups::slot_for` does, with no slot number needed: this
+                    // normal's slot is its own.
+                    Sums::Alone(elements[k])
+                } else {
+                    let welded = start.and_then(|s| source.welded(s + k));
+                    let slot = groups.slot(welded, values[k]);
+                    shared.merge_sums(slot, elements[k]);
+                    Sums::Shared(slot)
+                }
+            })
+            .collect();
+        slotted.push((n, layout, values, sums, tangents));
     }
     let mut changed = BTreeSet::new();
-    for (n, layout, slots, tangents) in slotted {
-        // The rotations are the costly part: worked out in parallel, written in order.
-        let turned: Vec<(usize, Turn, [f32; 3])> = slots
+    for (n, layout, values, sums, tangents) in slotted {
+        // The rotations: worked out in parallel, written in order.
+        let turns: Vec<Option<Turn>> = sums
             .par_iter()
-            .enumerate()
-            .filter_map(|(k, &slot)| {
-                let turn = turns.turn(slot)?;
-                Some((k, turn, turn.normal(gltf.read3(layout, k))))
+            .map(|sums| match sums {
+                Sums::Alone(element) => element.alone().turn(),
+                Sums::Shared(slot) => shared.turn(*slot),
             })
             .collect();
-        for (k, _, normal) in &turned {
-            joined.put(layout, *k, normal);
+        let normals: Vec<Option<[f32; 3]>> = turns
+            .par_iter()
+            .zip(&values)
+            .map(|(turn, &normal)| turn.map(|turn| turn.normal(normal)))
+            .collect();
+        let mut any = false;
+        for (k, normal) in normals.iter().enumerate() {
+            if let Some(normal) = normal {
+                joined.put(layout, k, normal);
+                any = true;
+            }
         }
-        if !turned.is_empty() {
+        if any {
             changed.insert(n);
         }
         for &t in tangents {
             match gltf.layout(t) {
                 Ok(tangent) if tangent.components == 4 && tangent.count == layout.count => {
-                    for &(k, turn, _) in &turned {
-                        let direction = turn.direction(gltf.read3(&tangent, k));
-                        joined.put(&tangent, k, &direction);
+                    for (k, turn) in turns.iter().enumerate() {
+                        if let Some(turn) = turn {
+                            let direction = turn.direction(gltf.read3(&tangent, k));
+                            joined.put(&tangent, k, &direction);
+                        }
                     }
-                    if !turned.is_empty() {
+                    if any {
                         changed.insert(t);
                     }
                 }
@@ -1039,6 +1078,48 @@ fn turn_normals(
     }
     changed
 }
+
+/// Where one element's normal turns: with the sums of its own faces alone, or with those of a
+/// slot it shares ([`SmoothGroups`]).
+#[derive(Clone, Copy)]
+enum Sums {
+    Alone(SlotSums),
+    Shared(usize),
+}
+
+/// The triangles of one primitive that uses a normal accessor, with its positions before and
+/// after (`None`: they did not move).
+struct FaceUse<'a> {
+    triangles: &'a [[usize; 3]],
+    before: Cow<'a, [[f32; 3]]>,
+    after: Option<&'a [Option<[f32; 3]>]>,
+}
+
+impl FaceUse<'_> {
+    fn corners(&self, t: [usize; 3]) -> ([DVec3; 3], [DVec3; 3]) {
+        let before = t.map(|v| dvec(self.before[v]));
+        let after = match self.after {
+            Some(after) => t.map(|v| dvec(after[v].unwrap_or(self.before[v]))),
+            None => before,
+        };
+        (before, after)
+    }
+}
+
+/// Per element of a normal accessor (`count` of them), the area sums of the faces that use it,
+/// before and after, in the order of the uses and their triangles (a face using it twice adds
+/// twice).
+fn element_sums(uses: &[FaceUse], count: usize) -> Vec<SlotSums> {
+    let mut sums = NormalTurns::new(count);
+    for u in uses {
+        for &t in u.triangles {
+            let (before, after) = u.corners(t);
+            sums.add(t, before, after);
+        }
+    }
+    sums.into_slots()
+}
+
 /// All buffers joined into one, and where each of them starts in it.
 struct Joined {
     bytes: Vec<u8>,
@@ -1072,7 +1153,12 @@ impl Joined {
                 let Some(range) = self.range(layout.buffer, at, layout.size) else {
                     continue;
                 };
-                let value = decode(&raw, &self.bytes[range]) as f64;
+                let bytes = &self.bytes[range];
+                let value = if layout.component == 5126 {
+                    f32::from_le_bytes([bytes[0], bytes[1], bytes[2], bytes[3]]) as f64
+                } else {
+                    decode(&raw, bytes) as f64
+                };
                 min[c] = min[c].min(value);
                 max[c] = max[c].max(value);
             }
@@ -1082,6 +1168,16 @@ impl Joined {
 
     /// Write the first three components of element `k`.
     fn put(&mut self, layout: &Layout, k: usize, values: &[f32; 3]) {
+        if layout.component == 5126 {
+            let at = layout.start + k * layout.stride;
+            if let Some(range) = self.range(layout.buffer, at, 12) {
+                let out = &mut self.bytes[range];
+                for (c, value) in values.iter().enumerate() {
+                    out[4 * c..4 * c + 4].copy_from_slice(&value.to_le_bytes());
+                }
+                return;
+            }
+        }
         for (c, value) in values.iter().enumerate() {
             let at = layout.start + k * layout.stride + c * layout.size;
             if let Some(range) = self.range(layout.buffer, at, layout.size) {

@@ -288,11 +288,51 @@ pub(crate) struct NormalTurns {
     slots: Vec<SlotSums>,
 }
 
+/// The area sums of one slot's faces, before and after the move, and whether any of them moved.
 #[derive(Clone, Copy, Default)]
-struct SlotSums {
+pub(crate) struct SlotSums {
     before: DVec3,
     after: DVec3,
     moved: bool,
+}
+
+impl SlotSums {
+    /// The sum of the area vectors of the faces before the move.
+    pub(crate) fn area_before(&self) -> DVec3 {
+        self.before
+    }
+
+    /// These sums added to those of an empty slot (exactly what [`NormalTurns::merge_slot`]
+    /// gives a slot that has only this one normal).
+    pub(crate) fn alone(self) -> SlotSums {
+        let mut sums = SlotSums::default();
+        sums.merge(self);
+        sums
+    }
+
+    #[inline]
+    fn merge(&mut self, add: SlotSums) {
+        self.before += add.before;
+        self.after += add.after;
+        self.moved |= add.moved;
+    }
+
+    /// The rotation for the normals of this slot, or `None` when they stay as they are.
+    pub(crate) fn turn(&self) -> Option<Turn> {
+        if !self.moved {
+            return None;
+        }
+        let after = self.after.normalize_or_zero();
+        if after == DVec3::ZERO {
+            return None;
+        }
+        let before = self.before.normalize_or_zero();
+        Some(if before == DVec3::ZERO {
+            Turn::Replace(after)
+        } else {
+            Turn::Rotate(DQuat::from_rotation_arc(before, after))
+        })
+    }
 }
 
 impl NormalTurns {
@@ -332,28 +372,22 @@ impl NormalTurns {
     /// Add the sums of `from`'s slot `n` to this one's slot `slot`.
     pub(crate) fn merge_slot(&mut self, slot: usize, from: &NormalTurns, n: usize) {
         let add = from.slots.get(n).copied().unwrap_or_default();
-        let sums = self.slot_mut(slot);
-        sums.before += add.before;
-        sums.after += add.after;
-        sums.moved |= add.moved;
+        self.merge_sums(slot, add);
+    }
+
+    /// Add `add` to slot `slot`'s sums.
+    pub(crate) fn merge_sums(&mut self, slot: usize, add: SlotSums) {
+        self.slot_mut(slot).merge(add);
+    }
+
+    /// The sums of every slot.
+    pub(crate) fn into_slots(self) -> Vec<SlotSums> {
+        self.slots
     }
 
     /// The rotation for normal `n`, or `None` when it stays as it is.
     pub(crate) fn turn(&self, n: usize) -> Option<Turn> {
-        let sums = self.slots.get(n)?;
-        if !sums.moved {
-            return None;
-        }
-        let after = sums.after.normalize_or_zero();
-        if after == DVec3::ZERO {
-            return None;
-        }
-        let before = sums.before.normalize_or_zero();
-        Some(if before == DVec3::ZERO {
-            Turn::Replace(after)
-        } else {
-            Turn::Rotate(DQuat::from_rotation_arc(before, after))
-        })
+        self.slots.get(n)?.turn()
     }
 }
 
@@ -382,9 +416,7 @@ impl SmoothGroups {
         welded: Option<usize>,
         normal: [f32; 3],
     ) -> usize {
-        let own = own.normalize_or_zero();
-        let n = dvec(normal).normalize_or_zero();
-        if own != DVec3::ZERO && own.dot(n) > 0.99999 {
+        if is_own_normal(own, normal) {
             return self.fresh();
         }
         self.slot(welded, normal)
@@ -416,10 +448,19 @@ impl SmoothGroups {
         }
     }
 
-    fn fresh(&mut self) -> usize {
+    pub(crate) fn fresh(&mut self) -> usize {
         self.next += 1;
         self.next - 1
     }
+}
+
+/// Whether a file normal is the normal of its own faces (whose area vectors add up to `own`):
+/// then it gets a slot of its own ([`SmoothGroups::slot_for`]).
+#[inline]
+pub(crate) fn is_own_normal(own: DVec3, normal: [f32; 3]) -> bool {
+    let own = own.normalize_or_zero();
+    let n = dvec(normal).normalize_or_zero();
+    own != DVec3::ZERO && own.dot(n) > 0.99999
 }
 
 /// What happens to one file normal.
