@@ -1341,13 +1341,7 @@ fn place_image_files(
     images: Vec<(usize, PathBuf)>,
     output: &Path,
 ) -> Vec<(PathBuf, PathBuf)> {
-    let out_dir = match output.parent() {
-        Some(dir) if !dir.as_os_str().is_empty() => dir.to_path_buf(),
-        _ => PathBuf::from("."),
-    };
-    let stem = output
-        .file_stem()
-        .map_or_else(|| "mesh".into(), |s| s.to_string_lossy().into_owned());
+    let (out_dir, stem) = super::folder_and_stem(output);
     let same = |a: &Path, b: &Path| match (a.canonicalize(), b.canonicalize()) {
         (Ok(a), Ok(b)) => a == b,
         _ => false,

@@ -759,6 +759,19 @@ fn check_writable(mesh: &TriMesh, path: &Path) -> Result<(), IoError> {
 }
 
 /// Where a `.gltf` file's buffer goes: `<stem>.bin` beside it.
+/// The folder an output file goes into (`.` for a bare file name) and its name without the
+/// extension (`mesh` when it has none): where files written beside it go, and their prefix.
+pub(crate) fn folder_and_stem(output: &Path) -> (PathBuf, String) {
+    let folder = match output.parent() {
+        Some(dir) if !dir.as_os_str().is_empty() => dir.to_path_buf(),
+        _ => PathBuf::from("."),
+    };
+    let stem = output
+        .file_stem()
+        .map_or_else(|| "mesh".into(), |s| s.to_string_lossy().into_owned());
+    (folder, stem)
+}
+
 pub fn gltf_bin_path(gltf_path: &Path) -> PathBuf {
     gltf_path.with_extension("bin")
 }

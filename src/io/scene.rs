@@ -386,13 +386,7 @@ impl Scene {
 
     /// Where each material's texture goes beside `output` (by material index).
     pub(crate) fn place_images(&self, output: &Path) -> Vec<Option<PlacedImage>> {
-        let out_dir = match output.parent() {
-            Some(dir) if !dir.as_os_str().is_empty() => dir.to_path_buf(),
-            _ => PathBuf::from("."),
-        };
-        let stem = output
-            .file_stem()
-            .map_or_else(|| "mesh".into(), |s| s.to_string_lossy().into_owned());
+        let (out_dir, stem) = super::folder_and_stem(output);
         let same_dir = |file: &Path| {
             file.parent()
                 .and_then(|d| {
