@@ -24,6 +24,7 @@
 //! fairing of the previous one through their generation numbers.
 
 pub mod camera;
+mod confirm_replace;
 mod frame_stats;
 pub mod history;
 mod input;
@@ -126,7 +127,12 @@ pub struct AppOptions {
 pub enum Command {
     Open(PathBuf),
     OpenDialog,
+    /// Export to a typed path (asks first if the file exists).
     Export(PathBuf),
+    /// Export to a path, replacing the file there (the user said so).
+    ReplaceExport(PathBuf),
+    /// The user said not to replace the file: nothing is written.
+    CancelExport,
     ExportDialog,
     FitView,
     /// The start level changed.
@@ -267,6 +273,8 @@ pub struct App {
     /// just changed).
     sharp_edges_shown_until: Option<std::time::Instant>,
     sharp_edges_drawn: usize,
+    /// An export waits for the user to say whether this existing file may be replaced.
+    confirm_replace: Option<PathBuf>,
 }
 
 /// Memory the undo history may keep alive.
@@ -351,6 +359,7 @@ impl App {
             hierarchy_built_with: (false, 0),
             sharp_edges_shown_until: None,
             sharp_edges_drawn: 0,
+            confirm_replace: None,
         };
         for viewport in app.viewports() {
             if let Some(bytes) = options.async_upload_bytes {
@@ -521,6 +530,16 @@ impl App {
             Command::Open(path) => self.open(path),
             Command::OpenDialog => self.open_dialog(DialogPurpose::Open),
             Command::Export(path) => self.export(path),
+            Command::ReplaceExport(path) => {
+                self.confirm_replace = None;
+                self.write_export(path);
+            }
+            Command::CancelExport => {
+                if let Some(path) = self.confirm_replace.take() {
+                    self.message =
+                        Some(format!("Export cancelled: {} is unchanged", path.display()));
+                }
+            }
             Command::ExportDialog => self.open_dialog(DialogPurpose::Export),
             Command::FitView => self.fit_view(),
             Command::SetLevel(level) => {
@@ -660,6 +679,7 @@ impl eframe::App for App {
         let upload_done = Instant::now();
         let compare = self.settings.compare;
         panels::show(self, ui);
+        confirm_replace::show(self, &ctx);
         for command in std::mem::take(&mut self.commands) {
             self.apply(command);
         }

@@ -168,7 +168,8 @@ impl App {
                 if let Some(document) = &mut self.document {
                     document.export_path = path.display().to_string();
                 }
-                self.export(path);
+                // The system's save dialog asked about replacing an existing file already.
+                self.write_export(path);
             }
             (_, None) => {
                 self.message =
