@@ -8,7 +8,7 @@ use egui::accesskit::Role;
 use egui_kittest::kittest::Queryable;
 
 mod editor_common;
-use editor_common::{bunny, harness_for, retype, settle};
+use editor_common::{bunny, harness_for, retype, settle, viewport_image};
 
 /// The bundled bunny copied into `dir` (what the editor writes beside it stays there).
 fn bunny_in(dir: &Path) -> PathBuf {
@@ -83,4 +83,75 @@ fn export_asks_before_replacing_a_file_and_cancel_writes_nothing() {
     settle(&mut harness);
     assert!(harness.query_by_label("Replace fresh.obj?").is_none());
     assert!(fresh.is_file());
+}
+
+/// Mean absolute difference of two images' RGB values, over their common part.
+fn mean_difference(a: &image::RgbaImage, b: &image::RgbaImage) -> f64 {
+    let (w, h) = (a.width().min(b.width()), a.height().min(b.height()));
+    let mut sum = 0u64;
+    for y in 0..h {
+        for x in 0..w {
+            let (p, q) = (a.get_pixel(x, y), b.get_pixel(x, y));
+            sum += (0..3).map(|c| p[c].abs_diff(q[c]) as u64).sum::<u64>();
+        }
+    }
+    sum as f64 / (3 * w * h) as f64
+}
+
+#[test]
+fn save_image_writes_the_views_pixels_beside_the_file_without_replacing_one() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = bunny_in(dir.path());
+    let mut harness = harness_for(input);
+    settle(&mut harness);
+
+    harness.key_press_modifiers(
+        egui::Modifiers::COMMAND | egui::Modifiers::SHIFT,
+        egui::Key::S,
+    );
+    settle(&mut harness);
+    let first = dir.path().join("bunny00_view.png");
+    let status = harness.state().status();
+    assert!(status.error.is_none(), "{:?}", status.error);
+    assert_eq!(
+        status.message,
+        Some(format!("Saved the view to {}", first.display()))
+    );
+    let saved = image::open(&first).unwrap().to_rgba8();
+    // The view's pixels: its size, not the window's, and the same picture (the saved one has
+    // no mouse hints at the bottom).
+    let view = viewport_image(&mut harness);
+    let full = harness.render().unwrap();
+    assert!(saved.width() < full.width(), "the side panel is left out");
+    assert!(
+        saved.width().abs_diff(view.width()) <= 1,
+        "{} vs {}",
+        saved.width(),
+        view.width()
+    );
+    assert!(saved.height().abs_diff(view.height()) <= 1);
+    let difference = mean_difference(&saved, &view);
+    assert!(difference < 2.0, "mean difference {difference}");
+    // Not an empty picture: the bunny is on it.
+    let background = *saved.get_pixel(2, 2);
+    let drawn = saved.pixels().filter(|p| **p != background).count();
+    assert!(
+        drawn > (saved.width() * saved.height() / 20) as usize,
+        "{drawn} pixels drawn"
+    );
+
+    // The button saves another one beside it; the first stays.
+    let before = std::fs::read(&first).unwrap();
+    harness
+        .get_by_role_and_label(Role::Button, "Save image")
+        .click();
+    settle(&mut harness);
+    let second = dir.path().join("bunny00_view_2.png");
+    assert!(second.is_file());
+    assert_eq!(std::fs::read(&first).unwrap(), before);
+    assert!(harness
+        .state()
+        .status()
+        .message
+        .is_some_and(|m| m.contains("bunny00_view_2.png")));
 }

@@ -135,6 +135,8 @@ pub enum Command {
     CancelExport,
     ExportDialog,
     FitView,
+    /// Save the 3D view as a PNG beside the document (taken in the next frame, without hints).
+    SaveViewImage,
     /// The start level changed.
     SetLevel(usize),
     /// A fairing option changed: run again.
@@ -275,6 +277,10 @@ pub struct App {
     sharp_edges_drawn: usize,
     /// An export waits for the user to say whether this existing file may be replaced.
     confirm_replace: Option<PathBuf>,
+    /// "Save image" was asked for: the next frame is drawn without the mouse hints and captured.
+    capture_next_frame: bool,
+    /// This frame is the one captured for "Save image".
+    capturing_view: bool,
 }
 
 /// Memory the undo history may keep alive.
@@ -360,6 +366,8 @@ impl App {
             sharp_edges_shown_until: None,
             sharp_edges_drawn: 0,
             confirm_replace: None,
+            capture_next_frame: false,
+            capturing_view: false,
         };
         for viewport in app.viewports() {
             if let Some(bytes) = options.async_upload_bytes {
@@ -394,6 +402,7 @@ impl App {
         self.jobs.in_flight() == 0
             && self.commands.is_empty()
             && self.measure_wanted.is_none()
+            && !self.capture_next_frame
             && !self.upload_pending()
     }
 
@@ -542,6 +551,7 @@ impl App {
             }
             Command::ExportDialog => self.open_dialog(DialogPurpose::Export),
             Command::FitView => self.fit_view(),
+            Command::SaveViewImage => self.save_view_image(),
             Command::SetLevel(level) => {
                 if let Some(document) = &mut self.document {
                     let top = document.level_count().unwrap_or(1).saturating_sub(1);
@@ -658,6 +668,13 @@ impl App {
                 elapsed,
             } => self.on_levels_exported(folder, result, elapsed),
             JobResult::DialogPicked { purpose, path } => self.on_dialog_picked(purpose, path),
+            JobResult::ViewCaptured {
+                image,
+                rect,
+                pixels_per_point,
+                beside,
+            } => self.on_view_captured(image, rect, pixels_per_point, beside),
+            JobResult::ViewImageSaved { result } => self.on_view_image_saved(result),
         }
     }
 
@@ -678,7 +695,11 @@ impl eframe::App for App {
         self.sync_viewport();
         let upload_done = Instant::now();
         let compare = self.settings.compare;
+        self.capturing_view = std::mem::take(&mut self.capture_next_frame);
         panels::show(self, ui);
+        if self.capturing_view {
+            self.capture_view(&ctx);
+        }
         confirm_replace::show(self, &ctx);
         for command in std::mem::take(&mut self.commands) {
             self.apply(command);

@@ -61,6 +61,7 @@ fn toolbar(app: &mut App, ui: &mut egui::Ui) {
         {
             app.commands.push(Command::FitView);
         }
+        super::tasks::view_image::button(app, ui);
         ui.checkbox(&mut app.settings.wireframe, "Wireframe (W)")
             .on_hover_text("Draw the edges over the faces (W)");
         ui.separator();
@@ -692,14 +693,18 @@ fn viewport(app: &mut App, ui: &mut egui::Ui) {
             );
         }
     }
+    // A saved image of the view leaves out the mouse hints.
+    let hint = if app.capturing_view {
+        ""
+    } else if painting {
+        "Painting: left drag paints (Shift: erase) · middle drag: orbit · right drag: pan · P: stop painting"
+    } else {
+        "Left drag: orbit · right/middle drag: pan · scroll: zoom · F: fit · W: wireframe · B: before/after · P: paint"
+    };
     painter.text(
         rect.left_bottom() + egui::vec2(8.0, -8.0),
         egui::Align2::LEFT_BOTTOM,
-        if painting {
-            "Painting: left drag paints (Shift: erase) · middle drag: orbit · right drag: pan · P: stop painting"
-        } else {
-            "Left drag: orbit · right/middle drag: pan · scroll: zoom · F: fit · W: wireframe · B: before/after · P: paint"
-        },
+        hint,
         egui::FontId::proportional(12.0),
         egui::Color32::from_gray(150),
     );
