@@ -155,3 +155,62 @@ fn save_image_writes_the_views_pixels_beside_the_file_without_replacing_one() {
         .message
         .is_some_and(|m| m.contains("bunny00_view_2.png")));
 }
+
+#[test]
+fn recent_files_reopen_and_a_missing_one_is_named_and_dropped() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = bunny_in(dir.path());
+    let other = dir.path().join("other.obj");
+    std::fs::copy(bunny(), &other).unwrap();
+    let mut harness = harness_for(input.clone());
+    settle(&mut harness);
+    retype(
+        &mut harness,
+        |v| v.ends_with("bunny00.obj"),
+        &other.display().to_string(),
+    );
+    harness.get_by_role_and_label(Role::Button, "Load").click();
+    settle(&mut harness);
+    assert_eq!(
+        harness.state().settings().recent_files,
+        vec![other.clone(), input.clone()],
+        "newest first"
+    );
+
+    // The first file again, from the menu.
+    open_recent_menu(&mut harness);
+    harness
+        .get_by_role_and_label(Role::Button, &input.display().to_string())
+        .click();
+    settle(&mut harness);
+    let status = harness.state().status();
+    assert_eq!(status.document.as_deref(), Some(input.as_path()));
+    assert!(status.error.is_none(), "{:?}", status.error);
+    assert_eq!(
+        harness.state().settings().recent_files,
+        vec![input.clone(), other.clone()]
+    );
+
+    // A file that is gone: the error names it, the mesh stays, the menu forgets it.
+    std::fs::remove_file(&other).unwrap();
+    open_recent_menu(&mut harness);
+    harness
+        .get_by_role_and_label(Role::Button, &other.display().to_string())
+        .click();
+    settle(&mut harness);
+    let status = harness.state().status();
+    let error = status.error.unwrap_or_default();
+    assert!(error.contains(&other.display().to_string()), "{error}");
+    assert!(error.contains("no longer there"), "{error}");
+    assert_eq!(status.document.as_deref(), Some(input.as_path()));
+    assert_eq!(harness.state().settings().recent_files, vec![input]);
+}
+
+fn open_recent_menu(harness: &mut egui_kittest::Harness<'_, fairmesh::app::App>) {
+    harness
+        .get_by_role_and_label(Role::Button, "Recent")
+        .click();
+    for _ in 0..3 {
+        harness.step();
+    }
+}

@@ -32,6 +32,7 @@ pub mod jobs;
 pub mod paint;
 mod paint_panel;
 pub mod panels;
+mod recent;
 mod sharp_edges;
 pub mod state;
 mod tasks;
@@ -126,6 +127,8 @@ pub struct AppOptions {
 #[derive(Clone, Debug, PartialEq)]
 pub enum Command {
     Open(PathBuf),
+    /// Open a file from the Recent menu (a missing one is named and dropped from the menu).
+    OpenRecent(PathBuf),
     OpenDialog,
     /// Export to a typed path (asks first if the file exists).
     Export(PathBuf),
@@ -537,6 +540,7 @@ impl App {
     fn apply(&mut self, command: Command) {
         match command {
             Command::Open(path) => self.open(path),
+            Command::OpenRecent(path) => self.open_recent(path),
             Command::OpenDialog => self.open_dialog(DialogPurpose::Open),
             Command::Export(path) => self.export(path),
             Command::ReplaceExport(path) => {

@@ -36,6 +36,7 @@ fn toolbar(app: &mut App, ui: &mut egui::Ui) {
         {
             app.commands.push(Command::OpenDialog);
         }
+        super::recent::menu(app, ui);
         let label = ui.label("Path:");
         let edit = ui
             .add(
