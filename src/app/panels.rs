@@ -42,7 +42,8 @@ fn toolbar(app: &mut App, ui: &mut egui::Ui) {
             .add(
                 egui::TextEdit::singleline(&mut app.open_path)
                     .hint_text("type a mesh path, or drop a file on the window")
-                    .desired_width(340.0),
+                    // Narrow enough that the toolbar stays one row at 1200 points.
+                    .desired_width(180.0),
             )
             .labelled_by(label.id);
         let entered = edit.lost_focus() && ui.input(|i| i.key_pressed(egui::Key::Enter));
@@ -233,6 +234,7 @@ fn controls(app: &mut App, ui: &mut egui::Ui) {
                 ui.add(
                     egui::ProgressBar::new(app.hierarchy_progress.get())
                         .show_percentage()
+                        // Narrow enough that the toolbar stays one row at 1200 points.
                         .desired_width(180.0),
                 );
                 if ui.button("Cancel").clicked() {
