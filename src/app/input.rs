@@ -39,6 +39,15 @@ impl App {
         if open {
             self.commands.push(Command::OpenDialog);
         }
+        let save_image = ctx.input(|i| {
+            i.modifiers.command
+                && i.modifiers.shift
+                && !i.modifiers.alt
+                && i.key_pressed(egui::Key::S)
+        });
+        if save_image {
+            self.commands.push(Command::SaveViewImage);
+        }
         if export {
             if let Some(document) = &self.document {
                 let path = PathBuf::from(document.export_path.trim());

@@ -293,6 +293,17 @@ pub enum JobResult {
         result: Result<(Vec<PathBuf>, Vec<String>), String>,
         elapsed: Duration,
     },
+    /// The window's pixels, asked for by "Save image": the view's part goes to a PNG.
+    ViewCaptured {
+        image: Arc<egui::ColorImage>,
+        /// The 3D view, in points.
+        rect: egui::Rect,
+        pixels_per_point: f32,
+        /// The document's file: the PNG goes beside it.
+        beside: PathBuf,
+    },
+    /// The PNG of the view was written (its path) or not (why).
+    ViewImageSaved { result: Result<PathBuf, String> },
     /// A file dialog closed; `None` when it was cancelled or no dialog could be shown.
     DialogPicked {
         purpose: DialogPurpose,

@@ -24,6 +24,7 @@
 //! fairing of the previous one through their generation numbers.
 
 pub mod camera;
+mod confirm_replace;
 mod frame_stats;
 pub mod history;
 mod input;
@@ -31,6 +32,7 @@ pub mod jobs;
 pub mod paint;
 mod paint_panel;
 pub mod panels;
+mod recent;
 mod sharp_edges;
 pub mod state;
 mod tasks;
@@ -125,10 +127,19 @@ pub struct AppOptions {
 #[derive(Clone, Debug, PartialEq)]
 pub enum Command {
     Open(PathBuf),
+    /// Open a file from the Recent menu (a missing one is named and dropped from the menu).
+    OpenRecent(PathBuf),
     OpenDialog,
+    /// Export to a typed path (asks first if the file exists).
     Export(PathBuf),
+    /// Export to a path, replacing the file there (the user said so).
+    ReplaceExport(PathBuf),
+    /// The user said not to replace the file: nothing is written.
+    CancelExport,
     ExportDialog,
     FitView,
+    /// Save the 3D view as a PNG beside the document (taken in the next frame, without hints).
+    SaveViewImage,
     /// The start level changed.
     SetLevel(usize),
     /// A fairing option changed: run again.
@@ -267,6 +278,12 @@ pub struct App {
     /// just changed).
     sharp_edges_shown_until: Option<std::time::Instant>,
     sharp_edges_drawn: usize,
+    /// An export waits for the user to say whether this existing file may be replaced.
+    confirm_replace: Option<PathBuf>,
+    /// "Save image" was asked for: the next frame is drawn without the mouse hints and captured.
+    capture_next_frame: bool,
+    /// This frame is the one captured for "Save image".
+    capturing_view: bool,
 }
 
 /// Memory the undo history may keep alive.
@@ -351,6 +368,9 @@ impl App {
             hierarchy_built_with: (false, 0),
             sharp_edges_shown_until: None,
             sharp_edges_drawn: 0,
+            confirm_replace: None,
+            capture_next_frame: false,
+            capturing_view: false,
         };
         for viewport in app.viewports() {
             if let Some(bytes) = options.async_upload_bytes {
@@ -385,6 +405,7 @@ impl App {
         self.jobs.in_flight() == 0
             && self.commands.is_empty()
             && self.measure_wanted.is_none()
+            && !self.capture_next_frame
             && !self.upload_pending()
     }
 
@@ -519,10 +540,22 @@ impl App {
     fn apply(&mut self, command: Command) {
         match command {
             Command::Open(path) => self.open(path),
+            Command::OpenRecent(path) => self.open_recent(path),
             Command::OpenDialog => self.open_dialog(DialogPurpose::Open),
             Command::Export(path) => self.export(path),
+            Command::ReplaceExport(path) => {
+                self.confirm_replace = None;
+                self.write_export(path);
+            }
+            Command::CancelExport => {
+                if let Some(path) = self.confirm_replace.take() {
+                    self.message =
+                        Some(format!("Export cancelled: {} is unchanged", path.display()));
+                }
+            }
             Command::ExportDialog => self.open_dialog(DialogPurpose::Export),
             Command::FitView => self.fit_view(),
+            Command::SaveViewImage => self.save_view_image(),
             Command::SetLevel(level) => {
                 if let Some(document) = &mut self.document {
                     let top = document.level_count().unwrap_or(1).saturating_sub(1);
@@ -639,6 +672,13 @@ impl App {
                 elapsed,
             } => self.on_levels_exported(folder, result, elapsed),
             JobResult::DialogPicked { purpose, path } => self.on_dialog_picked(purpose, path),
+            JobResult::ViewCaptured {
+                image,
+                rect,
+                pixels_per_point,
+                beside,
+            } => self.on_view_captured(image, rect, pixels_per_point, beside),
+            JobResult::ViewImageSaved { result } => self.on_view_image_saved(result),
         }
     }
 
@@ -659,7 +699,12 @@ impl eframe::App for App {
         self.sync_viewport();
         let upload_done = Instant::now();
         let compare = self.settings.compare;
+        self.capturing_view = std::mem::take(&mut self.capture_next_frame);
         panels::show(self, ui);
+        if self.capturing_view {
+            self.capture_view(&ctx);
+        }
+        confirm_replace::show(self, &ctx);
         for command in std::mem::take(&mut self.commands) {
             self.apply(command);
         }

@@ -36,12 +36,14 @@ fn toolbar(app: &mut App, ui: &mut egui::Ui) {
         {
             app.commands.push(Command::OpenDialog);
         }
+        super::recent::menu(app, ui);
         let label = ui.label("Path:");
         let edit = ui
             .add(
                 egui::TextEdit::singleline(&mut app.open_path)
                     .hint_text("type a mesh path, or drop a file on the window")
-                    .desired_width(340.0),
+                    // Narrow enough that the toolbar stays one row at 1200 points.
+                    .desired_width(180.0),
             )
             .labelled_by(label.id);
         let entered = edit.lost_focus() && ui.input(|i| i.key_pressed(egui::Key::Enter));
@@ -61,6 +63,7 @@ fn toolbar(app: &mut App, ui: &mut egui::Ui) {
         {
             app.commands.push(Command::FitView);
         }
+        super::tasks::view_image::button(app, ui);
         ui.checkbox(&mut app.settings.wireframe, "Wireframe (W)")
             .on_hover_text("Draw the edges over the faces (W)");
         ui.separator();
@@ -231,6 +234,7 @@ fn controls(app: &mut App, ui: &mut egui::Ui) {
                 ui.add(
                     egui::ProgressBar::new(app.hierarchy_progress.get())
                         .show_percentage()
+                        // Narrow enough that the toolbar stays one row at 1200 points.
                         .desired_width(180.0),
                 );
                 if ui.button("Cancel").clicked() {
@@ -692,14 +696,18 @@ fn viewport(app: &mut App, ui: &mut egui::Ui) {
             );
         }
     }
+    // A saved image of the view leaves out the mouse hints.
+    let hint = if app.capturing_view {
+        ""
+    } else if painting {
+        "Painting: left drag paints (Shift: erase) · middle drag: orbit · right drag: pan · P: stop painting"
+    } else {
+        "Left drag: orbit · right/middle drag: pan · scroll: zoom · F: fit · W: wireframe · B: before/after · P: paint"
+    };
     painter.text(
         rect.left_bottom() + egui::vec2(8.0, -8.0),
         egui::Align2::LEFT_BOTTOM,
-        if painting {
-            "Painting: left drag paints (Shift: erase) · middle drag: orbit · right drag: pan · P: stop painting"
-        } else {
-            "Left drag: orbit · right/middle drag: pan · scroll: zoom · F: fit · W: wireframe · B: before/after · P: paint"
-        },
+        hint,
         egui::FontId::proportional(12.0),
         egui::Color32::from_gray(150),
     );

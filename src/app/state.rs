@@ -164,6 +164,8 @@ pub struct Settings {
     pub keep_sharp_edges: bool,
     /// An edge is sharp when the surface folds there by more than this many degrees.
     pub sharp_edge_angle: f64,
+    /// The files opened last, newest first (at most [`Settings::RECENT_FILES`]): the Recent menu.
+    pub recent_files: Vec<PathBuf>,
 }
 
 impl Default for Settings {
@@ -196,6 +198,7 @@ impl Default for Settings {
             paint: Default::default(),
             keep_sharp_edges: HierarchyOptions::default().creases.is_some(),
             sharp_edge_angle: DEFAULT_CREASE_ANGLE,
+            recent_files: Vec::new(),
         }
     }
 }
@@ -203,6 +206,20 @@ impl Default for Settings {
 impl Settings {
     pub const STORAGE_KEY: &'static str = "fairmesh.settings";
     pub const REMEMBERED_FILES: usize = 64;
+    pub const RECENT_FILES: usize = 8;
+
+    /// Puts `path` first in the recent files (once), dropping the oldest beyond
+    /// [`Self::RECENT_FILES`].
+    pub fn remember_recent(&mut self, path: &Path) {
+        self.forget_recent(path);
+        self.recent_files.insert(0, path.to_path_buf());
+        self.recent_files.truncate(Self::RECENT_FILES);
+    }
+
+    /// Drops `path` from the recent files.
+    pub fn forget_recent(&mut self, path: &Path) {
+        self.recent_files.retain(|recent| recent != path);
+    }
 
     /// The start level to open `path` at, with `level_count` levels: the one last chosen for
     /// it, or a middle level (level 0 would show the input unchanged as the result).

@@ -18,7 +18,7 @@
 //!   failed export never leaves a partial file or damages an existing one. Meshes with non-finite
 //!   positions or out-of-range indices are refused before anything is written.
 
-mod atomic;
+pub(crate) mod atomic;
 mod carry;
 mod error;
 mod gltf;

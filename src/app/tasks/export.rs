@@ -10,15 +10,40 @@ use crate::app::App;
 use crate::TriMesh;
 
 impl App {
+    /// Export to a typed path: asks first when the file exists (see `confirm_replace.rs`).
     pub(in crate::app) fn export(&mut self, path: PathBuf) {
-        let Some(document) = &self.document else {
-            self.error = Some("Nothing to export: no mesh is loaded".into());
-            return;
-        };
-        if path.as_os_str().is_empty() {
-            self.error = Some("Export: type a file path first".into());
+        if self.export_refused(&path) {
             return;
         }
+        if path.exists() {
+            self.confirm_replace = Some(path);
+            return;
+        }
+        self.write_export(path);
+    }
+
+    /// Why nothing can be exported to `path` now, as the error shown (true when refused).
+    fn export_refused(&mut self, path: &std::path::Path) -> bool {
+        let error = if self.document.is_none() {
+            "Nothing to export: no mesh is loaded"
+        } else if path.as_os_str().is_empty() {
+            "Export: type a file path first"
+        } else {
+            return false;
+        };
+        self.error = Some(error.into());
+        true
+    }
+
+    /// Writes the result to `path` without asking (the user agreed to replace it, or picked it
+    /// in the system's save dialog, which asked already).
+    pub(in crate::app) fn write_export(&mut self, path: PathBuf) {
+        if self.export_refused(&path) {
+            return;
+        }
+        let Some(document) = &self.document else {
+            return;
+        };
         // The faired positions go with M0's triangles (the hierarchy's base mesh).
         let file_source = document.source.clone();
         let (positions, triangles_source) = match (&document.faired, &document.hierarchy) {

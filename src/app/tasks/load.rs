@@ -111,9 +111,18 @@ impl App {
         if !self.load_generation.is_current(load_generation) {
             return;
         }
-        self.loading = None;
+        let requested = self.loading.take();
         match result {
             Ok(loaded) => {
+                if let Some(requested) = requested {
+                    // The path as asked for (`@bunny` for the bundled one), made absolute.
+                    let requested = if crate::bundled::is_bunny_pseudo_path(&requested) {
+                        requested
+                    } else {
+                        std::path::absolute(&requested).unwrap_or(requested)
+                    };
+                    self.settings.remember_recent(&requested);
+                }
                 if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
                     self.settings.last_dir = Some(dir.to_path_buf());
                 }
@@ -168,7 +177,8 @@ impl App {
                 if let Some(document) = &mut self.document {
                     document.export_path = path.display().to_string();
                 }
-                self.export(path);
+                // The system's save dialog asked about replacing an existing file already.
+                self.write_export(path);
             }
             (_, None) => {
                 self.message =

@@ -8,3 +8,4 @@ pub mod hierarchy;
 pub mod load;
 pub mod mask;
 pub mod measure;
+pub mod view_image;
