@@ -174,13 +174,15 @@ fn controls(app: &mut App, ui: &mut egui::Ui) {
     let report = &document.report;
     if report.welded_vertices
         + report.removed_degenerate_faces
+        + report.removed_repeated_faces
         + report.removed_unreferenced_vertices
         > 0
     {
         ui.small(format!(
-            "welded {}, removed {} degenerate faces, {} unused vertices",
+            "welded {}, removed {} degenerate faces, {} repeated faces, {} unused vertices",
             report.welded_vertices,
             report.removed_degenerate_faces,
+            report.removed_repeated_faces,
             report.removed_unreferenced_vertices
         ));
     }

@@ -157,6 +157,7 @@ pub fn info(args: InfoArgs) -> anyhow::Result<()> {
         "bounding_box": bbox.map(|(lo, hi)| json!({"min": lo.to_array(), "max": hi.to_array()})),
         "welded_vertices": report.welded_vertices,
         "removed_degenerate_faces": report.removed_degenerate_faces,
+        "removed_repeated_faces": report.removed_repeated_faces,
         "removed_unreferenced_vertices": report.removed_unreferenced_vertices,
         "warnings": report.warnings,
         "file_contents": contents,
@@ -214,8 +215,10 @@ pub fn info(args: InfoArgs) -> anyhow::Result<()> {
     writeln!(out, "  welded vertices     {}", report.welded_vertices)?;
     writeln!(
         out,
-        "  removed             {} degenerate faces, {} unused vertices",
-        report.removed_degenerate_faces, report.removed_unreferenced_vertices
+        "  removed             {} degenerate faces, {} repeated faces, {} unused vertices",
+        report.removed_degenerate_faces,
+        report.removed_repeated_faces,
+        report.removed_unreferenced_vertices
     )?;
     if !contents.is_empty() {
         writeln!(

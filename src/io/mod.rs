@@ -127,6 +127,8 @@ impl Default for LoadOptions {
 pub struct LoadReport {
     pub welded_vertices: usize,
     pub removed_degenerate_faces: usize,
+    /// Triangles with the same three corners as an earlier one (see [`mesh::clean`]).
+    pub removed_repeated_faces: usize,
     pub removed_unreferenced_vertices: usize,
     pub warnings: Vec<String>,
 }
@@ -342,6 +344,15 @@ fn finish_with_map(mut mesh: TriMesh, options: &LoadOptions) -> (Loaded, Option<
         });
     }
     report.removed_degenerate_faces = cleaned.removed_degenerate_faces;
+    report.removed_repeated_faces = cleaned.removed_repeated_faces;
+    if cleaned.removed_repeated_faces > 0 {
+        report.warnings.push(format!(
+            "{} triangles had the same three corners as another triangle and were left out of \
+             the smoothing (they would be pulled to a point); written back into its own format, \
+             the file keeps them",
+            cleaned.removed_repeated_faces
+        ));
+    }
     report.removed_unreferenced_vertices = cleaned.removed_unreferenced_vertices;
     let mut topology = Topology::build(&mesh);
     if topology.inconsistent_edges > 0 {

@@ -3,8 +3,10 @@
 //! Files split vertices at normal and UV seams; unwelded, a scan falls apart into separate pieces
 //! and no smoother works. [`weld`] merges vertices whose positions are bit-identical (with -0.0
 //! treated as 0.0), keeping each vertex's first occurrence, so the welded order is the input order
-//! with repeats removed. [`clean`] drops triangles that repeat a vertex and vertices that no
-//! triangle uses, again keeping the remaining vertices in input order.
+//! with repeats removed. [`clean`] drops triangles that repeat a vertex, triangles that repeat an
+//! earlier triangle (the same three corners, in either orientation: a scan's reconstruction can
+//! leave such pockets, and fairing pulled them to a point), and vertices that no triangle uses,
+//! again keeping the remaining vertices and triangles in input order.
 
 use super::TriMesh;
 use std::collections::HashMap;
@@ -47,6 +49,8 @@ pub struct WeldReport {
 pub struct CleanReport {
     /// Triangles that used one vertex twice or three times.
     pub removed_degenerate_faces: usize,
+    /// Triangles with the same three corners as an earlier one (either orientation).
+    pub removed_repeated_faces: usize,
     /// Vertices that no triangle referenced.
     pub removed_unreferenced_vertices: usize,
 }
@@ -92,7 +96,8 @@ pub(crate) fn weld_with_map(mesh: &mut TriMesh) -> (WeldReport, Vec<u32>) {
     )
 }
 
-/// Remove triangles that repeat a vertex and vertices that no triangle uses.
+/// Remove triangles that repeat a vertex or an earlier triangle, and vertices that no triangle
+/// uses.
 pub fn clean(mesh: &mut TriMesh) -> CleanReport {
     clean_with_map(mesh).0
 }
@@ -104,6 +109,18 @@ pub(crate) fn clean_with_map(mesh: &mut TriMesh) -> (CleanReport, Option<Vec<u32
     mesh.triangles
         .retain(|&[a, b, c]| a != b && b != c && a != c);
     let removed_degenerate_faces = before_faces - mesh.triangles.len();
+    let mut seen: std::collections::HashSet<[u32; 3], BuildHasherDefault<PositionHasher>> =
+        std::collections::HashSet::with_capacity_and_hasher(
+            mesh.triangles.len(),
+            Default::default(),
+        );
+    let distinct = mesh.triangles.len();
+    mesh.triangles.retain(|t| {
+        let mut corners = *t;
+        corners.sort_unstable();
+        seen.insert(corners)
+    });
+    let removed_repeated_faces = distinct - mesh.triangles.len();
 
     let mut used = vec![false; mesh.positions.len()];
     for t in &mesh.triangles {
@@ -133,6 +150,7 @@ pub(crate) fn clean_with_map(mesh: &mut TriMesh) -> (CleanReport, Option<Vec<u32
     (
         CleanReport {
             removed_degenerate_faces,
+            removed_repeated_faces,
             removed_unreferenced_vertices: unused,
         },
         map,
@@ -180,5 +198,29 @@ mod tests {
             vec![[0., 0., 0.], [1., 0., 0.], [0., 1., 0.]]
         );
         assert_eq!(mesh.triangles, vec![[0, 1, 2]]);
+    }
+
+    #[test]
+    fn clean_drops_triangles_that_repeat_an_earlier_one_in_either_orientation() {
+        // A tetrahedron whose face 1-2-3 comes three times: once more rotated, once reversed.
+        let mut mesh = TriMesh::new(
+            vec![[0., 0., 0.], [1., 0., 0.], [0., 1., 0.], [0., 0., 1.]],
+            vec![
+                [0, 2, 1],
+                [1, 2, 3],
+                [2, 3, 1],
+                [0, 1, 3],
+                [3, 2, 1],
+                [0, 3, 2],
+            ],
+        );
+        let report = clean(&mut mesh);
+        assert_eq!(report.removed_repeated_faces, 2);
+        assert_eq!(report.removed_degenerate_faces, 0);
+        assert_eq!(
+            mesh.triangles,
+            vec![[0, 2, 1], [1, 2, 3], [0, 1, 3], [0, 3, 2]],
+            "the first of each kept, in input order"
+        );
     }
 }
