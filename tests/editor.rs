@@ -13,7 +13,7 @@ use egui_kittest::kittest::{NodeT, Queryable};
 use egui_kittest::SnapshotOptions;
 
 mod editor_common;
-use editor_common::{bunny, harness_for, harness_with, retype, settle, viewport_image};
+use editor_common::{bunny, drag, harness_for, harness_with, retype, settle, viewport_image};
 use fairmesh::app::AppOptions;
 
 fn snapshot_options() -> SnapshotOptions {
@@ -298,16 +298,7 @@ fn camera_orbits_pans_zooms_and_fits() {
     let fitted = *harness.state().camera();
 
     let centre = rect.center();
-    harness.hover_at(centre);
-    harness.step();
-    harness.drag_at(centre);
-    harness.step();
-    for i in 1..=5 {
-        harness.hover_at(centre + egui::vec2(20.0 * i as f32, 5.0 * i as f32));
-        harness.step();
-    }
-    harness.drop_at(centre + egui::vec2(100.0, 25.0));
-    harness.step();
+    drag(&mut harness, centre, centre + egui::vec2(100.0, 25.0), 5);
     let orbited = *harness.state().camera();
     assert!(orbited.yaw != fitted.yaw && orbited.pitch != fitted.pitch);
     assert_eq!(orbited.target, fitted.target);
@@ -636,16 +627,7 @@ fn side_by_side_halves_show_the_whole_mesh() {
     harness.step();
     let fitted = *harness.state().camera();
     let centre = harness.state().viewport_rect().unwrap().center();
-    harness.hover_at(centre);
-    harness.step();
-    harness.drag_at(centre);
-    harness.step();
-    for i in 1..=4 {
-        harness.hover_at(centre + egui::vec2(15.0 * i as f32, 0.0));
-        harness.step();
-    }
-    harness.drop_at(centre + egui::vec2(60.0, 0.0));
-    harness.step();
+    drag(&mut harness, centre, centre + egui::vec2(60.0, 0.0), 4);
     let orbited = *harness.state().camera();
     assert_ne!(orbited.yaw, fitted.yaw, "the drag orbited");
     harness.get_by_label("Side by side").click();

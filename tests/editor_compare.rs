@@ -11,7 +11,7 @@ use egui_kittest::Harness;
 use fairmesh::app::{App, Command};
 
 mod editor_common;
-use editor_common::{bunny, harness_for, retype, settle, viewport_image};
+use editor_common::{bunny, drag, harness_for, retype, settle, viewport_image};
 
 /// Loads the bunny, adds the default noise (sigma 0.3 of the mean edge, seed 1, along the
 /// normal) through the panel's button, and fairs from a middle level: M4 of the bunny's 19
@@ -357,19 +357,9 @@ fn before_after_toggle_split_and_side_by_side_render() {
     // Drag the divider to a third of the view.
     let rect = harness.state().viewport_rect().unwrap();
     let camera = *harness.state().camera();
-    let start = egui::pos2(rect.center().x, rect.center().y);
-    harness.hover_at(start);
-    harness.step();
-    harness.drag_at(start);
-    harness.step();
+    let start = rect.center();
     let target_x = rect.left() + rect.width() / 3.0;
-    for i in 1..=4 {
-        let x = start.x + (target_x - start.x) * i as f32 / 4.0;
-        harness.hover_at(egui::pos2(x, start.y));
-        harness.step();
-    }
-    harness.drop_at(egui::pos2(target_x, start.y));
-    harness.step();
+    drag(&mut harness, start, egui::pos2(target_x, start.y), 4);
     let split_at = harness.state().settings().split;
     assert!((split_at - 1.0 / 3.0).abs() < 0.03, "divider at {split_at}");
     assert_eq!(

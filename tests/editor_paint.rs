@@ -14,16 +14,7 @@ type Harness = egui_kittest::Harness<'static, App>;
 /// A short stroke with the left button across the middle of the view.
 fn stroke_across_the_middle(harness: &mut Harness) {
     let centre = harness.state().viewport_rect().unwrap().center();
-    harness.hover_at(centre);
-    harness.step();
-    harness.drag_at(centre);
-    harness.step();
-    for i in 1..=4 {
-        harness.hover_at(centre + egui::vec2(8.0 * i as f32, 0.0));
-        harness.step();
-    }
-    harness.drop_at(centre + egui::vec2(32.0, 0.0));
-    harness.step();
+    editor_common::drag(harness, centre, centre + egui::vec2(32.0, 0.0), 4);
 }
 
 /// Pixels of the view tinted orange (the mask's tint; the bunny itself is beige).

@@ -83,6 +83,21 @@ pub fn viewport_image(harness: &mut Harness<'_, App>) -> image::RgbaImage {
     .to_image()
 }
 
+/// A left-button drag from `from` to `to`: `steps` even moves, one frame each, then the release
+/// at `to` (orbits, strokes, the split view's divider).
+pub fn drag(harness: &mut Harness<'_, App>, from: egui::Pos2, to: egui::Pos2, steps: usize) {
+    harness.hover_at(from);
+    harness.step();
+    harness.drag_at(from);
+    harness.step();
+    for i in 1..=steps {
+        harness.hover_at(from.lerp(to, i as f32 / steps as f32));
+        harness.step();
+    }
+    harness.drop_at(to);
+    harness.step();
+}
+
 /// Replaces the text of the text field whose current value satisfies `which`.
 pub fn retype(harness: &mut Harness<'_, App>, which: impl Fn(&str) -> bool, text: &str) {
     let field = harness
