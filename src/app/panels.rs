@@ -1012,7 +1012,6 @@ fn sharp_edge_controls(app: &mut App, ui: &mut egui::Ui) {
         HierarchyState::Ready { hierarchy, .. } => Some(hierarchy.crease_edge_count()),
         _ => None,
     };
-    let before = app.settings.hierarchy_key();
     let enabled = not_for_baseline.is_none();
     let keep = ui.add_enabled(
         enabled,
@@ -1036,12 +1035,10 @@ fn sharp_edge_controls(app: &mut App, ui: &mut egui::Ui) {
     }
     // The hierarchy is built again when the angle is let go (not at every step of a drag).
     let settled = !angle.dragged();
+    // (`start_hierarchy` records the settings it builds with, before the next frame.)
     if settled && app.settings.hierarchy_key() != app.hierarchy_built_with {
-        app.hierarchy_built_with = app.settings.hierarchy_key();
         app.sharp_edges_shown_until = Some(now + SHARP_EDGES_LINGER);
         app.commands.push(Command::RebuildHierarchy);
-    } else if app.settings.hierarchy_key() != before {
-        ui.ctx().request_repaint();
     }
     if app.settings.keep_sharp_edges && enabled {
         match kept {
