@@ -4,7 +4,7 @@
 //! previous default (one round of 10 iterations, no creases) and to fixed round counts.
 //!
 //! Run: `cargo run --release --no-default-features --example fairing_default [-- --trace]`
-//! (`--trace` also prints, per round, the noise estimate and the distance to the clean surface,
+//! (`--only gear,cube` runs just those meshes; `--trace` also prints, per round, the noise estimate and the distance to the clean surface,
 //! the data the automatic rule was tuned on). `docs/measurements.md` holds what it printed and
 //! says which meshes the rule was tuned on and which were kept out.
 //!
@@ -79,7 +79,17 @@ fn main() {
     let trace = std::env::args().any(|a| a == "--trace");
     println!("| mesh | input | setting | mean | hausdorff | normal ° | vol % |");
     println!("|---|---|---|---:|---:|---:|---:|");
+    // `--only NAME[,NAME]`: just those meshes.
+    let args: Vec<String> = std::env::args().collect();
+    let only: Option<Vec<String>> = args
+        .iter()
+        .position(|a| a == "--only")
+        .and_then(|i| args.get(i + 1))
+        .map(|list| list.split(',').map(str::to_string).collect());
     for (name, clean) in meshes() {
+        if only.as_ref().is_some_and(|only| !only.contains(&name)) {
+            continue;
+        }
         let topology = Topology::build(&clean);
         let edge = mean_edge_length(&clean);
         let inputs = [
@@ -120,11 +130,24 @@ fn main() {
                 ),
                 &measure(&clean, &input, &normal_only, edge),
             );
+            let mut no_volume = input.clone();
+            let options = FairOptions::default().with_keep_volume(false);
+            let report = fair_constrained(&mut no_volume, &topology, &options);
+            print(
+                &name,
+                label,
+                &format!(
+                    "default without the volume correction: {} rounds",
+                    report.rounds_run
+                ),
+                &measure(&clean, &input, &no_volume, edge),
+            );
             let mut old = input.clone();
             let old_options = FairOptions::default()
                 .with_rounds(1)
                 .with_creases(None)
-                .with_tangential_relaxation(0.0);
+                .with_tangential_relaxation(0.0)
+                .with_keep_volume(false);
             fair_constrained(&mut old, &topology, &old_options);
             print(
                 &name,

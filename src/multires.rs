@@ -322,6 +322,8 @@ fn level_fair_options(options: &MultiresOptions) -> FairOptions {
         boundary: options.boundary,
         tolerance: 0.0,
         mask: None,
+        // Multires corrects the shrinkage per level itself.
+        keep_volume: false,
         // Both variants fair with the paper's operator: measured in multires, the
         // normal-projected operator roughly doubles the normal error from coarse levels (noisy
         // bunny00 from level 8: 22 degrees against 12) because the tangential part of the paper's

@@ -73,6 +73,10 @@ pub struct FairArgs {
     /// along the surface (0 to 1; 0 moves vertices only along their normals).
     #[arg(long, default_value_t = fairmesh::fairing::DEFAULT_TANGENTIAL_RELAXATION)]
     pub tangential: f64,
+    /// Constrained normal-projected only: do not give each part back its volume after every
+    /// round (by default a uniform offset along the normals undoes the little each round loses).
+    #[arg(long)]
+    pub no_volume_correction: bool,
     /// Constrained only: stop a round early once no vertex moves more than this many mean edge
     /// lengths in one iteration (0: always run all iterations).
     #[arg(long, default_value_t = 0.0)]
@@ -118,12 +122,14 @@ impl FairArgs {
         match self.method {
             MethodArg::Constrained => {
                 // `--variant paper` is the paper's method (`FairOptions::paper`): one round, no
-                // creases, no tangential relaxation; --crease-angle, --no-creases and
-                // --tangential do not apply to it, --rounds does.
+                // creases, no tangential relaxation, no volume correction; --crease-angle,
+                // --no-creases, --tangential and --no-volume-correction do not apply to it,
+                // --rounds does.
                 let base = match self.variant {
                     VariantArg::Paper => FairOptions::paper(),
                     VariantArg::NormalProjected => FairOptions::default()
                         .with_tangential_relaxation(self.tangential)
+                        .with_keep_volume(!self.no_volume_correction)
                         .with_creases((!self.no_creases).then(|| {
                             CreaseOptions::default().with_angle_degrees(self.crease_angle)
                         })),

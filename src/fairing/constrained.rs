@@ -61,6 +61,7 @@ use super::creases::{detect_creases, Creases, FeatureClass};
 use super::strength::{
     estimate_noise, normal_filtering_for, CLEAN_NOISE, MAX_AUTO_ROUNDS, MIN_NOISE_FALL, NOISE_LEFT,
 };
+use super::volume::VolumeKeeper;
 use super::{BoundaryMode, FairOptions, FairReport, FairVariant, Strength};
 use crate::mesh::{breadth_first_order, inverse_permutation, PositionHasher, Topology, TriMesh};
 use glam::{Vec3A, Vec3Swizzles};
@@ -1090,56 +1091,89 @@ pub fn fair_constrained(
         },
         _ => None,
     };
-    let creases = options.creases.as_ref().map(|crease_options| {
-        let mut crease_options = crease_options.clone();
-        crease_options.normal_filtering = crease_options
-            .normal_filtering
-            .max(estimate.map_or(0, normal_filtering_for));
-        detect_creases(mesh, topology, &crease_options)
-    });
+    // Creases are found again before every round: the noise left after a round makes fewer
+    // false creases, and a crease found on the noisy input may turn out to be noise
+    // (`docs/measurements.md`). The normals are filtered as much as the current noise asks for.
+    let detect = |mesh: &TriMesh, noise: Option<f64>| {
+        options.creases.as_ref().map(|crease_options| {
+            let mut crease_options = crease_options.clone();
+            crease_options.normal_filtering = crease_options
+                .normal_filtering
+                .max(noise.map_or(0, normal_filtering_for));
+            detect_creases(mesh, topology, &crease_options)
+        })
+    };
+    let mut creases = detect(mesh, estimate);
     let pinned = options
         .mask
         .as_ref()
         .map(|mask| mask.pinned_flags())
         .unwrap_or_default();
-    let fans = FanRings::new(&mesh.triangles, topology);
-    let mut fairing = ConstrainedFairing::with_fans(
-        mesh,
-        topology,
-        &fans,
-        options.variant,
-        options.boundary,
-        creases.as_ref(),
-        &pinned,
-    );
-    drop(fans);
-    fairing.set_tangential_relaxation(options.tangential_relaxation as f32);
-    let mut report = match auto_noise {
-        None => fairing.run(&mut mesh.positions, options),
-        Some(noise) => {
-            // Round by round until the noise left is a small part of the input's (or no longer
-            // falls): see [`super::strength`].
-            let mut report = FairReport::default();
-            let target = noise * NOISE_LEFT;
-            let mut last = noise;
-            fairing.load(&mesh.positions);
-            for round in 0..MAX_AUTO_ROUNDS {
-                if round > 0 {
-                    fairing.reanchor();
-                }
-                fairing.run_round(options, &mut report);
-                fairing.store(&mut mesh.positions);
-                let Some(now) = estimate_noise(mesh, topology) else {
-                    break;
-                };
-                if now <= target || now > last * MIN_NOISE_FALL {
-                    break;
-                }
-                last = now;
-            }
-            report
-        }
+    let max_rounds = match auto_noise {
+        Some(_) => MAX_AUTO_ROUNDS,
+        None => options.rounds,
     };
+    let redetect = options.creases.is_some() && max_rounds > 1;
+    let fans = FanRings::new(&mesh.triangles, topology);
+    let build = |mesh: &TriMesh, fans: &FanRings, creases: Option<&Creases>| {
+        let mut fairing = ConstrainedFairing::with_fans(
+            mesh,
+            topology,
+            fans,
+            options.variant,
+            options.boundary,
+            creases,
+            &pinned,
+        );
+        fairing.set_tangential_relaxation(options.tangential_relaxation as f32);
+        fairing
+    };
+    let mut fairing = build(mesh, &fans, creases.as_ref());
+    // Rebuilding for new creases needs the one-rings again; otherwise they are dropped now.
+    let fans = redetect.then_some(fans);
+    let volume = options
+        .keep_volume
+        .then(|| VolumeKeeper::new(mesh, topology, &pinned));
+    let mut report = FairReport::default();
+    // Automatic strength: round by round until the noise left is a small part of the input's
+    // (or no longer falls): see [`super::strength`].
+    let mut noise_now = estimate;
+    for round in 0..max_rounds {
+        if round > 0 {
+            if let Some(fans) = &fans {
+                let found = detect(mesh, noise_now);
+                if found.as_ref().map(|c| &c.edges) != creases.as_ref().map(|c| &c.edges) {
+                    creases = found;
+                    fairing = build(mesh, fans, creases.as_ref());
+                }
+            }
+        }
+        // Imposes the constraints on the positions this round starts from.
+        fairing.load(&mesh.positions);
+        fairing.run_round(options, &mut report);
+        fairing.store(&mut mesh.positions);
+        if let Some(volume) = &volume {
+            let held = creases.as_ref().map(|c| c.class.as_slice()).unwrap_or(&[]);
+            volume.restore(mesh, topology, |v| {
+                held.get(v) == Some(&FeatureClass::Corner)
+            });
+        }
+        if round + 1 == max_rounds {
+            break;
+        }
+        if let Some(noise) = auto_noise {
+            let Some(now) = estimate_noise(mesh, topology) else {
+                break;
+            };
+            let last = noise_now.unwrap_or(noise);
+            if now <= noise * NOISE_LEFT || now > last * MIN_NOISE_FALL {
+                break;
+            }
+            noise_now = Some(now);
+        } else if redetect {
+            noise_now = estimate_noise(mesh, topology);
+        }
+    }
     // The operator held the pinned vertices; the blend fades the rest by their weights (and
     // puts back pinned boundary vertices, which the boundary curves may have moved).
     if let (Some(mask), Some(original)) = (&options.mask, &original) {
