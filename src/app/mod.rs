@@ -9,7 +9,8 @@
 //!   fairing, measure, export), each holding its launch and the handling of its result;
 //! - [`jobs`]: worker threads, generation numbers, job results;
 //! - `view_sync.rs`: keeps the viewports' GPU buffers in step with what should be shown;
-//! - [`panels`]: the widgets; they emit [`Command`]s, applied after the frame;
+//! - [`panels`]: the widgets; they emit [`Command`]s, applied after the frame; [`view_panel`]:
+//!   the View section (compare, heat map, Shading and Lighting);
 //! - `input.rs`: shortcuts and dropped files; `frame_stats.rs`: the UI thread's frame times;
 //! - [`camera`]: the orbit camera; [`history`]: undo and redo;
 //! - [`paint`]: the brush that paints where to fair (`tasks/mask.rs` applies its strokes,
@@ -36,6 +37,7 @@ mod recent;
 mod sharp_edges;
 pub mod state;
 mod tasks;
+pub mod view_panel;
 mod view_sync;
 
 pub use frame_stats::FrameStats;

@@ -152,7 +152,7 @@ fn controls(app: &mut App, ui: &mut egui::Ui) {
     };
 
     ui.heading("View");
-    view_bar(app, ui);
+    super::view_panel::show(app, ui);
     let Some(document) = &app.document else {
         return;
     };
@@ -732,53 +732,6 @@ fn viewport(app: &mut App, ui: &mut egui::Ui) {
         );
         ui.put(area, egui::Label::new(text).selectable(false));
     }
-}
-
-/// The compare and heat-map controls (top of the side panel, so they never take the viewport's room).
-fn view_bar(app: &mut App, ui: &mut egui::Ui) {
-    ui.horizontal(|ui| {
-        ui.label("Compare:");
-        let mut compare = app.settings.compare;
-        ui.selectable_value(&mut compare, CompareView::Single, "Single")
-            .on_hover_text("One view; B toggles before and after");
-        ui.selectable_value(&mut compare, CompareView::Split, "Split")
-            .on_hover_text("Before left of the divider, after right of it (drag the divider)");
-        ui.selectable_value(&mut compare, CompareView::SideBySide, "Side by side")
-            .on_hover_text("Before and after next to each other, one camera");
-        app.settings.compare = compare;
-    });
-    ui.horizontal(|ui| {
-        ui.add_enabled(
-            app.settings.compare == CompareView::Single,
-            egui::Button::selectable(app.show_before, "Before (B)"),
-        )
-        .on_hover_text("Show the input mesh instead of the result (B)")
-        .clicked()
-        .then(|| app.show_before = !app.show_before);
-        ui.checkbox(&mut app.settings.heat_map, "Heat map (H)")
-            .on_hover_text("Colour each vertex by its distance from the reference mesh (H)");
-    });
-    ui.horizontal(|ui| {
-        let has_clean = app.document.as_ref().is_some_and(|d| d.clean.is_some());
-        ui.add_enabled_ui(app.settings.heat_map, |ui| {
-            ui.label("against");
-            ui.selectable_value(
-                &mut app.settings.heat_reference,
-                HeatReference::Document,
-                "input mesh",
-            );
-            ui.add_enabled(
-                has_clean,
-                egui::Button::selectable(
-                    app.settings.heat_reference == HeatReference::Clean,
-                    "clean mesh",
-                ),
-            )
-            .on_disabled_hover_text("Add noise first: the mesh before it becomes the clean one")
-            .clicked()
-            .then(|| app.settings.heat_reference = HeatReference::Clean);
-        });
-    });
 }
 
 /// The heat map's legend: the viridis strip with round tick values in model units.
