@@ -10,7 +10,8 @@
 //! - [`jobs`]: worker threads, generation numbers, job results;
 //! - `view_sync.rs`: keeps the viewports' GPU buffers in step with what should be shown;
 //! - [`panels`]: the widgets; they emit [`Command`]s, applied after the frame; [`view_panel`]:
-//!   the View section (compare, heat map, Shading and Lighting);
+//!   the View section (compare, heat map, Shading and Lighting); `viewport_panel.rs`: the 3D
+//!   view's area (camera input, the compare views, what is drawn over them);
 //! - `input.rs`: shortcuts and dropped files; `frame_stats.rs`: the UI thread's frame times;
 //! - [`camera`]: the orbit camera; [`history`]: undo and redo;
 //! - [`paint`]: the brush that paints where to fair (`tasks/mask.rs` applies its strokes,
@@ -39,6 +40,7 @@ pub mod state;
 mod tasks;
 pub mod view_panel;
 mod view_sync;
+mod viewport_panel;
 
 pub use frame_stats::FrameStats;
 use tasks::measure::MeasureRequest;

@@ -1,17 +1,17 @@
-//! The editor's widgets: toolbar (open, view toggles), error banner, controls side panel
-//! (hierarchy, fairing options, numbers, export, performance) and the 3D viewport.
+//! The editor's widgets: toolbar (open, view toggles), status bar, controls side panel
+//! (hierarchy, fairing options, numbers, export, performance); the View section is in
+//! `view_panel.rs`, the 3D viewport's area in `viewport_panel.rs`.
 //! Widgets read the app's state and emit [`Command`]s; the app applies them after the frame.
 //! Plain display toggles (wireframe, option values) are edited in place.
 
 use std::path::PathBuf;
 
 use super::state::{
-    BoundarySetting, CompareView, HeatReference, HierarchyState, Measures, MethodSetting,
-    VariantSetting, ViewMode, MAX_SHARP_EDGE_ANGLE, MIN_SHARP_EDGE_ANGLE,
+    BoundarySetting, CompareView, HierarchyState, Measures, MethodSetting, VariantSetting,
+    ViewMode, MAX_SHARP_EDGE_ANGLE, MIN_SHARP_EDGE_ANGLE,
 };
-use super::{App, Command, Slot};
+use super::{App, Command};
 use crate::noise::NoiseMode;
-use crate::render::colormap::{legend_ticks, viridis_strip};
 
 pub fn show(app: &mut App, ui: &mut egui::Ui) {
     egui::Panel::top("fairmesh-toolbar").show(ui, |ui| toolbar(app, ui));
@@ -22,7 +22,7 @@ pub fn show(app: &mut App, ui: &mut egui::Ui) {
         .show(ui, |ui| {
             egui::ScrollArea::vertical().show(ui, |ui| controls(app, ui));
         });
-    egui::CentralPanel::no_frame().show(ui, |ui| viewport(app, ui));
+    egui::CentralPanel::no_frame().show(ui, |ui| super::viewport_panel::show(app, ui));
 }
 
 fn toolbar(app: &mut App, ui: &mut egui::Ui) {
@@ -539,282 +539,6 @@ fn performance(app: &mut App, ui: &mut egui::Ui) {
     app.settings.show_performance = response.fully_open();
 }
 
-fn viewport(app: &mut App, ui: &mut egui::Ui) {
-    let rect = ui.available_rect_before_wrap();
-    let response = ui.allocate_rect(rect, egui::Sense::click_and_drag());
-    app.viewport_rect = Some(rect);
-    // The split view's divider sits on top of the camera's area and takes its drags first.
-    let divider_x = rect.left() + rect.width() * app.settings.split.clamp(0.0, 1.0);
-    let mut divider_dragged = false;
-    if app.settings.compare == CompareView::Split {
-        let handle = egui::Rect::from_x_y_ranges(divider_x - 6.0..=divider_x + 6.0, rect.y_range());
-        let divider = ui
-            .interact(
-                handle,
-                ui.scope_id().with("fairmesh-split-divider"),
-                egui::Sense::drag(),
-            )
-            .on_hover_cursor(egui::CursorIcon::ResizeHorizontal)
-            .on_hover_text("Drag to move the divider: before on the left, after on the right");
-        if divider.dragged() {
-            divider_dragged = true;
-            let x = divider
-                .interact_pointer_pos()
-                .map_or(divider_x + divider.drag_delta().x, |p| p.x);
-            app.settings.split = ((x - rect.left()) / rect.width().max(1.0)).clamp(0.02, 0.98);
-        }
-    }
-    let painting = !divider_dragged && super::paint_panel::viewport_brush(app, ui, &response, rect);
-    // While painting, the middle button turns the view instead of the left.
-    let orbit_button = match painting {
-        true => egui::PointerButton::Middle,
-        false => egui::PointerButton::Primary,
-    };
-    if !divider_dragged {
-        if response.dragged_by(orbit_button) {
-            app.camera.orbit(response.drag_delta());
-        }
-        if response.dragged_by(egui::PointerButton::Secondary)
-            || (!painting && response.dragged_by(egui::PointerButton::Middle))
-        {
-            app.camera.pan(response.drag_delta(), rect.height());
-        }
-    }
-    if response.hovered() {
-        let scroll = ui.input(|i| i.smooth_scroll_delta().y);
-        if scroll != 0.0 {
-            app.camera.zoom(scroll);
-        }
-    }
-    let painter = ui.painter_at(rect);
-    if app.viewport.is_none() {
-        painter.text(
-            rect.center(),
-            egui::Align2::CENTER_CENTER,
-            "No wgpu renderer: the 3D view needs eframe's wgpu backend",
-            egui::FontId::proportional(16.0),
-            ui.visuals().text_color(),
-        );
-    }
-    let caption = |painter: &egui::Painter, at: egui::Pos2, align: egui::Align2, text: &str| {
-        painter.text(
-            at,
-            align,
-            text,
-            egui::FontId::proportional(15.0),
-            egui::Color32::from_gray(220),
-        );
-    };
-    let after_name = match app.settings.view_mode {
-        ViewMode::Faired => "After (faired)",
-        ViewMode::Level => "Level mesh",
-        ViewMode::Original => "Input mesh",
-    };
-    match app.settings.compare {
-        CompareView::Single => {
-            let slot = if app.show_before {
-                Slot::Before
-            } else {
-                Slot::Main
-            };
-            let params = app.draw_params(rect, slot);
-            let viewport = match slot {
-                Slot::Main => &mut app.viewport,
-                Slot::Before => &mut app.viewport_before,
-            };
-            if let Some(viewport) = viewport {
-                viewport.paint(&painter, rect, params);
-            }
-            let name = if app.show_before {
-                "Before (B)"
-            } else {
-                after_name
-            };
-            caption(
-                &painter,
-                rect.left_top() + egui::vec2(10.0, 8.0),
-                egui::Align2::LEFT_TOP,
-                name,
-            );
-        }
-        CompareView::Split => {
-            let (left, right) = rect.split_left_right_at_x(divider_x);
-            let before_params = app.draw_params(rect, Slot::Before);
-            let after_params = app.draw_params(rect, Slot::Main);
-            if let Some(viewport) = &mut app.viewport_before {
-                viewport.paint_part(&painter, rect, left, before_params);
-            }
-            if let Some(viewport) = &mut app.viewport {
-                viewport.paint_part(&painter, rect, right, after_params);
-            }
-            painter.line_segment(
-                [
-                    egui::pos2(divider_x, rect.top()),
-                    egui::pos2(divider_x, rect.bottom()),
-                ],
-                egui::Stroke::new(2.0, egui::Color32::from_gray(230)),
-            );
-            caption(
-                &painter,
-                rect.left_top() + egui::vec2(10.0, 8.0),
-                egui::Align2::LEFT_TOP,
-                "Before",
-            );
-            caption(
-                &painter,
-                rect.right_top() + egui::vec2(-10.0, 8.0),
-                egui::Align2::RIGHT_TOP,
-                after_name,
-            );
-        }
-        CompareView::SideBySide => {
-            let (left, right) = rect.split_left_right_at_fraction(0.5);
-            let before_params = app.draw_params(left, Slot::Before);
-            let after_params = app.draw_params(right, Slot::Main);
-            if let Some(viewport) = &mut app.viewport_before {
-                viewport.paint(&painter, left, before_params);
-            }
-            if let Some(viewport) = &mut app.viewport {
-                viewport.paint(&painter, right, after_params);
-            }
-            painter.line_segment(
-                [
-                    egui::pos2(right.left(), rect.top()),
-                    egui::pos2(right.left(), rect.bottom()),
-                ],
-                egui::Stroke::new(1.0, egui::Color32::from_gray(90)),
-            );
-            caption(
-                &painter,
-                left.left_top() + egui::vec2(10.0, 8.0),
-                egui::Align2::LEFT_TOP,
-                "Before",
-            );
-            caption(
-                &painter,
-                right.left_top() + egui::vec2(10.0, 8.0),
-                egui::Align2::LEFT_TOP,
-                after_name,
-            );
-        }
-    }
-    // A saved image of the view leaves out the mouse hints.
-    let hint = if app.capturing_view {
-        ""
-    } else if painting {
-        "Painting: left drag paints (Shift: erase) · middle drag: orbit · right drag: pan · P: stop painting"
-    } else {
-        "Left drag: orbit · right/middle drag: pan · scroll: zoom · F: fit · W: wireframe · B: before/after · P: paint"
-    };
-    painter.text(
-        rect.left_bottom() + egui::vec2(8.0, -8.0),
-        egui::Align2::LEFT_BOTTOM,
-        hint,
-        egui::FontId::proportional(12.0),
-        egui::Color32::from_gray(150),
-    );
-    if let (Some(top), Some(reference)) = (app.heat_top(), app.heat_reference()) {
-        heat_legend(ui, rect, top, reference);
-    }
-    super::paint_panel::brush_outline(app, ui, rect);
-    sharp_edge_overlay(app, ui, rect);
-    let wireframe = app.settings.wireframe;
-    let problem = app
-        .viewports()
-        .find_map(|viewport| viewport.problem(wireframe));
-    if let Some(problem) = problem {
-        let text = egui::RichText::new(format!("Not drawn: {problem}"))
-            .size(14.0)
-            .color(egui::Color32::from_rgb(240, 150, 90));
-        let area = egui::Rect::from_min_size(
-            rect.left_top() + egui::vec2(8.0, 32.0),
-            egui::vec2(rect.width() - 16.0, 20.0),
-        );
-        ui.put(area, egui::Label::new(text).selectable(false));
-    }
-}
-
-/// The heat map's legend: the viridis strip with round tick values in model units.
-fn heat_legend(ui: &mut egui::Ui, viewport: egui::Rect, top: f32, reference: HeatReference) {
-    const WIDTH: f32 = 240.0;
-    let area = egui::Rect::from_min_size(
-        viewport.right_bottom() + egui::vec2(-WIDTH - 28.0, -92.0),
-        egui::vec2(WIDTH + 20.0, 84.0),
-    );
-    ui.scope_builder(egui::UiBuilder::new().max_rect(area), |ui| {
-        egui::Frame::new()
-            .fill(egui::Color32::from_black_alpha(180))
-            .inner_margin(8.0)
-            .corner_radius(4.0)
-            .show(ui, |ui| {
-                let title = match reference {
-                    HeatReference::Clean => "Distance to the clean mesh (model units)",
-                    HeatReference::Document => "Distance to the input mesh (model units)",
-                };
-                ui.label(
-                    egui::RichText::new(title)
-                        .small()
-                        .color(egui::Color32::WHITE),
-                );
-                let (strip, _) =
-                    ui.allocate_exact_size(egui::vec2(WIDTH, 14.0), egui::Sense::hover());
-                let colours = viridis_strip(64);
-                let step = strip.width() / colours.len() as f32;
-                for (i, [r, g, b, _]) in colours.into_iter().enumerate() {
-                    let x = strip.left() + i as f32 * step;
-                    ui.painter().rect_filled(
-                        egui::Rect::from_x_y_ranges(x..=x + step + 0.5, strip.y_range()),
-                        0.0,
-                        egui::Color32::from_rgb(r, g, b),
-                    );
-                }
-                let (labels, _) =
-                    ui.allocate_exact_size(egui::vec2(WIDTH, 16.0), egui::Sense::hover());
-                let ticks = legend_ticks(top as f64, 4);
-                let spacing = ticks.get(1).copied().unwrap_or(top as f64);
-                for value in ticks {
-                    let x = strip.left() + strip.width() * (value / top as f64) as f32;
-                    ui.painter().line_segment(
-                        [
-                            egui::pos2(x, strip.bottom()),
-                            egui::pos2(x, strip.bottom() + 3.0),
-                        ],
-                        egui::Stroke::new(1.0, egui::Color32::WHITE),
-                    );
-                    let text = tick_text(value, spacing);
-                    let at = egui::Rect::from_center_size(
-                        egui::pos2(
-                            x.clamp(labels.left() + 18.0, labels.right() - 18.0),
-                            labels.center().y,
-                        ),
-                        egui::vec2(44.0, 16.0),
-                    );
-                    ui.put(
-                        at,
-                        egui::Label::new(
-                            egui::RichText::new(text)
-                                .small()
-                                .color(egui::Color32::WHITE),
-                        ),
-                    );
-                }
-            });
-    });
-}
-
-/// A tick value with as many decimals as the tick spacing needs.
-fn tick_text(value: f64, spacing: f64) -> String {
-    if value == 0.0 {
-        return "0".into();
-    }
-    // NaN, zero and negative spacings fall outside the range too.
-    if !(1e-3..1e5).contains(&spacing) {
-        return format!("{value:.0e}");
-    }
-    let decimals = (-spacing.log10().floor()).max(0.0) as usize;
-    format!("{value:.decimals$}")
-}
-
 /// The fairing section: start level, method and its options, Apply. Every control says in its
 /// tooltip what it does and when to change it; the ones the chosen method does not use are
 /// disabled and say why.
@@ -1008,7 +732,7 @@ fn sharp_edge_controls(app: &mut App, ui: &mut egui::Ui) {
 const SHARP_EDGES_LINGER: std::time::Duration = std::time::Duration::from_millis(1500);
 
 /// Draws the kept sharp edges over the result's image while [`sharp_edge_controls`] asks for it.
-fn sharp_edge_overlay(app: &mut App, ui: &egui::Ui, rect: egui::Rect) {
+pub(super) fn sharp_edge_overlay(app: &mut App, ui: &egui::Ui, rect: egui::Rect) {
     app.sharp_edges_drawn = 0;
     let Some(until) = app.sharp_edges_shown_until else {
         return;

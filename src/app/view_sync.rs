@@ -7,7 +7,7 @@ use std::sync::Arc;
 use crate::app::state::{self, CompareView, HeatReference, HierarchyState, ViewMode};
 use crate::app::App;
 use crate::hierarchy;
-use crate::render::{DrawParams, MeshSource};
+use crate::render::{DrawParams, MeshSource, Viewport3d};
 use crate::TriMesh;
 
 /// What the viewport has uploaded, to know when to upload again.
@@ -308,6 +308,14 @@ impl App {
             (a, b) => a.or(b),
         }
         .map(|top| top.max(f32::MIN_POSITIVE))
+    }
+
+    /// A viewport's renderer handle, when there is a wgpu renderer.
+    pub(super) fn viewport_mut(&mut self, slot: Slot) -> Option<&mut Viewport3d> {
+        match slot {
+            Slot::Main => self.viewport.as_mut(),
+            Slot::Before => self.viewport_before.as_mut(),
+        }
     }
 
     /// What the main viewport's renderer is asked to draw with now (tests).
