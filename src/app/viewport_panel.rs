@@ -187,7 +187,7 @@ fn overlays(
         heat_legend(ui, rect, top, reference);
     }
     super::paint_panel::brush_outline(app, ui, rect);
-    super::panels::sharp_edge_overlay(app, ui, rect);
+    super::fairing_panel::sharp_edge_overlay(app, ui, rect);
     let wireframe = app.settings.wireframe;
     let problem = app
         .viewports()
