@@ -12,7 +12,8 @@
 //! - [`panels`]: the widgets; they emit [`Command`]s, applied after the frame. Beside it:
 //!   `fairing_panel.rs` (the Fairing section, the sharp-edge controls, every tooltip),
 //!   [`view_panel`] (the View section: compare, heat map, Shading, Studio lighting) and
-//!   `viewport_panel.rs` (the 3D view's area: camera input, the compare views, overlays);
+//!   `viewport_panel.rs` (the 3D view's area: camera input, the compare views, overlays),
+//!   `numbers_panel.rs` (the Numbers section);
 //! - `input.rs`: shortcuts and dropped files; `frame_stats.rs`: the UI thread's frame times;
 //! - [`camera`]: the orbit camera; [`history`]: undo and redo;
 //! - [`paint`]: the brush that paints where to fair (`tasks/mask.rs` applies its strokes,
@@ -33,6 +34,7 @@ mod frame_stats;
 pub mod history;
 mod input;
 pub mod jobs;
+mod numbers_panel;
 pub mod paint;
 mod paint_panel;
 pub mod panels;

@@ -1,14 +1,15 @@
 //! The editor's widgets: toolbar (open, view toggles), status bar, controls side panel
-//! (mesh, noise, hierarchy, numbers, export, performance); the View section is in
-//! `view_panel.rs`, the Fairing section and sharp-edge controls (and [`tips`], every control's
-//! tooltip) in `fairing_panel.rs`, the 3D viewport's area in `viewport_panel.rs`.
+//! (mesh, noise, hierarchy, export, performance, one function each, in the order shown); the
+//! View section is in `view_panel.rs`, the Fairing section and sharp-edge controls (and
+//! [`tips`], every control's tooltip) in `fairing_panel.rs`, the Numbers in
+//! `numbers_panel.rs`, the 3D viewport's area in `viewport_panel.rs`.
 //! Widgets read the app's state and emit [`Command`]s; the app applies them after the frame.
 //! Plain display toggles (wireframe, option values) are edited in place.
 
 use std::path::PathBuf;
 
 pub use super::fairing_panel::tips;
-use super::state::{HierarchyState, Measures, ViewMode};
+use super::state::{HierarchyState, ViewMode};
 use super::{App, Command};
 use crate::noise::NoiseMode;
 
@@ -149,13 +150,30 @@ fn controls(app: &mut App, ui: &mut egui::Ui) {
         performance(app, ui);
         return;
     };
-
     ui.heading("View");
     super::view_panel::show(app, ui);
+    mesh_section(app, ui);
+    noise_section(app, ui);
+    let top_level = hierarchy_section(app, ui);
+    super::fairing_panel::sharp_edge_controls(app, ui);
+    ui.separator();
+    ui.heading("Fairing");
+    super::fairing_panel::fairing_controls(app, ui, top_level);
+    export_section(app, ui);
+    ui.separator();
+    ui.heading("Numbers");
+    super::numbers_panel::show(app, ui);
+    // Below Export and the numbers: a painting session is an occasional step, and the controls
+    // used on every file stay where they were.
+    super::paint_panel::section(app, ui);
+    performance(app, ui);
+}
+
+/// The file's name and size, what loading repaired, and whether noise was added.
+fn mesh_section(app: &mut App, ui: &mut egui::Ui) {
     let Some(document) = &app.document else {
         return;
     };
-
     ui.separator();
     ui.heading("Mesh");
     let name = document
@@ -195,7 +213,10 @@ fn controls(app: &mut App, ui: &mut egui::Ui) {
             clean.vertex_count()
         ));
     }
+}
 
+/// Sigma, seed and direction of the noise, and the button that adds it.
+fn noise_section(app: &mut App, ui: &mut egui::Ui) {
     ui.separator();
     ui.heading("Noise");
     ui.add(egui::Slider::new(&mut app.settings.noise_sigma, 0.0..=2.0).text("Sigma (× mean edge)"));
@@ -225,7 +246,13 @@ fn controls(app: &mut App, ui: &mut egui::Ui) {
     {
         app.commands.push(Command::AddNoise);
     }
+}
 
+/// The hierarchy's progress, failure or levels; returns the top level (0 until it is built).
+fn hierarchy_section(app: &mut App, ui: &mut egui::Ui) -> usize {
+    let Some(document) = &app.document else {
+        return 0;
+    };
     ui.separator();
     ui.heading("Hierarchy");
     let mut top_level = 0;
@@ -272,15 +299,14 @@ fn controls(app: &mut App, ui: &mut egui::Ui) {
                 });
         }
     }
-    super::fairing_panel::sharp_edge_controls(app, ui);
+    top_level
+}
 
-    ui.separator();
-    ui.heading("Fairing");
-    super::fairing_panel::fairing_controls(app, ui, top_level);
+/// The export path and buttons, and the level chain's export.
+fn export_section(app: &mut App, ui: &mut egui::Ui) {
     let Some(document) = &app.document else {
         return;
     };
-
     ui.separator();
     ui.heading("Export");
     let mut export_path = document.export_path.clone();
@@ -350,137 +376,6 @@ fn controls(app: &mut App, ui: &mut egui::Ui) {
     {
         app.commands.push(Command::ExportLevels);
     }
-
-    let Some(document) = &app.document else {
-        return;
-    };
-    ui.separator();
-    ui.heading("Numbers");
-    let faired = document.faired.as_ref();
-    let against_document = faired.and_then(|f| f.against_document.as_ref());
-    let against_clean = faired.and_then(|f| f.against_clean.as_ref());
-    let has_clean = document.clean.is_some();
-    let (lo, hi) = document.bounds;
-    let diagonal = ((0..3).map(|k| (hi[k] - lo[k]).powi(2)).sum::<f32>()).sqrt() as f64;
-    ui.label(match faired {
-        Some(f) => format!("Result: {}", f.method.describe(f.level)),
-        None => "Result: none yet".to_owned(),
-    });
-    egui::Grid::new("fairmesh-measures")
-        .num_columns(if has_clean { 3 } else { 2 })
-        .striped(true)
-        .show(ui, |ui| {
-            ui.strong("Result vs.");
-            ui.strong("input")
-                .on_hover_text("The input mesh: the mesh the result was smoothed from");
-            if has_clean {
-                ui.strong("clean")
-                    .on_hover_text("The clean mesh: the input mesh before noise was added");
-            }
-            ui.end_row();
-            type Row = fn(&Measures) -> String;
-            let percent = |v: f64| format!("{v:+.4} %");
-            let rows: [(&str, Row); 5] = [
-                ("Volume change", |m| {
-                    m.volume_change_percent
-                        .map_or("–".into(), |v| format!("{v:+.4} %"))
-                }),
-                ("Mean distance", |m| format!("{:.3e}", m.mean_distance)),
-                ("Max distance", |m| format!("{:.3e}", m.max_distance)),
-                ("RMS displacement", |m| {
-                    m.vertex_rms.map_or("–".into(), |v| format!("{v:.3e}"))
-                }),
-                ("Barycenter drift", |m| {
-                    m.barycenter_drift
-                        .map_or("–".into(), |v| format!("{v:.3e}"))
-                }),
-            ];
-            // Volume change and RMS displacement against the input come with the result
-            // itself; the other numbers are measured a moment later. Until then they are the
-            // previous result's: greyed, and saying so.
-            let fresh = |name: &str| -> Option<(String, String)> {
-                let f = faired?;
-                match name {
-                    "Volume change" => Some((percent(f.volume_change * 100.0), String::new())),
-                    "RMS displacement" => Some((
-                        format!("{:.3e}", f.rms_displacement),
-                        format!(
-                            "{:.3} % of the bounding box diagonal",
-                            f.rms_displacement / diagonal.max(f64::MIN_POSITIVE) * 100.0
-                        ),
-                    )),
-                    _ => None,
-                }
-            };
-            let pending = faired.is_some_and(|f| f.measures_pending);
-            let value = |ui: &mut egui::Ui, text: String| {
-                let label = ui.add_enabled(!pending, egui::Label::new(text));
-                if pending {
-                    label.on_hover_text(PENDING_TIP);
-                }
-            };
-            for (name, row) in rows {
-                ui.label(name);
-                match fresh(name) {
-                    Some((text, tip)) if tip.is_empty() => {
-                        ui.label(text);
-                    }
-                    Some((text, tip)) => {
-                        ui.label(text).on_hover_text(tip);
-                    }
-                    None => value(ui, against_document.map_or("–".into(), row)),
-                }
-                if has_clean {
-                    value(ui, against_clean.map_or("–".into(), row));
-                }
-                ui.end_row();
-            }
-            if let Some(noise) = &document.against_clean {
-                ui.label("Noise");
-                ui.label(format!("{:.3e}", noise.mean_distance))
-                    .on_hover_text("Mean distance of the input mesh from the clean mesh");
-                ui.end_row();
-            }
-        });
-    ui.small("Distances in model units.");
-
-    egui::Grid::new("fairmesh-numbers")
-        .num_columns(2)
-        .show(ui, |ui| {
-            ui.label("Shown vertices");
-            ui.label(app.shown_counts.0.to_string());
-            ui.end_row();
-            ui.label("Shown faces");
-            ui.label(app.shown_counts.1.to_string());
-            ui.end_row();
-            ui.label("Load time");
-            ui.label(seconds(document.load_time));
-            ui.end_row();
-            ui.label("Hierarchy build");
-            ui.label(match &document.hierarchy {
-                HierarchyState::Ready { build_time, .. } => seconds(*build_time),
-                HierarchyState::Building => "building …".into(),
-                HierarchyState::Failed(_) => "–".into(),
-            });
-            ui.end_row();
-            ui.label("Last fairing");
-            ui.label(faired.map_or("–".into(), |f| seconds(f.elapsed)));
-            ui.end_row();
-            ui.label("Measuring");
-            ui.label(faired.map_or("–".into(), |f| {
-                if f.measures_pending {
-                    "running…".into()
-                } else {
-                    seconds(f.measure_time)
-                }
-            }));
-            ui.end_row();
-        });
-
-    // Below Export and the numbers: a painting session is an occasional step, and the controls
-    // used on every file stay where they were.
-    super::paint_panel::section(app, ui);
-    performance(app, ui);
 }
 
 fn performance(app: &mut App, ui: &mut egui::Ui) {
@@ -538,10 +433,6 @@ fn performance(app: &mut App, ui: &mut egui::Ui) {
     app.settings.show_performance = response.fully_open();
 }
 
-/// What a greyed number in the Numbers panel means.
-const PENDING_TIP: &str =
-    "From the previous result: the result on screen is being measured, its numbers follow";
-
 fn noise_mode_name(mode: NoiseMode) -> &'static str {
     match mode {
         NoiseMode::Normal => "Along the normal",
@@ -550,7 +441,7 @@ fn noise_mode_name(mode: NoiseMode) -> &'static str {
     }
 }
 
-fn seconds(duration: std::time::Duration) -> String {
+pub(super) fn seconds(duration: std::time::Duration) -> String {
     format!("{:.3} s", duration.as_secs_f64())
 }
 
