@@ -1,6 +1,8 @@
-// fairmesh viewport shader: flat-shaded triangles (one normal per triangle, from the screen-space
-// derivatives of the world position, so positions are uploaded once and shared by all corners),
-// an optional per-vertex heat map (viridis), and a wireframe drawn as lines over the filled mesh.
+// fairmesh viewport shader: triangles lit flat (one normal per triangle, from the screen-space
+// derivatives of the world position, so positions are uploaded once and shared by all corners) or
+// smooth (the area-weighted vertex normals the renderer computes, blended across each triangle),
+// under simple or studio lighting; an optional per-vertex heat map (viridis) or mask tint; and a
+// wireframe drawn as lines over the filled mesh.
 
 struct Uniforms {
     view_proj: mat4x4<f32>,
@@ -8,11 +10,17 @@ struct Uniforms {
     eye: vec4<f32>,
     // xyz: direction towards the key light, world space, unit length.
     light_dir: vec4<f32>,
+    // xyz: direction towards the studio fill light, world space, unit length.
+    fill_dir: vec4<f32>,
+    // xyz: the camera's up direction, world space, unit length.
+    up: vec4<f32>,
     base_color: vec4<f32>,
     wire_color: vec4<f32>,
     // x: scalar mapped to blue, y: scalar mapped to red, z: 1 when scalars are a heat map, 2
     // when they are a mask (0 to 1) tinted over the base colour.
     scalar_range: vec4<f32>,
+    // x: 1 for smooth shading (vertex normals), y: 1 for the studio lighting.
+    look: vec4<f32>,
 };
 
 @group(0) @binding(0) var<uniform> u: Uniforms;
@@ -21,14 +29,20 @@ struct MeshOut {
     @builtin(position) clip: vec4<f32>,
     @location(0) world: vec3<f32>,
     @location(1) scalar: f32,
+    @location(2) normal: vec3<f32>,
 };
 
 @vertex
-fn vs_mesh(@location(0) position: vec3<f32>, @location(1) scalar: f32) -> MeshOut {
+fn vs_mesh(
+    @location(0) position: vec3<f32>,
+    @location(1) scalar: f32,
+    @location(2) normal: vec3<f32>,
+) -> MeshOut {
     var out: MeshOut;
     out.clip = u.view_proj * vec4<f32>(position, 1.0);
     out.world = position;
     out.scalar = scalar;
+    out.normal = normal;
     return out;
 }
 
@@ -56,25 +70,89 @@ fn viridis(t: f32) -> vec3<f32> {
     return select(high, low, srgb <= vec3<f32>(0.04045));
 }
 
-@fragment
-fn fs_mesh(in: MeshOut, @builtin(front_facing) front: bool) -> @location(0) vec4<f32> {
-    // Both derivatives lie in the triangle's plane, so their cross product is the face normal:
-    // flat shading without duplicating vertices per triangle.
+// The unit normal to light this pixel with, turned towards the viewer's side of the surface.
+fn surface_normal(in: MeshOut, front: bool, to_eye: vec3<f32>) -> vec3<f32> {
+    // Both derivatives lie in the triangle's plane, so their cross product is the face normal.
     let across = cross(dpdx(in.world), dpdy(in.world));
-    let to_eye = normalize(u.eye.xyz - in.world);
-    var normal = to_eye;
+    var face = to_eye;
     if (dot(across, across) > 0.0) {
-        normal = normalize(across);
+        face = normalize(across);
     }
     // Light the side that faces the camera, whichever way the triangle is wound.
-    if (dot(normal, to_eye) < 0.0) {
-        normal = -normal;
+    if (dot(face, to_eye) < 0.0) {
+        face = -face;
     }
+    // A vertex with no usable triangle has a zero normal: such pixels stay flat.
+    let blended = in.normal;
+    if (u.look.x < 0.5 || dot(blended, blended) < 1e-8) {
+        return face;
+    }
+    var smooth_normal = normalize(blended);
+    // Seen from behind (a hole's inside, an inverted patch), the normal turns with the face.
+    if (!front) {
+        smooth_normal = -smooth_normal;
+    }
+    // Where interpolation tips the normal away from the eye (the silhouette), bend it back to
+    // the face's side so outlines do not go black.
+    let behind = dot(smooth_normal, to_eye);
+    if (behind < 0.0) {
+        smooth_normal = normalize(smooth_normal - to_eye * (behind * 1.05));
+    }
+    return smooth_normal;
+}
+
+// A heat map's colours are lit with less contrast, so they read as the legend shows them, plus
+// a little grey key light: the map's darkest colour is nearly black, and without it a mesh at
+// distance 0 everywhere (before, against itself) would show as a flat silhouette.
+fn heat_shape(key: f32) -> vec3<f32> {
+    return vec3<f32>(0.10 * key);
+}
+
+// Key, fill and rim lights, sky/ground ambient and a soft key highlight.
+fn studio(albedo: vec3<f32>, n: vec3<f32>, to_eye: vec3<f32>, heat: bool) -> vec3<f32> {
+    let up = u.up.xyz;
+    let key = max(dot(n, u.light_dir.xyz), 0.0);
+    // Wrapped fill: soft, reaches a little past the terminator.
+    let fill = max((dot(n, u.fill_dir.xyz) + 0.3) / 1.3, 0.0);
+    let sky = 0.5 + 0.5 * dot(n, up);
+    let ambient = mix(vec3<f32>(0.10, 0.09, 0.08), vec3<f32>(0.20, 0.22, 0.26), sky);
+    let facing = max(dot(n, to_eye), 0.0);
+    let rim = pow(1.0 - facing, 3.0) * (0.35 + 0.65 * sky);
+    let half_way = normalize(u.light_dir.xyz + to_eye);
+    let highlight = pow(max(dot(n, half_way), 0.0), 40.0) * key;
+    var diffuse = ambient + vec3<f32>(1.0, 0.95, 0.88) * (0.78 * key)
+        + vec3<f32>(0.55, 0.63, 0.78) * (0.32 * fill);
+    var shape = vec3<f32>(0.0);
+    if (heat) {
+        diffuse = vec3<f32>(0.42) + 0.62 * diffuse;
+        shape = heat_shape(key);
+    }
+    return albedo * diffuse + shape + vec3<f32>(0.20) * highlight + vec3<f32>(0.55, 0.62, 0.75) * (0.30 * rim);
+}
+
+// One key light above left of the viewer and light from the eye.
+fn simple(albedo: vec3<f32>, n: vec3<f32>, to_eye: vec3<f32>, heat: bool) -> vec3<f32> {
+    let key = max(dot(n, u.light_dir.xyz), 0.0);
+    let fill = max(dot(n, to_eye), 0.0);
+    if (heat) {
+        let half_way = normalize(u.light_dir.xyz + to_eye);
+        let highlight = pow(max(dot(n, half_way), 0.0), 24.0) * key;
+        return albedo * (0.5 + 0.35 * key + 0.2 * fill) + heat_shape(key)
+            + vec3<f32>(0.10) * highlight;
+    }
+    return albedo * (0.08 + 0.72 * key + 0.25 * fill);
+}
+
+@fragment
+fn fs_mesh(in: MeshOut, @builtin(front_facing) front: bool) -> @location(0) vec4<f32> {
+    let to_eye = normalize(u.eye.xyz - in.world);
+    let normal = surface_normal(in, front, to_eye);
     var albedo = u.base_color.rgb;
+    let heat = u.scalar_range.z > 0.5 && u.scalar_range.z < 1.5;
     if (u.scalar_range.z > 1.5) {
         // The painted region in a warm orange, as strong as its weight.
         albedo = mix(albedo, vec3<f32>(0.95, 0.28, 0.06), 0.5 * clamp(in.scalar, 0.0, 1.0));
-    } else if (u.scalar_range.z > 0.5) {
+    } else if (heat) {
         let span = max(u.scalar_range.y - u.scalar_range.x, 1e-20);
         albedo = viridis((in.scalar - u.scalar_range.x) / span);
     }
@@ -82,14 +160,10 @@ fn fs_mesh(in: MeshOut, @builtin(front_facing) front: bool) -> @location(0) vec4
         // Back faces (holes, inverted patches) in a cooler, darker tone.
         albedo = albedo * vec3<f32>(0.55, 0.6, 0.8);
     }
-    let key = max(dot(normal, u.light_dir.xyz), 0.0);
-    let fill = max(dot(normal, to_eye), 0.0);
-    var shade = 0.08 + 0.72 * key + 0.25 * fill;
-    if (u.scalar_range.z > 0.5 && u.scalar_range.z < 1.5) {
-        // Flatter lighting for the heat map, so its colours read as the legend shows them.
-        shade = 0.55 + 0.3 * key + 0.2 * fill;
+    if (u.look.y > 0.5) {
+        return vec4<f32>(studio(albedo, normal, to_eye, heat), 1.0);
     }
-    return vec4<f32>(albedo * shade, 1.0);
+    return vec4<f32>(simple(albedo, normal, to_eye, heat), 1.0);
 }
 
 @vertex

@@ -334,6 +334,11 @@ fn viewport_snapshots() {
     settle(&mut harness);
     // The loaded mesh, so the image does not depend on the fairing algorithm's details.
     harness.get_by_label("Input mesh").click();
+    // Flat shading under the simple light (tests/editor_shading.rs covers the others).
+    harness.get_by_label("Flat").click();
+    harness
+        .get_by_label(fairmesh::app::view_panel::STUDIO_LIGHTING)
+        .click();
     settle(&mut harness);
 
     let shaded = viewport_image(&mut harness);

@@ -1,7 +1,8 @@
 //! The mesh renderer's background uploads, driven directly on a software wgpu device (lavapipe or
 //! llvmpipe, as in the editor tests): the newest mesh wins over uploads still in flight, and an
 //! upload that panics inside the upload thread leaves a notice and a working renderer, not a
-//! mesh that never arrives.
+//! mesh that never arrives; the vertex normals smooth shading is drawn with are the ones of the
+//! positions on screen, whether computed in the frame or on the upload thread.
 #![cfg(feature = "gui")]
 
 use std::sync::atomic::{AtomicUsize, Ordering};
@@ -9,6 +10,7 @@ use std::sync::Arc;
 use std::time::{Duration, Instant};
 
 use egui_wgpu::wgpu;
+use fairmesh::render::normals::vertex_normals;
 use fairmesh::render::{MeshRenderer, MeshSource};
 
 /// A grid of `n` × `n` quads (two triangles each) in the z = 0 plane.
@@ -58,6 +60,20 @@ impl MeshSource for Grid {
     }
 }
 
+impl Grid {
+    /// The grid bent into a dome (z falls off with the distance from the centre): its vertex
+    /// normals lean outwards, unlike the flat grid's.
+    fn dome(n: u32) -> Self {
+        let mut grid = Self::new(n);
+        let centre = n as f32 / 2.0;
+        for p in &mut grid.positions {
+            let (dx, dy) = (p[0] - centre, p[1] - centre);
+            p[2] = -(dx * dx + dy * dy) / n as f32;
+        }
+        grid
+    }
+}
+
 fn device() -> (wgpu::Device, wgpu::Queue) {
     let state = egui_kittest::wgpu::create_render_state(
         egui_kittest::wgpu::default_wgpu_setup(),
@@ -89,8 +105,9 @@ fn the_newest_mesh_wins_over_uploads_in_flight() {
     // The mesh on screen is the last one: only its vertex count takes new positions.
     let last = (sizes[2] as usize + 1).pow(2);
     let first = (sizes[0] as usize + 1).pow(2);
-    assert!(!renderer.set_positions(&queue, &vec![[0.0; 3]; first]));
-    assert!(renderer.set_positions(&queue, &vec![[0.0; 3]; last]));
+    assert!(!renderer.set_positions(&queue, Arc::new(Grid::new(sizes[0]))));
+    assert!(first != last);
+    assert!(renderer.set_positions(&queue, Arc::new(Grid::new(sizes[2]))));
 
     // A big mesh goes to the upload thread, then a small one is uploaded in the frame: the big
     // one lands later and must not replace it.
@@ -99,7 +116,7 @@ fn the_newest_mesh_wins_over_uploads_in_flight() {
     renderer.set_mesh(&device, Arc::new(Grid::new(5)));
     std::thread::sleep(Duration::from_millis(300));
     wait_for_uploads(&mut renderer, &queue);
-    assert!(renderer.set_positions(&queue, &vec![[0.0; 3]; 36]));
+    assert!(renderer.set_positions(&queue, Arc::new(Grid::new(5))));
 }
 
 #[test]
@@ -122,5 +139,39 @@ fn a_failed_upload_leaves_a_notice_and_a_working_renderer() {
     wait_for_uploads(&mut renderer, &queue);
     assert!(renderer.has_mesh());
     assert_eq!(renderer.problem(false), None);
-    assert!(renderer.set_positions(&queue, &vec![[0.0; 3]; 21 * 21]));
+    assert!(renderer.set_positions(&queue, Arc::new(Grid::new(20))));
+}
+
+/// The normals in the GPU buffer: the flat grid's point straight up; after a move to the dome
+/// they are the dome's area-weighted normals (not the flat ones, and not face normals), both
+/// when computed in the frame and on the upload thread, where the move waits for them.
+#[test]
+fn uploaded_normals_follow_the_positions_on_screen() {
+    let (device, queue) = device();
+    let mut renderer = MeshRenderer::new(&device, Arc::new(|| {}));
+    let n = 12;
+    let count = ((n + 1) * (n + 1)) as usize;
+    for async_bytes in [usize::MAX, 0] {
+        renderer.set_async_upload_bytes(async_bytes);
+        renderer.set_mesh(&device, Arc::new(Grid::new(n)));
+        wait_for_uploads(&mut renderer, &queue);
+        let flat = renderer
+            .read_back_normals(&device, &queue)
+            .expect("normals");
+        assert_eq!(flat.len(), count);
+        assert!(flat.iter().all(|n| *n == [0.0, 0.0, 1.0]), "{:?}", flat[0]);
+
+        let dome = Grid::dome(n);
+        let expected = vertex_normals(&dome.positions, &dome.triangles);
+        assert!(renderer.set_positions(&queue, Arc::new(dome)));
+        wait_for_uploads(&mut renderer, &queue);
+        let moved = renderer
+            .read_back_normals(&device, &queue)
+            .expect("normals");
+        assert_eq!(moved, expected, "async upload: {}", async_bytes == 0);
+        // A corner's normal leans out of the dome; the centre's stays up.
+        assert!(moved[0][2] < 0.95 && moved[0][0] < 0.0 && moved[0][1] < 0.0);
+        let centre = (n / 2 * (n + 1) + n / 2) as usize;
+        assert!(moved[centre][2] > 0.999);
+    }
 }

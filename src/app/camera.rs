@@ -104,6 +104,12 @@ impl OrbitCamera {
         let (right, up) = self.basis();
         (self.backward() + up * 0.6 - right * 0.4).normalize()
     }
+
+    /// The studio lighting's fill light (towards it): right of the viewer, a little low.
+    pub fn fill_dir(&self) -> Vec3 {
+        let (right, up) = self.basis();
+        (self.backward() * 0.6 + right * 0.8 - up * 0.2).normalize()
+    }
 }
 
 /// Right-handed view matrix: the camera at `eye` looks at `target`, `up` roughly up.

@@ -9,7 +9,11 @@
 //!   fairing, measure, export), each holding its launch and the handling of its result;
 //! - [`jobs`]: worker threads, generation numbers, job results;
 //! - `view_sync.rs`: keeps the viewports' GPU buffers in step with what should be shown;
-//! - [`panels`]: the widgets; they emit [`Command`]s, applied after the frame;
+//! - [`panels`]: the widgets; they emit [`Command`]s, applied after the frame. Beside it:
+//!   `fairing_panel.rs` (the Fairing section, the sharp-edge controls, every tooltip),
+//!   [`view_panel`] (the View section: compare, heat map, Shading, Studio lighting) and
+//!   `viewport_panel.rs` (the 3D view's area: camera input, the compare views, overlays),
+//!   `numbers_panel.rs` (the Numbers section);
 //! - `input.rs`: shortcuts and dropped files; `frame_stats.rs`: the UI thread's frame times;
 //! - [`camera`]: the orbit camera; [`history`]: undo and redo;
 //! - [`paint`]: the brush that paints where to fair (`tasks/mask.rs` applies its strokes,
@@ -25,10 +29,12 @@
 
 pub mod camera;
 mod confirm_replace;
+mod fairing_panel;
 mod frame_stats;
 pub mod history;
 mod input;
 pub mod jobs;
+mod numbers_panel;
 pub mod paint;
 mod paint_panel;
 pub mod panels;
@@ -36,7 +42,9 @@ mod recent;
 mod sharp_edges;
 pub mod state;
 mod tasks;
+pub mod view_panel;
 mod view_sync;
+mod viewport_panel;
 
 pub use frame_stats::FrameStats;
 use tasks::measure::MeasureRequest;

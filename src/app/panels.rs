@@ -1,17 +1,17 @@
-//! The editor's widgets: toolbar (open, view toggles), error banner, controls side panel
-//! (hierarchy, fairing options, numbers, export, performance) and the 3D viewport.
+//! The editor's widgets: toolbar (open, view toggles), status bar, controls side panel
+//! (mesh, noise, hierarchy, export, performance, one function each, in the order shown); the
+//! View section is in `view_panel.rs`, the Fairing section and sharp-edge controls (and
+//! [`tips`], every control's tooltip) in `fairing_panel.rs`, the Numbers in
+//! `numbers_panel.rs`, the 3D viewport's area in `viewport_panel.rs`.
 //! Widgets read the app's state and emit [`Command`]s; the app applies them after the frame.
 //! Plain display toggles (wireframe, option values) are edited in place.
 
 use std::path::PathBuf;
 
-use super::state::{
-    BoundarySetting, CompareView, HeatReference, HierarchyState, Measures, MethodSetting,
-    VariantSetting, ViewMode, MAX_SHARP_EDGE_ANGLE, MIN_SHARP_EDGE_ANGLE,
-};
-use super::{App, Command, Slot};
+pub use super::fairing_panel::tips;
+use super::state::{HierarchyState, ViewMode};
+use super::{App, Command};
 use crate::noise::NoiseMode;
-use crate::render::colormap::{legend_ticks, viridis_strip};
 
 pub fn show(app: &mut App, ui: &mut egui::Ui) {
     egui::Panel::top("fairmesh-toolbar").show(ui, |ui| toolbar(app, ui));
@@ -22,7 +22,7 @@ pub fn show(app: &mut App, ui: &mut egui::Ui) {
         .show(ui, |ui| {
             egui::ScrollArea::vertical().show(ui, |ui| controls(app, ui));
         });
-    egui::CentralPanel::no_frame().show(ui, |ui| viewport(app, ui));
+    egui::CentralPanel::no_frame().show(ui, |ui| super::viewport_panel::show(app, ui));
 }
 
 fn toolbar(app: &mut App, ui: &mut egui::Ui) {
@@ -150,13 +150,30 @@ fn controls(app: &mut App, ui: &mut egui::Ui) {
         performance(app, ui);
         return;
     };
-
     ui.heading("View");
-    view_bar(app, ui);
+    super::view_panel::show(app, ui);
+    mesh_section(app, ui);
+    noise_section(app, ui);
+    let top_level = hierarchy_section(app, ui);
+    super::fairing_panel::sharp_edge_controls(app, ui);
+    ui.separator();
+    ui.heading("Fairing");
+    super::fairing_panel::fairing_controls(app, ui, top_level);
+    export_section(app, ui);
+    ui.separator();
+    ui.heading("Numbers");
+    super::numbers_panel::show(app, ui);
+    // Below Export and the numbers: a painting session is an occasional step, and the controls
+    // used on every file stay where they were.
+    super::paint_panel::section(app, ui);
+    performance(app, ui);
+}
+
+/// The file's name and size, what loading repaired, and whether noise was added.
+fn mesh_section(app: &mut App, ui: &mut egui::Ui) {
     let Some(document) = &app.document else {
         return;
     };
-
     ui.separator();
     ui.heading("Mesh");
     let name = document
@@ -196,7 +213,10 @@ fn controls(app: &mut App, ui: &mut egui::Ui) {
             clean.vertex_count()
         ));
     }
+}
 
+/// Sigma, seed and direction of the noise, and the button that adds it.
+fn noise_section(app: &mut App, ui: &mut egui::Ui) {
     ui.separator();
     ui.heading("Noise");
     ui.add(egui::Slider::new(&mut app.settings.noise_sigma, 0.0..=2.0).text("Sigma (× mean edge)"));
@@ -226,7 +246,13 @@ fn controls(app: &mut App, ui: &mut egui::Ui) {
     {
         app.commands.push(Command::AddNoise);
     }
+}
 
+/// The hierarchy's progress, failure or levels; returns the top level (0 until it is built).
+fn hierarchy_section(app: &mut App, ui: &mut egui::Ui) -> usize {
+    let Some(document) = &app.document else {
+        return 0;
+    };
     ui.separator();
     ui.heading("Hierarchy");
     let mut top_level = 0;
@@ -273,15 +299,14 @@ fn controls(app: &mut App, ui: &mut egui::Ui) {
                 });
         }
     }
-    sharp_edge_controls(app, ui);
+    top_level
+}
 
-    ui.separator();
-    ui.heading("Fairing");
-    fairing_controls(app, ui, top_level);
+/// The export path and buttons, and the level chain's export.
+fn export_section(app: &mut App, ui: &mut egui::Ui) {
     let Some(document) = &app.document else {
         return;
     };
-
     ui.separator();
     ui.heading("Export");
     let mut export_path = document.export_path.clone();
@@ -351,137 +376,6 @@ fn controls(app: &mut App, ui: &mut egui::Ui) {
     {
         app.commands.push(Command::ExportLevels);
     }
-
-    let Some(document) = &app.document else {
-        return;
-    };
-    ui.separator();
-    ui.heading("Numbers");
-    let faired = document.faired.as_ref();
-    let against_document = faired.and_then(|f| f.against_document.as_ref());
-    let against_clean = faired.and_then(|f| f.against_clean.as_ref());
-    let has_clean = document.clean.is_some();
-    let (lo, hi) = document.bounds;
-    let diagonal = ((0..3).map(|k| (hi[k] - lo[k]).powi(2)).sum::<f32>()).sqrt() as f64;
-    ui.label(match faired {
-        Some(f) => format!("Result: {}", f.method.describe(f.level)),
-        None => "Result: none yet".to_owned(),
-    });
-    egui::Grid::new("fairmesh-measures")
-        .num_columns(if has_clean { 3 } else { 2 })
-        .striped(true)
-        .show(ui, |ui| {
-            ui.strong("Result vs.");
-            ui.strong("input")
-                .on_hover_text("The input mesh: the mesh the result was smoothed from");
-            if has_clean {
-                ui.strong("clean")
-                    .on_hover_text("The clean mesh: the input mesh before noise was added");
-            }
-            ui.end_row();
-            type Row = fn(&Measures) -> String;
-            let percent = |v: f64| format!("{v:+.4} %");
-            let rows: [(&str, Row); 5] = [
-                ("Volume change", |m| {
-                    m.volume_change_percent
-                        .map_or("–".into(), |v| format!("{v:+.4} %"))
-                }),
-                ("Mean distance", |m| format!("{:.3e}", m.mean_distance)),
-                ("Max distance", |m| format!("{:.3e}", m.max_distance)),
-                ("RMS displacement", |m| {
-                    m.vertex_rms.map_or("–".into(), |v| format!("{v:.3e}"))
-                }),
-                ("Barycenter drift", |m| {
-                    m.barycenter_drift
-                        .map_or("–".into(), |v| format!("{v:.3e}"))
-                }),
-            ];
-            // Volume change and RMS displacement against the input come with the result
-            // itself; the other numbers are measured a moment later. Until then they are the
-            // previous result's: greyed, and saying so.
-            let fresh = |name: &str| -> Option<(String, String)> {
-                let f = faired?;
-                match name {
-                    "Volume change" => Some((percent(f.volume_change * 100.0), String::new())),
-                    "RMS displacement" => Some((
-                        format!("{:.3e}", f.rms_displacement),
-                        format!(
-                            "{:.3} % of the bounding box diagonal",
-                            f.rms_displacement / diagonal.max(f64::MIN_POSITIVE) * 100.0
-                        ),
-                    )),
-                    _ => None,
-                }
-            };
-            let pending = faired.is_some_and(|f| f.measures_pending);
-            let value = |ui: &mut egui::Ui, text: String| {
-                let label = ui.add_enabled(!pending, egui::Label::new(text));
-                if pending {
-                    label.on_hover_text(PENDING_TIP);
-                }
-            };
-            for (name, row) in rows {
-                ui.label(name);
-                match fresh(name) {
-                    Some((text, tip)) if tip.is_empty() => {
-                        ui.label(text);
-                    }
-                    Some((text, tip)) => {
-                        ui.label(text).on_hover_text(tip);
-                    }
-                    None => value(ui, against_document.map_or("–".into(), row)),
-                }
-                if has_clean {
-                    value(ui, against_clean.map_or("–".into(), row));
-                }
-                ui.end_row();
-            }
-            if let Some(noise) = &document.against_clean {
-                ui.label("Noise");
-                ui.label(format!("{:.3e}", noise.mean_distance))
-                    .on_hover_text("Mean distance of the input mesh from the clean mesh");
-                ui.end_row();
-            }
-        });
-    ui.small("Distances in model units.");
-
-    egui::Grid::new("fairmesh-numbers")
-        .num_columns(2)
-        .show(ui, |ui| {
-            ui.label("Shown vertices");
-            ui.label(app.shown_counts.0.to_string());
-            ui.end_row();
-            ui.label("Shown faces");
-            ui.label(app.shown_counts.1.to_string());
-            ui.end_row();
-            ui.label("Load time");
-            ui.label(seconds(document.load_time));
-            ui.end_row();
-            ui.label("Hierarchy build");
-            ui.label(match &document.hierarchy {
-                HierarchyState::Ready { build_time, .. } => seconds(*build_time),
-                HierarchyState::Building => "building …".into(),
-                HierarchyState::Failed(_) => "–".into(),
-            });
-            ui.end_row();
-            ui.label("Last fairing");
-            ui.label(faired.map_or("–".into(), |f| seconds(f.elapsed)));
-            ui.end_row();
-            ui.label("Measuring");
-            ui.label(faired.map_or("–".into(), |f| {
-                if f.measures_pending {
-                    "running…".into()
-                } else {
-                    seconds(f.measure_time)
-                }
-            }));
-            ui.end_row();
-        });
-
-    // Below Export and the numbers: a painting session is an occasional step, and the controls
-    // used on every file stay where they were.
-    super::paint_panel::section(app, ui);
-    performance(app, ui);
 }
 
 fn performance(app: &mut App, ui: &mut egui::Ui) {
@@ -539,617 +433,6 @@ fn performance(app: &mut App, ui: &mut egui::Ui) {
     app.settings.show_performance = response.fully_open();
 }
 
-fn viewport(app: &mut App, ui: &mut egui::Ui) {
-    let rect = ui.available_rect_before_wrap();
-    let response = ui.allocate_rect(rect, egui::Sense::click_and_drag());
-    app.viewport_rect = Some(rect);
-    // The split view's divider sits on top of the camera's area and takes its drags first.
-    let divider_x = rect.left() + rect.width() * app.settings.split.clamp(0.0, 1.0);
-    let mut divider_dragged = false;
-    if app.settings.compare == CompareView::Split {
-        let handle = egui::Rect::from_x_y_ranges(divider_x - 6.0..=divider_x + 6.0, rect.y_range());
-        let divider = ui
-            .interact(
-                handle,
-                ui.scope_id().with("fairmesh-split-divider"),
-                egui::Sense::drag(),
-            )
-            .on_hover_cursor(egui::CursorIcon::ResizeHorizontal)
-            .on_hover_text("Drag to move the divider: before on the left, after on the right");
-        if divider.dragged() {
-            divider_dragged = true;
-            let x = divider
-                .interact_pointer_pos()
-                .map_or(divider_x + divider.drag_delta().x, |p| p.x);
-            app.settings.split = ((x - rect.left()) / rect.width().max(1.0)).clamp(0.02, 0.98);
-        }
-    }
-    let painting = !divider_dragged && super::paint_panel::viewport_brush(app, ui, &response, rect);
-    // While painting, the middle button turns the view instead of the left.
-    let orbit_button = match painting {
-        true => egui::PointerButton::Middle,
-        false => egui::PointerButton::Primary,
-    };
-    if !divider_dragged {
-        if response.dragged_by(orbit_button) {
-            app.camera.orbit(response.drag_delta());
-        }
-        if response.dragged_by(egui::PointerButton::Secondary)
-            || (!painting && response.dragged_by(egui::PointerButton::Middle))
-        {
-            app.camera.pan(response.drag_delta(), rect.height());
-        }
-    }
-    if response.hovered() {
-        let scroll = ui.input(|i| i.smooth_scroll_delta().y);
-        if scroll != 0.0 {
-            app.camera.zoom(scroll);
-        }
-    }
-    let painter = ui.painter_at(rect);
-    if app.viewport.is_none() {
-        painter.text(
-            rect.center(),
-            egui::Align2::CENTER_CENTER,
-            "No wgpu renderer: the 3D view needs eframe's wgpu backend",
-            egui::FontId::proportional(16.0),
-            ui.visuals().text_color(),
-        );
-    }
-    let caption = |painter: &egui::Painter, at: egui::Pos2, align: egui::Align2, text: &str| {
-        painter.text(
-            at,
-            align,
-            text,
-            egui::FontId::proportional(15.0),
-            egui::Color32::from_gray(220),
-        );
-    };
-    let after_name = match app.settings.view_mode {
-        ViewMode::Faired => "After (faired)",
-        ViewMode::Level => "Level mesh",
-        ViewMode::Original => "Input mesh",
-    };
-    match app.settings.compare {
-        CompareView::Single => {
-            let slot = if app.show_before {
-                Slot::Before
-            } else {
-                Slot::Main
-            };
-            let params = app.draw_params(rect, slot);
-            let viewport = match slot {
-                Slot::Main => &mut app.viewport,
-                Slot::Before => &mut app.viewport_before,
-            };
-            if let Some(viewport) = viewport {
-                viewport.paint(&painter, rect, params);
-            }
-            let name = if app.show_before {
-                "Before (B)"
-            } else {
-                after_name
-            };
-            caption(
-                &painter,
-                rect.left_top() + egui::vec2(10.0, 8.0),
-                egui::Align2::LEFT_TOP,
-                name,
-            );
-        }
-        CompareView::Split => {
-            let (left, right) = rect.split_left_right_at_x(divider_x);
-            let before_params = app.draw_params(rect, Slot::Before);
-            let after_params = app.draw_params(rect, Slot::Main);
-            if let Some(viewport) = &mut app.viewport_before {
-                viewport.paint_part(&painter, rect, left, before_params);
-            }
-            if let Some(viewport) = &mut app.viewport {
-                viewport.paint_part(&painter, rect, right, after_params);
-            }
-            painter.line_segment(
-                [
-                    egui::pos2(divider_x, rect.top()),
-                    egui::pos2(divider_x, rect.bottom()),
-                ],
-                egui::Stroke::new(2.0, egui::Color32::from_gray(230)),
-            );
-            caption(
-                &painter,
-                rect.left_top() + egui::vec2(10.0, 8.0),
-                egui::Align2::LEFT_TOP,
-                "Before",
-            );
-            caption(
-                &painter,
-                rect.right_top() + egui::vec2(-10.0, 8.0),
-                egui::Align2::RIGHT_TOP,
-                after_name,
-            );
-        }
-        CompareView::SideBySide => {
-            let (left, right) = rect.split_left_right_at_fraction(0.5);
-            let before_params = app.draw_params(left, Slot::Before);
-            let after_params = app.draw_params(right, Slot::Main);
-            if let Some(viewport) = &mut app.viewport_before {
-                viewport.paint(&painter, left, before_params);
-            }
-            if let Some(viewport) = &mut app.viewport {
-                viewport.paint(&painter, right, after_params);
-            }
-            painter.line_segment(
-                [
-                    egui::pos2(right.left(), rect.top()),
-                    egui::pos2(right.left(), rect.bottom()),
-                ],
-                egui::Stroke::new(1.0, egui::Color32::from_gray(90)),
-            );
-            caption(
-                &painter,
-                left.left_top() + egui::vec2(10.0, 8.0),
-                egui::Align2::LEFT_TOP,
-                "Before",
-            );
-            caption(
-                &painter,
-                right.left_top() + egui::vec2(10.0, 8.0),
-                egui::Align2::LEFT_TOP,
-                after_name,
-            );
-        }
-    }
-    // A saved image of the view leaves out the mouse hints.
-    let hint = if app.capturing_view {
-        ""
-    } else if painting {
-        "Painting: left drag paints (Shift: erase) · middle drag: orbit · right drag: pan · P: stop painting"
-    } else {
-        "Left drag: orbit · right/middle drag: pan · scroll: zoom · F: fit · W: wireframe · B: before/after · P: paint"
-    };
-    painter.text(
-        rect.left_bottom() + egui::vec2(8.0, -8.0),
-        egui::Align2::LEFT_BOTTOM,
-        hint,
-        egui::FontId::proportional(12.0),
-        egui::Color32::from_gray(150),
-    );
-    if let (Some(top), Some(reference)) = (app.heat_top(), app.heat_reference()) {
-        heat_legend(ui, rect, top, reference);
-    }
-    super::paint_panel::brush_outline(app, ui, rect);
-    sharp_edge_overlay(app, ui, rect);
-    let wireframe = app.settings.wireframe;
-    let problem = app
-        .viewports()
-        .find_map(|viewport| viewport.problem(wireframe));
-    if let Some(problem) = problem {
-        let text = egui::RichText::new(format!("Not drawn: {problem}"))
-            .size(14.0)
-            .color(egui::Color32::from_rgb(240, 150, 90));
-        let area = egui::Rect::from_min_size(
-            rect.left_top() + egui::vec2(8.0, 32.0),
-            egui::vec2(rect.width() - 16.0, 20.0),
-        );
-        ui.put(area, egui::Label::new(text).selectable(false));
-    }
-}
-
-/// The compare and heat-map controls (top of the side panel, so they never take the viewport's room).
-fn view_bar(app: &mut App, ui: &mut egui::Ui) {
-    ui.horizontal(|ui| {
-        ui.label("Compare:");
-        let mut compare = app.settings.compare;
-        ui.selectable_value(&mut compare, CompareView::Single, "Single")
-            .on_hover_text("One view; B toggles before and after");
-        ui.selectable_value(&mut compare, CompareView::Split, "Split")
-            .on_hover_text("Before left of the divider, after right of it (drag the divider)");
-        ui.selectable_value(&mut compare, CompareView::SideBySide, "Side by side")
-            .on_hover_text("Before and after next to each other, one camera");
-        app.settings.compare = compare;
-    });
-    ui.horizontal(|ui| {
-        ui.add_enabled(
-            app.settings.compare == CompareView::Single,
-            egui::Button::selectable(app.show_before, "Before (B)"),
-        )
-        .on_hover_text("Show the input mesh instead of the result (B)")
-        .clicked()
-        .then(|| app.show_before = !app.show_before);
-        ui.checkbox(&mut app.settings.heat_map, "Heat map (H)")
-            .on_hover_text("Colour each vertex by its distance from the reference mesh (H)");
-    });
-    ui.horizontal(|ui| {
-        let has_clean = app.document.as_ref().is_some_and(|d| d.clean.is_some());
-        ui.add_enabled_ui(app.settings.heat_map, |ui| {
-            ui.label("against");
-            ui.selectable_value(
-                &mut app.settings.heat_reference,
-                HeatReference::Document,
-                "input mesh",
-            );
-            ui.add_enabled(
-                has_clean,
-                egui::Button::selectable(
-                    app.settings.heat_reference == HeatReference::Clean,
-                    "clean mesh",
-                ),
-            )
-            .on_disabled_hover_text("Add noise first: the mesh before it becomes the clean one")
-            .clicked()
-            .then(|| app.settings.heat_reference = HeatReference::Clean);
-        });
-    });
-}
-
-/// The heat map's legend: the viridis strip with round tick values in model units.
-fn heat_legend(ui: &mut egui::Ui, viewport: egui::Rect, top: f32, reference: HeatReference) {
-    const WIDTH: f32 = 240.0;
-    let area = egui::Rect::from_min_size(
-        viewport.right_bottom() + egui::vec2(-WIDTH - 28.0, -92.0),
-        egui::vec2(WIDTH + 20.0, 84.0),
-    );
-    ui.scope_builder(egui::UiBuilder::new().max_rect(area), |ui| {
-        egui::Frame::new()
-            .fill(egui::Color32::from_black_alpha(180))
-            .inner_margin(8.0)
-            .corner_radius(4.0)
-            .show(ui, |ui| {
-                let title = match reference {
-                    HeatReference::Clean => "Distance to the clean mesh (model units)",
-                    HeatReference::Document => "Distance to the input mesh (model units)",
-                };
-                ui.label(
-                    egui::RichText::new(title)
-                        .small()
-                        .color(egui::Color32::WHITE),
-                );
-                let (strip, _) =
-                    ui.allocate_exact_size(egui::vec2(WIDTH, 14.0), egui::Sense::hover());
-                let colours = viridis_strip(64);
-                let step = strip.width() / colours.len() as f32;
-                for (i, [r, g, b, _]) in colours.into_iter().enumerate() {
-                    let x = strip.left() + i as f32 * step;
-                    ui.painter().rect_filled(
-                        egui::Rect::from_x_y_ranges(x..=x + step + 0.5, strip.y_range()),
-                        0.0,
-                        egui::Color32::from_rgb(r, g, b),
-                    );
-                }
-                let (labels, _) =
-                    ui.allocate_exact_size(egui::vec2(WIDTH, 16.0), egui::Sense::hover());
-                let ticks = legend_ticks(top as f64, 4);
-                let spacing = ticks.get(1).copied().unwrap_or(top as f64);
-                for value in ticks {
-                    let x = strip.left() + strip.width() * (value / top as f64) as f32;
-                    ui.painter().line_segment(
-                        [
-                            egui::pos2(x, strip.bottom()),
-                            egui::pos2(x, strip.bottom() + 3.0),
-                        ],
-                        egui::Stroke::new(1.0, egui::Color32::WHITE),
-                    );
-                    let text = tick_text(value, spacing);
-                    let at = egui::Rect::from_center_size(
-                        egui::pos2(
-                            x.clamp(labels.left() + 18.0, labels.right() - 18.0),
-                            labels.center().y,
-                        ),
-                        egui::vec2(44.0, 16.0),
-                    );
-                    ui.put(
-                        at,
-                        egui::Label::new(
-                            egui::RichText::new(text)
-                                .small()
-                                .color(egui::Color32::WHITE),
-                        ),
-                    );
-                }
-            });
-    });
-}
-
-/// A tick value with as many decimals as the tick spacing needs.
-fn tick_text(value: f64, spacing: f64) -> String {
-    if value == 0.0 {
-        return "0".into();
-    }
-    // NaN, zero and negative spacings fall outside the range too.
-    if !(1e-3..1e5).contains(&spacing) {
-        return format!("{value:.0e}");
-    }
-    let decimals = (-spacing.log10().floor()).max(0.0) as usize;
-    format!("{value:.decimals$}")
-}
-
-/// The fairing section: start level, method and its options, Apply. Every control says in its
-/// tooltip what it does and when to change it; the ones the chosen method does not use are
-/// disabled and say why.
-fn fairing_controls(app: &mut App, ui: &mut egui::Ui, top_level: usize) {
-    let Some(document) = &app.document else {
-        return;
-    };
-    let ready = document.level_count().is_some();
-    let method = app.settings.method;
-    let not_for_baseline = (!method.uses_hierarchy()).then(|| {
-        format!(
-            "Not used by {}: it smooths the whole input mesh at once, without the hierarchy.",
-            method.label()
-        )
-    });
-    let level_off = match (&not_for_baseline, ready) {
-        (Some(why), _) => Some(why.clone()),
-        (None, false) => Some("Waiting for the hierarchy to be built.".to_owned()),
-        (None, true) => None,
-    };
-    let mut level = document.level;
-    let slider = ui.add_enabled(
-        level_off.is_none(),
-        egui::Slider::new(&mut level, 0..=top_level).text("Start level"),
-    );
-    if explain(slider, tips::START_LEVEL, level_off.as_deref()).changed() {
-        app.commands.push(Command::SetLevel(level));
-    }
-    let applied = document.applied;
-    let before = app.settings.clone();
-    let settings = &mut app.settings;
-    let combo = egui::ComboBox::from_label("Method")
-        .selected_text(settings.method.label())
-        .show_ui(ui, |ui| {
-            for method in MethodSetting::ALL {
-                ui.selectable_value(&mut settings.method, method, method.label());
-            }
-        });
-    explain(combo.response, tips::METHOD, None);
-    if method.uses_hierarchy() {
-        let iterations = ui
-            .add(egui::Slider::new(&mut settings.iterations, 1..=50).text("Iterations per level"));
-        explain(iterations, tips::ITERATIONS_PER_LEVEL, None);
-        let rounds = ui.add(egui::Slider::new(&mut settings.rounds, 1..=10).text("Rounds"));
-        explain(rounds, tips::ROUNDS, None);
-    } else {
-        ui.small("A baseline smooths the mesh itself (no hierarchy): watch the volume change.");
-        let iterations = ui
-            .add(egui::Slider::new(&mut settings.baseline_iterations, 1..=200).text("Iterations"));
-        explain(iterations, tips::BASELINE_ITERATIONS, None);
-        if matches!(method, MethodSetting::Laplacian | MethodSetting::Taubin) {
-            let lambda =
-                ui.add(egui::Slider::new(&mut settings.baseline_lambda, 0.05..=1.0).text("Lambda"));
-            explain(lambda, tips::LAMBDA, None);
-        }
-    }
-    let boundary = egui::ComboBox::from_label("Boundary")
-        .selected_text(match settings.boundary {
-            BoundarySetting::Curve => "Smooth as curve",
-            BoundarySetting::Fixed => "Fixed",
-        })
-        .show_ui(ui, |ui| {
-            ui.selectable_value(
-                &mut settings.boundary,
-                BoundarySetting::Curve,
-                "Smooth as curve",
-            );
-            ui.selectable_value(&mut settings.boundary, BoundarySetting::Fixed, "Fixed");
-        });
-    explain(boundary.response, tips::BOUNDARY, None);
-    let hierarchy_only = not_for_baseline.is_none();
-    let fair_finest = ui.add_enabled(
-        hierarchy_only,
-        egui::Checkbox::new(&mut settings.fair_finest, "Fair M0 too"),
-    );
-    explain(fair_finest, tips::FAIR_FINEST, not_for_baseline.as_deref());
-    let variant = ui.add_enabled_ui(hierarchy_only, |ui| {
-        egui::ComboBox::from_label("Variant")
-            .selected_text(match settings.variant {
-                VariantSetting::Paper => "Paper",
-                VariantSetting::Improved => "Improved",
-            })
-            .show_ui(ui, |ui| {
-                ui.selectable_value(&mut settings.variant, VariantSetting::Paper, "Paper");
-                ui.selectable_value(&mut settings.variant, VariantSetting::Improved, "Improved");
-            })
-            .response
-    });
-    explain(variant.inner, tips::VARIANT, not_for_baseline.as_deref());
-    if app.settings.fairing_key() != before.fairing_key() {
-        app.commands.push(Command::Refair);
-    }
-    if app.fair_in_flight {
-        ui.horizontal(|ui| {
-            ui.spinner();
-            ui.label(format!(
-                "fairing … {:.0} %",
-                app.fair_progress.get() * 100.0
-            ));
-        });
-    }
-    if applied {
-        ui.small(
-            "Showing the applied result as it is. Change the start level or an option to fair \
-             it again.",
-        );
-    }
-    let has_result = app.document.as_ref().is_some_and(|d| d.faired.is_some());
-    let apply = ui.add_enabled(has_result, egui::Button::new("Apply result"));
-    if explain(
-        apply,
-        tips::APPLY,
-        (!has_result).then_some("There is no result to apply yet."),
-    )
-    .clicked()
-    {
-        app.commands.push(Command::ApplyResult);
-    }
-}
-
-/// Shows `tip` on hover; when the control is disabled, shows `tip` and why it is off. The text
-/// is the control's accessible description either way (screen readers, tests).
-fn explain(response: egui::Response, tip: &str, off_because: Option<&str>) -> egui::Response {
-    match off_because {
-        Some(why) if !response.enabled() => {
-            let text = format!("{tip}\n\n{why}");
-            response
-                .on_hover_text(text.clone())
-                .on_disabled_hover_text(text)
-        }
-        _ => response.on_hover_text(tip),
-    }
-}
-
-/// "Keep sharp edges" and its angle (the hierarchy is built again when either changes; while
-/// they are hovered or just changed, the kept edges are drawn over the mesh).
-fn sharp_edge_controls(app: &mut App, ui: &mut egui::Ui) {
-    let Some(document) = &app.document else {
-        return;
-    };
-    let not_for_baseline = (!app.settings.method.uses_hierarchy()).then(|| {
-        format!(
-            "Not used by {}: it smooths the whole mesh at once, across sharp edges too.",
-            app.settings.method.label()
-        )
-    });
-    let kept = match &document.hierarchy {
-        HierarchyState::Ready { hierarchy, .. } => Some(hierarchy.crease_edge_count()),
-        _ => None,
-    };
-    let enabled = not_for_baseline.is_none();
-    let keep = ui.add_enabled(
-        enabled,
-        egui::Checkbox::new(&mut app.settings.keep_sharp_edges, "Keep sharp edges"),
-    );
-    let keep = explain(keep, tips::KEEP_SHARP_EDGES, not_for_baseline.as_deref());
-    let angle = ui.add_enabled(
-        enabled && app.settings.keep_sharp_edges,
-        egui::Slider::new(
-            &mut app.settings.sharp_edge_angle,
-            MIN_SHARP_EDGE_ANGLE..=MAX_SHARP_EDGE_ANGLE,
-        )
-        .suffix("°")
-        .fixed_decimals(0)
-        .text("Sharp edge angle"),
-    );
-    let angle = explain(angle, tips::SHARP_EDGE_ANGLE, not_for_baseline.as_deref());
-    let now = std::time::Instant::now();
-    if keep.hovered() || angle.hovered() || angle.dragged() {
-        app.sharp_edges_shown_until = Some(now + SHARP_EDGES_LINGER);
-    }
-    // The hierarchy is built again when the angle is let go (not at every step of a drag).
-    let settled = !angle.dragged();
-    // (`start_hierarchy` records the settings it builds with, before the next frame.)
-    if settled && app.settings.hierarchy_key() != app.hierarchy_built_with {
-        app.sharp_edges_shown_until = Some(now + SHARP_EDGES_LINGER);
-        app.commands.push(Command::RebuildHierarchy);
-    }
-    if app.settings.keep_sharp_edges && enabled {
-        match kept {
-            Some(0) => ui.small("No sharp edges found at this angle"),
-            Some(edges) => ui.small(format!(
-                "{edges} sharp edges kept (drawn in cyan while you point here)"
-            )),
-            None => ui.small("Finding sharp edges…"),
-        };
-    }
-}
-
-/// How long the kept sharp edges stay drawn after the pointer leaves their controls.
-const SHARP_EDGES_LINGER: std::time::Duration = std::time::Duration::from_millis(1500);
-
-/// Draws the kept sharp edges over the result's image while [`sharp_edge_controls`] asks for it.
-fn sharp_edge_overlay(app: &mut App, ui: &egui::Ui, rect: egui::Rect) {
-    app.sharp_edges_drawn = 0;
-    let Some(until) = app.sharp_edges_shown_until else {
-        return;
-    };
-    let now = std::time::Instant::now();
-    if now > until || app.settings.view_mode == ViewMode::Level {
-        return;
-    }
-    ui.ctx().request_repaint_after(until - now);
-    let Some(document) = &app.document else {
-        return;
-    };
-    let HierarchyState::Ready { sharp_edges, .. } = &document.hierarchy else {
-        return;
-    };
-    let faired = document.faired.as_ref().map(|f| f.positions.clone());
-    let shows_before = app.show_before && app.settings.compare == CompareView::Single;
-    let positions: &[[f32; 3]] = match (&faired, shows_before) {
-        (Some(faired), false) => faired,
-        _ => &document.original.positions,
-    };
-    let image = super::paint_panel::painted_image(app, rect);
-    let aspect = image.width() / image.height().max(1.0);
-    let segments = sharp_edges.segments(
-        positions,
-        app.camera.view_proj(aspect),
-        app.camera.eye(),
-        image,
-    );
-    app.sharp_edges_drawn = segments.len();
-    let painter = ui.painter_at(image);
-    let stroke = egui::Stroke::new(2.0, egui::Color32::from_rgb(60, 230, 255));
-    for segment in segments {
-        painter.line_segment(segment, stroke);
-    }
-}
-
-/// The fairing controls' tooltips: what each does and when to change it, in plain words.
-pub mod tips {
-    pub const KEEP_SHARP_EDGES: &str = "Keep the mesh's sharp edges (the edges of a machined \
-        part, a fold, a rim) sharp: the coarse levels keep them and the smoothing runs along them, \
-        not across them. Turn it off for organic shapes if smoothing leaves ridges where there \
-        should be none.";
-    pub const SHARP_EDGE_ANGLE: &str = "How sharply the surface must fold at an edge for the edge \
-        to be kept sharp. Lower: more edges are kept (gentle folds too). Higher: only the sharpest. \
-        The kept edges are drawn over the mesh while you point here.";
-    pub const START_LEVEL: &str = "How coarse a version of the mesh the smoothing starts from \
-        (M0 is the mesh itself). Higher: smoother, bigger bumps go. Lower: more of the detail \
-        stays. Raise it until the noise is gone; lower it if wanted features melt away.";
-    pub const METHOD: &str = "Constrained fairing (the paper's method) smooths without \
-        shrinking the mesh. The others are classic smoothers to compare with: watch the volume \
-        change under Numbers.";
-    pub const ITERATIONS_PER_LEVEL: &str = "Smoothing passes on each level on the way back to \
-        full detail. More: a little smoother and slower. The start level matters far more: \
-        change this last.";
-    pub const ROUNDS: &str = "How often each level's smoothing starts over from where it got \
-        to. More: a little smoother and slower; 1 is usually enough.";
-    pub const BASELINE_ITERATIONS: &str = "Smoothing passes over the whole mesh. More: \
-        smoother, and (for Laplacian) more shrinkage.";
-    pub const LAMBDA: &str = "How far each pass moves a vertex towards its neighbours (0 to \
-        1). Higher: faster smoothing, more shrinkage.";
-    pub const BOUNDARY: &str = "What happens to open borders (holes, cut edges). Smooth as \
-        curve: the border line is smoothed too. Fixed: border vertices stay where they are; use \
-        it when the mesh must still meet another part.";
-    pub const FAIR_FINEST: &str = "Also smooth the full-detail mesh (M0) at the end. On: the \
-        finest noise goes too. Off: the finest detail stays as it was.";
-    pub const VARIANT: &str = "Paper: the method as published. Improved: two corrections that \
-        keep the shape from drifting and shrinking over the levels. Keep Improved unless you \
-        compare with the paper.";
-    pub const PAINT: &str = "Paint where to fair (P). On: the left button paints on the mesh \
-        instead of turning the view (middle drag turns it, right drag pans). Only the painted \
-        part is smoothed; the rest keeps its exact shape.";
-    pub const BRUSH_ADD: &str = "The brush marks the part to smooth.";
-    pub const BRUSH_ERASE: &str = "The brush unmarks what it touches, so it keeps its shape \
-        (on a mesh with no mask yet: protects it while the rest is smoothed). Hold Shift to \
-        erase for a moment.";
-    pub const BRUSH_RADIUS: &str = "Size of the brush on screen, in points. Zoom in to paint \
-        finer detail.";
-    pub const BRUSH_SOFTNESS: &str = "How much of the brush's edge fades out. Higher: the \
-        smoothing blends gently into the untouched part; 0: a hard edge.";
-    pub const SHOW_MASK: &str = "Tint the painted part orange on the mesh (it replaces the \
-        heat map while shown).";
-    pub const CLEAR_MASK: &str = "Remove the paint: the whole mesh is smoothed again (undo \
-        with Ctrl+Z).";
-    pub const INVERT_MASK: &str = "Smooth what was left alone and keep what was painted \
-        (undo with Ctrl+Z).";
-    pub const APPLY: &str = "Make the result the input mesh, to add noise to it, fair it \
-        again or export it as it is (undo with Ctrl+Z).";
-}
-
-/// What a greyed number in the Numbers panel means.
-const PENDING_TIP: &str =
-    "From the previous result: the result on screen is being measured, its numbers follow";
-
 fn noise_mode_name(mode: NoiseMode) -> &'static str {
     match mode {
         NoiseMode::Normal => "Along the normal",
@@ -1158,7 +441,7 @@ fn noise_mode_name(mode: NoiseMode) -> &'static str {
     }
 }
 
-fn seconds(duration: std::time::Duration) -> String {
+pub(super) fn seconds(duration: std::time::Duration) -> String {
     format!("{:.3} s", duration.as_secs_f64())
 }
 

@@ -19,6 +19,7 @@ use crate::hierarchy::{Hierarchy, HierarchyOptions, LevelInfo};
 use crate::io::LoadReport;
 use crate::multires::{MultiresOptions, MultiresVariant};
 use crate::noise::{NoiseMode, NoiseOptions};
+use crate::render::{Lighting, Shading};
 use crate::TriMesh;
 
 use super::history::SizeInBytes;
@@ -166,6 +167,10 @@ pub struct Settings {
     pub sharp_edge_angle: f64,
     /// The files opened last, newest first (at most [`Settings::RECENT_FILES`]): the Recent menu.
     pub recent_files: Vec<PathBuf>,
+    /// Shading: Flat (every facet shows) or Smooth (vertex normals).
+    pub shading: Shading,
+    /// Lighting: Simple or Studio (key, fill and rim lights).
+    pub lighting: Lighting,
 }
 
 impl Default for Settings {
@@ -199,6 +204,8 @@ impl Default for Settings {
             keep_sharp_edges: HierarchyOptions::default().creases.is_some(),
             sharp_edge_angle: DEFAULT_CREASE_ANGLE,
             recent_files: Vec::new(),
+            shading: Shading::default(),
+            lighting: Lighting::default(),
         }
     }
 }
@@ -711,6 +718,27 @@ mod tests {
         let partial: Settings = serde_json::from_str(r#"{"rounds": 3}"#).unwrap();
         assert_eq!(partial.rounds, 3);
         assert_eq!(partial.iterations, Settings::default().iterations);
+    }
+
+    #[test]
+    fn shading_and_lighting_persist_and_old_settings_get_the_defaults() {
+        let settings = Settings {
+            shading: Shading::Flat,
+            lighting: Lighting::Simple,
+            ..Default::default()
+        };
+        let json = serde_json::to_string(&settings).unwrap();
+        let back: Settings = serde_json::from_str(&json).unwrap();
+        assert_eq!(
+            (back.shading, back.lighting),
+            (Shading::Flat, Lighting::Simple)
+        );
+        // A settings file written before these existed.
+        let old: Settings = serde_json::from_str(r#"{"wireframe": true}"#).unwrap();
+        assert_eq!(
+            (old.shading, old.lighting),
+            (Shading::Smooth, Lighting::Studio)
+        );
     }
 
     #[test]

@@ -7,7 +7,7 @@ use std::sync::Arc;
 use crate::app::state::{self, CompareView, HeatReference, HierarchyState, ViewMode};
 use crate::app::App;
 use crate::hierarchy;
-use crate::render::{DrawParams, MeshSource};
+use crate::render::{DrawParams, MeshSource, Viewport3d};
 use crate::TriMesh;
 
 /// What the viewport has uploaded, to know when to upload again.
@@ -264,8 +264,9 @@ impl App {
             };
             counts = Some((source.positions().len(), source.triangles().len()));
             if let Some(viewport) = viewport {
-                if !(same_connectivity && viewport.set_positions(source.positions())) {
-                    viewport.set_mesh(Arc::new(source));
+                let source: Arc<dyn MeshSource> = Arc::new(source);
+                if !(same_connectivity && viewport.set_positions(source.clone())) {
+                    viewport.set_mesh(source);
                 }
             }
         }
@@ -309,6 +310,29 @@ impl App {
         .map(|top| top.max(f32::MIN_POSITIVE))
     }
 
+    /// A viewport's renderer handle, when there is a wgpu renderer.
+    pub(super) fn viewport_mut(&mut self, slot: Slot) -> Option<&mut Viewport3d> {
+        match slot {
+            Slot::Main => self.viewport.as_mut(),
+            Slot::Before => self.viewport_before.as_mut(),
+        }
+    }
+
+    /// What the main viewport's renderer is asked to draw with now (tests).
+    pub fn main_draw_params(&self) -> Option<DrawParams> {
+        Some(self.draw_params(self.viewport_rect?, Slot::Main))
+    }
+
+    /// The vertex normals uploaded to a viewport's GPU buffer for the mesh it shows (tests;
+    /// waits for the GPU).
+    pub fn uploaded_normals(&self, slot: Slot) -> Option<Vec<[f32; 3]>> {
+        match slot {
+            Slot::Main => self.viewport.as_ref(),
+            Slot::Before => self.viewport_before.as_ref(),
+        }?
+        .read_back_normals()
+    }
+
     pub(super) fn draw_params(&self, rect: egui::Rect, slot: Slot) -> DrawParams {
         let aspect = rect.width() / rect.height().max(1.0);
         let top = self.heat_top();
@@ -322,6 +346,10 @@ impl App {
             view_proj: self.camera.view_proj(aspect).to_cols_array_2d(),
             eye: self.camera.eye().to_array(),
             light_dir: self.camera.light_dir().to_array(),
+            fill_dir: self.camera.fill_dir().to_array(),
+            up: self.camera.basis().1.to_array(),
+            shading: self.settings.shading,
+            lighting: self.settings.lighting,
             wireframe: self.settings.wireframe,
             scalar_range,
             mask_tint,

@@ -6,12 +6,16 @@
 //! mesh gets a depth buffer whatever egui's own render pass has (eframe without `depth_buffer`,
 //! or egui_kittest's single-sample pass with none), and the same code runs in the window and in
 //! headless tests. The renderer takes positions, triangles and (through `set_scalars`)
-//! per-vertex scalars, and knows nothing of fairing.
+//! per-vertex scalars, and knows nothing of fairing. It computes the vertex normals smooth
+//! shading needs itself ([`normals`]); [`shading`] names the shading and lighting choices.
 
 pub mod colormap;
+pub mod normals;
 pub mod pipeline;
+pub mod shading;
 
 pub use pipeline::{DrawParams, MeshRenderer, MeshSource};
+pub use shading::{Lighting, Shading};
 
 use egui_wgpu::wgpu;
 use std::sync::Arc;
@@ -94,11 +98,19 @@ impl Viewport3d {
         self.with_renderer(|r| r.set_async_upload_bytes(bytes));
     }
 
-    /// Moves the current mesh's vertices; `false` when the vertex count differs.
-    pub fn set_positions(&self, positions: &[[f32; 3]]) -> bool {
+    /// Moves the current mesh's vertices to `source`'s (same triangles); `false` when the
+    /// vertex count differs.
+    pub fn set_positions(&self, source: Arc<dyn MeshSource>) -> bool {
         let queue = &self.state.queue;
-        self.with_renderer(|r| r.set_positions(queue, positions))
+        self.with_renderer(|r| r.set_positions(queue, source))
             .unwrap_or(false)
+    }
+
+    /// The vertex normals uploaded for the mesh on screen (tests; waits for the GPU).
+    pub fn read_back_normals(&self) -> Option<Vec<[f32; 3]>> {
+        let (device, queue) = (&self.state.device, &self.state.queue);
+        self.with_renderer(|r| r.read_back_normals(device, queue))
+            .flatten()
     }
 
     /// Replaces the per-vertex scalars; `false` when the count differs.

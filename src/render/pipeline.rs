@@ -2,19 +2,24 @@
 //! the mesh's GPU buffers and an offscreen colour + depth target it draws into.
 //!
 //! Buffers are written only when the mesh changes ([`MeshRenderer::set_mesh`] for new
-//! connectivity, [`MeshRenderer::set_positions`] when only the positions move), and the offscreen
+//! connectivity, [`MeshRenderer::set_positions`] when only the positions move; both recompute
+//! the vertex normals smooth shading needs, `super::normals`), and the offscreen
 //! image is redrawn only when the view, the mesh or the target size changed, so a large mesh costs
 //! nothing per frame while nothing moves.
 //!
 //! New connectivity of a big mesh (4 MB of positions and triangles or more, ~170k faces) and its
 //! wireframe edges are filled into buffers on the renderer's own upload thread: for a 1.2M-face
 //! mesh that is ~30 ms of copying and page faults (positions, triangles) and ~20 ms (edges) that
-//! would otherwise stall one UI frame. The previous image stays until the upload lands.
+//! would otherwise stall one UI frame. New positions of a big mesh get their normals there too
+//! (~30 ms for 1.2M faces). The previous image stays until the upload lands.
 
 use bytemuck::{Pod, Zeroable};
 use std::sync::mpsc::{self, Receiver, Sender};
 use std::sync::{Arc, Mutex};
 use wgpu::util::DeviceExt;
+
+use super::normals::vertex_normals;
+use super::shading::{Lighting, Shading};
 
 /// Format of the image the mesh is drawn into (and that egui then samples).
 pub const COLOR_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8UnormSrgb;
@@ -31,6 +36,12 @@ pub struct DrawParams {
     pub eye: [f32; 3],
     /// Direction towards the key light, world space.
     pub light_dir: [f32; 3],
+    /// Direction towards the studio lighting's fill light, world space.
+    pub fill_dir: [f32; 3],
+    /// The camera's up direction, world space (the studio's sky and rim come from there).
+    pub up: [f32; 3],
+    pub shading: Shading,
+    pub lighting: Lighting,
     pub wireframe: bool,
     /// Scalars mapped to the heat map's two ends; `None` draws the plain base colour.
     pub scalar_range: Option<[f32; 2]>,
@@ -46,9 +57,13 @@ struct Uniforms {
     view_proj: [[f32; 4]; 4],
     eye: [f32; 4],
     light_dir: [f32; 4],
+    fill_dir: [f32; 4],
+    up: [f32; 4],
     base_color: [f32; 4],
     wire_color: [f32; 4],
     scalar_range: [f32; 4],
+    /// x: 1 for smooth shading, y: 1 for the studio lighting.
+    look: [f32; 4],
 }
 
 /// Mesh data the renderer may read on its upload thread (shared, never copied on the UI thread).
@@ -65,6 +80,8 @@ pub const DEFAULT_ASYNC_UPLOAD_BYTES: usize = 4 << 20;
 /// GPU copies of one mesh.
 struct MeshBuffers {
     positions: wgpu::Buffer,
+    /// Area-weighted unit vertex normals of the positions now in `positions`.
+    normals: wgpu::Buffer,
     scalars: wgpu::Buffer,
     triangles: wgpu::Buffer,
     vertex_count: usize,
@@ -72,12 +89,25 @@ struct MeshBuffers {
     /// Edge list for the wireframe, built when first needed (on the upload thread for a big
     /// mesh) from `source`'s triangles.
     lines: Option<(wgpu::Buffer, u32)>,
+    /// The mesh on screen: its triangles, and the positions last written.
     source: Arc<dyn MeshSource>,
     /// Which [`MeshRenderer::set_mesh`] call this mesh answers.
     generation: u64,
 }
 
 impl MeshBuffers {
+    /// Writes new positions of the same connectivity and their normals.
+    fn write_positions(
+        &mut self,
+        queue: &wgpu::Queue,
+        source: Arc<dyn MeshSource>,
+        normals: &[[f32; 3]],
+    ) {
+        queue.write_buffer(&self.positions, 0, bytemuck::cast_slice(source.positions()));
+        queue.write_buffer(&self.normals, 0, bytemuck::cast_slice(normals));
+        self.source = source;
+    }
+
     fn create(
         device: &wgpu::Device,
         source: Arc<dyn MeshSource>,
@@ -90,6 +120,14 @@ impl MeshBuffers {
             label: Some("fairmesh positions"),
             contents: bytemuck::cast_slice(positions),
             usage: wgpu::BufferUsages::VERTEX | wgpu::BufferUsages::COPY_DST,
+        });
+        let normals_buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("fairmesh normals"),
+            contents: bytemuck::cast_slice(&vertex_normals(positions, triangles)),
+            // COPY_SRC: tests read back what was uploaded.
+            usage: wgpu::BufferUsages::VERTEX
+                | wgpu::BufferUsages::COPY_DST
+                | wgpu::BufferUsages::COPY_SRC,
         });
         // Scalars come later through `set_scalars`; wgpu zero-fills a buffer that is not mapped
         // at creation.
@@ -107,6 +145,7 @@ impl MeshBuffers {
         let lines = with_lines.then(|| line_buffer(device, triangles));
         Self {
             positions: positions_buffer,
+            normals: normals_buffer,
             scalars: scalars_buffer,
             triangles: triangles_buffer,
             vertex_count: positions.len(),
@@ -165,12 +204,44 @@ enum UploadJob {
         generation: u64,
         source: Arc<dyn MeshSource>,
     },
+    /// New positions for the mesh of `generation`: their normals.
+    Move {
+        generation: u64,
+        serial: u64,
+        source: Arc<dyn MeshSource>,
+    },
 }
 
 impl UploadJob {
     fn generation(&self) -> u64 {
         match self {
-            Self::Mesh { generation, .. } | Self::Lines { generation, .. } => *generation,
+            Self::Mesh { generation, .. }
+            | Self::Lines { generation, .. }
+            | Self::Move { generation, .. } => *generation,
+        }
+    }
+
+    fn run(self, device: &wgpu::Device) -> Uploaded {
+        match self {
+            UploadJob::Mesh {
+                generation,
+                source,
+                with_lines,
+            } => Uploaded::Mesh(MeshBuffers::create(device, source, with_lines, generation)),
+            UploadJob::Lines { generation, source } => Uploaded::Lines {
+                generation,
+                lines: line_buffer(device, source.triangles()),
+            },
+            UploadJob::Move {
+                generation,
+                serial,
+                source,
+            } => Uploaded::Moved {
+                generation,
+                serial,
+                normals: vertex_normals(source.positions(), source.triangles()),
+                source,
+            },
         }
     }
 }
@@ -184,6 +255,12 @@ enum Uploaded {
     Lines {
         generation: u64,
         lines: (wgpu::Buffer, u32),
+    },
+    Moved {
+        generation: u64,
+        serial: u64,
+        source: Arc<dyn MeshSource>,
+        normals: Vec<[f32; 3]>,
     },
 }
 
@@ -207,24 +284,18 @@ impl Uploader {
                     let mut batch = vec![first];
                     batch.extend(jobs_rx.try_iter());
                     let newest = batch.iter().map(UploadJob::generation).max();
-                    for job in batch {
-                        if Some(job.generation()) != newest {
+                    // Only the last move counts: the positions before it are already old.
+                    let last_move = batch
+                        .iter()
+                        .rposition(|job| matches!(job, UploadJob::Move { .. }));
+                    for (index, job) in batch.into_iter().enumerate() {
+                        let old_move =
+                            matches!(job, UploadJob::Move { .. }) && Some(index) != last_move;
+                        if Some(job.generation()) != newest || old_move {
                             continue;
                         }
                         let generation = job.generation();
-                        let upload = std::panic::AssertUnwindSafe(|| match job {
-                            UploadJob::Mesh {
-                                generation,
-                                source,
-                                with_lines,
-                            } => Uploaded::Mesh(MeshBuffers::create(
-                                &device, source, with_lines, generation,
-                            )),
-                            UploadJob::Lines { generation, source } => Uploaded::Lines {
-                                generation,
-                                lines: line_buffer(&device, source.triangles()),
-                            },
-                        });
+                        let upload = std::panic::AssertUnwindSafe(|| job.run(&device));
                         // wgpu reports an error it cannot return (out of memory, say) by
                         // panicking: the upload fails, the thread and the app go on.
                         let uploaded = std::panic::catch_unwind(upload)
@@ -296,6 +367,11 @@ pub struct MeshRenderer {
     pending: Option<PendingMesh>,
     /// Generation of the mesh whose wireframe edges the upload thread is building.
     lines_requested: Option<u64>,
+    /// Counts [`Self::set_positions`] calls; normals that land for an older one are dropped.
+    move_serial: u64,
+    /// The newest positions whose normals the upload thread is computing (the mesh on screen
+    /// keeps its positions until they land, so positions and normals always match).
+    pending_move: Option<u64>,
     /// Whether the last image had the wireframe (a big upload then builds its edges too).
     wireframe: bool,
     /// Meshes of at least this many bytes (positions + triangles) upload on the upload thread.
@@ -370,6 +446,15 @@ impl MeshRenderer {
                 shader_location: 1,
             }],
         };
+        let normal_layout = wgpu::VertexBufferLayout {
+            array_stride: 12,
+            step_mode: wgpu::VertexStepMode::Vertex,
+            attributes: &[wgpu::VertexAttribute {
+                format: wgpu::VertexFormat::Float32x3,
+                offset: 0,
+                shader_location: 2,
+            }],
+        };
         let targets = [Some(wgpu::ColorTargetState {
             format: COLOR_FORMAT,
             blend: None,
@@ -387,7 +472,11 @@ impl MeshRenderer {
                 module: &shader,
                 entry_point: Some("vs_mesh"),
                 compilation_options: Default::default(),
-                buffers: &[Some(position_layout.clone()), Some(scalar_layout)],
+                buffers: &[
+                    Some(position_layout.clone()),
+                    Some(scalar_layout),
+                    Some(normal_layout),
+                ],
             },
             primitive: wgpu::PrimitiveState {
                 topology: wgpu::PrimitiveTopology::TriangleList,
@@ -462,6 +551,8 @@ impl MeshRenderer {
             generation: 0,
             pending: None,
             lines_requested: None,
+            move_serial: 0,
+            pending_move: None,
             wireframe: false,
             async_upload_bytes: DEFAULT_ASYNC_UPLOAD_BYTES,
             problem: None,
@@ -525,6 +616,7 @@ impl MeshRenderer {
     pub fn set_mesh(&mut self, device: &wgpu::Device, source: Arc<dyn MeshSource>) {
         self.generation += 1;
         self.pending = None;
+        self.pending_move = None;
         self.lines_requested = None;
         self.lines_failed = false;
         let (vertex_count, face_count) = (source.positions().len(), source.triangles().len());
@@ -607,6 +699,29 @@ impl MeshRenderer {
                         self.lines_failed = true;
                         self.drawn = None;
                     }
+                    if self
+                        .mesh
+                        .as_ref()
+                        .is_some_and(|m| m.generation == generation)
+                    {
+                        // A move's normals failed: the mesh keeps its last positions.
+                        self.pending_move = None;
+                    }
+                }
+                Uploaded::Moved {
+                    generation,
+                    serial,
+                    source,
+                    normals,
+                } => {
+                    if self.pending_move != Some(serial) {
+                        continue;
+                    }
+                    self.pending_move = None;
+                    if let Some(mesh) = self.mesh.as_mut().filter(|m| m.generation == generation) {
+                        mesh.write_positions(queue, source, &normals);
+                        self.drawn = None;
+                    }
                 }
                 Uploaded::Lines { generation, lines } => {
                     if self.lines_requested == Some(generation) {
@@ -624,25 +739,78 @@ impl MeshRenderer {
     /// Whether an upload is still in flight (takes in those that landed first).
     pub fn upload_pending(&mut self, queue: &wgpu::Queue) -> bool {
         self.poll_uploads(queue);
-        self.pending.is_some() || self.lines_requested.is_some()
+        self.pending.is_some() || self.lines_requested.is_some() || self.pending_move.is_some()
     }
 
-    /// Moves the vertices of the current mesh; returns `false` (and changes nothing) when the
-    /// vertex count differs from the uploaded mesh's or a new mesh is still uploading, in which
-    /// case call [`Self::set_mesh`].
-    pub fn set_positions(&mut self, queue: &wgpu::Queue, positions: &[[f32; 3]]) -> bool {
+    /// Moves the vertices of the current mesh to `source`'s positions (its triangles must be the
+    /// mesh's), with new normals; returns `false` (and changes nothing) when the vertex count
+    /// differs from the uploaded mesh's or a new mesh is still uploading, in which case call
+    /// [`Self::set_mesh`]. A big mesh's normals are computed on the upload thread: the mesh
+    /// moves once they land.
+    pub fn set_positions(&mut self, queue: &wgpu::Queue, source: Arc<dyn MeshSource>) -> bool {
         self.poll_uploads(queue);
         if self.pending.is_some() {
             return false;
         }
-        match &self.mesh {
-            Some(mesh) if mesh.vertex_count == positions.len() => {
-                queue.write_buffer(&mesh.positions, 0, bytemuck::cast_slice(positions));
-                self.drawn = None;
-                true
-            }
-            _ => false,
+        let Some(mesh) = self.mesh.as_mut() else {
+            return false;
+        };
+        let vertex_count = source.positions().len();
+        if mesh.vertex_count != vertex_count {
+            return false;
         }
+        self.move_serial += 1;
+        let faces = mesh.index_count as usize / 3;
+        if (vertex_count + faces) * 12 >= self.async_upload_bytes {
+            if let Some(uploader) = &self.uploader {
+                let job = UploadJob::Move {
+                    generation: mesh.generation,
+                    serial: self.move_serial,
+                    source: source.clone(),
+                };
+                if uploader.send(job).is_ok() {
+                    self.pending_move = Some(self.move_serial);
+                    return true;
+                }
+            }
+        }
+        self.pending_move = None;
+        let normals = vertex_normals(source.positions(), source.triangles());
+        mesh.write_positions(queue, source, &normals);
+        self.drawn = None;
+        true
+    }
+
+    /// Reads back the vertex normals in the GPU buffer of the mesh on screen (tests: what
+    /// smooth shading is drawn with). Waits for the GPU.
+    pub fn read_back_normals(
+        &mut self,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+    ) -> Option<Vec<[f32; 3]>> {
+        self.poll_uploads(queue);
+        let mesh = self.mesh.as_ref()?;
+        let size = (mesh.vertex_count * 12) as u64;
+        let staging = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("fairmesh normals read-back"),
+            size,
+            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let mut encoder = device.create_command_encoder(&Default::default());
+        encoder.copy_buffer_to_buffer(&mesh.normals, 0, &staging, 0, size);
+        queue.submit([encoder.finish()]);
+        let (tx, rx) = mpsc::channel();
+        staging.map_async(wgpu::MapMode::Read, .., move |result| {
+            let _ = tx.send(result);
+        });
+        device.poll(wgpu::PollType::wait_indefinitely()).ok()?;
+        rx.recv().ok()?.ok()?;
+        let view = staging.get_mapped_range(..).ok()?;
+        let normals = bytemuck::cast_slice::<u8, [f32; 3]>(&view).to_vec();
+        drop(view);
+        staging.unmap();
+        Some(normals)
     }
 
     /// Replaces the per-vertex scalars (one per vertex) of the mesh on screen or, while one
@@ -754,6 +922,13 @@ impl MeshRenderer {
                 params.light_dir[2],
                 0.0,
             ],
+            fill_dir: [
+                params.fill_dir[0],
+                params.fill_dir[1],
+                params.fill_dir[2],
+                0.0,
+            ],
+            up: [params.up[0], params.up[1], params.up[2], 0.0],
             base_color: [0.62, 0.56, 0.48, 1.0],
             wire_color: [0.02, 0.03, 0.05, 1.0],
             scalar_range: match (params.scalar_range, params.mask_tint) {
@@ -761,6 +936,12 @@ impl MeshRenderer {
                 (None, true) => [0.0, 1.0, 2.0, 0.0],
                 (None, false) => [0.0, 1.0, 0.0, 0.0],
             },
+            look: [
+                f32::from(u8::from(params.shading == Shading::Smooth)),
+                f32::from(u8::from(params.lighting == Lighting::Studio)),
+                0.0,
+                0.0,
+            ],
         };
         queue.write_buffer(&self.uniform_buffer, 0, bytemuck::bytes_of(&uniforms));
 
@@ -829,6 +1010,7 @@ impl MeshRenderer {
                 pass.set_pipeline(&self.fill_pipeline);
                 pass.set_vertex_buffer(0, mesh.positions.slice(..));
                 pass.set_vertex_buffer(1, mesh.scalars.slice(..));
+                pass.set_vertex_buffer(2, mesh.normals.slice(..));
                 pass.set_index_buffer(mesh.triangles.slice(..), wgpu::IndexFormat::Uint32);
                 pass.draw_indexed(0..mesh.index_count, 0, 0..1);
                 if params.wireframe {

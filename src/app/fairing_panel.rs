@@ -1,0 +1,295 @@
+//! The side panel's Fairing section and the sharp-edge controls under Hierarchy: start level,
+//! method and its options, Apply; "Keep sharp edges" and its angle, and the kept edges drawn
+//! over the mesh while those are pointed at. Every control says in its tooltip ([`tips`]) what
+//! it does and when to change it; the ones the chosen method does not use are disabled and say
+//! why.
+
+use super::state::{
+    BoundarySetting, CompareView, HierarchyState, MethodSetting, VariantSetting, ViewMode,
+    MAX_SHARP_EDGE_ANGLE, MIN_SHARP_EDGE_ANGLE,
+};
+use super::{App, Command};
+
+/// The fairing section: start level, method and its options, Apply. Every control says in its
+/// tooltip what it does and when to change it; the ones the chosen method does not use are
+/// disabled and say why.
+pub(super) fn fairing_controls(app: &mut App, ui: &mut egui::Ui, top_level: usize) {
+    let Some(document) = &app.document else {
+        return;
+    };
+    let ready = document.level_count().is_some();
+    let method = app.settings.method;
+    let not_for_baseline = (!method.uses_hierarchy()).then(|| {
+        format!(
+            "Not used by {}: it smooths the whole input mesh at once, without the hierarchy.",
+            method.label()
+        )
+    });
+    let level_off = match (&not_for_baseline, ready) {
+        (Some(why), _) => Some(why.clone()),
+        (None, false) => Some("Waiting for the hierarchy to be built.".to_owned()),
+        (None, true) => None,
+    };
+    let mut level = document.level;
+    let slider = ui.add_enabled(
+        level_off.is_none(),
+        egui::Slider::new(&mut level, 0..=top_level).text("Start level"),
+    );
+    if explain(slider, tips::START_LEVEL, level_off.as_deref()).changed() {
+        app.commands.push(Command::SetLevel(level));
+    }
+    let applied = document.applied;
+    let before = app.settings.clone();
+    let settings = &mut app.settings;
+    let combo = egui::ComboBox::from_label("Method")
+        .selected_text(settings.method.label())
+        .show_ui(ui, |ui| {
+            for method in MethodSetting::ALL {
+                ui.selectable_value(&mut settings.method, method, method.label());
+            }
+        });
+    explain(combo.response, tips::METHOD, None);
+    if method.uses_hierarchy() {
+        let iterations = ui
+            .add(egui::Slider::new(&mut settings.iterations, 1..=50).text("Iterations per level"));
+        explain(iterations, tips::ITERATIONS_PER_LEVEL, None);
+        let rounds = ui.add(egui::Slider::new(&mut settings.rounds, 1..=10).text("Rounds"));
+        explain(rounds, tips::ROUNDS, None);
+    } else {
+        ui.small("A baseline smooths the mesh itself (no hierarchy): watch the volume change.");
+        let iterations = ui
+            .add(egui::Slider::new(&mut settings.baseline_iterations, 1..=200).text("Iterations"));
+        explain(iterations, tips::BASELINE_ITERATIONS, None);
+        if matches!(method, MethodSetting::Laplacian | MethodSetting::Taubin) {
+            let lambda =
+                ui.add(egui::Slider::new(&mut settings.baseline_lambda, 0.05..=1.0).text("Lambda"));
+            explain(lambda, tips::LAMBDA, None);
+        }
+    }
+    let boundary = egui::ComboBox::from_label("Boundary")
+        .selected_text(match settings.boundary {
+            BoundarySetting::Curve => "Smooth as curve",
+            BoundarySetting::Fixed => "Fixed",
+        })
+        .show_ui(ui, |ui| {
+            ui.selectable_value(
+                &mut settings.boundary,
+                BoundarySetting::Curve,
+                "Smooth as curve",
+            );
+            ui.selectable_value(&mut settings.boundary, BoundarySetting::Fixed, "Fixed");
+        });
+    explain(boundary.response, tips::BOUNDARY, None);
+    let hierarchy_only = not_for_baseline.is_none();
+    let fair_finest = ui.add_enabled(
+        hierarchy_only,
+        egui::Checkbox::new(&mut settings.fair_finest, "Fair M0 too"),
+    );
+    explain(fair_finest, tips::FAIR_FINEST, not_for_baseline.as_deref());
+    let variant = ui.add_enabled_ui(hierarchy_only, |ui| {
+        egui::ComboBox::from_label("Variant")
+            .selected_text(match settings.variant {
+                VariantSetting::Paper => "Paper",
+                VariantSetting::Improved => "Improved",
+            })
+            .show_ui(ui, |ui| {
+                ui.selectable_value(&mut settings.variant, VariantSetting::Paper, "Paper");
+                ui.selectable_value(&mut settings.variant, VariantSetting::Improved, "Improved");
+            })
+            .response
+    });
+    explain(variant.inner, tips::VARIANT, not_for_baseline.as_deref());
+    if app.settings.fairing_key() != before.fairing_key() {
+        app.commands.push(Command::Refair);
+    }
+    if app.fair_in_flight {
+        ui.horizontal(|ui| {
+            ui.spinner();
+            ui.label(format!(
+                "fairing … {:.0} %",
+                app.fair_progress.get() * 100.0
+            ));
+        });
+    }
+    if applied {
+        ui.small(
+            "Showing the applied result as it is. Change the start level or an option to fair \
+             it again.",
+        );
+    }
+    let has_result = app.document.as_ref().is_some_and(|d| d.faired.is_some());
+    let apply = ui.add_enabled(has_result, egui::Button::new("Apply result"));
+    if explain(
+        apply,
+        tips::APPLY,
+        (!has_result).then_some("There is no result to apply yet."),
+    )
+    .clicked()
+    {
+        app.commands.push(Command::ApplyResult);
+    }
+}
+
+/// Shows `tip` on hover; when the control is disabled, shows `tip` and why it is off. The text
+/// is the control's accessible description either way (screen readers, tests).
+fn explain(response: egui::Response, tip: &str, off_because: Option<&str>) -> egui::Response {
+    match off_because {
+        Some(why) if !response.enabled() => {
+            let text = format!("{tip}\n\n{why}");
+            response
+                .on_hover_text(text.clone())
+                .on_disabled_hover_text(text)
+        }
+        _ => response.on_hover_text(tip),
+    }
+}
+
+/// "Keep sharp edges" and its angle (the hierarchy is built again when either changes; while
+/// they are hovered or just changed, the kept edges are drawn over the mesh).
+pub(super) fn sharp_edge_controls(app: &mut App, ui: &mut egui::Ui) {
+    let Some(document) = &app.document else {
+        return;
+    };
+    let not_for_baseline = (!app.settings.method.uses_hierarchy()).then(|| {
+        format!(
+            "Not used by {}: it smooths the whole mesh at once, across sharp edges too.",
+            app.settings.method.label()
+        )
+    });
+    let kept = match &document.hierarchy {
+        HierarchyState::Ready { hierarchy, .. } => Some(hierarchy.crease_edge_count()),
+        _ => None,
+    };
+    let enabled = not_for_baseline.is_none();
+    let keep = ui.add_enabled(
+        enabled,
+        egui::Checkbox::new(&mut app.settings.keep_sharp_edges, "Keep sharp edges"),
+    );
+    let keep = explain(keep, tips::KEEP_SHARP_EDGES, not_for_baseline.as_deref());
+    let angle = ui.add_enabled(
+        enabled && app.settings.keep_sharp_edges,
+        egui::Slider::new(
+            &mut app.settings.sharp_edge_angle,
+            MIN_SHARP_EDGE_ANGLE..=MAX_SHARP_EDGE_ANGLE,
+        )
+        .suffix("°")
+        .fixed_decimals(0)
+        .text("Sharp edge angle"),
+    );
+    let angle = explain(angle, tips::SHARP_EDGE_ANGLE, not_for_baseline.as_deref());
+    let now = std::time::Instant::now();
+    if keep.hovered() || angle.hovered() || angle.dragged() {
+        app.sharp_edges_shown_until = Some(now + SHARP_EDGES_LINGER);
+    }
+    // The hierarchy is built again when the angle is let go (not at every step of a drag).
+    let settled = !angle.dragged();
+    // (`start_hierarchy` records the settings it builds with, before the next frame.)
+    if settled && app.settings.hierarchy_key() != app.hierarchy_built_with {
+        app.sharp_edges_shown_until = Some(now + SHARP_EDGES_LINGER);
+        app.commands.push(Command::RebuildHierarchy);
+    }
+    if app.settings.keep_sharp_edges && enabled {
+        match kept {
+            Some(0) => ui.small("No sharp edges found at this angle"),
+            Some(edges) => ui.small(format!(
+                "{edges} sharp edges kept (drawn in cyan while you point here)"
+            )),
+            None => ui.small("Finding sharp edges…"),
+        };
+    }
+}
+
+/// How long the kept sharp edges stay drawn after the pointer leaves their controls.
+const SHARP_EDGES_LINGER: std::time::Duration = std::time::Duration::from_millis(1500);
+
+/// Draws the kept sharp edges over the result's image while [`sharp_edge_controls`] asks for it.
+pub(super) fn sharp_edge_overlay(app: &mut App, ui: &egui::Ui, rect: egui::Rect) {
+    app.sharp_edges_drawn = 0;
+    let Some(until) = app.sharp_edges_shown_until else {
+        return;
+    };
+    let now = std::time::Instant::now();
+    if now > until || app.settings.view_mode == ViewMode::Level {
+        return;
+    }
+    ui.ctx().request_repaint_after(until - now);
+    let Some(document) = &app.document else {
+        return;
+    };
+    let HierarchyState::Ready { sharp_edges, .. } = &document.hierarchy else {
+        return;
+    };
+    let faired = document.faired.as_ref().map(|f| f.positions.clone());
+    let shows_before = app.show_before && app.settings.compare == CompareView::Single;
+    let positions: &[[f32; 3]] = match (&faired, shows_before) {
+        (Some(faired), false) => faired,
+        _ => &document.original.positions,
+    };
+    let image = super::paint_panel::painted_image(app, rect);
+    let aspect = image.width() / image.height().max(1.0);
+    let segments = sharp_edges.segments(
+        positions,
+        app.camera.view_proj(aspect),
+        app.camera.eye(),
+        image,
+    );
+    app.sharp_edges_drawn = segments.len();
+    let painter = ui.painter_at(image);
+    let stroke = egui::Stroke::new(2.0, egui::Color32::from_rgb(60, 230, 255));
+    for segment in segments {
+        painter.line_segment(segment, stroke);
+    }
+}
+
+/// The fairing controls' tooltips: what each does and when to change it, in plain words.
+pub mod tips {
+    pub const KEEP_SHARP_EDGES: &str = "Keep the mesh's sharp edges (the edges of a machined \
+        part, a fold, a rim) sharp: the coarse levels keep them and the smoothing runs along them, \
+        not across them. Turn it off for organic shapes if smoothing leaves ridges where there \
+        should be none.";
+    pub const SHARP_EDGE_ANGLE: &str = "How sharply the surface must fold at an edge for the edge \
+        to be kept sharp. Lower: more edges are kept (gentle folds too). Higher: only the sharpest. \
+        The kept edges are drawn over the mesh while you point here.";
+    pub const START_LEVEL: &str = "How coarse a version of the mesh the smoothing starts from \
+        (M0 is the mesh itself). Higher: smoother, bigger bumps go. Lower: more of the detail \
+        stays. Raise it until the noise is gone; lower it if wanted features melt away.";
+    pub const METHOD: &str = "Constrained fairing (the paper's method) smooths without \
+        shrinking the mesh. The others are classic smoothers to compare with: watch the volume \
+        change under Numbers.";
+    pub const ITERATIONS_PER_LEVEL: &str = "Smoothing passes on each level on the way back to \
+        full detail. More: a little smoother and slower. The start level matters far more: \
+        change this last.";
+    pub const ROUNDS: &str = "How often each level's smoothing starts over from where it got \
+        to. More: a little smoother and slower; 1 is usually enough.";
+    pub const BASELINE_ITERATIONS: &str = "Smoothing passes over the whole mesh. More: \
+        smoother, and (for Laplacian) more shrinkage.";
+    pub const LAMBDA: &str = "How far each pass moves a vertex towards its neighbours (0 to \
+        1). Higher: faster smoothing, more shrinkage.";
+    pub const BOUNDARY: &str = "What happens to open borders (holes, cut edges). Smooth as \
+        curve: the border line is smoothed too. Fixed: border vertices stay where they are; use \
+        it when the mesh must still meet another part.";
+    pub const FAIR_FINEST: &str = "Also smooth the full-detail mesh (M0) at the end. On: the \
+        finest noise goes too. Off: the finest detail stays as it was.";
+    pub const VARIANT: &str = "Paper: the method as published. Improved: two corrections that \
+        keep the shape from drifting and shrinking over the levels. Keep Improved unless you \
+        compare with the paper.";
+    pub const PAINT: &str = "Paint where to fair (P). On: the left button paints on the mesh \
+        instead of turning the view (middle drag turns it, right drag pans). Only the painted \
+        part is smoothed; the rest keeps its exact shape.";
+    pub const BRUSH_ADD: &str = "The brush marks the part to smooth.";
+    pub const BRUSH_ERASE: &str = "The brush unmarks what it touches, so it keeps its shape \
+        (on a mesh with no mask yet: protects it while the rest is smoothed). Hold Shift to \
+        erase for a moment.";
+    pub const BRUSH_RADIUS: &str = "Size of the brush on screen, in points. Zoom in to paint \
+        finer detail.";
+    pub const BRUSH_SOFTNESS: &str = "How much of the brush's edge fades out. Higher: the \
+        smoothing blends gently into the untouched part; 0: a hard edge.";
+    pub const SHOW_MASK: &str = "Tint the painted part orange on the mesh (it replaces the \
+        heat map while shown).";
+    pub const CLEAR_MASK: &str = "Remove the paint: the whole mesh is smoothed again (undo \
+        with Ctrl+Z).";
+    pub const INVERT_MASK: &str = "Smooth what was left alone and keep what was painted \
+        (undo with Ctrl+Z).";
+    pub const APPLY: &str = "Make the result the input mesh, to add noise to it, fair it \
+        again or export it as it is (undo with Ctrl+Z).";
+}

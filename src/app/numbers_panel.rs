@@ -1,0 +1,156 @@
+//! The side panel's Numbers section: the result measured against the input mesh and the clean
+//! mesh (volume change, distances, RMS displacement, barycenter drift; the numbers of an older
+//! result greyed while the new one is measured), then the shown mesh's size and the times of
+//! loading, the hierarchy, the fairing and the measuring. Reads the app, writes nothing.
+
+use super::panels::seconds;
+use super::state::{HierarchyState, Measures};
+use super::App;
+
+/// What a greyed number in the Numbers panel means.
+const PENDING_TIP: &str =
+    "From the previous result: the result on screen is being measured, its numbers follow";
+
+pub(super) fn show(app: &App, ui: &mut egui::Ui) {
+    measures(app, ui);
+    timings(app, ui);
+}
+
+/// How one row of the measures grid shows a result's numbers.
+type Row = fn(&Measures) -> String;
+
+/// The measures grid's rows: name, and its value from a result's measures.
+const ROWS: [(&str, Row); 5] = [
+    ("Volume change", |m| {
+        m.volume_change_percent
+            .map_or("–".into(), |v| format!("{v:+.4} %"))
+    }),
+    ("Mean distance", |m| format!("{:.3e}", m.mean_distance)),
+    ("Max distance", |m| format!("{:.3e}", m.max_distance)),
+    ("RMS displacement", |m| {
+        m.vertex_rms.map_or("–".into(), |v| format!("{v:.3e}"))
+    }),
+    ("Barycenter drift", |m| {
+        m.barycenter_drift
+            .map_or("–".into(), |v| format!("{v:.3e}"))
+    }),
+];
+
+/// The result against the input mesh and, after noise, the clean mesh.
+fn measures(app: &App, ui: &mut egui::Ui) {
+    let Some(document) = &app.document else {
+        return;
+    };
+    let faired = document.faired.as_ref();
+    let against_document = faired.and_then(|f| f.against_document.as_ref());
+    let against_clean = faired.and_then(|f| f.against_clean.as_ref());
+    let has_clean = document.clean.is_some();
+    let (lo, hi) = document.bounds;
+    let diagonal = ((0..3).map(|k| (hi[k] - lo[k]).powi(2)).sum::<f32>()).sqrt() as f64;
+    ui.label(match faired {
+        Some(f) => format!("Result: {}", f.method.describe(f.level)),
+        None => "Result: none yet".to_owned(),
+    });
+    egui::Grid::new("fairmesh-measures")
+        .num_columns(if has_clean { 3 } else { 2 })
+        .striped(true)
+        .show(ui, |ui| {
+            ui.strong("Result vs.");
+            ui.strong("input")
+                .on_hover_text("The input mesh: the mesh the result was smoothed from");
+            if has_clean {
+                ui.strong("clean")
+                    .on_hover_text("The clean mesh: the input mesh before noise was added");
+            }
+            ui.end_row();
+            let percent = |v: f64| format!("{v:+.4} %");
+            let rows = ROWS;
+            // Volume change and RMS displacement against the input come with the result
+            // itself; the other numbers are measured a moment later. Until then they are the
+            // previous result's: greyed, and saying so.
+            let fresh = |name: &str| -> Option<(String, String)> {
+                let f = faired?;
+                match name {
+                    "Volume change" => Some((percent(f.volume_change * 100.0), String::new())),
+                    "RMS displacement" => Some((
+                        format!("{:.3e}", f.rms_displacement),
+                        format!(
+                            "{:.3} % of the bounding box diagonal",
+                            f.rms_displacement / diagonal.max(f64::MIN_POSITIVE) * 100.0
+                        ),
+                    )),
+                    _ => None,
+                }
+            };
+            let pending = faired.is_some_and(|f| f.measures_pending);
+            let value = |ui: &mut egui::Ui, text: String| {
+                let label = ui.add_enabled(!pending, egui::Label::new(text));
+                if pending {
+                    label.on_hover_text(PENDING_TIP);
+                }
+            };
+            for (name, row) in rows {
+                ui.label(name);
+                match fresh(name) {
+                    Some((text, tip)) if tip.is_empty() => {
+                        ui.label(text);
+                    }
+                    Some((text, tip)) => {
+                        ui.label(text).on_hover_text(tip);
+                    }
+                    None => value(ui, against_document.map_or("–".into(), row)),
+                }
+                if has_clean {
+                    value(ui, against_clean.map_or("–".into(), row));
+                }
+                ui.end_row();
+            }
+            if let Some(noise) = &document.against_clean {
+                ui.label("Noise");
+                ui.label(format!("{:.3e}", noise.mean_distance))
+                    .on_hover_text("Mean distance of the input mesh from the clean mesh");
+                ui.end_row();
+            }
+        });
+    ui.small("Distances in model units.");
+}
+
+/// The shown mesh's size and how long each step took.
+fn timings(app: &App, ui: &mut egui::Ui) {
+    let Some(document) = &app.document else {
+        return;
+    };
+    let faired = document.faired.as_ref();
+    egui::Grid::new("fairmesh-numbers")
+        .num_columns(2)
+        .show(ui, |ui| {
+            ui.label("Shown vertices");
+            ui.label(app.shown_counts.0.to_string());
+            ui.end_row();
+            ui.label("Shown faces");
+            ui.label(app.shown_counts.1.to_string());
+            ui.end_row();
+            ui.label("Load time");
+            ui.label(seconds(document.load_time));
+            ui.end_row();
+            ui.label("Hierarchy build");
+            ui.label(match &document.hierarchy {
+                HierarchyState::Ready { build_time, .. } => seconds(*build_time),
+                HierarchyState::Building => "building …".into(),
+                HierarchyState::Failed(_) => "–".into(),
+            });
+            ui.end_row();
+            ui.label("Last fairing");
+            ui.label(faired.map_or("–".into(), |f| seconds(f.elapsed)));
+            ui.end_row();
+            ui.label("Measuring");
+            ui.label(faired.map_or("–".into(), |f| {
+                if f.measures_pending {
+                    "running…".into()
+                } else {
+                    seconds(f.measure_time)
+                }
+            }));
+            ui.end_row();
+        });
+}
