@@ -57,9 +57,10 @@
 //! does not accumulate; the tests check volume to 1e-4 relative and equivariance to f32 accuracy.
 
 use super::boundary::BoundaryCurves;
-use super::creases::{detect_creases, Creases, FeatureClass};
+use super::creases::{detect_creases, detect_creases_with_estimate, Creases, FeatureClass};
 use super::strength::{
-    estimate_noise, normal_filtering_for, CLEAN_NOISE, MAX_AUTO_ROUNDS, MIN_NOISE_FALL, NOISE_LEFT,
+    estimate_noise_with_fans, normal_filtering_for, CLEAN_NOISE, MAX_AUTO_ROUNDS, MIN_NOISE_FALL,
+    NOISE_LEFT,
 };
 use super::{BoundaryMode, FairOptions, FairReport, FairVariant, Strength};
 use crate::mesh::{breadth_first_order, inverse_permutation, PositionHasher, Topology, TriMesh};
@@ -1072,11 +1073,23 @@ pub fn fair_constrained(
         }
     }
     let original = options.mask.as_ref().map(|_| mesh.positions.clone());
+    // The fan-ordered one-rings the operator is built from serve the noise estimate and the
+    // crease detection first (`estimate_noise_with_fans`, `detect_creases_with_estimate`).
+    let fans = FanRings::new(&mesh.triangles, topology);
     // The noise estimate decides the strength (automatic) and how much the normals are filtered
     // before creases are detected (raw normals of a noisy mesh make creases of the noise).
-    let estimate = (options.strength == Strength::Auto || options.creases.is_some())
-        .then(|| estimate_noise(mesh, topology))
-        .flatten();
+    // Automatic strength fairs only a noisy mesh, so its creases are always found on filtered
+    // normals; a fixed strength finds the estimate and the faces' own feature edges in one
+    // gather, and skips the filter when the mesh is clean.
+    let (estimate, found) = match (&options.creases, options.strength) {
+        (Some(crease_options), Strength::Fixed) => {
+            let (estimate, creases) =
+                detect_creases_with_estimate(mesh, topology, &fans, crease_options);
+            (estimate, Some(creases))
+        }
+        (_, Strength::Auto) => (estimate_noise_with_fans(mesh, topology, &fans), None),
+        (None, _) => (None, None),
+    };
     // Automatic strength: a clean mesh is left as it is.
     let auto_noise = match options.strength {
         Strength::Auto => match estimate {
@@ -1090,19 +1103,20 @@ pub fn fair_constrained(
         },
         _ => None,
     };
-    let creases = options.creases.as_ref().map(|crease_options| {
-        let mut crease_options = crease_options.clone();
-        crease_options.normal_filtering = crease_options
-            .normal_filtering
-            .max(estimate.map_or(0, normal_filtering_for));
-        detect_creases(mesh, topology, &crease_options)
+    let creases = found.or_else(|| {
+        options.creases.as_ref().map(|crease_options| {
+            let mut crease_options = crease_options.clone();
+            crease_options.normal_filtering = crease_options
+                .normal_filtering
+                .max(estimate.map_or(0, normal_filtering_for));
+            detect_creases(mesh, topology, &crease_options)
+        })
     });
     let pinned = options
         .mask
         .as_ref()
         .map(|mask| mask.pinned_flags())
         .unwrap_or_default();
-    let fans = FanRings::new(&mesh.triangles, topology);
     let mut fairing = ConstrainedFairing::with_fans(
         mesh,
         topology,
@@ -1112,7 +1126,6 @@ pub fn fair_constrained(
         creases.as_ref(),
         &pinned,
     );
-    drop(fans);
     fairing.set_tangential_relaxation(options.tangential_relaxation as f32);
     let mut report = match auto_noise {
         None => fairing.run(&mut mesh.positions, options),
@@ -1129,7 +1142,7 @@ pub fn fair_constrained(
                 }
                 fairing.run_round(options, &mut report);
                 fairing.store(&mut mesh.positions);
-                let Some(now) = estimate_noise(mesh, topology) else {
+                let Some(now) = estimate_noise_with_fans(mesh, topology, &fans) else {
                     break;
                 };
                 if now <= target || now > last * MIN_NOISE_FALL {
