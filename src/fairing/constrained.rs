@@ -57,9 +57,10 @@
 //! does not accumulate; the tests check volume to 1e-4 relative and equivariance to f32 accuracy.
 
 use super::boundary::BoundaryCurves;
-use super::creases::{detect_creases, Creases, FeatureClass};
+use super::creases::{detect_creases, detect_creases_with_estimate, Creases, FeatureClass};
 use super::strength::{
-    estimate_noise, normal_filtering_for, CLEAN_NOISE, MAX_AUTO_ROUNDS, MIN_NOISE_FALL, NOISE_LEFT,
+    estimate_noise_with_fans, normal_filtering_for, CLEAN_NOISE, MAX_AUTO_ROUNDS, MIN_NOISE_FALL,
+    NOISE_LEFT,
 };
 use super::volume::VolumeKeeper;
 use super::{BoundaryMode, FairOptions, FairReport, FairVariant, Strength};
@@ -1073,11 +1074,23 @@ pub fn fair_constrained(
         }
     }
     let original = options.mask.as_ref().map(|_| mesh.positions.clone());
+    // The fan-ordered one-rings the operator is built from serve the noise estimate and the
+    // crease detection first (`estimate_noise_with_fans`, `detect_creases_with_estimate`).
+    let fans = FanRings::new(&mesh.triangles, topology);
     // The noise estimate decides the strength (automatic) and how much the normals are filtered
     // before creases are detected (raw normals of a noisy mesh make creases of the noise).
-    let estimate = (options.strength == Strength::Auto || options.creases.is_some())
-        .then(|| estimate_noise(mesh, topology))
-        .flatten();
+    // Automatic strength fairs only a noisy mesh, so its creases are always found on filtered
+    // normals; a fixed strength finds the estimate and the faces' own feature edges in one
+    // gather, and skips the filter when the mesh is clean.
+    let (estimate, found) = match (&options.creases, options.strength) {
+        (Some(crease_options), Strength::Fixed) => {
+            let (estimate, creases) =
+                detect_creases_with_estimate(mesh, topology, &fans, crease_options);
+            (estimate, Some(creases))
+        }
+        (_, Strength::Auto) => (estimate_noise_with_fans(mesh, topology, &fans), None),
+        (None, _) => (None, None),
+    };
     // Automatic strength: a clean mesh is left as it is.
     let auto_noise = match options.strength {
         Strength::Auto => match estimate {
@@ -1103,7 +1116,7 @@ pub fn fair_constrained(
             detect_creases(mesh, topology, &crease_options)
         })
     };
-    let mut creases = detect(mesh, estimate);
+    let mut creases = found.or_else(|| detect(mesh, estimate));
     let pinned = options
         .mask
         .as_ref()
@@ -1114,12 +1127,11 @@ pub fn fair_constrained(
         None => options.rounds,
     };
     let redetect = options.creases.is_some() && max_rounds > 1;
-    let fans = FanRings::new(&mesh.triangles, topology);
-    let build = |mesh: &TriMesh, fans: &FanRings, creases: Option<&Creases>| {
+    let build = |mesh: &TriMesh, creases: Option<&Creases>| {
         let mut fairing = ConstrainedFairing::with_fans(
             mesh,
             topology,
-            fans,
+            &fans,
             options.variant,
             options.boundary,
             creases,
@@ -1128,9 +1140,7 @@ pub fn fair_constrained(
         fairing.set_tangential_relaxation(options.tangential_relaxation as f32);
         fairing
     };
-    let mut fairing = build(mesh, &fans, creases.as_ref());
-    // Rebuilding for new creases needs the one-rings again; otherwise they are dropped now.
-    let fans = redetect.then_some(fans);
+    let mut fairing = build(mesh, creases.as_ref());
     let volume = options
         .keep_volume
         .then(|| VolumeKeeper::new(mesh, topology, &pinned));
@@ -1139,13 +1149,11 @@ pub fn fair_constrained(
     // (or no longer falls): see [`super::strength`].
     let mut noise_now = estimate;
     for round in 0..max_rounds {
-        if round > 0 {
-            if let Some(fans) = &fans {
-                let found = detect(mesh, noise_now);
-                if found.as_ref().map(|c| &c.edges) != creases.as_ref().map(|c| &c.edges) {
-                    creases = found;
-                    fairing = build(mesh, fans, creases.as_ref());
-                }
+        if round > 0 && redetect {
+            let found = detect(mesh, noise_now);
+            if found.as_ref().map(|c| &c.edges) != creases.as_ref().map(|c| &c.edges) {
+                creases = found;
+                fairing = build(mesh, creases.as_ref());
             }
         }
         // Imposes the constraints on the positions this round starts from.
@@ -1162,7 +1170,7 @@ pub fn fair_constrained(
             break;
         }
         if let Some(noise) = auto_noise {
-            let Some(now) = estimate_noise(mesh, topology) else {
+            let Some(now) = estimate_noise_with_fans(mesh, topology, &fans) else {
                 break;
             };
             let last = noise_now.unwrap_or(noise);
@@ -1171,7 +1179,7 @@ pub fn fair_constrained(
             }
             noise_now = Some(now);
         } else if redetect {
-            noise_now = estimate_noise(mesh, topology);
+            noise_now = estimate_noise_with_fans(mesh, topology, &fans);
         }
     }
     // The operator held the pinned vertices; the blend fades the rest by their weights (and

@@ -31,9 +31,18 @@
 //!   either side do not) turn by less than [`CreaseOptions::corner_turn_degrees`]; any other vertex with feature edges is a corner (the
 //!   end of a crease, three or more creases meeting, a sharp turn, or a crease meeting the
 //!   boundary) and is held fixed.
+//!
+//! Speed (issue 12: detection and the noise estimate should add at most 10 % to a default round):
+//! constrained fairing and the hierarchy detect through [`detect_creases_with_estimate`], whose
+//! one gather over the fan-ordered one-rings gives the noise estimate and the feature edges of the
+//! faces' own normals at once, so a clean mesh reads no face and never runs the filter. The
+//! filter (noisy meshes) works in f32 on a face-around-face list built once for all passes.
+//! Every vertex and face is computed by the same operations whatever the thread count.
 
+use super::constrained::FanRings;
+use super::strength::{face_normals, normal_filtering_for, scan_fans};
 use crate::mesh::{Topology, TriMesh};
-use glam::DVec3;
+use glam::{Vec3A, Vec4};
 use rayon::prelude::*;
 use std::collections::HashMap;
 
@@ -149,114 +158,375 @@ pub fn filtered_face_normals(
     topology: &Topology,
     passes: usize,
     sigma: f64,
-) -> Vec<DVec3> {
-    let face_count = mesh.triangles.len();
-    let (mut normals, areas): (Vec<DVec3>, Vec<f64>) = (0..face_count)
-        .into_par_iter()
-        .map(|f| {
-            let n = mesh.face_normal(f);
+) -> Vec<Vec3A> {
+    filter_face_normals(mesh, topology, &face_normals(mesh), passes, sigma)
+}
+
+/// [`filtered_face_normals`] from the faces' area normals (`area_normals[f]`: (x_b − x_a) ×
+/// (x_c − x_a) of face f).
+///
+/// How it is computed: in f32 (normals are directions; a pass averages a dozen of them), with the
+/// faces around each face (those sharing a vertex with it, each with the number of vertices it
+/// shares) listed once, before the passes, in blocks of faces ([`FaceRings`]). A pass is then
+/// three parallel gathers over the faces: every patch's mean and spread (once per face), every
+/// face's guidance (the least spread among the patches around it), the filtered normal. Each face
+/// is computed by the same operations whatever the thread count. No pass (a clean mesh) builds
+/// nothing: the normals are the faces' own.
+fn filter_face_normals(
+    mesh: &TriMesh,
+    topology: &Topology,
+    area_normals: &[Vec3A],
+    passes: usize,
+    sigma: f64,
+) -> Vec<Vec3A> {
+    // Unit normal and area (twice the area: only ratios matter) of every face.
+    let mut current: Vec<Vec4> = area_normals
+        .par_iter()
+        .with_min_len(4096)
+        .map(|&n| {
             let length = n.length();
             if length > 0.0 && length.is_finite() {
-                (n / length, length)
+                (n / length).extend(length)
             } else {
-                (DVec3::ZERO, 0.0)
+                Vec4::ZERO
             }
         })
-        .unzip();
-    // The faces sharing a vertex with f (f included; a face sharing an edge appears twice).
-    let around = |f: usize| {
-        mesh.triangles[f]
-            .iter()
-            .flat_map(|&c| topology.faces_of(c).iter().map(|&g| g as usize))
-    };
-    let inverse = 1.0 / (2.0 * sigma * sigma);
-    for _ in 0..passes {
-        let current = &normals;
-        // Each patch (the faces around a face): its area-weighted mean normal and how much its
-        // normals disagree (the largest difference from the mean).
-        let patches: Vec<(DVec3, f64)> = (0..face_count)
-            .into_par_iter()
-            .map(|f| {
-                let mean = around(f)
-                    .map(|g| current[g] * areas[g])
-                    .sum::<DVec3>()
-                    .try_normalize()
-                    .unwrap_or(current[f]);
-                let spread = around(f)
-                    .map(|g| (current[g] - mean).length_squared())
-                    .fold(0.0, f64::max);
-                (mean, spread)
-            })
-            .collect();
-        // Guidance: the mean of the most consistent patch among those containing f.
-        let guidance: Vec<DVec3> = (0..face_count)
-            .into_par_iter()
-            .map(|f| {
-                around(f)
-                    .map(|g| patches[g])
-                    .min_by(|a, b| a.1.total_cmp(&b.1))
-                    .map_or(current[f], |(mean, _)| mean)
-            })
-            .collect();
-        normals = (0..face_count)
-            .into_par_iter()
-            .map(|f| {
-                let own = guidance[f];
-                let mut sum = DVec3::ZERO;
-                for g in around(f) {
-                    let d = (guidance[g] - own).length_squared();
-                    sum += current[g] * (areas[g] * (-d * inverse).exp());
+        .collect();
+    if passes > 0 {
+        let rings = FaceRings::build(mesh, topology);
+        let inverse = (1.0 / (2.0 * sigma * sigma)) as f32;
+        let face_count = current.len();
+        let mut patches = vec![Vec4::ZERO; face_count];
+        let mut guidance = vec![Vec3A::ZERO; face_count];
+        let mut next = vec![Vec4::ZERO; face_count];
+        for _ in 0..passes {
+            // Each patch (the faces around a face, with their multiplicities): its area-weighted
+            // mean normal and how much its normals disagree (the largest squared difference from
+            // the mean), as (mean, spread).
+            rings.for_each_face(&mut patches, |f, around, shared, patch| {
+                let own = xyz(current[f]);
+                let mut sum = Vec3A::ZERO;
+                for (&g, &m) in around.iter().zip(shared) {
+                    let n = current[g as usize];
+                    sum += xyz(n) * (n.w * m as f32);
                 }
-                sum.try_normalize().unwrap_or(current[f])
+                let mean = sum.try_normalize().unwrap_or(own);
+                let mut spread = 0.0f32;
+                for &g in around {
+                    spread = spread.max((xyz(current[g as usize]) - mean).length_squared());
+                }
+                *patch = mean.extend(spread);
+            });
+            // Guidance: the mean of the most consistent patch among those containing f (the
+            // first of the least spread, in the order of the list).
+            rings.for_each_face(&mut guidance, |f, around, _, guide| {
+                let mut best = xyz(current[f]).extend(f32::INFINITY);
+                for &g in around {
+                    let patch = patches[g as usize];
+                    if patch.w < best.w {
+                        best = patch;
+                    }
+                }
+                *guide = xyz(best);
+            });
+            rings.for_each_face(&mut next, |f, around, shared, out| {
+                let own = guidance[f];
+                let mut sum = Vec3A::ZERO;
+                for (&g, &m) in around.iter().zip(shared) {
+                    let d = (guidance[g as usize] - own).length_squared();
+                    let n = current[g as usize];
+                    sum += xyz(n) * (n.w * m as f32 * (-d * inverse).exp());
+                }
+                let area = current[f].w;
+                *out = sum.try_normalize().unwrap_or(xyz(current[f])).extend(area);
+            });
+            std::mem::swap(&mut current, &mut next);
+        }
+    }
+    current
+        .into_par_iter()
+        .with_min_len(4096)
+        .map(xyz)
+        .collect()
+}
+
+/// The x, y, z of a normal stored with its face's area in w.
+#[inline]
+fn xyz(v: Vec4) -> Vec3A {
+    Vec3A::from_vec4(v)
+}
+
+/// Faces per block of [`FaceRings`].
+const FACE_BLOCK: usize = 4096;
+
+/// For every face, the faces sharing a vertex with it (itself included), ascending, each once
+/// with the number of vertices it shares (3 for the face itself, 2 across an edge, 1 across a
+/// vertex): the union, with multiplicities, of its corners' face lists, which is what the guided
+/// filter averages over. Kept in blocks of [`FACE_BLOCK`] faces, built and read in parallel.
+struct FaceRings {
+    blocks: Vec<FaceRingBlock>,
+}
+
+struct FaceRingBlock {
+    /// `faces[offsets[i]..offsets[i + 1]]` are around the block's face `i`.
+    offsets: Vec<u32>,
+    faces: Vec<u32>,
+    /// How many vertices each listed face shares with the block's face.
+    shared: Vec<u8>,
+}
+
+impl FaceRings {
+    fn build(mesh: &TriMesh, topology: &Topology) -> FaceRings {
+        let blocks = mesh
+            .triangles
+            .par_chunks(FACE_BLOCK)
+            .map(|block| {
+                let mut ring = FaceRingBlock {
+                    offsets: Vec::with_capacity(block.len() + 1),
+                    faces: Vec::with_capacity(14 * block.len()),
+                    shared: Vec::with_capacity(14 * block.len()),
+                };
+                ring.offsets.push(0);
+                for &[a, b, c] in block {
+                    merge_face_lists(
+                        [
+                            topology.faces_of(a),
+                            topology.faces_of(b),
+                            topology.faces_of(c),
+                        ],
+                        &mut ring.faces,
+                        &mut ring.shared,
+                    );
+                    ring.offsets.push(ring.faces.len() as u32);
+                }
+                ring
             })
             .collect();
+        FaceRings { blocks }
     }
-    normals
+
+    /// Calls `visit(f, faces around f, their shared-vertex counts, &mut out[f])` for every face,
+    /// in parallel over blocks.
+    fn for_each_face<T: Send>(
+        &self,
+        out: &mut [T],
+        visit: impl Fn(usize, &[u32], &[u8], &mut T) + Sync,
+    ) {
+        out.par_chunks_mut(FACE_BLOCK)
+            .zip(&self.blocks)
+            .enumerate()
+            .for_each(|(b, (out, ring))| {
+                for (i, slot) in out.iter_mut().enumerate() {
+                    let (start, end) = (ring.offsets[i] as usize, ring.offsets[i + 1] as usize);
+                    visit(
+                        b * FACE_BLOCK + i,
+                        &ring.faces[start..end],
+                        &ring.shared[start..end],
+                        slot,
+                    );
+                }
+            });
+    }
+}
+
+/// Appends the union of three ascending face lists, each face once with the number of lists
+/// holding it.
+fn merge_face_lists(lists: [&[u32]; 3], faces: &mut Vec<u32>, shared: &mut Vec<u8>) {
+    let [mut a, mut b, mut c] = lists;
+    loop {
+        let head = |l: &[u32]| l.first().copied().unwrap_or(u32::MAX);
+        let (x, y, z) = (head(a), head(b), head(c));
+        let m = x.min(y).min(z);
+        if m == u32::MAX {
+            break;
+        }
+        faces.push(m);
+        shared.push((x == m) as u8 + (y == m) as u8 + (z == m) as u8);
+        a = &a[(x == m) as usize..];
+        b = &b[(y == m) as usize..];
+        c = &c[(z == m) as usize..];
+    }
 }
 
 /// Finds the creases of `mesh` (`topology` built from it).
 pub fn detect_creases(mesh: &TriMesh, topology: &Topology, options: &CreaseOptions) -> Creases {
-    let vertex_count = mesh.positions.len();
-    let normals = filtered_face_normals(
+    let normals = filter_face_normals(
         mesh,
         topology,
+        &face_normals(mesh),
         options.normal_filtering,
         options.normal_sigma,
     );
-    let threshold = options.angle_degrees.to_radians().cos();
-    // Feature edges, found from their lower end: the faces both ends share.
-    // Each feature edge with the direction its two faces' normals give it (n_a × n_b, along the
-    // crease however noisy the vertex positions are).
-    let found: Vec<([u32; 2], DVec3)> = (0..vertex_count as u32)
+    finish(
+        mesh,
+        topology,
+        feature_edges(mesh, topology, &normals, options),
+        options,
+    )
+}
+
+/// The noise estimate and the creases, with the normals filtered at least as much as the
+/// estimate asks for ([`super::strength::normal_filtering_for`]), for a caller that has the
+/// fan-ordered one-rings (constrained fairing builds them anyway; the hierarchy builds them for
+/// this). The estimate's gather finds the feature edges of the faces' own normals at once
+/// ([`super::strength::scan_fans`]); when the estimate says the mesh is clean (no filtering),
+/// those are the creases' edges, and the guided filter is skipped entirely.
+pub(crate) fn detect_creases_with_estimate(
+    mesh: &TriMesh,
+    topology: &Topology,
+    fans: &FanRings,
+    options: &CreaseOptions,
+) -> (Option<f64>, Creases) {
+    let scan = scan_fans(mesh, topology, fans, options.angle_degrees);
+    let mut options = options.clone();
+    options.normal_filtering = options
+        .normal_filtering
+        .max(scan.noise.map_or(0, normal_filtering_for));
+    let creases = if options.normal_filtering == 0 {
+        finish(mesh, topology, scan.edges, &options)
+    } else {
+        detect_creases(mesh, topology, &options)
+    };
+    (scan.noise, creases)
+}
+
+/// A feature edge `[v, u]` (v < u) with its crease direction (unit, either sign).
+pub(crate) type FeatureEdge = ([u32; 2], Vec3A);
+
+/// Every feature edge `[v, u]` (v < u, ascending by v then u) with the direction its two faces'
+/// normals give it (n_a × n_b, along the crease however noisy the vertex positions are); in
+/// parallel over the vertices, each edge found from its lower end.
+fn feature_edges(
+    mesh: &TriMesh,
+    topology: &Topology,
+    normals: &[Vec3A],
+    options: &CreaseOptions,
+) -> Vec<FeatureEdge> {
+    let threshold = options.angle_degrees.to_radians().cos() as f32;
+    (0..mesh.positions.len() as u32)
         .into_par_iter()
         .with_min_len(1024)
         .flat_map_iter(|v| {
-            // The faces of an edge v-u are among v's own: no other vertex's list is searched.
-            let faces_v = topology.faces_of(v);
-            let normals = &normals;
-            faces_v.iter().enumerate().flat_map(move |(i, &f)| {
-                mesh.triangles[f as usize]
-                    .into_iter()
-                    .filter(move |&u| u > v)
-                    .filter_map(move |u| {
-                        // Each edge once: from the first of its faces in v's list.
-                        let has_u = |g: &u32| mesh.triangles[*g as usize].contains(&u);
-                        if faces_v[..i].iter().any(has_u) {
-                            return None;
-                        }
-                        let mut others = faces_v[i + 1..].iter().filter(|g| has_u(g));
-                        let (Some(&g), None) = (others.next(), others.next()) else {
-                            return None;
-                        };
-                        let (na, nb) = (normals[f as usize], normals[g as usize]);
-                        (na != DVec3::ZERO && nb != DVec3::ZERO && na.dot(nb) < threshold)
-                            .then(|| ([v, u], na.cross(nb).normalize_or_zero()))
-                    })
-            })
+            let mut edges = Vec::new();
+            vertex_feature_edges(
+                mesh,
+                topology,
+                v,
+                |f| normals[f as usize],
+                threshold,
+                &mut edges,
+            );
+            edges
         })
-        .collect();
+        .collect()
+}
+
+/// Appends the feature edges `[v, u]` with u > v, ascending by u, with `normal(f)` the unit
+/// normal of face f: the edges with exactly two faces whose normals' dot product is below
+/// `threshold` (the cosine of the crease angle). The faces of an edge v–u are among v's own, so
+/// no other vertex's list is searched, and v's triangles are read once.
+pub(crate) fn vertex_feature_edges(
+    mesh: &TriMesh,
+    topology: &Topology,
+    v: u32,
+    normal: impl Fn(u32) -> Vec3A,
+    threshold: f32,
+    edges: &mut Vec<FeatureEdge>,
+) {
+    let first = edges.len();
+    let faces_v = topology.faces_of(v);
+    let mut buffer = [[0u32; 3]; 32];
+    let heap: Vec<[u32; 3]>;
+    let corners: &[[u32; 3]] = if faces_v.len() <= buffer.len() {
+        for (slot, &f) in buffer.iter_mut().zip(faces_v) {
+            *slot = mesh.triangles[f as usize];
+        }
+        &buffer[..faces_v.len()]
+    } else {
+        heap = faces_v
+            .iter()
+            .map(|&f| mesh.triangles[f as usize])
+            .collect();
+        &heap
+    };
+    for (i, &t) in corners.iter().enumerate() {
+        for u in t {
+            if u <= v {
+                continue;
+            }
+            // Each edge once: from the first of its faces in v's list; an edge with other than
+            // two faces is no feature edge.
+            let has_u = |t: &[u32; 3]| t.contains(&u);
+            if corners[..i].iter().any(has_u) {
+                continue;
+            }
+            let mut others = (i + 1..corners.len()).filter(|&j| has_u(&corners[j]));
+            let (Some(j), None) = (others.next(), others.next()) else {
+                continue;
+            };
+            if let Some(direction) = feature(normal(faces_v[i]), normal(faces_v[j]), threshold) {
+                edges.push(([v, u], direction));
+            }
+        }
+    }
+    edges[first..].sort_unstable_by_key(|&([_, u], _)| u);
+}
+
+/// [`vertex_feature_edges`] for a vertex with a closed fan, from its ring (`ring[k]` = x_k, face k
+/// = (v, x_k, x_(k+1)), at most 64) and the offsets `d[k]` = x_k − x_v: edge v–x_k lies on faces
+/// k − 1 and k, whose normals are d_(k−1) × d_k and d_k × d_(k+1), so no face is read.
+pub(crate) fn fan_feature_edges(
+    v: u32,
+    ring: &[u32],
+    d: &[Vec3A],
+    threshold: f32,
+    edges: &mut Vec<FeatureEdge>,
+) {
+    let first = edges.len();
+    let n = ring.len();
+    let unit = |k: usize| {
+        d[k].cross(d[(k + 1) % n])
+            .try_normalize()
+            .unwrap_or(Vec3A::ZERO)
+    };
+    let mut last = unit(n - 1);
+    for (k, &u) in ring.iter().enumerate() {
+        let face = unit(k);
+        if u > v {
+            if let Some(direction) = feature(last, face, threshold) {
+                edges.push(([v, u], direction));
+            }
+        }
+        last = face;
+    }
+    edges[first..].sort_unstable_by_key(|&([_, u], _)| u);
+}
+
+/// The crease direction of an edge whose faces have the unit normals `na` and `nb`, when it is a
+/// feature edge (`na · nb` below `threshold`; a face without a normal makes none).
+#[inline]
+fn feature(na: Vec3A, nb: Vec3A, threshold: f32) -> Option<Vec3A> {
+    (na != Vec3A::ZERO && nb != Vec3A::ZERO && na.dot(nb) < threshold)
+        .then(|| na.cross(nb).normalize_or_zero())
+}
+
+/// The creases from the feature edges: small and zigzagging groups dropped, vertices classified,
+/// chains walked.
+fn finish(
+    mesh: &TriMesh,
+    topology: &Topology,
+    found: Vec<FeatureEdge>,
+    options: &CreaseOptions,
+) -> Creases {
+    let vertex_count = mesh.positions.len();
+    if found.is_empty() {
+        return Creases {
+            class: vec![FeatureClass::Smooth; vertex_count],
+            ..Creases::default()
+        };
+    }
     let edges: Vec<[u32; 2]> = found.iter().map(|&(e, _)| e).collect();
-    let directions: HashMap<[u32; 2], DVec3> = found.into_iter().collect();
+    let directions: HashMap<[u32; 2], Vec3A> = found.into_iter().collect();
     // Small groups are noise or spikes; so are groups that zigzag (more corners than one per two
     // edges: a true crease, even a noisy one, runs straight between few corners).
     let max_turn = options.corner_turn_degrees.to_radians().cos();
@@ -397,7 +667,7 @@ enum Turn<'a> {
     /// Between the edges themselves (from the vertex positions).
     Positions(&'a TriMesh),
     /// Between the edges' crease directions (from their faces' filtered normals).
-    Directions(&'a HashMap<[u32; 2], DVec3>),
+    Directions(&'a HashMap<[u32; 2], Vec3A>),
 }
 
 /// Every vertex's class, from its feature edges.
@@ -425,7 +695,7 @@ fn classify(
                         // The signs of crease directions are arbitrary.
                         Turn::Directions(directions) => {
                             let key = |u: u32| [u.min(v as u32), u.max(v as u32)];
-                            directions[&key(a)].dot(directions[&key(b)]).abs()
+                            directions[&key(a)].dot(directions[&key(b)]).abs() as f64
                         }
                     };
                     if straight >= max_turn {
@@ -503,6 +773,48 @@ mod tests {
         // 4·(20 + 10 + 5) edges along the box's edges, their inner vertices crease vertices.
         assert_eq!(creases.edges.len(), 4 * 35);
         assert_eq!(crease, 4 * 35 - 12);
+    }
+
+    /// The path constrained fairing and the hierarchy take (the estimate's gather over the fans
+    /// finds the feature edges of the faces' own normals, and the guided filter is skipped on a
+    /// clean mesh) gives the creases the general path gives, and filters like it on a noisy one.
+    #[test]
+    fn the_fan_scan_finds_the_creases_the_general_path_finds() {
+        use crate::fairing::strength::{estimate_noise, normal_filtering_for};
+        use crate::noise::{add_noise, NoiseOptions};
+        let mut noisy = cuboid([1.0, 1.0, 1.0], 0.05);
+        add_noise(&mut noisy, &NoiseOptions::default().with_sigma(0.3));
+        for mesh in [cuboid([2.0, 1.0, 0.5], 0.1), cylinder(1.0, 1.0, 0.1), noisy] {
+            let topology = Topology::build(&mesh);
+            let fans = FanRings::new(&mesh.triangles, &topology);
+            let options = CreaseOptions::default();
+            let (estimate, creases) =
+                detect_creases_with_estimate(&mesh, &topology, &fans, &options);
+            let general_estimate = estimate_noise(&mesh, &topology).unwrap();
+            let estimate = estimate.unwrap();
+            assert!(
+                (estimate - general_estimate).abs() < 1e-5,
+                "{estimate} {general_estimate}"
+            );
+            let filtering = normal_filtering_for(estimate);
+            let general = detect_creases(
+                &mesh,
+                &topology,
+                &options.clone().with_normal_filtering(filtering),
+            );
+            assert!(!creases.is_empty());
+            assert_eq!(creases, general, "filtering {filtering}");
+            // And without filtering the scan's raw edges are the general path's.
+            let raw = scan_fans(&mesh, &topology, &fans, options.angle_degrees).edges;
+            let general: Vec<[u32; 2]> = {
+                let unit = filter_face_normals(&mesh, &topology, &face_normals(&mesh), 0, 0.5);
+                feature_edges(&mesh, &topology, &unit, &options)
+                    .into_iter()
+                    .map(|(e, _)| e)
+                    .collect()
+            };
+            assert_eq!(raw.into_iter().map(|(e, _)| e).collect::<Vec<_>>(), general);
+        }
     }
 
     #[test]

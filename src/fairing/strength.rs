@@ -20,8 +20,10 @@
 //! along the normals on a valence-6 mesh, measured) and by the mean edge length. The result reads
 //! as "noise of this standard deviation, in mean edge lengths".
 
+use super::constrained::FanRings;
+use super::creases::{fan_feature_edges, vertex_feature_edges, FeatureEdge};
 use crate::mesh::{Topology, TriMesh};
-use glam::DVec3;
+use glam::Vec3A;
 use rayon::prelude::*;
 
 /// The spread of r_v (see the module docs) for unit Gaussian noise along the normals: measured
@@ -31,49 +33,179 @@ pub const NOISE_GAIN: f64 = 1.5;
 
 /// The noise level of `mesh`, in mean edge lengths (see the module docs); `None` when fewer than
 /// 16 vertices have a closed fan.
+///
+/// In f32 (positions are f32, the differences x_u − x_v of neighbours are exact, and h_v, the
+/// normal part of their mean, carries a relative rounding error near 1e-7, far below the
+/// 0.001-edge-length resolution the estimate is read at), in two parallel gathers over the
+/// vertices; each vertex is computed by the same operations whatever the thread count, and the
+/// median does not depend on the order, so neither does the result.
 pub fn estimate_noise(mesh: &TriMesh, topology: &Topology) -> Option<f64> {
+    estimate(mesh, topology, None, None).0
+}
+
+/// [`estimate_noise`] for a caller that has the fan-ordered one-rings (constrained fairing builds
+/// them anyway): see [`scan_fans`].
+pub(crate) fn estimate_noise_with_fans(
+    mesh: &TriMesh,
+    topology: &Topology,
+    fans: &FanRings,
+) -> Option<f64> {
+    estimate(mesh, topology, Some(fans), None).0
+}
+
+/// What [`scan_fans`] finds.
+pub(crate) struct FanScan {
+    /// [`estimate_noise`].
+    pub noise: Option<f64>,
+    /// The feature edges of the faces' own normals at the crease angle asked for, as
+    /// [`super::creases::detect_creases`] finds them with no normal filtering.
+    pub edges: Vec<FeatureEdge>,
+}
+
+/// The noise estimate and, at once, the feature edges at `crease_angle` (degrees) of the faces'
+/// own normals (what crease detection needs when the estimate says the mesh is clean; a caller
+/// whose mesh turns out noisy filters the normals and finds them again), in one gather over the
+/// fan-ordered one-rings: a vertex with a closed fan takes its normal from the ring it reads for
+/// the umbrella, Σ (x_k − x) × (x_(k+1) − x) (the sum of its faces' area normals), and its faces'
+/// normals from consecutive offsets, so it reads no face at all. The other vertices (on a
+/// boundary, or whose faces are no single oriented fan) read their faces.
+pub(crate) fn scan_fans(
+    mesh: &TriMesh,
+    topology: &Topology,
+    fans: &FanRings,
+    crease_angle: f64,
+) -> FanScan {
+    let (noise, edges) = estimate(mesh, topology, Some(fans), Some(crease_angle));
+    FanScan { noise, edges }
+}
+
+/// Vertices per block of the estimate's gather (each block's edge-length sum and feature edges
+/// are kept apart and joined in order, so nothing depends on the thread count).
+const VERTEX_BLOCK: usize = 4096;
+
+/// The estimate (with the mean edge length summed in the same gather, as
+/// [`crate::metrics::mean_edge_length`] defines it) and, with a crease angle, the feature edges.
+fn estimate(
+    mesh: &TriMesh,
+    topology: &Topology,
+    fans: Option<&FanRings>,
+    crease_angle: Option<f64>,
+) -> (Option<f64>, Vec<FeatureEdge>) {
     let n = mesh.positions.len();
-    let edge = crate::metrics::mean_edge_length(mesh);
-    if !(edge > 0.0 && edge.is_finite()) {
-        return None;
-    }
-    // h_v with its validity (closed fan, finite normal).
-    let heights: Vec<Option<f64>> = (0..n as u32)
-        .into_par_iter()
-        .map(|v| {
-            let ring = topology.neighbors(v);
-            if topology.is_boundary_vertex(v) || ring.len() < 3 {
-                return None;
+    let point = |v: u32| Vec3A::from_array(mesh.positions[v as usize]);
+    let ring_offsets = topology.neighbor_csr().0;
+    let threshold = crease_angle.map(|angle| angle.to_radians().cos() as f32);
+    let mut heights = vec![0.0f32; n];
+    // Per vertex: h_v (NaN where it is not defined: an open fan, fewer than three neighbours, no
+    // normal); its share of the edge lengths (half of each of its faces' two edges at v, so that
+    // the shares add up to the faces' edge lengths); its feature edges.
+    let blocks: Vec<(f64, Vec<FeatureEdge>)> = heights
+        .par_chunks_mut(VERTEX_BLOCK)
+        .enumerate()
+        .map(|(b, out)| {
+            let mut edge_sum = 0.0f64;
+            let mut edges = Vec::new();
+            let mut d = [Vec3A::ZERO; 64];
+            for (i, h) in out.iter_mut().enumerate() {
+                let v = (b * VERTEX_BLOCK + i) as u32;
+                let valence = topology.valence(v);
+                let x = point(v);
+                let mut offset = Vec3A::ZERO;
+                let mut normal = Vec3A::ZERO;
+                let mut lengths = 0.0f32;
+                match fans.filter(|fans| fans.closed_fan[v as usize]) {
+                    Some(fans) => {
+                        let ring = &fans.ring[ring_offsets[v as usize] as usize
+                            ..ring_offsets[v as usize + 1] as usize];
+                        for (slot, &u) in d.iter_mut().zip(ring) {
+                            *slot = point(u) - x;
+                        }
+                        let d = &d[..valence];
+                        let mut previous = d[valence - 1];
+                        for &dk in d {
+                            offset += dk;
+                            normal += previous.cross(dk);
+                            lengths += dk.length();
+                            previous = dk;
+                        }
+                        if let Some(threshold) = threshold {
+                            fan_feature_edges(v, ring, d, threshold, &mut edges);
+                        }
+                    }
+                    None => {
+                        for &u in topology.neighbors(v) {
+                            offset += point(u) - x;
+                        }
+                        for &f in topology.faces_of(v) {
+                            normal += area_normal(mesh, f);
+                            for c in mesh.triangles[f as usize] {
+                                if c != v {
+                                    lengths += 0.5 * (point(c) - x).length();
+                                }
+                            }
+                        }
+                        if let Some(threshold) = threshold {
+                            let unit = |f: u32| {
+                                area_normal(mesh, f).try_normalize().unwrap_or(Vec3A::ZERO)
+                            };
+                            vertex_feature_edges(mesh, topology, v, unit, threshold, &mut edges);
+                        }
+                    }
+                }
+                edge_sum += lengths as f64;
+                *h = match normal.try_normalize() {
+                    Some(normal) if !topology.is_boundary_vertex(v) && valence >= 3 => {
+                        normal.dot(offset) / valence as f32
+                    }
+                    _ => f32::NAN,
+                };
             }
-            let x = mesh.point(v);
-            let mean = ring.iter().map(|&u| mesh.point(u)).sum::<DVec3>() / ring.len() as f64;
-            let normal = topology
-                .faces_of(v)
-                .iter()
-                .map(|&f| mesh.face_normal(f as usize))
-                .sum::<DVec3>()
-                .try_normalize()?;
-            Some(normal.dot(mean - x))
+            (edge_sum, edges)
         })
         .collect();
-    let mut residuals: Vec<f64> = (0..n as u32)
+    let edge = blocks.iter().map(|(sum, _)| sum).sum::<f64>() / (3 * mesh.triangles.len()) as f64;
+    let edges: Vec<FeatureEdge> = blocks.into_iter().flat_map(|(_, e)| e).collect();
+    if !(edge > 0.0 && edge.is_finite()) {
+        return (None, edges);
+    }
+    let mut residuals: Vec<f32> = (0..n as u32)
         .into_par_iter()
+        .with_min_len(VERTEX_BLOCK)
         .filter_map(|v| {
-            let own = heights[v as usize]?;
+            let own = heights[v as usize];
             let ring = topology.neighbors(v);
             let mut sum = 0.0;
             for &u in ring {
-                sum += heights[u as usize]?;
+                sum += heights[u as usize];
             }
-            Some((own - sum / ring.len() as f64).abs())
+            // NaN (a vertex or a neighbour without h) fails the comparison.
+            let residual = (own - sum / ring.len() as f32).abs();
+            (residual >= 0.0).then_some(residual)
         })
         .collect();
     if residuals.len() < 16 {
-        return None;
+        return (None, edges);
     }
     let middle = residuals.len() / 2;
-    let (_, median, _) = residuals.select_nth_unstable_by(middle, f64::total_cmp);
-    Some(1.4826 * *median / NOISE_GAIN / edge)
+    let (_, median, _) = residuals.select_nth_unstable_by(middle, f32::total_cmp);
+    (Some(1.4826 * *median as f64 / NOISE_GAIN / edge), edges)
+}
+
+/// The area normal of face `f`, (x_b − x_a) × (x_c − x_a) (twice its area long), in f32.
+#[inline]
+pub(crate) fn area_normal(mesh: &TriMesh, f: u32) -> Vec3A {
+    let [a, b, c] =
+        mesh.triangles[f as usize].map(|v| Vec3A::from_array(mesh.positions[v as usize]));
+    (b - a).cross(c - a)
+}
+
+/// Every face's area normal ([`area_normal`]), in parallel.
+pub(crate) fn face_normals(mesh: &TriMesh) -> Vec<Vec3A> {
+    (0..mesh.triangles.len() as u32)
+        .into_par_iter()
+        .with_min_len(4096)
+        .map(|f| area_normal(mesh, f))
+        .collect()
 }
 
 /// At or below this estimate a mesh counts as clean and automatic fairing leaves it alone (mean

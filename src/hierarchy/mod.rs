@@ -24,16 +24,17 @@
 //! estimate asks), corners never collapse and crease vertices collapse only along their crease
 //! (see `decimate.rs`), so every level's creases are M0's feature edges with their ends followed
 //! along `target` ([`Hierarchy::level_creases`]); multiresolution fairing fairs them as curves.
-//! The detection costs a topology, the noise estimate and the edge test (on the 1.2M-face mesh
-//! about 0.4 s, `docs/measurements.md`).
+//! The detection costs a topology, the fan-ordered one-rings and one gather over them that gives
+//! the noise estimate and the feature edges together (the guided normal filter only on a noisy
+//! mesh); figures in `docs/measurements.md`.
 //!
 //! Storage per M0 vertex: target 4 bytes, cone volume 4, the vertex order both ways 8, and the
 //! face order (about two faces per vertex) 8: 24 bytes, besides M0 itself in internal order.
 
 mod decimate;
 
-use crate::fairing::creases::{detect_creases, CreaseOptions, Creases, FeatureClass};
-use crate::fairing::strength::{estimate_noise, normal_filtering_for};
+use crate::fairing::constrained::FanRings;
+use crate::fairing::creases::{detect_creases_with_estimate, CreaseOptions, Creases, FeatureClass};
 use crate::mesh::{Topology, TriMesh};
 use crate::Progress;
 use decimate::NEVER;
@@ -431,11 +432,8 @@ pub fn build_hierarchy(
         .as_ref()
         .map(|crease_options| {
             let topology = Topology::build(mesh);
-            let mut crease_options = crease_options.clone();
-            crease_options.normal_filtering = crease_options
-                .normal_filtering
-                .max(estimate_noise(mesh, &topology).map_or(0, normal_filtering_for));
-            detect_creases(mesh, &topology, &crease_options)
+            let fans = FanRings::new(&mesh.triangles, &topology);
+            detect_creases_with_estimate(mesh, &topology, &fans, crease_options).1
         })
         .filter(|creases| !creases.is_empty());
     let setup_ms = started.elapsed().as_secs_f64() * 1e3;
