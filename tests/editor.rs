@@ -917,3 +917,30 @@ fn keep_sharp_edges_keeps_a_boxs_edges_in_the_hierarchy_and_draws_them_while_poi
     assert_eq!(harness.state().status().sharp_edges_kept, 0);
     assert!(!harness.state().settings().keep_sharp_edges);
 }
+
+/// The noise controls explain themselves too (sigma, seed, direction and the button).
+#[test]
+fn noise_controls_explain_themselves() {
+    let bunny = bunny();
+    let mut harness = egui_kittest::Harness::builder()
+        .with_size(egui::vec2(1200.0, 1600.0))
+        .wgpu()
+        .build_eframe(move |cc| fairmesh::app::App::new_for_test(cc, bunny));
+    settle(&mut harness);
+    use fairmesh::app::panels::tips;
+    for (label, tip) in [
+        ("Sigma (× mean edge)", tips::NOISE_SIGMA),
+        ("Seed", tips::NOISE_SEED),
+        ("Noise direction", tips::NOISE_DIRECTION),
+    ] {
+        let described = harness
+            .query_all_by(move |node| node.description().as_deref() == Some(tip))
+            .count();
+        assert!(described >= 1, "{label} has no tooltip");
+    }
+    let slider = harness.get_by_role_and_label(Role::Slider, "Sigma (× mean edge)");
+    assert_eq!(
+        slider.accesskit_node().description().as_deref(),
+        Some(tips::NOISE_SIGMA)
+    );
+}

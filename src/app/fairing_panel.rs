@@ -243,6 +243,14 @@ pub(super) fn sharp_edge_overlay(app: &mut App, ui: &egui::Ui, rect: egui::Rect)
 
 /// The fairing controls' tooltips: what each does and when to change it, in plain words.
 pub mod tips {
+    pub const NOISE_SIGMA: &str = "How strong the noise is: how far, on average, each vertex \
+        is pushed, in mean edge lengths. 0.3 looks like a rough scan; 1 and more hides the shape.";
+    pub const NOISE_SEED: &str = "Which random pattern the noise uses. The same seed and \
+        strength give the same noise again, to compare smoothers on it; change it for another.";
+    pub const NOISE_DIRECTION: &str = "Which way the noise pushes the vertices. Along the \
+        normal: in and out of the surface, like a scanner's depth error. Random direction (the \
+        paper's test) and Isotropic (x, y and z each on their own): also along the surface, \
+        which jitters the triangles too.";
     pub const KEEP_SHARP_EDGES: &str = "Keep the mesh's sharp edges (the edges of a machined \
         part, a fold, a rim) sharp: the coarse levels keep them and the smoothing runs along them, \
         not across them. Turn it off for organic shapes if smoothing leaves ridges where there \

@@ -219,11 +219,13 @@ fn mesh_section(app: &mut App, ui: &mut egui::Ui) {
 fn noise_section(app: &mut App, ui: &mut egui::Ui) {
     ui.separator();
     ui.heading("Noise");
-    ui.add(egui::Slider::new(&mut app.settings.noise_sigma, 0.0..=2.0).text("Sigma (× mean edge)"));
+    ui.add(egui::Slider::new(&mut app.settings.noise_sigma, 0.0..=2.0).text("Sigma (× mean edge)"))
+        .on_hover_text(tips::NOISE_SIGMA);
     ui.horizontal(|ui| {
-        let label = ui.label("Seed");
+        let label = ui.label("Seed").on_hover_text(tips::NOISE_SEED);
         ui.add(egui::DragValue::new(&mut app.settings.noise_seed))
-            .labelled_by(label.id);
+            .labelled_by(label.id)
+            .on_hover_text(tips::NOISE_SEED);
     });
     egui::ComboBox::from_label("Noise direction")
         .selected_text(noise_mode_name(app.settings.noise_mode))
@@ -235,7 +237,9 @@ fn noise_section(app: &mut App, ui: &mut egui::Ui) {
             ] {
                 ui.selectable_value(&mut app.settings.noise_mode, mode, noise_mode_name(mode));
             }
-        });
+        })
+        .response
+        .on_hover_text(tips::NOISE_DIRECTION);
     if ui
         .button("Add noise")
         .on_hover_text(
