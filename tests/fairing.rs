@@ -876,3 +876,30 @@ fn the_default_gives_a_thin_plate_its_volume_back_after_every_round() {
         assert!(outside < 1.5 * edge, "{mode:?}: {outside} outside the slab");
     }
 }
+
+#[test]
+fn automatic_strength_stops_before_the_rounds_wear_a_coarse_scans_detail_away() {
+    // The elephant is coarsely sampled for its detail: after 3-4 rounds the rounds move the
+    // vertices less than about twice the noise they leave, and each further round takes more
+    // detail than noise (`docs/measurements.md`). The automatic strength stops there.
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/elephant.obj");
+    let clean = fairmesh::io::load(&path).unwrap().mesh;
+    let topology = Topology::build(&clean);
+    let input = noisy(clean.clone(), 0.3, 1);
+    let distance = |mesh: &TriMesh| {
+        fairmesh::metrics::compare(&clean, mesh).mean_surface_distance / mean_edge_length(&clean)
+    };
+    let mut automatic = input.clone();
+    let report = fair_constrained(&mut automatic, &topology, &FairOptions::default());
+    assert!((2..=5).contains(&report.rounds_run), "{report:?}");
+    let mut longer = input.clone();
+    let options = FairOptions::default().with_rounds(report.rounds_run + 3);
+    fair_constrained(&mut longer, &topology, &options);
+    let (stopped, went_on) = (distance(&automatic), distance(&longer));
+    assert!(
+        stopped < 0.95 * went_on && stopped < 0.7 * distance(&input),
+        "stopped after {} rounds: {stopped}; 3 more: {went_on}; input {}",
+        report.rounds_run,
+        distance(&input)
+    );
+}

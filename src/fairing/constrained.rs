@@ -59,8 +59,8 @@
 use super::boundary::BoundaryCurves;
 use super::creases::{detect_creases, detect_creases_with_estimate, Creases, FeatureClass};
 use super::strength::{
-    estimate_noise_with_fans, normal_filtering_for, CLEAN_NOISE, MAX_AUTO_ROUNDS, MIN_NOISE_FALL,
-    NOISE_LEFT,
+    estimate_noise_with_fans, normal_filtering_for, CLEAN_NOISE, MAX_AUTO_ROUNDS,
+    MIN_MOVE_PER_NOISE, MIN_NOISE_FALL, NOISE_LEFT,
 };
 use super::volume::VolumeKeeper;
 use super::{BoundaryMode, FairOptions, FairReport, FairVariant, Strength};
@@ -1031,6 +1031,26 @@ fn split_by_offsets<'a, T>(data: &'a mut [T], offsets: &[u32]) -> Vec<&'a mut [T
     slices
 }
 
+/// Root mean square of the moves from `from` to `to` (same length), model units.
+fn rms_move(from: &[[f32; 3]], to: &[[f32; 3]]) -> f64 {
+    if from.is_empty() {
+        return 0.0;
+    }
+    let sum: f64 = from
+        .par_chunks(CHUNK)
+        .zip(to.par_chunks(CHUNK))
+        .map(|(a, b)| {
+            a.iter()
+                .zip(b)
+                .map(|(p, q)| (0..3).map(|k| f64::from(p[k] - q[k]).powi(2)).sum::<f64>())
+                .sum::<f64>()
+        })
+        .collect::<Vec<f64>>()
+        .iter()
+        .sum();
+    (sum / from.len() as f64).sqrt()
+}
+
 /// Constrained fairing of `mesh` in place (sections 3.2 and 3.3); `topology` must be built from
 /// `mesh`. Precomputes the operator (see [`ConstrainedFairing`] to reuse it) and runs
 /// `options.rounds` rounds of up to `options.iterations` iterations each.
@@ -1148,6 +1168,10 @@ pub fn fair_constrained(
     // Automatic strength: round by round until the noise left is a small part of the input's
     // (or no longer falls): see [`super::strength`].
     let mut noise_now = estimate;
+    // Automatic strength also watches how far each round moves the vertices, against the noise
+    // it leaves (see [`MIN_MOVE_PER_NOISE`]).
+    let edge = auto_noise.map(|_| crate::metrics::mean_edge_length(mesh));
+    let mut round_start = Vec::new();
     for round in 0..max_rounds {
         if round > 0 && redetect {
             let found = detect(mesh, noise_now);
@@ -1155,6 +1179,9 @@ pub fn fair_constrained(
                 creases = found;
                 fairing = build(mesh, creases.as_ref());
             }
+        }
+        if edge.is_some() {
+            round_start.clone_from(&mesh.positions);
         }
         // Imposes the constraints on the positions this round starts from.
         fairing.load(&mesh.positions);
@@ -1175,6 +1202,10 @@ pub fn fair_constrained(
             };
             let last = noise_now.unwrap_or(noise);
             if now <= noise * NOISE_LEFT || now > last * MIN_NOISE_FALL {
+                break;
+            }
+            let moved = rms_move(&round_start, &mesh.positions) / edge.unwrap_or(1.0);
+            if round > 0 && moved < MIN_MOVE_PER_NOISE * now {
                 break;
             }
             noise_now = Some(now);
