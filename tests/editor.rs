@@ -13,7 +13,9 @@ use egui_kittest::kittest::{NodeT, Queryable};
 use egui_kittest::SnapshotOptions;
 
 mod editor_common;
-use editor_common::{bunny, drag, harness_for, harness_with, retype, settle, viewport_image};
+use editor_common::{
+    bunny, drag, harness_for, harness_sized, harness_with, retype, settle, viewport_image,
+};
 use fairmesh::app::AppOptions;
 
 fn snapshot_options() -> SnapshotOptions {
@@ -570,11 +572,7 @@ fn numbers_of_the_previous_result_are_greyed_until_the_new_ones_arrive() {
 /// message or an error does not move the controls under the pointer (issue 13).
 #[test]
 fn small_window_keeps_the_toolbar_and_messages_do_not_move_the_controls() {
-    let bunny = bunny();
-    let mut harness = egui_kittest::Harness::builder()
-        .with_size(egui::vec2(800.0, 600.0))
-        .wgpu()
-        .build_eframe(move |cc| fairmesh::app::App::new_for_test(cc, bunny));
+    let mut harness = harness_sized(bunny(), egui::vec2(800.0, 600.0));
     settle(&mut harness);
     for label in ["Level mesh", "Input mesh", "Undo", "Redo"] {
         let rect = harness.get_by_label(label).rect();
@@ -649,12 +647,8 @@ fn side_by_side_halves_show_the_whole_mesh() {
 /// numbers name the method instead of a start level it did not use (issue 13).
 #[test]
 fn fairing_controls_explain_themselves_and_say_why_they_are_off() {
-    let bunny = bunny();
     // Tall enough that the whole side panel is on screen.
-    let mut harness = egui_kittest::Harness::builder()
-        .with_size(egui::vec2(1200.0, 1600.0))
-        .wgpu()
-        .build_eframe(move |cc| fairmesh::app::App::new_for_test(cc, bunny));
+    let mut harness = harness_sized(bunny(), egui::vec2(1200.0, 1600.0));
     settle(&mut harness);
     let description =
         |harness: &egui_kittest::Harness<'_, fairmesh::app::App>, role: Role, label: &str| {
@@ -741,11 +735,7 @@ fn a_file_opens_at_a_middle_level_then_at_the_last_one_chosen() {
 /// good, taking the viewport's room).
 #[test]
 fn performance_section_keeps_the_side_panel_width() {
-    let bunny = bunny();
-    let mut harness = egui_kittest::Harness::builder()
-        .with_size(egui::vec2(1200.0, 1600.0))
-        .wgpu()
-        .build_eframe(move |cc| fairmesh::app::App::new_for_test(cc, bunny));
+    let mut harness = harness_sized(bunny(), egui::vec2(1200.0, 1600.0));
     settle(&mut harness);
     let width = harness.state().viewport_rect().unwrap().width();
     harness.get_by_label("Performance").click();
@@ -921,11 +911,7 @@ fn keep_sharp_edges_keeps_a_boxs_edges_in_the_hierarchy_and_draws_them_while_poi
 /// The noise controls explain themselves too (sigma, seed, direction and the button).
 #[test]
 fn noise_controls_explain_themselves() {
-    let bunny = bunny();
-    let mut harness = egui_kittest::Harness::builder()
-        .with_size(egui::vec2(1200.0, 1600.0))
-        .wgpu()
-        .build_eframe(move |cc| fairmesh::app::App::new_for_test(cc, bunny));
+    let mut harness = harness_sized(bunny(), egui::vec2(1200.0, 1600.0));
     settle(&mut harness);
     use fairmesh::app::panels::tips;
     for (label, tip) in [

@@ -11,7 +11,7 @@ use egui_kittest::Harness;
 use fairmesh::app::{App, Command};
 
 mod editor_common;
-use editor_common::{bunny, drag, harness_for, retype, settle, viewport_image};
+use editor_common::{bunny, drag, harness_for, harness_sized, retype, settle, viewport_image};
 
 /// Loads the bunny, adds the default noise (sigma 0.3 of the mean edge, seed 1, along the
 /// normal) through the panel's button, and fairs from a middle level: M4 of the bunny's 19
@@ -423,12 +423,8 @@ fn baselines_shrink_where_the_paper_method_does_not() {
 fn exports_the_level_chain_into_a_folder() {
     let dir = tempfile::tempdir().unwrap();
     let folder = dir.path().join("lod");
-    let bunny = bunny();
     // Tall enough that the whole side panel is on screen.
-    let mut harness = Harness::builder()
-        .with_size(egui::vec2(1200.0, 1800.0))
-        .wgpu()
-        .build_eframe(move |cc| App::new_for_test(cc, bunny));
+    let mut harness = harness_sized(bunny(), egui::vec2(1200.0, 1800.0));
     settle(&mut harness);
     let levels = harness.state().status().level_count;
     assert!(levels >= 3);

@@ -6,7 +6,7 @@
 use egui_kittest::kittest::Queryable;
 
 mod editor_common;
-use editor_common::{bunny, harness_for, settle, viewport_image};
+use editor_common::{bunny, harness_for, harness_sized, settle, viewport_image};
 use fairmesh::app::App;
 
 type Harness = egui_kittest::Harness<'static, App>;
@@ -122,11 +122,7 @@ fn painting_a_disc_fairs_only_inside_it_and_undo_removes_the_mask() {
 #[test]
 fn invert_and_clear_change_the_mask_and_explain_themselves() {
     // Tall enough that the whole side panel is on screen.
-    let path = bunny();
-    let mut harness = egui_kittest::Harness::builder()
-        .with_size(egui::vec2(1200.0, 1600.0))
-        .wgpu()
-        .build_eframe(move |cc| App::new_for_test(cc, path));
+    let mut harness = harness_sized(bunny(), egui::vec2(1200.0, 1600.0));
     settle(&mut harness);
     harness.get_by_label("Paint (P)").click();
     harness.step();

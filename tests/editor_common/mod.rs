@@ -16,8 +16,13 @@ pub fn bunny() -> PathBuf {
 }
 
 pub fn harness_for(path: PathBuf) -> Harness<'static, App> {
+    harness_sized(path, egui::vec2(1200.0, 800.0))
+}
+
+/// Like [`harness_for`], in a window of `size` points (tall ones show the whole side panel).
+pub fn harness_sized(path: PathBuf, size: egui::Vec2) -> Harness<'static, App> {
     Harness::builder()
-        .with_size(egui::vec2(1200.0, 800.0))
+        .with_size(size)
         .wgpu()
         .build_eframe(move |cc| App::new_for_test(cc, path))
 }
