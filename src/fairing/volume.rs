@@ -34,7 +34,7 @@ const NEWTON_STEPS: usize = 2;
 pub struct VolumeKeeper {
     /// Connected part of each face.
     face_part: Vec<u32>,
-    /// Connected part of each vertex (`u32::MAX`: on no face).
+    /// Connected part of each vertex (`Topology::component_of_vertex`).
     vertex_part: Vec<u32>,
     /// Per part: the apex of its cone volume and the volume to keep.
     apex: Vec<DVec3>,
@@ -48,13 +48,10 @@ impl VolumeKeeper {
     /// vertex) marks vertices that must not move. Boundary vertices never move.
     pub fn new(mesh: &TriMesh, topology: &Topology, fixed: &[bool]) -> Self {
         let n = mesh.positions.len();
-        let vertex_part = connected_parts(mesh, topology);
-        let parts = vertex_part
-            .iter()
-            .filter(|&&p| p != u32::MAX)
-            .map(|&p| p as usize + 1)
-            .max()
-            .unwrap_or(0);
+        // The topology's connected components (an isolated vertex is a part of its own, with
+        // no face and nothing to move).
+        let vertex_part = topology.component_of_vertex.clone();
+        let parts = topology.components.len();
         let face_part: Vec<u32> = mesh
             .triangles
             .iter()
@@ -63,10 +60,8 @@ impl VolumeKeeper {
         let mut sum = vec![DVec3::ZERO; parts];
         let mut count = vec![0usize; parts];
         for (v, &p) in vertex_part.iter().enumerate() {
-            if p != u32::MAX {
-                sum[p as usize] += mesh.point(v as u32);
-                count[p as usize] += 1;
-            }
+            sum[p as usize] += mesh.point(v as u32);
+            count[p as usize] += 1;
         }
         let apex: Vec<DVec3> = sum
             .iter()
@@ -75,7 +70,7 @@ impl VolumeKeeper {
             .collect();
         let movable = (0..n)
             .map(|v| {
-                vertex_part[v] != u32::MAX
+                !topology.faces_of(v as u32).is_empty()
                     && !topology.is_boundary_vertex(v as u32)
                     && !fixed.get(v).copied().unwrap_or(false)
             })
@@ -218,32 +213,6 @@ impl VolumeKeeper {
         }
         total.iter().fold(0.0, |m, d| m.max(d.abs()))
     }
-}
-
-/// The connected part of every vertex (vertices on no face: `u32::MAX`), numbered in order of
-/// their lowest vertex.
-fn connected_parts(mesh: &TriMesh, topology: &Topology) -> Vec<u32> {
-    let n = mesh.positions.len();
-    let mut part = vec![u32::MAX; n];
-    let mut next = 0u32;
-    let mut stack = Vec::new();
-    for start in 0..n as u32 {
-        if part[start as usize] != u32::MAX || topology.faces_of(start).is_empty() {
-            continue;
-        }
-        part[start as usize] = next;
-        stack.push(start);
-        while let Some(v) = stack.pop() {
-            for &u in topology.neighbors(v) {
-                if part[u as usize] == u32::MAX {
-                    part[u as usize] = next;
-                    stack.push(u);
-                }
-            }
-        }
-        next += 1;
-    }
-    part
 }
 
 #[cfg(test)]
