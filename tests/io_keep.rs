@@ -1437,3 +1437,115 @@ fn non_finite_uvs_normals_and_colours_never_reach_another_format() {
         }
     }
 }
+
+/// `gltf` written as a GLB file at `path` (its one buffer as the BIN chunk).
+fn write_glb(gltf: &Gltf, path: &Path) {
+    let mut json = serde_json::to_vec(&gltf.json).unwrap();
+    while json.len() % 4 != 0 {
+        json.push(b' ');
+    }
+    let mut bin = gltf.buffers[0].clone();
+    while bin.len() % 4 != 0 {
+        bin.push(0);
+    }
+    let total = 12 + 8 + json.len() + 8 + bin.len();
+    let mut out = Vec::with_capacity(total);
+    out.extend_from_slice(b"glTF");
+    out.extend_from_slice(&2u32.to_le_bytes());
+    out.extend_from_slice(&(total as u32).to_le_bytes());
+    out.extend_from_slice(&(json.len() as u32).to_le_bytes());
+    out.extend_from_slice(b"JSON");
+    out.extend_from_slice(&json);
+    out.extend_from_slice(&(bin.len() as u32).to_le_bytes());
+    out.extend_from_slice(b"BIN\0");
+    out.extend_from_slice(&bin);
+    std::fs::write(path, out).unwrap();
+}
+
+#[test]
+fn tangents_turn_with_their_normals_and_keep_length_and_handedness() {
+    // The ball of scene.glb with a TANGENT accessor added: per vertex a direction across its
+    // normal (length 1 or 2, handedness +1 or -1 by turns).
+    let dir = tempfile::tempdir().unwrap();
+    let mut input = read_gltf(&data("scene.glb"));
+    let normals = input.floats(input.attribute("ball_mesh", "NORMAL"));
+    let mut bytes = Vec::new();
+    for (k, n) in normals.iter().enumerate() {
+        let n = glam::Vec3::from_slice(n);
+        let across = if n.y.abs() < 0.9 {
+            glam::Vec3::Y
+        } else {
+            glam::Vec3::X
+        };
+        let length = if k % 3 == 0 { 2.0 } else { 1.0 };
+        let t = n.cross(across).normalize() * length;
+        let w = if k % 2 == 0 { 1.0f32 } else { -1.0 };
+        for c in [t.x, t.y, t.z, w] {
+            bytes.extend_from_slice(&c.to_le_bytes());
+        }
+    }
+    let buffer = &mut input.buffers[0];
+    while buffer.len() % 4 != 0 {
+        buffer.push(0);
+    }
+    let offset = buffer.len();
+    buffer.extend_from_slice(&bytes);
+    let length = buffer.len();
+    let json = &mut input.json;
+    json["buffers"][0]["byteLength"] = length.into();
+    let views = json["bufferViews"].as_array_mut().unwrap();
+    views.push(serde_json::json!({"buffer": 0, "byteOffset": offset, "byteLength": bytes.len()}));
+    let view = views.len() - 1;
+    let accessors = json["accessors"].as_array_mut().unwrap();
+    accessors.push(serde_json::json!({
+        "bufferView": view, "componentType": 5126, "count": normals.len(), "type": "VEC4"
+    }));
+    let tangent = accessors.len() - 1;
+    for mesh in json["meshes"].as_array_mut().unwrap() {
+        if mesh["name"] == "ball_mesh" {
+            mesh["primitives"][0]["attributes"]["TANGENT"] = tangent.into();
+        }
+    }
+    let with_tangents = dir.path().join("tangents.glb");
+    write_glb(&input, &with_tangents);
+
+    let loaded = io::load(&with_tangents).unwrap();
+    let mesh = faired(&loaded);
+    let out = dir.path().join("faired.glb");
+    io::save_with_source(&out, &mesh, &loaded.source).unwrap();
+    let output = read_gltf(&out);
+    assert_only_shape_changed(&input, &output, "tangents.glb");
+    let before = input.floats(tangent);
+    let after = output.floats(output.attribute("ball_mesh", "TANGENT"));
+    let turned_normals = output.floats(output.attribute("ball_mesh", "NORMAL"));
+    assert_eq!(after.len(), before.len());
+    let mut turned = 0;
+    for k in 0..before.len() {
+        let (t0, t1) = (
+            glam::Vec3::from_slice(&before[k][..3]),
+            glam::Vec3::from_slice(&after[k][..3]),
+        );
+        let n = glam::Vec3::from_slice(&turned_normals[k]);
+        assert_eq!(
+            after[k][3].to_bits(),
+            before[k][3].to_bits(),
+            "handedness of {k}"
+        );
+        assert!(
+            (t1.length() - t0.length()).abs() < 1e-5,
+            "length of {k}: {t0} -> {t1}"
+        );
+        assert!(
+            t1.dot(n).abs() < 1e-4 * t1.length(),
+            "tangent {k} {t1} not across normal {n}"
+        );
+        if t1.normalize().dot(t0.normalize()) < 0.99999 {
+            turned += 1;
+        }
+    }
+    assert!(
+        turned > before.len() / 4,
+        "only {turned} of {} tangents turned",
+        before.len()
+    );
+}

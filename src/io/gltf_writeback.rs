@@ -194,16 +194,24 @@ impl GltfSource {
             .collect()
     }
 
-    /// The indices of a primitive's triangles (strips and fans unrolled), in its own space.
-    fn triangles(&self, primitive: &Value, vertex_count: usize) -> Vec<[usize; 3]> {
-        let corners: Vec<usize> = match index(primitive, "indices") {
+    /// The indices of a primitive's triangles (strips and fans unrolled), in its own space;
+    /// triangles with a corner past `vertex_count` are left out.
+    fn triangles(&self, primitive: &Value, vertex_count: usize) -> Vec<[u32; 3]> {
+        let mode = primitive.get("mode").and_then(Value::as_u64).unwrap_or(4);
+        let in_range = |t: &[u32; 3]| t.iter().all(|&v| (v as usize) < vertex_count);
+        let corners: Vec<u32> = match index(primitive, "indices") {
             Some(a) => match self.layout(a) {
+                // A triangle list (nearly every file): read straight into triangles.
+                Ok(layout) if layout.components == 1 && mode == 4 => {
+                    let mut triangles = self.read_triangle_list(&layout);
+                    triangles.retain(in_range);
+                    return triangles;
+                }
                 Ok(layout) if layout.components == 1 => self.read_indices(&layout),
                 _ => return Vec::new(),
             },
-            None => (0..vertex_count).collect(),
+            None => (0..vertex_count.min(u32::MAX as usize) as u32).collect(),
         };
-        let mode = primitive.get("mode").and_then(Value::as_u64).unwrap_or(4);
         let mut triangles = Vec::with_capacity(corners.len() / 3);
         match mode {
             4 => triangles.extend(corners.chunks_exact(3).map(|c| [c[0], c[1], c[2]])),
@@ -221,12 +229,12 @@ impl GltfSource {
             }
             _ => {}
         }
-        triangles.retain(|t| t.iter().all(|&v| v < vertex_count));
+        triangles.retain(in_range);
         triangles
     }
 
     /// Every element of an index accessor (its layout checked), read straight from the bytes.
-    fn read_indices(&self, layout: &Layout) -> Vec<usize> {
+    fn read_indices(&self, layout: &Layout) -> Vec<u32> {
         let size = layout.size;
         let bytes = &self.buffers[layout.buffer][layout.start..];
         let elements = bytes
@@ -234,14 +242,42 @@ impl GltfSource {
             .take(layout.count)
             .map(|element| &element[..size]);
         match size {
-            1 => elements.map(|b| b[0] as usize).collect(),
+            1 => elements.map(|b| b[0] as u32).collect(),
             2 => elements
-                .map(|b| u16::from_le_bytes([b[0], b[1]]) as usize)
+                .map(|b| u16::from_le_bytes([b[0], b[1]]) as u32)
                 .collect(),
             _ => elements
-                .map(|b| u32::from_le_bytes([b[0], b[1], b[2], b[3]]) as usize)
+                .map(|b| u32::from_le_bytes([b[0], b[1], b[2], b[3]]))
                 .collect(),
         }
+    }
+
+    /// The triangles of an index accessor read as a triangle list (its layout checked; a last
+    /// incomplete triple is left out), in one pass over the bytes.
+    fn read_triangle_list(&self, layout: &Layout) -> Vec<[u32; 3]> {
+        let (size, stride) = (layout.size, layout.stride);
+        let bytes = &self.buffers[layout.buffer][layout.start..];
+        let at = |k: usize| -> u32 {
+            let b = &bytes[k * stride..k * stride + size];
+            match size {
+                1 => b[0] as u32,
+                2 => u16::from_le_bytes([b[0], b[1]]) as u32,
+                _ => u32::from_le_bytes([b[0], b[1], b[2], b[3]]),
+            }
+        };
+        if size == 4 && stride == 4 {
+            // Tightly packed 32-bit indices: three words a triangle.
+            return bytes[..layout.count / 3 * 12]
+                .chunks_exact(12)
+                .map(|b| {
+                    let word = |i: usize| u32::from_le_bytes([b[i], b[i + 1], b[i + 2], b[i + 3]]);
+                    [word(0), word(4), word(8)]
+                })
+                .collect();
+        }
+        (0..layout.count / 3)
+            .map(|t| [at(3 * t), at(3 * t + 1), at(3 * t + 2)])
+            .collect()
     }
 
     /// TEXCOORD_0 and COLOR_0 per welded vertex, for saving in another format: each read
@@ -407,7 +443,7 @@ impl GltfSource {
                 .into_iter()
                 .map(|t| {
                     let t = if flip { [t[0], t[2], t[1]] } else { t };
-                    t.map(|v| (read.raw_start + v) as u32)
+                    t.map(|v| (read.raw_start + v as usize) as u32)
                 })
                 .collect();
             scene.parts[part].primitives.push(Primitive {
@@ -953,7 +989,7 @@ fn turn_normals(
     }
     // Normal accessor -> its layout, its primitives' triangles with their position accessor, and
     // its tangent accessors.
-    type Uses = Vec<(usize, Layout, Vec<[usize; 3]>)>;
+    type Uses = Vec<(usize, Layout, Vec<[u32; 3]>)>;
     let mut normals: BTreeMap<usize, (Layout, Uses, BTreeSet<usize>)> = BTreeMap::new();
     for primitive in primitives(&gltf.json) {
         let (Some(p), Some(n)) = (
@@ -985,13 +1021,14 @@ fn turn_normals(
             tangents.insert(t);
         }
     }
-    // Per element: the area sums of its faces before and after (gathered in parallel, each
-    // element adding its faces in the order of the triangles, as a serial pass would); then slots
-    // (see `SmoothGroups`): a normal that is its own faces' normal has a slot of its own, and the
-    // others share the sums of their slot, kept in `shared`.
+    // Per element: the area sums of its faces before and after, block by block in parallel
+    // (`block_sums`: each element adds its faces in the order of the triangles, as a serial pass
+    // would). A normal that is its own faces' normal turns with its own sums, worked out in the
+    // same block; the others (`SmoothGroups`) share the sums of their slot, gathered in `shared`
+    // in the order of the elements and turned once every accessor has added to them.
     let mut groups = SmoothGroups::default();
     let mut shared = NormalTurns::new(0);
-    let mut slotted: Vec<(usize, &Layout, Vec<[f32; 3]>, Vec<Sums>, &BTreeSet<usize>)> = Vec::new();
+    let mut slotted: Vec<Slotted> = Vec::new();
     for (&n, (layout, uses, tangents)) in &normals {
         let faces: Vec<FaceUse> = uses
             .iter()
@@ -1008,59 +1045,72 @@ fn turn_normals(
                 },
             })
             .collect();
-        let elements = element_sums(&faces, layout.count);
         let values = gltf.read3_all(layout);
-        let own: Vec<bool> = elements
-            .par_iter()
-            .zip(&values)
-            .map(|(sums, &normal)| is_own_normal(sums.area_before(), normal))
-            .collect();
-        let start = first_read.get(&uses[0].0).copied();
-        let sums: Vec<Sums> = (0..layout.count)
-            .map(|k| {
-                if own[k] {
-                    // What `SmoothGroups::slot_for` does, with no slot number needed: this
-                    // normal's slot is its own.
-                    Sums::Alone(elements[k])
+        let keep_turns = !tangents.is_empty();
+        let blocks = block_sums(&faces, layout.count, |first, sums| {
+            let mut block = BlockTurns::default();
+            for (k, sums) in (first..).zip(sums) {
+                let turn = if is_own_normal(sums.area_before(), values[k]) {
+                    sums.alone().turn()
                 } else {
-                    let welded = start.and_then(|s| source.welded(s + k));
-                    let slot = groups.slot(welded, values[k]);
-                    shared.merge_sums(slot, elements[k]);
-                    Sums::Shared(slot)
+                    block.shared.push((k, *sums));
+                    None
+                };
+                block.normals.push(turn.map(|turn| turn.normal(values[k])));
+                if keep_turns {
+                    block.turns.push(turn);
                 }
-            })
-            .collect();
-        slotted.push((n, layout, values, sums, tangents));
+            }
+            block
+        });
+        let start = first_read.get(&uses[0].0).copied();
+        let mut slots = Vec::new();
+        for &(k, sums) in blocks.iter().flat_map(|block| &block.shared) {
+            let welded = start.and_then(|s| source.welded(s + k));
+            let slot = groups.slot(welded, values[k]);
+            shared.merge_sums(slot, sums);
+            slots.push((k, slot));
+        }
+        slotted.push(Slotted {
+            accessor: n,
+            layout,
+            values,
+            blocks,
+            slots,
+            tangents,
+        });
     }
     let mut changed = BTreeSet::new();
-    for (n, layout, values, sums, tangents) in slotted {
-        // The rotations: worked out in parallel, written in order.
-        let turns: Vec<Option<Turn>> = sums
-            .par_iter()
-            .map(|sums| match sums {
-                Sums::Alone(element) => element.alone().turn(),
-                Sums::Shared(slot) => shared.turn(*slot),
-            })
-            .collect();
-        let normals: Vec<Option<[f32; 3]>> = turns
-            .par_iter()
-            .zip(&values)
-            .map(|(turn, &normal)| turn.map(|turn| turn.normal(normal)))
+    for normal in slotted {
+        let layout = normal.layout;
+        let shared_turns: Vec<(usize, Option<Turn>)> = normal
+            .slots
+            .iter()
+            .map(|&(k, slot)| (k, shared.turn(slot)))
             .collect();
         let mut any = false;
-        for (k, normal) in normals.iter().enumerate() {
-            if let Some(normal) = normal {
-                joined.put(layout, k, normal);
+        let own = normal.blocks.iter().flat_map(|block| &block.normals);
+        for (k, value) in own.enumerate() {
+            if let Some(value) = value {
+                joined.put(layout, k, value);
+                any = true;
+            }
+        }
+        for &(k, turn) in &shared_turns {
+            if let Some(turn) = turn {
+                joined.put(layout, k, &turn.normal(normal.values[k]));
                 any = true;
             }
         }
         if any {
-            changed.insert(n);
+            changed.insert(normal.accessor);
         }
-        for &t in tangents {
+        for &t in normal.tangents {
             match gltf.layout(t) {
                 Ok(tangent) if tangent.components == 4 && tangent.count == layout.count => {
-                    for (k, turn) in turns.iter().enumerate() {
+                    let own = normal.blocks.iter().flat_map(|block| &block.turns);
+                    let turns = own.copied().enumerate().chain(shared_turns.iter().copied());
+                    for (k, turn) in turns {
                         if let Some(turn) = turn {
                             let direction = turn.direction(gltf.read3(&tangent, k));
                             joined.put(&tangent, k, &direction);
@@ -1079,24 +1129,38 @@ fn turn_normals(
     changed
 }
 
-/// Where one element's normal turns: with the sums of its own faces alone, or with those of a
-/// slot it shares ([`SmoothGroups`]).
-#[derive(Clone, Copy)]
-enum Sums {
-    Alone(SlotSums),
-    Shared(usize),
+/// One block of a normal accessor's elements after [`block_sums`]: per element, the turned
+/// normal when it turns with its own faces (`None` when it stays, or shares a slot), the turn
+/// itself when the accessor has tangents, and the elements that share a slot with their sums.
+#[derive(Default)]
+struct BlockTurns {
+    normals: Vec<Option<[f32; 3]>>,
+    turns: Vec<Option<Turn>>,
+    shared: Vec<(usize, SlotSums)>,
+}
+
+/// One normal accessor ready to turn: its values, its blocks, and the slot of each element that
+/// shares one.
+struct Slotted<'a> {
+    accessor: usize,
+    layout: &'a Layout,
+    values: Vec<[f32; 3]>,
+    blocks: Vec<BlockTurns>,
+    slots: Vec<(usize, usize)>,
+    tangents: &'a BTreeSet<usize>,
 }
 
 /// The triangles of one primitive that uses a normal accessor, with its positions before and
 /// after (`None`: they did not move).
 struct FaceUse<'a> {
-    triangles: &'a [[usize; 3]],
+    triangles: &'a [[u32; 3]],
     before: Cow<'a, [[f32; 3]]>,
     after: Option<&'a [Option<[f32; 3]>]>,
 }
 
 impl FaceUse<'_> {
-    fn corners(&self, t: [usize; 3]) -> ([DVec3; 3], [DVec3; 3]) {
+    fn corners(&self, t: [u32; 3]) -> ([DVec3; 3], [DVec3; 3]) {
+        let t = t.map(|v| v as usize);
         let before = t.map(|v| dvec(self.before[v]));
         let after = match self.after {
             Some(after) => t.map(|v| dvec(after[v].unwrap_or(self.before[v]))),
@@ -1106,18 +1170,49 @@ impl FaceUse<'_> {
     }
 }
 
-/// Per element of a normal accessor (`count` of them), the area sums of the faces that use it,
-/// before and after, in the order of the uses and their triangles (a face using it twice adds
-/// twice).
-fn element_sums(uses: &[FaceUse], count: usize) -> Vec<SlotSums> {
-    let mut sums = NormalTurns::new(count);
-    for u in uses {
-        for &t in u.triangles {
-            let (before, after) = u.corners(t);
-            sums.add(t, before, after);
-        }
-    }
-    sums.into_slots()
+/// Per block of a normal accessor's elements (`count` of them; one block per thread),
+/// `finish(first element, the block's area sums)`, the blocks worked out in parallel and
+/// returned in order. Each element's sums are those of the faces that use it, before and after,
+/// added in the order of the uses and their triangles (a face using it twice adds twice), exactly
+/// as one serial pass adds them: the same bits for any number of threads. Each block's task goes
+/// through all the triangles and adds those with a corner in its block (a triangle across two
+/// blocks is worked out in both).
+fn block_sums<R: Send>(
+    uses: &[FaceUse],
+    count: usize,
+    finish: impl Fn(usize, &[SlotSums]) -> R + Sync,
+) -> Vec<R> {
+    let threads = rayon::current_num_threads().max(1);
+    let triangles: usize = uses.iter().map(|u| u.triangles.len()).sum();
+    let block = if threads == 1 || triangles < 100_000 {
+        count.max(1)
+    } else {
+        count.div_ceil(threads).max(1)
+    };
+    (0..count.div_ceil(block))
+        .into_par_iter()
+        .map(|b| {
+            let first = b * block;
+            let len = block.min(count - first);
+            let mut sums = vec![SlotSums::default(); len];
+            let ours = |v: u32| (v as usize).wrapping_sub(first) < len;
+            for u in uses {
+                for &t in u.triangles {
+                    if !t.iter().any(|&v| ours(v)) {
+                        continue;
+                    }
+                    let (before, after) = u.corners(t);
+                    let add = SlotSums::of_triangle(before, after);
+                    for v in t {
+                        if ours(v) {
+                            sums[v as usize - first].merge(add);
+                        }
+                    }
+                }
+            }
+            finish(first, &sums)
+        })
+        .collect()
 }
 
 /// All buffers joined into one, and where each of them starts in it.

@@ -310,8 +310,18 @@ impl SlotSums {
         sums
     }
 
+    /// The sums of one triangle with corners `before` and `after` the move.
     #[inline]
-    fn merge(&mut self, add: SlotSums) {
+    pub(crate) fn of_triangle(before: [DVec3; 3], after: [DVec3; 3]) -> SlotSums {
+        SlotSums {
+            before: (before[1] - before[0]).cross(before[2] - before[0]),
+            after: (after[1] - after[0]).cross(after[2] - after[0]),
+            moved: before != after,
+        }
+    }
+
+    #[inline]
+    pub(crate) fn merge(&mut self, add: SlotSums) {
         self.before += add.before;
         self.after += add.after;
         self.moved |= add.moved;
@@ -353,14 +363,9 @@ impl NormalTurns {
     /// and after.
     #[inline]
     pub(crate) fn add(&mut self, slots: [usize; 3], before: [DVec3; 3], after: [DVec3; 3]) {
-        let area_before = (before[1] - before[0]).cross(before[2] - before[0]);
-        let area_after = (after[1] - after[0]).cross(after[2] - after[0]);
-        let moved = before != after;
+        let add = SlotSums::of_triangle(before, after);
         for n in slots {
-            let sums = self.slot_mut(n);
-            sums.before += area_before;
-            sums.after += area_after;
-            sums.moved |= moved;
+            self.slot_mut(n).merge(add);
         }
     }
 
@@ -378,11 +383,6 @@ impl NormalTurns {
     /// Add `add` to slot `slot`'s sums.
     pub(crate) fn merge_sums(&mut self, slot: usize, add: SlotSums) {
         self.slot_mut(slot).merge(add);
-    }
-
-    /// The sums of every slot.
-    pub(crate) fn into_slots(self) -> Vec<SlotSums> {
-        self.slots
     }
 
     /// The rotation for normal `n`, or `None` when it stays as it is.

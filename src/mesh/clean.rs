@@ -109,17 +109,17 @@ pub(crate) fn clean_with_map(mesh: &mut TriMesh) -> (CleanReport, Option<Vec<u32
     mesh.triangles
         .retain(|&[a, b, c]| a != b && b != c && a != c);
     let removed_degenerate_faces = before_faces - mesh.triangles.len();
-    let mut seen: std::collections::HashSet<[u32; 3], BuildHasherDefault<PositionHasher>> =
-        std::collections::HashSet::with_capacity_and_hasher(
-            mesh.triangles.len(),
-            Default::default(),
-        );
     let distinct = mesh.triangles.len();
-    mesh.triangles.retain(|t| {
-        let mut corners = *t;
-        corners.sort_unstable();
-        seen.insert(corners)
-    });
+    let repeats = repeated_triangles(&mesh.triangles, mesh.positions.len());
+    if !repeats.is_empty() {
+        let mut next = repeats.iter().copied().peekable();
+        let mut index = 0u32;
+        mesh.triangles.retain(|_| {
+            let repeat = next.next_if_eq(&index).is_some();
+            index += 1;
+            !repeat
+        });
+    }
     let removed_repeated_faces = distinct - mesh.triangles.len();
 
     let mut used = vec![false; mesh.positions.len()];
@@ -155,6 +155,71 @@ pub(crate) fn clean_with_map(mesh: &mut TriMesh) -> (CleanReport, Option<Vec<u32
         },
         map,
     )
+}
+
+/// The triangles (ascending indices) whose three corners an earlier triangle already has, in any
+/// order. The triangles are listed by their smallest corner (a counting sort: no hashing, and
+/// the lists are short), and only triangles in the same list are compared.
+fn repeated_triangles(triangles: &[[u32; 3]], vertices: usize) -> Vec<u32> {
+    let sorted = |t: [u32; 3]| {
+        let mut t = t;
+        t.sort_unstable();
+        t
+    };
+    // Indices past `vertices` are not this function's to refuse: list them all the same.
+    let vertices = triangles
+        .iter()
+        .flatten()
+        .max()
+        .map_or(0, |&v| v as usize + 1)
+        .max(vertices);
+    let mut starts = vec![0u32; vertices + 1];
+    for t in triangles {
+        let low = t[0].min(t[1]).min(t[2]) as usize;
+        starts[low + 1] += 1;
+    }
+    for v in 0..vertices {
+        starts[v + 1] += starts[v];
+    }
+    let mut next = starts.clone();
+    let mut listed = vec![0u32; triangles.len()];
+    for (f, t) in triangles.iter().enumerate() {
+        let low = t[0].min(t[1]).min(t[2]) as usize;
+        listed[next[low] as usize] = f as u32;
+        next[low] += 1;
+    }
+    let mut repeats = Vec::new();
+    let mut keyed: Vec<([u32; 3], u32)> = Vec::new();
+    for v in 0..vertices {
+        let list = &listed[starts[v] as usize..starts[v + 1] as usize];
+        if list.len() < 2 {
+            continue;
+        }
+        if list.len() <= 16 {
+            // In triangle order: a later one with an earlier one's corners repeats it.
+            for (i, &f) in list.iter().enumerate() {
+                let corners = sorted(triangles[f as usize]);
+                if list[..i]
+                    .iter()
+                    .any(|&g| sorted(triangles[g as usize]) == corners)
+                {
+                    repeats.push(f);
+                }
+            }
+        } else {
+            // A busy vertex (a fan's hub): sort by corners, then triangle.
+            keyed.clear();
+            keyed.extend(list.iter().map(|&f| (sorted(triangles[f as usize]), f)));
+            keyed.sort_unstable();
+            for pair in keyed.windows(2) {
+                if pair[0].0 == pair[1].0 {
+                    repeats.push(pair[1].1);
+                }
+            }
+        }
+    }
+    repeats.sort_unstable();
+    repeats
 }
 
 #[cfg(test)]
@@ -220,6 +285,37 @@ mod tests {
         assert_eq!(
             mesh.triangles,
             vec![[0, 2, 1], [1, 2, 3], [0, 1, 3], [0, 3, 2]],
+            "the first of each kept, in input order"
+        );
+    }
+
+    #[test]
+    fn repeats_around_a_busy_hub_are_found_and_the_first_kept() {
+        // A fan of 40 triangles around hub 0 (more than a short list holds), with triangle 5
+        // repeated reversed at the end and triangle 30 repeated rotated in the middle.
+        let mut positions = vec![[0.0f32, 0.0, 1.0]];
+        let mut triangles = Vec::new();
+        for i in 0..40u32 {
+            let angle = i as f32 * std::f32::consts::TAU / 40.0;
+            positions.push([angle.cos(), angle.sin(), 0.0]);
+            triangles.push([0, 1 + i, 1 + (i + 1) % 40]);
+        }
+        let five = triangles[5];
+        let thirty = triangles[30];
+        triangles.insert(20, [thirty[1], thirty[2], thirty[0]]);
+        triangles.push([five[0], five[2], five[1]]);
+        let mut expected = triangles.clone();
+        expected.remove(41);
+        expected.remove(31);
+        assert_eq!(
+            repeated_triangles(&triangles, positions.len()),
+            vec![31, 41]
+        );
+        let mut mesh = TriMesh::new(positions, triangles);
+        let report = clean(&mut mesh);
+        assert_eq!(report.removed_repeated_faces, 2);
+        assert_eq!(
+            mesh.triangles, expected,
             "the first of each kept, in input order"
         );
     }
