@@ -9,6 +9,7 @@
 //! again keeping the remaining vertices and triangles in input order.
 
 use super::TriMesh;
+use rayon::prelude::*;
 use std::collections::HashMap;
 use std::hash::{BuildHasherDefault, Hasher};
 
@@ -188,36 +189,43 @@ fn repeated_triangles(triangles: &[[u32; 3]], vertices: usize) -> Vec<u32> {
         listed[next[low] as usize] = f as u32;
         next[low] += 1;
     }
-    let mut repeats = Vec::new();
-    let mut keyed: Vec<([u32; 3], u32)> = Vec::new();
-    for v in 0..vertices {
-        let list = &listed[starts[v] as usize..starts[v + 1] as usize];
-        if list.len() < 2 {
-            continue;
-        }
-        if list.len() <= 16 {
-            // In triangle order: a later one with an earlier one's corners repeats it.
-            for (i, &f) in list.iter().enumerate() {
-                let corners = sorted(triangles[f as usize]);
-                if list[..i]
+    // The lists are independent: checked in parallel, in chunks of vertices, and joined in order.
+    let chunks: Vec<Vec<u32>> = (0..vertices)
+        .into_par_iter()
+        .with_min_len(16_384)
+        .fold(Vec::new, |mut repeats, v| {
+            let list = &listed[starts[v] as usize..starts[v + 1] as usize];
+            if list.len() < 2 {
+                return repeats;
+            }
+            if list.len() <= 16 {
+                // In triangle order: a later one with an earlier one's corners repeats it.
+                for (i, &f) in list.iter().enumerate() {
+                    let corners = sorted(triangles[f as usize]);
+                    if list[..i]
+                        .iter()
+                        .any(|&g| sorted(triangles[g as usize]) == corners)
+                    {
+                        repeats.push(f);
+                    }
+                }
+            } else {
+                // A busy vertex (a fan's hub): sort by corners, then triangle.
+                let mut keyed: Vec<([u32; 3], u32)> = list
                     .iter()
-                    .any(|&g| sorted(triangles[g as usize]) == corners)
-                {
-                    repeats.push(f);
+                    .map(|&f| (sorted(triangles[f as usize]), f))
+                    .collect();
+                keyed.sort_unstable();
+                for pair in keyed.windows(2) {
+                    if pair[0].0 == pair[1].0 {
+                        repeats.push(pair[1].1);
+                    }
                 }
             }
-        } else {
-            // A busy vertex (a fan's hub): sort by corners, then triangle.
-            keyed.clear();
-            keyed.extend(list.iter().map(|&f| (sorted(triangles[f as usize]), f)));
-            keyed.sort_unstable();
-            for pair in keyed.windows(2) {
-                if pair[0].0 == pair[1].0 {
-                    repeats.push(pair[1].1);
-                }
-            }
-        }
-    }
+            repeats
+        })
+        .collect();
+    let mut repeats: Vec<u32> = chunks.concat();
     repeats.sort_unstable();
     repeats
 }
