@@ -3,6 +3,7 @@
 use std::path::PathBuf;
 
 use crate::app::{App, Command};
+use crate::render::Shading;
 
 impl App {
     pub(super) fn handle_global_input(&mut self, ctx: &egui::Context) {
@@ -64,16 +65,17 @@ impl App {
     }
 
     /// The keys without modifiers: F fit view, W wireframe, B before/after, H heat map,
-    /// P paint.
+    /// P paint, S shading (Flat / Smooth).
     fn plain_key_toggles(&mut self, ctx: &egui::Context) {
         let plain = |i: &egui::InputState, key| i.key_pressed(key) && i.modifiers.is_none();
-        let (fit, wire, before, heat, paint) = ctx.input(|i| {
+        let (fit, wire, before, heat, paint, shading) = ctx.input(|i| {
             (
                 plain(i, egui::Key::F),
                 plain(i, egui::Key::W),
                 plain(i, egui::Key::B),
                 plain(i, egui::Key::H),
                 plain(i, egui::Key::P),
+                plain(i, egui::Key::S),
             )
         });
         if paint {
@@ -93,6 +95,12 @@ impl App {
         }
         if heat {
             self.settings.heat_map = !self.settings.heat_map;
+        }
+        if shading {
+            self.settings.shading = match self.settings.shading {
+                Shading::Flat => Shading::Smooth,
+                Shading::Smooth => Shading::Flat,
+            };
         }
     }
 }
