@@ -1,7 +1,8 @@
 //! Headless tests of the View section's Shading (Flat / Smooth) and "Studio lighting":
 //! the controls are there and explain themselves, choosing one changes the setting, the draw
 //! parameters and the image, smooth shading draws with the area-weighted vertex normals of the
-//! mesh on screen (read back from the GPU buffer), and the heat map is lit in every view.
+//! mesh on screen (read back from the GPU buffer), the heat map is lit in every view, and the
+//! S key switches between Flat and Smooth.
 #![cfg(feature = "gui")]
 
 use egui_kittest::kittest::{NodeT, Queryable};
@@ -175,4 +176,34 @@ fn the_heat_map_is_lit_in_the_before_view() {
             "{shading}, studio {studio}: brightness spread {spread}"
         );
     }
+}
+
+/// S switches the shading between Flat and Smooth, like a click on the other choice; typed into
+/// a text field it does not.
+#[test]
+fn the_s_key_switches_between_flat_and_smooth() {
+    let mut harness = bunny_input_mesh();
+    assert_eq!(harness.state().settings().shading, Shading::Smooth);
+    harness.key_press(egui::Key::S);
+    settle(&mut harness);
+    assert_eq!(harness.state().settings().shading, Shading::Flat);
+    assert_eq!(
+        harness.state().main_draw_params().unwrap().shading,
+        Shading::Flat
+    );
+    harness.key_press(egui::Key::S);
+    settle(&mut harness);
+    assert_eq!(harness.state().settings().shading, Shading::Smooth);
+
+    harness
+        .get_by_role_and_label(egui::accesskit::Role::TextInput, "Path:")
+        .focus();
+    harness.step();
+    harness.key_press(egui::Key::S);
+    settle(&mut harness);
+    assert_eq!(
+        harness.state().settings().shading,
+        Shading::Smooth,
+        "an S typed into the path field is text, not a shortcut"
+    );
 }

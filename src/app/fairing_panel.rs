@@ -5,8 +5,8 @@
 //! why.
 
 use super::state::{
-    BoundarySetting, CompareView, HierarchyState, MethodSetting, VariantSetting, ViewMode,
-    MAX_SHARP_EDGE_ANGLE, MIN_SHARP_EDGE_ANGLE,
+    BoundarySetting, CompareView, HierarchyState, MethodSetting, Settings, VariantSetting,
+    ViewMode, MAX_SHARP_EDGE_ANGLE, MIN_SHARP_EDGE_ANGLE,
 };
 use super::{App, Command};
 
@@ -17,7 +17,11 @@ pub(super) fn fairing_controls(app: &mut App, ui: &mut egui::Ui, top_level: usiz
     let Some(document) = &app.document else {
         return;
     };
-    let ready = document.level_count().is_some();
+    let (ready, level, applied) = (
+        document.level_count().is_some(),
+        document.level,
+        document.applied,
+    );
     let method = app.settings.method;
     let not_for_baseline = (!method.uses_hierarchy()).then(|| {
         format!(
@@ -25,22 +29,49 @@ pub(super) fn fairing_controls(app: &mut App, ui: &mut egui::Ui, top_level: usiz
             method.label()
         )
     });
-    let level_off = match (&not_for_baseline, ready) {
-        (Some(why), _) => Some(why.clone()),
+    let not_for_baseline = not_for_baseline.as_deref();
+    start_level_slider(
+        &mut app.commands,
+        ui,
+        (level, top_level),
+        ready,
+        not_for_baseline,
+    );
+    let before = app.settings.clone();
+    method_controls(&mut app.settings, ui, method);
+    boundary_and_variant(&mut app.settings, ui, not_for_baseline);
+    if app.settings.fairing_key() != before.fairing_key() {
+        app.commands.push(Command::Refair);
+    }
+    progress_and_apply(app, ui, applied);
+}
+
+/// The start level slider (`level` of `0..=top`), off for a baseline and until the hierarchy
+/// is `ready`.
+fn start_level_slider(
+    commands: &mut Vec<Command>,
+    ui: &mut egui::Ui,
+    (mut level, top_level): (usize, usize),
+    ready: bool,
+    not_for_baseline: Option<&str>,
+) {
+    let level_off = match (not_for_baseline, ready) {
+        (Some(why), _) => Some(why.to_owned()),
         (None, false) => Some("Waiting for the hierarchy to be built.".to_owned()),
         (None, true) => None,
     };
-    let mut level = document.level;
     let slider = ui.add_enabled(
         level_off.is_none(),
         egui::Slider::new(&mut level, 0..=top_level).text("Start level"),
     );
     if explain(slider, tips::START_LEVEL, level_off.as_deref()).changed() {
-        app.commands.push(Command::SetLevel(level));
+        commands.push(Command::SetLevel(level));
     }
-    let applied = document.applied;
-    let before = app.settings.clone();
-    let settings = &mut app.settings;
+}
+
+/// The method and the options of `method` (the one chosen when the frame began): iterations and
+/// rounds over the hierarchy, or a baseline's iterations and step.
+fn method_controls(settings: &mut Settings, ui: &mut egui::Ui, method: MethodSetting) {
     let combo = egui::ComboBox::from_label("Method")
         .selected_text(settings.method.label())
         .show_ui(ui, |ui| {
@@ -66,6 +97,15 @@ pub(super) fn fairing_controls(app: &mut App, ui: &mut egui::Ui, top_level: usiz
             explain(lambda, tips::LAMBDA, None);
         }
     }
+}
+
+/// Boundary handling (every method), "Fair M0 too" and the variant (the hierarchy's only: off,
+/// saying why, for a baseline).
+fn boundary_and_variant(
+    settings: &mut Settings,
+    ui: &mut egui::Ui,
+    not_for_baseline: Option<&str>,
+) {
     let boundary = egui::ComboBox::from_label("Boundary")
         .selected_text(match settings.boundary {
             BoundarySetting::Curve => "Smooth as curve",
@@ -85,7 +125,7 @@ pub(super) fn fairing_controls(app: &mut App, ui: &mut egui::Ui, top_level: usiz
         hierarchy_only,
         egui::Checkbox::new(&mut settings.fair_finest, "Fair M0 too"),
     );
-    explain(fair_finest, tips::FAIR_FINEST, not_for_baseline.as_deref());
+    explain(fair_finest, tips::FAIR_FINEST, not_for_baseline);
     let variant = ui.add_enabled_ui(hierarchy_only, |ui| {
         egui::ComboBox::from_label("Variant")
             .selected_text(match settings.variant {
@@ -98,10 +138,12 @@ pub(super) fn fairing_controls(app: &mut App, ui: &mut egui::Ui, top_level: usiz
             })
             .response
     });
-    explain(variant.inner, tips::VARIANT, not_for_baseline.as_deref());
-    if app.settings.fairing_key() != before.fairing_key() {
-        app.commands.push(Command::Refair);
-    }
+    explain(variant.inner, tips::VARIANT, not_for_baseline);
+}
+
+/// The fairing's progress while it runs, a note when the mesh is an `applied` result, and
+/// "Apply result".
+fn progress_and_apply(app: &mut App, ui: &mut egui::Ui, applied: bool) {
     if app.fair_in_flight {
         ui.horizontal(|ui| {
             ui.spinner();

@@ -3,23 +3,25 @@
 use std::path::PathBuf;
 
 use crate::app::{App, Command};
+use crate::render::Shading;
 
 impl App {
     pub(super) fn handle_global_input(&mut self, ctx: &egui::Context) {
-        let dropped: Vec<PathBuf> = ctx.input(|i| {
-            i.raw
-                .dropped_files
-                .iter()
-                .map(|f| f.path().to_path_buf())
-                .filter(|p| !p.as_os_str().is_empty())
-                .collect()
-        });
-        if let Some(path) = dropped.into_iter().next() {
+        if let Some(path) = dropped_file(ctx) {
             self.commands.push(Command::Open(path));
         }
         // Shortcuts work unless a text field has the keyboard (it has its own undo, and typing
         // an F or a W must not fit the view or toggle the wireframe).
         let text_focus = ctx.text_edit_focused();
+        self.command_shortcuts(ctx, text_focus);
+        if !text_focus {
+            self.plain_key_toggles(ctx);
+        }
+    }
+
+    /// The shortcuts with Ctrl (Cmd on macOS): open, export, save image, undo and redo (the
+    /// last two not while a text field has the keyboard).
+    fn command_shortcuts(&mut self, ctx: &egui::Context, text_focus: bool) {
         let (undo, redo) = ctx.input(|i| {
             let command = i.modifiers.command;
             (
@@ -60,17 +62,20 @@ impl App {
         if !text_focus && redo {
             self.commands.push(Command::Redo);
         }
-        if text_focus {
-            return;
-        }
+    }
+
+    /// The keys without modifiers: F fit view, W wireframe, B before/after, H heat map,
+    /// P paint, S shading (Flat / Smooth).
+    fn plain_key_toggles(&mut self, ctx: &egui::Context) {
         let plain = |i: &egui::InputState, key| i.key_pressed(key) && i.modifiers.is_none();
-        let (fit, wire, before, heat, paint) = ctx.input(|i| {
+        let (fit, wire, before, heat, paint, shading) = ctx.input(|i| {
             (
                 plain(i, egui::Key::F),
                 plain(i, egui::Key::W),
                 plain(i, egui::Key::B),
                 plain(i, egui::Key::H),
                 plain(i, egui::Key::P),
+                plain(i, egui::Key::S),
             )
         });
         if paint {
@@ -91,5 +96,24 @@ impl App {
         if heat {
             self.settings.heat_map = !self.settings.heat_map;
         }
+        if shading {
+            self.settings.shading = match self.settings.shading {
+                Shading::Flat => Shading::Smooth,
+                Shading::Smooth => Shading::Flat,
+            };
+        }
     }
+}
+
+/// The first file dropped on the window in this frame.
+fn dropped_file(ctx: &egui::Context) -> Option<PathBuf> {
+    let dropped: Vec<PathBuf> = ctx.input(|i| {
+        i.raw
+            .dropped_files
+            .iter()
+            .map(|f| f.path().to_path_buf())
+            .filter(|p| !p.as_os_str().is_empty())
+            .collect()
+    });
+    dropped.into_iter().next()
 }

@@ -29,84 +29,97 @@ fn toolbar(app: &mut App, ui: &mut egui::Ui) {
     ui.add_space(4.0);
     // Wraps in a narrow window, so that no control ends up off screen.
     ui.horizontal_wrapped(|ui| {
-        if ui
-            .button("Open…")
-            .on_hover_text("Pick a mesh file (Ctrl+O)")
-            .clicked()
-        {
-            app.commands.push(Command::OpenDialog);
-        }
-        super::recent::menu(app, ui);
-        let label = ui.label("Path:");
-        let edit = ui
-            .add(
-                egui::TextEdit::singleline(&mut app.open_path)
-                    .hint_text("type a mesh path, or drop a file on the window")
-                    // Narrow enough that the toolbar stays one row at 1200 points.
-                    .desired_width(180.0),
-            )
-            .labelled_by(label.id);
-        let entered = edit.lost_focus() && ui.input(|i| i.key_pressed(egui::Key::Enter));
-        if ui.button("Load").clicked() || entered {
-            let typed = app.open_path.trim();
-            if typed.is_empty() {
-                app.error = Some("Type the path of a mesh file to load".into());
-            } else {
-                app.commands.push(Command::Open(PathBuf::from(typed)));
-            }
-        }
+        file_controls(app, ui);
         ui.separator();
-        if ui
-            .button("Fit view (F)")
-            .on_hover_text("Fit the mesh into the view (F)")
-            .clicked()
-        {
-            app.commands.push(Command::FitView);
-        }
-        super::tasks::view_image::button(app, ui);
-        ui.checkbox(&mut app.settings.wireframe, "Wireframe (W)")
-            .on_hover_text("Draw the edges over the faces (W)");
+        view_controls(app, ui);
         ui.separator();
-        let mut mode = app.settings.view_mode;
-        ui.selectable_value(&mut mode, ViewMode::Faired, "Faired")
-            .on_hover_text("Show the result of the fairing");
-        ui.selectable_value(&mut mode, ViewMode::Level, "Level mesh")
-            .on_hover_text("Show the coarse mesh of the start level, where the fairing begins");
-        ui.selectable_value(&mut mode, ViewMode::Original, "Input mesh")
-            .on_hover_text(
-                "Show the input mesh: as loaded, or as Add noise or Apply result left it",
-            );
-        if mode != app.settings.view_mode {
-            app.commands.push(Command::SetViewMode(mode));
-        }
-        ui.separator();
-        let undo_label = app.history.undo_label().map(str::to_owned);
-        let redo_label = app.history.redo_label().map(str::to_owned);
-        let undo = ui
-            .add_enabled(undo_label.is_some(), egui::Button::new("Undo"))
-            .on_hover_text(match &undo_label {
-                Some(label) => format!("Undo {label} (Ctrl+Z)"),
-                None => "Nothing to undo (Ctrl+Z)".into(),
-            })
-            .on_disabled_hover_text("Nothing to undo (Ctrl+Z)");
-        if undo.clicked() {
-            app.commands.push(Command::Undo);
-        }
-        let redo = ui
-            .add_enabled(redo_label.is_some(), egui::Button::new("Redo"))
-            .on_hover_text(match &redo_label {
-                Some(label) => format!("Redo {label} (Ctrl+Shift+Z, Ctrl+Y)"),
-                None => "Nothing to redo (Ctrl+Shift+Z, Ctrl+Y)".into(),
-            })
-            .on_disabled_hover_text("Nothing to redo (Ctrl+Shift+Z, Ctrl+Y)");
-        if redo.clicked() {
-            app.commands.push(Command::Redo);
-        }
-        if let Some(label) = &undo_label {
-            ui.small(format!("undo: {label}"));
-        }
+        undo_redo_buttons(app, ui);
     });
     ui.add_space(2.0);
+}
+
+/// Open…, the Recent menu, and the typed path with Load.
+fn file_controls(app: &mut App, ui: &mut egui::Ui) {
+    if ui
+        .button("Open…")
+        .on_hover_text("Pick a mesh file (Ctrl+O)")
+        .clicked()
+    {
+        app.commands.push(Command::OpenDialog);
+    }
+    super::recent::menu(app, ui);
+    let label = ui.label("Path:");
+    let edit = ui
+        .add(
+            egui::TextEdit::singleline(&mut app.open_path)
+                .hint_text("type a mesh path, or drop a file on the window")
+                // Narrow enough that the toolbar stays one row at 1200 points.
+                .desired_width(180.0),
+        )
+        .labelled_by(label.id);
+    let entered = edit.lost_focus() && ui.input(|i| i.key_pressed(egui::Key::Enter));
+    if ui.button("Load").clicked() || entered {
+        let typed = app.open_path.trim();
+        if typed.is_empty() {
+            app.error = Some("Type the path of a mesh file to load".into());
+        } else {
+            app.commands.push(Command::Open(PathBuf::from(typed)));
+        }
+    }
+}
+
+/// Fit view, Save image, Wireframe, and which mesh the view shows (result, level, input).
+fn view_controls(app: &mut App, ui: &mut egui::Ui) {
+    if ui
+        .button("Fit view (F)")
+        .on_hover_text("Fit the mesh into the view (F)")
+        .clicked()
+    {
+        app.commands.push(Command::FitView);
+    }
+    super::tasks::view_image::button(app, ui);
+    ui.checkbox(&mut app.settings.wireframe, "Wireframe (W)")
+        .on_hover_text("Draw the edges over the faces (W)");
+    ui.separator();
+    let mut mode = app.settings.view_mode;
+    ui.selectable_value(&mut mode, ViewMode::Faired, "Faired")
+        .on_hover_text("Show the result of the fairing");
+    ui.selectable_value(&mut mode, ViewMode::Level, "Level mesh")
+        .on_hover_text("Show the coarse mesh of the start level, where the fairing begins");
+    ui.selectable_value(&mut mode, ViewMode::Original, "Input mesh")
+        .on_hover_text("Show the input mesh: as loaded, or as Add noise or Apply result left it");
+    if mode != app.settings.view_mode {
+        app.commands.push(Command::SetViewMode(mode));
+    }
+}
+
+/// Undo and Redo, saying what they would undo or redo, and the next undo step's name.
+fn undo_redo_buttons(app: &mut App, ui: &mut egui::Ui) {
+    let undo_label = app.history.undo_label().map(str::to_owned);
+    let redo_label = app.history.redo_label().map(str::to_owned);
+    let undo = ui
+        .add_enabled(undo_label.is_some(), egui::Button::new("Undo"))
+        .on_hover_text(match &undo_label {
+            Some(label) => format!("Undo {label} (Ctrl+Z)"),
+            None => "Nothing to undo (Ctrl+Z)".into(),
+        })
+        .on_disabled_hover_text("Nothing to undo (Ctrl+Z)");
+    if undo.clicked() {
+        app.commands.push(Command::Undo);
+    }
+    let redo = ui
+        .add_enabled(redo_label.is_some(), egui::Button::new("Redo"))
+        .on_hover_text(match &redo_label {
+            Some(label) => format!("Redo {label} (Ctrl+Shift+Z, Ctrl+Y)"),
+            None => "Nothing to redo (Ctrl+Shift+Z, Ctrl+Y)".into(),
+        })
+        .on_disabled_hover_text("Nothing to redo (Ctrl+Shift+Z, Ctrl+Y)");
+    if redo.clicked() {
+        app.commands.push(Command::Redo);
+    }
+    if let Some(label) = &undo_label {
+        ui.small(format!("undo: {label}"));
+    }
 }
 
 /// Loading, errors and messages, at the bottom of the window: their coming and going does not

@@ -10,10 +10,10 @@ use crate::render::{Lighting, Shading};
 /// What each choice does, in the words the tooltips use (tests look them up).
 pub mod tips {
     pub const FLAT: &str = "Light each triangle with its own normal: every facet shows, as \
-        it is. Use it to judge the triangles themselves";
+        it is. Use it to judge the triangles themselves. S switches between Flat and Smooth";
     pub const SMOOTH: &str = "Blend the light across triangles from normals at the corners: \
         the surface looks as a render would show it. Bumps that remain show as wobbly \
-        highlights";
+        highlights. S switches between Flat and Smooth";
     pub const STUDIO: &str = "On: a warm key light, a cool fill light and a rim light along \
         the outline, with a soft highlight: uneven spots show as kinks in the highlight. Off: \
         one plain light from above left of you";

@@ -4,7 +4,7 @@
 
 use std::sync::Arc;
 
-use crate::app::state::{self, CompareView, HeatReference, HierarchyState, ViewMode};
+use crate::app::state::{self, CompareView, Document, HeatReference, HierarchyState, ViewMode};
 use crate::app::App;
 use crate::hierarchy;
 use crate::render::{DrawParams, MeshSource, Viewport3d};
@@ -62,6 +62,40 @@ pub(in crate::app) fn heat_map_top(distances: &[f32]) -> f32 {
     let rank = ((finite.len() - 1) as f64 * 0.99).round() as usize;
     let (_, value, _) = finite.select_nth_unstable_by(rank, f32::total_cmp);
     value.max(0.0)
+}
+
+/// The mesh `what` names, as a viewport takes it: its triangles (the hierarchy's M0 for a result
+/// whose `base` does not match the document's mesh) and its positions. `None` when it is not
+/// computed yet.
+fn view_mesh(
+    document: &Document,
+    what: ShownMesh,
+    base: Option<(Arc<hierarchy::Hierarchy>, bool)>,
+) -> Option<ViewMesh> {
+    Some(match what {
+        ShownMesh::Original => ViewMesh {
+            connectivity: SharedMesh::Mesh(document.original.clone()),
+            positions: None,
+        },
+        ShownMesh::Faired { .. } => {
+            let faired = document.faired.as_ref()?;
+            let connectivity = match base {
+                Some((hierarchy, false)) => SharedMesh::Base(hierarchy),
+                _ => SharedMesh::Mesh(document.original.clone()),
+            };
+            ViewMesh {
+                connectivity,
+                positions: Some(faired.positions.clone()),
+            }
+        }
+        ShownMesh::Level { .. } => {
+            let (_, mesh) = document.level_mesh.as_ref()?;
+            ViewMesh {
+                connectivity: SharedMesh::Mesh(mesh.clone()),
+                positions: None,
+            }
+        }
+    })
 }
 
 /// A mesh held by the document, shared with a worker or the renderer without copying it.
@@ -207,83 +241,19 @@ impl App {
             Slot::Main => self.shown,
             Slot::Before => self.shown_before,
         };
-        if shown == Some(wanted) {
+        if shown == Some(wanted) || self.document.is_none() {
             return;
         }
-        let Some(document) = &self.document else {
-            return;
-        };
-        let viewport = match slot {
-            Slot::Main => self.viewport.as_ref(),
-            Slot::Before => self.viewport_before.as_ref(),
-        };
         let mesh_changed =
             shown.is_none_or(|s| (s.document, s.what) != (wanted.document, wanted.what));
         let mut counts = None;
         if mesh_changed {
-            let base = match &document.hierarchy {
-                HierarchyState::Ready {
-                    hierarchy,
-                    base_matches_original,
-                    ..
-                } => Some((hierarchy.clone(), *base_matches_original)),
-                _ => None,
+            let Some(uploaded) = self.upload_mesh(slot, shown, wanted) else {
+                return;
             };
-            let matches = base.as_ref().is_none_or(|b| b.1);
-            let same_connectivity = shown.is_some_and(|shown| {
-                shown.document == wanted.document
-                    && shown.what.connectivity(matches) == wanted.what.connectivity(matches)
-            });
-            let source = match wanted.what {
-                ShownMesh::Original => ViewMesh {
-                    connectivity: SharedMesh::Mesh(document.original.clone()),
-                    positions: None,
-                },
-                ShownMesh::Faired { .. } => {
-                    let Some(faired) = &document.faired else {
-                        return;
-                    };
-                    let connectivity = match &base {
-                        Some((hierarchy, false)) => SharedMesh::Base(hierarchy.clone()),
-                        _ => SharedMesh::Mesh(document.original.clone()),
-                    };
-                    ViewMesh {
-                        connectivity,
-                        positions: Some(faired.positions.clone()),
-                    }
-                }
-                ShownMesh::Level { .. } => {
-                    let Some((_, mesh)) = &document.level_mesh else {
-                        return;
-                    };
-                    ViewMesh {
-                        connectivity: SharedMesh::Mesh(mesh.clone()),
-                        positions: None,
-                    }
-                }
-            };
-            counts = Some((source.positions().len(), source.triangles().len()));
-            if let Some(viewport) = viewport {
-                let source: Arc<dyn MeshSource> = Arc::new(source);
-                if !(same_connectivity && viewport.set_positions(source.clone())) {
-                    viewport.set_mesh(source);
-                }
-            }
+            counts = Some(uploaded);
         }
-        let mut heat_max = None;
-        if let Some(reference) = wanted.heat {
-            if let Some(scalars) = self.heat_scalars(wanted.what, reference) {
-                if viewport.is_none_or(|v| v.set_scalars(&scalars)) {
-                    heat_max = Some(heat_map_top(&scalars));
-                }
-            }
-        }
-        if wanted.mask.is_some() {
-            if let (Some(mask), Some(viewport)) = (&document.mask, viewport) {
-                viewport.set_scalars(mask.weights());
-            }
-        }
-        self.heat_max[slot as usize] = heat_max;
+        self.heat_max[slot as usize] = self.upload_tint(slot, wanted);
         match slot {
             Slot::Main => {
                 if let Some(counts) = counts {
@@ -293,6 +263,69 @@ impl App {
             }
             Slot::Before => self.shown_before = Some(wanted),
         }
+    }
+
+    /// The slot's renderer handle, when there is a wgpu renderer.
+    fn slot_viewport(&self, slot: Slot) -> Option<&Viewport3d> {
+        match slot {
+            Slot::Main => self.viewport.as_ref(),
+            Slot::Before => self.viewport_before.as_ref(),
+        }
+    }
+
+    /// Uploads the wanted mesh to the slot's viewport (only its positions when the GPU holds its
+    /// triangles already, from `shown`); its vertex and face counts, or `None` when that mesh
+    /// is not there (yet).
+    fn upload_mesh(
+        &self,
+        slot: Slot,
+        shown: Option<Shown>,
+        wanted: Shown,
+    ) -> Option<(usize, usize)> {
+        let document = self.document.as_ref()?;
+        let base = match &document.hierarchy {
+            HierarchyState::Ready {
+                hierarchy,
+                base_matches_original,
+                ..
+            } => Some((hierarchy.clone(), *base_matches_original)),
+            _ => None,
+        };
+        let matches = base.as_ref().is_none_or(|b| b.1);
+        let same_connectivity = shown.is_some_and(|shown| {
+            shown.document == wanted.document
+                && shown.what.connectivity(matches) == wanted.what.connectivity(matches)
+        });
+        let source = view_mesh(document, wanted.what, base)?;
+        let counts = (source.positions().len(), source.triangles().len());
+        if let Some(viewport) = self.slot_viewport(slot) {
+            let source: Arc<dyn MeshSource> = Arc::new(source);
+            if !(same_connectivity && viewport.set_positions(source.clone())) {
+                viewport.set_mesh(source);
+            }
+        }
+        Some(counts)
+    }
+
+    /// Uploads what the wanted view tints the mesh with: the heat map's scalars or the painted
+    /// mask's weights. The heat map's top when its scalars went up.
+    fn upload_tint(&self, slot: Slot, wanted: Shown) -> Option<f32> {
+        let viewport = self.slot_viewport(slot);
+        let mut heat_max = None;
+        if let Some(reference) = wanted.heat {
+            if let Some(scalars) = self.heat_scalars(wanted.what, reference) {
+                if viewport.is_none_or(|v| v.set_scalars(&scalars)) {
+                    heat_max = Some(heat_map_top(&scalars));
+                }
+            }
+        }
+        if wanted.mask.is_some() {
+            let mask = self.document.as_ref().and_then(|d| d.mask.as_ref());
+            if let (Some(mask), Some(viewport)) = (mask, viewport) {
+                viewport.set_scalars(mask.weights());
+            }
+        }
+        heat_max
     }
 
     /// The heat map's top value for the slots on screen (shared, so the colours compare).

@@ -1,5 +1,8 @@
-//! The mesh renderer: wgpu pipelines (filled triangles and wireframe lines, `shaders/mesh.wgsl`),
-//! the mesh's GPU buffers and an offscreen colour + depth target it draws into.
+//! The mesh renderer: [`MeshRenderer`] owns the pipelines, the mesh's GPU buffers and an
+//! offscreen colour + depth target it draws into. One file per concern beside it:
+//! `pipeline/passes.rs` (the pipelines, `shaders/mesh.wgsl`, the uniforms, the target and the
+//! render pass), `pipeline/buffers.rs` (a mesh's buffers and its wireframe edges) and
+//! `pipeline/upload.rs` (the upload thread for big meshes).
 //!
 //! Buffers are written only when the mesh changes ([`MeshRenderer::set_mesh`] for new
 //! connectivity, [`MeshRenderer::set_positions`] when only the positions move; both recompute
@@ -13,13 +16,18 @@
 //! would otherwise stall one UI frame. New positions of a big mesh get their normals there too
 //! (~30 ms for 1.2M faces). The previous image stays until the upload lands.
 
-use bytemuck::{Pod, Zeroable};
-use std::sync::mpsc::{self, Receiver, Sender};
-use std::sync::{Arc, Mutex};
-use wgpu::util::DeviceExt;
+mod buffers;
+mod passes;
+mod upload;
+
+use std::sync::mpsc;
+use std::sync::Arc;
 
 use super::normals::vertex_normals;
 use super::shading::{Lighting, Shading};
+use buffers::{line_buffer, MeshBuffers};
+use passes::{Pipelines, Target, Uniforms};
+use upload::{PendingMesh, UploadJob, Uploaded, Uploader};
 
 /// Format of the image the mesh is drawn into (and that egui then samples).
 pub const COLOR_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8UnormSrgb;
@@ -51,21 +59,6 @@ pub struct DrawParams {
     pub size: [u32; 2],
 }
 
-#[repr(C)]
-#[derive(Clone, Copy, Pod, Zeroable)]
-struct Uniforms {
-    view_proj: [[f32; 4]; 4],
-    eye: [f32; 4],
-    light_dir: [f32; 4],
-    fill_dir: [f32; 4],
-    up: [f32; 4],
-    base_color: [f32; 4],
-    wire_color: [f32; 4],
-    scalar_range: [f32; 4],
-    /// x: 1 for smooth shading, y: 1 for the studio lighting.
-    look: [f32; 4],
-}
-
 /// Mesh data the renderer may read on its upload thread (shared, never copied on the UI thread).
 pub trait MeshSource: Send + Sync + 'static {
     fn positions(&self) -> &[[f32; 3]];
@@ -77,283 +70,9 @@ pub trait MeshSource: Send + Sync + 'static {
 /// mesh does not stall the UI for the ~30 ms its buffers take to fill.
 pub const DEFAULT_ASYNC_UPLOAD_BYTES: usize = 4 << 20;
 
-/// GPU copies of one mesh.
-struct MeshBuffers {
-    positions: wgpu::Buffer,
-    /// Area-weighted unit vertex normals of the positions now in `positions`.
-    normals: wgpu::Buffer,
-    scalars: wgpu::Buffer,
-    triangles: wgpu::Buffer,
-    vertex_count: usize,
-    index_count: u32,
-    /// Edge list for the wireframe, built when first needed (on the upload thread for a big
-    /// mesh) from `source`'s triangles.
-    lines: Option<(wgpu::Buffer, u32)>,
-    /// The mesh on screen: its triangles, and the positions last written.
-    source: Arc<dyn MeshSource>,
-    /// Which [`MeshRenderer::set_mesh`] call this mesh answers.
-    generation: u64,
-}
-
-impl MeshBuffers {
-    /// Writes new positions of the same connectivity and their normals.
-    fn write_positions(
-        &mut self,
-        queue: &wgpu::Queue,
-        source: Arc<dyn MeshSource>,
-        normals: &[[f32; 3]],
-    ) {
-        queue.write_buffer(&self.positions, 0, bytemuck::cast_slice(source.positions()));
-        queue.write_buffer(&self.normals, 0, bytemuck::cast_slice(normals));
-        self.source = source;
-    }
-
-    fn create(
-        device: &wgpu::Device,
-        source: Arc<dyn MeshSource>,
-        with_lines: bool,
-        generation: u64,
-    ) -> Self {
-        let positions = source.positions();
-        let triangles = source.triangles();
-        let positions_buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-            label: Some("fairmesh positions"),
-            contents: bytemuck::cast_slice(positions),
-            usage: wgpu::BufferUsages::VERTEX | wgpu::BufferUsages::COPY_DST,
-        });
-        let normals_buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-            label: Some("fairmesh normals"),
-            contents: bytemuck::cast_slice(&vertex_normals(positions, triangles)),
-            // COPY_SRC: tests read back what was uploaded.
-            usage: wgpu::BufferUsages::VERTEX
-                | wgpu::BufferUsages::COPY_DST
-                | wgpu::BufferUsages::COPY_SRC,
-        });
-        // Scalars come later through `set_scalars`; wgpu zero-fills a buffer that is not mapped
-        // at creation.
-        let scalars_buffer = device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("fairmesh scalars"),
-            size: (positions.len() * 4) as u64,
-            usage: wgpu::BufferUsages::VERTEX | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
-        let triangles_buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-            label: Some("fairmesh triangles"),
-            contents: bytemuck::cast_slice(triangles),
-            usage: wgpu::BufferUsages::INDEX,
-        });
-        let lines = with_lines.then(|| line_buffer(device, triangles));
-        Self {
-            positions: positions_buffer,
-            normals: normals_buffer,
-            scalars: scalars_buffer,
-            triangles: triangles_buffer,
-            vertex_count: positions.len(),
-            index_count: (triangles.len() * 3) as u32,
-            lines,
-            source,
-            generation,
-        }
-    }
-}
-
-/// The wireframe's index buffer: each triangle's three edges as line segments (an edge shared by
-/// two triangles is drawn twice, which looks the same and needs no edge map).
-fn line_buffer(device: &wgpu::Device, triangles: &[[u32; 3]]) -> (wgpu::Buffer, u32) {
-    const BLOCK: usize = 4096;
-    let count = triangles.len() * 6;
-    let buffer = device.create_buffer(&wgpu::BufferDescriptor {
-        label: Some("fairmesh wireframe edges"),
-        size: (count * 4) as u64,
-        usage: wgpu::BufferUsages::INDEX,
-        mapped_at_creation: true,
-    });
-    // The mapping is write-only (it may be write-combining memory): edges are built a block of
-    // triangles at a time in a small scratch array and copied in, with no full-size temporary.
-    let mut scratch = vec![0u32; BLOCK * 6];
-    match buffer.slice(..).get_mapped_range_mut() {
-        Ok(mut view) => {
-            for (block_index, block) in triangles.chunks(BLOCK).enumerate() {
-                let edges = &mut scratch[..block.len() * 6];
-                for (edge, &[a, b, c]) in edges.chunks_exact_mut(6).zip(block) {
-                    edge.copy_from_slice(&[a, b, b, c, c, a]);
-                }
-                let start = block_index * BLOCK * 6 * 4;
-                view.slice(start..start + edges.len() * 4)
-                    .copy_from_slice(bytemuck::cast_slice(edges));
-            }
-        }
-        // Cannot happen for a buffer mapped at creation; the wireframe is then just not drawn.
-        Err(_) => {
-            buffer.unmap();
-            return (buffer, 0);
-        }
-    }
-    buffer.unmap();
-    (buffer, count as u32)
-}
-
-/// Work for the upload thread.
-enum UploadJob {
-    Mesh {
-        generation: u64,
-        source: Arc<dyn MeshSource>,
-        with_lines: bool,
-    },
-    Lines {
-        generation: u64,
-        source: Arc<dyn MeshSource>,
-    },
-    /// New positions for the mesh of `generation`: their normals.
-    Move {
-        generation: u64,
-        serial: u64,
-        source: Arc<dyn MeshSource>,
-    },
-}
-
-impl UploadJob {
-    fn generation(&self) -> u64 {
-        match self {
-            Self::Mesh { generation, .. }
-            | Self::Lines { generation, .. }
-            | Self::Move { generation, .. } => *generation,
-        }
-    }
-
-    fn run(self, device: &wgpu::Device) -> Uploaded {
-        match self {
-            UploadJob::Mesh {
-                generation,
-                source,
-                with_lines,
-            } => Uploaded::Mesh(MeshBuffers::create(device, source, with_lines, generation)),
-            UploadJob::Lines { generation, source } => Uploaded::Lines {
-                generation,
-                lines: line_buffer(device, source.triangles()),
-            },
-            UploadJob::Move {
-                generation,
-                serial,
-                source,
-            } => Uploaded::Moved {
-                generation,
-                serial,
-                normals: vertex_normals(source.positions(), source.triangles()),
-                source,
-            },
-        }
-    }
-}
-
-enum Uploaded {
-    Mesh(MeshBuffers),
-    /// Filling the buffers of `generation` panicked inside wgpu.
-    Failed {
-        generation: u64,
-    },
-    Lines {
-        generation: u64,
-        lines: (wgpu::Buffer, u32),
-    },
-    Moved {
-        generation: u64,
-        serial: u64,
-        source: Arc<dyn MeshSource>,
-        normals: Vec<[f32; 3]>,
-    },
-}
-
-/// The renderer's upload thread: fills buffers for big meshes off the UI thread. Only the newest
-/// generation's jobs in the queue are done; older ones are superseded.
-struct Uploader {
-    jobs: Option<Sender<UploadJob>>,
-    /// In a mutex only because egui_wgpu's callback resources must be `Sync`.
-    done: Mutex<Receiver<Uploaded>>,
-    thread: Option<std::thread::JoinHandle<()>>,
-}
-
-impl Uploader {
-    fn spawn(device: wgpu::Device, on_done: Arc<dyn Fn() + Send + Sync>) -> Option<Self> {
-        let (jobs_tx, jobs_rx) = mpsc::channel::<UploadJob>();
-        let (done_tx, done_rx) = mpsc::channel();
-        let thread = std::thread::Builder::new()
-            .name("fairmesh-upload".into())
-            .spawn(move || {
-                while let Ok(first) = jobs_rx.recv() {
-                    let mut batch = vec![first];
-                    batch.extend(jobs_rx.try_iter());
-                    let newest = batch.iter().map(UploadJob::generation).max();
-                    // Only the last move counts: the positions before it are already old.
-                    let last_move = batch
-                        .iter()
-                        .rposition(|job| matches!(job, UploadJob::Move { .. }));
-                    for (index, job) in batch.into_iter().enumerate() {
-                        let old_move =
-                            matches!(job, UploadJob::Move { .. }) && Some(index) != last_move;
-                        if Some(job.generation()) != newest || old_move {
-                            continue;
-                        }
-                        let generation = job.generation();
-                        let upload = std::panic::AssertUnwindSafe(|| job.run(&device));
-                        // wgpu reports an error it cannot return (out of memory, say) by
-                        // panicking: the upload fails, the thread and the app go on.
-                        let uploaded = std::panic::catch_unwind(upload)
-                            .unwrap_or(Uploaded::Failed { generation });
-                        if done_tx.send(uploaded).is_err() {
-                            return;
-                        }
-                        on_done();
-                    }
-                }
-            })
-            .ok()?;
-        Some(Self {
-            jobs: Some(jobs_tx),
-            done: Mutex::new(done_rx),
-            thread: Some(thread),
-        })
-    }
-
-    /// Queues a job; gives it back when the thread is gone.
-    fn send(&self, job: UploadJob) -> Result<(), UploadJob> {
-        match &self.jobs {
-            Some(jobs) => jobs.send(job).map_err(|e| e.0),
-            None => Err(job),
-        }
-    }
-}
-
-impl Drop for Uploader {
-    fn drop(&mut self) {
-        // Closing the queue ends the thread after the job in hand.
-        self.jobs = None;
-        if let Some(thread) = self.thread.take() {
-            let _ = thread.join();
-        }
-    }
-}
-
-struct PendingMesh {
-    generation: u64,
-    vertex_count: usize,
-    /// Scalars set while the upload was in flight, written once it lands.
-    scalars: Option<Vec<f32>>,
-}
-
-struct Target {
-    size: [u32; 2],
-    multisampled: wgpu::TextureView,
-    resolved: wgpu::TextureView,
-    depth: wgpu::TextureView,
-}
-
 /// Owns the pipelines, the mesh buffers and the offscreen target. Knows nothing of fairing.
 pub struct MeshRenderer {
-    fill_pipeline: wgpu::RenderPipeline,
-    line_pipeline: wgpu::RenderPipeline,
-    uniform_buffer: wgpu::Buffer,
-    bind_group: wgpu::BindGroup,
+    pipelines: Pipelines,
     mesh: Option<MeshBuffers>,
     target: Option<Target>,
     /// Parameters of the image now in the target; `None` forces a redraw.
@@ -391,156 +110,8 @@ impl MeshRenderer {
     /// Pipelines on `device`, and an upload thread for big meshes that calls `on_upload_done`
     /// (from that thread) whenever an upload lands, so the UI can repaint.
     pub fn new(device: &wgpu::Device, on_upload_done: Arc<dyn Fn() + Send + Sync>) -> Self {
-        let shader = device.create_shader_module(wgpu::ShaderModuleDescriptor {
-            label: Some("fairmesh mesh shader"),
-            source: wgpu::ShaderSource::Wgsl(include_str!("../../shaders/mesh.wgsl").into()),
-        });
-        let bind_group_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("fairmesh uniforms"),
-            entries: &[wgpu::BindGroupLayoutEntry {
-                binding: 0,
-                visibility: wgpu::ShaderStages::VERTEX_FRAGMENT,
-                ty: wgpu::BindingType::Buffer {
-                    ty: wgpu::BufferBindingType::Uniform,
-                    has_dynamic_offset: false,
-                    min_binding_size: None,
-                },
-                count: None,
-            }],
-        });
-        let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-            label: Some("fairmesh pipeline layout"),
-            bind_group_layouts: &[Some(&bind_group_layout)],
-            immediate_size: 0,
-        });
-        let uniform_buffer = device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("fairmesh uniforms"),
-            size: std::mem::size_of::<Uniforms>() as u64,
-            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
-        let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("fairmesh uniforms"),
-            layout: &bind_group_layout,
-            entries: &[wgpu::BindGroupEntry {
-                binding: 0,
-                resource: uniform_buffer.as_entire_binding(),
-            }],
-        });
-
-        let position_layout = wgpu::VertexBufferLayout {
-            array_stride: 12,
-            step_mode: wgpu::VertexStepMode::Vertex,
-            attributes: &[wgpu::VertexAttribute {
-                format: wgpu::VertexFormat::Float32x3,
-                offset: 0,
-                shader_location: 0,
-            }],
-        };
-        let scalar_layout = wgpu::VertexBufferLayout {
-            array_stride: 4,
-            step_mode: wgpu::VertexStepMode::Vertex,
-            attributes: &[wgpu::VertexAttribute {
-                format: wgpu::VertexFormat::Float32,
-                offset: 0,
-                shader_location: 1,
-            }],
-        };
-        let normal_layout = wgpu::VertexBufferLayout {
-            array_stride: 12,
-            step_mode: wgpu::VertexStepMode::Vertex,
-            attributes: &[wgpu::VertexAttribute {
-                format: wgpu::VertexFormat::Float32x3,
-                offset: 0,
-                shader_location: 2,
-            }],
-        };
-        let targets = [Some(wgpu::ColorTargetState {
-            format: COLOR_FORMAT,
-            blend: None,
-            write_mask: wgpu::ColorWrites::ALL,
-        })];
-        let multisample = wgpu::MultisampleState {
-            count: SAMPLE_COUNT,
-            ..Default::default()
-        };
-
-        let fill_pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-            label: Some("fairmesh triangles"),
-            layout: Some(&layout),
-            vertex: wgpu::VertexState {
-                module: &shader,
-                entry_point: Some("vs_mesh"),
-                compilation_options: Default::default(),
-                buffers: &[
-                    Some(position_layout.clone()),
-                    Some(scalar_layout),
-                    Some(normal_layout),
-                ],
-            },
-            primitive: wgpu::PrimitiveState {
-                topology: wgpu::PrimitiveTopology::TriangleList,
-                cull_mode: None,
-                ..Default::default()
-            },
-            depth_stencil: Some(wgpu::DepthStencilState {
-                format: DEPTH_FORMAT,
-                depth_write_enabled: Some(true),
-                depth_compare: Some(wgpu::CompareFunction::Less),
-                stencil: Default::default(),
-                // Push triangles back a little so the wireframe lines on them win the depth test.
-                bias: wgpu::DepthBiasState {
-                    constant: 2,
-                    slope_scale: 1.0,
-                    clamp: 0.0,
-                },
-            }),
-            multisample,
-            fragment: Some(wgpu::FragmentState {
-                module: &shader,
-                entry_point: Some("fs_mesh"),
-                compilation_options: Default::default(),
-                targets: &targets,
-            }),
-            multiview_mask: None,
-            cache: None,
-        });
-        let line_pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-            label: Some("fairmesh wireframe"),
-            layout: Some(&layout),
-            vertex: wgpu::VertexState {
-                module: &shader,
-                entry_point: Some("vs_line"),
-                compilation_options: Default::default(),
-                buffers: &[Some(position_layout)],
-            },
-            primitive: wgpu::PrimitiveState {
-                topology: wgpu::PrimitiveTopology::LineList,
-                ..Default::default()
-            },
-            depth_stencil: Some(wgpu::DepthStencilState {
-                format: DEPTH_FORMAT,
-                depth_write_enabled: Some(false),
-                depth_compare: Some(wgpu::CompareFunction::LessEqual),
-                stencil: Default::default(),
-                bias: Default::default(),
-            }),
-            multisample,
-            fragment: Some(wgpu::FragmentState {
-                module: &shader,
-                entry_point: Some("fs_line"),
-                compilation_options: Default::default(),
-                targets: &targets,
-            }),
-            multiview_mask: None,
-            cache: None,
-        });
-
         Self {
-            fill_pipeline,
-            line_pipeline,
-            uniform_buffer,
-            bind_group,
+            pipelines: Pipelines::new(device),
             mesh: None,
             target: None,
             drawn: None,
@@ -846,46 +417,7 @@ impl MeshRenderer {
         if self.target.as_ref().is_some_and(|t| t.size == size) {
             return false;
         }
-        let extent = wgpu::Extent3d {
-            width: size[0],
-            height: size[1],
-            depth_or_array_layers: 1,
-        };
-        let make = |label, format, samples, usage| {
-            device
-                .create_texture(&wgpu::TextureDescriptor {
-                    label: Some(label),
-                    size: extent,
-                    mip_level_count: 1,
-                    sample_count: samples,
-                    dimension: wgpu::TextureDimension::D2,
-                    format,
-                    usage,
-                    view_formats: &[],
-                })
-                .create_view(&Default::default())
-        };
-        self.target = Some(Target {
-            size,
-            multisampled: make(
-                "fairmesh colour (multisampled)",
-                COLOR_FORMAT,
-                SAMPLE_COUNT,
-                wgpu::TextureUsages::RENDER_ATTACHMENT,
-            ),
-            resolved: make(
-                "fairmesh colour",
-                COLOR_FORMAT,
-                1,
-                wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING,
-            ),
-            depth: make(
-                "fairmesh depth",
-                DEPTH_FORMAT,
-                SAMPLE_COUNT,
-                wgpu::TextureUsages::RENDER_ATTACHMENT,
-            ),
-        });
+        self.target = Some(Target::new(device, size));
         self.drawn = None;
         true
     }
@@ -906,126 +438,61 @@ impl MeshRenderer {
     ) -> bool {
         self.poll_uploads(queue);
         self.wireframe = params.wireframe;
-        let Some(target) = &self.target else {
-            return false;
-        };
-        if self.drawn.as_ref() == Some(params) || target.size != params.size {
+        let wrong_size = self.target.as_ref().is_none_or(|t| t.size != params.size);
+        if self.drawn.as_ref() == Some(params) || wrong_size {
             return false;
         }
         let started = std::time::Instant::now();
-        let uniforms = Uniforms {
-            view_proj: params.view_proj,
-            eye: [params.eye[0], params.eye[1], params.eye[2], 1.0],
-            light_dir: [
-                params.light_dir[0],
-                params.light_dir[1],
-                params.light_dir[2],
-                0.0,
-            ],
-            fill_dir: [
-                params.fill_dir[0],
-                params.fill_dir[1],
-                params.fill_dir[2],
-                0.0,
-            ],
-            up: [params.up[0], params.up[1], params.up[2], 0.0],
-            base_color: [0.62, 0.56, 0.48, 1.0],
-            wire_color: [0.02, 0.03, 0.05, 1.0],
-            scalar_range: match (params.scalar_range, params.mask_tint) {
-                (Some([lo, hi]), _) => [lo, hi, 1.0, 0.0],
-                (None, true) => [0.0, 1.0, 2.0, 0.0],
-                (None, false) => [0.0, 1.0, 0.0, 0.0],
-            },
-            look: [
-                f32::from(u8::from(params.shading == Shading::Smooth)),
-                f32::from(u8::from(params.lighting == Lighting::Studio)),
-                0.0,
-                0.0,
-            ],
-        };
-        queue.write_buffer(&self.uniform_buffer, 0, bytemuck::bytes_of(&uniforms));
-
+        let uniforms = Uniforms::of(params);
+        queue.write_buffer(
+            &self.pipelines.uniform_buffer,
+            0,
+            bytemuck::bytes_of(&uniforms),
+        );
         if params.wireframe {
-            if let Some(mesh) = &mut self.mesh {
-                let faces = mesh.index_count as usize / 3;
-                let fits = faces as u64 * 24 <= self.max_buffer_size;
-                if fits
-                    && !self.lines_failed
-                    && mesh.lines.is_none()
-                    && self.lines_requested != Some(mesh.generation)
-                {
-                    // A big mesh's edges are built on the upload thread (the image shows the
-                    // mesh without them meanwhile); a small one's here.
-                    let bytes = (mesh.vertex_count + faces) * 12;
-                    let job = UploadJob::Lines {
-                        generation: mesh.generation,
-                        source: mesh.source.clone(),
-                    };
-                    let sent = match &self.uploader {
-                        Some(uploader) if bytes >= self.async_upload_bytes => {
-                            uploader.send(job).is_ok()
-                        }
-                        _ => false,
-                    };
-                    if sent {
-                        self.lines_requested = Some(mesh.generation);
-                    } else {
-                        mesh.lines = Some(line_buffer(device, mesh.source.triangles()));
-                    }
-                }
-            }
+            self.ensure_lines(device);
         }
-
-        {
-            let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-                label: Some("fairmesh viewport"),
-                color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                    view: &target.multisampled,
-                    depth_slice: None,
-                    resolve_target: Some(&target.resolved),
-                    ops: wgpu::Operations {
-                        load: wgpu::LoadOp::Clear(wgpu::Color {
-                            r: 0.018,
-                            g: 0.021,
-                            b: 0.026,
-                            a: 1.0,
-                        }),
-                        store: wgpu::StoreOp::Discard,
-                    },
-                })],
-                depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
-                    view: &target.depth,
-                    depth_ops: Some(wgpu::Operations {
-                        load: wgpu::LoadOp::Clear(1.0),
-                        store: wgpu::StoreOp::Discard,
-                    }),
-                    stencil_ops: None,
-                }),
-                timestamp_writes: None,
-                occlusion_query_set: None,
-                multiview_mask: None,
-            });
-            if let Some(mesh) = &self.mesh {
-                pass.set_bind_group(0, &self.bind_group, &[]);
-                pass.set_pipeline(&self.fill_pipeline);
-                pass.set_vertex_buffer(0, mesh.positions.slice(..));
-                pass.set_vertex_buffer(1, mesh.scalars.slice(..));
-                pass.set_vertex_buffer(2, mesh.normals.slice(..));
-                pass.set_index_buffer(mesh.triangles.slice(..), wgpu::IndexFormat::Uint32);
-                pass.draw_indexed(0..mesh.index_count, 0, 0..1);
-                if params.wireframe {
-                    if let Some((lines, count)) = &mesh.lines {
-                        pass.set_pipeline(&self.line_pipeline);
-                        pass.set_vertex_buffer(0, mesh.positions.slice(..));
-                        pass.set_index_buffer(lines.slice(..), wgpu::IndexFormat::Uint32);
-                        pass.draw_indexed(0..*count, 0, 0..1);
-                    }
-                }
-            }
+        if let Some(target) = &self.target {
+            self.pipelines
+                .draw(encoder, target, self.mesh.as_ref(), params.wireframe);
         }
         self.drawn = Some(*params);
         self.images_drawn += 1;
         self.last_draw_time = started.elapsed();
         true
+    }
+
+    /// Builds the wireframe's edges of the mesh on screen when they are missing and fit: a big
+    /// mesh's on the upload thread (the image shows the mesh without them meanwhile), a small
+    /// one's here.
+    fn ensure_lines(&mut self, device: &wgpu::Device) {
+        if let Some(mesh) = &mut self.mesh {
+            let faces = mesh.index_count as usize / 3;
+            let fits = faces as u64 * 24 <= self.max_buffer_size;
+            if fits
+                && !self.lines_failed
+                && mesh.lines.is_none()
+                && self.lines_requested != Some(mesh.generation)
+            {
+                // A big mesh's edges are built on the upload thread (the image shows the
+                // mesh without them meanwhile); a small one's here.
+                let bytes = (mesh.vertex_count + faces) * 12;
+                let job = UploadJob::Lines {
+                    generation: mesh.generation,
+                    source: mesh.source.clone(),
+                };
+                let sent = match &self.uploader {
+                    Some(uploader) if bytes >= self.async_upload_bytes => {
+                        uploader.send(job).is_ok()
+                    }
+                    _ => false,
+                };
+                if sent {
+                    self.lines_requested = Some(mesh.generation);
+                } else {
+                    mesh.lines = Some(line_buffer(device, mesh.source.triangles()));
+                }
+            }
+        }
     }
 }

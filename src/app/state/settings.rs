@@ -1,0 +1,420 @@
+//! The settings that persist between runs ([`Settings`], saved through eframe's persistence),
+//! the choices they are made of (method, boundary, variant, view mode, compare view, heat-map
+//! reference) and the options they give the fairing, the hierarchy and the noise.
+
+use std::path::{Path, PathBuf};
+
+use serde::{Deserialize, Serialize};
+
+use crate::fairing::creases::{CreaseOptions, DEFAULT_CREASE_ANGLE};
+use crate::fairing::{BoundaryMode, HcOptions, LaplacianOptions, MethodOptions, TaubinOptions};
+use crate::hierarchy::HierarchyOptions;
+use crate::multires::{MultiresOptions, MultiresVariant};
+use crate::noise::{NoiseMode, NoiseOptions};
+use crate::render::{Lighting, Shading};
+
+/// Boundary handling, as stored in the settings.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+pub enum BoundarySetting {
+    #[default]
+    Curve,
+    Fixed,
+}
+
+/// Fairing variant, as stored in the settings.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+pub enum VariantSetting {
+    Paper,
+    #[default]
+    Improved,
+}
+
+/// The smoothing method of the fairing panel: the paper's (coarse to fine over the hierarchy) or
+/// a baseline run on the document's mesh, to see its shrinkage next to the paper's.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+pub enum MethodSetting {
+    #[default]
+    Constrained,
+    Laplacian,
+    Taubin,
+    Hc,
+}
+
+impl MethodSetting {
+    pub const ALL: [MethodSetting; 4] = [
+        MethodSetting::Constrained,
+        MethodSetting::Laplacian,
+        MethodSetting::Taubin,
+        MethodSetting::Hc,
+    ];
+
+    pub fn label(self) -> &'static str {
+        match self {
+            MethodSetting::Constrained => "Constrained fairing",
+            MethodSetting::Laplacian => "Laplacian",
+            MethodSetting::Taubin => "Taubin λ|μ",
+            MethodSetting::Hc => "HC Laplacian",
+        }
+    }
+
+    /// Whether the method works over the hierarchy (start level, Fair M0, variant apply).
+    pub fn uses_hierarchy(self) -> bool {
+        self == MethodSetting::Constrained
+    }
+
+    /// What a result of this method from `start_level` is, in words ("from M4" means nothing
+    /// to a baseline, which smooths the whole input mesh).
+    pub fn describe(self, start_level: usize) -> String {
+        if self.uses_hierarchy() {
+            format!("{} from M{start_level}", self.label())
+        } else {
+            format!("{}, whole mesh", self.label())
+        }
+    }
+}
+
+/// What the viewport shows.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+pub enum ViewMode {
+    /// M0 with the faired positions (falls back to the loaded mesh until the first result).
+    #[default]
+    Faired,
+    /// The coarse mesh of the selected level itself.
+    Level,
+    /// The mesh as loaded.
+    Original,
+}
+
+/// Which mesh the heat map and the second column of numbers measure against.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+pub enum HeatReference {
+    /// The document's mesh as loaded (or as it became after noise or an applied result).
+    #[default]
+    Document,
+    /// The clean mesh kept when noise was injected (falls back to the document without one).
+    Clean,
+}
+
+/// How before (the document's mesh) and after (the faired result) are shown.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+pub enum CompareView {
+    /// One mesh; a key toggles between before and after.
+    #[default]
+    Single,
+    /// One image, before left of a draggable divider, after right of it.
+    Split,
+    /// Two views next to each other, one camera.
+    SideBySide,
+}
+
+/// The range of the sharp-edge angle the editor offers, in degrees.
+pub const MIN_SHARP_EDGE_ANGLE: f64 = 10.0;
+pub const MAX_SHARP_EDGE_ANGLE: f64 = 90.0;
+
+/// Settings that persist between runs.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
+pub struct Settings {
+    pub iterations: usize,
+    pub rounds: usize,
+    pub boundary: BoundarySetting,
+    pub fair_finest: bool,
+    pub variant: VariantSetting,
+    pub wireframe: bool,
+    pub view_mode: ViewMode,
+    pub show_performance: bool,
+    /// Directory of the last file opened or exported, where dialogs start.
+    pub last_dir: Option<PathBuf>,
+    /// Noise injection: standard deviation as a fraction of the mean edge length.
+    pub noise_sigma: f64,
+    pub noise_seed: u64,
+    pub noise_mode: NoiseMode,
+    /// Colour the mesh by its distance from the reference.
+    pub heat_map: bool,
+    pub heat_reference: HeatReference,
+    pub compare: CompareView,
+    /// Where the split view's divider sits, as a fraction of the view's width.
+    pub split: f32,
+    pub method: MethodSetting,
+    /// Iterations and step of the baseline methods.
+    pub baseline_iterations: usize,
+    pub baseline_lambda: f64,
+    /// Folder and level range of the level-chain export.
+    pub levels_folder: String,
+    pub levels_from: usize,
+    pub levels_to: usize,
+    /// The start level last chosen for each file, most recent last (at most
+    /// [`Settings::REMEMBERED_FILES`]): a file opens at the level the user left it at.
+    pub start_levels: Vec<(PathBuf, usize)>,
+    /// The brush, and the mask last painted on each file.
+    pub paint: crate::app::paint::PaintSettings,
+    /// Keep sharp edges: the hierarchy keeps them on every level and the fairing smooths along
+    /// them, not across them.
+    pub keep_sharp_edges: bool,
+    /// An edge is sharp when the surface folds there by more than this many degrees.
+    pub sharp_edge_angle: f64,
+    /// The files opened last, newest first (at most [`Settings::RECENT_FILES`]): the Recent menu.
+    pub recent_files: Vec<PathBuf>,
+    /// Shading: Flat (every facet shows) or Smooth (vertex normals).
+    pub shading: Shading,
+    /// Lighting: Simple or Studio (key, fill and rim lights).
+    pub lighting: Lighting,
+}
+
+impl Default for Settings {
+    fn default() -> Self {
+        let defaults = MultiresOptions::default();
+        Self {
+            iterations: defaults.iterations,
+            rounds: defaults.rounds,
+            boundary: BoundarySetting::Curve,
+            fair_finest: defaults.fair_finest,
+            variant: VariantSetting::Improved,
+            wireframe: false,
+            view_mode: ViewMode::Faired,
+            show_performance: false,
+            last_dir: None,
+            noise_sigma: NoiseOptions::default().sigma,
+            noise_seed: NoiseOptions::default().seed,
+            noise_mode: NoiseOptions::default().mode,
+            heat_map: false,
+            heat_reference: HeatReference::Document,
+            compare: CompareView::Single,
+            split: 0.5,
+            method: MethodSetting::Constrained,
+            baseline_iterations: 10,
+            baseline_lambda: 0.5,
+            levels_folder: String::new(),
+            levels_from: 0,
+            levels_to: usize::MAX,
+            start_levels: Vec::new(),
+            paint: Default::default(),
+            keep_sharp_edges: HierarchyOptions::default().creases.is_some(),
+            sharp_edge_angle: DEFAULT_CREASE_ANGLE,
+            recent_files: Vec::new(),
+            shading: Shading::default(),
+            lighting: Lighting::default(),
+        }
+    }
+}
+
+impl Settings {
+    pub const STORAGE_KEY: &'static str = "fairmesh.settings";
+    pub const REMEMBERED_FILES: usize = 64;
+    pub const RECENT_FILES: usize = 8;
+
+    /// Puts `path` first in the recent files (once), dropping the oldest beyond
+    /// [`Self::RECENT_FILES`].
+    pub fn remember_recent(&mut self, path: &Path) {
+        self.forget_recent(path);
+        self.recent_files.insert(0, path.to_path_buf());
+        self.recent_files.truncate(Self::RECENT_FILES);
+    }
+
+    /// Drops `path` from the recent files.
+    pub fn forget_recent(&mut self, path: &Path) {
+        self.recent_files.retain(|recent| recent != path);
+    }
+
+    /// The start level to open `path` at, with `level_count` levels: the one last chosen for
+    /// it, or a middle level (level 0 would show the input unchanged as the result).
+    pub fn start_level_for(&self, path: &Path, level_count: usize) -> usize {
+        let top = level_count.saturating_sub(1);
+        self.start_levels
+            .iter()
+            .rev()
+            .find(|(remembered, _)| remembered == path)
+            .map_or(top / 2, |&(_, level)| level)
+            .min(top)
+    }
+
+    /// Remembers `level` as the start level chosen for `path`.
+    pub fn remember_start_level(&mut self, path: &Path, level: usize) {
+        self.start_levels
+            .retain(|(remembered, _)| remembered != path);
+        self.start_levels.push((path.to_path_buf(), level));
+        let excess = self
+            .start_levels
+            .len()
+            .saturating_sub(Self::REMEMBERED_FILES);
+        self.start_levels.drain(..excess);
+    }
+
+    /// The settings that change the fairing result (a change means: run again).
+    #[allow(clippy::type_complexity)]
+    pub fn fairing_key(
+        &self,
+    ) -> (
+        usize,
+        usize,
+        BoundarySetting,
+        bool,
+        VariantSetting,
+        MethodSetting,
+        usize,
+        u64,
+    ) {
+        (
+            self.iterations,
+            self.rounds,
+            self.boundary,
+            self.fair_finest,
+            self.variant,
+            self.method,
+            self.baseline_iterations,
+            self.baseline_lambda.to_bits(),
+        )
+    }
+
+    /// The baseline method's options, or `None` for the paper's method.
+    pub fn baseline_options(&self) -> Option<MethodOptions> {
+        let iterations = self.baseline_iterations.clamp(1, 1000);
+        let lambda = if self.baseline_lambda.is_finite() {
+            self.baseline_lambda.clamp(0.01, 1.0)
+        } else {
+            0.5
+        };
+        let boundary = match self.boundary {
+            BoundarySetting::Curve => BoundaryMode::Curve,
+            BoundarySetting::Fixed => BoundaryMode::Fixed,
+        };
+        match self.method {
+            MethodSetting::Constrained => None,
+            MethodSetting::Laplacian => Some(MethodOptions::Laplacian(LaplacianOptions {
+                iterations,
+                lambda,
+                boundary,
+            })),
+            // Taubin's pass band k_PB = 0.1: 1/λ + 1/μ = 0.1.
+            MethodSetting::Taubin => Some(MethodOptions::Taubin(TaubinOptions {
+                iterations,
+                lambda,
+                mu: -lambda / (1.0 - 0.1 * lambda),
+                boundary,
+            })),
+            MethodSetting::Hc => Some(MethodOptions::Hc(HcOptions {
+                iterations,
+                boundary,
+                ..HcOptions::default()
+            })),
+        }
+    }
+
+    /// The noise these settings ask for (sigma clamped to a sane range).
+    pub fn noise_options(&self) -> NoiseOptions {
+        NoiseOptions {
+            sigma: if self.noise_sigma.is_finite() {
+                self.noise_sigma.clamp(0.0, 10.0)
+            } else {
+                0.0
+            },
+            seed: self.noise_seed,
+            mode: self.noise_mode,
+        }
+    }
+
+    /// The settings that change the hierarchy (a change means: build it again).
+    pub fn hierarchy_key(&self) -> (bool, u64) {
+        (self.keep_sharp_edges, self.sharp_edge_angle.to_bits())
+    }
+
+    /// The hierarchy these settings ask for (the angle clamped to a sane range).
+    pub fn hierarchy_options(&self) -> HierarchyOptions {
+        let angle = if self.sharp_edge_angle.is_finite() {
+            self.sharp_edge_angle
+                .clamp(MIN_SHARP_EDGE_ANGLE, MAX_SHARP_EDGE_ANGLE)
+        } else {
+            DEFAULT_CREASE_ANGLE
+        };
+        HierarchyOptions::default().with_creases(
+            self.keep_sharp_edges
+                .then(|| CreaseOptions::default().with_angle_degrees(angle)),
+        )
+    }
+
+    /// The multires options these settings give for `start_level`.
+    pub fn multires_options(&self, start_level: usize) -> MultiresOptions {
+        MultiresOptions {
+            start_level,
+            iterations: self.iterations.clamp(1, 1000),
+            rounds: self.rounds.clamp(1, 100),
+            boundary: match self.boundary {
+                BoundarySetting::Curve => BoundaryMode::Curve,
+                BoundarySetting::Fixed => BoundaryMode::Fixed,
+            },
+            fair_finest: self.fair_finest,
+            variant: match self.variant {
+                VariantSetting::Paper => MultiresVariant::Paper,
+                VariantSetting::Improved => MultiresVariant::Improved,
+            },
+            mask: None,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn settings_round_trip_through_json_and_tolerate_missing_fields() {
+        let settings = Settings {
+            iterations: 7,
+            wireframe: true,
+            ..Default::default()
+        };
+        let json = serde_json::to_string(&settings).unwrap();
+        let back: Settings = serde_json::from_str(&json).unwrap();
+        assert_eq!(back, settings);
+        let partial: Settings = serde_json::from_str(r#"{"rounds": 3}"#).unwrap();
+        assert_eq!(partial.rounds, 3);
+        assert_eq!(partial.iterations, Settings::default().iterations);
+    }
+
+    #[test]
+    fn shading_and_lighting_persist_and_old_settings_get_the_defaults() {
+        let settings = Settings {
+            shading: Shading::Flat,
+            lighting: Lighting::Simple,
+            ..Default::default()
+        };
+        let json = serde_json::to_string(&settings).unwrap();
+        let back: Settings = serde_json::from_str(&json).unwrap();
+        assert_eq!(
+            (back.shading, back.lighting),
+            (Shading::Flat, Lighting::Simple)
+        );
+        // A settings file written before these existed.
+        let old: Settings = serde_json::from_str(r#"{"wireframe": true}"#).unwrap();
+        assert_eq!(
+            (old.shading, old.lighting),
+            (Shading::Smooth, Lighting::Studio)
+        );
+    }
+
+    #[test]
+    fn start_level_is_the_files_last_choice_or_a_middle_one() {
+        let mut settings = Settings::default();
+        let (bunny, scan) = (Path::new("/a/bunny.obj"), Path::new("/b/scan.ply"));
+        assert_eq!(settings.start_level_for(bunny, 20), 9);
+        assert_eq!(settings.start_level_for(bunny, 1), 0);
+        settings.remember_start_level(bunny, 3);
+        settings.remember_start_level(scan, 12);
+        settings.remember_start_level(bunny, 5);
+        assert_eq!(settings.start_level_for(bunny, 20), 5);
+        assert_eq!(
+            settings.start_level_for(scan, 8),
+            7,
+            "clamped to the levels there are"
+        );
+        for i in 0..Settings::REMEMBERED_FILES {
+            settings.remember_start_level(&PathBuf::from(format!("/c/{i}.obj")), 1);
+        }
+        assert_eq!(settings.start_levels.len(), Settings::REMEMBERED_FILES);
+        assert_eq!(
+            settings.start_level_for(bunny, 20),
+            9,
+            "the oldest are forgotten"
+        );
+    }
+}

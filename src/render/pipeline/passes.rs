@@ -1,0 +1,367 @@
+//! The GPU side of drawing one image: the shader's uniforms ([`Uniforms`], made from the
+//! [`DrawParams`]), the two pipelines (filled triangles and wireframe lines, `shaders/mesh.wgsl`)
+//! with their uniform buffer ([`Pipelines`]), the offscreen colour + depth [`Target`], and the
+//! render pass that draws a mesh into it.
+
+use bytemuck::{Pod, Zeroable};
+
+use super::buffers::MeshBuffers;
+use super::{DrawParams, COLOR_FORMAT, DEPTH_FORMAT, SAMPLE_COUNT};
+use crate::render::shading::{Lighting, Shading};
+
+#[repr(C)]
+#[derive(Clone, Copy, Pod, Zeroable)]
+pub(super) struct Uniforms {
+    view_proj: [[f32; 4]; 4],
+    eye: [f32; 4],
+    light_dir: [f32; 4],
+    fill_dir: [f32; 4],
+    up: [f32; 4],
+    base_color: [f32; 4],
+    wire_color: [f32; 4],
+    scalar_range: [f32; 4],
+    /// x: 1 for smooth shading, y: 1 for the studio lighting.
+    look: [f32; 4],
+}
+
+impl Uniforms {
+    /// What the shader is told for `params`.
+    pub(super) fn of(params: &DrawParams) -> Self {
+        Uniforms {
+            view_proj: params.view_proj,
+            eye: [params.eye[0], params.eye[1], params.eye[2], 1.0],
+            light_dir: [
+                params.light_dir[0],
+                params.light_dir[1],
+                params.light_dir[2],
+                0.0,
+            ],
+            fill_dir: [
+                params.fill_dir[0],
+                params.fill_dir[1],
+                params.fill_dir[2],
+                0.0,
+            ],
+            up: [params.up[0], params.up[1], params.up[2], 0.0],
+            base_color: [0.62, 0.56, 0.48, 1.0],
+            wire_color: [0.02, 0.03, 0.05, 1.0],
+            scalar_range: match (params.scalar_range, params.mask_tint) {
+                (Some([lo, hi]), _) => [lo, hi, 1.0, 0.0],
+                (None, true) => [0.0, 1.0, 2.0, 0.0],
+                (None, false) => [0.0, 1.0, 0.0, 0.0],
+            },
+            look: [
+                f32::from(u8::from(params.shading == Shading::Smooth)),
+                f32::from(u8::from(params.lighting == Lighting::Studio)),
+                0.0,
+                0.0,
+            ],
+        }
+    }
+}
+
+/// The offscreen image a renderer draws into: multisampled colour and depth, resolved into a
+/// single-sample colour texture that egui shows.
+pub(super) struct Target {
+    pub(super) size: [u32; 2],
+    multisampled: wgpu::TextureView,
+    pub(super) resolved: wgpu::TextureView,
+    depth: wgpu::TextureView,
+}
+
+impl Target {
+    /// Textures of `size` (physical pixels) on `device`.
+    pub(super) fn new(device: &wgpu::Device, size: [u32; 2]) -> Self {
+        let extent = wgpu::Extent3d {
+            width: size[0],
+            height: size[1],
+            depth_or_array_layers: 1,
+        };
+        let make = |label, format, samples, usage| {
+            device
+                .create_texture(&wgpu::TextureDescriptor {
+                    label: Some(label),
+                    size: extent,
+                    mip_level_count: 1,
+                    sample_count: samples,
+                    dimension: wgpu::TextureDimension::D2,
+                    format,
+                    usage,
+                    view_formats: &[],
+                })
+                .create_view(&Default::default())
+        };
+        Self {
+            size,
+            multisampled: make(
+                "fairmesh colour (multisampled)",
+                COLOR_FORMAT,
+                SAMPLE_COUNT,
+                wgpu::TextureUsages::RENDER_ATTACHMENT,
+            ),
+            resolved: make(
+                "fairmesh colour",
+                COLOR_FORMAT,
+                1,
+                wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING,
+            ),
+            depth: make(
+                "fairmesh depth",
+                DEPTH_FORMAT,
+                SAMPLE_COUNT,
+                wgpu::TextureUsages::RENDER_ATTACHMENT,
+            ),
+        }
+    }
+}
+
+/// The pipelines and their uniforms, made once per renderer.
+pub(super) struct Pipelines {
+    fill: wgpu::RenderPipeline,
+    line: wgpu::RenderPipeline,
+    pub(super) uniform_buffer: wgpu::Buffer,
+    bind_group: wgpu::BindGroup,
+}
+
+impl Pipelines {
+    pub(super) fn new(device: &wgpu::Device) -> Self {
+        let shader = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+            label: Some("fairmesh mesh shader"),
+            source: wgpu::ShaderSource::Wgsl(include_str!("../../../shaders/mesh.wgsl").into()),
+        });
+        let bind_group_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("fairmesh uniforms"),
+            entries: &[wgpu::BindGroupLayoutEntry {
+                binding: 0,
+                visibility: wgpu::ShaderStages::VERTEX_FRAGMENT,
+                ty: wgpu::BindingType::Buffer {
+                    ty: wgpu::BufferBindingType::Uniform,
+                    has_dynamic_offset: false,
+                    min_binding_size: None,
+                },
+                count: None,
+            }],
+        });
+        let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("fairmesh pipeline layout"),
+            bind_group_layouts: &[Some(&bind_group_layout)],
+            immediate_size: 0,
+        });
+        let uniform_buffer = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("fairmesh uniforms"),
+            size: std::mem::size_of::<Uniforms>() as u64,
+            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("fairmesh uniforms"),
+            layout: &bind_group_layout,
+            entries: &[wgpu::BindGroupEntry {
+                binding: 0,
+                resource: uniform_buffer.as_entire_binding(),
+            }],
+        });
+
+        Self {
+            fill: fill_pipeline(device, &layout, &shader),
+            line: line_pipeline(device, &layout, &shader),
+            uniform_buffer,
+            bind_group,
+        }
+    }
+
+    /// Records the pass that clears `target` and draws `mesh` into it (with its wireframe edges
+    /// when `wireframe` and they are built).
+    pub(super) fn draw(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        target: &Target,
+        mesh: Option<&MeshBuffers>,
+        wireframe: bool,
+    ) {
+        let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+            label: Some("fairmesh viewport"),
+            color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+                view: &target.multisampled,
+                depth_slice: None,
+                resolve_target: Some(&target.resolved),
+                ops: wgpu::Operations {
+                    load: wgpu::LoadOp::Clear(wgpu::Color {
+                        r: 0.018,
+                        g: 0.021,
+                        b: 0.026,
+                        a: 1.0,
+                    }),
+                    store: wgpu::StoreOp::Discard,
+                },
+            })],
+            depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                view: &target.depth,
+                depth_ops: Some(wgpu::Operations {
+                    load: wgpu::LoadOp::Clear(1.0),
+                    store: wgpu::StoreOp::Discard,
+                }),
+                stencil_ops: None,
+            }),
+            timestamp_writes: None,
+            occlusion_query_set: None,
+            multiview_mask: None,
+        });
+        if let Some(mesh) = mesh {
+            pass.set_bind_group(0, &self.bind_group, &[]);
+            pass.set_pipeline(&self.fill);
+            pass.set_vertex_buffer(0, mesh.positions.slice(..));
+            pass.set_vertex_buffer(1, mesh.scalars.slice(..));
+            pass.set_vertex_buffer(2, mesh.normals.slice(..));
+            pass.set_index_buffer(mesh.triangles.slice(..), wgpu::IndexFormat::Uint32);
+            pass.draw_indexed(0..mesh.index_count, 0, 0..1);
+            if wireframe {
+                if let Some((lines, count)) = &mesh.lines {
+                    pass.set_pipeline(&self.line);
+                    pass.set_vertex_buffer(0, mesh.positions.slice(..));
+                    pass.set_index_buffer(lines.slice(..), wgpu::IndexFormat::Uint32);
+                    pass.draw_indexed(0..*count, 0, 0..1);
+                }
+            }
+        }
+    }
+}
+
+/// The vertex buffers' layouts: positions (location 0), scalars (1), normals (2).
+fn vertex_layouts() -> [wgpu::VertexBufferLayout<'static>; 3] {
+    let position_layout = wgpu::VertexBufferLayout {
+        array_stride: 12,
+        step_mode: wgpu::VertexStepMode::Vertex,
+        attributes: &[wgpu::VertexAttribute {
+            format: wgpu::VertexFormat::Float32x3,
+            offset: 0,
+            shader_location: 0,
+        }],
+    };
+    let scalar_layout = wgpu::VertexBufferLayout {
+        array_stride: 4,
+        step_mode: wgpu::VertexStepMode::Vertex,
+        attributes: &[wgpu::VertexAttribute {
+            format: wgpu::VertexFormat::Float32,
+            offset: 0,
+            shader_location: 1,
+        }],
+    };
+    let normal_layout = wgpu::VertexBufferLayout {
+        array_stride: 12,
+        step_mode: wgpu::VertexStepMode::Vertex,
+        attributes: &[wgpu::VertexAttribute {
+            format: wgpu::VertexFormat::Float32x3,
+            offset: 0,
+            shader_location: 2,
+        }],
+    };
+    [position_layout, scalar_layout, normal_layout]
+}
+
+/// The colour target both pipelines draw into.
+fn color_targets() -> [Option<wgpu::ColorTargetState>; 1] {
+    [Some(wgpu::ColorTargetState {
+        format: COLOR_FORMAT,
+        blend: None,
+        write_mask: wgpu::ColorWrites::ALL,
+    })]
+}
+
+/// The target's multisampling, for both pipelines.
+fn multisample() -> wgpu::MultisampleState {
+    wgpu::MultisampleState {
+        count: SAMPLE_COUNT,
+        ..Default::default()
+    }
+}
+
+/// Filled triangles, pushed back a little in depth so the wireframe on them wins.
+fn fill_pipeline(
+    device: &wgpu::Device,
+    layout: &wgpu::PipelineLayout,
+    shader: &wgpu::ShaderModule,
+) -> wgpu::RenderPipeline {
+    let [position_layout, scalar_layout, normal_layout] = vertex_layouts();
+    let targets = color_targets();
+    device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+        label: Some("fairmesh triangles"),
+        layout: Some(layout),
+        vertex: wgpu::VertexState {
+            module: shader,
+            entry_point: Some("vs_mesh"),
+            compilation_options: Default::default(),
+            buffers: &[
+                Some(position_layout),
+                Some(scalar_layout),
+                Some(normal_layout),
+            ],
+        },
+        primitive: wgpu::PrimitiveState {
+            topology: wgpu::PrimitiveTopology::TriangleList,
+            cull_mode: None,
+            ..Default::default()
+        },
+        depth_stencil: Some(wgpu::DepthStencilState {
+            format: DEPTH_FORMAT,
+            depth_write_enabled: Some(true),
+            depth_compare: Some(wgpu::CompareFunction::Less),
+            stencil: Default::default(),
+            // Push triangles back a little so the wireframe lines on them win the depth test.
+            bias: wgpu::DepthBiasState {
+                constant: 2,
+                slope_scale: 1.0,
+                clamp: 0.0,
+            },
+        }),
+        multisample: multisample(),
+        fragment: Some(wgpu::FragmentState {
+            module: shader,
+            entry_point: Some("fs_mesh"),
+            compilation_options: Default::default(),
+            targets: &targets,
+        }),
+        multiview_mask: None,
+        cache: None,
+    })
+}
+
+/// The wireframe's lines, over the triangles.
+fn line_pipeline(
+    device: &wgpu::Device,
+    layout: &wgpu::PipelineLayout,
+    shader: &wgpu::ShaderModule,
+) -> wgpu::RenderPipeline {
+    let [position_layout, _, _] = vertex_layouts();
+    let targets = color_targets();
+    device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+        label: Some("fairmesh wireframe"),
+        layout: Some(layout),
+        vertex: wgpu::VertexState {
+            module: shader,
+            entry_point: Some("vs_line"),
+            compilation_options: Default::default(),
+            buffers: &[Some(position_layout)],
+        },
+        primitive: wgpu::PrimitiveState {
+            topology: wgpu::PrimitiveTopology::LineList,
+            ..Default::default()
+        },
+        depth_stencil: Some(wgpu::DepthStencilState {
+            format: DEPTH_FORMAT,
+            depth_write_enabled: Some(false),
+            depth_compare: Some(wgpu::CompareFunction::LessEqual),
+            stencil: Default::default(),
+            bias: Default::default(),
+        }),
+        multisample: multisample(),
+        fragment: Some(wgpu::FragmentState {
+            module: shader,
+            entry_point: Some("fs_line"),
+            compilation_options: Default::default(),
+            targets: &targets,
+        }),
+        multiview_mask: None,
+        cache: None,
+    })
+}

@@ -1,0 +1,162 @@
+//! The renderer's upload thread ([`Uploader`]): the jobs it takes ([`UploadJob`]: a big mesh's
+//! buffers, its wireframe edges, new positions' normals), what comes back ([`Uploaded`]), and
+//! the upload in flight ([`PendingMesh`]).
+
+use std::sync::mpsc::{self, Receiver, Sender};
+use std::sync::{Arc, Mutex};
+
+use super::buffers::{line_buffer, MeshBuffers};
+use super::MeshSource;
+use crate::render::normals::vertex_normals;
+
+/// Work for the upload thread.
+pub(super) enum UploadJob {
+    Mesh {
+        generation: u64,
+        source: Arc<dyn MeshSource>,
+        with_lines: bool,
+    },
+    Lines {
+        generation: u64,
+        source: Arc<dyn MeshSource>,
+    },
+    /// New positions for the mesh of `generation`: their normals.
+    Move {
+        generation: u64,
+        serial: u64,
+        source: Arc<dyn MeshSource>,
+    },
+}
+
+impl UploadJob {
+    fn generation(&self) -> u64 {
+        match self {
+            Self::Mesh { generation, .. }
+            | Self::Lines { generation, .. }
+            | Self::Move { generation, .. } => *generation,
+        }
+    }
+
+    fn run(self, device: &wgpu::Device) -> Uploaded {
+        match self {
+            UploadJob::Mesh {
+                generation,
+                source,
+                with_lines,
+            } => Uploaded::Mesh(MeshBuffers::create(device, source, with_lines, generation)),
+            UploadJob::Lines { generation, source } => Uploaded::Lines {
+                generation,
+                lines: line_buffer(device, source.triangles()),
+            },
+            UploadJob::Move {
+                generation,
+                serial,
+                source,
+            } => Uploaded::Moved {
+                generation,
+                serial,
+                normals: vertex_normals(source.positions(), source.triangles()),
+                source,
+            },
+        }
+    }
+}
+
+pub(super) enum Uploaded {
+    Mesh(MeshBuffers),
+    /// Filling the buffers of `generation` panicked inside wgpu.
+    Failed {
+        generation: u64,
+    },
+    Lines {
+        generation: u64,
+        lines: (wgpu::Buffer, u32),
+    },
+    Moved {
+        generation: u64,
+        serial: u64,
+        source: Arc<dyn MeshSource>,
+        normals: Vec<[f32; 3]>,
+    },
+}
+
+/// The renderer's upload thread: fills buffers for big meshes off the UI thread. Only the newest
+/// generation's jobs in the queue are done; older ones are superseded.
+pub(super) struct Uploader {
+    jobs: Option<Sender<UploadJob>>,
+    /// In a mutex only because egui_wgpu's callback resources must be `Sync`.
+    pub(super) done: Mutex<Receiver<Uploaded>>,
+    thread: Option<std::thread::JoinHandle<()>>,
+}
+
+impl Uploader {
+    pub(super) fn spawn(
+        device: wgpu::Device,
+        on_done: Arc<dyn Fn() + Send + Sync>,
+    ) -> Option<Self> {
+        let (jobs_tx, jobs_rx) = mpsc::channel::<UploadJob>();
+        let (done_tx, done_rx) = mpsc::channel();
+        let thread = std::thread::Builder::new()
+            .name("fairmesh-upload".into())
+            .spawn(move || {
+                while let Ok(first) = jobs_rx.recv() {
+                    let mut batch = vec![first];
+                    batch.extend(jobs_rx.try_iter());
+                    let newest = batch.iter().map(UploadJob::generation).max();
+                    // Only the last move counts: the positions before it are already old.
+                    let last_move = batch
+                        .iter()
+                        .rposition(|job| matches!(job, UploadJob::Move { .. }));
+                    for (index, job) in batch.into_iter().enumerate() {
+                        let old_move =
+                            matches!(job, UploadJob::Move { .. }) && Some(index) != last_move;
+                        if Some(job.generation()) != newest || old_move {
+                            continue;
+                        }
+                        let generation = job.generation();
+                        let upload = std::panic::AssertUnwindSafe(|| job.run(&device));
+                        // wgpu reports an error it cannot return (out of memory, say) by
+                        // panicking: the upload fails, the thread and the app go on.
+                        let uploaded = std::panic::catch_unwind(upload)
+                            .unwrap_or(Uploaded::Failed { generation });
+                        if done_tx.send(uploaded).is_err() {
+                            return;
+                        }
+                        on_done();
+                    }
+                }
+            })
+            .ok()?;
+        Some(Self {
+            jobs: Some(jobs_tx),
+            done: Mutex::new(done_rx),
+            thread: Some(thread),
+        })
+    }
+
+    /// Queues a job; gives it back when the thread is gone.
+    pub(super) fn send(&self, job: UploadJob) -> Result<(), UploadJob> {
+        match &self.jobs {
+            Some(jobs) => jobs.send(job).map_err(|e| e.0),
+            None => Err(job),
+        }
+    }
+}
+
+impl Drop for Uploader {
+    fn drop(&mut self) {
+        // Closing the queue ends the thread after the job in hand.
+        self.jobs = None;
+        if let Some(thread) = self.thread.take() {
+            let _ = thread.join();
+        }
+    }
+}
+
+/// A mesh whose buffers the upload thread is filling.
+pub(super) struct PendingMesh {
+    pub(super) generation: u64,
+    pub(super) vertex_count: usize,
+    /// Scalars set while the upload was in flight, written once it lands.
+    pub(super) scalars: Option<Vec<f32>>,
+}
