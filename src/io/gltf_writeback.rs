@@ -39,7 +39,6 @@ use crate::mesh::TriMesh;
 use glam::{DMat3, DMat4, DVec3};
 use rayon::prelude::*;
 use serde_json::{json, Value};
-use std::borrow::Cow;
 use std::collections::{BTreeMap, BTreeSet};
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -1033,16 +1032,8 @@ fn turn_normals(
         let faces: Vec<FaceUse> = uses
             .iter()
             .map(|(p, positions, triangles)| match edits.get(p) {
-                Some(edit) => FaceUse {
-                    triangles,
-                    before: Cow::Borrowed(edit.before.as_slice()),
-                    after: Some(edit.after.as_slice()),
-                },
-                None => FaceUse {
-                    triangles,
-                    before: Cow::Owned(gltf.read3_all(positions)),
-                    after: None,
-                },
+                Some(edit) => FaceUse::new(triangles, &edit.before, Some(&edit.after)),
+                None => FaceUse::new(triangles, &gltf.read3_all(positions), None),
             })
             .collect();
         let values = gltf.read3_all(layout);
@@ -1154,19 +1145,36 @@ struct Slotted<'a> {
 /// after (`None`: they did not move).
 struct FaceUse<'a> {
     triangles: &'a [[u32; 3]],
-    before: Cow<'a, [[f32; 3]]>,
-    after: Option<&'a [Option<[f32; 3]>]>,
+    /// Per vertex of the primitive, its position before and after, side by side (one place to
+    /// read per corner).
+    points: Vec<[[f32; 3]; 2]>,
 }
 
-impl FaceUse<'_> {
-    fn corners(&self, t: [u32; 3]) -> ([DVec3; 3], [DVec3; 3]) {
-        let t = t.map(|v| v as usize);
-        let before = t.map(|v| dvec(self.before[v]));
-        let after = match self.after {
-            Some(after) => t.map(|v| dvec(after[v].unwrap_or(self.before[v]))),
-            None => before,
+impl<'a> FaceUse<'a> {
+    fn new(
+        triangles: &'a [[u32; 3]],
+        before: &[[f32; 3]],
+        after: Option<&[Option<[f32; 3]>]>,
+    ) -> FaceUse<'a> {
+        let points = match after {
+            Some(after) => before
+                .par_iter()
+                .zip(after)
+                .with_min_len(4096)
+                .map(|(&b, a)| [b, a.unwrap_or(b)])
+                .collect(),
+            None => before
+                .par_iter()
+                .with_min_len(4096)
+                .map(|&b| [b, b])
+                .collect(),
         };
-        (before, after)
+        FaceUse { triangles, points }
+    }
+
+    fn corners(&self, t: [u32; 3]) -> ([DVec3; 3], [DVec3; 3]) {
+        let points = t.map(|v| self.points[v as usize]);
+        (points.map(|p| dvec(p[0])), points.map(|p| dvec(p[1])))
     }
 }
 
