@@ -57,10 +57,12 @@
 //! does not accumulate; the tests check volume to 1e-4 relative and equivariance to f32 accuracy.
 
 use super::boundary::BoundaryCurves;
-use super::creases::{detect_creases, detect_creases_with_estimate, Creases, FeatureClass};
+use super::creases::{
+    detect_creases, detect_creases_with_estimate, CreaseOptions, Creases, FeatureClass,
+};
 use super::strength::{
-    estimate_noise_with_fans, normal_filtering_for, CLEAN_NOISE, MAX_AUTO_ROUNDS,
-    MIN_MOVE_PER_NOISE, MIN_NOISE_FALL, NOISE_LEFT,
+    estimate_noise_away_from_edges, estimate_noise_with_fans, normal_filtering_for, CLEAN_NOISE,
+    MAX_AUTO_ROUNDS, MIN_MOVE_PER_NOISE, MIN_NOISE_FALL, NOISE_LEFT,
 };
 use super::volume::VolumeKeeper;
 use super::{BoundaryMode, FairOptions, FairReport, FairVariant, Strength};
@@ -1111,10 +1113,20 @@ pub fn fair_constrained(
         (_, Strength::Auto) => (estimate_noise_with_fans(mesh, topology, &fans), None),
         (None, _) => (None, None),
     };
-    // Automatic strength: a clean mesh is left as it is.
+    // Automatic strength: a clean mesh is left as it is, and so is one that reads noisy only
+    // because of its sharp edges (a coarse CAD part: most of its vertices lie on or beside an
+    // edge, and those make the median read noise; away from the edges it reads clean).
+    let clean_away_from_edges = || {
+        let angle = options
+            .creases
+            .as_ref()
+            .map_or(CreaseOptions::default().angle_degrees, |c| c.angle_degrees);
+        estimate_noise_away_from_edges(mesh, topology, &fans, angle)
+            .is_some_and(|away| away <= CLEAN_NOISE)
+    };
     let auto_noise = match options.strength {
         Strength::Auto => match estimate {
-            Some(noise) if noise > CLEAN_NOISE => Some(noise),
+            Some(noise) if noise > CLEAN_NOISE && !clean_away_from_edges() => Some(noise),
             _ => {
                 return FairReport {
                     noise_estimate: estimate,

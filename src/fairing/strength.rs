@@ -54,6 +54,27 @@ pub(crate) fn estimate_noise_with_fans(
     estimate(mesh, topology, Some(fans), None).0
 }
 
+/// [`estimate_noise_with_fans`] with the vertices on sharp edges left out (edges where the faces'
+/// own normals turn by more than `crease_angle` degrees; such a vertex is neither counted nor
+/// taken into its neighbours' means), the less of two readings: with the vertices beside those
+/// edges counted, and without them (where a curved surface meets a sharp feature its curvature
+/// does not cancel in the neighbours' mean); `None` when both leave fewer than a quarter of the
+/// vertices. On a coarse CAD part most vertices lie on or beside its edges, and those make the
+/// median read noise where there is none.
+pub(crate) fn estimate_noise_away_from_edges(
+    mesh: &TriMesh,
+    topology: &Topology,
+    fans: &FanRings,
+    crease_angle: f64,
+) -> Option<f64> {
+    [false, true]
+        .into_iter()
+        .filter_map(|beside| {
+            estimate_with(mesh, topology, Some(fans), Some(crease_angle), true, beside).0
+        })
+        .reduce(f64::min)
+}
+
 /// What [`scan_fans`] finds.
 pub(crate) struct FanScan {
     /// [`estimate_noise`].
@@ -92,6 +113,22 @@ fn estimate(
     fans: Option<&FanRings>,
     crease_angle: Option<f64>,
 ) -> (Option<f64>, Vec<FeatureEdge>) {
+    estimate_with(mesh, topology, fans, crease_angle, false, false)
+}
+
+/// [`estimate`]; with `away_from_edges` (and a crease angle), the vertices on a feature edge are
+/// left out (neither counted nor taken into their neighbours' means), and `None` comes back when
+/// fewer than a quarter of the vertices are left; with `beside_edges` too, the vertices beside
+/// them are not counted either.
+fn estimate_with(
+    mesh: &TriMesh,
+    topology: &Topology,
+    fans: Option<&FanRings>,
+    crease_angle: Option<f64>,
+    away_from_edges: bool,
+    beside_edges: bool,
+) -> (Option<f64>, Vec<FeatureEdge>) {
+    let beside_edges = away_from_edges && beside_edges;
     let n = mesh.positions.len();
     let point = |v: u32| Vec3A::from_array(mesh.positions[v as usize]);
     let ring_offsets = topology.neighbor_csr().0;
@@ -169,22 +206,46 @@ fn estimate(
     if !(edge > 0.0 && edge.is_finite()) {
         return (None, edges);
     }
+    let mut on_edge = vec![false; if away_from_edges { n } else { 0 }];
+    for ([a, b], _) in edges.iter().filter(|_| away_from_edges) {
+        on_edge[*a as usize] = true;
+        on_edge[*b as usize] = true;
+    }
+    // Away from the edges: a vertex on a feature edge is not counted, nor taken into its
+    // neighbours' mean (on a flat face beside a crease h is 0 but for the crease's own vertices).
+    let skip = |v: u32| away_from_edges && on_edge[v as usize];
+    let beside =
+        |v: u32| beside_edges && topology.neighbors(v).iter().any(|&u| on_edge[u as usize]);
+    let defined = (0..n as u32)
+        .into_par_iter()
+        .with_min_len(VERTEX_BLOCK)
+        .filter(|&v| heights[v as usize].is_finite())
+        .count();
     let mut residuals: Vec<f32> = (0..n as u32)
         .into_par_iter()
         .with_min_len(VERTEX_BLOCK)
         .filter_map(|v| {
+            if skip(v) || beside(v) {
+                return None;
+            }
             let own = heights[v as usize];
-            let ring = topology.neighbors(v);
             let mut sum = 0.0;
-            for &u in ring {
-                sum += heights[u as usize];
+            let mut count = 0usize;
+            for &u in topology.neighbors(v) {
+                if !skip(u) {
+                    sum += heights[u as usize];
+                    count += 1;
+                }
+            }
+            if count == 0 {
+                return None;
             }
             // NaN (a vertex or a neighbour without h) fails the comparison.
-            let residual = (own - sum / ring.len() as f32).abs();
+            let residual = (own - sum / count as f32).abs();
             (residual >= 0.0).then_some(residual)
         })
         .collect();
-    if residuals.len() < 16 {
+    if residuals.len() < 16 || (away_from_edges && 4 * residuals.len() < defined) {
         return (None, edges);
     }
     let middle = residuals.len() / 2;
