@@ -5,10 +5,12 @@
 //! why.
 
 use super::state::{
-    BoundarySetting, CompareView, HierarchyState, MethodSetting, Settings, VariantSetting,
-    ViewMode, MAX_SHARP_EDGE_ANGLE, MIN_SHARP_EDGE_ANGLE,
+    CompareView, HierarchyState, MethodChoice, Settings, ViewMode, MAX_SHARP_EDGE_ANGLE,
+    MIN_SHARP_EDGE_ANGLE,
 };
 use super::{App, Command};
+use crate::fairing::{BoundaryMode, Method};
+use crate::multires::MultiresVariant;
 
 /// The fairing section: start level, method and its options, Apply. Every control says in its
 /// tooltip what it does and when to change it; the ones the chosen method does not use are
@@ -71,11 +73,11 @@ fn start_level_slider(
 
 /// The method and the options of `method` (the one chosen when the frame began): iterations and
 /// rounds over the hierarchy, or a baseline's iterations and step.
-fn method_controls(settings: &mut Settings, ui: &mut egui::Ui, method: MethodSetting) {
+fn method_controls(settings: &mut Settings, ui: &mut egui::Ui, method: Method) {
     let combo = egui::ComboBox::from_label("Method")
         .selected_text(settings.method.label())
         .show_ui(ui, |ui| {
-            for method in MethodSetting::ALL {
+            for method in Method::ALL {
                 ui.selectable_value(&mut settings.method, method, method.label());
             }
         });
@@ -91,7 +93,7 @@ fn method_controls(settings: &mut Settings, ui: &mut egui::Ui, method: MethodSet
         let iterations = ui
             .add(egui::Slider::new(&mut settings.baseline_iterations, 1..=200).text("Iterations"));
         explain(iterations, tips::BASELINE_ITERATIONS, None);
-        if matches!(method, MethodSetting::Laplacian | MethodSetting::Taubin) {
+        if matches!(method, Method::Laplacian | Method::Taubin) {
             let lambda =
                 ui.add(egui::Slider::new(&mut settings.baseline_lambda, 0.05..=1.0).text("Lambda"));
             explain(lambda, tips::LAMBDA, None);
@@ -108,16 +110,16 @@ fn boundary_and_variant(
 ) {
     let boundary = egui::ComboBox::from_label("Boundary")
         .selected_text(match settings.boundary {
-            BoundarySetting::Curve => "Smooth as curve",
-            BoundarySetting::Fixed => "Fixed",
+            BoundaryMode::Curve => "Smooth as curve",
+            BoundaryMode::Fixed => "Fixed",
         })
         .show_ui(ui, |ui| {
             ui.selectable_value(
                 &mut settings.boundary,
-                BoundarySetting::Curve,
+                BoundaryMode::Curve,
                 "Smooth as curve",
             );
-            ui.selectable_value(&mut settings.boundary, BoundarySetting::Fixed, "Fixed");
+            ui.selectable_value(&mut settings.boundary, BoundaryMode::Fixed, "Fixed");
         });
     explain(boundary.response, tips::BOUNDARY, None);
     let hierarchy_only = not_for_baseline.is_none();
@@ -129,12 +131,12 @@ fn boundary_and_variant(
     let variant = ui.add_enabled_ui(hierarchy_only, |ui| {
         egui::ComboBox::from_label("Variant")
             .selected_text(match settings.variant {
-                VariantSetting::Paper => "Paper",
-                VariantSetting::Improved => "Improved",
+                MultiresVariant::Paper => "Paper",
+                MultiresVariant::Improved => "Improved",
             })
             .show_ui(ui, |ui| {
-                ui.selectable_value(&mut settings.variant, VariantSetting::Paper, "Paper");
-                ui.selectable_value(&mut settings.variant, VariantSetting::Improved, "Improved");
+                ui.selectable_value(&mut settings.variant, MultiresVariant::Paper, "Paper");
+                ui.selectable_value(&mut settings.variant, MultiresVariant::Improved, "Improved");
             })
             .response
     });

@@ -4,7 +4,7 @@
 //! loading, the hierarchy, the fairing and the measuring. Reads the app, writes nothing.
 
 use super::panels::seconds;
-use super::state::{HierarchyState, Measures};
+use super::state::{HierarchyState, Measures, MethodChoice};
 use super::App;
 
 /// What a greyed number in the Numbers panel means.
