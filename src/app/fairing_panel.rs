@@ -4,6 +4,8 @@
 //! it does and when to change it; the ones the chosen method does not use are disabled and say
 //! why.
 
+use super::command::PanelChange;
+use super::panel_view::{Commands, PanelView};
 use super::state::{
     CompareView, HierarchyState, MethodChoice, Settings, ViewMode, MAX_SHARP_EDGE_ANGLE,
     MIN_SHARP_EDGE_ANGLE,
@@ -15,8 +17,14 @@ use crate::multires::MultiresVariant;
 /// The fairing section: start level, method and its options, Apply. Every control says in its
 /// tooltip what it does and when to change it; the ones the chosen method does not use are
 /// disabled and say why.
-pub(super) fn fairing_controls(app: &mut App, ui: &mut egui::Ui, top_level: usize) {
-    let Some(document) = &app.document else {
+pub(super) fn fairing_controls(
+    ui: &mut egui::Ui,
+    view: &PanelView,
+    settings: &mut Settings,
+    commands: &mut Commands,
+    top_level: usize,
+) {
+    let Some(document) = view.document else {
         return;
     };
     let (ready, level, applied) = (
@@ -24,7 +32,7 @@ pub(super) fn fairing_controls(app: &mut App, ui: &mut egui::Ui, top_level: usiz
         document.level,
         document.applied,
     );
-    let method = app.settings.method;
+    let method = settings.method;
     let not_for_baseline = (!method.uses_hierarchy()).then(|| {
         format!(
             "Not used by {}: it smooths the whole input mesh at once, without the hierarchy.",
@@ -32,20 +40,14 @@ pub(super) fn fairing_controls(app: &mut App, ui: &mut egui::Ui, top_level: usiz
         )
     });
     let not_for_baseline = not_for_baseline.as_deref();
-    start_level_slider(
-        &mut app.commands,
-        ui,
-        (level, top_level),
-        ready,
-        not_for_baseline,
-    );
-    let before = app.settings.clone();
-    method_controls(&mut app.settings, ui, method);
-    boundary_and_variant(&mut app.settings, ui, not_for_baseline);
-    if app.settings.fairing_key() != before.fairing_key() {
-        app.commands.push(Command::Refair);
+    start_level_slider(commands, ui, (level, top_level), ready, not_for_baseline);
+    let before = settings.clone();
+    method_controls(settings, ui, method);
+    boundary_and_variant(settings, ui, not_for_baseline);
+    if settings.fairing_key() != before.fairing_key() {
+        commands.push(Command::Refair);
     }
-    progress_and_apply(app, ui, applied);
+    progress_and_apply(ui, view, commands, applied);
 }
 
 /// The start level slider (`level` of `0..=top`), off for a baseline and until the hierarchy
@@ -145,14 +147,11 @@ fn boundary_and_variant(
 
 /// The fairing's progress while it runs, a note when the mesh is an `applied` result, and
 /// "Apply result".
-fn progress_and_apply(app: &mut App, ui: &mut egui::Ui, applied: bool) {
-    if app.fair_in_flight {
+fn progress_and_apply(ui: &mut egui::Ui, view: &PanelView, commands: &mut Commands, applied: bool) {
+    if view.fair_in_flight {
         ui.horizontal(|ui| {
             ui.spinner();
-            ui.label(format!(
-                "fairing … {:.0} %",
-                app.fair_progress.get() * 100.0
-            ));
+            ui.label(format!("fairing … {:.0} %", view.fair_progress * 100.0));
         });
     }
     if applied {
@@ -161,7 +160,7 @@ fn progress_and_apply(app: &mut App, ui: &mut egui::Ui, applied: bool) {
              it again.",
         );
     }
-    let has_result = app.document.as_ref().is_some_and(|d| d.faired.is_some());
+    let has_result = view.document.is_some_and(|d| d.faired.is_some());
     let apply = ui.add_enabled(has_result, egui::Button::new("Apply result"));
     if explain(
         apply,
@@ -170,7 +169,7 @@ fn progress_and_apply(app: &mut App, ui: &mut egui::Ui, applied: bool) {
     )
     .clicked()
     {
-        app.commands.push(Command::ApplyResult);
+        commands.push(Command::ApplyResult);
     }
 }
 
@@ -190,14 +189,19 @@ fn explain(response: egui::Response, tip: &str, off_because: Option<&str>) -> eg
 
 /// "Keep sharp edges" and its angle (the hierarchy is built again when either changes; while
 /// they are hovered or just changed, the kept edges are drawn over the mesh).
-pub(super) fn sharp_edge_controls(app: &mut App, ui: &mut egui::Ui) {
-    let Some(document) = &app.document else {
+pub(super) fn sharp_edge_controls(
+    ui: &mut egui::Ui,
+    view: &PanelView,
+    settings: &mut Settings,
+    commands: &mut Commands,
+) {
+    let Some(document) = view.document else {
         return;
     };
-    let not_for_baseline = (!app.settings.method.uses_hierarchy()).then(|| {
+    let not_for_baseline = (!settings.method.uses_hierarchy()).then(|| {
         format!(
             "Not used by {}: it smooths the whole mesh at once, across sharp edges too.",
-            app.settings.method.label()
+            settings.method.label()
         )
     });
     let kept = match &document.hierarchy {
@@ -207,13 +211,13 @@ pub(super) fn sharp_edge_controls(app: &mut App, ui: &mut egui::Ui) {
     let enabled = not_for_baseline.is_none();
     let keep = ui.add_enabled(
         enabled,
-        egui::Checkbox::new(&mut app.settings.keep_sharp_edges, "Keep sharp edges"),
+        egui::Checkbox::new(&mut settings.keep_sharp_edges, "Keep sharp edges"),
     );
     let keep = explain(keep, tips::KEEP_SHARP_EDGES, not_for_baseline.as_deref());
     let angle = ui.add_enabled(
-        enabled && app.settings.keep_sharp_edges,
+        enabled && settings.keep_sharp_edges,
         egui::Slider::new(
-            &mut app.settings.sharp_edge_angle,
+            &mut settings.sharp_edge_angle,
             MIN_SHARP_EDGE_ANGLE..=MAX_SHARP_EDGE_ANGLE,
         )
         .suffix("°")
@@ -222,17 +226,20 @@ pub(super) fn sharp_edge_controls(app: &mut App, ui: &mut egui::Ui) {
     );
     let angle = explain(angle, tips::SHARP_EDGE_ANGLE, not_for_baseline.as_deref());
     let now = std::time::Instant::now();
-    if keep.hovered() || angle.hovered() || angle.dragged() {
-        app.sharp_edges_shown_until = Some(now + SHARP_EDGES_LINGER);
-    }
+    let pointed_at = keep.hovered() || angle.hovered() || angle.dragged();
     // The hierarchy is built again when the angle is let go (not at every step of a drag).
     let settled = !angle.dragged();
     // (`start_hierarchy` records the settings it builds with, before the next frame.)
-    if settled && app.settings.hierarchy_key() != app.hierarchy_built_with {
-        app.sharp_edges_shown_until = Some(now + SHARP_EDGES_LINGER);
-        app.commands.push(Command::RebuildHierarchy);
+    let rebuild = settled && settings.hierarchy_key() != view.hierarchy_built_with;
+    if pointed_at || rebuild {
+        commands.push(Command::Panel(PanelChange::ShowSharpEdgesUntil(
+            now + SHARP_EDGES_LINGER,
+        )));
     }
-    if app.settings.keep_sharp_edges && enabled {
+    if rebuild {
+        commands.push(Command::RebuildHierarchy);
+    }
+    if settings.keep_sharp_edges && enabled {
         match kept {
             Some(0) => ui.small("No sharp edges found at this angle"),
             Some(edges) => ui.small(format!(
