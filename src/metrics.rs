@@ -143,6 +143,38 @@ pub fn volume_change_percent(reference: &TriMesh, other: &TriMesh) -> Option<f64
     (before.abs() > 0.0 && before.is_finite()).then(|| (after - before) / before.abs() * 100.0)
 }
 
+/// How far `positions` (new positions of `base`'s vertices, as a fairing returns them) moved
+/// `base`: the relative change of the enclosed volume (a fraction, not percent; each volume
+/// taken with [`signed_volume`]; NaN when `base` encloses none) and the root mean square vertex
+/// displacement. Both are NaN when the vertex counts differ or there are no vertices. The
+/// editor shows these with every result, before [`compare`]'s slower surface distances arrive.
+pub fn change_of_positions(base: &TriMesh, positions: &[[f32; 3]]) -> (f64, f64) {
+    if positions.len() != base.positions.len() || positions.is_empty() {
+        return (f64::NAN, f64::NAN);
+    }
+    let before = signed_volume(base);
+    let after_mesh = TriMesh {
+        positions: positions.to_vec(),
+        triangles: base.triangles.clone(),
+    };
+    let after = signed_volume(&after_mesh);
+    let volume_change = if before.abs() > 0.0 {
+        (after - before) / before.abs()
+    } else {
+        f64::NAN
+    };
+    let sum_squared: f64 = positions
+        .iter()
+        .zip(&base.positions)
+        .map(|(p, q)| {
+            (0..3)
+                .map(|k| (p[k] as f64 - q[k] as f64).powi(2))
+                .sum::<f64>()
+        })
+        .sum();
+    (volume_change, (sum_squared / positions.len() as f64).sqrt())
+}
+
 /// Per-vertex comparisons, when `other` has the same triangles as `reference`.
 pub fn compare_vertices(reference: &TriMesh, other: &TriMesh) -> Option<VertexComparison> {
     if reference.triangles != other.triangles || reference.positions.len() != other.positions.len()
@@ -501,6 +533,32 @@ pub fn closest_point_on_triangle(p: DVec3, a: DVec3, b: DVec3, c: DVec3) -> DVec
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn change_of_identical_or_translated_positions_keeps_the_volume() {
+        let mesh = TriMesh::new(
+            vec![
+                [0.0, 0.0, 0.0],
+                [1.0, 0.0, 0.0],
+                [0.0, 1.0, 0.0],
+                [0.0, 0.0, 1.0],
+            ],
+            vec![[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]],
+        );
+        let (dv, rms) = change_of_positions(&mesh, &mesh.positions);
+        assert_eq!(dv, 0.0);
+        assert_eq!(rms, 0.0);
+        let moved: Vec<_> = mesh
+            .positions
+            .iter()
+            .map(|p| [p[0] + 0.5, p[1], p[2]])
+            .collect();
+        let (dv, rms) = change_of_positions(&mesh, &moved);
+        assert!(dv.abs() < 1e-12, "translation keeps the volume");
+        assert!((rms - 0.5).abs() < 1e-12);
+        let (dv, rms) = change_of_positions(&mesh, &moved[..3]);
+        assert!(dv.is_nan() && rms.is_nan(), "other vertex count");
+    }
 
     fn octahedron(scale: f32) -> TriMesh {
         crate::mesh::fixtures::octahedron(scale)

@@ -61,7 +61,7 @@ use crate::Progress;
 use glam::Vec3A;
 use rayon::prelude::*;
 
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 #[non_exhaustive]
 pub enum MultiresVariant {
     Paper,

@@ -53,6 +53,29 @@ pub enum Command {
     ClearMask,
     /// Paint what was unpainted and the other way round.
     InvertMask,
+    /// What a panel shows changed, not the document.
+    Panel(PanelChange),
+}
+
+/// A change of what the panels and the viewport show (not of the document), asked for by a
+/// panel, which only reads the app's state.
+#[derive(Clone, Debug, PartialEq)]
+pub enum PanelChange {
+    /// The typed path field for opening files changed.
+    OpenPath(String),
+    /// Say what went wrong in the status bar.
+    Error(String),
+    /// The document's export path field changed.
+    ExportPath(String),
+    /// Forget the largest frame time while working (the Performance section).
+    ResetBusyMax,
+    /// The single view toggles between before and after.
+    ToggleBefore,
+    /// The left button paints (`true`) or orbits.
+    PaintMode(bool),
+    /// Draw the kept sharp edges over the mesh until then (their controls are pointed at or
+    /// were just changed).
+    ShowSharpEdgesUntil(std::time::Instant),
 }
 
 impl App {
@@ -117,6 +140,51 @@ impl App {
             Command::InvertMask => {
                 self.change_mask("Invert mask", |mask| mask.map(|m| m.inverted()))
             }
+            Command::Panel(change) => self.apply_panel_change(change),
+        }
+    }
+
+    /// The changes of what the panels and the viewport show, not the document: the
+    /// panels drew this frame before them, so the next frame shows them.
+    fn apply_panel_change(&mut self, change: PanelChange) {
+        let repaint = match change {
+            PanelChange::OpenPath(path) => {
+                self.open_path = path;
+                false
+            }
+            PanelChange::Error(error) => {
+                self.error = Some(error);
+                true
+            }
+            PanelChange::ExportPath(path) => {
+                if let Some(document) = &mut self.document {
+                    document.export_path = path;
+                }
+                false
+            }
+            PanelChange::ResetBusyMax => {
+                self.frame_stats.reset_busy_max();
+                false
+            }
+            PanelChange::ToggleBefore => {
+                self.show_before = !self.show_before;
+                true
+            }
+            PanelChange::PaintMode(on) => {
+                self.paint_mode = on;
+                true
+            }
+            PanelChange::ShowSharpEdgesUntil(until) => {
+                let shown = self
+                    .sharp_edges_shown_until
+                    .is_some_and(|shown| shown > std::time::Instant::now());
+                self.sharp_edges_shown_until = Some(until);
+                // Drawn from the next frame; one already drawing them repaints on its own.
+                !shown
+            }
+        };
+        if repaint {
+            self.ctx.request_repaint();
         }
     }
 }

@@ -2,11 +2,12 @@
 //! and Cancel. The system's save dialog ("Export as…") asks on its own, so only typed paths and
 //! Ctrl+E come here.
 
-use crate::app::{App, Command};
+use crate::app::panel_view::{Commands, PanelView};
+use crate::app::Command;
 
 /// Shows the question while an export waits for an answer.
-pub(super) fn show(app: &mut App, ctx: &egui::Context) {
-    let Some(path) = app.confirm_replace.clone() else {
+pub(super) fn show(ctx: &egui::Context, view: &PanelView, commands: &mut Commands) {
+    let Some(path) = view.confirm_replace.map(|path| path.to_path_buf()) else {
         return;
     };
     let name = path.file_name().map_or_else(
@@ -34,8 +35,8 @@ pub(super) fn show(app: &mut App, ctx: &egui::Context) {
     });
     let (replace, cancel) = modal.inner;
     if replace {
-        app.commands.push(Command::ReplaceExport(path));
+        commands.push(Command::ReplaceExport(path));
     } else if cancel || modal.should_close() {
-        app.commands.push(Command::CancelExport);
+        commands.push(Command::CancelExport);
     }
 }

@@ -4,17 +4,27 @@
 //! it does and when to change it; the ones the chosen method does not use are disabled and say
 //! why.
 
+use super::command::PanelChange;
+use super::panel_view::{Commands, PanelView};
 use super::state::{
-    BoundarySetting, CompareView, HierarchyState, MethodSetting, Settings, VariantSetting,
-    ViewMode, MAX_SHARP_EDGE_ANGLE, MIN_SHARP_EDGE_ANGLE,
+    CompareView, HierarchyState, MethodChoice, Settings, ViewMode, MAX_SHARP_EDGE_ANGLE,
+    MIN_SHARP_EDGE_ANGLE,
 };
 use super::{App, Command};
+use crate::fairing::{BoundaryMode, Method};
+use crate::multires::MultiresVariant;
 
 /// The fairing section: start level, method and its options, Apply. Every control says in its
 /// tooltip what it does and when to change it; the ones the chosen method does not use are
 /// disabled and say why.
-pub(super) fn fairing_controls(app: &mut App, ui: &mut egui::Ui, top_level: usize) {
-    let Some(document) = &app.document else {
+pub(super) fn fairing_controls(
+    ui: &mut egui::Ui,
+    view: &PanelView,
+    settings: &mut Settings,
+    commands: &mut Commands,
+    top_level: usize,
+) {
+    let Some(document) = view.document else {
         return;
     };
     let (ready, level, applied) = (
@@ -22,7 +32,7 @@ pub(super) fn fairing_controls(app: &mut App, ui: &mut egui::Ui, top_level: usiz
         document.level,
         document.applied,
     );
-    let method = app.settings.method;
+    let method = settings.method;
     let not_for_baseline = (!method.uses_hierarchy()).then(|| {
         format!(
             "Not used by {}: it smooths the whole input mesh at once, without the hierarchy.",
@@ -30,20 +40,14 @@ pub(super) fn fairing_controls(app: &mut App, ui: &mut egui::Ui, top_level: usiz
         )
     });
     let not_for_baseline = not_for_baseline.as_deref();
-    start_level_slider(
-        &mut app.commands,
-        ui,
-        (level, top_level),
-        ready,
-        not_for_baseline,
-    );
-    let before = app.settings.clone();
-    method_controls(&mut app.settings, ui, method);
-    boundary_and_variant(&mut app.settings, ui, not_for_baseline);
-    if app.settings.fairing_key() != before.fairing_key() {
-        app.commands.push(Command::Refair);
+    start_level_slider(commands, ui, (level, top_level), ready, not_for_baseline);
+    let before = settings.clone();
+    method_controls(settings, ui, method);
+    boundary_and_variant(settings, ui, not_for_baseline);
+    if settings.fairing_key() != before.fairing_key() {
+        commands.push(Command::Refair);
     }
-    progress_and_apply(app, ui, applied);
+    progress_and_apply(ui, view, commands, applied);
 }
 
 /// The start level slider (`level` of `0..=top`), off for a baseline and until the hierarchy
@@ -71,11 +75,11 @@ fn start_level_slider(
 
 /// The method and the options of `method` (the one chosen when the frame began): iterations and
 /// rounds over the hierarchy, or a baseline's iterations and step.
-fn method_controls(settings: &mut Settings, ui: &mut egui::Ui, method: MethodSetting) {
+fn method_controls(settings: &mut Settings, ui: &mut egui::Ui, method: Method) {
     let combo = egui::ComboBox::from_label("Method")
         .selected_text(settings.method.label())
         .show_ui(ui, |ui| {
-            for method in MethodSetting::ALL {
+            for method in Method::ALL {
                 ui.selectable_value(&mut settings.method, method, method.label());
             }
         });
@@ -91,7 +95,7 @@ fn method_controls(settings: &mut Settings, ui: &mut egui::Ui, method: MethodSet
         let iterations = ui
             .add(egui::Slider::new(&mut settings.baseline_iterations, 1..=200).text("Iterations"));
         explain(iterations, tips::BASELINE_ITERATIONS, None);
-        if matches!(method, MethodSetting::Laplacian | MethodSetting::Taubin) {
+        if matches!(method, Method::Laplacian | Method::Taubin) {
             let lambda =
                 ui.add(egui::Slider::new(&mut settings.baseline_lambda, 0.05..=1.0).text("Lambda"));
             explain(lambda, tips::LAMBDA, None);
@@ -108,16 +112,16 @@ fn boundary_and_variant(
 ) {
     let boundary = egui::ComboBox::from_label("Boundary")
         .selected_text(match settings.boundary {
-            BoundarySetting::Curve => "Smooth as curve",
-            BoundarySetting::Fixed => "Fixed",
+            BoundaryMode::Curve => "Smooth as curve",
+            BoundaryMode::Fixed => "Fixed",
         })
         .show_ui(ui, |ui| {
             ui.selectable_value(
                 &mut settings.boundary,
-                BoundarySetting::Curve,
+                BoundaryMode::Curve,
                 "Smooth as curve",
             );
-            ui.selectable_value(&mut settings.boundary, BoundarySetting::Fixed, "Fixed");
+            ui.selectable_value(&mut settings.boundary, BoundaryMode::Fixed, "Fixed");
         });
     explain(boundary.response, tips::BOUNDARY, None);
     let hierarchy_only = not_for_baseline.is_none();
@@ -129,12 +133,12 @@ fn boundary_and_variant(
     let variant = ui.add_enabled_ui(hierarchy_only, |ui| {
         egui::ComboBox::from_label("Variant")
             .selected_text(match settings.variant {
-                VariantSetting::Paper => "Paper",
-                VariantSetting::Improved => "Improved",
+                MultiresVariant::Paper => "Paper",
+                MultiresVariant::Improved => "Improved",
             })
             .show_ui(ui, |ui| {
-                ui.selectable_value(&mut settings.variant, VariantSetting::Paper, "Paper");
-                ui.selectable_value(&mut settings.variant, VariantSetting::Improved, "Improved");
+                ui.selectable_value(&mut settings.variant, MultiresVariant::Paper, "Paper");
+                ui.selectable_value(&mut settings.variant, MultiresVariant::Improved, "Improved");
             })
             .response
     });
@@ -143,14 +147,11 @@ fn boundary_and_variant(
 
 /// The fairing's progress while it runs, a note when the mesh is an `applied` result, and
 /// "Apply result".
-fn progress_and_apply(app: &mut App, ui: &mut egui::Ui, applied: bool) {
-    if app.fair_in_flight {
+fn progress_and_apply(ui: &mut egui::Ui, view: &PanelView, commands: &mut Commands, applied: bool) {
+    if view.fair_in_flight {
         ui.horizontal(|ui| {
             ui.spinner();
-            ui.label(format!(
-                "fairing … {:.0} %",
-                app.fair_progress.get() * 100.0
-            ));
+            ui.label(format!("fairing … {:.0} %", view.fair_progress * 100.0));
         });
     }
     if applied {
@@ -159,7 +160,7 @@ fn progress_and_apply(app: &mut App, ui: &mut egui::Ui, applied: bool) {
              it again.",
         );
     }
-    let has_result = app.document.as_ref().is_some_and(|d| d.faired.is_some());
+    let has_result = view.document.is_some_and(|d| d.faired.is_some());
     let apply = ui.add_enabled(has_result, egui::Button::new("Apply result"));
     if explain(
         apply,
@@ -168,7 +169,7 @@ fn progress_and_apply(app: &mut App, ui: &mut egui::Ui, applied: bool) {
     )
     .clicked()
     {
-        app.commands.push(Command::ApplyResult);
+        commands.push(Command::ApplyResult);
     }
 }
 
@@ -188,14 +189,19 @@ fn explain(response: egui::Response, tip: &str, off_because: Option<&str>) -> eg
 
 /// "Keep sharp edges" and its angle (the hierarchy is built again when either changes; while
 /// they are hovered or just changed, the kept edges are drawn over the mesh).
-pub(super) fn sharp_edge_controls(app: &mut App, ui: &mut egui::Ui) {
-    let Some(document) = &app.document else {
+pub(super) fn sharp_edge_controls(
+    ui: &mut egui::Ui,
+    view: &PanelView,
+    settings: &mut Settings,
+    commands: &mut Commands,
+) {
+    let Some(document) = view.document else {
         return;
     };
-    let not_for_baseline = (!app.settings.method.uses_hierarchy()).then(|| {
+    let not_for_baseline = (!settings.method.uses_hierarchy()).then(|| {
         format!(
             "Not used by {}: it smooths the whole mesh at once, across sharp edges too.",
-            app.settings.method.label()
+            settings.method.label()
         )
     });
     let kept = match &document.hierarchy {
@@ -205,13 +211,13 @@ pub(super) fn sharp_edge_controls(app: &mut App, ui: &mut egui::Ui) {
     let enabled = not_for_baseline.is_none();
     let keep = ui.add_enabled(
         enabled,
-        egui::Checkbox::new(&mut app.settings.keep_sharp_edges, "Keep sharp edges"),
+        egui::Checkbox::new(&mut settings.keep_sharp_edges, "Keep sharp edges"),
     );
     let keep = explain(keep, tips::KEEP_SHARP_EDGES, not_for_baseline.as_deref());
     let angle = ui.add_enabled(
-        enabled && app.settings.keep_sharp_edges,
+        enabled && settings.keep_sharp_edges,
         egui::Slider::new(
-            &mut app.settings.sharp_edge_angle,
+            &mut settings.sharp_edge_angle,
             MIN_SHARP_EDGE_ANGLE..=MAX_SHARP_EDGE_ANGLE,
         )
         .suffix("°")
@@ -220,17 +226,20 @@ pub(super) fn sharp_edge_controls(app: &mut App, ui: &mut egui::Ui) {
     );
     let angle = explain(angle, tips::SHARP_EDGE_ANGLE, not_for_baseline.as_deref());
     let now = std::time::Instant::now();
-    if keep.hovered() || angle.hovered() || angle.dragged() {
-        app.sharp_edges_shown_until = Some(now + SHARP_EDGES_LINGER);
-    }
+    let pointed_at = keep.hovered() || angle.hovered() || angle.dragged();
     // The hierarchy is built again when the angle is let go (not at every step of a drag).
     let settled = !angle.dragged();
     // (`start_hierarchy` records the settings it builds with, before the next frame.)
-    if settled && app.settings.hierarchy_key() != app.hierarchy_built_with {
-        app.sharp_edges_shown_until = Some(now + SHARP_EDGES_LINGER);
-        app.commands.push(Command::RebuildHierarchy);
+    let rebuild = settled && settings.hierarchy_key() != view.hierarchy_built_with;
+    if pointed_at || rebuild {
+        commands.push(Command::Panel(PanelChange::ShowSharpEdgesUntil(
+            now + SHARP_EDGES_LINGER,
+        )));
     }
-    if app.settings.keep_sharp_edges && enabled {
+    if rebuild {
+        commands.push(Command::RebuildHierarchy);
+    }
+    if settings.keep_sharp_edges && enabled {
         match kept {
             Some(0) => ui.small("No sharp edges found at this angle"),
             Some(edges) => ui.small(format!(

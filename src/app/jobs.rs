@@ -225,7 +225,7 @@ pub struct Faired {
     pub rms_displacement: f64,
     pub elapsed: Duration,
     /// The method that made it (a baseline ignores the start level).
-    pub method: super::state::MethodSetting,
+    pub method: crate::fairing::Method,
 }
 
 /// A job's answer to the UI. Each carries the generation it was started under.

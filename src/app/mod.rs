@@ -12,7 +12,9 @@
 //!   fairing, measure, export), each holding its launch and the handling of its result;
 //! - [`jobs`]: worker threads, generation numbers, job results;
 //! - `view_sync.rs`: keeps the viewports' GPU buffers in step with what should be shown;
-//! - [`panels`]: the widgets; they emit [`Command`]s, applied after the frame. Beside it:
+//! - [`panels`]: the widgets; each section reads the app's state through a `PanelView`
+//!   (`panel_view.rs`), edits the [`state::Settings`] in place and emits [`Command`]s, applied
+//!   after the frame. Beside it:
 //!   `fairing_panel.rs` (the Fairing section, the sharp-edge controls, every tooltip),
 //!   [`view_panel`] (the View section: compare, heat map, Shading, Studio lighting) and
 //!   `viewport_panel.rs` (the 3D view's area: camera input, the compare views, overlays),
@@ -42,6 +44,7 @@ mod launch;
 mod numbers_panel;
 pub mod paint;
 mod paint_panel;
+mod panel_view;
 pub mod panels;
 mod recent;
 mod results;
@@ -53,7 +56,7 @@ pub mod view_panel;
 mod view_sync;
 mod viewport_panel;
 
-pub use command::Command;
+pub use command::{Command, PanelChange};
 pub use frame_stats::FrameStats;
 pub use launch::{run, AppOptions};
 pub use status::AppStatus;
@@ -270,7 +273,7 @@ impl eframe::App for App {
         if self.capturing_view {
             self.capture_view(&ctx);
         }
-        confirm_replace::show(self, &ctx);
+        self.panel(|view, _, commands| confirm_replace::show(&ctx, view, commands));
         self.apply_commands(compare);
         let widgets_done = Instant::now();
         self.sync_viewport();

@@ -1,19 +1,19 @@
 //! The side panel's Numbers section: the result measured against the input mesh and the clean
 //! mesh (volume change, distances, RMS displacement, barycenter drift; the numbers of an older
 //! result greyed while the new one is measured), then the shown mesh's size and the times of
-//! loading, the hierarchy, the fairing and the measuring. Reads the app, writes nothing.
+//! loading, the hierarchy, the fairing and the measuring. Reads the app's state, writes nothing.
 
+use super::panel_view::PanelView;
 use super::panels::seconds;
-use super::state::{HierarchyState, Measures};
-use super::App;
+use super::state::{HierarchyState, Measures, MethodChoice};
 
 /// What a greyed number in the Numbers panel means.
 const PENDING_TIP: &str =
     "From the previous result: the result on screen is being measured, its numbers follow";
 
-pub(super) fn show(app: &App, ui: &mut egui::Ui) {
-    measures(app, ui);
-    timings(app, ui);
+pub(super) fn show(ui: &mut egui::Ui, view: &PanelView) {
+    measures(ui, view);
+    timings(ui, view);
 }
 
 /// How one row of the measures grid shows a result's numbers.
@@ -37,8 +37,8 @@ const ROWS: [(&str, Row); 5] = [
 ];
 
 /// The result against the input mesh and, after noise, the clean mesh.
-fn measures(app: &App, ui: &mut egui::Ui) {
-    let Some(document) = &app.document else {
+fn measures(ui: &mut egui::Ui, view: &PanelView) {
+    let Some(document) = view.document else {
         return;
     };
     let faired = document.faired.as_ref();
@@ -116,8 +116,8 @@ fn measures(app: &App, ui: &mut egui::Ui) {
 }
 
 /// The shown mesh's size and how long each step took.
-fn timings(app: &App, ui: &mut egui::Ui) {
-    let Some(document) = &app.document else {
+fn timings(ui: &mut egui::Ui, view: &PanelView) {
+    let Some(document) = view.document else {
         return;
     };
     let faired = document.faired.as_ref();
@@ -125,10 +125,10 @@ fn timings(app: &App, ui: &mut egui::Ui) {
         .num_columns(2)
         .show(ui, |ui| {
             ui.label("Shown vertices");
-            ui.label(app.shown_counts.0.to_string());
+            ui.label(view.shown_counts.0.to_string());
             ui.end_row();
             ui.label("Shown faces");
-            ui.label(app.shown_counts.1.to_string());
+            ui.label(view.shown_counts.1.to_string());
             ui.end_row();
             ui.label("Load time");
             ui.label(seconds(document.load_time));

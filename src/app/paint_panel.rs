@@ -2,30 +2,41 @@
 //! painting, the left button emits [`Command::Paint`] dabs (one stroke per press) and the brush's
 //! outline follows the cursor.
 
+use super::command::PanelChange;
 use super::paint::BrushView;
+use super::panel_view::{Commands, PanelView};
 use super::panels::tips;
-use super::state::{CompareView, ViewMode};
+use super::state::{CompareView, Settings, ViewMode};
 use super::{App, Command};
 
 /// The side panel's section: paint mode, brush, mask tint, clear and invert.
-pub(super) fn section(app: &mut App, ui: &mut egui::Ui) {
+pub(super) fn section(
+    ui: &mut egui::Ui,
+    view: &PanelView,
+    settings: &mut Settings,
+    commands: &mut Commands,
+) {
     ui.separator();
     ui.heading("Paint where to fair");
-    let level_view = app.settings.view_mode == ViewMode::Level;
+    let level_view = settings.view_mode == ViewMode::Level;
+    let mut paint_mode = view.paint_mode;
     let paint = ui
         .add_enabled(
             !level_view,
-            egui::Checkbox::new(&mut app.paint_mode, "Paint (P)"),
+            egui::Checkbox::new(&mut paint_mode, "Paint (P)"),
         )
         .on_hover_text(tips::PAINT)
         .on_disabled_hover_text(format!(
             "{}\n\nThe level view shows a coarse mesh: switch to Faired to paint.",
             tips::PAINT
         ));
-    if paint.changed() && !app.paint_mode {
-        app.commands.push(Command::EndStroke);
+    if paint.changed() {
+        commands.push(Command::Panel(PanelChange::PaintMode(paint_mode)));
+        if !paint_mode {
+            commands.push(Command::EndStroke);
+        }
     }
-    let brush = &mut app.settings.paint;
+    let brush = &mut settings.paint;
     ui.horizontal(|ui| {
         ui.selectable_value(&mut brush.erase, false, "Add")
             .on_hover_text(tips::BRUSH_ADD);
@@ -38,7 +49,7 @@ pub(super) fn section(app: &mut App, ui: &mut egui::Ui) {
         .on_hover_text(tips::BRUSH_SOFTNESS);
     ui.checkbox(&mut brush.show_mask, "Show mask")
         .on_hover_text(tips::SHOW_MASK);
-    let mask = app.document.as_ref().and_then(|d| d.mask.as_ref());
+    let mask = view.document.and_then(|d| d.mask.as_ref());
     ui.horizontal(|ui| {
         let has_mask = mask.is_some();
         let clear = ui
@@ -46,14 +57,14 @@ pub(super) fn section(app: &mut App, ui: &mut egui::Ui) {
             .on_hover_text(tips::CLEAR_MASK)
             .on_disabled_hover_text(format!("{}\n\nNothing is painted.", tips::CLEAR_MASK));
         if clear.clicked() {
-            app.commands.push(Command::ClearMask);
+            commands.push(Command::ClearMask);
         }
         let invert = ui
             .add_enabled(has_mask, egui::Button::new("Invert mask"))
             .on_hover_text(tips::INVERT_MASK)
             .on_disabled_hover_text(format!("{}\n\nNothing is painted.", tips::INVERT_MASK));
         if invert.clicked() {
-            app.commands.push(Command::InvertMask);
+            commands.push(Command::InvertMask);
         }
     });
     match mask {

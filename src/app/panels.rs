@@ -3,19 +3,26 @@
 //! View section is in `view_panel.rs`, the Fairing section and sharp-edge controls (and
 //! [`tips`], every control's tooltip) in `fairing_panel.rs`, the Numbers in
 //! `numbers_panel.rs`, the 3D viewport's area in `viewport_panel.rs`.
-//! Widgets read the app's state and emit [`Command`]s; the app applies them after the frame.
-//! Plain display toggles (wireframe, option values) are edited in place.
+//! Each section takes the app's state read-only ([`PanelView`]), the [`Settings`] it edits in
+//! place (display toggles, option values) and the frame's commands: whatever else it asks for
+//! is a [`Command`], applied by the app after the frame's widgets are drawn.
 
 use std::path::PathBuf;
 
+use super::command::PanelChange;
 pub use super::fairing_panel::tips;
-use super::state::{HierarchyState, ViewMode};
+use super::panel_view::{Commands, PanelView};
+use super::state::{HierarchyState, Settings, ViewMode};
 use super::{App, Command};
 use crate::noise::NoiseMode;
 
 pub fn show(app: &mut App, ui: &mut egui::Ui) {
-    egui::Panel::top("fairmesh-toolbar").show(ui, |ui| toolbar(app, ui));
-    egui::Panel::bottom("fairmesh-status").show(ui, |ui| status_bar(app, ui));
+    egui::Panel::top("fairmesh-toolbar").show(ui, |ui| {
+        app.panel(|view, settings, commands| toolbar(ui, view, settings, commands))
+    });
+    egui::Panel::bottom("fairmesh-status").show(ui, |ui| {
+        app.panel(|view, _, commands| status_bar(ui, view, commands))
+    });
     egui::Panel::right("fairmesh-controls")
         .resizable(true)
         .default_size(310.0)
@@ -25,78 +32,94 @@ pub fn show(app: &mut App, ui: &mut egui::Ui) {
     egui::CentralPanel::no_frame().show(ui, |ui| super::viewport_panel::show(app, ui));
 }
 
-fn toolbar(app: &mut App, ui: &mut egui::Ui) {
+fn toolbar(ui: &mut egui::Ui, view: &PanelView, settings: &mut Settings, commands: &mut Commands) {
     ui.add_space(4.0);
     // Wraps in a narrow window, so that no control ends up off screen.
     ui.horizontal_wrapped(|ui| {
-        file_controls(app, ui);
+        file_controls(ui, view, settings, commands);
         ui.separator();
-        view_controls(app, ui);
+        view_controls(ui, view, settings, commands);
         ui.separator();
-        undo_redo_buttons(app, ui);
+        undo_redo_buttons(ui, view, commands);
     });
     ui.add_space(2.0);
 }
 
 /// Open…, the Recent menu, and the typed path with Load.
-fn file_controls(app: &mut App, ui: &mut egui::Ui) {
+fn file_controls(
+    ui: &mut egui::Ui,
+    view: &PanelView,
+    settings: &mut Settings,
+    commands: &mut Commands,
+) {
     if ui
         .button("Open…")
         .on_hover_text("Pick a mesh file (Ctrl+O)")
         .clicked()
     {
-        app.commands.push(Command::OpenDialog);
+        commands.push(Command::OpenDialog);
     }
-    super::recent::menu(app, ui);
+    super::recent::menu(ui, settings, commands);
     let label = ui.label("Path:");
+    let mut open_path = view.open_path.to_owned();
     let edit = ui
         .add(
-            egui::TextEdit::singleline(&mut app.open_path)
+            egui::TextEdit::singleline(&mut open_path)
                 .hint_text("type a mesh path, or drop a file on the window")
                 // Narrow enough that the toolbar stays one row at 1200 points.
                 .desired_width(180.0),
         )
         .labelled_by(label.id);
+    if open_path != view.open_path {
+        commands.push(Command::Panel(PanelChange::OpenPath(open_path.clone())));
+    }
     let entered = edit.lost_focus() && ui.input(|i| i.key_pressed(egui::Key::Enter));
     if ui.button("Load").clicked() || entered {
-        let typed = app.open_path.trim();
+        let typed = open_path.trim();
         if typed.is_empty() {
-            app.error = Some("Type the path of a mesh file to load".into());
+            commands.push(Command::Panel(PanelChange::Error(
+                "Type the path of a mesh file to load".into(),
+            )));
         } else {
-            app.commands.push(Command::Open(PathBuf::from(typed)));
+            commands.push(Command::Open(PathBuf::from(typed)));
         }
     }
 }
 
 /// Fit view, Save image, Wireframe, and which mesh the view shows (result, level, input).
-fn view_controls(app: &mut App, ui: &mut egui::Ui) {
+fn view_controls(
+    ui: &mut egui::Ui,
+    view: &PanelView,
+    settings: &mut Settings,
+    commands: &mut Commands,
+) {
     if ui
         .button("Fit view (F)")
         .on_hover_text("Fit the mesh into the view (F)")
         .clicked()
     {
-        app.commands.push(Command::FitView);
+        commands.push(Command::FitView);
     }
-    super::tasks::view_image::button(app, ui);
-    ui.checkbox(&mut app.settings.wireframe, "Wireframe (W)")
+    super::tasks::view_image::button(ui, view, commands);
+    ui.checkbox(&mut settings.wireframe, "Wireframe (W)")
         .on_hover_text("Draw the edges over the faces (W)");
     ui.separator();
-    let mut mode = app.settings.view_mode;
+    let mut mode = settings.view_mode;
     ui.selectable_value(&mut mode, ViewMode::Faired, "Faired")
         .on_hover_text("Show the result of the fairing");
     ui.selectable_value(&mut mode, ViewMode::Level, "Level mesh")
         .on_hover_text("Show the coarse mesh of the start level, where the fairing begins");
     ui.selectable_value(&mut mode, ViewMode::Original, "Input mesh")
         .on_hover_text("Show the input mesh: as loaded, or as Add noise or Apply result left it");
-    if mode != app.settings.view_mode {
-        app.commands.push(Command::SetViewMode(mode));
+    if mode != settings.view_mode {
+        commands.push(Command::SetViewMode(mode));
     }
 }
 
 /// Undo and Redo, saying what they would undo or redo, and the next undo step's name.
-fn undo_redo_buttons(app: &mut App, ui: &mut egui::Ui) {
-    let undo_label = app.history.undo_label().map(str::to_owned);
-    let redo_label = app.history.redo_label().map(str::to_owned);
+fn undo_redo_buttons(ui: &mut egui::Ui, view: &PanelView, commands: &mut Commands) {
+    let undo_label = view.history.undo_label().map(str::to_owned);
+    let redo_label = view.history.redo_label().map(str::to_owned);
     let undo = ui
         .add_enabled(undo_label.is_some(), egui::Button::new("Undo"))
         .on_hover_text(match &undo_label {
@@ -105,7 +128,7 @@ fn undo_redo_buttons(app: &mut App, ui: &mut egui::Ui) {
         })
         .on_disabled_hover_text("Nothing to undo (Ctrl+Z)");
     if undo.clicked() {
-        app.commands.push(Command::Undo);
+        commands.push(Command::Undo);
     }
     let redo = ui
         .add_enabled(redo_label.is_some(), egui::Button::new("Redo"))
@@ -115,7 +138,7 @@ fn undo_redo_buttons(app: &mut App, ui: &mut egui::Ui) {
         })
         .on_disabled_hover_text("Nothing to redo (Ctrl+Shift+Z, Ctrl+Y)");
     if redo.clicked() {
-        app.commands.push(Command::Redo);
+        commands.push(Command::Redo);
     }
     if let Some(label) = &undo_label {
         ui.small(format!("undo: {label}"));
@@ -124,15 +147,15 @@ fn undo_redo_buttons(app: &mut App, ui: &mut egui::Ui) {
 
 /// Loading, errors and messages, at the bottom of the window: their coming and going does not
 /// move the controls (a click meant for one button would hit another).
-fn status_bar(app: &mut App, ui: &mut egui::Ui) {
+fn status_bar(ui: &mut egui::Ui, view: &PanelView, commands: &mut Commands) {
     ui.add_space(2.0);
-    if let Some(path) = &app.loading {
+    if let Some(path) = view.loading {
         ui.horizontal(|ui| {
             ui.spinner();
             ui.label(format!("Loading {} …", path.display()));
         });
     }
-    if let Some(error) = app.error.clone() {
+    if let Some(error) = view.error {
         egui::Frame::new()
             .fill(egui::Color32::from_rgb(110, 24, 24))
             .inner_margin(6.0)
@@ -141,50 +164,54 @@ fn status_bar(app: &mut App, ui: &mut egui::Ui) {
                 ui.horizontal(|ui| {
                     ui.colored_label(egui::Color32::WHITE, format!("Error: {error}"));
                     if ui.button("Dismiss").clicked() {
-                        app.commands.push(Command::DismissError);
+                        commands.push(Command::DismissError);
                     }
                 });
             });
     }
-    if let Some(message) = &app.message {
+    if let Some(message) = view.message {
         ui.colored_label(egui::Color32::from_rgb(140, 200, 140), message);
     }
-    if app.loading.is_none() && app.error.is_none() && app.message.is_none() {
+    if view.loading.is_none() && view.error.is_none() && view.message.is_none() {
         // The bar keeps its height when there is nothing to say.
         ui.weak("Ready");
     }
     ui.add_space(2.0);
 }
 
+/// The side panel's sections, in the order shown; each gets the app's state read-only, the
+/// settings and the frame's commands.
 fn controls(app: &mut App, ui: &mut egui::Ui) {
-    if app.document.is_none() {
-        ui.heading("No mesh");
-        ui.label("Open a file, type a path above, or drop a mesh file on the window.");
-        performance(app, ui);
-        return;
-    };
-    ui.heading("View");
-    super::view_panel::show(app, ui);
-    mesh_section(app, ui);
-    noise_section(app, ui);
-    let top_level = hierarchy_section(app, ui);
-    super::fairing_panel::sharp_edge_controls(app, ui);
-    ui.separator();
-    ui.heading("Fairing");
-    super::fairing_panel::fairing_controls(app, ui, top_level);
-    export_section(app, ui);
-    ui.separator();
-    ui.heading("Numbers");
-    super::numbers_panel::show(app, ui);
-    // Below Export and the numbers: a painting session is an occasional step, and the controls
-    // used on every file stay where they were.
-    super::paint_panel::section(app, ui);
-    performance(app, ui);
+    app.panel(|view, settings, commands| {
+        if view.document.is_none() {
+            ui.heading("No mesh");
+            ui.label("Open a file, type a path above, or drop a mesh file on the window.");
+            performance(ui, view, settings, commands);
+            return;
+        };
+        ui.heading("View");
+        super::view_panel::show(ui, view, settings, commands);
+        mesh_section(ui, view);
+        noise_section(ui, settings, commands);
+        let top_level = hierarchy_section(ui, view, commands);
+        super::fairing_panel::sharp_edge_controls(ui, view, settings, commands);
+        ui.separator();
+        ui.heading("Fairing");
+        super::fairing_panel::fairing_controls(ui, view, settings, commands, top_level);
+        export_section(ui, view, settings, commands);
+        ui.separator();
+        ui.heading("Numbers");
+        super::numbers_panel::show(ui, view);
+        // Below Export and the numbers: a painting session is an occasional step, and the
+        // controls used on every file stay where they were.
+        super::paint_panel::section(ui, view, settings, commands);
+        performance(ui, view, settings, commands);
+    })
 }
 
 /// The file's name and size, what loading repaired, and whether noise was added.
-fn mesh_section(app: &mut App, ui: &mut egui::Ui) {
-    let Some(document) = &app.document else {
+fn mesh_section(ui: &mut egui::Ui, view: &PanelView) {
+    let Some(document) = view.document else {
         return;
     };
     ui.separator();
@@ -229,26 +256,26 @@ fn mesh_section(app: &mut App, ui: &mut egui::Ui) {
 }
 
 /// Sigma, seed and direction of the noise, and the button that adds it.
-fn noise_section(app: &mut App, ui: &mut egui::Ui) {
+fn noise_section(ui: &mut egui::Ui, settings: &mut Settings, commands: &mut Commands) {
     ui.separator();
     ui.heading("Noise");
-    ui.add(egui::Slider::new(&mut app.settings.noise_sigma, 0.0..=2.0).text("Sigma (× mean edge)"))
+    ui.add(egui::Slider::new(&mut settings.noise_sigma, 0.0..=2.0).text("Sigma (× mean edge)"))
         .on_hover_text(tips::NOISE_SIGMA);
     ui.horizontal(|ui| {
         let label = ui.label("Seed").on_hover_text(tips::NOISE_SEED);
-        ui.add(egui::DragValue::new(&mut app.settings.noise_seed))
+        ui.add(egui::DragValue::new(&mut settings.noise_seed))
             .labelled_by(label.id)
             .on_hover_text(tips::NOISE_SEED);
     });
     egui::ComboBox::from_label("Noise direction")
-        .selected_text(noise_mode_name(app.settings.noise_mode))
+        .selected_text(noise_mode_name(settings.noise_mode))
         .show_ui(ui, |ui| {
             for mode in [
                 NoiseMode::Normal,
                 NoiseMode::Direction,
                 NoiseMode::Isotropic,
             ] {
-                ui.selectable_value(&mut app.settings.noise_mode, mode, noise_mode_name(mode));
+                ui.selectable_value(&mut settings.noise_mode, mode, noise_mode_name(mode));
             }
         })
         .response
@@ -261,13 +288,13 @@ fn noise_section(app: &mut App, ui: &mut egui::Ui) {
         )
         .clicked()
     {
-        app.commands.push(Command::AddNoise);
+        commands.push(Command::AddNoise);
     }
 }
 
 /// The hierarchy's progress, failure or levels; returns the top level (0 until it is built).
-fn hierarchy_section(app: &mut App, ui: &mut egui::Ui) -> usize {
-    let Some(document) = &app.document else {
+fn hierarchy_section(ui: &mut egui::Ui, view: &PanelView, commands: &mut Commands) -> usize {
+    let Some(document) = view.document else {
         return 0;
     };
     ui.separator();
@@ -277,20 +304,20 @@ fn hierarchy_section(app: &mut App, ui: &mut egui::Ui) -> usize {
         HierarchyState::Building => {
             ui.horizontal(|ui| {
                 ui.add(
-                    egui::ProgressBar::new(app.hierarchy_progress.get())
+                    egui::ProgressBar::new(view.hierarchy_progress)
                         .show_percentage()
                         // Narrow enough that the toolbar stays one row at 1200 points.
                         .desired_width(180.0),
                 );
                 if ui.button("Cancel").clicked() {
-                    app.commands.push(Command::CancelHierarchy);
+                    commands.push(Command::CancelHierarchy);
                 }
             });
         }
         HierarchyState::Failed(reason) => {
             ui.label(format!("Not built: {reason}"));
             if ui.button("Build hierarchy").clicked() {
-                app.commands.push(Command::RebuildHierarchy);
+                commands.push(Command::RebuildHierarchy);
             }
         }
         HierarchyState::Ready { levels, .. } => {
@@ -320,8 +347,13 @@ fn hierarchy_section(app: &mut App, ui: &mut egui::Ui) -> usize {
 }
 
 /// The export path and buttons, and the level chain's export.
-fn export_section(app: &mut App, ui: &mut egui::Ui) {
-    let Some(document) = &app.document else {
+fn export_section(
+    ui: &mut egui::Ui,
+    view: &PanelView,
+    settings: &mut Settings,
+    commands: &mut Commands,
+) {
+    let Some(document) = view.document else {
         return;
     };
     ui.separator();
@@ -337,70 +369,68 @@ fn export_section(app: &mut App, ui: &mut egui::Ui) {
             .on_hover_text("Write the result to the export path (Ctrl+E)")
             .clicked()
         {
-            app.commands
-                .push(Command::Export(PathBuf::from(export_path.trim())));
+            commands.push(Command::Export(PathBuf::from(export_path.trim())));
         }
         if ui.button("Export as…").clicked() {
-            app.commands.push(Command::ExportDialog);
+            commands.push(Command::ExportDialog);
         }
     });
-    if let Some(document) = &mut app.document {
-        document.export_path = export_path;
+    if export_path != document.export_path {
+        commands.push(Command::Panel(PanelChange::ExportPath(export_path)));
     }
 
     ui.add_space(4.0);
     ui.strong("Level chain (LOD)");
-    let placeholder = app
-        .levels_folder()
+    let placeholder = view
+        .levels_folder
+        .as_ref()
         .map_or_else(String::new, |p| p.display().to_string());
     let label = ui.label("Levels folder:");
     ui.add(
-        egui::TextEdit::singleline(&mut app.settings.levels_folder)
+        egui::TextEdit::singleline(&mut settings.levels_folder)
             .hint_text(placeholder)
             .desired_width(f32::INFINITY),
     )
     .labelled_by(label.id);
-    let top = app
-        .document
-        .as_ref()
-        .and_then(|d| d.level_count())
-        .unwrap_or(1)
-        .saturating_sub(1);
+    let top = document.level_count().unwrap_or(1).saturating_sub(1);
     // Edit copies: the stored range may reach past this mesh's levels (its end "to the top").
-    let mut to = app.settings.levels_to.min(top);
-    let mut from = app.settings.levels_from.min(to);
+    let mut to = settings.levels_to.min(top);
+    let mut from = settings.levels_from.min(to);
     ui.horizontal(|ui| {
         ui.label("Levels");
         let a = ui.add(egui::DragValue::new(&mut from).range(0..=top).prefix("M"));
         ui.label("to");
         let b = ui.add(egui::DragValue::new(&mut to).range(0..=top).prefix("M"));
         if a.changed() {
-            app.settings.levels_from = from;
+            settings.levels_from = from;
         }
         if b.changed() {
-            app.settings.levels_to = if to == top { usize::MAX } else { to };
+            settings.levels_to = if to == top { usize::MAX } else { to };
         }
     });
     if ui
         .add_enabled(
-            app.document
-                .as_ref()
-                .is_some_and(|d| d.level_count().is_some()),
+            document.level_count().is_some(),
             egui::Button::new("Export levels"),
         )
         .on_hover_text("One GLB per level of the hierarchy, for LOD")
         .clicked()
     {
-        app.commands.push(Command::ExportLevels);
+        commands.push(Command::ExportLevels);
     }
 }
 
-fn performance(app: &mut App, ui: &mut egui::Ui) {
+fn performance(
+    ui: &mut egui::Ui,
+    view: &PanelView,
+    settings: &mut Settings,
+    commands: &mut Commands,
+) {
     ui.separator();
     let response = egui::CollapsingHeader::new("Performance")
-        .default_open(app.settings.show_performance)
+        .default_open(settings.show_performance)
         .show(ui, |ui| {
-            let stats = &app.frame_stats;
+            let stats = view.frame_stats;
             egui::Grid::new("fairmesh-performance")
                 .num_columns(2)
                 .show(ui, |ui| {
@@ -427,14 +457,14 @@ fn performance(app: &mut App, ui: &mut egui::Ui) {
                     ui.label("frames");
                     ui.label(stats.frames.to_string());
                     ui.end_row();
-                    if let Some(viewport) = &app.viewport {
+                    if let Some(viewport) = view.viewport {
                         ui.label("viewport images");
                         ui.label(viewport.images_drawn().to_string());
                         ui.end_row();
                     }
                 });
             // Long adapter names wrap at the panel's width instead of widening it.
-            if let Some(viewport) = &app.viewport {
+            if let Some(viewport) = view.viewport {
                 ui.add(
                     egui::Label::new(
                         egui::RichText::new(format!("Adapter: {}", viewport.adapter_description()))
@@ -444,10 +474,10 @@ fn performance(app: &mut App, ui: &mut egui::Ui) {
                 );
             }
             if ui.button("Reset max").clicked() {
-                app.frame_stats.reset_busy_max();
+                commands.push(Command::Panel(PanelChange::ResetBusyMax));
             }
         });
-    app.settings.show_performance = response.fully_open();
+    settings.show_performance = response.fully_open();
 }
 
 fn noise_mode_name(mode: NoiseMode) -> &'static str {

@@ -2,11 +2,13 @@
 
 use std::path::PathBuf;
 
+use crate::app::panel_view::Commands;
+use crate::app::state::Settings;
 use crate::app::{App, Command};
 
 /// The toolbar's Recent menu.
-pub(super) fn menu(app: &mut App, ui: &mut egui::Ui) {
-    let recent = app.settings.recent_files.clone();
+pub(super) fn menu(ui: &mut egui::Ui, settings: &Settings, commands: &mut Commands) {
+    let recent = settings.recent_files.clone();
     ui.add_enabled_ui(!recent.is_empty(), |ui| {
         let response = ui
             .menu_button("Recent", |ui| {
@@ -17,7 +19,7 @@ pub(super) fn menu(app: &mut App, ui: &mut egui::Ui) {
                         .on_hover_text("Open this file again")
                         .clicked()
                     {
-                        app.commands.push(Command::OpenRecent(path));
+                        commands.push(Command::OpenRecent(path));
                         ui.close();
                     }
                 }

@@ -16,6 +16,6 @@ pub use document::{
 };
 pub use measures::Measures;
 pub use settings::{
-    BoundarySetting, CompareView, HeatReference, MethodSetting, Settings, VariantSetting, ViewMode,
-    MAX_SHARP_EDGE_ANGLE, MIN_SHARP_EDGE_ANGLE,
+    CompareView, HeatReference, MethodChoice, Settings, ViewMode, MAX_SHARP_EDGE_ANGLE,
+    MIN_SHARP_EDGE_ANGLE,
 };

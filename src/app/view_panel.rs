@@ -3,8 +3,11 @@
 //! (Shading: Flat / Smooth, and Studio lighting on or off). Display settings only: they are edited
 //! in place, and the next frame's view sync and draw parameters pick them up.
 
+use super::command::PanelChange;
+use super::panel_view::{Commands, PanelView};
+use super::state::Settings;
 use super::state::{CompareView, HeatReference};
-use super::App;
+use super::Command;
 use crate::render::{Lighting, Shading};
 
 /// What each choice does, in the words the tooltips use (tests look them up).
@@ -24,49 +27,59 @@ pub mod tips {
 }
 
 /// The section's rows, top of the side panel so they never take the viewport's room.
-pub fn show(app: &mut App, ui: &mut egui::Ui) {
-    compare_row(app, ui);
-    heat_rows(app, ui);
-    look_rows(app, ui);
+pub(super) fn show(
+    ui: &mut egui::Ui,
+    view: &PanelView,
+    settings: &mut Settings,
+    commands: &mut Commands,
+) {
+    compare_row(ui, settings);
+    heat_rows(ui, view, settings, commands);
+    look_rows(ui, settings);
 }
 
-fn compare_row(app: &mut App, ui: &mut egui::Ui) {
+fn compare_row(ui: &mut egui::Ui, settings: &mut Settings) {
     ui.horizontal(|ui| {
         ui.label("Compare:");
-        let mut compare = app.settings.compare;
+        let mut compare = settings.compare;
         ui.selectable_value(&mut compare, CompareView::Single, "Single")
             .on_hover_text("One view; B toggles before and after");
         ui.selectable_value(&mut compare, CompareView::Split, "Split")
             .on_hover_text("Before left of the divider, after right of it (drag the divider)");
         ui.selectable_value(&mut compare, CompareView::SideBySide, "Side by side")
             .on_hover_text("Before and after next to each other, one camera");
-        app.settings.compare = compare;
+        settings.compare = compare;
     });
 }
 
-fn heat_rows(app: &mut App, ui: &mut egui::Ui) {
+fn heat_rows(
+    ui: &mut egui::Ui,
+    view: &PanelView,
+    settings: &mut Settings,
+    commands: &mut Commands,
+) {
     ui.horizontal(|ui| {
         ui.add_enabled(
-            app.settings.compare == CompareView::Single,
-            egui::Button::selectable(app.show_before, "Before (B)"),
+            settings.compare == CompareView::Single,
+            egui::Button::selectable(view.show_before, "Before (B)"),
         )
         .on_hover_text("Show the input mesh instead of the result (B)")
         .on_disabled_hover_text("Split and Side by side show before and after already")
         .clicked()
-        .then(|| app.show_before = !app.show_before);
-        ui.checkbox(&mut app.settings.heat_map, "Heat map (H)")
+        .then(|| commands.push(Command::Panel(PanelChange::ToggleBefore)));
+        ui.checkbox(&mut settings.heat_map, "Heat map (H)")
             .on_hover_text("Colour each vertex by its distance from the reference mesh (H)");
     });
     // The reference only while the heat map is on: the panel below stays a row higher, so
     // Export fits an 800-point-high window.
-    if !app.settings.heat_map {
+    if !settings.heat_map {
         return;
     }
     ui.horizontal(|ui| {
-        let has_clean = app.document.as_ref().is_some_and(|d| d.clean.is_some());
+        let has_clean = view.document.is_some_and(|d| d.clean.is_some());
         ui.label("against");
         ui.selectable_value(
-            &mut app.settings.heat_reference,
+            &mut settings.heat_reference,
             HeatReference::Document,
             "input mesh",
         )
@@ -74,20 +87,20 @@ fn heat_rows(app: &mut App, ui: &mut egui::Ui) {
         ui.add_enabled(
             has_clean,
             egui::Button::selectable(
-                app.settings.heat_reference == HeatReference::Clean,
+                settings.heat_reference == HeatReference::Clean,
                 "clean mesh",
             ),
         )
         .on_hover_text(tips::HEAT_CLEAN)
         .on_disabled_hover_text("Add noise first: the mesh before it becomes the clean one")
         .clicked()
-        .then(|| app.settings.heat_reference = HeatReference::Clean);
+        .then(|| settings.heat_reference = HeatReference::Clean);
     });
 }
 
 /// Shading and lighting: how the surface is lit in every view (before, after, heat map, mask).
 /// One row, so that the panel's lower sections stay on a 800-point-high screen.
-fn look_rows(app: &mut App, ui: &mut egui::Ui) {
+fn look_rows(ui: &mut egui::Ui, settings: &mut Settings) {
     ui.horizontal(|ui| {
         ui.label("Shading:");
         for shading in Shading::ALL {
@@ -95,16 +108,16 @@ fn look_rows(app: &mut App, ui: &mut egui::Ui) {
                 Shading::Flat => tips::FLAT,
                 Shading::Smooth => tips::SMOOTH,
             };
-            ui.selectable_value(&mut app.settings.shading, shading, shading.label())
+            ui.selectable_value(&mut settings.shading, shading, shading.label())
                 .on_hover_text(tip);
         }
-        let mut studio = app.settings.lighting == Lighting::Studio;
+        let mut studio = settings.lighting == Lighting::Studio;
         if ui
             .checkbox(&mut studio, STUDIO_LIGHTING)
             .on_hover_text(tips::STUDIO)
             .changed()
         {
-            app.settings.lighting = match studio {
+            settings.lighting = match studio {
                 true => Lighting::Studio,
                 false => Lighting::Simple,
             };

@@ -68,7 +68,7 @@ pub use mask::{Mask, MaskError};
 pub use strength::estimate_noise;
 
 /// How boundary vertices of open meshes move.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 #[non_exhaustive]
 pub enum BoundaryMode {
     /// Each boundary loop is smoothed as a closed curve (section 3.3).
@@ -225,7 +225,7 @@ pub struct FairReport {
 }
 
 /// The smoothing methods offered by the CLI and the editor.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 #[non_exhaustive]
 pub enum Method {
     /// Constrained fairing (the paper's method).

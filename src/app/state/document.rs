@@ -9,12 +9,12 @@ use std::time::Duration;
 
 use crate::app::history::SizeInBytes;
 use crate::app::sharp_edges::SharpEdgeLines;
-use crate::fairing::Mask;
+use crate::fairing::{Mask, Method};
 use crate::hierarchy::{Hierarchy, LevelInfo};
 use crate::io::LoadReport;
 use crate::TriMesh;
 
-use super::{Measures, MethodSetting};
+use super::Measures;
 
 /// Where the hierarchy of the current document stands.
 pub enum HierarchyState {
@@ -36,7 +36,7 @@ pub enum HierarchyState {
 pub struct FairedResult {
     pub positions: Arc<Vec<[f32; 3]>>,
     pub level: usize,
-    pub method: MethodSetting,
+    pub method: Method,
     pub volume_change: f64,
     pub rms_displacement: f64,
     pub elapsed: Duration,

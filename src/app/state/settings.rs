@@ -7,69 +7,47 @@ use std::path::{Path, PathBuf};
 use serde::{Deserialize, Serialize};
 
 use crate::fairing::creases::{CreaseOptions, DEFAULT_CREASE_ANGLE};
-use crate::fairing::{BoundaryMode, HcOptions, LaplacianOptions, MethodOptions, TaubinOptions};
+use crate::fairing::{
+    BoundaryMode, HcOptions, LaplacianOptions, Method, MethodOptions, TaubinOptions,
+};
 use crate::hierarchy::HierarchyOptions;
 use crate::multires::{MultiresOptions, MultiresVariant};
 use crate::noise::{NoiseMode, NoiseOptions};
 use crate::render::{Lighting, Shading};
 
-/// Boundary handling, as stored in the settings.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
-pub enum BoundarySetting {
-    #[default]
-    Curve,
-    Fixed,
-}
-
-/// Fairing variant, as stored in the settings.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
-pub enum VariantSetting {
-    Paper,
-    #[default]
-    Improved,
-}
-
-/// The smoothing method of the fairing panel: the paper's (coarse to fine over the hierarchy) or
-/// a baseline run on the document's mesh, to see its shrinkage next to the paper's.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
-pub enum MethodSetting {
-    #[default]
-    Constrained,
-    Laplacian,
-    Taubin,
-    Hc,
-}
-
-impl MethodSetting {
-    pub const ALL: [MethodSetting; 4] = [
-        MethodSetting::Constrained,
-        MethodSetting::Laplacian,
-        MethodSetting::Taubin,
-        MethodSetting::Hc,
-    ];
-
-    pub fn label(self) -> &'static str {
-        match self {
-            MethodSetting::Constrained => "Constrained fairing",
-            MethodSetting::Laplacian => "Laplacian",
-            MethodSetting::Taubin => "Taubin λ|μ",
-            MethodSetting::Hc => "HC Laplacian",
-        }
-    }
+/// What the editor says about a smoothing method: the paper's (coarse to fine over the
+/// hierarchy) or a baseline run on the document's mesh, to see its shrinkage next to the
+/// paper's. The settings store the library's [`Method`] itself.
+pub trait MethodChoice: Copy {
+    /// The method's name in the fairing panel.
+    fn label(self) -> &'static str;
 
     /// Whether the method works over the hierarchy (start level, Fair M0, variant apply).
-    pub fn uses_hierarchy(self) -> bool {
-        self == MethodSetting::Constrained
-    }
+    fn uses_hierarchy(self) -> bool;
 
     /// What a result of this method from `start_level` is, in words ("from M4" means nothing
     /// to a baseline, which smooths the whole input mesh).
-    pub fn describe(self, start_level: usize) -> String {
+    fn describe(self, start_level: usize) -> String {
         if self.uses_hierarchy() {
             format!("{} from M{start_level}", self.label())
         } else {
             format!("{}, whole mesh", self.label())
         }
+    }
+}
+
+impl MethodChoice for Method {
+    fn label(self) -> &'static str {
+        match self {
+            Method::Constrained => "Constrained fairing",
+            Method::Laplacian => "Laplacian",
+            Method::Taubin => "Taubin λ|μ",
+            Method::Hc => "HC Laplacian",
+        }
+    }
+
+    fn uses_hierarchy(self) -> bool {
+        self == Method::Constrained
     }
 }
 
@@ -117,9 +95,9 @@ pub const MAX_SHARP_EDGE_ANGLE: f64 = 90.0;
 pub struct Settings {
     pub iterations: usize,
     pub rounds: usize,
-    pub boundary: BoundarySetting,
+    pub boundary: BoundaryMode,
     pub fair_finest: bool,
-    pub variant: VariantSetting,
+    pub variant: MultiresVariant,
     pub wireframe: bool,
     pub view_mode: ViewMode,
     pub show_performance: bool,
@@ -135,7 +113,7 @@ pub struct Settings {
     pub compare: CompareView,
     /// Where the split view's divider sits, as a fraction of the view's width.
     pub split: f32,
-    pub method: MethodSetting,
+    pub method: Method,
     /// Iterations and step of the baseline methods.
     pub baseline_iterations: usize,
     pub baseline_lambda: f64,
@@ -167,9 +145,9 @@ impl Default for Settings {
         Self {
             iterations: defaults.iterations,
             rounds: defaults.rounds,
-            boundary: BoundarySetting::Curve,
+            boundary: BoundaryMode::Curve,
             fair_finest: defaults.fair_finest,
-            variant: VariantSetting::Improved,
+            variant: MultiresVariant::Improved,
             wireframe: false,
             view_mode: ViewMode::Faired,
             show_performance: false,
@@ -181,7 +159,7 @@ impl Default for Settings {
             heat_reference: HeatReference::Document,
             compare: CompareView::Single,
             split: 0.5,
-            method: MethodSetting::Constrained,
+            method: Method::Constrained,
             baseline_iterations: 10,
             baseline_lambda: 0.5,
             levels_folder: String::new(),
@@ -247,10 +225,10 @@ impl Settings {
     ) -> (
         usize,
         usize,
-        BoundarySetting,
+        BoundaryMode,
         bool,
-        VariantSetting,
-        MethodSetting,
+        MultiresVariant,
+        Method,
         usize,
         u64,
     ) {
@@ -274,25 +252,22 @@ impl Settings {
         } else {
             0.5
         };
-        let boundary = match self.boundary {
-            BoundarySetting::Curve => BoundaryMode::Curve,
-            BoundarySetting::Fixed => BoundaryMode::Fixed,
-        };
+        let boundary = self.boundary;
         match self.method {
-            MethodSetting::Constrained => None,
-            MethodSetting::Laplacian => Some(MethodOptions::Laplacian(LaplacianOptions {
+            Method::Constrained => None,
+            Method::Laplacian => Some(MethodOptions::Laplacian(LaplacianOptions {
                 iterations,
                 lambda,
                 boundary,
             })),
             // Taubin's pass band k_PB = 0.1: 1/λ + 1/μ = 0.1.
-            MethodSetting::Taubin => Some(MethodOptions::Taubin(TaubinOptions {
+            Method::Taubin => Some(MethodOptions::Taubin(TaubinOptions {
                 iterations,
                 lambda,
                 mu: -lambda / (1.0 - 0.1 * lambda),
                 boundary,
             })),
-            MethodSetting::Hc => Some(MethodOptions::Hc(HcOptions {
+            Method::Hc => Some(MethodOptions::Hc(HcOptions {
                 iterations,
                 boundary,
                 ..HcOptions::default()
@@ -338,15 +313,9 @@ impl Settings {
             start_level,
             iterations: self.iterations.clamp(1, 1000),
             rounds: self.rounds.clamp(1, 100),
-            boundary: match self.boundary {
-                BoundarySetting::Curve => BoundaryMode::Curve,
-                BoundarySetting::Fixed => BoundaryMode::Fixed,
-            },
+            boundary: self.boundary,
             fair_finest: self.fair_finest,
-            variant: match self.variant {
-                VariantSetting::Paper => MultiresVariant::Paper,
-                VariantSetting::Improved => MultiresVariant::Improved,
-            },
+            variant: self.variant,
             mask: None,
         }
     }
@@ -389,6 +358,54 @@ mod tests {
         assert_eq!(
             (old.shading, old.lighting),
             (Shading::Smooth, Lighting::Studio)
+        );
+    }
+
+    #[test]
+    fn settings_written_with_the_old_copy_enums_still_load() {
+        // Boundary, variant and method were once stored through editor copies of the library's
+        // enums (`BoundarySetting`, `VariantSetting`, `MethodSetting`); a file saved then spells
+        // them the same way the library's enums do now.
+        let old = r#"{"iterations": 4, "rounds": 2, "boundary": "Fixed", "fair_finest": true,
+            "variant": "Paper", "method": "Taubin", "baseline_iterations": 12}"#;
+        let settings: Settings = serde_json::from_str(old).unwrap();
+        assert_eq!(settings.boundary, BoundaryMode::Fixed);
+        assert_eq!(settings.variant, MultiresVariant::Paper);
+        assert_eq!(settings.method, Method::Taubin);
+        assert_eq!((settings.iterations, settings.rounds), (4, 2));
+        for (json, boundary) in [
+            ("Curve", BoundaryMode::Curve),
+            ("Fixed", BoundaryMode::Fixed),
+        ] {
+            let text = format!(r#"{{"boundary": "{json}"}}"#);
+            let settings: Settings = serde_json::from_str(&text).unwrap();
+            assert_eq!(settings.boundary, boundary);
+        }
+        for (json, variant) in [
+            ("Paper", MultiresVariant::Paper),
+            ("Improved", MultiresVariant::Improved),
+        ] {
+            let text = format!(r#"{{"variant": "{json}"}}"#);
+            let settings: Settings = serde_json::from_str(&text).unwrap();
+            assert_eq!(settings.variant, variant);
+        }
+        for (json, method) in [
+            ("Constrained", Method::Constrained),
+            ("Laplacian", Method::Laplacian),
+            ("Taubin", Method::Taubin),
+            ("Hc", Method::Hc),
+        ] {
+            let text = format!(r#"{{"method": "{json}"}}"#);
+            let settings: Settings = serde_json::from_str(&text).unwrap();
+            assert_eq!(settings.method, method);
+            // And they are written the same way again.
+            let written = serde_json::to_value(&settings).unwrap();
+            assert_eq!(written["method"], json);
+        }
+        let written = serde_json::to_value(Settings::default()).unwrap();
+        assert_eq!(
+            (&written["boundary"], &written["variant"]),
+            (&serde_json::json!("Curve"), &serde_json::json!("Improved"))
         );
     }
 

@@ -4,7 +4,7 @@
 use std::sync::Arc;
 
 use crate::app::jobs::JobResult;
-use crate::app::state::{Document, DocumentSnapshot, HierarchyState, Measures};
+use crate::app::state::{Document, DocumentSnapshot, HierarchyState, Measures, MethodChoice};
 use crate::app::App;
 use crate::TriMesh;
 

@@ -96,7 +96,7 @@ impl App {
             };
             let result = positions.map(|positions| {
                 let (volume_change, rms_displacement) =
-                    compare_to_base(hierarchy.base_mesh(), &positions);
+                    metrics::change_of_positions(hierarchy.base_mesh(), &positions);
                 Faired {
                     positions,
                     volume_change,
@@ -203,62 +203,5 @@ impl App {
         }
         self.applied_level_view = view;
         current.level_mesh = Some((level, mesh));
-    }
-}
-
-/// Relative volume change and RMS vertex displacement of `positions` against `base`.
-fn compare_to_base(base: &TriMesh, positions: &[[f32; 3]]) -> (f64, f64) {
-    if positions.len() != base.positions.len() || positions.is_empty() {
-        return (f64::NAN, f64::NAN);
-    }
-    let before = metrics::signed_volume(base);
-    let after_mesh = TriMesh {
-        positions: positions.to_vec(),
-        triangles: base.triangles.clone(),
-    };
-    let after = metrics::signed_volume(&after_mesh);
-    let volume_change = if before.abs() > 0.0 {
-        (after - before) / before.abs()
-    } else {
-        f64::NAN
-    };
-    let sum_squared: f64 = positions
-        .iter()
-        .zip(&base.positions)
-        .map(|(p, q)| {
-            (0..3)
-                .map(|k| (p[k] as f64 - q[k] as f64).powi(2))
-                .sum::<f64>()
-        })
-        .sum();
-    (volume_change, (sum_squared / positions.len() as f64).sqrt())
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn displacement_and_volume_of_identical_meshes_are_zero() {
-        let mesh = TriMesh::new(
-            vec![
-                [0.0, 0.0, 0.0],
-                [1.0, 0.0, 0.0],
-                [0.0, 1.0, 0.0],
-                [0.0, 0.0, 1.0],
-            ],
-            vec![[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]],
-        );
-        let (dv, rms) = compare_to_base(&mesh, &mesh.positions);
-        assert_eq!(dv, 0.0);
-        assert_eq!(rms, 0.0);
-        let moved: Vec<_> = mesh
-            .positions
-            .iter()
-            .map(|p| [p[0] + 0.5, p[1], p[2]])
-            .collect();
-        let (dv, rms) = compare_to_base(&mesh, &moved);
-        assert!(dv.abs() < 1e-12, "translation keeps the volume");
-        assert!((rms - 0.5).abs() < 1e-12);
     }
 }

@@ -7,19 +7,20 @@ use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
 use crate::app::jobs::JobResult;
+use crate::app::panel_view::{Commands, PanelView};
 use crate::app::{App, Command};
 
 /// The toolbar's button.
-pub(in crate::app) fn button(app: &mut App, ui: &mut egui::Ui) {
+pub(in crate::app) fn button(ui: &mut egui::Ui, view: &PanelView, commands: &mut Commands) {
     let response = ui
-        .add_enabled(app.document.is_some(), egui::Button::new("Save image"))
+        .add_enabled(view.document.is_some(), egui::Button::new("Save image"))
         .on_hover_text(
             "Save the 3D view as a PNG picture beside the mesh file, named <name>_view.png \
              (Ctrl+Shift+S)",
         )
         .on_disabled_hover_text("Open a mesh first");
     if response.clicked() {
-        app.commands.push(Command::SaveViewImage);
+        commands.push(Command::SaveViewImage);
     }
 }
 
