@@ -33,7 +33,7 @@
 //!   boundary) and is held fixed.
 //!
 //! Speed (issue 12: detection and the noise estimate should add at most 10 % to a default round):
-//! constrained fairing and the hierarchy detect through [`detect_creases_with_estimate`], whose
+//! constrained fairing and the hierarchy detect through `detect_creases_with_estimate`, whose
 //! one gather over the fan-ordered one-rings gives the noise estimate and the feature edges of the
 //! faces' own normals at once, so a clean mesh reads no face and never runs the filter. The
 //! filter (noisy meshes) works in f32 on a face-around-face list built once for all passes.

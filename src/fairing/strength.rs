@@ -6,7 +6,7 @@
 //! the best count differs from mesh to mesh (2, 5 and 40-60 rounds on three scans), while a clean
 //! mesh should not be touched at all. So the default measures the noise before fairing (at or
 //! below [`CLEAN_NOISE`] it does nothing; nor when the mesh reads that clean once the vertices on
-//! its sharp edges are left out, [`estimate_noise_away_from_edges`]) and after every round, and stops once a round lowers the
+//! its sharp edges are left out, `estimate_noise_away_from_edges`) and after every round, and stops once a round lowers the
 //! estimate by less than 10 % ([`MIN_NOISE_FALL`]; in the measurements this ends after 5 to 11
 //! rounds), once the estimate is below [`NOISE_LEFT`] of the input's, once a round moved the
 //! vertices by less than [`MIN_MOVE_PER_NOISE`] times the estimate it left (coarse scans), or
