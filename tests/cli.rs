@@ -682,6 +682,53 @@ fn a_bad_mask_names_the_file_and_the_line() {
 }
 
 #[test]
+fn two_boxes_touching_at_a_corner_still_get_a_hierarchy_and_multires() {
+    // The second box's lowest corner is the first's highest: welded on load, that vertex has two
+    // fans. It and its neighbours stay in every level; the rest is decimated and faired.
+    let dir = tempfile::tempdir().unwrap();
+    let a = fairmesh::mesh::shapes::cuboid([1.0, 1.0, 1.0], 0.1);
+    let low = a.positions.iter().fold([f32::MAX; 3], |m, p| {
+        [m[0].min(p[0]), m[1].min(p[1]), m[2].min(p[2])]
+    });
+    let high = a.positions.iter().fold([f32::MIN; 3], |m, p| {
+        [m[0].max(p[0]), m[1].max(p[1]), m[2].max(p[2])]
+    });
+    let n = a.positions.len() as u32;
+    let mut positions = a.positions.clone();
+    positions.extend(
+        a.positions
+            .iter()
+            .map(|p| [0, 1, 2].map(|c| p[c] + (high[c] - low[c]))),
+    );
+    let mut triangles = a.triangles.clone();
+    triangles.extend(a.triangles.iter().map(|t| t.map(|v| v + n)));
+    let path = dir.path().join("boxes.obj");
+    fairmesh::io::save(&path, &fairmesh::TriMesh::new(positions, triangles)).unwrap();
+    let file = path.to_str().unwrap();
+    let levels = json_of(&["hierarchy", file, "--json"]);
+    assert_eq!(levels["non_manifold_vertices"], 1, "{levels}");
+    let count = levels["levels"].as_array().unwrap().len();
+    assert!(count > 3, "{levels}");
+    let output = dir.path().join("out.obj");
+    let out = fairmesh(&[
+        "multires",
+        file,
+        "-o",
+        output.to_str().unwrap(),
+        "--level",
+        &(count - 1).to_string(),
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let faired = fairmesh::io::load(&output).unwrap().mesh;
+    assert_eq!(faired.vertex_count(), 2 * n as usize - 1);
+    assert!(faired.positions.iter().flatten().all(|c| c.is_finite()));
+}
+
+#[test]
 fn hierarchy_keeps_a_boxs_edges_only_when_asked() {
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("box.obj");
@@ -693,6 +740,7 @@ fn hierarchy_keeps_a_boxs_edges_only_when_asked() {
         plain["crease_edges"], 0,
         "the paper's hierarchy has no creases"
     );
+    assert_eq!(plain["non_manifold_vertices"], 0);
     // A 2 × 1 × 0.5 box sampled every 0.1: its top and bottom outlines have 60 edges each, its
     // four upright edges 5 each.
     let kept = json_of(&["hierarchy", file, "--json", "--keep-creases"]);

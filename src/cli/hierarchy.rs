@@ -219,6 +219,7 @@ pub fn run_hierarchy(args: HierarchyArgs) -> anyhow::Result<()> {
             "levels": levels,
             "total_ms": total_ms,
             "crease_edges": hierarchy.crease_edge_count(),
+            "non_manifold_vertices": hierarchy.non_manifold_vertices().len(),
             "record_bytes_per_vertex":
                 hierarchy.record_bytes() as f64 / loaded.mesh.vertex_count().max(1) as f64,
         });
@@ -228,6 +229,13 @@ pub fn run_hierarchy(args: HierarchyArgs) -> anyhow::Result<()> {
         0 => String::new(),
         edges => format!(", {edges} crease edges kept sharp"),
     };
+    if let [first, ..] = hierarchy.non_manifold_vertices() {
+        eprintln!(
+            "note: {}: {} vertices where the mesh is not an oriented 2-manifold (e.g. vertex {first}) stay in every level, with their neighbours",
+            args.input.display(),
+            hierarchy.non_manifold_vertices().len()
+        );
+    }
     let mut out = format!(
         "{}: {} levels in {:.1} ms ({:.1} bytes of collapse records per vertex{creases})\nlevel  vertices     faces   time ms\n",
         args.input.display(),

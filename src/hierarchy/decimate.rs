@@ -35,9 +35,12 @@
 //!   keeps M0's corners and its crease edges, relabelled, and a coarse level of a CAD part still
 //!   has its edges. Each vertex's crease neighbours are kept per level in `Level::crease`.
 //!
-//! - The input must be an oriented 2-manifold (checked on the first pass's fans: every vertex's
-//!   faces form one consistently oriented fan); otherwise the build refuses with
-//!   `HierarchyError::Unsupported` naming the vertex.
+//! - Where the input is not an oriented 2-manifold (found on the first pass's fans: a vertex
+//!   whose faces are not one consistently oriented fan: an edge with more than two faces, two
+//!   fans meeting at the vertex, faces of opposite orientation), that vertex and its neighbours
+//!   stay in every level, so no face at it ever changes and every collapse is between manifold
+//!   vertices; the rest of the mesh is decimated as usual (`Hierarchy::non_manifold_vertices`).
+//!   Before, one such vertex refused the whole build (a cow from PyMeshLab's test meshes has one).
 //!
 //! Speed. Each level is a compact mesh: vertices `0..V`, faces `0..F`, positions and M0 ids in
 //! flat arrays. M0 enters in Morton order of its positions (faces by their first corner), since
@@ -90,6 +93,9 @@ pub(super) struct BuildOutput {
     pub face_removed_in_pass: Vec<u32>,
     /// Milliseconds each pass took.
     pub pass_ms: Vec<f64>,
+    /// M0 ids of the vertices whose faces are not one oriented fan (ascending): they and their
+    /// neighbours stay in every level.
+    pub non_manifold: Vec<u32>,
 }
 
 /// A pass that removes fewer than one vertex in this many ends the build, without its level.
@@ -105,18 +111,11 @@ pub(super) fn build(
     progress: &mut dyn Progress,
 ) -> Result<BuildOutput, HierarchyError> {
     passes(mesh, first_level(mesh, creases), options, progress).map_err(|e| match e {
-        BuildFailure::NonManifold(v) => HierarchyError::Unsupported(format!(
-            "the mesh is not an oriented 2-manifold at vertex {v}: its faces do not form one \
-             consistently oriented fan (an edge with more than two faces, two fans meeting at \
-             the vertex, or faces of opposite orientation)"
-        )),
         BuildFailure::Cancelled => HierarchyError::Cancelled,
     })
 }
 
 enum BuildFailure {
-    /// M0 id of a vertex whose faces are not one oriented fan.
-    NonManifold(u32),
     Cancelled,
 }
 
@@ -271,7 +270,12 @@ fn passes(
         six_split_volume: vec![0.0; n],
         face_removed_in_pass: vec![NEVER; mesh.face_count()],
         pass_ms: Vec::new(),
+        non_manifold: Vec::new(),
     };
+    // M0 ids of the vertices that stay: those whose faces are not one oriented fan, and their
+    // neighbours (so no face at such a vertex ever changes, and every collapse is between
+    // manifold vertices).
+    let mut pinned: Vec<bool> = Vec::new();
     let isolated = n - level.points.len();
     let mut next = Level::default();
     let mut state = PassState::default();
@@ -291,8 +295,20 @@ fn passes(
         let level_vertices = level.points.len();
         build_fans(&level.corners, level_vertices, &mut state);
         if pass == 0 {
-            if let Some(v) = first_non_manifold_vertex(&state.fan_offsets, &state.fans) {
-                return Err(BuildFailure::NonManifold(level.vertex_id[v]));
+            let non_manifold = non_manifold_vertices(&state.fan_offsets, &state.fans);
+            if !non_manifold.is_empty() {
+                pinned = vec![false; n];
+                for &v in &non_manifold {
+                    pinned[level.vertex_id[v] as usize] = true;
+                    let fan = &state.fans
+                        [state.fan_offsets[v] as usize..state.fan_offsets[v + 1] as usize];
+                    for &[a, b] in fan {
+                        pinned[level.vertex_id[a as usize] as usize] = true;
+                        pinned[level.vertex_id[b as usize] as usize] = true;
+                    }
+                }
+                out.non_manifold = non_manifold.iter().map(|&v| level.vertex_id[v]).collect();
+                out.non_manifold.sort_unstable();
             }
             if vertex_count <= options.min_vertices || options.max_levels == 0 {
                 break;
@@ -322,7 +338,11 @@ fn passes(
                 continue;
             }
             let open = state.open[v as usize];
-            if open && options.keep_boundary {
+            if open && options.keep_boundary
+                || pinned
+                    .get(level.vertex_id[v as usize] as usize)
+                    .is_some_and(|&p| p)
+            {
                 continue;
             }
             // A crease vertex collapses only along its crease; a corner never. Nor when its crease
@@ -593,10 +613,11 @@ fn point(points: &[[f32; 3]], v: u32) -> DVec3 {
     DVec3::new(p[0] as f64, p[1] as f64, p[2] as f64)
 }
 
-/// A vertex whose faces are not a single consistently oriented fan, if any: with the faces
-/// `(v, a, b)` of `v`, every `a` and every `b` must be distinct and following `a -> b` from the
-/// fan's start (an `a` that is no `b`, or any `a` when the fan is closed) must visit every face.
-fn first_non_manifold_vertex(fan_offsets: &[u32], fans: &[[u32; 2]]) -> Option<usize> {
+/// The vertices whose faces are not a single consistently oriented fan, ascending: with the
+/// faces `(v, a, b)` of `v`, every `a` and every `b` must be distinct and following `a -> b` from
+/// the fan's start (an `a` that is no `b`, or any `a` when the fan is closed) must visit every
+/// face.
+fn non_manifold_vertices(fan_offsets: &[u32], fans: &[[u32; 2]]) -> Vec<usize> {
     let n = fan_offsets.len() - 1;
     (0..n)
         .into_par_iter()
@@ -605,8 +626,9 @@ fn first_non_manifold_vertex(fan_offsets: &[u32], fans: &[[u32; 2]]) -> Option<u
             let fan = &fans[fan_offsets[v] as usize..fan_offsets[v + 1] as usize];
             (v, !is_one_fan(fan, next))
         })
-        .find_first(|&(_, bad)| bad)
+        .filter(|&(_, bad)| bad)
         .map(|(v, _)| v)
+        .collect()
 }
 
 /// Whether `fan` (the `(a, b)` of the faces `(v, a, b)` of one vertex) is one consistently

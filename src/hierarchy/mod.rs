@@ -141,6 +141,8 @@ pub struct Hierarchy {
     /// empty when the build kept no creases).
     feature_class: Vec<FeatureClass>,
     crease_edges: Vec<[u32; 2]>,
+    /// M0 ids of the vertices whose faces are not one oriented fan (ascending).
+    non_manifold: Vec<u32>,
 }
 
 impl Hierarchy {
@@ -277,6 +279,12 @@ impl Hierarchy {
         let class = self.feature_class[..vertex_count as usize].to_vec();
         Some(Creases::from_classified(edges, class))
     }
+    /// The vertices of M0 (the input mesh's ids, ascending) whose faces are not one consistently
+    /// oriented fan: they and their neighbours stay in every level.
+    pub fn non_manifold_vertices(&self) -> &[u32] {
+        &self.non_manifold
+    }
+
     /// M0's feature edges the build kept, in M0's own vertex ids (the input mesh's), lower id
     /// first; empty without creases.
     pub fn crease_edges(&self) -> Vec<[u32; 2]> {
@@ -388,8 +396,9 @@ impl LevelCursor {
 
 /// Builds the decimation hierarchy of `mesh` (section 4.1): M0 is `mesh`, each further level
 /// removes an independent set of vertices by volume-preserving half-edge collapses. `progress`
-/// may cancel the build ([`HierarchyError::Cancelled`]); a mesh that is not an oriented
-/// 2-manifold is refused ([`HierarchyError::Unsupported`]).
+/// may cancel the build ([`HierarchyError::Cancelled`]). Where the mesh is not an oriented
+/// 2-manifold, those vertices and their neighbours stay in every level
+/// ([`Hierarchy::non_manifold_vertices`]).
 ///
 /// ```
 /// use fairmesh::hierarchy::{build_hierarchy, HierarchyOptions};
@@ -523,6 +532,7 @@ pub fn build_hierarchy(
         level_ms,
         feature_class,
         crease_edges,
+        non_manifold: built.non_manifold,
     })
 }
 

@@ -169,10 +169,63 @@ fn coarsen_to_top_and_refine_back_restores_m0() {
 }
 
 #[test]
-fn refuses_non_manifold_input() {
-    let mesh = crate::mesh::fixtures::three_triangles_on_one_edge();
-    let error = build_hierarchy(&mesh, &HierarchyOptions::default(), &mut NoProgress);
-    assert!(matches!(error, Err(HierarchyError::Unsupported(m)) if m.contains("2-manifold")));
+fn non_manifold_vertices_and_their_neighbours_stay_and_the_rest_is_decimated() {
+    // Two spheres touching at one vertex (two fans meeting there): that vertex and its
+    // neighbours stay in every level, the rest of both spheres is decimated as usual.
+    let one = sphere(3);
+    let top = one
+        .positions
+        .iter()
+        .enumerate()
+        .max_by(|a, b| a.1[2].total_cmp(&b.1[2]))
+        .unwrap()
+        .0 as u32;
+    let n = one.positions.len() as u32;
+    let mut positions = one.positions.clone();
+    // The second sphere, mirrored above the first's top vertex, shares that vertex.
+    let top_z = one.positions[top as usize][2];
+    let id = |v: u32| {
+        if v == top {
+            top
+        } else if v < top {
+            n + v
+        } else {
+            n + v - 1
+        }
+    };
+    for (v, p) in one.positions.iter().enumerate() {
+        if v as u32 != top {
+            positions.push([p[0], p[1], 2.0 * top_z - p[2]]);
+        }
+    }
+    let mut triangles = one.triangles.clone();
+    // Mirrored, so each face is reversed to keep the outside out.
+    triangles.extend(one.triangles.iter().map(|t| [id(t[0]), id(t[2]), id(t[1])]));
+    let mesh = TriMesh::new(positions, triangles);
+    let h = build_hierarchy(&mesh, &HierarchyOptions::default(), &mut NoProgress).unwrap();
+    assert_eq!(h.non_manifold_vertices(), &[top]);
+    let coarsest = h.coarsest_level();
+    assert!(
+        h.level_info(coarsest).vertices < mesh.vertex_count() / 4,
+        "{:?}",
+        h.level_info(coarsest)
+    );
+    let topology = Topology::build(&mesh);
+    let mut stay: Vec<u32> = topology.neighbors(top).to_vec();
+    stay.push(top);
+    for level in 0..=coarsest {
+        let kept: std::collections::HashSet<u32> = (0..h.level_info(level).vertices as u32)
+            .map(|v| h.original_vertex(v))
+            .collect();
+        for &v in &stay {
+            assert!(kept.contains(&v), "vertex {v} left at level {level}");
+        }
+    }
+    // The three triangles on one edge: every vertex is on it or beside it, nothing collapses.
+    let fin = crate::mesh::fixtures::three_triangles_on_one_edge();
+    let h = build_hierarchy(&fin, &HierarchyOptions::default(), &mut NoProgress).unwrap();
+    assert_eq!(h.coarsest_level(), 0);
+    assert_eq!(h.non_manifold_vertices().len(), 2);
 }
 
 #[test]
