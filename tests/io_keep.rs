@@ -1441,11 +1441,11 @@ fn non_finite_uvs_normals_and_colours_never_reach_another_format() {
 /// `gltf` written as a GLB file at `path` (its one buffer as the BIN chunk).
 fn write_glb(gltf: &Gltf, path: &Path) {
     let mut json = serde_json::to_vec(&gltf.json).unwrap();
-    while json.len() % 4 != 0 {
+    while !json.len().is_multiple_of(4) {
         json.push(b' ');
     }
     let mut bin = gltf.buffers[0].clone();
-    while bin.len() % 4 != 0 {
+    while !bin.len().is_multiple_of(4) {
         bin.push(0);
     }
     let total = 12 + 8 + json.len() + 8 + bin.len();
@@ -1485,7 +1485,7 @@ fn tangents_turn_with_their_normals_and_keep_length_and_handedness() {
         }
     }
     let buffer = &mut input.buffers[0];
-    while buffer.len() % 4 != 0 {
+    while !buffer.len().is_multiple_of(4) {
         buffer.push(0);
     }
     let offset = buffer.len();
