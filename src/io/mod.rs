@@ -331,7 +331,7 @@ fn finish_with_map(mut mesh: TriMesh, options: &LoadOptions) -> (Loaded, Option<
             map = Some(weld_map);
         }
     }
-    let (cleaned, clean_map) = mesh::clean_with_map(&mut mesh);
+    let (mut cleaned, clean_map) = mesh::clean_with_map_but_repeats(&mut mesh);
     if let Some(clean_map) = clean_map {
         map = Some(match map {
             None => clean_map,
@@ -343,6 +343,15 @@ fn finish_with_map(mut mesh: TriMesh, options: &LoadOptions) -> (Loaded, Option<
             }
         });
     }
+    // Triangles that repeat an earlier one's corners: found from the topology, which is built
+    // anyway (and built again only when some go).
+    let mut topology = Topology::build(&mesh);
+    let repeats = mesh::repeated_triangles_around(&mesh.triangles, &topology);
+    if !repeats.is_empty() {
+        mesh::remove_triangles(&mut mesh, &repeats);
+        topology = Topology::build(&mesh);
+    }
+    cleaned.removed_repeated_faces = repeats.len();
     report.removed_degenerate_faces = cleaned.removed_degenerate_faces;
     report.removed_repeated_faces = cleaned.removed_repeated_faces;
     if cleaned.removed_repeated_faces > 0 {
@@ -354,7 +363,6 @@ fn finish_with_map(mut mesh: TriMesh, options: &LoadOptions) -> (Loaded, Option<
         ));
     }
     report.removed_unreferenced_vertices = cleaned.removed_unreferenced_vertices;
-    let mut topology = Topology::build(&mesh);
     if topology.inconsistent_edges > 0 {
         // Neighbouring triangles facing opposite ways: orient each component consistently (the
         // file itself keeps its own faces when it is written back; only positions change).

@@ -8,7 +8,7 @@
 //! leave such pockets, and fairing pulled them to a point), and vertices that no triangle uses,
 //! again keeping the remaining vertices and triangles in input order.
 
-use super::TriMesh;
+use super::{Topology, TriMesh};
 use rayon::prelude::*;
 use std::collections::HashMap;
 use std::hash::{BuildHasherDefault, Hasher};
@@ -106,20 +106,25 @@ pub fn clean(mesh: &mut TriMesh) -> CleanReport {
 /// [`clean`], also giving the map from each input vertex to the vertex it became (`u32::MAX` for
 /// a removed vertex); `None` when no vertex was removed.
 pub(crate) fn clean_with_map(mesh: &mut TriMesh) -> (CleanReport, Option<Vec<u32>>) {
+    clean_with_map_and(mesh, true)
+}
+
+/// [`clean_with_map`] but for the repeated triangles, which a caller that builds the topology
+/// next finds from it ([`repeated_triangles_around`]) for less. Repeated triangles leave no
+/// vertex unused, so leaving them for later changes no other result.
+pub(crate) fn clean_with_map_but_repeats(mesh: &mut TriMesh) -> (CleanReport, Option<Vec<u32>>) {
+    clean_with_map_and(mesh, false)
+}
+
+fn clean_with_map_and(mesh: &mut TriMesh, repeats: bool) -> (CleanReport, Option<Vec<u32>>) {
     let before_faces = mesh.triangles.len();
     mesh.triangles
         .retain(|&[a, b, c]| a != b && b != c && a != c);
     let removed_degenerate_faces = before_faces - mesh.triangles.len();
     let distinct = mesh.triangles.len();
-    let repeats = repeated_triangles(&mesh.triangles, mesh.positions.len());
-    if !repeats.is_empty() {
-        let mut next = repeats.iter().copied().peekable();
-        let mut index = 0u32;
-        mesh.triangles.retain(|_| {
-            let repeat = next.next_if_eq(&index).is_some();
-            index += 1;
-            !repeat
-        });
+    if repeats {
+        let repeats = repeated_triangles(&mesh.triangles, mesh.positions.len());
+        remove_triangles(mesh, &repeats);
     }
     let removed_repeated_faces = distinct - mesh.triangles.len();
 
@@ -162,11 +167,6 @@ pub(crate) fn clean_with_map(mesh: &mut TriMesh) -> (CleanReport, Option<Vec<u32
 /// order. The triangles are listed by their smallest corner (a counting sort: no hashing, and
 /// the lists are short), and only triangles in the same list are compared.
 fn repeated_triangles(triangles: &[[u32; 3]], vertices: usize) -> Vec<u32> {
-    let sorted = |t: [u32; 3]| {
-        let mut t = t;
-        t.sort_unstable();
-        t
-    };
     // Indices past `vertices` are not this function's to refuse: list them all the same.
     let vertices = triangles
         .iter()
@@ -189,41 +189,89 @@ fn repeated_triangles(triangles: &[[u32; 3]], vertices: usize) -> Vec<u32> {
         listed[next[low] as usize] = f as u32;
         next[low] += 1;
     }
-    // The lists are independent: checked in parallel, in chunks of vertices, and joined in order.
-    let chunks: Vec<Vec<u32>> = (0..vertices)
+    repeats_in_lists(triangles, vertices, |v, list| {
+        list.extend_from_slice(
+            &listed[starts[v as usize] as usize..starts[v as usize + 1] as usize],
+        )
+    })
+}
+
+/// [`repeated_triangles`] with the triangles around each vertex read from `topology` (built
+/// for `triangles`) instead of listed anew.
+pub(crate) fn repeated_triangles_around(triangles: &[[u32; 3]], topology: &Topology) -> Vec<u32> {
+    repeats_in_lists(triangles, topology.vertex_count(), |v, list| {
+        let low = |f: &u32| {
+            let t = triangles[*f as usize];
+            t[0].min(t[1]).min(t[2]) == v
+        };
+        list.extend(topology.faces_of(v).iter().filter(|f| low(f)));
+    })
+}
+
+/// Remove the triangles at `indices` (ascending), keeping the others in order.
+pub(crate) fn remove_triangles(mesh: &mut TriMesh, indices: &[u32]) {
+    if indices.is_empty() {
+        return;
+    }
+    let mut next = indices.iter().copied().peekable();
+    let mut index = 0u32;
+    mesh.triangles.retain(|_| {
+        let repeat = next.next_if_eq(&index).is_some();
+        index += 1;
+        !repeat
+    });
+}
+
+/// The repeated triangles (ascending), given for each vertex `v < vertices` the triangles whose
+/// smallest corner is `v`, ascending (`list(v, &mut out)` appends them): only triangles of the
+/// same list are compared. The lists are independent: checked in parallel, in chunks of vertices,
+/// and joined in order.
+fn repeats_in_lists(
+    triangles: &[[u32; 3]],
+    vertices: usize,
+    list: impl Fn(u32, &mut Vec<u32>) + Sync,
+) -> Vec<u32> {
+    let sorted = |t: [u32; 3]| {
+        let mut t = t;
+        t.sort_unstable();
+        t
+    };
+    let chunks: Vec<Vec<u32>> = (0..vertices as u32)
         .into_par_iter()
         .with_min_len(16_384)
-        .fold(Vec::new, |mut repeats, v| {
-            let list = &listed[starts[v] as usize..starts[v + 1] as usize];
-            if list.len() < 2 {
-                return repeats;
-            }
-            if list.len() <= 16 {
-                // In triangle order: a later one with an earlier one's corners repeats it.
-                for (i, &f) in list.iter().enumerate() {
-                    let corners = sorted(triangles[f as usize]);
-                    if list[..i]
+        .fold(
+            || (Vec::new(), Vec::new()),
+            |(mut repeats, mut faces), v| {
+                faces.clear();
+                list(v, &mut faces);
+                if faces.len() <= 16 {
+                    // In triangle order: a later one with an earlier one's corners repeats it.
+                    for (i, &f) in faces.iter().enumerate() {
+                        let corners = sorted(triangles[f as usize]);
+                        if faces[..i]
+                            .iter()
+                            .any(|&g| sorted(triangles[g as usize]) == corners)
+                        {
+                            repeats.push(f);
+                        }
+                    }
+                } else {
+                    // A busy vertex (a fan's hub): sort by corners, then triangle.
+                    let mut keyed: Vec<([u32; 3], u32)> = faces
                         .iter()
-                        .any(|&g| sorted(triangles[g as usize]) == corners)
-                    {
-                        repeats.push(f);
+                        .map(|&f| (sorted(triangles[f as usize]), f))
+                        .collect();
+                    keyed.sort_unstable();
+                    for pair in keyed.windows(2) {
+                        if pair[0].0 == pair[1].0 {
+                            repeats.push(pair[1].1);
+                        }
                     }
                 }
-            } else {
-                // A busy vertex (a fan's hub): sort by corners, then triangle.
-                let mut keyed: Vec<([u32; 3], u32)> = list
-                    .iter()
-                    .map(|&f| (sorted(triangles[f as usize]), f))
-                    .collect();
-                keyed.sort_unstable();
-                for pair in keyed.windows(2) {
-                    if pair[0].0 == pair[1].0 {
-                        repeats.push(pair[1].1);
-                    }
-                }
-            }
-            repeats
-        })
+                (repeats, faces)
+            },
+        )
+        .map(|(repeats, _)| repeats)
         .collect();
     let mut repeats: Vec<u32> = chunks.concat();
     repeats.sort_unstable();
@@ -318,6 +366,26 @@ mod tests {
         assert_eq!(
             repeated_triangles(&triangles, positions.len()),
             vec![31, 41]
+        );
+        // The same from the topology, as loading finds them; and a tetrahedron's short lists.
+        let fan = TriMesh::new(positions.clone(), triangles.clone());
+        assert_eq!(
+            repeated_triangles_around(&triangles, &Topology::build(&fan)),
+            vec![31, 41]
+        );
+        let tetrahedron = [
+            [0, 2, 1],
+            [1, 2, 3],
+            [2, 3, 1],
+            [0, 1, 3],
+            [3, 2, 1],
+            [0, 3, 2],
+        ];
+        let corners = vec![[0.0f32; 3]; 4];
+        let with_repeats = TriMesh::new(corners, tetrahedron.to_vec());
+        assert_eq!(
+            repeated_triangles_around(&tetrahedron, &Topology::build(&with_repeats)),
+            vec![2, 4]
         );
         let mut mesh = TriMesh::new(positions, triangles);
         let report = clean(&mut mesh);

@@ -19,7 +19,10 @@ mod subdivide;
 mod topology;
 
 pub use clean::{clean, weld, CleanReport, WeldReport};
-pub(crate) use clean::{clean_with_map, weld_with_map, PositionHasher};
+pub(crate) use clean::{
+    clean_with_map_but_repeats, remove_triangles, repeated_triangles_around, weld_with_map,
+    PositionHasher,
+};
 pub use orient::{orient_consistently, OrientReport};
 pub use reorder::{breadth_first_order, inverse_permutation};
 pub use subdivide::subdivide_loop;
