@@ -217,11 +217,12 @@ fn estimate_with(
     let skip = |v: u32| away_from_edges && on_edge[v as usize];
     let beside =
         |v: u32| beside_edges && topology.neighbors(v).iter().any(|&u| on_edge[u as usize]);
-    let defined = (0..n as u32)
-        .into_par_iter()
-        .with_min_len(VERTEX_BLOCK)
-        .filter(|&v| heights[v as usize].is_finite())
-        .count();
+    // Only the reading away from the edges needs it (the per-round estimate skips the pass).
+    let defined = if away_from_edges {
+        heights.par_iter().filter(|h| h.is_finite()).count()
+    } else {
+        0
+    };
     let mut residuals: Vec<f32> = (0..n as u32)
         .into_par_iter()
         .with_min_len(VERTEX_BLOCK)
