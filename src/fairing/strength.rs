@@ -68,11 +68,16 @@ pub(crate) fn estimate_noise_away_from_edges(
     fans: &FanRings,
     crease_angle: f64,
 ) -> Option<f64> {
+    let (heights, edges) = gather(mesh, topology, Some(fans), Some(crease_angle));
+    let heights = heights?;
+    let mut on_edge = vec![false; mesh.positions.len()];
+    for ([a, b], _) in &edges {
+        on_edge[*a as usize] = true;
+        on_edge[*b as usize] = true;
+    }
     [false, true]
         .into_iter()
-        .filter_map(|beside| {
-            estimate_with(mesh, topology, Some(fans), Some(crease_angle), true, beside).0
-        })
+        .filter_map(|beside| heights.spread(topology, Some((&on_edge, beside))))
         .reduce(f64::min)
 }
 
@@ -114,22 +119,26 @@ fn estimate(
     fans: Option<&FanRings>,
     crease_angle: Option<f64>,
 ) -> (Option<f64>, Vec<FeatureEdge>) {
-    estimate_with(mesh, topology, fans, crease_angle, false, false)
+    let (heights, edges) = gather(mesh, topology, fans, crease_angle);
+    (heights.and_then(|h| h.spread(topology, None)), edges)
 }
 
-/// [`estimate`]; with `away_from_edges` (and a crease angle), the vertices on a feature edge are
-/// left out (neither counted nor taken into their neighbours' means), and `None` comes back when
-/// fewer than a quarter of the vertices are left; with `beside_edges` too, the vertices beside
-/// them are not counted either.
-fn estimate_with(
+/// Every vertex's h_v and the mean edge length, from one gather (see the module docs).
+struct Heights {
+    /// h_v, NaN where it is not defined.
+    heights: Vec<f32>,
+    /// The mean edge length (positive and finite).
+    edge: f64,
+}
+
+/// The gather behind [`estimate`]: [`Heights`] (`None` when the mean edge length is not
+/// positive and finite) and, with a crease angle, the feature edges.
+fn gather(
     mesh: &TriMesh,
     topology: &Topology,
     fans: Option<&FanRings>,
     crease_angle: Option<f64>,
-    away_from_edges: bool,
-    beside_edges: bool,
-) -> (Option<f64>, Vec<FeatureEdge>) {
-    let beside_edges = away_from_edges && beside_edges;
+) -> (Option<Heights>, Vec<FeatureEdge>) {
     let n = mesh.positions.len();
     let point = |v: u32| Vec3A::from_array(mesh.positions[v as usize]);
     let ring_offsets = topology.neighbor_csr().0;
@@ -204,55 +213,60 @@ fn estimate_with(
         .collect();
     let edge = blocks.iter().map(|(sum, _)| sum).sum::<f64>() / (3 * mesh.triangles.len()) as f64;
     let edges: Vec<FeatureEdge> = blocks.into_iter().flat_map(|(_, e)| e).collect();
-    if !(edge > 0.0 && edge.is_finite()) {
-        return (None, edges);
-    }
-    let mut on_edge = vec![false; if away_from_edges { n } else { 0 }];
-    for ([a, b], _) in edges.iter().filter(|_| away_from_edges) {
-        on_edge[*a as usize] = true;
-        on_edge[*b as usize] = true;
-    }
-    // Away from the edges: a vertex on a feature edge is not counted, nor taken into its
-    // neighbours' mean (on a flat face beside a crease h is 0 but for the crease's own vertices).
-    let skip = |v: u32| away_from_edges && on_edge[v as usize];
-    let beside =
-        |v: u32| beside_edges && topology.neighbors(v).iter().any(|&u| on_edge[u as usize]);
-    // Only the reading away from the edges needs it (the per-round estimate skips the pass).
-    let defined = if away_from_edges {
-        heights.par_iter().filter(|h| h.is_finite()).count()
-    } else {
-        0
-    };
-    let mut residuals: Vec<f32> = (0..n as u32)
-        .into_par_iter()
-        .with_min_len(VERTEX_BLOCK)
-        .filter_map(|v| {
-            if skip(v) || beside(v) {
-                return None;
-            }
-            let own = heights[v as usize];
-            let mut sum = 0.0;
-            let mut count = 0usize;
-            for &u in topology.neighbors(v) {
-                if !skip(u) {
-                    sum += heights[u as usize];
-                    count += 1;
+    let heights = (edge > 0.0 && edge.is_finite()).then_some(Heights { heights, edge });
+    (heights, edges)
+}
+
+impl Heights {
+    /// The noise level: the robust spread of r_v (see the module docs), `None` with fewer than
+    /// 16 vertices to read. With `away = Some((on_edge, beside))` the vertices on a feature edge
+    /// are left out (neither counted nor taken into their neighbours' means: on a flat face
+    /// beside a crease h is 0 but for the crease's own vertices), with `beside` the vertices
+    /// beside one are not counted either, and `None` comes back when fewer than a quarter of the
+    /// vertices with a defined h are left.
+    fn spread(&self, topology: &Topology, away: Option<(&[bool], bool)>) -> Option<f64> {
+        let heights = &self.heights;
+        let skip = |v: u32| away.is_some_and(|(on_edge, _)| on_edge[v as usize]);
+        let beside = |v: u32| {
+            away.is_some_and(|(on_edge, beside)| {
+                beside && topology.neighbors(v).iter().any(|&u| on_edge[u as usize])
+            })
+        };
+        let mut residuals: Vec<f32> = (0..heights.len() as u32)
+            .into_par_iter()
+            .with_min_len(VERTEX_BLOCK)
+            .filter_map(|v| {
+                if skip(v) || beside(v) {
+                    return None;
                 }
-            }
-            if count == 0 {
-                return None;
-            }
-            // NaN (a vertex or a neighbour without h) fails the comparison.
-            let residual = (own - sum / count as f32).abs();
-            (residual >= 0.0).then_some(residual)
-        })
-        .collect();
-    if residuals.len() < 16 || (away_from_edges && 4 * residuals.len() < defined) {
-        return (None, edges);
+                let own = heights[v as usize];
+                let mut sum = 0.0;
+                let mut count = 0usize;
+                for &u in topology.neighbors(v) {
+                    if !skip(u) {
+                        sum += heights[u as usize];
+                        count += 1;
+                    }
+                }
+                if count == 0 {
+                    return None;
+                }
+                // NaN (a vertex or a neighbour without h) fails the comparison.
+                let residual = (own - sum / count as f32).abs();
+                (residual >= 0.0).then_some(residual)
+            })
+            .collect();
+        // Only a reading away from the edges needs the count (the per-round estimate skips it).
+        if residuals.len() < 16
+            || away.is_some()
+                && 4 * residuals.len() < heights.par_iter().filter(|h| h.is_finite()).count()
+        {
+            return None;
+        }
+        let middle = residuals.len() / 2;
+        let (_, median, _) = residuals.select_nth_unstable_by(middle, f32::total_cmp);
+        Some(1.4826 * *median as f64 / NOISE_GAIN / self.edge)
     }
-    let middle = residuals.len() / 2;
-    let (_, median, _) = residuals.select_nth_unstable_by(middle, f32::total_cmp);
-    (Some(1.4826 * *median as f64 / NOISE_GAIN / edge), edges)
 }
 
 /// The area normal of face `f`, (x_b − x_a) × (x_c − x_a) (twice its area long), in f32.
