@@ -327,9 +327,7 @@ fn finish_with_map(mut mesh: TriMesh, options: &LoadOptions) -> (Loaded, Option<
     if options.weld {
         let (welded, weld_map) = mesh::weld_with_map(&mut mesh);
         report.welded_vertices = welded.merged_vertices;
-        if welded.merged_vertices > 0 {
-            map = Some(weld_map);
-        }
+        map = weld_map;
     }
     let (mut cleaned, clean_map) = mesh::clean_with_map_but_repeats(&mut mesh);
     if let Some(clean_map) = clean_map {
@@ -346,7 +344,7 @@ fn finish_with_map(mut mesh: TriMesh, options: &LoadOptions) -> (Loaded, Option<
     // Triangles that repeat an earlier one's corners: found from the topology, which is built
     // anyway (and built again only when some go).
     let mut topology = Topology::build(&mesh);
-    let repeats = mesh::repeated_triangles_around(&mesh.triangles, &topology);
+    let repeats = std::mem::take(&mut topology.repeated_triangles);
     if !repeats.is_empty() {
         mesh::remove_triangles(&mut mesh, &repeats);
         topology = Topology::build(&mesh);

@@ -8,7 +8,7 @@
 //! leave such pockets, and fairing pulled them to a point), and vertices that no triangle uses,
 //! again keeping the remaining vertices and triangles in input order.
 
-use super::{Topology, TriMesh};
+use super::TriMesh;
 use rayon::prelude::*;
 use std::collections::HashMap;
 use std::hash::{BuildHasherDefault, Hasher};
@@ -67,34 +67,116 @@ pub fn weld(mesh: &mut TriMesh) -> WeldReport {
     weld_with_map(mesh).0
 }
 
-/// [`weld`], also giving the map from each input vertex to the vertex it became.
-pub(crate) fn weld_with_map(mesh: &mut TriMesh) -> (WeldReport, Vec<u32>) {
-    let n = mesh.positions.len();
-    let mut first_index: HashMap<[u32; 3], u32, BuildHasherDefault<PositionHasher>> =
-        HashMap::with_capacity_and_hasher(n, Default::default());
-    let mut remap = Vec::with_capacity(n);
-    let mut kept = Vec::with_capacity(n);
-    for p in &mesh.positions {
-        let next = kept.len() as u32;
-        let index = *first_index.entry(position_key(p)).or_insert(next);
-        if index == next {
-            kept.push(*p);
-        }
-        remap.push(index);
+/// [`weld`], also giving the map from each input vertex to the vertex it became (`None` when no
+/// vertex merged).
+///
+/// In parallel without changing the result: the positions are dealt into as many shards as there
+/// are threads by their hash, each shard finds (with its own hash map) every vertex whose
+/// position an earlier vertex of the shard has, and one pass in input order then numbers the
+/// first occurrences. A position's first occurrence is the same whichever shard finds it, so the
+/// map is the same for any thread count.
+pub(crate) fn weld_with_map(mesh: &mut TriMesh) -> (WeldReport, Option<Vec<u32>>) {
+    let positions = &mesh.positions;
+    let n = positions.len();
+    let shards = rayon::current_num_threads().clamp(1, 64) as u64;
+    let shard_of = |hash: u64| ((hash >> 24 & 0xffff_ffff) * shards >> 32) as usize;
+    // Each shard lists (later vertex, its first occurrence) pairs.
+    let repeats: Vec<Vec<[u32; 2]>> = (0..shards as usize)
+        .into_par_iter()
+        .map(|shard| {
+            let mut first: HashMap<KeyedPosition, u32, BuildHasherDefault<PositionHasher>> =
+                HashMap::with_capacity_and_hasher(
+                    n / shards as usize + n / 16 + 1,
+                    Default::default(),
+                );
+            let mut repeats = Vec::new();
+            for (v, p) in positions.iter().enumerate() {
+                let key = KeyedPosition::new(p);
+                if shard_of(key.hash) != shard {
+                    continue;
+                }
+                match first.entry(key) {
+                    std::collections::hash_map::Entry::Occupied(earlier) => {
+                        repeats.push([v as u32, *earlier.get()])
+                    }
+                    std::collections::hash_map::Entry::Vacant(slot) => {
+                        slot.insert(v as u32);
+                    }
+                }
+            }
+            repeats
+        })
+        .collect();
+    let merged: usize = repeats.iter().map(Vec::len).sum();
+    if merged == 0 {
+        return (WeldReport { merged_vertices: 0 }, None);
     }
-    let merged = n - kept.len();
-    if merged > 0 {
-        for t in &mut mesh.triangles {
-            *t = t.map(|v| remap[v as usize]);
+    // remap[v]: u32::MAX for a first occurrence, else the earlier vertex; then, in input order,
+    // the welded index (an earlier vertex is numbered before any later copy reads it).
+    let mut remap = vec![u32::MAX; n];
+    for list in &repeats {
+        for &[later, earlier] in list {
+            remap[later as usize] = earlier;
         }
-        mesh.positions = kept;
     }
+    drop(repeats);
+    let mut kept = Vec::with_capacity(n - merged);
+    for v in 0..n {
+        remap[v] = match remap[v] {
+            u32::MAX => {
+                kept.push(positions[v]);
+                kept.len() as u32 - 1
+            }
+            earlier => remap[earlier as usize],
+        };
+    }
+    mesh.triangles
+        .par_iter_mut()
+        .with_min_len(65_536)
+        .for_each(|t| *t = t.map(|v| remap[v as usize]));
+    mesh.positions = kept;
     (
         WeldReport {
             merged_vertices: merged,
         },
-        remap,
+        Some(remap),
     )
+}
+
+/// A position's key (its bits, -0.0 as 0.0) with its hash worked out once: the shard and the
+/// map both use it.
+#[derive(Clone, Copy)]
+struct KeyedPosition {
+    bits: [u32; 3],
+    hash: u64,
+}
+
+impl KeyedPosition {
+    fn new(p: &[f32; 3]) -> KeyedPosition {
+        let bits = position_key(p);
+        // A multiply-xorshift mix of the three words (every output bit depends on every input bit).
+        let mut h = (bits[0] as u64 | (bits[1] as u64) << 32).wrapping_mul(0x9e37_79b9_7f4a_7c15)
+            ^ bits[2] as u64;
+        h = (h ^ h >> 29).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+        KeyedPosition {
+            bits,
+            hash: h ^ h >> 32,
+        }
+    }
+}
+
+impl PartialEq for KeyedPosition {
+    fn eq(&self, other: &Self) -> bool {
+        self.bits == other.bits
+    }
+}
+
+impl Eq for KeyedPosition {}
+
+impl std::hash::Hash for KeyedPosition {
+    fn hash<H: Hasher>(&self, state: &mut H) {
+        state.write_u64(self.hash);
+    }
 }
 
 /// Remove triangles that repeat a vertex or an earlier triangle, and vertices that no triangle
@@ -110,7 +192,7 @@ pub(crate) fn clean_with_map(mesh: &mut TriMesh) -> (CleanReport, Option<Vec<u32
 }
 
 /// [`clean_with_map`] but for the repeated triangles, which a caller that builds the topology
-/// next finds from it ([`repeated_triangles_around`]) for less. Repeated triangles leave no
+/// next finds from it ([`Topology::repeated_triangles`]) for less. Repeated triangles leave no
 /// vertex unused, so leaving them for later changes no other result.
 pub(crate) fn clean_with_map_but_repeats(mesh: &mut TriMesh) -> (CleanReport, Option<Vec<u32>>) {
     clean_with_map_and(mesh, false)
@@ -196,18 +278,6 @@ fn repeated_triangles(triangles: &[[u32; 3]], vertices: usize) -> Vec<u32> {
     })
 }
 
-/// [`repeated_triangles`] with the triangles around each vertex read from `topology` (built
-/// for `triangles`) instead of listed anew.
-pub(crate) fn repeated_triangles_around(triangles: &[[u32; 3]], topology: &Topology) -> Vec<u32> {
-    repeats_in_lists(triangles, topology.vertex_count(), |v, list| {
-        let low = |f: &u32| {
-            let t = triangles[*f as usize];
-            t[0].min(t[1]).min(t[2]) == v
-        };
-        list.extend(topology.faces_of(v).iter().filter(|f| low(f)));
-    })
-}
-
 /// Remove the triangles at `indices` (ascending), keeping the others in order.
 pub(crate) fn remove_triangles(mesh: &mut TriMesh, indices: &[u32]) {
     if indices.is_empty() {
@@ -231,11 +301,6 @@ fn repeats_in_lists(
     vertices: usize,
     list: impl Fn(u32, &mut Vec<u32>) + Sync,
 ) -> Vec<u32> {
-    let sorted = |t: [u32; 3]| {
-        let mut t = t;
-        t.sort_unstable();
-        t
-    };
     let chunks: Vec<Vec<u32>> = (0..vertices as u32)
         .into_par_iter()
         .with_min_len(16_384)
@@ -244,30 +309,7 @@ fn repeats_in_lists(
             |(mut repeats, mut faces), v| {
                 faces.clear();
                 list(v, &mut faces);
-                if faces.len() <= 16 {
-                    // In triangle order: a later one with an earlier one's corners repeats it.
-                    for (i, &f) in faces.iter().enumerate() {
-                        let corners = sorted(triangles[f as usize]);
-                        if faces[..i]
-                            .iter()
-                            .any(|&g| sorted(triangles[g as usize]) == corners)
-                        {
-                            repeats.push(f);
-                        }
-                    }
-                } else {
-                    // A busy vertex (a fan's hub): sort by corners, then triangle.
-                    let mut keyed: Vec<([u32; 3], u32)> = faces
-                        .iter()
-                        .map(|&f| (sorted(triangles[f as usize]), f))
-                        .collect();
-                    keyed.sort_unstable();
-                    for pair in keyed.windows(2) {
-                        if pair[0].0 == pair[1].0 {
-                            repeats.push(pair[1].1);
-                        }
-                    }
-                }
+                repeats_among(triangles, &faces, &mut repeats);
                 (repeats, faces)
             },
         )
@@ -278,9 +320,44 @@ fn repeats_in_lists(
     repeats
 }
 
+/// Of `faces` (ascending, all with the same smallest corner), append to `repeats` those whose
+/// corners an earlier one of them has, in any order.
+pub(crate) fn repeats_among(triangles: &[[u32; 3]], faces: &[u32], repeats: &mut Vec<u32>) {
+    let sorted = |t: [u32; 3]| {
+        let mut t = t;
+        t.sort_unstable();
+        t
+    };
+    if faces.len() <= 16 {
+        // In triangle order: a later one with an earlier one's corners repeats it.
+        for (i, &f) in faces.iter().enumerate() {
+            let corners = sorted(triangles[f as usize]);
+            if faces[..i]
+                .iter()
+                .any(|&g| sorted(triangles[g as usize]) == corners)
+            {
+                repeats.push(f);
+            }
+        }
+    } else {
+        // A busy vertex (a fan's hub): sort by corners, then triangle.
+        let mut keyed: Vec<([u32; 3], u32)> = faces
+            .iter()
+            .map(|&f| (sorted(triangles[f as usize]), f))
+            .collect();
+        keyed.sort_unstable();
+        for pair in keyed.windows(2) {
+            if pair[0].0 == pair[1].0 {
+                repeats.push(pair[1].1);
+            }
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::mesh::Topology;
 
     #[test]
     fn weld_merges_seam_copies_in_first_occurrence_order() {
@@ -303,6 +380,68 @@ mod tests {
             vec![[0., 0., 0.], [1., 0., 0.], [0., 1., 0.], [1., 1., 0.]]
         );
         assert_eq!(mesh.triangles, vec![[0, 1, 2], [1, 3, 2]]);
+    }
+
+    #[test]
+    fn weld_gives_the_first_occurrence_map_for_any_thread_count() {
+        // A 12 x 12 grid stored as separate triangles (every corner copied), shuffled so first
+        // occurrences are spread over the file, with -0.0 and 0.0 both present.
+        let mut positions = Vec::new();
+        let mut triangles = Vec::new();
+        let corner = |i: u32, j: u32| [i as f32 - 6.0, j as f32 * 0.5, 0.0f32];
+        for k in 0..144u32 {
+            let (i, j) = ((k * 37) % 144 / 12, (k * 37) % 144 % 12);
+            for [a, b] in [[(i, j), (i + 1, j)], [(i + 1, j + 1), (i, j + 1)]] {
+                let first = positions.len() as u32;
+                positions.push(corner(a.0, a.1));
+                positions.push(corner(b.0, b.1));
+                positions.push(if k % 2 == 0 {
+                    [-0.0, 1.0, 0.0]
+                } else {
+                    [0.0, 1.0, 0.0]
+                });
+                triangles.push([first, first + 1, first + 2]);
+            }
+        }
+        // The map by definition: each vertex to the count of distinct positions before its first
+        // occurrence.
+        let key = |p: &[f32; 3]| p.map(|c| if c == 0.0 { 0 } else { c.to_bits() });
+        let mut firsts: Vec<[u32; 3]> = Vec::new();
+        let expected: Vec<u32> = positions
+            .iter()
+            .map(|p| match firsts.iter().position(|f| *f == key(p)) {
+                Some(i) => i as u32,
+                None => {
+                    firsts.push(key(p));
+                    firsts.len() as u32 - 1
+                }
+            })
+            .collect();
+        for threads in [1, 2, 3, 7] {
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .unwrap();
+            let mut mesh = TriMesh::new(positions.clone(), triangles.clone());
+            let (report, map) = pool.install(|| weld_with_map(&mut mesh));
+            assert_eq!(report.merged_vertices, positions.len() - firsts.len());
+            assert_eq!(map.as_deref(), Some(&expected[..]), "{threads} threads");
+            assert_eq!(mesh.positions.len(), firsts.len());
+            for (t, original) in mesh.triangles.iter().zip(&triangles) {
+                for (&w, &v) in t.iter().zip(original) {
+                    assert_eq!(
+                        key(&mesh.positions[w as usize]),
+                        key(&positions[v as usize])
+                    );
+                }
+            }
+        }
+        // Nothing to merge: no map.
+        let mut welded = TriMesh::new(
+            vec![[0., 0., 0.], [1., 0., 0.], [0., 1., 0.]],
+            vec![[0, 1, 2]],
+        );
+        assert_eq!(weld_with_map(&mut welded).1, None);
     }
 
     #[test]
@@ -369,10 +508,7 @@ mod tests {
         );
         // The same from the topology, as loading finds them; and a tetrahedron's short lists.
         let fan = TriMesh::new(positions.clone(), triangles.clone());
-        assert_eq!(
-            repeated_triangles_around(&triangles, &Topology::build(&fan)),
-            vec![31, 41]
-        );
+        assert_eq!(Topology::build(&fan).repeated_triangles, vec![31, 41]);
         let tetrahedron = [
             [0, 2, 1],
             [1, 2, 3],
@@ -384,7 +520,7 @@ mod tests {
         let corners = vec![[0.0f32; 3]; 4];
         let with_repeats = TriMesh::new(corners, tetrahedron.to_vec());
         assert_eq!(
-            repeated_triangles_around(&tetrahedron, &Topology::build(&with_repeats)),
+            Topology::build(&with_repeats).repeated_triangles,
             vec![2, 4]
         );
         let mut mesh = TriMesh::new(positions, triangles);

@@ -20,8 +20,7 @@ mod topology;
 
 pub use clean::{clean, weld, CleanReport, WeldReport};
 pub(crate) use clean::{
-    clean_with_map_but_repeats, remove_triangles, repeated_triangles_around, weld_with_map,
-    PositionHasher,
+    clean_with_map_but_repeats, remove_triangles, repeats_among, weld_with_map, PositionHasher,
 };
 pub use orient::{orient_consistently, OrientReport};
 pub use reorder::{breadth_first_order, inverse_permutation};

@@ -6,6 +6,8 @@
 //! tagged with the direction of the edge in that face, which gives at once its neighbours, which
 //! of its edges lie on the boundary (used by one face), which are non-manifold (more than two
 //! faces) and which are inconsistently oriented (two faces traversing the edge the same way).
+//! The same pass compares the triangles whose smallest corner the vertex is, which finds the
+//! triangles that repeat an earlier one's corners (loading drops them) without a pass of its own.
 //!
 //! Boundary loops follow the faces' orientation: a boundary half-edge `v -> u` is one that a face
 //! traverses from `v` to `u` and no face traverses back.
@@ -52,6 +54,8 @@ pub struct Topology {
     /// Component index of every vertex (isolated vertices get their own component).
     pub component_of_vertex: Vec<u32>,
     pub components: Vec<ComponentInfo>,
+    /// Triangles (ascending) whose three corners an earlier triangle has, in either orientation.
+    pub repeated_triangles: Vec<u32>,
     edge_count: usize,
 }
 
@@ -63,6 +67,9 @@ struct VertexScan {
     non_manifold_edge: bool,
     multiple_fans: bool,
     inconsistent_edges: u32,
+    /// Among the triangles whose smallest corner this vertex is, two have the same corners (or
+    /// there are too many to tell in the scan).
+    repeats: bool,
 }
 
 impl Topology {
@@ -171,7 +178,22 @@ impl Topology {
             inconsistent_edges: inconsistent / 2,
             component_of_vertex: Vec::new(),
             components: Vec::new(),
+            repeated_triangles: Vec::new(),
         };
+        // The vertices the scan flagged list their triangles again, exactly (rare: none on a
+        // clean mesh).
+        let mut lowest = Vec::new();
+        for (v, s) in scans.iter().enumerate() {
+            if s.repeats {
+                lowest.clear();
+                lowest.extend(topology.faces_of(v as u32).iter().filter(|&&f| {
+                    let t = triangles[f as usize];
+                    t[0].min(t[1]).min(t[2]) == v as u32
+                }));
+                super::repeats_among(triangles, &lowest, &mut topology.repeated_triangles);
+            }
+        }
+        topology.repeated_triangles.sort_unstable();
         topology.boundary_loops = topology.trace_boundary_loops(triangles);
         topology.find_components(triangles);
         topology
@@ -395,16 +417,31 @@ fn edge_face_count(v: u32, u: u32, faces: &[u32], triangles: &[[u32; 3]]) -> usi
 /// Fills `slot` with v's neighbours (deduplicated, ascending, in its prefix) and classifies v's
 /// edges and fans.
 fn scan_vertex(v: u32, faces: &[u32], triangles: &[[u32; 3]], slot: &mut [u32]) -> VertexScan {
+    let mut scan = VertexScan::default();
     let mut len = 0;
+    // The other two corners (ascending) of the triangles whose smallest corner is v: two equal
+    // pairs are two triangles with the same corners.
+    let mut lowest = [[0u32; 2]; 16];
+    let mut lowest_count = 0;
     for &f in faces {
         let t = triangles[f as usize];
-        slot[len] = next_in_face(t, v) << 1 | 1; // edge v -> next
-        slot[len + 1] = prev_in_face(t, v) << 1; // edge prev -> v
+        let (next, prev) = (next_in_face(t, v), prev_in_face(t, v));
+        slot[len] = next << 1 | 1; // edge v -> next
+        slot[len + 1] = prev << 1; // edge prev -> v
         len += 2;
+        if v < next && v < prev {
+            let pair = [next.min(prev), next.max(prev)];
+            if lowest_count == lowest.len() {
+                scan.repeats = true;
+            } else {
+                scan.repeats |= lowest[..lowest_count].contains(&pair);
+                lowest[lowest_count] = pair;
+                lowest_count += 1;
+            }
+        }
     }
     slot[..len].sort_unstable();
 
-    let mut scan = VertexScan::default();
     let mut write = 0usize;
     let mut i = 0usize;
     while i < len {
