@@ -764,3 +764,35 @@ fn hierarchy_keeps_a_boxs_edges_only_when_asked() {
     );
     assert!(!output.exists(), "nothing is written");
 }
+
+#[test]
+fn bench_times_only_the_groups_asked_for() {
+    let out = fairmesh(&[
+        "bench",
+        &data("mushroom_open.obj"),
+        "--runs",
+        "1",
+        "--only",
+        "creases,mesh",
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let table = String::from_utf8_lossy(&out.stdout);
+    for row in [
+        "topology",
+        "creases: detection",
+        "creases: guided normal filter, 3",
+    ] {
+        assert!(table.contains(row), "no {row:?} row in\n{table}");
+    }
+    for row in ["load +", "hierarchy build", "fair: constrained", "save"] {
+        assert!(!table.contains(row), "a {row:?} row in\n{table}");
+    }
+    // An unknown group is refused with the ones there are.
+    let out = fairmesh(&["bench", &data("mushroom_open.obj"), "--only", "everything"]);
+    assert!(!out.status.success());
+    assert!(String::from_utf8_lossy(&out.stderr).contains("hierarchy"));
+}

@@ -1,7 +1,9 @@
 //! The decimation hierarchy (section 4.1) and multiresolution fairing (4.2) on real meshes.
 
 use fairmesh::fairing::{fair_constrained, FairOptions};
-use fairmesh::hierarchy::{build_hierarchy, Hierarchy, HierarchyOptions, LevelCursor};
+use fairmesh::hierarchy::{
+    build_hierarchy, build_hierarchy_with_topology, Hierarchy, HierarchyOptions, LevelCursor,
+};
 use fairmesh::multires::{fair_multires, MultiresOptions, MultiresVariant, MultiresWorkspace};
 use fairmesh::noise::{add_noise, NoiseOptions};
 use fairmesh::{metrics, NoProgress, Topology, TriMesh};
@@ -312,6 +314,34 @@ fn multires_distance(reference: &TriMesh, mesh: &TriMesh, creases: bool, level: 
     .unwrap();
     let result = TriMesh::new(positions, mesh.triangles.clone());
     metrics::compare(reference, &result).mean_surface_distance
+}
+
+#[test]
+fn a_hierarchy_from_the_loaded_topology_is_the_one_built_alone() {
+    let clean = fairmesh::mesh::shapes::cuboid([2.0, 1.0, 0.5], 0.05);
+    let options =
+        HierarchyOptions::default().with_creases(Some(fairmesh::fairing::CreaseOptions::default()));
+    let alone = build_hierarchy(&clean, &options, &mut NoProgress).unwrap();
+    let same = |h: &Hierarchy| {
+        assert_eq!(h.coarsest_level(), alone.coarsest_level());
+        assert_eq!(h.crease_edges(), alone.crease_edges());
+        for level in 0..=h.coarsest_level() {
+            assert_eq!(
+                h.level_mesh(level),
+                alone.level_mesh(level),
+                "level {level}"
+            );
+        }
+    };
+    let topology = Topology::build(&clean);
+    same(&build_hierarchy_with_topology(&clean, &topology, &options, &mut NoProgress).unwrap());
+    // Another mesh's connectivity is not used: the build makes its own.
+    let other = Topology::build(&fairmesh::mesh::shapes::cuboid([1.0, 1.0, 1.0], 0.25));
+    same(&build_hierarchy_with_topology(&clean, &other, &options, &mut NoProgress).unwrap());
+    assert!(
+        alone.crease_edges().len() > 12,
+        "the box's edges are creases"
+    );
 }
 
 #[test]

@@ -16,6 +16,33 @@ pub struct BenchArgs {
     /// Subdivide the mesh this many times first (Loop; each time 4x the faces), to time large meshes.
     #[arg(long, default_value_t = 0)]
     pub subdivide: usize,
+    /// Time only these groups of operations (comma-separated: load, save, mesh, fair, creases,
+    /// hierarchy); all of them when left out.
+    #[arg(long, value_delimiter = ',')]
+    pub only: Vec<BenchGroup>,
+}
+
+/// A group of operations `bench` times.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum BenchGroup {
+    /// Loading (with weld, clean and topology).
+    Load,
+    /// Saving, into the kept file and bare.
+    Save,
+    /// Topology, weld, volume, area, edge length.
+    Mesh,
+    /// A constrained fairing set-up and iterations, and a Laplacian iteration.
+    Fair,
+    /// Crease detection and the guided normal filter.
+    Creases,
+    /// The hierarchy build.
+    Hierarchy,
+}
+
+impl BenchArgs {
+    fn wants(&self, group: BenchGroup) -> bool {
+        self.only.is_empty() || self.only.contains(&group)
+    }
 }
 
 /// Saving a moved copy of the mesh in the input's format: written into the kept file
@@ -78,42 +105,55 @@ pub fn median_ms(runs: usize, mut f: impl FnMut()) -> f64 {
 
 pub fn run(args: BenchArgs) -> anyhow::Result<()> {
     let mut rows: Vec<(String, f64)> = Vec::new();
-    let load_ms = median_ms(args.runs, || {
-        let _ = super::basic::load(&args.input, true);
-    });
+    if args.wants(BenchGroup::Load) {
+        let load_ms = median_ms(args.runs, || {
+            let _ = super::basic::load(&args.input, true);
+        });
+        rows.push(("load + weld + clean + topology".into(), load_ms));
+    }
     let mut loaded = super::basic::load(&args.input, true)?;
-    rows.push(("load + weld + clean + topology".into(), load_ms));
-    if args.subdivide == 0 {
+    if args.subdivide == 0 && args.wants(BenchGroup::Save) {
         rows.extend(save_rows(&args, &loaded)?);
     }
     for _ in 0..args.subdivide {
         loaded.mesh = mesh::subdivide_loop(&loaded.mesh);
     }
     let mesh = loaded.mesh;
-    let mut topology = Topology::default();
-    rows.push((
-        "topology".into(),
-        median_ms(args.runs, || topology = Topology::build(&mesh)),
-    ));
-    rows.push((
-        "weld (already welded mesh)".into(),
-        median_ms(args.runs, || {
-            let mut copy = mesh.clone();
-            mesh::weld(&mut copy);
-        }),
-    ));
-    rows.push((
-        "volume + area + mean edge length".into(),
-        median_ms(args.runs, || {
-            std::hint::black_box((
-                metrics::signed_volume(&mesh),
-                metrics::area(&mesh),
-                metrics::mean_edge_length(&mesh),
-            ));
-        }),
-    ));
-    rows.extend(super::fair::bench_rows(&mesh, &topology));
-    rows.extend(super::hierarchy::bench_rows(&mesh));
+    let topology = Topology::build(&mesh);
+    if args.wants(BenchGroup::Mesh) {
+        rows.push((
+            "topology".into(),
+            median_ms(args.runs, || {
+                std::hint::black_box(Topology::build(&mesh));
+            }),
+        ));
+        rows.push((
+            "weld (already welded mesh)".into(),
+            median_ms(args.runs, || {
+                let mut copy = mesh.clone();
+                mesh::weld(&mut copy);
+            }),
+        ));
+        rows.push((
+            "volume + area + mean edge length".into(),
+            median_ms(args.runs, || {
+                std::hint::black_box((
+                    metrics::signed_volume(&mesh),
+                    metrics::area(&mesh),
+                    metrics::mean_edge_length(&mesh),
+                ));
+            }),
+        ));
+    }
+    if args.wants(BenchGroup::Fair) {
+        rows.extend(super::fair::bench_rows(&mesh, &topology));
+    }
+    if args.wants(BenchGroup::Creases) {
+        rows.extend(super::fair::crease_bench_rows(&mesh, &topology, args.runs));
+    }
+    if args.wants(BenchGroup::Hierarchy) {
+        rows.extend(super::hierarchy::bench_rows(&mesh, &topology));
+    }
 
     let mut out = format!(
         "{}: {} vertices, {} faces{} ({} threads; median of {} runs)\n",

@@ -5,10 +5,12 @@ use anyhow::Context;
 use clap::{Args, ValueEnum};
 use fairmesh::fairing::creases::CreaseOptions;
 use fairmesh::fairing::BoundaryMode;
-use fairmesh::hierarchy::{build_hierarchy, Hierarchy, HierarchyOptions};
+use fairmesh::hierarchy::{
+    build_hierarchy, build_hierarchy_with_topology, Hierarchy, HierarchyOptions,
+};
 use fairmesh::multires::{fair_multires, MultiresOptions, MultiresVariant, MultiresWorkspace};
 use fairmesh::noise::{self, NoiseOptions};
-use fairmesh::{io, metrics, NoProgress, TriMesh};
+use fairmesh::{io, metrics, NoProgress, Topology, TriMesh};
 use serde_json::json;
 use std::fmt::Write as _;
 use std::path::PathBuf;
@@ -151,7 +153,13 @@ pub struct MultiresArgs {
     pub mask: super::mask::MaskArgs,
 }
 
-fn build(mesh: &TriMesh, args: &BuildArgs) -> anyhow::Result<Hierarchy> {
+/// Builds the hierarchy; `topology` (the mesh's, from loading) saves building it again when
+/// creases are kept.
+fn build(
+    mesh: &TriMesh,
+    topology: Option<&Topology>,
+    args: &BuildArgs,
+) -> anyhow::Result<Hierarchy> {
     if let Some(angle) = args.crease_angle {
         anyhow::ensure!(
             angle > 0.0 && angle < 180.0,
@@ -159,7 +167,11 @@ fn build(mesh: &TriMesh, args: &BuildArgs) -> anyhow::Result<Hierarchy> {
         );
     }
     let mut step = super::progress::Step::start("building the hierarchy");
-    Ok(build_hierarchy(mesh, &args.options(), &mut step)?)
+    let options = args.options();
+    Ok(match topology {
+        Some(topology) => build_hierarchy_with_topology(mesh, topology, &options, &mut step)?,
+        None => build_hierarchy(mesh, &options, &mut step)?,
+    })
 }
 
 pub fn run_hierarchy(args: HierarchyArgs) -> anyhow::Result<()> {
@@ -172,7 +184,7 @@ pub fn run_hierarchy(args: HierarchyArgs) -> anyhow::Result<()> {
         loaded.mesh = fairmesh::mesh::subdivide_loop(&loaded.mesh);
     }
     let started = Instant::now();
-    let hierarchy = build(&loaded.mesh, &args.build)
+    let hierarchy = build(&loaded.mesh, Some(&loaded.topology), &args.build)
         .with_context(|| format!("building the hierarchy of {}", args.input.display()))?;
     let total_ms = started.elapsed().as_secs_f64() * 1e3;
     if let Some(dir) = &args.write_levels {
@@ -269,7 +281,13 @@ pub fn run_multires(args: MultiresArgs) -> anyhow::Result<()> {
     let loaded = super::basic::load_shown(&args.input, true, args.stdio.format)?;
     let source = loaded.source;
     let mask = super::mask::load_for(&args.mask, &source, &loaded.mesh, Some(&loaded.topology))?;
-    drop(loaded.topology);
+    // The connectivity serves the crease detection only; otherwise it goes before the build.
+    let topology = args
+        .build
+        .options()
+        .creases
+        .is_some()
+        .then_some(loaded.topology);
     let mut input = loaded.mesh;
     let reference_file = match &args.reference {
         Some(path) => Some(super::basic::load_shown(path, true, None)?.mesh),
@@ -293,7 +311,8 @@ pub fn run_multires(args: MultiresArgs) -> anyhow::Result<()> {
     }
     let reference = measure.then(|| reference_file.as_ref().or(clean.as_ref()).unwrap_or(&input));
     let started = Instant::now();
-    let hierarchy = build(&input, &args.build)?;
+    let hierarchy = build(&input, topology.as_ref(), &args.build)?;
+    drop(topology);
     let hierarchy_ms = started.elapsed().as_secs_f64() * 1e3;
     // One run holds only the level it is at; several runs share every level's set-up.
     let mut workspace = if args.variant.len() * args.level.len() == 1 {
@@ -425,7 +444,7 @@ pub fn run_multires(args: MultiresArgs) -> anyhow::Result<()> {
 }
 
 /// Rows for `fairmesh bench`: (operation, milliseconds).
-pub fn bench_rows(mesh: &TriMesh) -> Vec<(String, f64)> {
+pub fn bench_rows(mesh: &TriMesh, topology: &Topology) -> Vec<(String, f64)> {
     let runs = 5;
     let options = HierarchyOptions::default();
     let mut hierarchy = None;
@@ -433,6 +452,18 @@ pub fn bench_rows(mesh: &TriMesh) -> Vec<(String, f64)> {
         hierarchy = build_hierarchy(mesh, &options, &mut NoProgress).ok();
     });
     let mut rows = vec![("hierarchy build".to_string(), build_ms)];
+    // With `--keep-creases` (detection on the mesh, then the collapses kept along the creases),
+    // from the loaded connectivity as the commands do.
+    let with_creases =
+        HierarchyOptions::default().with_creases(Some(fairmesh::fairing::CreaseOptions::default()));
+    rows.push((
+        "hierarchy build keeping creases".to_string(),
+        super::bench::median_ms(runs, || {
+            std::hint::black_box(
+                build_hierarchy_with_topology(mesh, topology, &with_creases, &mut NoProgress).ok(),
+            );
+        }),
+    ));
     let Some(hierarchy) = hierarchy else {
         return rows;
     };

@@ -58,7 +58,8 @@
 
 use super::boundary::BoundaryCurves;
 use super::creases::{
-    detect_creases, detect_creases_with_estimate, CreaseOptions, Creases, FeatureClass,
+    detect_creases_cached, detect_creases_with_estimate, CreaseOptions, Creases, FaceRingCache,
+    FeatureClass,
 };
 use super::strength::{
     estimate_noise_away_from_edges, estimate_noise_with_fans, normal_filtering_for, CLEAN_NOISE,
@@ -1139,13 +1140,14 @@ pub fn fair_constrained(
     // Creases are found again before every round: the noise left after a round makes fewer
     // false creases, and a crease found on the noisy input may turn out to be noise
     // (`docs/measurements.md`). The normals are filtered as much as the current noise asks for.
-    let detect = |mesh: &TriMesh, noise: Option<f64>| {
+    let mut face_rings = FaceRingCache::default();
+    let mut detect = |mesh: &TriMesh, noise: Option<f64>| {
         options.creases.as_ref().map(|crease_options| {
             let mut crease_options = crease_options.clone();
             crease_options.normal_filtering = crease_options
                 .normal_filtering
                 .max(noise.map_or(0, normal_filtering_for));
-            detect_creases(mesh, topology, &crease_options)
+            detect_creases_cached(mesh, topology, &crease_options, &mut face_rings)
         })
     };
     let mut creases = found.or_else(|| detect(mesh, estimate));

@@ -159,8 +159,21 @@ pub fn filtered_face_normals(
     passes: usize,
     sigma: f64,
 ) -> Vec<Vec3A> {
-    filter_face_normals(mesh, topology, &face_normals(mesh), passes, sigma)
+    filter_face_normals(
+        mesh,
+        topology,
+        &face_normals(mesh),
+        passes,
+        sigma,
+        &mut FaceRingCache::default(),
+    )
 }
+
+/// The faces around each face, built the first time the guided filter runs and kept for later
+/// detections on the same connectivity (constrained fairing finds the creases again before every
+/// round: the lists stay, only the normals change).
+#[derive(Default)]
+pub(crate) struct FaceRingCache(Option<FaceRings>);
 
 /// [`filtered_face_normals`] from the faces' area normals (`area_normals[f]`: (x_b − x_a) ×
 /// (x_c − x_a) of face f).
@@ -178,6 +191,7 @@ fn filter_face_normals(
     area_normals: &[Vec3A],
     passes: usize,
     sigma: f64,
+    cache: &mut FaceRingCache,
 ) -> Vec<Vec3A> {
     // Unit normal and area (twice the area: only ratios matter) of every face.
     let mut current: Vec<Vec4> = area_normals
@@ -193,7 +207,9 @@ fn filter_face_normals(
         })
         .collect();
     if passes > 0 {
-        let rings = FaceRings::build(mesh, topology);
+        let rings = cache
+            .0
+            .get_or_insert_with(|| FaceRings::build(mesh, topology));
         let inverse = (1.0 / (2.0 * sigma * sigma)) as f32;
         let face_count = current.len();
         let mut patches = vec![Vec4::ZERO; face_count];
@@ -350,12 +366,24 @@ fn merge_face_lists(lists: [&[u32]; 3], faces: &mut Vec<u32>, shared: &mut Vec<u
 
 /// Finds the creases of `mesh` (`topology` built from it).
 pub fn detect_creases(mesh: &TriMesh, topology: &Topology, options: &CreaseOptions) -> Creases {
+    detect_creases_cached(mesh, topology, options, &mut FaceRingCache::default())
+}
+
+/// [`detect_creases`] keeping the faces around each face in `cache` for the next detection on
+/// the same connectivity.
+pub(crate) fn detect_creases_cached(
+    mesh: &TriMesh,
+    topology: &Topology,
+    options: &CreaseOptions,
+    cache: &mut FaceRingCache,
+) -> Creases {
     let normals = filter_face_normals(
         mesh,
         topology,
         &face_normals(mesh),
         options.normal_filtering,
         options.normal_sigma,
+        cache,
     );
     finish(
         mesh,
@@ -807,7 +835,14 @@ mod tests {
             // And without filtering the scan's raw edges are the general path's.
             let raw = scan_fans(&mesh, &topology, &fans, options.angle_degrees).edges;
             let general: Vec<[u32; 2]> = {
-                let unit = filter_face_normals(&mesh, &topology, &face_normals(&mesh), 0, 0.5);
+                let unit = filter_face_normals(
+                    &mesh,
+                    &topology,
+                    &face_normals(&mesh),
+                    0,
+                    0.5,
+                    &mut FaceRingCache::default(),
+                );
                 feature_edges(&mesh, &topology, &unit, &options)
                     .into_iter()
                     .map(|(e, _)| e)
