@@ -79,7 +79,7 @@ pub(crate) fn weld_with_map(mesh: &mut TriMesh) -> (WeldReport, Option<Vec<u32>>
     let positions = &mesh.positions;
     let n = positions.len();
     let shards = rayon::current_num_threads().clamp(1, 64) as u64;
-    let shard_of = |hash: u64| ((hash >> 24 & 0xffff_ffff) * shards >> 32) as usize;
+    let shard_of = |hash: u64| ((((hash >> 24) & 0xffff_ffff) * shards) >> 32) as usize;
     // Each shard lists (later vertex, its first occurrence) pairs.
     let repeats: Vec<Vec<[u32; 2]>> = (0..shards as usize)
         .into_par_iter()
