@@ -17,7 +17,9 @@
 //!   after the frame. Beside it:
 //!   `fairing_panel.rs` (the Fairing section, the sharp-edge controls, every tooltip),
 //!   [`view_panel`] (the View section: compare, heat map, Shading, Studio lighting) and
-//!   `viewport_panel.rs` (the 3D view's area: camera input, the compare views, overlays),
+//!   `viewport_panel.rs` (the 3D view's area: camera input, the brush, the compare views,
+//!   overlays; it reads a `ViewportView` and moves only what it owns, the camera, the brush's
+//!   last dab and the renderers it draws with, through a `ViewportState`),
 //!   `numbers_panel.rs` (the Numbers section);
 //! - `input.rs`: shortcuts and dropped files; `frame_stats.rs`: the UI thread's frame times;
 //! - [`camera`]: the orbit camera; [`history`]: undo and redo;

@@ -29,7 +29,11 @@ pub fn show(app: &mut App, ui: &mut egui::Ui) {
         .show(ui, |ui| {
             egui::ScrollArea::vertical().show(ui, |ui| controls(app, ui));
         });
-    egui::CentralPanel::no_frame().show(ui, |ui| super::viewport_panel::show(app, ui));
+    egui::CentralPanel::no_frame().show(ui, |ui| {
+        app.viewport_section(|view, state, settings, commands| {
+            super::viewport_panel::show(ui, view, state, settings, commands)
+        })
+    });
 }
 
 fn toolbar(ui: &mut egui::Ui, view: &PanelView, settings: &mut Settings, commands: &mut Commands) {
