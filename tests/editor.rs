@@ -292,6 +292,30 @@ fn a_broken_file_shows_an_error_and_keeps_the_mesh() {
     }
 }
 
+/// A path pasted into the Path field opens with Load. In the window Ctrl+V becomes this paste
+/// event from the system clipboard (eframe's `clipboard` feature); without that feature egui
+/// only pastes what was copied inside the editor.
+#[test]
+fn a_pasted_path_opens_with_load() {
+    let mushroom = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/mushroom_open.obj");
+    let mut harness = harness_for(bunny());
+    settle(&mut harness);
+    harness
+        .get_by_role_and_label(Role::TextInput, "Path:")
+        .focus();
+    harness.step();
+    // The field holds the open file's path: select it, so the paste replaces it.
+    harness.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::A);
+    harness.step();
+    harness.event(egui::Event::Paste(mushroom.display().to_string()));
+    harness.step();
+    harness.get_by_role_and_label(Role::Button, "Load").click();
+    settle(&mut harness);
+    let status = harness.state().status();
+    assert!(status.error.is_none(), "{:?}", status.error);
+    assert_eq!(status.document.as_deref(), Some(mushroom.as_path()));
+}
+
 #[test]
 fn camera_orbits_pans_zooms_and_fits() {
     let mut harness = harness_for(bunny());

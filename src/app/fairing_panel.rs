@@ -4,13 +4,14 @@
 //! it does and when to change it; the ones the chosen method does not use are disabled and say
 //! why.
 
+use super::camera::OrbitCamera;
 use super::command::PanelChange;
-use super::panel_view::{Commands, PanelView};
+use super::panel_view::{Commands, PanelView, ViewportView};
 use super::state::{
     CompareView, HierarchyState, MethodChoice, Settings, ViewMode, MAX_SHARP_EDGE_ANGLE,
     MIN_SHARP_EDGE_ANGLE,
 };
-use super::{App, Command};
+use super::Command;
 use crate::fairing::{BoundaryMode, Method};
 use crate::multires::MultiresVariant;
 
@@ -254,42 +255,42 @@ pub(super) fn sharp_edge_controls(
 const SHARP_EDGES_LINGER: std::time::Duration = std::time::Duration::from_millis(1500);
 
 /// Draws the kept sharp edges over the result's image while [`sharp_edge_controls`] asks for it.
-pub(super) fn sharp_edge_overlay(app: &mut App, ui: &egui::Ui, rect: egui::Rect) {
-    app.sharp_edges_drawn = 0;
-    let Some(until) = app.sharp_edges_shown_until else {
-        return;
+pub(super) fn sharp_edge_overlay(
+    ui: &egui::Ui,
+    view: &ViewportView,
+    camera: &OrbitCamera,
+    settings: &Settings,
+    rect: egui::Rect,
+) -> usize {
+    let Some(until) = view.sharp_edges_shown_until else {
+        return 0;
     };
     let now = std::time::Instant::now();
-    if now > until || app.settings.view_mode == ViewMode::Level {
-        return;
+    if now > until || settings.view_mode == ViewMode::Level {
+        return 0;
     }
     ui.ctx().request_repaint_after(until - now);
-    let Some(document) = &app.document else {
-        return;
+    let Some(document) = view.document else {
+        return 0;
     };
     let HierarchyState::Ready { sharp_edges, .. } = &document.hierarchy else {
-        return;
+        return 0;
     };
-    let faired = document.faired.as_ref().map(|f| f.positions.clone());
-    let shows_before = app.show_before && app.settings.compare == CompareView::Single;
-    let positions: &[[f32; 3]] = match (&faired, shows_before) {
-        (Some(faired), false) => faired,
+    let shows_before = view.show_before && settings.compare == CompareView::Single;
+    let positions: &[[f32; 3]] = match (&document.faired, shows_before) {
+        (Some(faired), false) => &faired.positions,
         _ => &document.original.positions,
     };
-    let image = super::paint_panel::painted_image(app, rect);
+    let image = super::paint_panel::painted_image(settings, rect);
     let aspect = image.width() / image.height().max(1.0);
-    let segments = sharp_edges.segments(
-        positions,
-        app.camera.view_proj(aspect),
-        app.camera.eye(),
-        image,
-    );
-    app.sharp_edges_drawn = segments.len();
+    let segments = sharp_edges.segments(positions, camera.view_proj(aspect), camera.eye(), image);
+    let drawn = segments.len();
     let painter = ui.painter_at(image);
     let stroke = egui::Stroke::new(2.0, egui::Color32::from_rgb(60, 230, 255));
     for segment in segments {
         painter.line_segment(segment, stroke);
     }
+    drawn
 }
 
 /// The fairing controls' tooltips: what each does and when to change it, in plain words.

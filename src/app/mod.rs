@@ -17,8 +17,11 @@
 //!   after the frame. Beside it:
 //!   `fairing_panel.rs` (the Fairing section, the sharp-edge controls, every tooltip),
 //!   [`view_panel`] (the View section: compare, heat map, Shading, Studio lighting) and
-//!   `viewport_panel.rs` (the 3D view's area: camera input, the compare views, overlays),
-//!   `numbers_panel.rs` (the Numbers section);
+//!   `viewport_panel.rs` (the 3D view's area: camera input, the brush, the compare views,
+//!   overlays; it reads a `ViewportView` and moves only what it owns, the camera, the brush's
+//!   last dab and the renderers it draws with, through a `ViewportState`),
+//!   `numbers_panel.rs` (the Numbers section), `export_panel.rs` (the Export section) and
+//!   `performance_panel.rs` (the Performance section);
 //! - `input.rs`: shortcuts and dropped files; `frame_stats.rs`: the UI thread's frame times;
 //! - [`camera`]: the orbit camera; [`history`]: undo and redo;
 //! - [`paint`]: the brush that paints where to fair (`tasks/mask.rs` applies its strokes,
@@ -35,6 +38,7 @@
 pub mod camera;
 mod command;
 mod confirm_replace;
+mod export_panel;
 mod fairing_panel;
 mod frame_stats;
 pub mod history;
@@ -46,6 +50,7 @@ pub mod paint;
 mod paint_panel;
 mod panel_view;
 pub mod panels;
+mod performance_panel;
 mod recent;
 mod results;
 mod sharp_edges;

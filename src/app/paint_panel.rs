@@ -4,10 +4,10 @@
 
 use super::command::PanelChange;
 use super::paint::BrushView;
-use super::panel_view::{Commands, PanelView};
+use super::panel_view::{Commands, PanelView, ViewportState, ViewportView};
 use super::panels::tips;
 use super::state::{CompareView, Settings, ViewMode};
-use super::{App, Command};
+use super::Command;
 
 /// The side panel's section: paint mode, brush, mask tint, clear and invert.
 pub(super) fn section(
@@ -81,18 +81,21 @@ pub(super) fn section(
 /// mode and ends the stroke on release. Returns whether the left button belongs to the brush
 /// (so it does not orbit).
 pub(super) fn viewport_brush(
-    app: &mut App,
     ui: &egui::Ui,
     response: &egui::Response,
     rect: egui::Rect,
+    view: &ViewportView,
+    state: &mut ViewportState,
+    settings: &Settings,
+    commands: &mut Commands,
 ) -> bool {
-    if !app.paint_mode || app.settings.view_mode == ViewMode::Level {
-        if app.stroke.is_some() {
-            app.commands.push(Command::EndStroke);
+    if !view.paint_mode || settings.view_mode == ViewMode::Level {
+        if view.stroking {
+            commands.push(Command::EndStroke);
         }
         return false;
     }
-    let image = painted_image(app, rect);
+    let image = painted_image(settings, rect);
     let (primary_down, shift, hover) = ui.input(|i| {
         (
             i.pointer.primary_down(),
@@ -100,33 +103,33 @@ pub(super) fn viewport_brush(
             i.pointer.hover_pos(),
         )
     });
-    let radius = app.settings.paint.radius;
+    let radius = settings.paint.radius;
     let pressed_here = response.is_pointer_button_down_on() && primary_down;
     match response.interact_pointer_pos().or(hover) {
         Some(cursor) if pressed_here && image.contains(cursor) => {
             // Dabs every quarter radius from the last one, so a fast stroke leaves no gaps
             // between the frames' cursor positions; at most 8 a frame (each dab tests every
             // triangle: on a big mesh a frame must not pay for dozens).
-            let from = app.last_dab.unwrap_or(cursor);
+            let from = state.last_dab.unwrap_or(cursor);
             let spacing = (radius * 0.25).max(1.0);
             let steps = ((cursor - from).length() / spacing).ceil().clamp(1.0, 8.0) as usize;
             let aspect = image.width() / image.height().max(1.0);
-            let erase = app.settings.paint.erase != shift;
+            let erase = settings.paint.erase != shift;
             for step in 1..=steps {
                 let view = BrushView {
-                    view_proj: app.camera.view_proj(aspect),
-                    eye: app.camera.eye(),
+                    view_proj: state.camera.view_proj(aspect),
+                    eye: state.camera.eye(),
                     rect: image,
                     cursor: from.lerp(cursor, step as f32 / steps as f32),
                     radius,
                 };
-                app.commands.push(Command::Paint { view, erase });
+                commands.push(Command::Paint { view, erase });
             }
-            app.last_dab = Some(cursor);
+            *state.last_dab = Some(cursor);
         }
-        _ if !primary_down && (app.stroke.is_some() || app.last_dab.is_some()) => {
-            app.last_dab = None;
-            app.commands.push(Command::EndStroke);
+        _ if !primary_down && (view.stroking || state.last_dab.is_some()) => {
+            *state.last_dab = None;
+            commands.push(Command::EndStroke);
         }
         _ => {}
     }
@@ -135,8 +138,8 @@ pub(super) fn viewport_brush(
 
 /// The image the brush paints on: the result's, the right half side by side, the whole view
 /// otherwise.
-pub(super) fn painted_image(app: &App, rect: egui::Rect) -> egui::Rect {
-    match app.settings.compare {
+pub(super) fn painted_image(settings: &Settings, rect: egui::Rect) -> egui::Rect {
+    match settings.compare {
         CompareView::SideBySide => rect.split_left_right_at_fraction(0.5).1,
         CompareView::Single | CompareView::Split => rect,
     }
@@ -144,15 +147,20 @@ pub(super) fn painted_image(app: &App, rect: egui::Rect) -> egui::Rect {
 
 /// The brush's outline at the cursor (and its hard inner part), over the drawn mesh; orange
 /// adds, blue erases.
-pub(super) fn brush_outline(app: &App, ui: &egui::Ui, rect: egui::Rect) {
-    if !app.paint_mode || app.settings.view_mode == ViewMode::Level {
+pub(super) fn brush_outline(
+    ui: &egui::Ui,
+    view: &ViewportView,
+    settings: &Settings,
+    rect: egui::Rect,
+) {
+    if !view.paint_mode || settings.view_mode == ViewMode::Level {
         return;
     }
     let (shift, hover) = ui.input(|i| (i.modifiers.shift, i.pointer.hover_pos()));
-    let Some(cursor) = hover.filter(|p| painted_image(app, rect).contains(*p)) else {
+    let Some(cursor) = hover.filter(|p| painted_image(settings, rect).contains(*p)) else {
         return;
     };
-    let brush = &app.settings.paint;
+    let brush = &settings.paint;
     let colour = if brush.erase != shift {
         egui::Color32::from_rgb(120, 190, 255)
     } else {

@@ -2,12 +2,20 @@
 //! from the app for one section. A section takes it with `&mut Settings` (the choices it edits
 //! in place) and the frame's command list (everything else it asks for, applied by
 //! [`App::apply`] after the widgets are drawn); [`App::panel`] hands the three out.
+//!
+//! The 3D view's area gets the same, with its own read-only [`ViewportView`], plus
+//! [`ViewportState`]: what it owns and changes as the mouse moves (the camera, the brush's last
+//! dab, the renderers it draws into); [`App::viewport_section`] hands them out and keeps what
+//! the area reports back ([`ViewportDrawn`]).
 
 use std::path::{Path, PathBuf};
+use std::time::Instant;
 
+use super::camera::OrbitCamera;
 use super::history::History;
-use super::state::{Document, DocumentSnapshot, Settings};
-use super::{App, Command, FrameStats};
+use super::state::{Document, DocumentSnapshot, HeatReference, Settings};
+use super::view_sync::SlotLook;
+use super::{App, Command, FrameStats, Slot};
 use crate::render::Viewport3d;
 
 /// The app's state as the panels see it: read-only.
@@ -69,5 +77,87 @@ impl App {
             confirm_replace: self.confirm_replace.as_deref(),
         };
         section(&view, &mut self.settings, &mut self.commands)
+    }
+}
+
+/// The app's state as the 3D view's area sees it: read-only.
+pub struct ViewportView<'a> {
+    pub document: Option<&'a Document>,
+    /// The single view shows "before" instead of "after".
+    pub show_before: bool,
+    /// The left button paints the mask instead of orbiting.
+    pub paint_mode: bool,
+    /// A brush stroke is under way (its dabs were applied, its end not yet).
+    pub stroking: bool,
+    /// This frame is the one captured for "Save image": no mouse hints.
+    pub capturing_view: bool,
+    /// The heat map's top value and reference, when the legend is shown.
+    pub heat_legend: Option<(f32, HeatReference)>,
+    /// How each slot's image is coloured (indexed by [`Slot`]).
+    pub looks: [SlotLook; 2],
+    /// Draw the kept sharp edges over the mesh until then.
+    pub sharp_edges_shown_until: Option<Instant>,
+}
+
+/// What the 3D view's area owns and changes itself, frame by frame: not the document, the mask
+/// or the settings (those change through commands and `&mut Settings`).
+pub struct ViewportState<'a> {
+    /// Orbited, panned and zoomed by the mouse.
+    pub camera: &'a mut OrbitCamera,
+    /// Where the brush's last dab of the stroke was (screen points).
+    pub last_dab: &'a mut Option<egui::Pos2>,
+    /// The renderers the views are drawn with (`None` without a wgpu render state), indexed
+    /// by [`Slot`].
+    pub viewports: [Option<&'a mut Viewport3d>; 2],
+}
+
+impl ViewportState<'_> {
+    /// A slot's renderer, when there is a wgpu renderer.
+    pub fn viewport(&mut self, slot: Slot) -> Option<&mut Viewport3d> {
+        self.viewports[slot as usize].as_deref_mut()
+    }
+}
+
+/// What the 3D view's area reports after drawing.
+#[derive(Clone, Copy, Debug)]
+pub struct ViewportDrawn {
+    /// Where the view was drawn (points).
+    pub rect: egui::Rect,
+    /// Sharp edges drawn over the mesh.
+    pub sharp_edges_drawn: usize,
+}
+
+impl App {
+    /// Runs the 3D view's area with what it shows, what it owns, the settings and the frame's
+    /// command list, and keeps what it reports.
+    pub(super) fn viewport_section(
+        &mut self,
+        section: impl FnOnce(
+            &ViewportView<'_>,
+            &mut ViewportState<'_>,
+            &mut Settings,
+            &mut Commands,
+        ) -> ViewportDrawn,
+    ) {
+        let heat_legend = self.heat_top().zip(self.heat_reference());
+        let looks = [self.slot_look(Slot::Main), self.slot_look(Slot::Before)];
+        let view = ViewportView {
+            document: self.document.as_ref(),
+            show_before: self.show_before,
+            paint_mode: self.paint_mode,
+            stroking: self.stroke.is_some(),
+            capturing_view: self.capturing_view,
+            heat_legend,
+            looks,
+            sharp_edges_shown_until: self.sharp_edges_shown_until,
+        };
+        let mut state = ViewportState {
+            camera: &mut self.camera,
+            last_dab: &mut self.last_dab,
+            viewports: [self.viewport.as_mut(), self.viewport_before.as_mut()],
+        };
+        let drawn = section(&view, &mut state, &mut self.settings, &mut self.commands);
+        self.viewport_rect = Some(drawn.rect);
+        self.sharp_edges_drawn = drawn.sharp_edges_drawn;
     }
 }

@@ -1,8 +1,9 @@
 //! The editor's widgets: toolbar (open, view toggles), status bar, controls side panel
-//! (mesh, noise, hierarchy, export, performance, one function each, in the order shown); the
-//! View section is in `view_panel.rs`, the Fairing section and sharp-edge controls (and
-//! [`tips`], every control's tooltip) in `fairing_panel.rs`, the Numbers in
-//! `numbers_panel.rs`, the 3D viewport's area in `viewport_panel.rs`.
+//! (mesh, noise, hierarchy, one function each, in the order shown); the View section is in
+//! `view_panel.rs`, the Fairing section and sharp-edge controls (and [`tips`], every
+//! control's tooltip) in `fairing_panel.rs`, Export in `export_panel.rs`, the Numbers in
+//! `numbers_panel.rs`, Paint in `paint_panel.rs`, Performance in `performance_panel.rs`, the
+//! 3D viewport's area in `viewport_panel.rs`.
 //! Each section takes the app's state read-only ([`PanelView`]), the [`Settings`] it edits in
 //! place (display toggles, option values) and the frame's commands: whatever else it asks for
 //! is a [`Command`], applied by the app after the frame's widgets are drawn.
@@ -29,7 +30,11 @@ pub fn show(app: &mut App, ui: &mut egui::Ui) {
         .show(ui, |ui| {
             egui::ScrollArea::vertical().show(ui, |ui| controls(app, ui));
         });
-    egui::CentralPanel::no_frame().show(ui, |ui| super::viewport_panel::show(app, ui));
+    egui::CentralPanel::no_frame().show(ui, |ui| {
+        app.viewport_section(|view, state, settings, commands| {
+            super::viewport_panel::show(ui, view, state, settings, commands)
+        })
+    });
 }
 
 fn toolbar(ui: &mut egui::Ui, view: &PanelView, settings: &mut Settings, commands: &mut Commands) {
@@ -186,7 +191,7 @@ fn controls(app: &mut App, ui: &mut egui::Ui) {
         if view.document.is_none() {
             ui.heading("No mesh");
             ui.label("Open a file, type a path above, or drop a mesh file on the window.");
-            performance(ui, view, settings, commands);
+            super::performance_panel::show(ui, view, settings, commands);
             return;
         };
         ui.heading("View");
@@ -198,14 +203,14 @@ fn controls(app: &mut App, ui: &mut egui::Ui) {
         ui.separator();
         ui.heading("Fairing");
         super::fairing_panel::fairing_controls(ui, view, settings, commands, top_level);
-        export_section(ui, view, settings, commands);
+        super::export_panel::show(ui, view, settings, commands);
         ui.separator();
         ui.heading("Numbers");
         super::numbers_panel::show(ui, view);
         // Below Export and the numbers: a painting session is an occasional step, and the
         // controls used on every file stay where they were.
         super::paint_panel::section(ui, view, settings, commands);
-        performance(ui, view, settings, commands);
+        super::performance_panel::show(ui, view, settings, commands);
     })
 }
 
@@ -346,140 +351,6 @@ fn hierarchy_section(ui: &mut egui::Ui, view: &PanelView, commands: &mut Command
     top_level
 }
 
-/// The export path and buttons, and the level chain's export.
-fn export_section(
-    ui: &mut egui::Ui,
-    view: &PanelView,
-    settings: &mut Settings,
-    commands: &mut Commands,
-) {
-    let Some(document) = view.document else {
-        return;
-    };
-    ui.separator();
-    ui.heading("Export");
-    let mut export_path = document.export_path.clone();
-    let label = ui.label("Export path:");
-    ui.add(egui::TextEdit::singleline(&mut export_path).desired_width(f32::INFINITY))
-        .labelled_by(label.id);
-    ui.small("GLB, glTF, OBJ or PLY, by extension");
-    ui.horizontal(|ui| {
-        if ui
-            .button("Export")
-            .on_hover_text("Write the result to the export path (Ctrl+E)")
-            .clicked()
-        {
-            commands.push(Command::Export(PathBuf::from(export_path.trim())));
-        }
-        if ui.button("Export as…").clicked() {
-            commands.push(Command::ExportDialog);
-        }
-    });
-    if export_path != document.export_path {
-        commands.push(Command::Panel(PanelChange::ExportPath(export_path)));
-    }
-
-    ui.add_space(4.0);
-    ui.strong("Level chain (LOD)");
-    let placeholder = view
-        .levels_folder
-        .as_ref()
-        .map_or_else(String::new, |p| p.display().to_string());
-    let label = ui.label("Levels folder:");
-    ui.add(
-        egui::TextEdit::singleline(&mut settings.levels_folder)
-            .hint_text(placeholder)
-            .desired_width(f32::INFINITY),
-    )
-    .labelled_by(label.id);
-    let top = document.level_count().unwrap_or(1).saturating_sub(1);
-    // Edit copies: the stored range may reach past this mesh's levels (its end "to the top").
-    let mut to = settings.levels_to.min(top);
-    let mut from = settings.levels_from.min(to);
-    ui.horizontal(|ui| {
-        ui.label("Levels");
-        let a = ui.add(egui::DragValue::new(&mut from).range(0..=top).prefix("M"));
-        ui.label("to");
-        let b = ui.add(egui::DragValue::new(&mut to).range(0..=top).prefix("M"));
-        if a.changed() {
-            settings.levels_from = from;
-        }
-        if b.changed() {
-            settings.levels_to = if to == top { usize::MAX } else { to };
-        }
-    });
-    if ui
-        .add_enabled(
-            document.level_count().is_some(),
-            egui::Button::new("Export levels"),
-        )
-        .on_hover_text("One GLB per level of the hierarchy, for LOD")
-        .clicked()
-    {
-        commands.push(Command::ExportLevels);
-    }
-}
-
-fn performance(
-    ui: &mut egui::Ui,
-    view: &PanelView,
-    settings: &mut Settings,
-    commands: &mut Commands,
-) {
-    ui.separator();
-    let response = egui::CollapsingHeader::new("Performance")
-        .default_open(settings.show_performance)
-        .show(ui, |ui| {
-            let stats = view.frame_stats;
-            egui::Grid::new("fairmesh-performance")
-                .num_columns(2)
-                .show(ui, |ui| {
-                    ui.label("UI frame (CPU)");
-                    ui.label(milliseconds(stats.last()));
-                    ui.end_row();
-                    ui.label("mean / max of 240");
-                    ui.label(format!(
-                        "{} / {}",
-                        milliseconds(stats.mean()),
-                        milliseconds(stats.max())
-                    ));
-                    ui.end_row();
-                    ui.label("max while working");
-                    let [results, upload, widgets] = stats.max_while_busy_parts;
-                    ui.label(milliseconds(stats.max_while_busy))
-                        .on_hover_text(format!(
-                            "Results {}, upload {}, widgets {}",
-                            milliseconds(results),
-                            milliseconds(upload),
-                            milliseconds(widgets)
-                        ));
-                    ui.end_row();
-                    ui.label("frames");
-                    ui.label(stats.frames.to_string());
-                    ui.end_row();
-                    if let Some(viewport) = view.viewport {
-                        ui.label("viewport images");
-                        ui.label(viewport.images_drawn().to_string());
-                        ui.end_row();
-                    }
-                });
-            // Long adapter names wrap at the panel's width instead of widening it.
-            if let Some(viewport) = view.viewport {
-                ui.add(
-                    egui::Label::new(
-                        egui::RichText::new(format!("Adapter: {}", viewport.adapter_description()))
-                            .small(),
-                    )
-                    .wrap(),
-                );
-            }
-            if ui.button("Reset max").clicked() {
-                commands.push(Command::Panel(PanelChange::ResetBusyMax));
-            }
-        });
-    settings.show_performance = response.fully_open();
-}
-
 fn noise_mode_name(mode: NoiseMode) -> &'static str {
     match mode {
         NoiseMode::Normal => "Along the normal",
@@ -490,8 +361,4 @@ fn noise_mode_name(mode: NoiseMode) -> &'static str {
 
 pub(super) fn seconds(duration: std::time::Duration) -> String {
     format!("{:.3} s", duration.as_secs_f64())
-}
-
-fn milliseconds(duration: std::time::Duration) -> String {
-    format!("{:.2} ms", duration.as_secs_f64() * 1000.0)
 }

@@ -4,7 +4,10 @@
 
 use std::sync::Arc;
 
-use crate::app::state::{self, CompareView, Document, HeatReference, HierarchyState, ViewMode};
+use crate::app::camera::OrbitCamera;
+use crate::app::state::{
+    self, CompareView, Document, HeatReference, HierarchyState, Settings, ViewMode,
+};
 use crate::app::App;
 use crate::hierarchy;
 use crate::render::{DrawParams, MeshSource, Viewport3d};
@@ -19,6 +22,39 @@ pub(in crate::app) struct Shown {
     pub(in crate::app) heat: Option<HeatReference>,
     /// The painted mask's revision, when it is tinted over the mesh (instead of a heat map).
     pub(in crate::app) mask: Option<u64>,
+}
+
+/// How one viewport's image is coloured, apart from the camera and the settings: the heat map's
+/// range or the painted mask's tint (see [`App::slot_look`]).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub(in crate::app) struct SlotLook {
+    pub(in crate::app) scalar_range: Option<[f32; 2]>,
+    pub(in crate::app) mask_tint: bool,
+}
+
+impl SlotLook {
+    /// What a renderer is asked to draw with, for an image in `rect` seen by `camera`.
+    pub(in crate::app) fn draw_params(
+        self,
+        camera: &OrbitCamera,
+        settings: &Settings,
+        rect: egui::Rect,
+    ) -> DrawParams {
+        let aspect = rect.width() / rect.height().max(1.0);
+        DrawParams {
+            view_proj: camera.view_proj(aspect).to_cols_array_2d(),
+            eye: camera.eye().to_array(),
+            light_dir: camera.light_dir().to_array(),
+            fill_dir: camera.fill_dir().to_array(),
+            up: camera.basis().1.to_array(),
+            shading: settings.shading,
+            lighting: settings.lighting,
+            wireframe: settings.wireframe,
+            scalar_range: self.scalar_range,
+            mask_tint: self.mask_tint,
+            size: [0, 0],
+        }
+    }
 }
 
 /// The two viewports: the main one (the view mode's mesh: the result, a level, the original)
@@ -343,14 +379,6 @@ impl App {
         .map(|top| top.max(f32::MIN_POSITIVE))
     }
 
-    /// A viewport's renderer handle, when there is a wgpu renderer.
-    pub(super) fn viewport_mut(&mut self, slot: Slot) -> Option<&mut Viewport3d> {
-        match slot {
-            Slot::Main => self.viewport.as_mut(),
-            Slot::Before => self.viewport_before.as_mut(),
-        }
-    }
-
     /// What the main viewport's renderer is asked to draw with now (tests).
     pub fn main_draw_params(&self) -> Option<DrawParams> {
         Some(self.draw_params(self.viewport_rect?, Slot::Main))
@@ -367,7 +395,12 @@ impl App {
     }
 
     pub(super) fn draw_params(&self, rect: egui::Rect, slot: Slot) -> DrawParams {
-        let aspect = rect.width() / rect.height().max(1.0);
+        self.slot_look(slot)
+            .draw_params(&self.camera, &self.settings, rect)
+    }
+
+    /// How a viewport's image is coloured now (the heat map's range, or the mask's tint).
+    pub(super) fn slot_look(&self, slot: Slot) -> SlotLook {
         let top = self.heat_top();
         let scalar_range = self.heat_max[slot as usize].and(top).map(|top| [0.0, top]);
         let shown = match slot {
@@ -375,18 +408,9 @@ impl App {
             Slot::Before => self.shown_before,
         };
         let mask_tint = scalar_range.is_none() && shown.is_some_and(|s| s.mask.is_some());
-        DrawParams {
-            view_proj: self.camera.view_proj(aspect).to_cols_array_2d(),
-            eye: self.camera.eye().to_array(),
-            light_dir: self.camera.light_dir().to_array(),
-            fill_dir: self.camera.fill_dir().to_array(),
-            up: self.camera.basis().1.to_array(),
-            shading: self.settings.shading,
-            lighting: self.settings.lighting,
-            wireframe: self.settings.wireframe,
+        SlotLook {
             scalar_range,
             mask_tint,
-            size: [0, 0],
         }
     }
 

@@ -4,22 +4,32 @@
 //! mouse hints, the heat map's legend, the brush outline, the kept sharp edges, and why a mesh
 //! is not drawn.
 
-use super::state::{CompareView, HeatReference, ViewMode};
-use super::{App, Slot};
+use super::panel_view::{Commands, ViewportDrawn, ViewportState, ViewportView};
+use super::state::{CompareView, HeatReference, Settings, ViewMode};
+use super::Slot;
 use crate::render::colormap::{legend_ticks, viridis_strip};
 
-pub fn show(app: &mut App, ui: &mut egui::Ui) {
+/// The 3D view's area. Like the panels it reads the app's state ([`ViewportView`]), edits the
+/// settings in place (the split's divider) and emits commands (the brush's dabs and strokes);
+/// it also moves the camera and draws with the renderers it owns ([`ViewportState`]).
+pub fn show(
+    ui: &mut egui::Ui,
+    view: &ViewportView,
+    state: &mut ViewportState,
+    settings: &mut Settings,
+    commands: &mut Commands,
+) -> ViewportDrawn {
     let rect = ui.available_rect_before_wrap();
     let response = ui.allocate_rect(rect, egui::Sense::click_and_drag());
-    app.viewport_rect = Some(rect);
-    let divider_x = rect.left() + rect.width() * app.settings.split.clamp(0.0, 1.0);
-    let divider_dragged = split_divider(app, ui, rect, divider_x);
-    let painting = !divider_dragged && super::paint_panel::viewport_brush(app, ui, &response, rect);
+    let divider_x = rect.left() + rect.width() * settings.split.clamp(0.0, 1.0);
+    let divider_dragged = split_divider(ui, settings, rect, divider_x);
+    let painting = !divider_dragged
+        && super::paint_panel::viewport_brush(ui, &response, rect, view, state, settings, commands);
     if !divider_dragged {
-        camera_input(app, ui, &response, painting);
+        camera_input(state, ui, &response, painting);
     }
     let painter = ui.painter_at(rect);
-    if app.viewport.is_none() {
+    if state.viewports[Slot::Main as usize].is_none() {
         painter.text(
             rect.center(),
             egui::Align2::CENTER_CENTER,
@@ -28,14 +38,23 @@ pub fn show(app: &mut App, ui: &mut egui::Ui) {
             ui.visuals().text_color(),
         );
     }
-    draw_views(app, &painter, rect, divider_x);
-    overlays(app, ui, &painter, rect, painting);
+    draw_views(view, state, settings, &painter, rect, divider_x);
+    let sharp_edges_drawn = overlays(ui, view, state, settings, &painter, rect, painting);
+    ViewportDrawn {
+        rect,
+        sharp_edges_drawn,
+    }
 }
 
 /// The split view's divider sits on top of the camera's area and takes its drags first; returns
 /// whether it is being dragged.
-fn split_divider(app: &mut App, ui: &mut egui::Ui, rect: egui::Rect, divider_x: f32) -> bool {
-    if app.settings.compare != CompareView::Split {
+fn split_divider(
+    ui: &mut egui::Ui,
+    settings: &mut Settings,
+    rect: egui::Rect,
+    divider_x: f32,
+) -> bool {
+    if settings.compare != CompareView::Split {
         return false;
     }
     let handle = egui::Rect::from_x_y_ranges(divider_x - 6.0..=divider_x + 6.0, rect.y_range());
@@ -53,29 +72,35 @@ fn split_divider(app: &mut App, ui: &mut egui::Ui, rect: egui::Rect, divider_x: 
     let x = divider
         .interact_pointer_pos()
         .map_or(divider_x + divider.drag_delta().x, |p| p.x);
-    app.settings.split = ((x - rect.left()) / rect.width().max(1.0)).clamp(0.02, 0.98);
+    settings.split = ((x - rect.left()) / rect.width().max(1.0)).clamp(0.02, 0.98);
     true
 }
 
 /// Orbit, pan and zoom (while painting, the middle button turns the view instead of the left).
-fn camera_input(app: &mut App, ui: &egui::Ui, response: &egui::Response, painting: bool) {
+fn camera_input(
+    state: &mut ViewportState,
+    ui: &egui::Ui,
+    response: &egui::Response,
+    painting: bool,
+) {
     let orbit_button = match painting {
         true => egui::PointerButton::Middle,
         false => egui::PointerButton::Primary,
     };
     if response.dragged_by(orbit_button) {
-        app.camera.orbit(response.drag_delta());
+        state.camera.orbit(response.drag_delta());
     }
     if response.dragged_by(egui::PointerButton::Secondary)
         || (!painting && response.dragged_by(egui::PointerButton::Middle))
     {
-        app.camera
+        state
+            .camera
             .pan(response.drag_delta(), response.rect.height());
     }
     if response.hovered() {
         let scroll = ui.input(|i| i.smooth_scroll_delta().y);
         if scroll != 0.0 {
-            app.camera.zoom(scroll);
+            state.camera.zoom(scroll);
         }
     }
 }
@@ -91,24 +116,34 @@ fn caption(painter: &egui::Painter, at: egui::Pos2, align: egui::Align2, text: &
 }
 
 /// The views the compare mode shows, each with its caption.
-fn draw_views(app: &mut App, painter: &egui::Painter, rect: egui::Rect, divider_x: f32) {
-    let after_name = match app.settings.view_mode {
+fn draw_views(
+    view: &ViewportView,
+    state: &mut ViewportState,
+    settings: &Settings,
+    painter: &egui::Painter,
+    rect: egui::Rect,
+    divider_x: f32,
+) {
+    let after_name = match settings.view_mode {
         ViewMode::Faired => "After (faired)",
         ViewMode::Level => "Level mesh",
         ViewMode::Original => "Input mesh",
     };
     let top_left = |r: egui::Rect| r.left_top() + egui::vec2(10.0, 8.0);
-    match app.settings.compare {
+    let params = |state: &ViewportState, rect: egui::Rect, slot: Slot| {
+        view.looks[slot as usize].draw_params(state.camera, settings, rect)
+    };
+    match settings.compare {
         CompareView::Single => {
-            let slot = match app.show_before {
+            let slot = match view.show_before {
                 true => Slot::Before,
                 false => Slot::Main,
             };
-            let params = app.draw_params(rect, slot);
-            if let Some(viewport) = app.viewport_mut(slot) {
+            let params = params(state, rect, slot);
+            if let Some(viewport) = state.viewport(slot) {
                 viewport.paint(painter, rect, params);
             }
-            let name = if app.show_before {
+            let name = if view.show_before {
                 "Before (B)"
             } else {
                 after_name
@@ -117,12 +152,12 @@ fn draw_views(app: &mut App, painter: &egui::Painter, rect: egui::Rect, divider_
         }
         CompareView::Split => {
             let (left, right) = rect.split_left_right_at_x(divider_x);
-            let before_params = app.draw_params(rect, Slot::Before);
-            let after_params = app.draw_params(rect, Slot::Main);
-            if let Some(viewport) = app.viewport_mut(Slot::Before) {
+            let before_params = params(state, rect, Slot::Before);
+            let after_params = params(state, rect, Slot::Main);
+            if let Some(viewport) = state.viewport(Slot::Before) {
                 viewport.paint_part(painter, rect, left, before_params);
             }
-            if let Some(viewport) = app.viewport_mut(Slot::Main) {
+            if let Some(viewport) = state.viewport(Slot::Main) {
                 viewport.paint_part(painter, rect, right, after_params);
             }
             painter.line_segment(
@@ -138,12 +173,12 @@ fn draw_views(app: &mut App, painter: &egui::Painter, rect: egui::Rect, divider_
         }
         CompareView::SideBySide => {
             let (left, right) = rect.split_left_right_at_fraction(0.5);
-            let before_params = app.draw_params(left, Slot::Before);
-            let after_params = app.draw_params(right, Slot::Main);
-            if let Some(viewport) = app.viewport_mut(Slot::Before) {
+            let before_params = params(state, left, Slot::Before);
+            let after_params = params(state, right, Slot::Main);
+            if let Some(viewport) = state.viewport(Slot::Before) {
                 viewport.paint(painter, left, before_params);
             }
-            if let Some(viewport) = app.viewport_mut(Slot::Main) {
+            if let Some(viewport) = state.viewport(Slot::Main) {
                 viewport.paint(painter, right, after_params);
             }
             painter.line_segment(
@@ -160,16 +195,18 @@ fn draw_views(app: &mut App, painter: &egui::Painter, rect: egui::Rect, divider_
 }
 
 /// The mouse hints, the heat map's legend, the brush, the kept sharp edges and why a mesh is
-/// not drawn, over the views.
+/// not drawn, over the views; returns how many sharp edges were drawn.
 fn overlays(
-    app: &mut App,
     ui: &mut egui::Ui,
+    view: &ViewportView,
+    state: &ViewportState,
+    settings: &Settings,
     painter: &egui::Painter,
     rect: egui::Rect,
     painting: bool,
-) {
+) -> usize {
     // A saved image of the view leaves out the mouse hints.
-    let hint = if app.capturing_view {
+    let hint = if view.capturing_view {
         ""
     } else if painting {
         "Painting: left drag paints (Shift: erase) · middle drag: orbit · right drag: pan · P: stop painting"
@@ -183,15 +220,17 @@ fn overlays(
         egui::FontId::proportional(12.0),
         egui::Color32::from_gray(150),
     );
-    if let (Some(top), Some(reference)) = (app.heat_top(), app.heat_reference()) {
+    if let Some((top, reference)) = view.heat_legend {
         heat_legend(ui, rect, top, reference);
     }
-    super::paint_panel::brush_outline(app, ui, rect);
-    super::fairing_panel::sharp_edge_overlay(app, ui, rect);
-    let wireframe = app.settings.wireframe;
-    let problem = app
-        .viewports()
-        .find_map(|viewport| viewport.problem(wireframe));
+    super::paint_panel::brush_outline(ui, view, settings, rect);
+    let sharp_edges_drawn =
+        super::fairing_panel::sharp_edge_overlay(ui, view, state.camera, settings, rect);
+    let problem = state
+        .viewports
+        .iter()
+        .flatten()
+        .find_map(|viewport| viewport.problem(settings.wireframe));
     if let Some(problem) = problem {
         let text = egui::RichText::new(format!("Not drawn: {problem}"))
             .size(14.0)
@@ -202,6 +241,7 @@ fn overlays(
         );
         ui.put(area, egui::Label::new(text).selectable(false));
     }
+    sharp_edges_drawn
 }
 
 /// The heat map's legend: the viridis strip with round tick values in model units.
