@@ -464,16 +464,12 @@ fn build(
         .creases
         .as_ref()
         .map(|crease_options| {
-            let built;
-            let topology = match topology {
-                Some(topology) => topology,
-                None => {
-                    built = Topology::build(mesh);
-                    &built
-                }
-            };
-            let fans = FanRings::new(&mesh.triangles, topology);
-            detect_creases_with_estimate(mesh, topology, &fans, crease_options).1
+            let topology = topology.map_or_else(
+                || std::borrow::Cow::Owned(Topology::build(mesh)),
+                std::borrow::Cow::Borrowed,
+            );
+            let fans = FanRings::new(&mesh.triangles, &topology);
+            detect_creases_with_estimate(mesh, &topology, &fans, crease_options).1
         })
         .filter(|creases| !creases.is_empty());
     let setup_ms = started.elapsed().as_secs_f64() * 1e3;
