@@ -359,6 +359,16 @@ mod tests {
     use super::*;
     use crate::mesh::Topology;
 
+    /// A tetrahedron whose face 1-2-3 comes three times: once more rotated (2), once reversed (4).
+    const TETRAHEDRON_WITH_REPEATS: [[u32; 3]; 6] = [
+        [0, 2, 1],
+        [1, 2, 3],
+        [2, 3, 1],
+        [0, 1, 3],
+        [3, 2, 1],
+        [0, 3, 2],
+    ];
+
     #[test]
     fn weld_merges_seam_copies_in_first_occurrence_order() {
         // Two triangles sharing an edge, stored with the shared corners duplicated.
@@ -462,17 +472,9 @@ mod tests {
 
     #[test]
     fn clean_drops_triangles_that_repeat_an_earlier_one_in_either_orientation() {
-        // A tetrahedron whose face 1-2-3 comes three times: once more rotated, once reversed.
         let mut mesh = TriMesh::new(
             vec![[0., 0., 0.], [1., 0., 0.], [0., 1., 0.], [0., 0., 1.]],
-            vec![
-                [0, 2, 1],
-                [1, 2, 3],
-                [2, 3, 1],
-                [0, 1, 3],
-                [3, 2, 1],
-                [0, 3, 2],
-            ],
+            TETRAHEDRON_WITH_REPEATS.to_vec(),
         );
         let report = clean(&mut mesh);
         assert_eq!(report.removed_repeated_faces, 2);
@@ -509,14 +511,7 @@ mod tests {
         // The same from the topology, as loading finds them; and a tetrahedron's short lists.
         let fan = TriMesh::new(positions.clone(), triangles.clone());
         assert_eq!(Topology::build(&fan).repeated_triangles, vec![31, 41]);
-        let tetrahedron = [
-            [0, 2, 1],
-            [1, 2, 3],
-            [2, 3, 1],
-            [0, 1, 3],
-            [3, 2, 1],
-            [0, 3, 2],
-        ];
+        let tetrahedron = TETRAHEDRON_WITH_REPEATS;
         let corners = vec![[0.0f32; 3]; 4];
         let with_repeats = TriMesh::new(corners, tetrahedron.to_vec());
         assert_eq!(
