@@ -85,6 +85,7 @@ pub(crate) fn weld_with_map(mesh: &mut TriMesh) -> (WeldReport, Option<Vec<u32>>
         .into_par_iter()
         .map(|shard| {
             let mut first: HashMap<KeyedPosition, u32, BuildHasherDefault<PositionHasher>> =
+                // A shard's even share, and room for the deal to be uneven.
                 HashMap::with_capacity_and_hasher(
                     n / shards as usize + n / 16 + 1,
                     Default::default(),
@@ -271,11 +272,19 @@ fn repeated_triangles(triangles: &[[u32; 3]], vertices: usize) -> Vec<u32> {
         listed[next[low] as usize] = f as u32;
         next[low] += 1;
     }
-    repeats_in_lists(triangles, vertices, |v, list| {
-        list.extend_from_slice(
-            &listed[starts[v as usize] as usize..starts[v as usize + 1] as usize],
-        )
-    })
+    // The lists are independent: checked in parallel, in chunks of vertices, joined in order.
+    let chunks: Vec<Vec<u32>> = (0..vertices)
+        .into_par_iter()
+        .with_min_len(16_384)
+        .fold(Vec::new, |mut repeats, v| {
+            let list = &listed[starts[v] as usize..starts[v + 1] as usize];
+            repeats_among(triangles, list, &mut repeats);
+            repeats
+        })
+        .collect();
+    let mut repeats: Vec<u32> = chunks.concat();
+    repeats.sort_unstable();
+    repeats
 }
 
 /// Remove the triangles at `indices` (ascending), keeping the others in order.
@@ -290,34 +299,6 @@ pub(crate) fn remove_triangles(mesh: &mut TriMesh, indices: &[u32]) {
         index += 1;
         !repeat
     });
-}
-
-/// The repeated triangles (ascending), given for each vertex `v < vertices` the triangles whose
-/// smallest corner is `v`, ascending (`list(v, &mut out)` appends them): only triangles of the
-/// same list are compared. The lists are independent: checked in parallel, in chunks of vertices,
-/// and joined in order.
-fn repeats_in_lists(
-    triangles: &[[u32; 3]],
-    vertices: usize,
-    list: impl Fn(u32, &mut Vec<u32>) + Sync,
-) -> Vec<u32> {
-    let chunks: Vec<Vec<u32>> = (0..vertices as u32)
-        .into_par_iter()
-        .with_min_len(16_384)
-        .fold(
-            || (Vec::new(), Vec::new()),
-            |(mut repeats, mut faces), v| {
-                faces.clear();
-                list(v, &mut faces);
-                repeats_among(triangles, &faces, &mut repeats);
-                (repeats, faces)
-            },
-        )
-        .map(|(repeats, _)| repeats)
-        .collect();
-    let mut repeats: Vec<u32> = chunks.concat();
-    repeats.sort_unstable();
-    repeats
 }
 
 /// Of `faces` (ascending, all with the same smallest corner), append to `repeats` those whose
