@@ -2,7 +2,7 @@
 //! runs. Each part of the library adds its own rows (`fair::bench_rows`, `hierarchy::bench_rows`).
 
 use clap::Args;
-use fairmesh::{io, mesh, metrics, Topology};
+use fairmesh::{io, mesh, metrics, Topology, TriMesh};
 use std::path::PathBuf;
 use std::time::Instant;
 
@@ -103,28 +103,16 @@ pub fn median_ms(runs: usize, mut f: impl FnMut()) -> f64 {
     times[times.len() / 2]
 }
 
-pub fn run(args: BenchArgs) -> anyhow::Result<()> {
-    let mut rows: Vec<(String, f64)> = Vec::new();
-    if args.wants(BenchGroup::Load) {
-        let load_ms = median_ms(args.runs, || {
-            let _ = super::basic::load(&args.input, true);
-        });
-        rows.push(("load + weld + clean + topology".into(), load_ms));
-    }
-    let mut loaded = super::basic::load(&args.input, true)?;
-    if args.subdivide == 0 && args.wants(BenchGroup::Save) {
-        rows.extend(save_rows(&args, &loaded)?);
-    }
-    for _ in 0..args.subdivide {
-        loaded.mesh = mesh::subdivide_loop(&loaded.mesh);
-    }
-    let mesh = loaded.mesh;
-    let topology = Topology::build(&mesh);
+/// The rows timed on the (subdivided) mesh: its topology, weld and measures, fairing, creases
+/// and the hierarchy, as `args` asks.
+fn mesh_rows(args: &BenchArgs, mesh: &TriMesh) -> Vec<(String, f64)> {
+    let mut rows = Vec::new();
+    let topology = Topology::build(mesh);
     if args.wants(BenchGroup::Mesh) {
         rows.push((
             "topology".into(),
             median_ms(args.runs, || {
-                std::hint::black_box(Topology::build(&mesh));
+                std::hint::black_box(Topology::build(mesh));
             }),
         ));
         rows.push((
@@ -138,30 +126,62 @@ pub fn run(args: BenchArgs) -> anyhow::Result<()> {
             "volume + area + mean edge length".into(),
             median_ms(args.runs, || {
                 std::hint::black_box((
-                    metrics::signed_volume(&mesh),
-                    metrics::area(&mesh),
-                    metrics::mean_edge_length(&mesh),
+                    metrics::signed_volume(mesh),
+                    metrics::area(mesh),
+                    metrics::mean_edge_length(mesh),
                 ));
             }),
         ));
     }
     if args.wants(BenchGroup::Fair) {
-        rows.extend(super::fair::bench_rows(&mesh, &topology));
+        rows.extend(super::fair::bench_rows(mesh, &topology));
     }
     if args.wants(BenchGroup::Creases) {
-        rows.extend(super::fair::crease_bench_rows(&mesh, &topology, args.runs));
+        rows.extend(super::fair::crease_bench_rows(mesh, &topology, args.runs));
     }
     if args.wants(BenchGroup::Hierarchy) {
-        rows.extend(super::hierarchy::bench_rows(&mesh, &topology));
+        rows.extend(super::hierarchy::bench_rows(mesh, &topology));
     }
+    rows
+}
+
+pub fn run(args: BenchArgs) -> anyhow::Result<()> {
+    let mut rows: Vec<(String, f64)> = Vec::new();
+    if args.wants(BenchGroup::Load) {
+        let load_ms = median_ms(args.runs, || {
+            let _ = super::basic::load(&args.input, true);
+        });
+        rows.push(("load + weld + clean + topology".into(), load_ms));
+    }
+    let mut loaded = super::basic::load(&args.input, true)?;
+    if args.subdivide == 0 && args.wants(BenchGroup::Save) {
+        rows.extend(save_rows(&args, &loaded)?);
+    }
+    let on_the_mesh = [
+        BenchGroup::Mesh,
+        BenchGroup::Fair,
+        BenchGroup::Creases,
+        BenchGroup::Hierarchy,
+    ];
+    // Only these read the (subdivided) mesh and its topology: not built for `--only load,save`.
+    let subdivisions = if on_the_mesh.iter().any(|&group| args.wants(group)) {
+        for _ in 0..args.subdivide {
+            loaded.mesh = mesh::subdivide_loop(&loaded.mesh);
+        }
+        rows.extend(mesh_rows(&args, &loaded.mesh));
+        args.subdivide
+    } else {
+        0
+    };
+    let mesh = loaded.mesh;
 
     let mut out = format!(
         "{}: {} vertices, {} faces{} ({} threads; median of {} runs)\n",
         args.input.display(),
         mesh.vertex_count(),
         mesh.face_count(),
-        if args.subdivide > 0 {
-            format!(" after {} subdivisions", args.subdivide)
+        if subdivisions > 0 {
+            format!(" after {subdivisions} subdivisions")
         } else {
             String::new()
         },

@@ -370,19 +370,23 @@ pub fn crease_bench_rows(
     let mut rows = Vec::new();
     // Crease detection: on the faces' own normals (a clean mesh), and the guided normal filter
     // a noisy one runs first (one pass and three, so a pass's own cost is their difference / 2).
-    use fairmesh::fairing::creases::{filtered_face_normals, NORMAL_SIGMA};
-    let options = fairmesh::fairing::CreaseOptions::default();
+    let options = CreaseOptions::default();
     rows.push((
         "creases: detection (no filtering)".to_string(),
         median_ms(runs, || {
-            std::hint::black_box(fairmesh::fairing::detect_creases(mesh, topology, &options));
+            std::hint::black_box(fairing::detect_creases(mesh, topology, &options));
         }),
     ));
     for passes in [1, 3] {
         rows.push((
             format!("creases: guided normal filter, {passes} pass(es)"),
             median_ms(runs, || {
-                std::hint::black_box(filtered_face_normals(mesh, topology, passes, NORMAL_SIGMA));
+                std::hint::black_box(fairing::creases::filtered_face_normals(
+                    mesh,
+                    topology,
+                    passes,
+                    fairing::creases::NORMAL_SIGMA,
+                ));
             }),
         ));
     }
