@@ -60,6 +60,9 @@ pub struct Document {
     pub generation: u64,
     /// The document's mesh: as loaded, or as noise or an applied result made it.
     pub original: Arc<TriMesh>,
+    /// The connectivity of `original`'s triangles (the same for every snapshot of one file:
+    /// noise and Apply move positions only).
+    pub topology: Arc<crate::Topology>,
     /// The mesh before noise was injected (the clean reference), when there is one.
     pub clean: Option<Arc<TriMesh>>,
     /// The document mesh measured against the clean mesh (same connectivity).
@@ -101,6 +104,7 @@ impl Document {
         let source = Arc::new(crate::io::Source::plain(&original));
         Self {
             source,
+            topology: Arc::new(crate::Topology::build(&original)),
             path,
             generation,
             original: Arc::new(original),
@@ -146,6 +150,8 @@ impl Document {
 pub struct DocumentSnapshot {
     pub path: PathBuf,
     pub mesh: Arc<TriMesh>,
+    /// See [`Document::topology`].
+    pub topology: Arc<crate::Topology>,
     pub clean: Option<Arc<TriMesh>>,
     pub against_clean: Option<Measures>,
     pub report: LoadReport,
@@ -191,6 +197,7 @@ impl Document {
         DocumentSnapshot {
             path: self.path.clone(),
             mesh: self.original.clone(),
+            topology: self.topology.clone(),
             clean: self.clean.clone(),
             against_clean: self.against_clean.clone(),
             report: self.report.clone(),
@@ -241,6 +248,7 @@ impl Document {
             path: snapshot.path,
             generation,
             original: snapshot.mesh,
+            topology: snapshot.topology,
             clean: snapshot.clean,
             against_clean: snapshot.against_clean,
             report: snapshot.report,

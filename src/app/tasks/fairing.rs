@@ -46,6 +46,15 @@ impl App {
         view: u64,
     ) {
         let mask = self.document.as_ref().and_then(|d| d.mask.clone());
+        // The document's connectivity, when the hierarchy's M0 has the document's triangles
+        // (otherwise it is built for M0 where needed).
+        let topology = self.document.as_ref().and_then(|d| match &d.hierarchy {
+            HierarchyState::Ready {
+                base_matches_original: true,
+                ..
+            } => Some(d.topology.clone()),
+            _ => None,
+        });
         let mut options = self.settings.multires_options(level);
         let baseline = self.settings.baseline_options();
         let method = self.settings.method;
@@ -70,26 +79,32 @@ impl App {
             // A few rings of fade inside the painted region's edge, whatever the brush left: where
             // the brush stopped at a silhouette the mask drops from 1 to 0 at once, and the
             // result would show a step there.
-            let mask = mask.map(|mask| {
-                let topology = crate::Topology::build(hierarchy.base_mesh());
-                mask.with_falloff(&topology, MASK_EDGE_RINGS)
-            });
+            let needs_topology = mask.is_some() || baseline.is_some();
+            let topology = match topology {
+                Some(topology) => Some(topology),
+                None if needs_topology => {
+                    Some(Arc::new(crate::Topology::build(hierarchy.base_mesh())))
+                }
+                None => None,
+            };
+            let mask = mask
+                .zip(topology.as_deref())
+                .map(|(mask, topology)| mask.with_falloff(topology, MASK_EDGE_RINGS));
             options.mask = mask.clone();
-            let positions = match &baseline {
+            let positions = match (&baseline, topology.as_deref()) {
                 // A baseline smooths the document's mesh itself; the level does not apply.
-                Some(method) => {
+                (Some(method), Some(topology)) => {
                     let mut mesh = hierarchy.base_mesh().clone();
-                    let topology = crate::Topology::build(&mesh);
                     match &mask {
                         Some(mask) => {
-                            crate::fairing::fair_masked(&mut mesh, &topology, method, mask)
+                            crate::fairing::fair_masked(&mut mesh, topology, method, mask)
                         }
-                        None => crate::fairing::fair(&mut mesh, &topology, method),
+                        None => crate::fairing::fair(&mut mesh, topology, method),
                     };
                     progress(1.0);
                     Some(mesh.positions)
                 }
-                None => {
+                _ => {
                     let mut workspace = workspace.lock().unwrap_or_else(PoisonError::into_inner);
                     multires::fair_multires(&hierarchy, &options, &mut workspace, &mut progress)
                 }

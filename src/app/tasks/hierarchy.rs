@@ -20,6 +20,7 @@ impl App {
         document.hierarchy = HierarchyState::Building;
         self.hierarchy_progress.set(0.0);
         let mesh = document.original.clone();
+        let topology = document.topology.clone();
         let options = self.settings.hierarchy_options();
         let document_generation = document.generation;
         let hierarchy_generation = self.hierarchy_generation.clone();
@@ -34,7 +35,9 @@ impl App {
                 progress_out.set(fraction);
                 hierarchy_generation.is_current(generation)
             };
-            let result = hierarchy::build_hierarchy(&mesh, &options, &mut progress).map(|built| {
+            let built =
+                hierarchy::build_hierarchy_with_topology(&mesh, &topology, &options, &mut progress);
+            let result = built.map(|built| {
                 // Compared here, not on the UI thread (millions of triangles).
                 let matches = built.base_mesh().triangles == mesh.triangles;
                 let sharp_edges = if matches {

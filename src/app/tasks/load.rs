@@ -32,9 +32,9 @@ impl App {
                     if loaded.mesh.triangles.is_empty() {
                         Err(format!("{}: the file holds no triangles", path.display()))
                     } else {
-                        // The topology is dropped here, on the io worker.
                         Ok(Box::new(LoadedMesh {
                             mesh: loaded.mesh,
+                            topology: Arc::new(loaded.topology),
                             report: loaded.report,
                             source: loaded.source,
                         }))
@@ -141,6 +141,7 @@ impl App {
                     export_path: state::default_export_path(&path).display().to_string(),
                     path,
                     mesh: Arc::new(loaded.mesh),
+                    topology: loaded.topology,
                     source: loaded.source,
                     clean: None,
                     against_clean: None,
