@@ -77,6 +77,7 @@ use crate::mesh::TriMesh;
 use crate::Progress;
 use glam::DVec3;
 use rayon::prelude::*;
+use std::sync::atomic::{AtomicU32, Ordering::Relaxed};
 use std::time::Instant;
 
 pub(super) const NEVER: u32 = u32::MAX;
@@ -242,16 +243,24 @@ struct PassState {
     fan_offsets: Vec<u32>,
     fans: Vec<[u32; 2]>,
     cursor: Vec<u32>,
-    /// `(cost bits << 32) | vertex`, sorted into visiting order.
-    keys: Vec<u64>,
-    sort_buffer: Vec<u64>,
+    /// Each vertex's cost, as the bits of a non-negative f32.
+    cost: Vec<u32>,
     /// Whether the vertex's fan is open (it is on a boundary).
     open: Vec<bool>,
-    /// `FREE`, `LOCKED`, or the collapse target of a vertex removed in this pass.
-    mark: Vec<u32>,
+    /// `FREE`, `LOCKED`, or the collapse target of a vertex removed in this pass. (This and
+    /// the next three are atomics only so that regions can be visited at the same time: a
+    /// region's visits read and write only its own vertices' entries, with relaxed loads and
+    /// stores, which are plain moves.)
+    mark: Vec<AtomicU32>,
     /// Vertices collapsed into a vertex during this pass, as linked lists.
-    absorbed_head: Vec<u32>,
-    absorbed_next: Vec<u32>,
+    absorbed_head: Vec<AtomicU32>,
+    absorbed_next: Vec<AtomicU32>,
+    /// `Level::crease` during the pass (empty when creases are not kept).
+    crease: Vec<[AtomicU32; 2]>,
+    /// Whether every neighbour of a vertex is in its region (of the current round).
+    inside: Vec<bool>,
+    /// Whether a vertex was visited in an earlier round of this pass.
+    visited: Vec<bool>,
     /// Id in the next level of every vertex's image (its target's if removed).
     label: Vec<u32>,
 }
@@ -279,11 +288,9 @@ fn passes(
     let isolated = n - level.points.len();
     let mut next = Level::default();
     let mut state = PassState::default();
-    let mut scratch = Scratch::default();
     let start_vertices = level.points.len() as f64;
     let goal = (start_vertices - options.min_vertices as f64).max(1.0);
     let mut vertex_count = n;
-    let mut visits = 0usize;
 
     for pass in 0..options.max_levels.max(1) as u32 {
         // Pass 0 always builds its fans, to check the input.
@@ -314,93 +321,30 @@ fn passes(
                 break;
             }
         }
-        visiting_order(&level, options, &mut state);
+        vertex_costs(&level, options, &mut state);
 
-        state.mark.clear();
-        state.mark.resize(level_vertices, FREE);
-        state.absorbed_head.clear();
-        state.absorbed_head.resize(level_vertices, NEVER);
-        state.absorbed_next.resize(level_vertices, NEVER);
-        let mut removed = 0usize;
-        for &key in &state.keys {
-            visits += 1;
-            if visits.is_multiple_of(REPORT_EVERY) {
-                let done = (start_vertices - vertex_count as f64 + isolated as f64) / goal;
-                if !progress.report(done.clamp(0.0, 1.0) as f32) {
-                    return Err(BuildFailure::Cancelled);
-                }
-            }
-            if vertex_count <= options.min_vertices {
-                break;
-            }
-            let v = key as u32;
-            if state.mark[v as usize] != FREE {
-                continue;
-            }
-            let open = state.open[v as usize];
-            if open && options.keep_boundary
-                || pinned
-                    .get(level.vertex_id[v as usize] as usize)
-                    .is_some_and(|&p| p)
-            {
-                continue;
-            }
-            // A crease vertex collapses only along its crease; a corner never. Nor when its crease
-            // neighbours are joined by an edge already: a loop of three would close on itself, and
-            // where a face holds the three (a noisy crease zigzags), the split would put the vertex
-            // back between the other two, on their line, and leave that face with no area.
-            let along = level.crease.get(v as usize).copied().unwrap_or(NO_CREASE);
-            if along == CORNER
-                || along != NO_CREASE
-                    && (level.crease[along[0] as usize].contains(&along[1])
-                        || state.fans[state.fan_offsets[v as usize] as usize
-                            ..state.fan_offsets[v as usize + 1] as usize]
-                            .iter()
-                            .any(|&[a, b]| along == [a, b] || along == [b, a]))
-            {
-                continue;
-            }
-            let along = (along != NO_CREASE).then_some(along);
-            let view = PassView {
-                points: &level.points,
-                fan_offsets: &state.fan_offsets,
-                fans: &state.fans,
-                mark: &state.mark,
-                absorbed_head: &state.absorbed_head,
-                absorbed_next: &state.absorbed_next,
-            };
-            let Some((k, six_volume)) =
-                choose_collapse(v, open, along, &view, &level.vertex_id, &mut scratch)
-            else {
-                continue;
-            };
-            if let Some([a, b]) = along {
-                // The crease now runs w - k.
-                let w = if k == a { b } else { a };
-                for (x, from, to) in [(k, v, w), (w, v, k)] {
-                    for slot in level.crease[x as usize].iter_mut() {
-                        if *slot == from {
-                            *slot = to;
-                        }
-                    }
-                }
-            }
-
-            // Perform v -> k: faces are relabelled when the next level is built (a pass's
-            // collapses touch disjoint face sets, so they compose as one simultaneous relabelling).
-            state.mark[v as usize] = k;
-            for &x in &scratch.neighbors {
-                state.mark[x as usize] = LOCKED;
-            }
-            state.absorbed_next[v as usize] = state.absorbed_head[k as usize];
-            state.absorbed_head[k as usize] = v;
+        // How many vertices this pass may remove before the level reaches `min_vertices`.
+        let budget = vertex_count.saturating_sub(options.min_vertices);
+        let removals = visit_level(
+            &mut level,
+            &mut state,
+            &pinned,
+            options,
+            budget,
+            &mut |removed| {
+                let done =
+                    (start_vertices - (vertex_count - removed) as f64 + isolated as f64) / goal;
+                progress.report(done.clamp(0.0, 1.0) as f32)
+            },
+        )?;
+        let removed = removals.len();
+        for &(v, k, six_volume) in &removals {
             let id = level.vertex_id[v as usize] as usize;
             out.removed_in_pass[id] = pass;
             out.target[id] = level.vertex_id[k as usize];
-            out.six_split_volume[id] = six_volume as f32;
-            vertex_count -= 1;
-            removed += 1;
+            out.six_split_volume[id] = six_volume;
         }
+        vertex_count -= removed;
         if removed == 0 {
             break;
         }
@@ -412,9 +356,9 @@ fn passes(
             // last pass cut short by `min_vertices` is kept).
             // (Kept creases make these: once the smooth parts are coarse, only crease vertices
             // can still collapse, a few per pass, and multires from such levels lost volume.)
-            for (v, &m) in state.mark.iter().enumerate() {
-                if m < LOCKED {
-                    let id = level.vertex_id[v] as usize;
+            for &(v, _, _) in &removals {
+                {
+                    let id = level.vertex_id[v as usize] as usize;
                     out.removed_in_pass[id] = NEVER;
                     out.target[id] = NEVER;
                     out.six_split_volume[id] = 0.0;
@@ -433,6 +377,240 @@ fn passes(
         out.pass_ms.push(started.elapsed().as_secs_f64() * 1e3);
     }
     Ok(out)
+}
+
+/// How a level is cut into regions that are visited at the same time: consecutive ranges of its
+/// vertices (which are in Morton order, so a range is a compact patch), of at least `min` vertices
+/// and at most `max_count` of them. The sizes depend on the level only, never on the number of
+/// threads, so the hierarchy does not either.
+#[derive(Clone, Copy, Debug)]
+pub(super) struct RegionSize {
+    pub min: usize,
+    pub max_count: usize,
+}
+
+impl RegionSize {
+    /// Regions of 16k vertices at least (a region's arrays then fit in the last-level cache)
+    /// and at most 64 of them (the border share stays small on big meshes).
+    pub const DEFAULT: RegionSize = RegionSize {
+        min: 16_384,
+        max_count: 64,
+    };
+
+    /// Vertices per region for a level of `vertices`, or `None` when it is too small for two.
+    fn for_level(self, vertices: usize) -> Option<usize> {
+        (vertices >= 2 * self.min.max(1))
+            .then(|| self.min.max(vertices.div_ceil(self.max_count.max(1))))
+    }
+}
+
+/// One removal of a pass: the vertex, its collapse target and its six split volume.
+type Removal = (u32, u32, f32);
+
+/// Visits the level's vertices and returns the pass's removals.
+///
+/// In regions (when the level has room for two): in a first round, each region visits its
+/// *interior* vertices (those whose two-ring is in the region) in cost order, all regions at
+/// once; a second round does the same with regions shifted by half a region, for the vertices
+/// not visited yet; the rest are visited in cost order, one at a time. A visit reads the state of
+/// its vertex's two-ring and writes only that of its one-ring (marks, absorbed lists, crease
+/// neighbours), so interior visits of different regions of one round never meet, and the result
+/// is the same for any number of threads. If the regions removed more than `budget` (the level
+/// would go below `min_vertices`), the pass is visited again one vertex at a time, as a level
+/// too small for regions is: every vertex in cost order, stopping once `budget` are removed.
+///
+/// Cost order: increasing cost, ties by M0 id. `report` is called now and then with the
+/// removals so far; `false` cancels.
+fn visit_level(
+    level: &mut Level,
+    state: &mut PassState,
+    pinned: &[bool],
+    options: &HierarchyOptions,
+    budget: usize,
+    report: &mut dyn FnMut(usize) -> bool,
+) -> Result<Vec<Removal>, BuildFailure> {
+    if !report(0) {
+        return Err(BuildFailure::Cancelled);
+    }
+    let n = level.points.len();
+    let mut removals = Vec::new();
+    reset_pass(level, state);
+    state.visited.clear();
+    state.visited.resize(n, false);
+    if let Some(size) = options.regions.for_level(n) {
+        for offset in [0, size / 2] {
+            find_inside(state, size, offset);
+            let view = PassView::new(level, state, pinned, options.keep_boundary);
+            let region_count = (n + offset).div_ceil(size);
+            let per_region: Vec<(Vec<u32>, Vec<Removal>)> = (0..region_count)
+                .into_par_iter()
+                .map_init(Scratch::default, |scratch, r| {
+                    let range = (r * size).saturating_sub(offset)..((r + 1) * size - offset).min(n);
+                    let mut order = Vec::new();
+                    let interior = range.filter(|&v| {
+                        !state.visited[v]
+                            && state.inside[v]
+                            && view
+                                .fan(v as u32)
+                                .iter()
+                                .all(|&[a, b]| state.inside[a as usize] && state.inside[b as usize])
+                    });
+                    in_cost_order(interior, state, level, &mut order);
+                    let removed = order
+                        .iter()
+                        .filter_map(|&v| visit(v, &view, scratch).map(|(k, vol)| (v, k, vol)))
+                        .collect();
+                    (order, removed)
+                })
+                .collect();
+            for (visited, removed) in per_region {
+                for v in visited {
+                    state.visited[v as usize] = true;
+                }
+                removals.extend(removed);
+            }
+        }
+        if removals.len() > budget {
+            removals.clear();
+            reset_pass(level, state);
+            state.visited.fill(false);
+        }
+    }
+    let mut order = Vec::new();
+    let rest = (0..n).filter(|&v| !state.visited[v]);
+    in_cost_order(rest, state, level, &mut order);
+    let view = PassView::new(level, state, pinned, options.keep_boundary);
+    let mut scratch = Scratch::default();
+    for (visits, &v) in order.iter().enumerate() {
+        if visits % REPORT_EVERY == REPORT_EVERY - 1 && !report(removals.len()) {
+            return Err(BuildFailure::Cancelled);
+        }
+        if removals.len() >= budget {
+            break;
+        }
+        if let Some((k, vol)) = visit(v, &view, &mut scratch) {
+            removals.push((v, k, vol));
+        }
+    }
+    for (kept, during) in level.crease.iter_mut().zip(&state.crease) {
+        *kept = during.each_ref().map(|c| c.load(Relaxed));
+    }
+    Ok(removals)
+}
+
+/// `vertices` in cost order (increasing cost, ties by M0 id) into `order`.
+fn in_cost_order(
+    vertices: impl Iterator<Item = usize>,
+    state: &PassState,
+    level: &Level,
+    order: &mut Vec<u32>,
+) {
+    let mut keyed: Vec<(u64, u32)> = vertices
+        .map(|v| {
+            let key = (state.cost[v] as u64) << 32 | level.vertex_id[v] as u64;
+            (key, v as u32)
+        })
+        .collect();
+    // M0 ids are distinct, so the keys are: an unstable sort gives one order.
+    keyed.sort_unstable_by_key(|&(key, _)| key);
+    order.clear();
+    order.extend(keyed.iter().map(|&(_, v)| v));
+}
+
+/// Whether each vertex's neighbours are all in its region, for regions of `size` vertices whose
+/// boundaries are `offset` vertices early (into `state.inside`).
+fn find_inside(state: &mut PassState, size: usize, offset: usize) {
+    let (offsets, fans) = (&state.fan_offsets, &state.fans);
+    let n = offsets.len() - 1;
+    state.inside.resize(n, false);
+    state
+        .inside
+        .par_iter_mut()
+        .enumerate()
+        .with_min_len(4096)
+        .for_each(|(v, inside)| {
+            let start = ((v + offset) / size * size).saturating_sub(offset) as u32;
+            let end = ((v + offset) / size * size + size - offset) as u32;
+            *inside = fans[offsets[v] as usize..offsets[v + 1] as usize]
+                .iter()
+                .all(|&[a, b]| (start..end).contains(&a) && (start..end).contains(&b));
+        });
+}
+
+/// Every vertex free, no absorbed lists, the crease neighbours as the level has them.
+fn reset_pass(level: &Level, state: &mut PassState) {
+    let n = level.points.len();
+    let fill = |cells: &mut Vec<AtomicU32>, value: u32| {
+        cells.clear();
+        cells.resize_with(n, || AtomicU32::new(value));
+    };
+    fill(&mut state.mark, FREE);
+    fill(&mut state.absorbed_head, NEVER);
+    fill(&mut state.absorbed_next, NEVER);
+    state.crease.clear();
+    state
+        .crease
+        .extend(level.crease.iter().map(|c| c.map(AtomicU32::new)));
+}
+
+/// Visits `v`: if it is free and may go, performs its first valid collapse and returns the target
+/// and the six split volume.
+fn visit(v: u32, view: &PassView, scratch: &mut Scratch) -> Option<(u32, f32)> {
+    if view.mark[v as usize].load(Relaxed) != FREE {
+        return None;
+    }
+    let open = view.open[v as usize];
+    if open && view.keep_boundary
+        || view
+            .pinned
+            .get(view.vertex_id[v as usize] as usize)
+            .is_some_and(|&p| p)
+    {
+        return None;
+    }
+    // A crease vertex collapses only along its crease; a corner never. Nor when its crease
+    // neighbours are joined by an edge already: a loop of three would close on itself, and where a
+    // face holds the three (a noisy crease zigzags), the split would put the vertex back between
+    // the other two, on their line, and leave that face with no area.
+    let crease_of = |u: u32| view.crease[u as usize].each_ref().map(|c| c.load(Relaxed));
+    let along = if view.crease.is_empty() {
+        NO_CREASE
+    } else {
+        crease_of(v)
+    };
+    if along == CORNER
+        || along != NO_CREASE
+            && (crease_of(along[0]).contains(&along[1])
+                || view
+                    .fan(v)
+                    .iter()
+                    .any(|&[a, b]| along == [a, b] || along == [b, a]))
+    {
+        return None;
+    }
+    let along = (along != NO_CREASE).then_some(along);
+    let (k, six_volume) = choose_collapse(v, open, along, view, scratch)?;
+    if let Some([a, b]) = along {
+        // The crease now runs w - k.
+        let w = if k == a { b } else { a };
+        for (x, from, to) in [(k, v, w), (w, v, k)] {
+            for slot in &view.crease[x as usize] {
+                if slot.load(Relaxed) == from {
+                    slot.store(to, Relaxed);
+                }
+            }
+        }
+    }
+    // Perform v -> k: faces are relabelled when the next level is built (a pass's collapses touch
+    // disjoint face sets, so they compose as one simultaneous relabelling).
+    view.mark[v as usize].store(k, Relaxed);
+    for &x in &scratch.neighbors {
+        view.mark[x as usize].store(LOCKED, Relaxed);
+    }
+    let head = view.absorbed_head[k as usize].load(Relaxed);
+    view.absorbed_next[v as usize].store(head, Relaxed);
+    view.absorbed_head[k as usize].store(v, Relaxed);
+    Some((k, six_volume as f32))
 }
 
 /// The fans of a level with `vertex_count` vertices in CSR form, by a counting sort of the
@@ -462,15 +640,15 @@ fn build_fans(corners: &[[u32; 3]], vertex_count: usize, state: &mut PassState) 
     }
 }
 
-/// The level's vertices in increasing cost (ties by M0 id) into `state.keys`, and which of them
-/// are on a boundary into `state.open`.
-fn visiting_order(level: &Level, options: &HierarchyOptions, state: &mut PassState) {
+/// Every vertex's cost (as the bits of a non-negative f32, which order like the value) into
+/// `state.cost`, and whether it is on a boundary into `state.open`.
+fn vertex_costs(level: &Level, options: &HierarchyOptions, state: &mut PassState) {
     let vertex_count = level.points.len();
     let (offsets, fans, points) = (&state.fan_offsets, &state.fans, &level.points);
-    state.keys.resize(vertex_count, 0);
+    state.cost.resize(vertex_count, 0);
     state.open.resize(vertex_count, false);
     state
-        .keys
+        .cost
         .par_iter_mut()
         .zip(state.open.par_iter_mut())
         .enumerate()
@@ -508,23 +686,8 @@ fn visiting_order(level: &Level, options: &HierarchyOptions, state: &mut PassSta
             } else {
                 f32::INFINITY.to_bits()
             };
-            *key = (bits as u64) << 32 | v as u64;
+            *key = bits;
         });
-    sort_by_high_half(&mut state.keys, &mut state.sort_buffer);
-    // Equal costs go by M0's vertex id (the sort left them by level id).
-    let keys = &mut state.keys;
-    let mut run = 0;
-    while run < keys.len() {
-        let cost = keys[run] >> 32;
-        let mut end = run + 1;
-        while end < keys.len() && keys[end] >> 32 == cost {
-            end += 1;
-        }
-        if end - run > 1 {
-            keys[run..end].sort_unstable_by_key(|&k| level.vertex_id[k as u32 as usize]);
-        }
-        run = end;
-    }
 }
 
 /// Stable LSD radix sort of `keys` by their upper 32 bits, a byte at a time (bytes that are the
@@ -571,7 +734,8 @@ fn next_level(
     next.corners.clear();
     next.face_id.clear();
     next.crease.clear();
-    let (mark, label) = (&state.mark, &mut state.label);
+    let mark: Vec<u32> = state.mark.iter().map(|m| m.load(Relaxed)).collect();
+    let label = &mut state.label;
     label.clear();
     label.resize(level.points.len(), NEVER);
     for (v, &m) in mark.iter().enumerate() {
@@ -673,14 +837,43 @@ fn is_one_fan(fan: &[[u32; 2]], next: &mut Vec<usize>) -> bool {
 /// No face (in `is_one_fan`).
 const NONE: usize = usize::MAX;
 
-/// Read-only view of the pass state for choosing a collapse.
+/// The level and the pass state as visits see them.
 struct PassView<'a> {
     points: &'a [[f32; 3]],
+    vertex_id: &'a [u32],
     fan_offsets: &'a [u32],
     fans: &'a [[u32; 2]],
-    mark: &'a [u32],
-    absorbed_head: &'a [u32],
-    absorbed_next: &'a [u32],
+    open: &'a [bool],
+    /// Per M0 id, empty when nothing is pinned.
+    pinned: &'a [bool],
+    keep_boundary: bool,
+    mark: &'a [AtomicU32],
+    absorbed_head: &'a [AtomicU32],
+    absorbed_next: &'a [AtomicU32],
+    crease: &'a [[AtomicU32; 2]],
+}
+
+impl<'a> PassView<'a> {
+    fn new(
+        level: &'a Level,
+        state: &'a PassState,
+        pinned: &'a [bool],
+        keep_boundary: bool,
+    ) -> Self {
+        PassView {
+            points: &level.points,
+            vertex_id: &level.vertex_id,
+            fan_offsets: &state.fan_offsets,
+            fans: &state.fans,
+            open: &state.open,
+            pinned,
+            keep_boundary,
+            mark: &state.mark,
+            absorbed_head: &state.absorbed_head,
+            absorbed_next: &state.absorbed_next,
+            crease: &state.crease,
+        }
+    }
 }
 
 impl PassView<'_> {
@@ -692,7 +885,7 @@ impl PassView<'_> {
     /// The current label of a vertex of the level: its target if removed in this pass.
     #[inline]
     fn current(&self, c: u32) -> u32 {
-        let m = self.mark[c as usize];
+        let m = self.mark[c as usize].load(Relaxed);
         if m < LOCKED {
             m
         } else {
@@ -711,7 +904,7 @@ impl PassView<'_> {
                 visit(a, b);
             }
         }
-        let mut absorbed = self.absorbed_head[k as usize];
+        let mut absorbed = self.absorbed_head[k as usize].load(Relaxed);
         while absorbed != NEVER {
             for &[a, b] in self.fan(absorbed) {
                 // The absorbed vertex's neighbours were locked when it went: they are unchanged.
@@ -719,7 +912,7 @@ impl PassView<'_> {
                     visit(a, b);
                 }
             }
-            absorbed = self.absorbed_next[absorbed as usize];
+            absorbed = self.absorbed_next[absorbed as usize].load(Relaxed);
         }
     }
 }
@@ -740,9 +933,9 @@ fn choose_collapse(
     on_boundary: bool,
     along: Option<[u32; 2]>,
     view: &PassView,
-    m0_id: &[u32],
     scratch: &mut Scratch,
 ) -> Option<(u32, f64)> {
+    let m0_id = view.vertex_id;
     let fan = view.fan(v);
     if fan.is_empty() {
         return None;

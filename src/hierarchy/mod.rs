@@ -61,6 +61,8 @@ pub struct HierarchyOptions {
     /// into one of its two neighbours along the crease, and corners never collapse, so every
     /// level keeps M0's creases and corners ([`Hierarchy::level_creases`]). `None`: no creases.
     pub creases: Option<CreaseOptions>,
+    /// How a level is cut into regions visited in parallel (tests make them small).
+    pub(crate) regions: decimate::RegionSize,
 }
 
 with_setters!(HierarchyOptions {
@@ -81,6 +83,7 @@ impl Default for HierarchyOptions {
             max_levels: 64,
             keep_boundary: false,
             creases: None,
+            regions: decimate::RegionSize::DEFAULT,
         }
     }
 }

@@ -288,3 +288,74 @@ fn same_hierarchy_on_one_thread_and_on_several() {
         }
     }
 }
+
+/// Small regions, so that meshes of a few thousand vertices are visited in regions.
+fn in_small_regions(options: HierarchyOptions) -> HierarchyOptions {
+    HierarchyOptions {
+        regions: decimate::RegionSize {
+            min: 128,
+            max_count: 64,
+        },
+        ..options
+    }
+}
+
+#[test]
+fn levels_visited_in_regions_are_valid_and_the_same_on_any_thread_count() {
+    let mut mesh = sphere(5);
+    for (i, p) in mesh.positions.iter_mut().enumerate() {
+        let bump = 1.0 + 0.02 * ((i * 7919 % 101) as f32 / 101.0);
+        *p = p.map(|c| c * bump);
+    }
+    let options = in_small_regions(HierarchyOptions::default());
+    let build_on = |threads: usize| {
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap()
+            .install(|| build_hierarchy(&mesh, &options, &mut NoProgress))
+            .unwrap()
+    };
+    let one = build_on(1);
+    for threads in [2, 3, 5] {
+        let several = build_on(threads);
+        assert_eq!(several.vertex_order(), one.vertex_order());
+        for level in 0..one.level_count() {
+            assert_eq!(several.level_info(level), one.level_info(level));
+            assert_eq!(several.level_triangles(level), one.level_triangles(level));
+        }
+        for v in 0..mesh.vertex_count() as u32 {
+            assert_eq!(several.collapse_target(v), one.collapse_target(v));
+            assert_eq!(
+                several.six_split_volume(v).to_bits(),
+                one.six_split_volume(v).to_bits()
+            );
+        }
+    }
+    // Every level an oriented manifold of the same topology, removals independent.
+    let checked = check_levels(&mesh, &options);
+    assert_eq!(checked.vertex_order(), one.vertex_order());
+    // (The regions were used: one vertex at a time visits in another order.)
+    let sequential = build_hierarchy(&mesh, &HierarchyOptions::default(), &mut NoProgress).unwrap();
+    assert_ne!(sequential.vertex_order(), one.vertex_order());
+}
+
+#[test]
+fn creases_survive_every_level_visited_in_regions() {
+    let mesh = crate::mesh::shapes::cuboid([2.0, 1.0, 0.5], 0.04);
+    let options = in_small_regions(
+        HierarchyOptions::default().with_creases(Some(crate::fairing::CreaseOptions::default())),
+    );
+    let h = check_levels(&mesh, &options);
+    assert!(h.crease_edges().len() > 100);
+    for level in 0..h.level_count() {
+        let creases = h.level_creases(level).expect("creases kept");
+        let topology = Topology::build(&h.level_mesh(level));
+        for [a, b] in creases.edges {
+            assert!(
+                topology.neighbors(a).contains(&b),
+                "level {level}: crease edge {a}-{b} is no edge of the level"
+            );
+        }
+    }
+}
