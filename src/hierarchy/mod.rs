@@ -62,7 +62,7 @@ pub struct HierarchyOptions {
     /// level keeps M0's creases and corners ([`Hierarchy::level_creases`]). `None`: no creases.
     pub creases: Option<CreaseOptions>,
     /// How a level is cut into regions visited in parallel (tests make them small).
-    pub(crate) regions: decimate::RegionSize,
+    regions: decimate::RegionSize,
 }
 
 with_setters!(HierarchyOptions {
