@@ -1,7 +1,7 @@
 //! CPU time the UI thread spends per frame, for the Performance section and `--log-frames`.
 
 use std::collections::VecDeque;
-use std::time::Duration;
+use std::time::{Duration, Instant};
 
 /// CPU time the UI thread spent per frame, for the performance readout.
 #[derive(Default)]
@@ -16,6 +16,10 @@ pub struct FrameStats {
     pub(super) log_over: Option<Duration>,
     /// The main viewport's image count at the last frame (to tell whether it drew since).
     pub(super) images_seen: u64,
+    /// When the previous frame began (for the wait of input, see [`FrameStats::record_start`]).
+    previous_start: Option<Instant>,
+    /// When the first frame began (the log says when each late frame came).
+    first_start: Option<Instant>,
 }
 
 impl FrameStats {
@@ -56,6 +60,36 @@ impl FrameStats {
             self.max_while_busy_parts = parts;
         }
         self.frames += 1;
+    }
+
+    /// Notes the start of a frame. With logging on, a frame that takes input events more than
+    /// `max(limit, 50 ms)` after the previous frame began is printed: while input arrives
+    /// continuously (a pointer being moved), that gap is how long the input waited for an answer,
+    /// whatever held the window (the UI thread, the GPU, the window system). After a quiet
+    /// spell the gap only says the window was idle.
+    pub(super) fn record_start(&mut self, started: Instant, had_input: bool) {
+        let previous = self.previous_start.replace(started);
+        let first = *self.first_start.get_or_insert(started);
+        let (Some(limit), Some(previous)) = (self.log_over, previous) else {
+            return;
+        };
+        let gap = started.saturating_duration_since(previous);
+        if had_input && gap > limit.max(Duration::from_millis(50)) {
+            eprintln!(
+                "frame {} at {:.2} s: input waited up to {:.1} ms (since the previous frame began)",
+                self.frames,
+                started.saturating_duration_since(first).as_secs_f64(),
+                gap.as_secs_f64() * 1e3
+            );
+        }
+    }
+
+    /// With logging on, prints when a background job's result arrived (to tell which long frames
+    /// followed which result).
+    pub(super) fn log_arrival(&self, what: &str) {
+        if let (Some(_), Some(first)) = (self.log_over, self.first_start) {
+            eprintln!("at {:.2} s: {what} arrived", first.elapsed().as_secs_f64());
+        }
     }
 
     /// Frame statistics that print frames over `limit` to standard error.

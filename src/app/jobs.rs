@@ -313,6 +313,26 @@ pub enum JobResult {
     },
 }
 
+impl JobResult {
+    /// What arrived, in a few words (for `--log-frames`).
+    pub fn describe(&self) -> &'static str {
+        match self {
+            JobResult::Loaded { .. } => "a loaded file",
+            JobResult::Hierarchy { .. } => "the hierarchy",
+            JobResult::Faired { .. } => "a fairing result",
+            JobResult::LevelMesh { .. } => "a level mesh",
+            JobResult::Measured { .. } => "measures",
+            JobResult::MeasureStopped { .. } => "a stopped measure",
+            JobResult::Noised { .. } => "the noisy mesh",
+            JobResult::Exported { .. } => "an export",
+            JobResult::LevelsExported { .. } => "the level files",
+            JobResult::ViewCaptured { .. } => "the window's pixels",
+            JobResult::ViewImageSaved { .. } => "a saved view image",
+            JobResult::DialogPicked { .. } => "a file dialog's answer",
+        }
+    }
+}
+
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum DialogPurpose {
     Open,

@@ -263,6 +263,8 @@ impl eframe::App for App {
     fn ui(&mut self, ui: &mut egui::Ui, _frame: &mut eframe::Frame) {
         let started = Instant::now();
         let ctx = ui.ctx().clone();
+        let had_input = ctx.input(|i| !i.events.is_empty());
+        self.frame_stats.record_start(started, had_input);
         // Busy at the start counts too: the frame that applies the last result is a working one.
         let busy_before = self.busy();
         self.poll_results();

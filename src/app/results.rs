@@ -22,6 +22,7 @@ impl App {
     /// Applies every result that has come back since the last frame.
     pub(super) fn poll_results(&mut self) {
         while let Ok((result, ticket)) = self.results_rx.try_recv() {
+            self.frame_stats.log_arrival(result.describe());
             self.apply_result(result);
             // The job counts as finished only once its result is applied.
             drop(ticket);
