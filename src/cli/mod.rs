@@ -32,7 +32,9 @@ pub struct EditArgs {
     /// The mesh to open; the bundled bunny when left out.
     pub file: Option<PathBuf>,
     /// Print every UI frame that takes more than MS milliseconds of CPU time to standard error,
-    /// split into its parts (applying results, uploading to the GPU, widgets, viewport draw).
+    /// split into its parts (applying results, uploading to the GPU, widgets, viewport draw);
+    /// also every frame whose input waited more than MS (at least 50) milliseconds since the
+    /// previous frame began, and when each background result arrived.
     #[arg(long, value_name = "MS")]
     pub log_frames: Option<f64>,
     /// Close the window once the mesh is loaded and all work is done, printing one line about it
