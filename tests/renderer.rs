@@ -175,3 +175,55 @@ fn uploaded_normals_follow_the_positions_on_screen() {
         assert!(moved[centre][2] > 0.999);
     }
 }
+
+/// Draws what is on screen into a target of `size`, checking that wgpu reports no error.
+fn draw(renderer: &mut MeshRenderer, device: &wgpu::Device, queue: &wgpu::Queue, size: [u32; 2]) {
+    let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
+    renderer.ensure_target(device, size);
+    let params = fairmesh::render::DrawParams {
+        view_proj: [
+            [0.01, 0.0, 0.0, 0.0],
+            [0.0, 0.01, 0.0, 0.0],
+            [0.0, 0.0, -0.01, 0.0],
+            [-1.0, -1.0, 0.5, 1.0],
+        ],
+        eye: [100.0, 100.0, 100.0],
+        light_dir: [0.0, 0.0, 1.0],
+        fill_dir: [1.0, 0.0, 0.0],
+        up: [0.0, 1.0, 0.0],
+        shading: Default::default(),
+        lighting: Default::default(),
+        wireframe: false,
+        scalar_range: None,
+        mask_tint: false,
+        size,
+    };
+    let mut encoder = device.create_command_encoder(&Default::default());
+    assert!(renderer.render(device, queue, &mut encoder, &params));
+    queue.submit([encoder.finish()]);
+    let error = pollster::block_on(scope.pop());
+    assert!(error.is_none(), "{error:?}");
+}
+
+#[test]
+fn a_software_renderer_draws_big_meshes_with_one_sample_and_small_ones_with_four() {
+    let (device, queue) = device();
+    let mut renderer = MeshRenderer::new(&device, Arc::new(|| {}));
+    renderer.set_async_upload_bytes(0);
+    renderer.set_software_adapter(true);
+    // 460² quads: 423k faces, over the threshold.
+    let big = 460;
+    assert!(2 * big * big > fairmesh::render::SOFTWARE_SINGLE_SAMPLE_FACES as u32);
+    for (n, samples) in [(20, 4), (big, 1), (20, 4)] {
+        renderer.set_mesh(&device, Arc::new(Grid::new(n)));
+        wait_for_uploads(&mut renderer, &queue);
+        assert_eq!(renderer.samples(), samples, "{n}×{n} grid");
+        draw(&mut renderer, &device, &queue, [64, 48]);
+    }
+    // A GPU keeps its four samples for any mesh.
+    renderer.set_software_adapter(false);
+    renderer.set_mesh(&device, Arc::new(Grid::new(big)));
+    wait_for_uploads(&mut renderer, &queue);
+    assert_eq!(renderer.samples(), 4);
+    draw(&mut renderer, &device, &queue, [64, 48]);
+}

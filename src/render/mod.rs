@@ -14,7 +14,7 @@ pub mod normals;
 pub mod pipeline;
 pub mod shading;
 
-pub use pipeline::{DrawParams, MeshRenderer, MeshSource};
+pub use pipeline::{DrawParams, MeshRenderer, MeshSource, SOFTWARE_SINGLE_SAMPLE_FACES};
 pub use shading::{Lighting, Shading};
 
 use egui_wgpu::wgpu;
@@ -38,7 +38,10 @@ impl Viewport3d {
     /// device; `ctx` repaints when a background upload lands.
     pub fn new(state: &egui_wgpu::RenderState, ctx: &egui::Context) -> Self {
         let ctx = ctx.clone();
-        let renderer = MeshRenderer::new(&state.device, Arc::new(move || ctx.request_repaint()));
+        let mut renderer =
+            MeshRenderer::new(&state.device, Arc::new(move || ctx.request_repaint()));
+        renderer
+            .set_software_adapter(state.adapter.get_info().device_type == wgpu::DeviceType::Cpu);
         let mut egui_renderer = state.renderer.write();
         let resources = &mut egui_renderer.callback_resources;
         if resources.get::<MeshRenderers>().is_none() {

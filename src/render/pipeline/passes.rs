@@ -6,7 +6,7 @@
 use bytemuck::{Pod, Zeroable};
 
 use super::buffers::MeshBuffers;
-use super::{DrawParams, COLOR_FORMAT, DEPTH_FORMAT, SAMPLE_COUNT};
+use super::{DrawParams, COLOR_FORMAT, DEPTH_FORMAT};
 use crate::render::shading::{Lighting, Shading};
 
 #[repr(C)]
@@ -64,14 +64,16 @@ impl Uniforms {
 /// single-sample colour texture that egui shows.
 pub(super) struct Target {
     pub(super) size: [u32; 2],
-    multisampled: wgpu::TextureView,
+    pub(super) samples: u32,
+    /// The colour drawn into and resolved from; `None` with one sample (drawn into `resolved`).
+    multisampled: Option<wgpu::TextureView>,
     pub(super) resolved: wgpu::TextureView,
     depth: wgpu::TextureView,
 }
 
 impl Target {
-    /// Textures of `size` (physical pixels) on `device`.
-    pub(super) fn new(device: &wgpu::Device, size: [u32; 2]) -> Self {
+    /// Textures of `size` (physical pixels) with `samples` per pixel on `device`.
+    pub(super) fn new(device: &wgpu::Device, size: [u32; 2], samples: u32) -> Self {
         let extent = wgpu::Extent3d {
             width: size[0],
             height: size[1],
@@ -93,12 +95,15 @@ impl Target {
         };
         Self {
             size,
-            multisampled: make(
-                "fairmesh colour (multisampled)",
-                COLOR_FORMAT,
-                SAMPLE_COUNT,
-                wgpu::TextureUsages::RENDER_ATTACHMENT,
-            ),
+            samples,
+            multisampled: (samples > 1).then(|| {
+                make(
+                    "fairmesh colour (multisampled)",
+                    COLOR_FORMAT,
+                    samples,
+                    wgpu::TextureUsages::RENDER_ATTACHMENT,
+                )
+            }),
             resolved: make(
                 "fairmesh colour",
                 COLOR_FORMAT,
@@ -108,7 +113,7 @@ impl Target {
             depth: make(
                 "fairmesh depth",
                 DEPTH_FORMAT,
-                SAMPLE_COUNT,
+                samples,
                 wgpu::TextureUsages::RENDER_ATTACHMENT,
             ),
         }
@@ -124,7 +129,8 @@ pub(super) struct Pipelines {
 }
 
 impl Pipelines {
-    pub(super) fn new(device: &wgpu::Device) -> Self {
+    /// Pipelines drawing into targets with `samples` per pixel.
+    pub(super) fn new(device: &wgpu::Device, samples: u32) -> Self {
         let shader = device.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some("fairmesh mesh shader"),
             source: wgpu::ShaderSource::Wgsl(include_str!("../../../shaders/mesh.wgsl").into()),
@@ -163,8 +169,8 @@ impl Pipelines {
         });
 
         Self {
-            fill: fill_pipeline(device, &layout, &shader),
-            line: line_pipeline(device, &layout, &shader),
+            fill: fill_pipeline(device, &layout, &shader, samples),
+            line: line_pipeline(device, &layout, &shader, samples),
             uniform_buffer,
             bind_group,
         }
@@ -182,9 +188,9 @@ impl Pipelines {
         let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
             label: Some("fairmesh viewport"),
             color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                view: &target.multisampled,
+                view: target.multisampled.as_ref().unwrap_or(&target.resolved),
                 depth_slice: None,
-                resolve_target: Some(&target.resolved),
+                resolve_target: target.multisampled.as_ref().map(|_| &target.resolved),
                 ops: wgpu::Operations {
                     load: wgpu::LoadOp::Clear(wgpu::Color {
                         r: 0.018,
@@ -192,7 +198,12 @@ impl Pipelines {
                         b: 0.026,
                         a: 1.0,
                     }),
-                    store: wgpu::StoreOp::Discard,
+                    // The multisampled colour is resolved; a single-sample one is the image.
+                    store: if target.multisampled.is_some() {
+                        wgpu::StoreOp::Discard
+                    } else {
+                        wgpu::StoreOp::Store
+                    },
                 },
             })],
             depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
@@ -269,9 +280,9 @@ fn color_targets() -> [Option<wgpu::ColorTargetState>; 1] {
 }
 
 /// The target's multisampling, for both pipelines.
-fn multisample() -> wgpu::MultisampleState {
+fn multisample(samples: u32) -> wgpu::MultisampleState {
     wgpu::MultisampleState {
-        count: SAMPLE_COUNT,
+        count: samples,
         ..Default::default()
     }
 }
@@ -281,6 +292,7 @@ fn fill_pipeline(
     device: &wgpu::Device,
     layout: &wgpu::PipelineLayout,
     shader: &wgpu::ShaderModule,
+    samples: u32,
 ) -> wgpu::RenderPipeline {
     let [position_layout, scalar_layout, normal_layout] = vertex_layouts();
     let targets = color_targets();
@@ -314,7 +326,7 @@ fn fill_pipeline(
                 clamp: 0.0,
             },
         }),
-        multisample: multisample(),
+        multisample: multisample(samples),
         fragment: Some(wgpu::FragmentState {
             module: shader,
             entry_point: Some("fs_mesh"),
@@ -331,6 +343,7 @@ fn line_pipeline(
     device: &wgpu::Device,
     layout: &wgpu::PipelineLayout,
     shader: &wgpu::ShaderModule,
+    samples: u32,
 ) -> wgpu::RenderPipeline {
     let [position_layout, _, _] = vertex_layouts();
     let targets = color_targets();
@@ -354,7 +367,7 @@ fn line_pipeline(
             stencil: Default::default(),
             bias: Default::default(),
         }),
-        multisample: multisample(),
+        multisample: multisample(samples),
         fragment: Some(wgpu::FragmentState {
             module: shader,
             entry_point: Some("fs_line"),
