@@ -82,6 +82,9 @@ pub struct MeshRenderer {
     single_sample: Option<Pipelines>,
     /// The adapter is a CPU (a software renderer): big meshes are drawn with one sample.
     software: bool,
+    /// Faces of the mesh last given to [`Self::set_mesh`], uploaded or not: the target gets that
+    /// mesh's sampling before its upload lands, so its first image is drawn once.
+    newest_faces: usize,
     mesh: Option<MeshBuffers>,
     target: Option<Target>,
     /// Parameters of the image now in the target; `None` forces a redraw.
@@ -123,6 +126,7 @@ impl MeshRenderer {
             pipelines: Pipelines::new(device, SAMPLE_COUNT),
             single_sample: None,
             software: false,
+            newest_faces: 0,
             mesh: None,
             target: None,
             drawn: None,
@@ -202,6 +206,7 @@ impl MeshRenderer {
         self.lines_requested = None;
         self.lines_failed = false;
         let (vertex_count, face_count) = (source.positions().len(), source.triangles().len());
+        self.newest_faces = face_count;
         // Positions and triangles take 12 bytes per vertex and per face.
         self.problem = self.too_big("the mesh", vertex_count.max(face_count) * 12, face_count);
         if vertex_count == 0 || face_count == 0 || self.problem.is_some() {
@@ -426,11 +431,10 @@ impl MeshRenderer {
         self.software = software;
     }
 
-    /// Samples per pixel the current mesh is drawn with (4, or 1 for a big mesh on a software
+    /// Samples per pixel the newest mesh is drawn with (4, or 1 for a big mesh on a software
     /// renderer).
     pub fn samples(&self) -> u32 {
-        let faces = self.mesh.as_ref().map_or(0, |m| m.index_count as usize / 3);
-        if self.software && faces > SOFTWARE_SINGLE_SAMPLE_FACES {
+        if self.software && self.newest_faces > SOFTWARE_SINGLE_SAMPLE_FACES {
             1
         } else {
             SAMPLE_COUNT
