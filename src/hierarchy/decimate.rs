@@ -194,7 +194,7 @@ fn first_level(mesh: &TriMesh, creases: Option<&Creases>) -> Level {
         })
         .collect();
     sort_by_high_half(&mut keys, &mut Vec::new());
-    let vertex_id: Vec<u32> = keys.iter().map(|&k| k as u32).collect();
+    let vertex_id: Vec<u32> = keys.par_iter().map(|&k| k as u32).collect();
     drop(keys);
     for (i, &v) in vertex_id.iter().enumerate() {
         level_of[v as usize] = i as u32;
@@ -237,11 +237,11 @@ fn first_level(mesh: &TriMesh, creases: Option<&Creases>) -> Level {
     Level {
         crease,
         points: vertex_id
-            .iter()
+            .par_iter()
             .map(|&v| mesh.positions[v as usize])
             .collect(),
         corners: face_id
-            .iter()
+            .par_iter()
             .map(|&f| mesh.triangles[f as usize].map(|c| level_of[c as usize]))
             .collect(),
         vertex_id,
