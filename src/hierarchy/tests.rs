@@ -261,17 +261,27 @@ fn same_hierarchy_on_one_thread_and_on_several() {
         let bump = 1.0 + 0.01 * ((i * 7919 % 101) as f32 / 101.0);
         *p = p.map(|c| c * bump);
     }
+    let one = same_on_thread_counts(&mesh, &HierarchyOptions::default(), &[2, 3]);
+    assert!(one.level_count() > 3);
+}
+
+/// The hierarchy of `mesh` built on one thread, after checking that it is built bit for bit the
+/// same on each of `threads`.
+fn same_on_thread_counts(
+    mesh: &TriMesh,
+    options: &HierarchyOptions,
+    threads: &[usize],
+) -> Hierarchy {
     let build_on = |threads: usize| {
         rayon::ThreadPoolBuilder::new()
             .num_threads(threads)
             .build()
             .unwrap()
-            .install(|| build_hierarchy(&mesh, &HierarchyOptions::default(), &mut NoProgress))
+            .install(|| build_hierarchy(mesh, options, &mut NoProgress))
             .unwrap()
     };
     let one = build_on(1);
-    assert!(one.level_count() > 3);
-    for threads in [2, 3] {
+    for &threads in threads {
         let several = build_on(threads);
         assert_eq!(several.vertex_order(), one.vertex_order());
         assert_eq!(several.level_count(), one.level_count());
@@ -287,6 +297,7 @@ fn same_hierarchy_on_one_thread_and_on_several() {
             );
         }
     }
+    one
 }
 
 /// Small regions, so that meshes of a few thousand vertices are visited in regions.
@@ -308,30 +319,7 @@ fn levels_visited_in_regions_are_valid_and_the_same_on_any_thread_count() {
         *p = p.map(|c| c * bump);
     }
     let options = in_small_regions(HierarchyOptions::default());
-    let build_on = |threads: usize| {
-        rayon::ThreadPoolBuilder::new()
-            .num_threads(threads)
-            .build()
-            .unwrap()
-            .install(|| build_hierarchy(&mesh, &options, &mut NoProgress))
-            .unwrap()
-    };
-    let one = build_on(1);
-    for threads in [2, 3, 5] {
-        let several = build_on(threads);
-        assert_eq!(several.vertex_order(), one.vertex_order());
-        for level in 0..one.level_count() {
-            assert_eq!(several.level_info(level), one.level_info(level));
-            assert_eq!(several.level_triangles(level), one.level_triangles(level));
-        }
-        for v in 0..mesh.vertex_count() as u32 {
-            assert_eq!(several.collapse_target(v), one.collapse_target(v));
-            assert_eq!(
-                several.six_split_volume(v).to_bits(),
-                one.six_split_volume(v).to_bits()
-            );
-        }
-    }
+    let one = same_on_thread_counts(&mesh, &options, &[2, 3, 5]);
     // Every level an oriented manifold of the same topology, removals independent.
     let checked = check_levels(&mesh, &options);
     assert_eq!(checked.vertex_order(), one.vertex_order());
