@@ -56,9 +56,9 @@
 //!   taken over squared lengths (square root and rounding to f32 are monotone, so they commute
 //!   with min and max), and a fan is open exactly when the sums of its `a`s and its `b`s differ
 //!   (see `vertex_costs`);
-//! - visits them (in regions, below), each list of visits sorted by cost. No face is rewritten during the pass: the removed vertices are independent,
-//!   so their collapses touch disjoint face sets and compose as one simultaneous relabelling
-//!   `v -> target[v]`. A vertex that is not locked still has exactly its pass-start fan; the
+//! - visits them (in regions, below), each list of visits sorted by cost. No face is rewritten
+//!   during the pass: the removed vertices are independent, so their collapses touch disjoint
+//!   face sets and compose as one simultaneous relabelling `v -> target[v]`. A vertex that is not locked still has exactly its pass-start fan; the
 //!   current faces of a collapse target `k` are its pass-start fan relabelled through this pass's
 //!   removals (a face that degenerates is gone) plus the fans of the vertices collapsed into it,
 //!   chained in `absorbed` lists. The cone volume of every candidate is summed over all of `v`'s
