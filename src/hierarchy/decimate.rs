@@ -57,14 +57,15 @@
 //!   with min and max), and a fan is open exactly when the sums of its `a`s and its `b`s differ
 //!   (see `vertex_costs`);
 //! - visits them (in regions, below), each list of visits sorted by cost. No face is rewritten
-//!   during the pass: the removed vertices are independent, so their collapses touch disjoint
-//!   face sets and compose as one simultaneous relabelling `v -> target[v]`. A vertex that is not locked still has exactly its pass-start fan; the
-//!   current faces of a collapse target `k` are its pass-start fan relabelled through this pass's
-//!   removals (a face that degenerates is gone) plus the fans of the vertices collapsed into it,
-//!   chained in `absorbed` lists. The cone volume of every candidate is summed over all of `v`'s
-//!   faces in fan order (those that contain the candidate add an exact zero), and candidates
-//!   are taken least first rather than sorted, since the first is nearly always valid. The
-//!   fan and link checks compare without early exits, which would be mispredicted;
+//!   during the pass: the removed vertices are independent, so their collapses touch disjoint face
+//!   sets and compose as one simultaneous relabelling `v -> target[v]`. A vertex that is not locked
+//!   still has exactly its pass-start fan; the current faces of a collapse target `k` are its
+//!   pass-start fan relabelled through this pass's removals (a face that degenerates is gone) plus
+//!   the fans of the vertices collapsed into it, chained in `absorbed` lists. The cone volume of
+//!   every candidate is summed over all of `v`'s faces in fan order (those that contain the
+//!   candidate add an exact zero), and candidates are taken least first rather than sorted, since
+//!   the first is nearly always valid. The fan and link checks compare without early exits, which
+//!   would be mispredicted;
 //! - writes the next level: survivors keep their order, faces are relabelled, and those that
 //!   degenerate are the removed ones.
 //!
