@@ -37,7 +37,7 @@ const SAMPLE_COUNT: u32 = 4;
 
 /// On a software renderer (lavapipe, llvmpipe: a CPU adapter), meshes with more faces than this
 /// are drawn without multisampling: the 1.2M-face bunny's image took 1.7 s with 4 samples and
-/// 0.67 s with one under lavapipe on two cores, and the window waits for it.
+/// 0.6-0.85 s with one under lavapipe on two cores, and the window waits for it.
 pub const SOFTWARE_SINGLE_SAMPLE_FACES: usize = 400_000;
 
 /// Everything that decides what one rendered image looks like, apart from the mesh itself.
