@@ -357,6 +357,19 @@ fn passes(
             },
         )?;
         let removed = removals.len();
+        if removed == 0 {
+            break;
+        }
+        if removed * MIN_PASS_SHARE < level_vertices
+            && pass > 0
+            && vertex_count - removed > options.min_vertices
+        {
+            // A level that barely differs from the one below: left out, and the build ends (a
+            // last pass cut short by `min_vertices` is kept).
+            // (Kept creases make these: once the smooth parts are coarse, only crease vertices
+            // can still collapse, a few per pass, and multires from such levels lost volume.)
+            break;
+        }
         for &(v, k, six_volume) in &removals {
             let id = level.vertex_id[v as usize] as usize;
             out.removed_in_pass[id] = pass;
@@ -364,27 +377,6 @@ fn passes(
             out.six_split_volume[id] = six_volume;
         }
         vertex_count -= removed;
-        if removed == 0 {
-            break;
-        }
-        if removed * MIN_PASS_SHARE < level_vertices
-            && pass > 0
-            && vertex_count > options.min_vertices
-        {
-            // A level that barely differs from the one below: left out, and the build ends (a
-            // last pass cut short by `min_vertices` is kept).
-            // (Kept creases make these: once the smooth parts are coarse, only crease vertices
-            // can still collapse, a few per pass, and multires from such levels lost volume.)
-            for &(v, _, _) in &removals {
-                {
-                    let id = level.vertex_id[v as usize] as usize;
-                    out.removed_in_pass[id] = NEVER;
-                    out.target[id] = NEVER;
-                    out.six_split_volume[id] = 0.0;
-                }
-            }
-            break;
-        }
         next_level(
             &level,
             &mut state,
@@ -753,24 +745,24 @@ fn next_level(
     next.corners.clear();
     next.face_id.clear();
     next.crease.clear();
-    let mark: Vec<u32> = state.mark.iter().map(|m| m.load(Relaxed)).collect();
-    let label = &mut state.label;
+    let (mark, label) = (&state.mark, &mut state.label);
+    let mark = || mark.iter().map(|m| m.load(Relaxed));
     label.clear();
     label.resize(level.points.len(), NEVER);
-    for (v, &m) in mark.iter().enumerate() {
+    for (v, m) in mark().enumerate() {
         if m >= LOCKED {
             label[v] = next.points.len() as u32;
             next.points.push(level.points[v]);
             next.vertex_id.push(level.vertex_id[v]);
         }
     }
-    for (v, &m) in mark.iter().enumerate() {
+    for (v, m) in mark().enumerate() {
         if m < LOCKED {
             label[v] = label[m as usize];
         }
     }
     // Crease neighbours were moved to survivors as the collapses happened.
-    for (&c, &m) in level.crease.iter().zip(mark.iter()) {
+    for (&c, m) in level.crease.iter().zip(mark()) {
         if m >= LOCKED {
             next.crease.push(if c == NO_CREASE || c == CORNER {
                 c
