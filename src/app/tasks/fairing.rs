@@ -76,17 +76,13 @@ impl App {
                 progress_out.set(fraction);
                 document_generation.is_current(document)
             };
+            // Only a mask or a baseline reads M0's connectivity.
+            let topology = (mask.is_some() || baseline.is_some()).then(|| {
+                topology.unwrap_or_else(|| Arc::new(crate::Topology::build(hierarchy.base_mesh())))
+            });
             // A few rings of fade inside the painted region's edge, whatever the brush left: where
             // the brush stopped at a silhouette the mask drops from 1 to 0 at once, and the
             // result would show a step there.
-            let needs_topology = mask.is_some() || baseline.is_some();
-            let topology = match topology {
-                Some(topology) => Some(topology),
-                None if needs_topology => {
-                    Some(Arc::new(crate::Topology::build(hierarchy.base_mesh())))
-                }
-                None => None,
-            };
             let mask = mask
                 .zip(topology.as_deref())
                 .map(|(mask, topology)| mask.with_falloff(topology, MASK_EDGE_RINGS));
