@@ -74,6 +74,21 @@ impl Grid {
     }
 }
 
+impl Grid {
+    /// The dome, then a flat grid behind it (z = -40, further from the test camera than any of
+    /// the dome): the flat grid's faces come later and must lose the depth test.
+    fn dome_over_plane(n: u32) -> Self {
+        let mut dome = Self::dome(n);
+        let plane = Self::new(n);
+        let offset = dome.positions.len() as u32;
+        dome.positions
+            .extend(plane.positions.iter().map(|p| [p[0], p[1], -40.0]));
+        dome.triangles
+            .extend(plane.triangles.iter().map(|t| t.map(|v| v + offset)));
+        dome
+    }
+}
+
 fn device() -> (wgpu::Device, wgpu::Queue) {
     let state = egui_kittest::wgpu::create_render_state(
         egui_kittest::wgpu::default_wgpu_setup(),
@@ -176,14 +191,13 @@ fn uploaded_normals_follow_the_positions_on_screen() {
     }
 }
 
-/// Draws what is on screen into a target of `size`, checking that wgpu reports no error.
-fn draw(renderer: &mut MeshRenderer, device: &wgpu::Device, queue: &wgpu::Queue, size: [u32; 2]) {
-    let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
-    renderer.ensure_target(device, size);
-    let params = fairmesh::render::DrawParams {
+/// A camera looking down at the grids (x and y from 0 to 200 fill the view), scaled by `zoom`.
+fn params(size: [u32; 2], zoom: f32, wireframe: bool) -> fairmesh::render::DrawParams {
+    let s = 0.01 * zoom;
+    fairmesh::render::DrawParams {
         view_proj: [
-            [0.01, 0.0, 0.0, 0.0],
-            [0.0, 0.01, 0.0, 0.0],
+            [s, 0.0, 0.0, 0.0],
+            [0.0, s, 0.0, 0.0],
             [0.0, 0.0, -0.01, 0.0],
             [-1.0, -1.0, 0.5, 1.0],
         ],
@@ -193,16 +207,120 @@ fn draw(renderer: &mut MeshRenderer, device: &wgpu::Device, queue: &wgpu::Queue,
         up: [0.0, 1.0, 0.0],
         shading: Default::default(),
         lighting: Default::default(),
-        wireframe: false,
+        wireframe,
         scalar_range: None,
         mask_tint: false,
         size,
-    };
+    }
+}
+
+/// Draws what is on screen into a target of `size`, checking that wgpu reports no error.
+fn draw(renderer: &mut MeshRenderer, device: &wgpu::Device, queue: &wgpu::Queue, size: [u32; 2]) {
+    renderer.ensure_target(device, size);
+    assert!(render_once(
+        renderer,
+        device,
+        queue,
+        &params(size, 1.0, false)
+    ));
+}
+
+/// One frame's `render` with `params`, submitted; checks that wgpu reports no error.
+fn render_once(
+    renderer: &mut MeshRenderer,
+    device: &wgpu::Device,
+    queue: &wgpu::Queue,
+    params: &fairmesh::render::DrawParams,
+) -> bool {
+    let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
     let mut encoder = device.create_command_encoder(&Default::default());
-    assert!(renderer.render(device, queue, &mut encoder, &params));
+    let drew = renderer.render(device, queue, &mut encoder, params);
     queue.submit([encoder.finish()]);
     let error = pollster::block_on(scope.pop());
     assert!(error.is_none(), "{error:?}");
+    drew
+}
+
+#[test]
+fn an_image_drawn_over_several_frames_is_the_image_drawn_at_once() {
+    let (device, queue) = device();
+    let mut renderer = MeshRenderer::new(&device, Arc::new(|| {}));
+    renderer.set_async_upload_bytes(usize::MAX);
+    // A dome over a plane, 2 × 2 × 40² = 6400 faces (and 19200 wireframe edges), into a 4×
+    // multisampled target: the plane's faces, drawn in later parts, are hidden by the depth the
+    // dome's left.
+    renderer.set_mesh(&device, Arc::new(Grid::dome_over_plane(40)));
+    let size = [96, 80];
+    renderer.ensure_target(&device, size);
+    let near = params(size, 3.0, true);
+    let far = params(size, 1.0, true);
+    // At once: the reference images of both views.
+    assert!(render_once(&mut renderer, &device, &queue, &near));
+    let near_image = renderer.read_back_image(&device, &queue).unwrap();
+    assert!(render_once(&mut renderer, &device, &queue, &far));
+    let far_image = renderer.read_back_image(&device, &queue).unwrap();
+    assert_ne!(near_image, far_image);
+
+    // In parts of 1000 faces or edges: 6400 + 19200 take 26 frames; meanwhile the target keeps
+    // the previous image and no image counts as drawn.
+    renderer.set_faces_per_frame(1000);
+    let drawn_before = renderer.images_drawn;
+    for frame in 0..26 {
+        assert!(
+            render_once(&mut renderer, &device, &queue, &near),
+            "frame {frame}"
+        );
+        if frame < 25 {
+            assert!(renderer.drawing(), "frame {frame}");
+            assert_eq!(renderer.images_drawn, drawn_before);
+            // Set once the first part was drawn: which image is shown must not change meanwhile.
+            if frame % 9 == 0 {
+                let shown = renderer.read_back_image(&device, &queue).unwrap();
+                assert!(shown == far_image, "frame {frame} shows a part-drawn image");
+            }
+        }
+    }
+    assert!(!renderer.drawing());
+    assert_eq!(renderer.images_drawn, drawn_before + 1);
+    assert!(renderer.read_back_image(&device, &queue).unwrap() == near_image);
+    assert!(
+        !render_once(&mut renderer, &device, &queue, &near),
+        "nothing new to draw"
+    );
+
+    // An image in progress is finished with its own view before a newer view begins.
+    assert!(render_once(&mut renderer, &device, &queue, &far));
+    for _ in 1..26 {
+        assert!(render_once(&mut renderer, &device, &queue, &near));
+    }
+    assert!(!renderer.drawing());
+    assert!(renderer.read_back_image(&device, &queue).unwrap() == far_image);
+
+    // New positions drop a half-drawn image: the next one starts over with them.
+    assert!(render_once(&mut renderer, &device, &queue, &near));
+    assert!(renderer.drawing());
+    assert!(renderer.set_positions(&queue, Arc::new(Grid::dome_over_plane(40))));
+    assert!(!renderer.drawing());
+
+    // A resized target has no image to show meanwhile: its first image is drawn at once.
+    let smaller = [80, 64];
+    renderer.ensure_target(&device, smaller);
+    let drawn_before = renderer.images_drawn;
+    assert!(render_once(
+        &mut renderer,
+        &device,
+        &queue,
+        &params(smaller, 3.0, true)
+    ));
+    assert!(!renderer.drawing());
+    assert_eq!(renderer.images_drawn, drawn_before + 1);
+    assert!(render_once(
+        &mut renderer,
+        &device,
+        &queue,
+        &params(smaller, 1.0, true)
+    ));
+    assert!(renderer.drawing(), "the next one is drawn in parts again");
 }
 
 #[test]

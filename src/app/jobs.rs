@@ -135,6 +135,8 @@ impl Drop for Worker {
 }
 
 fn worker_loop(shared: &Shared) {
+    // The window comes first: jobs run at background priority (see `priority`).
+    super::priority::lower_this_thread();
     loop {
         let job = {
             let mut queue = shared.queue.lock().unwrap_or_else(PoisonError::into_inner);
@@ -155,7 +157,9 @@ fn worker_loop(shared: &Shared) {
             }
         };
         // A panicking job must not take the worker down with it; its result is simply missing.
-        let _ = std::panic::catch_unwind(std::panic::AssertUnwindSafe(job));
+        let _ = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+            super::priority::run_in_background(job)
+        }));
         shared
             .queue
             .lock()

@@ -102,6 +102,7 @@ impl Workers {
         let measure_pool = rayon::ThreadPoolBuilder::new()
             .num_threads(1)
             .thread_name(|_| "fairmesh-measure-pool".into())
+            .start_handler(|_| super::priority::lower_this_thread())
             .build()
             .ok()
             .map(Arc::new);

@@ -51,6 +51,7 @@ mod paint_panel;
 mod panel_view;
 pub mod panels;
 mod performance_panel;
+mod priority;
 mod recent;
 mod results;
 mod sharp_edges;
@@ -183,6 +184,12 @@ impl App {
             && self.measure_wanted.is_none()
             && !self.capture_next_frame
             && !self.upload_pending()
+            && !self.drawing()
+    }
+
+    /// Whether a viewport is drawing a new image over several frames.
+    fn drawing(&self) -> bool {
+        self.viewports().any(Viewport3d::drawing)
     }
 
     /// Whether a viewport's background upload of a big mesh has not landed yet.
@@ -227,6 +234,7 @@ impl App {
                 let drew = images != self.frame_stats.images_seen;
                 self.frame_stats.images_seen = images;
                 if drew {
+                    self.frame_stats.log_arrival("a new image of the 3D view");
                     viewport.last_draw_time()
                 } else {
                     Duration::ZERO
@@ -275,7 +283,9 @@ impl eframe::App for App {
         self.sync_viewport();
         let upload_done = Instant::now();
         let compare = self.settings.compare;
-        self.capturing_view = std::mem::take(&mut self.capture_next_frame);
+        // A saved view waits for an image being drawn over several frames to be complete.
+        self.capturing_view = self.capture_next_frame && !self.drawing();
+        self.capture_next_frame &= !self.capturing_view;
         panels::show(self, ui);
         if self.capturing_view {
             self.capture_view(&ctx);

@@ -34,6 +34,9 @@ pub struct AppStatus {
     pub error: Option<String>,
     pub message: Option<String>,
     pub images_drawn: u64,
+    /// A viewport is drawing a new image over several frames (a big mesh on a software
+    /// renderer); the view shows the one before it.
+    pub drawing: bool,
     /// Sharp edges the current hierarchy keeps (0 without "Keep sharp edges").
     pub sharp_edges_kept: usize,
     /// Sharp edges drawn over the mesh in the last frame (while their controls are pointed at).
@@ -132,6 +135,7 @@ impl App {
             error: self.error.clone(),
             message: self.message.clone(),
             images_drawn: self.viewport.as_ref().map_or(0, Viewport3d::images_drawn),
+            drawing: self.drawing(),
             sharp_edges_kept: document.map_or(0, |d| match &d.hierarchy {
                 HierarchyState::Ready { hierarchy, .. } => hierarchy.crease_edge_count(),
                 _ => 0,

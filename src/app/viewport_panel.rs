@@ -220,6 +220,17 @@ fn overlays(
         egui::FontId::proportional(12.0),
         egui::Color32::from_gray(150),
     );
+    if !view.capturing_view && state.viewports.iter().flatten().any(|v| v.drawing()) {
+        // A big mesh's new image on a software renderer takes several frames; the view shows
+        // the previous image until then.
+        painter.text(
+            rect.right_bottom() + egui::vec2(-8.0, -8.0),
+            egui::Align2::RIGHT_BOTTOM,
+            "Drawing the new image…",
+            egui::FontId::proportional(12.0),
+            egui::Color32::from_gray(190),
+        );
+    }
     if let Some((top, reference)) = view.heat_legend {
         heat_legend(ui, rect, top, reference);
     }

@@ -96,6 +96,12 @@ impl Viewport3d {
             .unwrap_or(false)
     }
 
+    /// Whether a new image is being drawn over several frames (a big mesh on a software
+    /// renderer: see [`MeshRenderer::set_faces_per_frame`]); the view shows the previous one.
+    pub fn drawing(&self) -> bool {
+        self.with_renderer(|r| r.drawing()).unwrap_or(false)
+    }
+
     /// Meshes of at least `bytes` upload in the background (tests set 0 to exercise that path).
     pub fn set_async_upload_bytes(&self, bytes: usize) {
         self.with_renderer(|r| r.set_async_upload_bytes(bytes));

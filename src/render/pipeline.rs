@@ -22,11 +22,12 @@ mod upload;
 
 use std::sync::mpsc;
 use std::sync::Arc;
+use std::time::Duration;
 
 use super::normals::vertex_normals;
 use super::shading::{Lighting, Shading};
 use buffers::{line_buffer, MeshBuffers};
-use passes::{Pipelines, Target, Uniforms};
+use passes::{Part, Pipelines, Target, Uniforms};
 use upload::{PendingMesh, UploadJob, Uploaded, Uploader};
 
 /// Format of the image the mesh is drawn into (and that egui then samples).
@@ -39,6 +40,13 @@ const SAMPLE_COUNT: u32 = 4;
 /// are drawn without multisampling: the 1.2M-face bunny's image took 1.7 s with 4 samples and
 /// 0.6-0.85 s with one under lavapipe on two cores, and the window waits for it.
 pub const SOFTWARE_SINGLE_SAMPLE_FACES: usize = 400_000;
+
+/// On a software renderer, a new image draws at most this many faces (or wireframe edges) per
+/// frame: a bigger mesh's image is drawn over several frames into a second target while the
+/// previous image stays on screen, then copied over it. Drawing the 1.2M-face bunny's image
+/// in one frame kept the window from answering input for 0.6-0.85 s under lavapipe on two cores;
+/// in parts of this size each frame stays under ~100 ms.
+pub const SOFTWARE_FACES_PER_FRAME: usize = 50_000;
 
 /// Everything that decides what one rendered image looks like, apart from the mesh itself.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -75,6 +83,15 @@ pub trait MeshSource: Send + Sync + 'static {
 /// mesh does not stall the UI for the ~30 ms its buffers take to fill.
 pub const DEFAULT_ASYNC_UPLOAD_BYTES: usize = 4 << 20;
 
+/// An image drawn over several frames: what it shows and how far it got.
+struct Progress {
+    params: DrawParams,
+    /// Faces, then wireframe edges, drawn so far.
+    done: u32,
+    /// CPU time spent recording its parts so far.
+    recording: Duration,
+}
+
 /// Owns the pipelines, the mesh buffers and the offscreen target. Knows nothing of fairing.
 pub struct MeshRenderer {
     pipelines: Pipelines,
@@ -89,6 +106,18 @@ pub struct MeshRenderer {
     target: Option<Target>,
     /// Parameters of the image now in the target; `None` forces a redraw.
     drawn: Option<DrawParams>,
+    /// Faces (or edges) a new image draws per frame at most; more take several frames.
+    faces_per_frame: usize,
+    /// The image being drawn over several frames, if one is.
+    progress: Option<Progress>,
+    /// The target holds a complete image (it has since it was made): only then is a new image
+    /// drawn over several frames, the old one staying on screen meanwhile. A new target (the
+    /// view was resized) gets its first image at once rather than a blank view for a while.
+    target_has_image: bool,
+    /// Where that image is drawn (the target's size and sampling; kept between images).
+    work: Option<Target>,
+    /// Asks the UI for another frame (an image drawn over several frames needs them).
+    repaint: Arc<dyn Fn() + Send + Sync>,
     /// Offscreen images drawn so far (for tests and the performance readout).
     pub images_drawn: u64,
     uploader: Option<Uploader>,
@@ -115,7 +144,7 @@ pub struct MeshRenderer {
     max_buffer_size: u64,
     /// CPU time of the last [`Self::render`] that drew (recording commands, building the
     /// wireframe's edges on first use).
-    pub last_draw_time: std::time::Duration,
+    pub last_draw_time: Duration,
 }
 
 impl MeshRenderer {
@@ -130,8 +159,13 @@ impl MeshRenderer {
             mesh: None,
             target: None,
             drawn: None,
+            faces_per_frame: usize::MAX,
+            progress: None,
+            target_has_image: false,
+            work: None,
+            repaint: on_upload_done.clone(),
             images_drawn: 0,
-            last_draw_time: std::time::Duration::ZERO,
+            last_draw_time: Duration::ZERO,
             // Without the thread (it failed to start) every upload happens in the calling frame.
             uploader: Uploader::spawn(device.clone(), on_upload_done),
             generation: 0,
@@ -211,7 +245,7 @@ impl MeshRenderer {
         self.problem = self.too_big("the mesh", vertex_count.max(face_count) * 12, face_count);
         if vertex_count == 0 || face_count == 0 || self.problem.is_some() {
             self.mesh = None;
-            self.drawn = None;
+            self.redraw();
             return;
         }
         let generation = self.generation;
@@ -243,7 +277,7 @@ impl MeshRenderer {
             }
         }
         self.mesh = Some(MeshBuffers::create(device, source, false, generation));
-        self.drawn = None;
+        self.redraw();
     }
 
     /// Takes in the uploads that landed since the last call (a stale one is dropped).
@@ -267,7 +301,7 @@ impl MeshRenderer {
                             queue.write_buffer(&buffers.scalars, 0, bytemuck::cast_slice(&scalars));
                         }
                         self.mesh = Some(buffers);
-                        self.drawn = None;
+                        self.redraw();
                     }
                 }
                 Uploaded::Failed { generation } => {
@@ -278,13 +312,13 @@ impl MeshRenderer {
                     {
                         self.pending = None;
                         self.mesh = None;
-                        self.drawn = None;
+                        self.redraw();
                         self.problem = Some("the GPU could not take the mesh's buffers".into());
                     }
                     if self.lines_requested == Some(generation) {
                         self.lines_requested = None;
                         self.lines_failed = true;
-                        self.drawn = None;
+                        self.redraw();
                     }
                     if self
                         .mesh
@@ -307,7 +341,7 @@ impl MeshRenderer {
                     self.pending_move = None;
                     if let Some(mesh) = self.mesh.as_mut().filter(|m| m.generation == generation) {
                         mesh.write_positions(queue, source, &normals);
-                        self.drawn = None;
+                        self.redraw();
                     }
                 }
                 Uploaded::Lines { generation, lines } => {
@@ -316,7 +350,7 @@ impl MeshRenderer {
                     }
                     if let Some(mesh) = self.mesh.as_mut().filter(|m| m.generation == generation) {
                         mesh.lines = Some(lines);
-                        self.drawn = None;
+                        self.redraw();
                     }
                 }
             }
@@ -364,7 +398,7 @@ impl MeshRenderer {
         self.pending_move = None;
         let normals = vertex_normals(source.positions(), source.triangles());
         mesh.write_positions(queue, source, &normals);
-        self.drawn = None;
+        self.redraw();
         true
     }
 
@@ -400,6 +434,12 @@ impl MeshRenderer {
         Some(normals)
     }
 
+    /// Reads back the image in the target (RGBA, sRGB, rows top to bottom; tests). Waits for
+    /// the GPU.
+    pub fn read_back_image(&self, device: &wgpu::Device, queue: &wgpu::Queue) -> Option<Vec<u8>> {
+        self.target.as_ref()?.read_back(device, queue)
+    }
+
     /// Replaces the per-vertex scalars (one per vertex) of the mesh on screen or, while one
     /// uploads, of that one; `false` when the count does not match.
     pub fn set_scalars(&mut self, queue: &wgpu::Queue, scalars: &[f32]) -> bool {
@@ -414,7 +454,7 @@ impl MeshRenderer {
         match &self.mesh {
             Some(mesh) if mesh.vertex_count == scalars.len() => {
                 queue.write_buffer(&mesh.scalars, 0, bytemuck::cast_slice(scalars));
-                self.drawn = None;
+                self.redraw();
                 true
             }
             _ => false,
@@ -429,6 +469,33 @@ impl MeshRenderer {
     /// [`SOFTWARE_SINGLE_SAMPLE_FACES`] faces are then drawn without multisampling.
     pub fn set_software_adapter(&mut self, software: bool) {
         self.software = software;
+        self.set_faces_per_frame(if software {
+            SOFTWARE_FACES_PER_FRAME
+        } else {
+            usize::MAX
+        });
+    }
+
+    /// A new image draws at most `faces` faces (or wireframe edges) per [`Self::render`]; a
+    /// bigger mesh's image takes several calls, the previous image staying in the target until
+    /// the new one is complete. Software renderers get [`SOFTWARE_FACES_PER_FRAME`]; GPUs draw
+    /// every image at once.
+    pub fn set_faces_per_frame(&mut self, faces: usize) {
+        self.faces_per_frame = faces.max(1);
+        self.redraw();
+    }
+
+    /// Whether an image is being drawn over several frames (the target still shows the one
+    /// before it).
+    pub fn drawing(&self) -> bool {
+        self.progress.is_some()
+    }
+
+    /// The image in the target no longer shows the mesh as it is: draw it again, and drop an
+    /// image half drawn from the old buffers.
+    fn redraw(&mut self) {
+        self.drawn = None;
+        self.progress = None;
     }
 
     /// Samples per pixel the newest mesh is drawn with (4, or 1 for a big mesh on a software
@@ -458,7 +525,8 @@ impl MeshRenderer {
             self.single_sample = Some(Pipelines::new(device, samples));
         }
         self.target = Some(Target::new(device, size, samples));
-        self.drawn = None;
+        self.target_has_image = false;
+        self.redraw();
         true
     }
 
@@ -469,6 +537,12 @@ impl MeshRenderer {
 
     /// Records the drawing of the mesh into the offscreen target, unless the image there already
     /// shows exactly this. Returns whether it drew.
+    ///
+    /// When the image has more faces (plus wireframe edges) than [`Self::set_faces_per_frame`]
+    /// allows, each call draws the next part of it into a second target instead, and the
+    /// complete image is copied into the shown target by the call that draws its last part. An
+    /// image being drawn is finished before one with newer parameters begins (an orbit shows
+    /// complete images, each a few frames late); a new mesh or new positions drop it.
     pub fn render(
         &mut self,
         device: &wgpu::Device,
@@ -477,13 +551,18 @@ impl MeshRenderer {
         params: &DrawParams,
     ) -> bool {
         self.poll_uploads(queue);
-        self.wireframe = params.wireframe;
         let wrong_size = self.target.as_ref().is_none_or(|t| t.size != params.size);
-        if self.drawn.as_ref() == Some(params) || wrong_size {
+        if wrong_size {
             return false;
         }
+        let params = match &self.progress {
+            Some(progress) => progress.params,
+            None if self.drawn.as_ref() == Some(params) => return false,
+            None => *params,
+        };
+        self.wireframe = params.wireframe;
         let started = std::time::Instant::now();
-        let uniforms = Uniforms::of(params);
+        let uniforms = Uniforms::of(&params);
         if params.wireframe {
             self.ensure_lines(device);
         }
@@ -495,12 +574,64 @@ impl MeshRenderer {
             _ => return false,
         };
         queue.write_buffer(&pipelines.uniform_buffer, 0, bytemuck::bytes_of(&uniforms));
-        if let Some(target) = &self.target {
-            pipelines.draw(encoder, target, self.mesh.as_ref(), params.wireframe);
+        let Some(target) = &self.target else {
+            return false;
+        };
+        let mesh = self.mesh.as_ref();
+        let faces = mesh.map_or(0, |m| m.index_count / 3);
+        let edges = match mesh.and_then(|m| m.lines.as_ref()) {
+            Some((_, count)) if params.wireframe => count / 2,
+            _ => 0,
+        };
+        let total = faces as usize + edges as usize;
+        let at_once = total <= self.faces_per_frame || !self.target_has_image;
+        if at_once {
+            pipelines.draw(encoder, target, mesh, params.wireframe);
+        } else {
+            // Part of an image too big for one frame, into the work target.
+            if self
+                .work
+                .as_ref()
+                .is_none_or(|w| w.size != target.size || w.samples != target.samples)
+            {
+                self.work = Some(Target::new(device, target.size, target.samples));
+            }
+            let Some(work) = &self.work else {
+                return false;
+            };
+            let start = self.progress.as_ref().map_or(0, |p| p.done);
+            let end = (start as usize + self.faces_per_frame).min(total) as u32;
+            let part = Part {
+                faces: start.min(faces)..end.min(faces),
+                edges: start.saturating_sub(faces)..end.saturating_sub(faces),
+                first: start == 0,
+            };
+            let last = end as usize == total;
+            pipelines.draw_part(encoder, work, mesh, params.wireframe, &part, last);
+            let recording = self
+                .progress
+                .as_ref()
+                .map_or(Duration::ZERO, |p| p.recording)
+                + started.elapsed();
+            if !last {
+                self.progress = Some(Progress {
+                    params,
+                    done: end,
+                    recording,
+                });
+                (self.repaint)();
+                return true;
+            }
+            work.copy_image_to(encoder, target);
+            self.progress = None;
+            self.last_draw_time = recording;
         }
-        self.drawn = Some(*params);
+        if at_once {
+            self.last_draw_time = started.elapsed();
+        }
+        self.target_has_image = true;
+        self.drawn = Some(params);
         self.images_drawn += 1;
-        self.last_draw_time = started.elapsed();
         true
     }
 

@@ -49,6 +49,11 @@ pub fn settle(harness: &mut Harness<'_, App>) {
     let deadline = Instant::now() + Duration::from_secs(300);
     for _ in 0..200_000 {
         harness.step();
+        if harness.state().status().drawing {
+            // A big image drawn over several frames (software renderers) advances when frames
+            // are rendered, which `step` alone does not do.
+            harness.render().expect("the wgpu test renderer renders");
+        }
         if harness.state().is_settled() {
             // One more frame: the results applied in the last one reach the viewport and labels.
             harness.step();
@@ -63,8 +68,26 @@ pub fn settle(harness: &mut Harness<'_, App>) {
 }
 
 /// The viewport's pixels out of a full-window render (the harness is 1200 points wide).
+/// An image drawn over several frames (a big mesh on the software test renderer) is rendered
+/// to its end first: the pixels are those of the complete image.
 pub fn viewport_image(harness: &mut Harness<'_, App>) -> image::RgbaImage {
-    let full = harness.render().expect("the wgpu test renderer renders");
+    let mut full = harness.render().expect("the wgpu test renderer renders");
+    if harness.state().status().drawing {
+        for _ in 0..10_000 {
+            harness.step();
+            harness.render().expect("the wgpu test renderer renders");
+            if !harness.state().status().drawing {
+                break;
+            }
+        }
+        assert!(
+            !harness.state().status().drawing,
+            "the image was never completed"
+        );
+        // One more frame, whose panels know the image is complete (no "Drawing" caption).
+        harness.step();
+        full = harness.render().expect("the wgpu test renderer renders");
+    }
     let rect = harness
         .state()
         .viewport_rect()

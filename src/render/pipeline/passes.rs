@@ -4,6 +4,7 @@
 //! render pass that draws a mesh into it.
 
 use bytemuck::{Pod, Zeroable};
+use std::ops::Range;
 
 use super::buffers::MeshBuffers;
 use super::{DrawParams, COLOR_FORMAT, DEPTH_FORMAT};
@@ -68,6 +69,8 @@ pub(super) struct Target {
     /// The colour drawn into and resolved from; `None` with one sample (drawn into `resolved`).
     multisampled: Option<wgpu::TextureView>,
     pub(super) resolved: wgpu::TextureView,
+    /// The texture behind `resolved` (an image drawn over several frames is copied into it).
+    resolved_texture: wgpu::Texture,
     depth: wgpu::TextureView,
 }
 
@@ -79,20 +82,30 @@ impl Target {
             height: size[1],
             depth_or_array_layers: 1,
         };
-        let make = |label, format, samples, usage| {
-            device
-                .create_texture(&wgpu::TextureDescriptor {
-                    label: Some(label),
-                    size: extent,
-                    mip_level_count: 1,
-                    sample_count: samples,
-                    dimension: wgpu::TextureDimension::D2,
-                    format,
-                    usage,
-                    view_formats: &[],
-                })
-                .create_view(&Default::default())
+        let texture = |label, format, samples, usage| {
+            device.create_texture(&wgpu::TextureDescriptor {
+                label: Some(label),
+                size: extent,
+                mip_level_count: 1,
+                sample_count: samples,
+                dimension: wgpu::TextureDimension::D2,
+                format,
+                usage,
+                view_formats: &[],
+            })
         };
+        let make = |label, format, samples, usage| {
+            texture(label, format, samples, usage).create_view(&Default::default())
+        };
+        let resolved_texture = texture(
+            "fairmesh colour",
+            COLOR_FORMAT,
+            1,
+            wgpu::TextureUsages::RENDER_ATTACHMENT
+                | wgpu::TextureUsages::TEXTURE_BINDING
+                | wgpu::TextureUsages::COPY_SRC
+                | wgpu::TextureUsages::COPY_DST,
+        );
         Self {
             size,
             samples,
@@ -104,12 +117,8 @@ impl Target {
                     wgpu::TextureUsages::RENDER_ATTACHMENT,
                 )
             }),
-            resolved: make(
-                "fairmesh colour",
-                COLOR_FORMAT,
-                1,
-                wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING,
-            ),
+            resolved: resolved_texture.create_view(&Default::default()),
+            resolved_texture,
             depth: make(
                 "fairmesh depth",
                 DEPTH_FORMAT,
@@ -118,6 +127,71 @@ impl Target {
             ),
         }
     }
+
+    /// The resolved image's pixels (RGBA, rows top to bottom). Waits for the GPU.
+    pub(super) fn read_back(&self, device: &wgpu::Device, queue: &wgpu::Queue) -> Option<Vec<u8>> {
+        let [width, height] = self.size;
+        let row = width as usize * 4;
+        let padded = row.div_ceil(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT as usize)
+            * wgpu::COPY_BYTES_PER_ROW_ALIGNMENT as usize;
+        let staging = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("fairmesh image read-back"),
+            size: (padded * height as usize) as u64,
+            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let mut encoder = device.create_command_encoder(&Default::default());
+        encoder.copy_texture_to_buffer(
+            self.resolved_texture.as_image_copy(),
+            wgpu::TexelCopyBufferInfo {
+                buffer: &staging,
+                layout: wgpu::TexelCopyBufferLayout {
+                    offset: 0,
+                    bytes_per_row: Some(padded as u32),
+                    rows_per_image: Some(height),
+                },
+            },
+            self.resolved_texture.size(),
+        );
+        queue.submit([encoder.finish()]);
+        let (tx, rx) = std::sync::mpsc::channel();
+        staging.map_async(wgpu::MapMode::Read, .., move |result| {
+            let _ = tx.send(result);
+        });
+        device.poll(wgpu::PollType::wait_indefinitely()).ok()?;
+        rx.recv().ok()?.ok()?;
+        let view = staging.get_mapped_range(..).ok()?;
+        let pixels = view
+            .chunks(padded)
+            .flat_map(|r| &r[..row])
+            .copied()
+            .collect();
+        drop(view);
+        staging.unmap();
+        Some(pixels)
+    }
+
+    /// Records copying this target's image into `other`'s (the same size).
+    pub(super) fn copy_image_to(&self, encoder: &mut wgpu::CommandEncoder, other: &Target) {
+        encoder.copy_texture_to_texture(
+            self.resolved_texture.as_image_copy(),
+            other.resolved_texture.as_image_copy(),
+            self.resolved_texture.size(),
+        );
+    }
+}
+
+/// A part of one image: the faces and wireframe edges one render pass draws. An image drawn in
+/// one pass is one part with every face and edge; a software renderer draws a big mesh's image
+/// in several (see `MeshRenderer::render`), each adding to what the earlier ones drew.
+#[derive(Clone, Debug, PartialEq)]
+pub(super) struct Part {
+    /// Faces drawn (indices into the mesh's triangles).
+    pub(super) faces: Range<u32>,
+    /// Wireframe edges drawn (indices into the edge list), when the wireframe is on.
+    pub(super) edges: Range<u32>,
+    /// The first part clears the target; the others keep what is there.
+    pub(super) first: bool,
 }
 
 /// The pipelines and their uniforms, made once per renderer.
@@ -185,6 +259,34 @@ impl Pipelines {
         mesh: Option<&MeshBuffers>,
         wireframe: bool,
     ) {
+        let whole = Part {
+            faces: 0..mesh.map_or(0, |m| m.index_count / 3),
+            edges: 0..mesh
+                .and_then(|m| m.lines.as_ref())
+                .map_or(0, |(_, n)| n / 2),
+            first: true,
+        };
+        self.draw_part(encoder, target, mesh, wireframe, &whole, true);
+    }
+
+    /// Records the pass that draws `part` of the image into `target`: the first part clears
+    /// it. With `last`, the multisampled colour and the depth are not kept after the pass
+    /// (the resolved image is); parts drawn later need them.
+    pub(super) fn draw_part(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        target: &Target,
+        mesh: Option<&MeshBuffers>,
+        wireframe: bool,
+        part: &Part,
+        last: bool,
+    ) {
+        let background = wgpu::Color {
+            r: 0.018,
+            g: 0.021,
+            b: 0.026,
+            a: 1.0,
+        };
         let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
             label: Some("fairmesh viewport"),
             color_attachments: &[Some(wgpu::RenderPassColorAttachment {
@@ -192,14 +294,13 @@ impl Pipelines {
                 depth_slice: None,
                 resolve_target: target.multisampled.as_ref().map(|_| &target.resolved),
                 ops: wgpu::Operations {
-                    load: wgpu::LoadOp::Clear(wgpu::Color {
-                        r: 0.018,
-                        g: 0.021,
-                        b: 0.026,
-                        a: 1.0,
-                    }),
+                    load: if part.first {
+                        wgpu::LoadOp::Clear(background)
+                    } else {
+                        wgpu::LoadOp::Load
+                    },
                     // The multisampled colour is resolved; a single-sample one is the image.
-                    store: if target.multisampled.is_some() {
+                    store: if target.multisampled.is_some() && last {
                         wgpu::StoreOp::Discard
                     } else {
                         wgpu::StoreOp::Store
@@ -209,8 +310,16 @@ impl Pipelines {
             depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
                 view: &target.depth,
                 depth_ops: Some(wgpu::Operations {
-                    load: wgpu::LoadOp::Clear(1.0),
-                    store: wgpu::StoreOp::Discard,
+                    load: if part.first {
+                        wgpu::LoadOp::Clear(1.0)
+                    } else {
+                        wgpu::LoadOp::Load
+                    },
+                    store: if last {
+                        wgpu::StoreOp::Discard
+                    } else {
+                        wgpu::StoreOp::Store
+                    },
                 }),
                 stencil_ops: None,
             }),
@@ -225,13 +334,20 @@ impl Pipelines {
             pass.set_vertex_buffer(1, mesh.scalars.slice(..));
             pass.set_vertex_buffer(2, mesh.normals.slice(..));
             pass.set_index_buffer(mesh.triangles.slice(..), wgpu::IndexFormat::Uint32);
-            pass.draw_indexed(0..mesh.index_count, 0, 0..1);
+            let face_count = mesh.index_count / 3;
+            let faces = part.faces.start.min(face_count)..part.faces.end.min(face_count);
+            if !faces.is_empty() {
+                pass.draw_indexed(faces.start * 3..faces.end * 3, 0, 0..1);
+            }
             if wireframe {
                 if let Some((lines, count)) = &mesh.lines {
-                    pass.set_pipeline(&self.line);
-                    pass.set_vertex_buffer(0, mesh.positions.slice(..));
-                    pass.set_index_buffer(lines.slice(..), wgpu::IndexFormat::Uint32);
-                    pass.draw_indexed(0..*count, 0, 0..1);
+                    let edges = part.edges.start.min(count / 2)..part.edges.end.min(count / 2);
+                    if !edges.is_empty() {
+                        pass.set_pipeline(&self.line);
+                        pass.set_vertex_buffer(0, mesh.positions.slice(..));
+                        pass.set_index_buffer(lines.slice(..), wgpu::IndexFormat::Uint32);
+                        pass.draw_indexed(edges.start * 2..edges.end * 2, 0, 0..1);
+                    }
                 }
             }
         }
