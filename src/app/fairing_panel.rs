@@ -151,7 +151,7 @@ fn boundary_and_variant(
 fn progress_and_apply(ui: &mut egui::Ui, view: &PanelView, commands: &mut Commands, applied: bool) {
     if view.fair_in_flight {
         ui.horizontal(|ui| {
-            ui.spinner();
+            super::panels::activity_spinner(ui);
             ui.label(format!("fairing … {:.0} %", view.fair_progress * 100.0));
         });
     }

@@ -139,6 +139,12 @@ impl Viewport3d {
         self.with_renderer(|r| r.last_draw_time).unwrap_or_default()
     }
 
+    /// Whether the adapter is a CPU (a software renderer such as lavapipe): every frame then
+    /// costs tens of milliseconds of the same cores the background work runs on.
+    pub fn software(&self) -> bool {
+        self.state.adapter.get_info().device_type == wgpu::DeviceType::Cpu
+    }
+
     /// Adapter name and backend, for the performance readout.
     pub fn adapter_description(&self) -> String {
         let info = self.state.adapter.get_info();
