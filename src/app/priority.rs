@@ -41,8 +41,8 @@ pub fn background_pool() -> Option<&'static rayon::ThreadPool> {
     .as_ref()
 }
 
-/// Runs `job` at background priority: on this thread with its priority lowered, its parallel
-/// loops in [`background_pool`].
+/// Runs `job` at background priority: on a thread of [`background_pool`] (the caller waits for
+/// it), its parallel loops in that pool too; on the calling thread if there is no pool.
 pub fn run_in_background<R>(job: impl FnOnce() -> R + Send) -> R
 where
     R: Send,
