@@ -26,13 +26,18 @@ pub fn lower_this_thread() {
     }
 }
 
-/// The rayon pool background jobs run their parallel loops in (as many threads as rayon's
-/// global pool, each at background priority); `None` if it could not be started, in which
-/// case they use the global pool.
+/// The editor's workers (io, compute, measure) whose jobs run in [`background_pool`].
+const WORKERS: usize = 3;
+
+/// The rayon pool background jobs run in, each at background priority: one thread per core plus
+/// one per worker, because a job holds the pool thread it runs on (a long measure must not keep
+/// an export waiting for a free thread); the extra threads only run while there is work.
+/// `None` if it could not be started, in which case jobs run on their worker's thread.
 pub fn background_pool() -> Option<&'static rayon::ThreadPool> {
     static POOL: OnceLock<Option<rayon::ThreadPool>> = OnceLock::new();
     POOL.get_or_init(|| {
         rayon::ThreadPoolBuilder::new()
+            .num_threads(rayon::current_num_threads() + WORKERS)
             .thread_name(|i| format!("fairmesh-background-{i}"))
             .start_handler(|_| lower_this_thread())
             .build()
