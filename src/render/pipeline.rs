@@ -20,7 +20,6 @@ mod buffers;
 mod passes;
 mod upload;
 
-use std::sync::mpsc;
 use std::sync::Arc;
 use std::time::Duration;
 
@@ -421,17 +420,9 @@ impl MeshRenderer {
         let mut encoder = device.create_command_encoder(&Default::default());
         encoder.copy_buffer_to_buffer(&mesh.normals, 0, &staging, 0, size);
         queue.submit([encoder.finish()]);
-        let (tx, rx) = mpsc::channel();
-        staging.map_async(wgpu::MapMode::Read, .., move |result| {
-            let _ = tx.send(result);
-        });
-        device.poll(wgpu::PollType::wait_indefinitely()).ok()?;
-        rx.recv().ok()?.ok()?;
-        let view = staging.get_mapped_range(..).ok()?;
-        let normals = bytemuck::cast_slice::<u8, [f32; 3]>(&view).to_vec();
-        drop(view);
-        staging.unmap();
-        Some(normals)
+        passes::read_mapped(device, &staging, |bytes| {
+            bytemuck::cast_slice::<u8, [f32; 3]>(bytes).to_vec()
+        })
     }
 
     /// Reads back the image in the target (RGBA, sRGB, rows top to bottom; tests). Waits for
@@ -587,6 +578,7 @@ impl MeshRenderer {
         let at_once = total <= self.faces_per_frame || !self.target_has_image;
         if at_once {
             pipelines.draw(encoder, target, mesh, params.wireframe);
+            self.last_draw_time = started.elapsed();
         } else {
             // Part of an image too big for one frame, into the work target.
             if self
@@ -625,9 +617,6 @@ impl MeshRenderer {
             work.copy_image_to(encoder, target);
             self.progress = None;
             self.last_draw_time = recording;
-        }
-        if at_once {
-            self.last_draw_time = started.elapsed();
         }
         self.target_has_image = true;
         self.drawn = Some(params);

@@ -154,21 +154,13 @@ impl Target {
             self.resolved_texture.size(),
         );
         queue.submit([encoder.finish()]);
-        let (tx, rx) = std::sync::mpsc::channel();
-        staging.map_async(wgpu::MapMode::Read, .., move |result| {
-            let _ = tx.send(result);
-        });
-        device.poll(wgpu::PollType::wait_indefinitely()).ok()?;
-        rx.recv().ok()?.ok()?;
-        let view = staging.get_mapped_range(..).ok()?;
-        let pixels = view
-            .chunks(padded)
-            .flat_map(|r| &r[..row])
-            .copied()
-            .collect();
-        drop(view);
-        staging.unmap();
-        Some(pixels)
+        read_mapped(device, &staging, |bytes| {
+            bytes
+                .chunks(padded)
+                .flat_map(|r| &r[..row])
+                .copied()
+                .collect()
+        })
     }
 
     /// Records copying this target's image into `other`'s (the same size).
@@ -179,6 +171,26 @@ impl Target {
             self.resolved_texture.size(),
         );
     }
+}
+
+/// Maps `staging` (whose copy was submitted), waits for the GPU, and reads its bytes with `read`;
+/// `None` when the GPU or the mapping fails. The read-backs of images and normals (tests) share it.
+pub(super) fn read_mapped<T>(
+    device: &wgpu::Device,
+    staging: &wgpu::Buffer,
+    read: impl FnOnce(&[u8]) -> T,
+) -> Option<T> {
+    let (tx, rx) = std::sync::mpsc::channel();
+    staging.map_async(wgpu::MapMode::Read, .., move |result| {
+        let _ = tx.send(result);
+    });
+    device.poll(wgpu::PollType::wait_indefinitely()).ok()?;
+    rx.recv().ok()?.ok()?;
+    let view = staging.get_mapped_range(..).ok()?;
+    let value = read(&view);
+    drop(view);
+    staging.unmap();
+    Some(value)
 }
 
 /// A part of one image: the faces and wireframe edges one render pass draws. An image drawn in
