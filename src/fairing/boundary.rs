@@ -130,9 +130,9 @@ impl BoundaryCurves {
 
     /// One constrained curve step (section 3.3): reads `previous` and `anchors`, writes the
     /// boundary vertices of `next`. `accumulator` is a reusable buffer. Returns the largest move.
-    pub fn constrained_step<P: CurvePoint>(
+    pub fn constrained_step<P: CurvePoint, Q: CurvePoint>(
         &self,
-        previous: &[P],
+        previous: &[Q],
         anchors: &[P],
         next: &mut [P],
         normal_projected: bool,
@@ -140,7 +140,6 @@ impl BoundaryCurves {
     ) -> f64 {
         accumulator.clear();
         accumulator.resize(self.vertices.len(), ([0.0; 3], 0));
-        let point = |p: &P| p.xyz().map(|c| c as f64);
         for (stencil, &slot) in self.stencils.iter().zip(&self.slot_of_stencil) {
             // An open chain's stencil lacks p_{i−2} or p_{i+2} next to its ends: that edge's
             // estimate is left out.
@@ -201,6 +200,11 @@ impl BoundaryCurves {
         }
         max_move
     }
+}
+
+#[inline]
+fn point(p: &impl CurvePoint) -> [f64; 3] {
+    p.xyz().map(|c| c as f64)
 }
 
 #[inline]

@@ -231,7 +231,7 @@ pub struct ConstrainedFairing {
 
 /// Row indices into [`ConstrainedFairing::entry_weights`]: two bytes per entry unless the mesh
 /// has more than 65536 distinct rows.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, PartialEq)]
 enum EntryWeightIndex {
     Narrow(Vec<u16>),
     Wide(Vec<u32>),
@@ -261,7 +261,6 @@ struct Workspace {
     anchors: Vec<Vec3A>,
     anchor_terms: Vec<Vec3A>,
     position_and_mean: Vec<PositionAndMean>,
-    next: Vec<Vec3A>,
     curve_accumulator: Vec<([f64; 3], u32)>,
 }
 impl ConstrainedFairing {
@@ -451,26 +450,38 @@ impl ConstrainedFairing {
                 - ring_offsets[v];
             internal_offsets.push(end);
         }
+        // The weight rows are deduplicated in the mesh's order first (16 bytes per entry become
+        // an index of 2 or 4), so that only the index is permuted: permuting the rows and then
+        // deduplicating held two 16-byte copies of every entry at once, the peak of the whole
+        // set-up (~60 B per face on the 1.2M-face mesh). The distinct rows are then renumbered
+        // in order of first use in the internal order, as deduplicating the permuted rows
+        // numbers them, so the operator is the same bit for bit and its table is read in order.
+        let (mesh_rows, mesh_index) = deduplicate_rows(&ring_weights);
+        drop(ring_weights);
         let mut internal_ring = vec![0u32; ring.len()];
-        let mut internal_entry_weights = vec![[0.0f32; 4]; ring.len()];
+        let mut internal_index = vec![0u32; ring.len()];
         split_by_offsets(&mut internal_ring, &internal_offsets)
             .into_par_iter()
-            .zip(split_by_offsets(
-                &mut internal_entry_weights,
-                &internal_offsets,
-            ))
+            .zip(split_by_offsets(&mut internal_index, &internal_offsets))
             .zip(order.par_iter())
-            .for_each(|((ring_out, weights_out), &v)| {
+            .for_each(|((ring_out, index_out), &v)| {
                 let entries =
                     ring_offsets[v as usize] as usize..ring_offsets[v as usize + 1] as usize;
                 for (out, &u) in ring_out.iter_mut().zip(&ring[entries.clone()]) {
                     *out = internal[u as usize];
                 }
-                weights_out.copy_from_slice(&ring_weights[entries]);
+                match &mesh_index {
+                    EntryWeightIndex::Narrow(index) => {
+                        for (out, &i) in index_out.iter_mut().zip(&index[entries]) {
+                            *out = i as u32;
+                        }
+                    }
+                    EntryWeightIndex::Wide(index) => index_out.copy_from_slice(&index[entries]),
+                }
             });
-        drop(ring_weights);
-        let (entry_weights, entry_weight_index) = deduplicate_rows(&internal_entry_weights);
-        drop(internal_entry_weights);
+        drop(mesh_index);
+        let (entry_weights, entry_weight_index) = renumber_by_first_use(&mesh_rows, internal_index);
+        drop(mesh_rows);
         let self_weights = order.iter().map(|&v| self_weights[v as usize]).collect();
         // A vertex with no local solution keeps its position: it gets neither the projection nor
         // the tangential relaxation (corners of creases, vertices whose triangles all touch the
@@ -492,7 +503,6 @@ impl ConstrainedFairing {
             anchors: vec![Vec3A::ZERO; vertex_count],
             anchor_terms: vec![Vec3A::ZERO; vertex_count],
             position_and_mean: vec![PositionAndMean::default(); vertex_count],
-            next: vec![Vec3A::ZERO; vertex_count],
             curve_accumulator: Vec::new(),
         };
         ConstrainedFairing {
@@ -678,7 +688,7 @@ impl ConstrainedFairing {
                 &ws.anchor_terms,
                 closed_fan,
                 self.tangential,
-                &mut ws.next
+                &mut ws.current
             ))
         } else {
             with_stencil!(self, |stencil| stencil.averaged_solutions::<false>(
@@ -686,7 +696,7 @@ impl ConstrainedFairing {
                 &ws.anchor_terms,
                 closed_fan,
                 0.0,
-                &mut ws.next
+                &mut ws.current
             ))
         };
         let mut max_move = (max_move_squared as f64).sqrt();
@@ -694,15 +704,14 @@ impl ConstrainedFairing {
         // The boundary curves, from the same previous iterate.
         if !self.curves.is_empty() {
             let curve_move = self.curves.constrained_step(
-                &ws.current,
+                &ws.position_and_mean,
                 &ws.anchors,
-                &mut ws.next,
+                &mut ws.current,
                 project,
                 &mut ws.curve_accumulator,
             );
             max_move = max_move.max(curve_move);
         }
-        std::mem::swap(&mut ws.current, &mut ws.next);
         max_move
     }
 }
@@ -728,7 +737,8 @@ impl<I: Copy + Into<u32> + Sync> Stencil<'_, I> {
     }
 
     /// Pass 2 of an iteration: x̃_v = anchor term + own terms + Σ (α·m_u + β·x_u) over the
-    /// one-ring, into `next`. With `PROJECT`, vertices with a closed fan keep only the part of
+    /// one-ring, into `next` (the iterate itself: pass 2 reads the previous positions from
+    /// `pairs`, so no second position buffer is needed). With `PROJECT`, vertices with a closed fan keep only the part of
     /// the move x̃_v − x_v along the normal of their fan of umbrella means (centre m_v, ring m_u,
     /// gathered anyway for the update). Returns the largest squared move.
     fn averaged_solutions<const PROJECT: bool>(
@@ -914,6 +924,46 @@ fn deduplicate_rows(rows: &[[f32; 4]]) -> (Vec<[f32; 4]>, EntryWeightIndex) {
         EntryWeightIndex::Wide(index)
     };
     (distinct, index)
+}
+
+/// The rows `rows` (distinct) renumbered in order of their first use in `index`, with `index`
+/// rewritten to the new numbers: what [`deduplicate_rows`] gives for the rows `index` picks, in
+/// that order, without making those rows (2 or 4 bytes per entry instead of 16).
+fn renumber_by_first_use(
+    rows: &[[f32; 4]],
+    mut index: Vec<u32>,
+) -> (Vec<[f32; 4]>, EntryWeightIndex) {
+    let mut new_of_old = vec![u32::MAX; rows.len()];
+    let mut renumbered = Vec::new();
+    for i in index.iter_mut() {
+        let slot = &mut new_of_old[*i as usize];
+        if *slot == u32::MAX {
+            *slot = renumbered.len() as u32;
+            renumbered.push(rows[*i as usize]);
+        }
+        *i = *slot;
+    }
+    let index = if renumbered.len() <= 1 << 16 {
+        EntryWeightIndex::Narrow(index.into_par_iter().map(|i| i as u16).collect())
+    } else {
+        EntryWeightIndex::Wide(index)
+    };
+    (renumbered, index)
+}
+
+/// The boundary curves read the previous iterate from the pairs pass 1 wrote.
+impl super::boundary::CurvePoint for PositionAndMean {
+    #[inline]
+    fn xyz(&self) -> [f32; 3] {
+        self.position.to_array()
+    }
+    #[inline]
+    fn from_xyz(p: [f32; 3]) -> Self {
+        PositionAndMean {
+            position: Vec3A::from_array(p),
+            mean: Vec3A::ZERO,
+        }
+    }
 }
 
 impl super::boundary::CurvePoint for Vec3A {
@@ -1479,6 +1529,45 @@ mod tests {
                     |t| (0..3).any(|r| t[r] == v && t[(r + 1) % 3] == a && t[(r + 2) % 3] == b)
                 ));
             }
+        }
+    }
+
+    /// The set-up deduplicates the weight rows in the mesh's order and renumbers them in the
+    /// internal order: that must be exactly what deduplicating the permuted rows gives (the
+    /// same table, in the same order, and the same index), with narrow and wide indices.
+    #[test]
+    fn rows_deduplicated_then_renumbered_are_the_permuted_rows_deduplicated() {
+        let mut rng = Rng(7);
+        for distinct in [37usize, 70_001] {
+            let rows: Vec<[f32; 4]> = (0..150_000)
+                .map(|_| {
+                    let i = (rng.next() * distinct as f64) as usize;
+                    [i as f32, 0.25 * i as f32, -(i as f32), 0.0]
+                })
+                .collect();
+            // A permutation of the entries (the internal order moves whole rings; any
+            // permutation must do).
+            let mut order: Vec<usize> = (0..rows.len()).collect();
+            for i in (1..order.len()).rev() {
+                order.swap(i, (rng.next() * (i + 1) as f64) as usize);
+            }
+            let permuted: Vec<[f32; 4]> = order.iter().map(|&e| rows[e]).collect();
+            let expected = deduplicate_rows(&permuted);
+
+            let (mesh_rows, mesh_index) = deduplicate_rows(&rows);
+            let wide = |index: &EntryWeightIndex| -> Vec<u32> {
+                match index {
+                    EntryWeightIndex::Narrow(i) => i.iter().map(|&k| k as u32).collect(),
+                    EntryWeightIndex::Wide(i) => i.clone(),
+                }
+            };
+            let mesh_index = wide(&mesh_index);
+            let permuted_index = order.iter().map(|&e| mesh_index[e]).collect();
+            let got = renumber_by_first_use(&mesh_rows, permuted_index);
+            // The mesh-order table is in another order (else the renumbering would be moot).
+            assert_ne!(mesh_rows, expected.0);
+            assert_eq!(got.0, expected.0, "{distinct} distinct rows");
+            assert_eq!(got.1, expected.1, "{distinct} distinct rows");
         }
     }
 
