@@ -370,68 +370,93 @@ impl ConstrainedFairing {
 
         // Per vertex, gather the weights of its triangles' solutions (f64, then rounded), written
         // straight into the vertex's slice of the CSR weight rows (mean, position, anchor, 0).
-        let mut ring_weights = vec![[0.0f32; 4]; ring.len()];
         let mut self_weights = vec![[0.0f32; 3]; vertex_count];
         let mut solved = vec![false; vertex_count];
-        split_by_offsets(&mut ring_weights, &ring_offsets)
-            .into_par_iter()
-            .zip(self_weights.par_iter_mut().zip(solved.par_iter_mut()))
+        let gather = |v: usize,
+                      ring_weights_v: &mut [[f32; 4]],
+                      own_out: &mut [f32; 3],
+                      solved_out: &mut bool| {
+            let ring_v = &ring[ring_offsets[v] as usize..ring_offsets[v + 1] as usize];
+            let mut own = [0.0f64; 3];
+            let mut stack_entries = [[0.0f64; 3]; 64];
+            let mut heap_entries = Vec::new();
+            let entries: &mut [[f64; 3]] = if ring_v.len() <= 64 {
+                &mut stack_entries[..ring_v.len()]
+            } else {
+                heap_entries.resize(ring_v.len(), [0.0f64; 3]);
+                &mut heap_entries
+            };
+            let mut count = 0usize;
+            for &f in topology.faces_of(v as u32) {
+                let slot = triangle_operator[f as usize];
+                if slot == u32::MAX {
+                    continue;
+                }
+                count += 1;
+                let t = &triangles[f as usize];
+                let r = t
+                    .iter()
+                    .position(|&c| c as usize == v)
+                    .expect("v is a corner");
+                for (c, weights) in operators[slot as usize][r].iter().enumerate() {
+                    let slot = if t[c] as usize == v {
+                        &mut own
+                    } else {
+                        let at = ring_v
+                            .iter()
+                            .position(|&u| u == t[c])
+                            .expect("a triangle's corners are one-ring neighbours");
+                        &mut entries[at]
+                    };
+                    for k in 0..3 {
+                        slot[k] += weights[k];
+                    }
+                }
+            }
+            if count == 0 {
+                // No local solution: the vertex keeps its position (ring weights stay 0).
+                *own_out = [0.0, 1.0, 0.0];
+                return;
+            }
+            let inv = 1.0 / count as f64;
+            *own_out = own.map(|w| (w * inv) as f32);
+            for (out, e) in ring_weights_v.iter_mut().zip(entries.iter()) {
+                *out = [
+                    (e[0] * inv) as f32,
+                    (e[1] * inv) as f32,
+                    (e[2] * inv) as f32,
+                    0.0,
+                ];
+            }
+            *solved_out = true;
+        };
+        // In blocks of vertices, each block's rows deduplicated as soon as they are gathered:
+        // the 16-byte rows of the whole mesh are never held at once (on the 1.2M-face mesh they
+        // were 58 MB at the set-up's peak); only a 4-byte index per entry and the few distinct
+        // rows. The rows are a function of the valences around the vertex, so they repeat.
+        let blocks: Vec<(Vec<u32>, Vec<[f32; 4]>)> = self_weights
+            .par_chunks_mut(GATHER_BLOCK)
+            .zip(solved.par_chunks_mut(GATHER_BLOCK))
             .enumerate()
-            .for_each(|(v, (ring_weights_v, (own_out, solved_out)))| {
-                let ring_v = &ring[ring_offsets[v] as usize..ring_offsets[v + 1] as usize];
-                let mut own = [0.0f64; 3];
-                let mut stack_entries = [[0.0f64; 3]; 64];
-                let mut heap_entries = Vec::new();
-                let entries: &mut [[f64; 3]] = if ring_v.len() <= 64 {
-                    &mut stack_entries[..ring_v.len()]
-                } else {
-                    heap_entries.resize(ring_v.len(), [0.0f64; 3]);
-                    &mut heap_entries
-                };
-                let mut count = 0usize;
-                for &f in topology.faces_of(v as u32) {
-                    let slot = triangle_operator[f as usize];
-                    if slot == u32::MAX {
-                        continue;
-                    }
-                    count += 1;
-                    let t = &triangles[f as usize];
-                    let r = t
-                        .iter()
-                        .position(|&c| c as usize == v)
-                        .expect("v is a corner");
-                    for (c, weights) in operators[slot as usize][r].iter().enumerate() {
-                        let slot = if t[c] as usize == v {
-                            &mut own
-                        } else {
-                            let at = ring_v
-                                .iter()
-                                .position(|&u| u == t[c])
-                                .expect("a triangle's corners are one-ring neighbours");
-                            &mut entries[at]
-                        };
-                        for k in 0..3 {
-                            slot[k] += weights[k];
-                        }
-                    }
+            .map(|(b, (own_block, solved_block))| {
+                let first = b * GATHER_BLOCK;
+                let base = ring_offsets[first] as usize;
+                let end = ring_offsets[first + own_block.len()] as usize;
+                let mut rows = vec![[0.0f32; 4]; end - base];
+                for (i, (own_out, solved_out)) in own_block
+                    .iter_mut()
+                    .zip(solved_block.iter_mut())
+                    .enumerate()
+                {
+                    let v = first + i;
+                    let entries =
+                        ring_offsets[v] as usize - base..ring_offsets[v + 1] as usize - base;
+                    gather(v, &mut rows[entries], own_out, solved_out);
                 }
-                if count == 0 {
-                    // No local solution: the vertex keeps its position (ring weights stay 0).
-                    *own_out = [0.0, 1.0, 0.0];
-                    return;
-                }
-                let inv = 1.0 / count as f64;
-                *own_out = own.map(|w| (w * inv) as f32);
-                for (out, e) in ring_weights_v.iter_mut().zip(entries.iter()) {
-                    *out = [
-                        (e[0] * inv) as f32,
-                        (e[1] * inv) as f32,
-                        (e[2] * inv) as f32,
-                        0.0,
-                    ];
-                }
-                *solved_out = true;
-            });
+                deduplicate_chunk(&rows)
+            })
+            .collect();
+        let (mesh_rows, mesh_index) = join_deduplicated(blocks);
         let solved_vertices = solved.iter().filter(|&&s| s).count();
 
         // Renumber for locality: internal vertex i is `order[i]`; every per-vertex array is
@@ -456,8 +481,6 @@ impl ConstrainedFairing {
         // set-up (~60 B per face on the 1.2M-face mesh). The distinct rows are then renumbered
         // in order of first use in the internal order, as deduplicating the permuted rows
         // numbers them, so the operator is the same bit for bit and its table is read in order.
-        let (mesh_rows, mesh_index) = deduplicate_rows(&ring_weights);
-        drop(ring_weights);
         let mut internal_ring = vec![0u32; ring.len()];
         let mut internal_index = vec![0u32; ring.len()];
         split_by_offsets(&mut internal_ring, &internal_offsets)
@@ -470,14 +493,7 @@ impl ConstrainedFairing {
                 for (out, &u) in ring_out.iter_mut().zip(&ring[entries.clone()]) {
                     *out = internal[u as usize];
                 }
-                match &mesh_index {
-                    EntryWeightIndex::Narrow(index) => {
-                        for (out, &i) in index_out.iter_mut().zip(&index[entries]) {
-                            *out = i as u32;
-                        }
-                    }
-                    EntryWeightIndex::Wide(index) => index_out.copy_from_slice(&index[entries]),
-                }
+                index_out.copy_from_slice(&mesh_index[entries]);
             });
         drop(mesh_index);
         let (entry_weights, entry_weight_index) = renumber_by_first_use(&mesh_rows, internal_index);
@@ -870,30 +886,38 @@ fn fairing_curves(
     BoundaryCurves::with_open_chains(&relabel(closed), &relabel(open), internal.len())
 }
 
-/// The distinct rows of `rows` (compared bit for bit) in order of first appearance, and each
-/// row's index among them. Chunks are deduplicated in parallel against small local tables, then
-/// their distinct rows are numbered in chunk order, which is the order of first appearance.
-fn deduplicate_rows(rows: &[[f32; 4]]) -> (Vec<[f32; 4]>, EntryWeightIndex) {
-    type RowMap = HashMap<[u32; 3], u32, BuildHasherDefault<PositionHasher>>;
-    let key = |row: &[f32; 4]| [row[0].to_bits(), row[1].to_bits(), row[2].to_bits()];
-    const ROWS_PER_CHUNK: usize = 1 << 16;
-    let mut local: Vec<(Vec<u32>, Vec<[f32; 4]>)> = rows
-        .par_chunks(ROWS_PER_CHUNK)
-        .map(|chunk| {
-            let mut distinct = Vec::new();
-            let mut slot = RowMap::default();
-            let index = chunk
-                .iter()
-                .map(|row| {
-                    *slot.entry(key(row)).or_insert_with(|| {
-                        distinct.push(*row);
-                        (distinct.len() - 1) as u32
-                    })
-                })
-                .collect();
-            (index, distinct)
+/// Vertices per block of the operator's gather (each block's weight rows are deduplicated as
+/// soon as they are made).
+const GATHER_BLOCK: usize = 8192;
+
+type RowMap = HashMap<[u32; 3], u32, BuildHasherDefault<PositionHasher>>;
+
+/// A weight row's key: its three weights, bit for bit (the fourth lane is always 0).
+fn row_key(row: &[f32; 4]) -> [u32; 3] {
+    [row[0].to_bits(), row[1].to_bits(), row[2].to_bits()]
+}
+
+/// One chunk of rows deduplicated against a table of its own: each row's index among the
+/// chunk's distinct rows, and those rows in order of first appearance.
+fn deduplicate_chunk(rows: &[[f32; 4]]) -> (Vec<u32>, Vec<[f32; 4]>) {
+    let mut distinct = Vec::new();
+    let mut slot = RowMap::default();
+    let index = rows
+        .iter()
+        .map(|row| {
+            *slot.entry(row_key(row)).or_insert_with(|| {
+                distinct.push(*row);
+                (distinct.len() - 1) as u32
+            })
         })
         .collect();
+    (index, distinct)
+}
+
+/// Consecutive chunks deduplicated by [`deduplicate_chunk`], joined: the distinct rows of them
+/// all, numbered in chunk order (which is the order of first appearance over the whole
+/// sequence), and every row's index among them, in order.
+fn join_deduplicated(mut local: Vec<(Vec<u32>, Vec<[f32; 4]>)>) -> (Vec<[f32; 4]>, Vec<u32>) {
     let mut distinct: Vec<[f32; 4]> = Vec::new();
     let mut slot = RowMap::default();
     let global_of_local: Vec<Vec<u32>> = local
@@ -901,7 +925,7 @@ fn deduplicate_rows(rows: &[[f32; 4]]) -> (Vec<[f32; 4]>, EntryWeightIndex) {
         .map(|(_, rows)| {
             rows.iter()
                 .map(|row| {
-                    *slot.entry(key(row)).or_insert_with(|| {
+                    *slot.entry(row_key(row)).or_insert_with(|| {
                         distinct.push(*row);
                         (distinct.len() - 1) as u32
                     })
@@ -917,12 +941,31 @@ fn deduplicate_rows(rows: &[[f32; 4]]) -> (Vec<[f32; 4]>, EntryWeightIndex) {
                 *i = global[*i as usize];
             }
         });
-    let index: Vec<u32> = local.into_iter().flat_map(|(index, _)| index).collect();
-    let index = if distinct.len() <= 1 << 16 {
+    let index = local.into_iter().flat_map(|(index, _)| index).collect();
+    (distinct, index)
+}
+
+/// Two-byte indices where the rows allow.
+fn narrowed(distinct: usize, index: Vec<u32>) -> EntryWeightIndex {
+    if distinct <= 1 << 16 {
         EntryWeightIndex::Narrow(index.into_par_iter().map(|i| i as u16).collect())
     } else {
         EntryWeightIndex::Wide(index)
-    };
+    }
+}
+
+/// The distinct rows of `rows` (compared bit for bit) in order of first appearance, and each
+/// row's index among them. Chunks are deduplicated in parallel against small local tables, then
+/// their distinct rows are numbered in chunk order, which is the order of first appearance.
+#[cfg(test)]
+fn deduplicate_rows(rows: &[[f32; 4]]) -> (Vec<[f32; 4]>, EntryWeightIndex) {
+    const ROWS_PER_CHUNK: usize = 1 << 16;
+    let local = rows
+        .par_chunks(ROWS_PER_CHUNK)
+        .map(deduplicate_chunk)
+        .collect();
+    let (distinct, index) = join_deduplicated(local);
+    let index = narrowed(distinct.len(), index);
     (distinct, index)
 }
 
@@ -943,11 +986,7 @@ fn renumber_by_first_use(
         }
         *i = *slot;
     }
-    let index = if renumbered.len() <= 1 << 16 {
-        EntryWeightIndex::Narrow(index.into_par_iter().map(|i| i as u16).collect())
-    } else {
-        EntryWeightIndex::Wide(index)
-    };
+    let index = narrowed(renumbered.len(), index);
     (renumbered, index)
 }
 
