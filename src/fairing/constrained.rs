@@ -483,17 +483,28 @@ impl ConstrainedFairing {
         // numbers them, so the operator is the same bit for bit and its table is read in order.
         let mut internal_ring = vec![0u32; ring.len()];
         let mut internal_index = vec![0u32; ring.len()];
-        split_by_offsets(&mut internal_ring, &internal_offsets)
+        split_into_vertex_blocks(&mut internal_ring, &internal_offsets)
             .into_par_iter()
-            .zip(split_by_offsets(&mut internal_index, &internal_offsets))
-            .zip(order.par_iter())
-            .for_each(|((ring_out, index_out), &v)| {
-                let entries =
-                    ring_offsets[v as usize] as usize..ring_offsets[v as usize + 1] as usize;
-                for (out, &u) in ring_out.iter_mut().zip(&ring[entries.clone()]) {
-                    *out = internal[u as usize];
+            .zip(split_into_vertex_blocks(
+                &mut internal_index,
+                &internal_offsets,
+            ))
+            .for_each(|((first, ring_block), (_, index_block))| {
+                let base = internal_offsets[first] as usize;
+                let last = (first + VERTEX_BLOCK).min(vertex_count);
+                for (i, &v) in order[first..last].iter().enumerate() {
+                    let slots = internal_offsets[first + i] as usize - base
+                        ..internal_offsets[first + i + 1] as usize - base;
+                    let entries =
+                        ring_offsets[v as usize] as usize..ring_offsets[v as usize + 1] as usize;
+                    for (out, &u) in ring_block[slots.clone()]
+                        .iter_mut()
+                        .zip(&ring[entries.clone()])
+                    {
+                        *out = internal[u as usize];
+                    }
+                    index_block[slots].copy_from_slice(&mesh_index[entries]);
                 }
-                index_out.copy_from_slice(&mesh_index[entries]);
             });
         drop(mesh_index);
         let (entry_weights, entry_weight_index) = renumber_by_first_use(&mesh_rows, internal_index);
@@ -1056,15 +1067,21 @@ impl FanRings {
         let is_boundary = topology.boundary_flags();
         let mut ring = vec![0u32; neighbors.len()];
         let mut closed = vec![false; offsets.len().saturating_sub(1)];
-        split_by_offsets(&mut ring, offsets)
+        split_into_vertex_blocks(&mut ring, offsets)
             .into_par_iter()
-            .zip(closed.par_iter_mut())
-            .enumerate()
-            .for_each(|(v, (ring_v, closed_v))| {
-                let v = v as u32;
-                *closed_v = !is_boundary[v as usize] && closed_fan(v, topology, triangles, ring_v);
-                if !*closed_v {
-                    ring_v.copy_from_slice(topology.neighbors(v));
+            .zip(closed.par_chunks_mut(VERTEX_BLOCK))
+            .for_each(|((first, block), closed_block)| {
+                let base = offsets[first] as usize;
+                for (i, closed_v) in closed_block.iter_mut().enumerate() {
+                    let v = first + i;
+                    let ring_v =
+                        &mut block[offsets[v] as usize - base..offsets[v + 1] as usize - base];
+                    let v = v as u32;
+                    *closed_v =
+                        !is_boundary[v as usize] && closed_fan(v, topology, triangles, ring_v);
+                    if !*closed_v {
+                        ring_v.copy_from_slice(topology.neighbors(v));
+                    }
                 }
             });
         FanRings {
@@ -1111,16 +1128,28 @@ fn closed_fan(v: u32, topology: &Topology, triangles: &[[u32; 3]], fan: &mut [u3
     len == faces.len() && used[..edges.len()].iter().all(|&u| u)
 }
 
-/// `data` cut into the consecutive slices `offsets[v]..offsets[v + 1]`.
-fn split_by_offsets<'a, T>(data: &'a mut [T], offsets: &[u32]) -> Vec<&'a mut [T]> {
-    let mut slices = Vec::with_capacity(offsets.len().saturating_sub(1));
+/// Vertices per block of [`split_into_vertex_blocks`].
+const VERTEX_BLOCK: usize = 4096;
+
+/// `data`, a CSR array with `offsets`, cut at every [`VERTEX_BLOCK`]-th vertex: (the block's first
+/// vertex, its entries `offsets[first]..offsets[first + VERTEX_BLOCK]`), for parallel passes that
+/// write every vertex's slice (a slice per vertex cost 16 bytes a vertex, allocated and filled
+/// on one thread before the pass).
+fn split_into_vertex_blocks<'a, T>(
+    data: &'a mut [T],
+    offsets: &[u32],
+) -> Vec<(usize, &'a mut [T])> {
+    let vertices = offsets.len().saturating_sub(1);
+    let mut blocks = Vec::with_capacity(vertices.div_ceil(VERTEX_BLOCK));
     let mut rest = data;
-    for w in offsets.windows(2) {
-        let (head, tail) = std::mem::take(&mut rest).split_at_mut((w[1] - w[0]) as usize);
-        slices.push(head);
+    for first in (0..vertices).step_by(VERTEX_BLOCK) {
+        let last = (first + VERTEX_BLOCK).min(vertices);
+        let (head, tail) =
+            std::mem::take(&mut rest).split_at_mut((offsets[last] - offsets[first]) as usize);
+        blocks.push((first, head));
         rest = tail;
     }
-    slices
+    blocks
 }
 
 /// Root mean square of the moves from `from` to `to` (same length), model units.
