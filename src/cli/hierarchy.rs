@@ -180,12 +180,18 @@ pub fn run_hierarchy(args: HierarchyArgs) -> anyhow::Result<()> {
         super::progress::Step::run(format!("loading {}", args.input.display()), || {
             super::basic::load(&args.input, true)
         })?;
+    // The connectivity serves the crease detection only (as in `multires`); otherwise it goes
+    // before the build (on 1.2M faces 36 MB of the build's 199 MB heap peak).
+    let topology = std::mem::take(&mut loaded.topology);
+    let topology =
+        (args.subdivide == 0 && args.build.options().creases.is_some()).then_some(topology);
     for _ in 0..args.subdivide {
         loaded.mesh = fairmesh::mesh::subdivide_loop(&loaded.mesh);
     }
     let started = Instant::now();
-    let hierarchy = build(&loaded.mesh, Some(&loaded.topology), &args.build)
+    let hierarchy = build(&loaded.mesh, topology.as_ref(), &args.build)
         .with_context(|| format!("building the hierarchy of {}", args.input.display()))?;
+    drop(topology);
     let total_ms = started.elapsed().as_secs_f64() * 1e3;
     if let Some(dir) = &args.write_levels {
         std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
