@@ -368,8 +368,8 @@ impl ConstrainedFairing {
             .collect();
         drop(triangle_valences);
 
-        // Per vertex, gather the weights of its triangles' solutions (f64, then rounded), written
-        // straight into the vertex's slice of the CSR weight rows (mean, position, anchor, 0).
+        // Per vertex, gather the weights of its triangles' solutions (f64, then rounded), one row
+        // (mean, position, anchor, 0) per one-ring entry.
         let mut self_weights = vec![[0.0f32; 3]; vertex_count];
         let mut solved = vec![false; vertex_count];
         let gather = |v: usize,
@@ -435,11 +435,11 @@ impl ConstrainedFairing {
         // were 58 MB at the set-up's peak); only a 4-byte index per entry and the few distinct
         // rows. The rows are a function of the valences around the vertex, so they repeat.
         let blocks: Vec<(Vec<u32>, Vec<[f32; 4]>)> = self_weights
-            .par_chunks_mut(GATHER_BLOCK)
-            .zip(solved.par_chunks_mut(GATHER_BLOCK))
+            .par_chunks_mut(VERTEX_BLOCK)
+            .zip(solved.par_chunks_mut(VERTEX_BLOCK))
             .enumerate()
             .map(|(b, (own_block, solved_block))| {
-                let first = b * GATHER_BLOCK;
+                let first = b * VERTEX_BLOCK;
                 let base = ring_offsets[first] as usize;
                 let end = ring_offsets[first + own_block.len()] as usize;
                 let mut rows = vec![[0.0f32; 4]; end - base];
@@ -475,12 +475,11 @@ impl ConstrainedFairing {
                 - ring_offsets[v];
             internal_offsets.push(end);
         }
-        // The weight rows are deduplicated in the mesh's order first (16 bytes per entry become
-        // an index of 2 or 4), so that only the index is permuted: permuting the rows and then
-        // deduplicating held two 16-byte copies of every entry at once, the peak of the whole
-        // set-up (~60 B per face on the 1.2M-face mesh). The distinct rows are then renumbered
-        // in order of first use in the internal order, as deduplicating the permuted rows
-        // numbers them, so the operator is the same bit for bit and its table is read in order.
+        // Only the rows' 4-byte index is permuted (permuting the 16-byte rows and then
+        // deduplicating them held two copies of every entry's row at once). The distinct rows
+        // are then renumbered in order of first use in the internal order, as deduplicating the
+        // permuted rows numbers them, so the operator is the same bit for bit and its table is
+        // read in order.
         let mut internal_ring = vec![0u32; ring.len()];
         let mut internal_index = vec![0u32; ring.len()];
         split_into_vertex_blocks(&mut internal_ring, &internal_offsets)
@@ -897,10 +896,6 @@ fn fairing_curves(
     BoundaryCurves::with_open_chains(&relabel(closed), &relabel(open), internal.len())
 }
 
-/// Vertices per block of the operator's gather (each block's weight rows are deduplicated as
-/// soon as they are made).
-const GATHER_BLOCK: usize = 8192;
-
 type RowMap = HashMap<[u32; 3], u32, BuildHasherDefault<PositionHasher>>;
 
 /// A weight row's key: its three weights, bit for bit (the fourth lane is always 0).
@@ -1128,7 +1123,8 @@ fn closed_fan(v: u32, topology: &Topology, triangles: &[[u32; 3]], fan: &mut [u3
     len == faces.len() && used[..edges.len()].iter().all(|&u| u)
 }
 
-/// Vertices per block of [`split_into_vertex_blocks`].
+/// Vertices per block of [`split_into_vertex_blocks`] and of the operator's gather (each
+/// block's weight rows are deduplicated as soon as they are made).
 const VERTEX_BLOCK: usize = 4096;
 
 /// `data`, a CSR array with `offsets`, cut at every [`VERTEX_BLOCK`]-th vertex: (the block's first
