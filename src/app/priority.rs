@@ -12,7 +12,9 @@
 use std::sync::OnceLock;
 
 /// The nice value of background threads (0 is normal, 19 the lowest): with the scheduler's
-/// weights a thread at 10 gets about a tenth of a core that a normal thread also wants.
+/// weights a thread at 5 gets about a third of the share of a normal thread that wants the same
+/// core (10 and 15 answered input a little better but made results wait twice as long:
+/// `docs/measurements.md`).
 pub const BACKGROUND_NICE: i32 = 5;
 
 /// Lowers the calling thread's scheduling priority to [`BACKGROUND_NICE`] (Linux only; a

@@ -569,11 +569,8 @@ impl MeshRenderer {
             return false;
         };
         let mesh = self.mesh.as_ref();
-        let faces = mesh.map_or(0, |m| m.index_count / 3);
-        let edges = match mesh.and_then(|m| m.lines.as_ref()) {
-            Some((_, count)) if params.wireframe => count / 2,
-            _ => 0,
-        };
+        let whole = Part::whole(mesh, params.wireframe);
+        let (faces, edges) = (whole.faces.end, whole.edges.end);
         let total = faces as usize + edges as usize;
         let at_once = total <= self.faces_per_frame || !self.target_has_image;
         if at_once {

@@ -206,6 +206,21 @@ pub(super) struct Part {
     pub(super) first: bool,
 }
 
+impl Part {
+    /// Every face of `mesh` and, with `wireframe`, every wireframe edge it has built.
+    pub(super) fn whole(mesh: Option<&MeshBuffers>, wireframe: bool) -> Part {
+        let edges = match mesh.and_then(|m| m.lines.as_ref()) {
+            Some((_, count)) if wireframe => count / 2,
+            _ => 0,
+        };
+        Part {
+            faces: 0..mesh.map_or(0, |m| m.index_count / 3),
+            edges: 0..edges,
+            first: true,
+        }
+    }
+}
+
 /// The pipelines and their uniforms, made once per renderer.
 pub(super) struct Pipelines {
     fill: wgpu::RenderPipeline,
@@ -271,13 +286,7 @@ impl Pipelines {
         mesh: Option<&MeshBuffers>,
         wireframe: bool,
     ) {
-        let whole = Part {
-            faces: 0..mesh.map_or(0, |m| m.index_count / 3),
-            edges: 0..mesh
-                .and_then(|m| m.lines.as_ref())
-                .map_or(0, |(_, n)| n / 2),
-            first: true,
-        };
+        let whole = Part::whole(mesh, wireframe);
         self.draw_part(encoder, target, mesh, wireframe, &whole, true);
     }
 
