@@ -377,6 +377,10 @@ fn passes(
             out.six_split_volume[id] = six_volume;
         }
         vertex_count -= removed;
+        // The next level is written without the fans: they go first, so the two levels' arrays
+        // and the fans are never held at once (the build's peak on pass 0; the next pass builds
+        // its own, smaller fans).
+        state.fans = Vec::new();
         next_level(
             &level,
             &mut state,
