@@ -390,8 +390,8 @@ fn passes(
         );
         // The level just left goes too, rather than wait as the buffers of the one after next:
         // at any time at most two levels and one set of fans are held, never two levels and
-        // fans (1.2M faces: the build's heap peak 132 MB -> below the loader's 120 MB; the fresh buffers
-        // cost no measurable time).
+        // fans (1.2M faces: the build's heap peak 132 MB -> below the loader's 120 MB; the
+        // fresh buffers cost no measurable time).
         level = std::mem::take(&mut next);
         out.pass_ms.push(started.elapsed().as_secs_f64() * 1e3);
     }
