@@ -193,23 +193,33 @@ fn filter_face_normals(
     sigma: f64,
     cache: &mut FaceRingCache,
 ) -> Vec<Vec3A> {
-    // Unit normal and area (twice the area: only ratios matter) of every face.
-    let mut current: Vec<Vec4> = area_normals
+    // Unit normal and area (twice the area: only ratios matter) of a face.
+    let unit = |n: Vec3A| {
+        let length = n.length();
+        if length > 0.0 && length.is_finite() {
+            (n / length).extend(length)
+        } else {
+            Vec4::ZERO
+        }
+    };
+    if passes == 0 {
+        return area_normals
+            .par_iter()
+            .with_min_len(4096)
+            .map(|&n| xyz(unit(n)))
+            .collect();
+    }
+    let rings = cache
+        .0
+        .get_or_insert_with(|| FaceRings::build(mesh, topology));
+    // The passes' arrays are in the rings' order of the faces.
+    let mut current: Vec<Vec4> = rings
+        .order
         .par_iter()
         .with_min_len(4096)
-        .map(|&n| {
-            let length = n.length();
-            if length > 0.0 && length.is_finite() {
-                (n / length).extend(length)
-            } else {
-                Vec4::ZERO
-            }
-        })
+        .map(|&f| unit(area_normals[f as usize]))
         .collect();
-    if passes > 0 {
-        let rings = cache
-            .0
-            .get_or_insert_with(|| FaceRings::build(mesh, topology));
+    {
         let inverse = (1.0 / (2.0 * sigma * sigma)) as f32;
         let face_count = current.len();
         let mut patches = vec![Vec4::ZERO; face_count];
@@ -259,11 +269,11 @@ fn filter_face_normals(
             std::mem::swap(&mut current, &mut next);
         }
     }
-    current
-        .into_par_iter()
-        .with_min_len(4096)
-        .map(xyz)
-        .collect()
+    let mut normals = vec![Vec3A::ZERO; current.len()];
+    for (&f, n) in rings.order.iter().zip(&current) {
+        normals[f as usize] = xyz(*n);
+    }
+    normals
 }
 
 /// The x, y, z of a normal stored with its face's area in w.
@@ -275,11 +285,22 @@ fn xyz(v: Vec4) -> Vec3A {
 /// Faces per block of [`FaceRings`].
 const FACE_BLOCK: usize = 4096;
 
-/// For every face, the faces sharing a vertex with it (itself included), ascending, each once
-/// with the number of vertices it shares (3 for the face itself, 2 across an edge, 1 across a
-/// vertex): the union, with multiplicities, of its corners' face lists, which is what the guided
-/// filter averages over. Kept in blocks of [`FACE_BLOCK`] faces, built and read in parallel.
+/// For every face, the faces sharing a vertex with it (itself included), in ascending order of
+/// their ids, each once with the number of vertices it shares (3 for the face itself, 2 across an
+/// edge, 1 across a vertex): the union, with multiplicities, of its corners' face lists, which is
+/// what the guided filter averages over. Kept in blocks of [`FACE_BLOCK`] faces, built and read in
+/// parallel.
+///
+/// The faces are numbered here in Morton order of their centroids (`order`), and the lists hold
+/// these numbers, so that the faces around a face are near it in the passes' arrays whatever the
+/// file's face order: the passes are gathers, bound by the memory's latency. The lists keep the
+/// order of the faces' ids, so every face's sums and choices are made in the same order as with
+/// the file's numbering, and the filtered normals are the same bit for bit. (1.2M-face bunny, 5
+/// passes: 1.14-1.24 s in the subdivided file's order, 0.77-0.81 s in Morton order, 3.4-3.9 s
+/// with its faces shuffled.)
 struct FaceRings {
+    /// `order[i]`: the id of the face numbered `i`.
+    order: Vec<u32>,
     blocks: Vec<FaceRingBlock>,
 }
 
@@ -293,8 +314,9 @@ struct FaceRingBlock {
 
 impl FaceRings {
     fn build(mesh: &TriMesh, topology: &Topology) -> FaceRings {
-        let blocks = mesh
-            .triangles
+        let order = morton_face_order(mesh);
+        let number = crate::mesh::inverse_permutation(&order);
+        let blocks = order
             .par_chunks(FACE_BLOCK)
             .map(|block| {
                 let mut ring = FaceRingBlock {
@@ -303,7 +325,9 @@ impl FaceRings {
                     shared: Vec::with_capacity(14 * block.len()),
                 };
                 ring.offsets.push(0);
-                for &[a, b, c] in block {
+                for &f in block {
+                    let [a, b, c] = mesh.triangles[f as usize];
+                    let start = ring.faces.len();
                     merge_face_lists(
                         [
                             topology.faces_of(a),
@@ -313,12 +337,15 @@ impl FaceRings {
                         &mut ring.faces,
                         &mut ring.shared,
                     );
+                    for g in &mut ring.faces[start..] {
+                        *g = number[*g as usize];
+                    }
                     ring.offsets.push(ring.faces.len() as u32);
                 }
                 ring
             })
             .collect();
-        FaceRings { blocks }
+        FaceRings { order, blocks }
     }
 
     /// Calls `visit(f, faces around f, their shared-vertex counts, &mut out[f])` for every face,
@@ -343,6 +370,31 @@ impl FaceRings {
                 }
             });
     }
+}
+
+/// The faces' ids in Morton order of their centroids (quantized to 10 bits per axis in the
+/// bounding box of the vertices; ties by id, so the order is the same on any thread count).
+fn morton_face_order(mesh: &TriMesh) -> Vec<u32> {
+    let (lo, hi) = crate::metrics::bounding_box(mesh).unwrap_or_default();
+    let scale = 1023.0 / (hi - lo).max_element().max(f64::MIN_POSITIVE);
+    let mut keys: Vec<u64> = mesh
+        .triangles
+        .par_iter()
+        .with_min_len(4096)
+        .enumerate()
+        .map(|(f, t)| {
+            let q = |c: usize| {
+                let centre = t
+                    .iter()
+                    .map(|&v| mesh.positions[v as usize][c] as f64)
+                    .sum::<f64>();
+                ((centre / 3.0 - lo[c]) * scale).clamp(0.0, 1023.0) as u64
+            };
+            crate::mesh::morton_code_10([q(0), q(1), q(2)]) << 32 | f as u64
+        })
+        .collect();
+    keys.par_sort_unstable();
+    keys.into_iter().map(|k| k as u32).collect()
 }
 
 /// Appends the union of three ascending face lists, each face once with the number of lists

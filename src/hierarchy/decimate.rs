@@ -176,14 +176,6 @@ fn first_level(mesh: &TriMesh, creases: Option<&Creases>) -> Level {
     }
     let (lo, hi) = crate::metrics::bounding_box(mesh).unwrap_or_default();
     let scale = (hi - lo).max_element().max(f64::MIN_POSITIVE);
-    let spread = |x: u64| {
-        // Spreads 10 bits to every third bit.
-        let mut x = x & 0x3ff;
-        x = (x | x << 16) & 0x030000ff;
-        x = (x | x << 8) & 0x0300f00f;
-        x = (x | x << 4) & 0x030c30c3;
-        (x | x << 2) & 0x09249249
-    };
     let mut keys: Vec<u64> = (0..n)
         .into_par_iter()
         .with_min_len(4096)
@@ -191,7 +183,7 @@ fn first_level(mesh: &TriMesh, creases: Option<&Creases>) -> Level {
         .map(|v| {
             let p = mesh.positions[v];
             let q = |c: usize| (((p[c] as f64 - lo[c]) / scale * 1023.0).clamp(0.0, 1023.0)) as u64;
-            (spread(q(0)) | spread(q(1)) << 1 | spread(q(2)) << 2) << 32 | v as u64
+            crate::mesh::morton_code_10([q(0), q(1), q(2)]) << 32 | v as u64
         })
         .collect();
     sort_by_high_half(&mut keys, &mut Vec::new());
