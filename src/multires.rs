@@ -524,6 +524,9 @@ fn fair_level(workspace: &mut MultiresWorkspace, level: usize, options: &FairOpt
         .before_fairing
         .extend_from_slice(&workspace.positions[..n]);
     fairing.run(&mut workspace.positions[..n], options);
+    // The levels are faired one at a time: the operators kept for the next runs (the editor
+    // keeps every level's) hold no working buffers between runs.
+    fairing.release_buffers();
     true
 }
 

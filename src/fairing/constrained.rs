@@ -188,8 +188,9 @@ macro_rules! with_stencil {
     }};
 }
 
-/// Precomputed constrained fairing for one mesh connectivity, with its workspace buffers: build it
-/// once, then run it on as many position sets (of that connectivity) as wanted.
+/// Precomputed constrained fairing for one mesh connectivity, with its workspace buffers (from
+/// the first run on, until [`Self::release_buffers`]): build it once, then run it on as many
+/// position sets (of that connectivity) as wanted.
 ///
 /// Internally the vertices are renumbered in a breadth-first locality order
 /// ([`crate::mesh::breadth_first_order`]) so that every gather reads neighbours that sit close in
@@ -262,6 +263,18 @@ struct Workspace {
     anchor_terms: Vec<Vec3A>,
     position_and_mean: Vec<PositionAndMean>,
     curve_accumulator: Vec<([f64; 3], u32)>,
+}
+
+impl Workspace {
+    fn for_vertices(vertex_count: usize) -> Workspace {
+        Workspace {
+            current: vec![Vec3A::ZERO; vertex_count],
+            anchors: vec![Vec3A::ZERO; vertex_count],
+            anchor_terms: vec![Vec3A::ZERO; vertex_count],
+            position_and_mean: vec![PositionAndMean::default(); vertex_count],
+            curve_accumulator: Vec::new(),
+        }
+    }
 }
 impl ConstrainedFairing {
     /// Precomputes the operator for `mesh`'s connectivity (`topology` must be built from it).
@@ -524,13 +537,6 @@ impl ConstrainedFairing {
             })
             .collect();
         let curves = fairing_curves(topology, boundary, creases, &internal);
-        let workspace = Workspace {
-            current: vec![Vec3A::ZERO; vertex_count],
-            anchors: vec![Vec3A::ZERO; vertex_count],
-            anchor_terms: vec![Vec3A::ZERO; vertex_count],
-            position_and_mean: vec![PositionAndMean::default(); vertex_count],
-            curve_accumulator: Vec::new(),
-        };
         ConstrainedFairing {
             variant,
             boundary,
@@ -546,7 +552,8 @@ impl ConstrainedFairing {
             curves,
             tangential: 0.0,
             solved_vertices,
-            workspace,
+            // Allocated by the first load.
+            workspace: Workspace::default(),
         }
     }
 
@@ -633,6 +640,23 @@ impl ConstrainedFairing {
         report.rounds_run += 1;
     }
 
+    /// Frees the buffers a run works in (80 bytes per vertex: the current state, the anchors and
+    /// their terms, the positions with their umbrella means); the next [`Self::load`] allocates
+    /// them again. For a caller that keeps many operators and runs one at a time (the editor
+    /// keeps one per level of the hierarchy, and these buffers were over half of their memory).
+    pub fn release_buffers(&mut self) {
+        self.workspace = Workspace::default();
+    }
+
+    /// The run's buffers, allocated if [`Self::release_buffers`] freed them or none was loaded
+    /// yet (then the state is all zeros until a load).
+    fn buffers(&mut self) -> &mut Workspace {
+        if self.workspace.current.len() != self.vertex_count() {
+            self.workspace = Workspace::for_vertices(self.vertex_count());
+        }
+        &mut self.workspace
+    }
+
     /// Takes `positions` (the mesh's numbering) as the current state and imposes the constraints
     /// on them (they become the anchors P⁰ of the next iterations).
     pub fn load(&mut self, positions: &[[f32; 3]]) {
@@ -641,6 +665,7 @@ impl ConstrainedFairing {
             self.vertex_count(),
             "positions do not fit this connectivity"
         );
+        self.buffers();
         let order = &self.order;
         self.workspace
             .current
@@ -655,9 +680,13 @@ impl ConstrainedFairing {
         self.reanchor();
     }
 
-    /// Copies the current state into `positions` (the mesh's numbering).
+    /// Copies the current state into `positions` (the mesh's numbering); leaves them as they are
+    /// when no state is held (before the first load, or after [`Self::release_buffers`]).
     pub fn store(&self, positions: &mut [[f32; 3]]) {
         let (current, internal) = (&self.workspace.current, &self.internal);
+        if current.len() != internal.len() {
+            return;
+        }
         positions
             .par_chunks_mut(CHUNK)
             .zip(internal.par_chunks(CHUNK))
@@ -670,6 +699,7 @@ impl ConstrainedFairing {
 
     /// Re-imposes the constraints on the current state (the start of a new round).
     pub fn reanchor(&mut self) {
+        self.buffers();
         let ws = &mut self.workspace;
         ws.anchors.copy_from_slice(&ws.current);
         with_stencil!(self, |stencil| stencil
@@ -680,6 +710,7 @@ impl ConstrainedFairing {
     /// [`Self::reanchor`]). Returns the largest vertex move.
     pub fn step(&mut self) -> f64 {
         let project = self.variant == FairVariant::NormalProjected;
+        self.buffers();
         let ws = &mut self.workspace;
         let offsets = &self.ring_offsets;
         let ring = &self.ring;
@@ -1688,6 +1719,48 @@ mod tests {
                 },
             );
             assert_eq!(mesh.positions, before);
+        }
+    }
+
+    #[test]
+    fn a_run_after_the_buffers_were_released_is_the_run_with_them_kept() {
+        let mesh = irregular_sphere();
+        let topology = Topology::build(&mesh);
+        let noisy: Vec<[f32; 3]> = mesh
+            .positions
+            .iter()
+            .enumerate()
+            .map(|(v, p)| {
+                let bump = ((v * 37) % 11) as f32 * 0.01 - 0.05;
+                [p[0] + bump, p[1] - 0.5 * bump, p[2] + 0.3 * bump]
+            })
+            .collect();
+        for variant in [FairVariant::Paper, FairVariant::NormalProjected] {
+            let options = FairOptions {
+                iterations: 4,
+                rounds: 2,
+                variant,
+                ..Default::default()
+            };
+            let mut kept = ConstrainedFairing::new(&mesh, &topology, variant, BoundaryMode::Curve);
+            let mut released = kept.clone();
+            let (mut a, mut b) = (noisy.clone(), noisy.clone());
+            kept.run(&mut a, &options);
+            released.run(&mut b, &options);
+            released.release_buffers();
+            assert!(released.workspace.current.is_empty());
+            // No state is held: storing leaves the positions as they are.
+            let mut untouched = noisy.clone();
+            released.store(&mut untouched);
+            assert_eq!(untouched, noisy);
+            // The second run starts from other positions than the first one ended with.
+            let (mut a2, mut b2) = (noisy.clone(), noisy.clone());
+            a2.reverse();
+            b2.reverse();
+            kept.run(&mut a2, &options);
+            released.run(&mut b2, &options);
+            assert_eq!(a2, b2);
+            assert_ne!(a2, a);
         }
     }
 }
