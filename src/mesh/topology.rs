@@ -96,6 +96,7 @@ impl Topology {
                 *slot += 1;
             }
         }
+        drop(cursor);
 
         // Each vertex: its faces' other corners tagged with direction (bit 0: the face goes from
         // this vertex to the neighbour). At most two entries per face, so the scratch space is
@@ -121,17 +122,21 @@ impl Topology {
             .collect();
 
         // Compact the neighbour lists (entries are sorted; neighbours are entries >> 1, deduplicated
-        // in place by scan_vertex into the slot's prefix).
+        // in place by scan_vertex into the slot's prefix) within the scratch space itself: a vertex
+        // has at most two neighbours per face, so every list moves down or stays, and no second
+        // array of all the neighbours is held beside the scratch space (the peak of a load).
         let mut neighbor_offsets = vec![0u32; vertex_count + 1];
         for v in 0..vertex_count {
             neighbor_offsets[v + 1] = neighbor_offsets[v] + scans[v].neighbor_count;
         }
-        let mut neighbors = Vec::with_capacity(neighbor_offsets[vertex_count] as usize);
+        let mut neighbors = scratch;
         for v in 0..vertex_count {
             let start = 2 * face_offsets[v] as usize;
-            neighbors.extend_from_slice(&scratch[start..start + scans[v].neighbor_count as usize]);
+            let count = scans[v].neighbor_count as usize;
+            neighbors.copy_within(start..start + count, neighbor_offsets[v] as usize);
         }
-        drop(scratch);
+        neighbors.truncate(neighbor_offsets[vertex_count] as usize);
+        neighbors.shrink_to_fit();
 
         let is_boundary: Vec<bool> = scans.iter().map(|s| s.boundary_edges > 0).collect();
         let mut non_manifold_edges = Vec::new();
