@@ -219,55 +219,53 @@ fn filter_face_normals(
         .with_min_len(4096)
         .map(|&f| unit(area_normals[f as usize]))
         .collect();
-    {
-        let inverse = (1.0 / (2.0 * sigma * sigma)) as f32;
-        let face_count = current.len();
-        let mut patches = vec![Vec4::ZERO; face_count];
-        let mut guidance = vec![Vec3A::ZERO; face_count];
-        let mut next = vec![Vec4::ZERO; face_count];
-        for _ in 0..passes {
-            // Each patch (the faces around a face, with their multiplicities): its area-weighted
-            // mean normal and how much its normals disagree (the largest squared difference from
-            // the mean), as (mean, spread).
-            rings.for_each_face(&mut patches, |f, around, shared, patch| {
-                let own = xyz(current[f]);
-                let mut sum = Vec3A::ZERO;
-                for (&g, &m) in around.iter().zip(shared) {
-                    let n = current[g as usize];
-                    sum += xyz(n) * (n.w * m as f32);
+    let inverse = (1.0 / (2.0 * sigma * sigma)) as f32;
+    let face_count = current.len();
+    let mut patches = vec![Vec4::ZERO; face_count];
+    let mut guidance = vec![Vec3A::ZERO; face_count];
+    let mut next = vec![Vec4::ZERO; face_count];
+    for _ in 0..passes {
+        // Each patch (the faces around a face, with their multiplicities): its area-weighted
+        // mean normal and how much its normals disagree (the largest squared difference from
+        // the mean), as (mean, spread).
+        rings.for_each_face(&mut patches, |f, around, shared, patch| {
+            let own = xyz(current[f]);
+            let mut sum = Vec3A::ZERO;
+            for (&g, &m) in around.iter().zip(shared) {
+                let n = current[g as usize];
+                sum += xyz(n) * (n.w * m as f32);
+            }
+            let mean = sum.try_normalize().unwrap_or(own);
+            let mut spread = 0.0f32;
+            for &g in around {
+                spread = spread.max((xyz(current[g as usize]) - mean).length_squared());
+            }
+            *patch = mean.extend(spread);
+        });
+        // Guidance: the mean of the most consistent patch among those containing f (the
+        // first of the least spread, in the order of the list).
+        rings.for_each_face(&mut guidance, |f, around, _, guide| {
+            let mut best = xyz(current[f]).extend(f32::INFINITY);
+            for &g in around {
+                let patch = patches[g as usize];
+                if patch.w < best.w {
+                    best = patch;
                 }
-                let mean = sum.try_normalize().unwrap_or(own);
-                let mut spread = 0.0f32;
-                for &g in around {
-                    spread = spread.max((xyz(current[g as usize]) - mean).length_squared());
-                }
-                *patch = mean.extend(spread);
-            });
-            // Guidance: the mean of the most consistent patch among those containing f (the
-            // first of the least spread, in the order of the list).
-            rings.for_each_face(&mut guidance, |f, around, _, guide| {
-                let mut best = xyz(current[f]).extend(f32::INFINITY);
-                for &g in around {
-                    let patch = patches[g as usize];
-                    if patch.w < best.w {
-                        best = patch;
-                    }
-                }
-                *guide = xyz(best);
-            });
-            rings.for_each_face(&mut next, |f, around, shared, out| {
-                let own = guidance[f];
-                let mut sum = Vec3A::ZERO;
-                for (&g, &m) in around.iter().zip(shared) {
-                    let d = (guidance[g as usize] - own).length_squared();
-                    let n = current[g as usize];
-                    sum += xyz(n) * (n.w * m as f32 * (-d * inverse).exp());
-                }
-                let area = current[f].w;
-                *out = sum.try_normalize().unwrap_or(xyz(current[f])).extend(area);
-            });
-            std::mem::swap(&mut current, &mut next);
-        }
+            }
+            *guide = xyz(best);
+        });
+        rings.for_each_face(&mut next, |f, around, shared, out| {
+            let own = guidance[f];
+            let mut sum = Vec3A::ZERO;
+            for (&g, &m) in around.iter().zip(shared) {
+                let d = (guidance[g as usize] - own).length_squared();
+                let n = current[g as usize];
+                sum += xyz(n) * (n.w * m as f32 * (-d * inverse).exp());
+            }
+            let area = current[f].w;
+            *out = sum.try_normalize().unwrap_or(xyz(current[f])).extend(area);
+        });
+        std::mem::swap(&mut current, &mut next);
     }
     let mut normals = vec![Vec3A::ZERO; current.len()];
     for (&f, n) in rings.order.iter().zip(&current) {
