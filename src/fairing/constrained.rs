@@ -283,22 +283,9 @@ impl Layout {
             let end = offsets[offsets.len() - 1] + ring_offsets[v + 1] - ring_offsets[v];
             offsets.push(end);
         }
-        let mut internal_ring = vec![0u32; ring.len()];
-        split_into_vertex_blocks(&mut internal_ring, &offsets)
-            .into_par_iter()
-            .for_each(|(first, ring_block)| {
-                let base = offsets[first] as usize;
-                let last = (first + VERTEX_BLOCK).min(vertex_count);
-                for (i, &v) in order[first..last].iter().enumerate() {
-                    let slots =
-                        offsets[first + i] as usize - base..offsets[first + i + 1] as usize - base;
-                    let entries =
-                        ring_offsets[v as usize] as usize..ring_offsets[v as usize + 1] as usize;
-                    for (out, &u) in ring_block[slots].iter_mut().zip(&ring[entries]) {
-                        *out = internal[u as usize];
-                    }
-                }
-            });
+        let internal_ring = entries_in_order(&order, &offsets, ring_offsets, ring, |u| {
+            internal[u as usize]
+        });
         Layout {
             order,
             internal,
@@ -306,6 +293,35 @@ impl Layout {
             ring: internal_ring,
         }
     }
+}
+
+/// One value per one-ring entry (`values`, laid out by `ring_offsets` in the mesh's numbering)
+/// moved with its vertex into the internal order (`order`, laid out by `offsets`), in parallel
+/// over blocks of vertices, each passed through `map`.
+fn entries_in_order(
+    order: &[u32],
+    offsets: &[u32],
+    ring_offsets: &[u32],
+    values: &[u32],
+    map: impl Fn(u32) -> u32 + Sync,
+) -> Vec<u32> {
+    let mut out = vec![0u32; values.len()];
+    split_into_vertex_blocks(&mut out, offsets)
+        .into_par_iter()
+        .for_each(|(first, block)| {
+            let base = offsets[first] as usize;
+            let last = (first + VERTEX_BLOCK).min(order.len());
+            for (i, &v) in order[first..last].iter().enumerate() {
+                let slots =
+                    offsets[first + i] as usize - base..offsets[first + i + 1] as usize - base;
+                let entries =
+                    ring_offsets[v as usize] as usize..ring_offsets[v as usize + 1] as usize;
+                for (out, &value) in block[slots].iter_mut().zip(&values[entries]) {
+                    *out = map(value);
+                }
+            }
+        });
+    out
 }
 
 #[derive(Clone, Debug, Default)]
@@ -592,20 +608,8 @@ impl ConstrainedFairing {
         // are then renumbered in order of first use in the internal order, as deduplicating the
         // permuted rows numbers them, so the operator is the same bit for bit and its table is
         // read in order.
-        let mut internal_index = vec![0u32; ring.len()];
-        split_into_vertex_blocks(&mut internal_index, &internal_offsets)
-            .into_par_iter()
-            .for_each(|(first, index_block)| {
-                let base = internal_offsets[first] as usize;
-                let last = (first + VERTEX_BLOCK).min(vertex_count);
-                for (i, &v) in order[first..last].iter().enumerate() {
-                    let slots = internal_offsets[first + i] as usize - base
-                        ..internal_offsets[first + i + 1] as usize - base;
-                    let entries =
-                        ring_offsets[v as usize] as usize..ring_offsets[v as usize + 1] as usize;
-                    index_block[slots].copy_from_slice(&mesh_index[entries]);
-                }
-            });
+        let internal_index =
+            entries_in_order(&order, &internal_offsets, &ring_offsets, &mesh_index, |i| i);
         drop(mesh_index);
         let (entry_weights, entry_weight_index) = renumber_by_first_use(&mesh_rows, internal_index);
         drop(mesh_rows);
