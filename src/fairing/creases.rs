@@ -374,21 +374,19 @@ impl FaceRings {
 /// bounding box of the vertices; ties by id, so the order is the same on any thread count).
 fn morton_face_order(mesh: &TriMesh) -> Vec<u32> {
     let (lo, hi) = crate::metrics::bounding_box(mesh).unwrap_or_default();
-    let scale = 1023.0 / (hi - lo).max_element().max(f64::MIN_POSITIVE);
+    let extent = (hi - lo).max_element().max(f64::MIN_POSITIVE);
     let mut keys: Vec<u64> = mesh
         .triangles
         .par_iter()
         .with_min_len(4096)
         .enumerate()
         .map(|(f, t)| {
-            let q = |c: usize| {
-                let centre = t
-                    .iter()
-                    .map(|&v| mesh.positions[v as usize][c] as f64)
-                    .sum::<f64>();
-                ((centre / 3.0 - lo[c]) * scale).clamp(0.0, 1023.0) as u64
-            };
-            crate::mesh::morton_code_10([q(0), q(1), q(2)]) << 32 | f as u64
+            let centre = t
+                .iter()
+                .map(|&v| glam::DVec3::from(mesh.positions[v as usize].map(f64::from)))
+                .sum::<glam::DVec3>()
+                / 3.0;
+            crate::mesh::morton_code(centre, lo, extent) << 32 | f as u64
         })
         .collect();
     keys.par_sort_unstable();

@@ -181,9 +181,8 @@ fn first_level(mesh: &TriMesh, creases: Option<&Creases>) -> Level {
         .with_min_len(4096)
         .filter(|&v| level_of[v] == 0)
         .map(|v| {
-            let p = mesh.positions[v];
-            let q = |c: usize| (((p[c] as f64 - lo[c]) / scale * 1023.0).clamp(0.0, 1023.0)) as u64;
-            crate::mesh::morton_code_10([q(0), q(1), q(2)]) << 32 | v as u64
+            let p = mesh.positions[v].map(f64::from);
+            crate::mesh::morton_code(p.into(), lo, scale) << 32 | v as u64
         })
         .collect();
     sort_by_high_half(&mut keys, &mut Vec::new());

@@ -37,10 +37,11 @@ pub fn breadth_first_order(offsets: &[u32], neighbors: &[u32]) -> Vec<u32> {
     order
 }
 
-/// The Morton code of a point quantized to 10 bits per axis (`q[c]` in 0..1024): the bits of the
-/// three coordinates interleaved, x lowest. Sorting by it puts points that are close in space
-/// mostly close in the order (the hierarchy's first level, the guided normal filter's faces).
-pub(crate) fn morton_code_10(q: [u64; 3]) -> u64 {
+/// The Morton code of point `p` in the cube of side `extent` from corner `lo` (the bounding box's
+/// low corner and its longest side), quantized to 10 bits per axis: the bits of the three
+/// coordinates interleaved, x lowest. Sorting by it puts points that are close in space mostly
+/// close in the order (the hierarchy's first level, the guided normal filter's faces).
+pub(crate) fn morton_code(p: glam::DVec3, lo: glam::DVec3, extent: f64) -> u64 {
     // Spreads 10 bits to every third bit.
     let spread = |x: u64| {
         let mut x = x & 0x3ff;
@@ -49,7 +50,8 @@ pub(crate) fn morton_code_10(q: [u64; 3]) -> u64 {
         x = (x | x << 4) & 0x030c30c3;
         (x | x << 2) & 0x09249249
     };
-    spread(q[0]) | spread(q[1]) << 1 | spread(q[2]) << 2
+    let q = |c: usize| ((p[c] - lo[c]) / extent * 1023.0).clamp(0.0, 1023.0) as u64;
+    spread(q(0)) | spread(q(1)) << 1 | spread(q(2)) << 2
 }
 
 /// The inverse permutation of `order`: `position[order[i]] = i`.
