@@ -86,9 +86,12 @@
 //! `min_vertices`, the pass is visited again one vertex at a time. Smaller levels are visited one
 //! vertex at a time, exactly as before regions.
 //!
-//! Building the fans and the next level in parallel blocks was tried (a two-step counting sort;
-//! ordered parallel filters) and was slower on one thread and no faster on two: both are
-//! streaming passes that the serial code already runs at memory speed.
+//! A level visited in regions also builds its fans and writes the next level in parallel: the
+//! fans in one block of consecutive vertices per thread (each block reads every face and places
+//! only its own corners, so every fan keeps face order), the next level in chunks of a region's
+//! least size (each chunk counts what it keeps, the running sums place it). Both give the same
+//! arrays for any number of threads. (Sorting each chunk of faces by block first, and ordered
+//! parallel filters that gather the labels twice, were tried before and were slower.)
 
 use super::{HierarchyError, HierarchyOptions};
 use crate::fairing::creases::{Creases, FeatureClass};
@@ -271,8 +274,9 @@ struct PassState {
     inside: Vec<bool>,
     /// Whether a vertex was visited in an earlier round of this pass.
     visited: Vec<bool>,
-    /// Id in the next level of every vertex's image (its target's if removed).
-    label: Vec<u32>,
+    /// Id in the next level of every vertex's image (its target's if removed; atomic only so
+    /// that chunks of vertices can be labelled at once).
+    label: Vec<AtomicU32>,
 }
 
 /// The passes, from M0 (given as its first level) up.
@@ -287,7 +291,7 @@ fn passes(
         removed_in_pass: vec![NEVER; n],
         target: vec![NEVER; n],
         six_split_volume: vec![0.0; n],
-        face_removed_in_pass: vec![NEVER; mesh.face_count()],
+        face_removed_in_pass: Vec::new(),
         pass_ms: Vec::new(),
         non_manifold: Vec::new(),
     };
@@ -295,6 +299,9 @@ fn passes(
     // neighbours (so no face at such a vertex ever changes, and every collapse is between
     // manifold vertices).
     let mut pinned: Vec<bool> = Vec::new();
+    let face_removed_in_pass: Vec<AtomicU32> = (0..mesh.face_count())
+        .map(|_| AtomicU32::new(NEVER))
+        .collect();
     let isolated = n - level.points.len();
     let mut next = Level::default();
     let mut state = PassState::default();
@@ -310,7 +317,13 @@ fn passes(
         }
         let started = Instant::now();
         let level_vertices = level.points.len();
-        build_fans(&level.corners, level_vertices, &mut state);
+        // A level visited in regions builds its fans and the next level in parallel too, in
+        // chunks of a region's least size.
+        let chunk = options
+            .regions
+            .for_level(level_vertices)
+            .map(|_| options.regions.min.max(1));
+        build_fans(&level.corners, level_vertices, chunk.is_some(), &mut state);
         if pass == 0 {
             let non_manifold = non_manifold_vertices(&state.fan_offsets, &state.fans);
             if !non_manifold.is_empty() {
@@ -372,11 +385,12 @@ fn passes(
         // and the fans are never held at once (the next pass builds its own, smaller fans).
         state.fans = Vec::new();
         next_level(
-            &level,
+            &mut level,
             &mut state,
             pass,
             removed,
-            &mut out.face_removed_in_pass,
+            &face_removed_in_pass,
+            chunk,
             &mut next,
         );
         // The level just left goes too, rather than wait as the buffers of the one after next:
@@ -386,6 +400,12 @@ fn passes(
         level = std::mem::take(&mut next);
         out.pass_ms.push(started.elapsed().as_secs_f64() * 1e3);
     }
+    // (Atomics only so that the next level's chunks can record their faces at once; the same
+    // layout, so this reuses the memory.)
+    out.face_removed_in_pass = face_removed_in_pass
+        .into_iter()
+        .map(AtomicU32::into_inner)
+        .collect();
     Ok(out)
 }
 
@@ -625,30 +645,76 @@ fn visit(v: u32, view: &PassView, scratch: &mut Scratch) -> Option<(u32, f32)> {
 
 /// The fans of a level with `vertex_count` vertices in CSR form, by a counting sort of the
 /// faces' corners (a vertex's pairs come in face order).
-fn build_fans(corners: &[[u32; 3]], vertex_count: usize, state: &mut PassState) {
+fn build_fans(corners: &[[u32; 3]], vertex_count: usize, parallel: bool, state: &mut PassState) {
+    // In parallel: blocks of consecutive vertices, one per thread: each block reads every face
+    // and counts, then places, only the corners that fall in it, so every fan is still in face
+    // order and the fans are the same for any number of blocks. (Reading the faces once per
+    // block costs little next to the scattered writes, which are what the blocks share out.)
+    let blocks = if parallel {
+        rayon::current_num_threads().clamp(1, MAX_BLOCKS)
+    } else {
+        1
+    };
+    let block_len = vertex_count.div_ceil(blocks).max(1);
     let offsets = &mut state.fan_offsets;
     offsets.clear();
     offsets.resize(vertex_count + 1, 0);
-    for t in corners {
-        for &c in t {
-            offsets[c as usize + 1] += 1;
-        }
-    }
-    for v in 0..vertex_count {
-        offsets[v + 1] += offsets[v];
-    }
-    state.fans.clear();
-    state.fans.resize(3 * corners.len(), [0; 2]);
+    // Each block's counts, then their running sums within the block.
+    offsets[1..]
+        .par_chunks_mut(block_len)
+        .enumerate()
+        .for_each(|(b, ends)| {
+            let (first, len) = ((b * block_len) as u32, ends.len() as u32);
+            for t in corners {
+                for &c in t {
+                    let i = c.wrapping_sub(first);
+                    if i < len {
+                        ends[i as usize] += 1;
+                    }
+                }
+            }
+            for i in 1..ends.len() {
+                ends[i] += ends[i - 1];
+            }
+        });
+    // Then each block's start added to its entries.
+    let block_fans: Vec<u32> = offsets[1..]
+        .chunks(block_len)
+        .map(|ends| ends.last().copied().unwrap_or(0))
+        .collect();
+    let block_start = running_starts(&block_fans);
+    offsets[1..]
+        .par_chunks_mut(block_len)
+        .zip(&block_start)
+        .for_each(|(ends, &start)| ends.iter_mut().for_each(|e| *e += start));
+    // Zeroed pages from the allocator: the blocks' writes fault them in, in parallel.
+    state.fans = vec![[0; 2]; 3 * corners.len()];
     state.cursor.clear();
     state.cursor.extend_from_slice(&offsets[..vertex_count]);
-    for &[x, y, z] in corners {
-        for (v, pair) in [(x, [y, z]), (y, [z, x]), (z, [x, y])] {
-            let slot = &mut state.cursor[v as usize];
-            state.fans[*slot as usize] = pair;
-            *slot += 1;
-        }
-    }
+    let fans_of_block = split_by_lengths(&mut state.fans, &block_fans);
+    state
+        .cursor
+        .par_chunks_mut(block_len)
+        .zip(fans_of_block)
+        .enumerate()
+        .for_each(|(b, (cursor, fans))| {
+            let (first, len) = ((b * block_len) as u32, cursor.len() as u32);
+            let base = block_start[b];
+            for &[x, y, z] in corners {
+                for (v, pair) in [(x, [y, z]), (y, [z, x]), (z, [x, y])] {
+                    let i = v.wrapping_sub(first);
+                    if i < len {
+                        let slot = &mut cursor[i as usize];
+                        fans[(*slot - base) as usize] = pair;
+                        *slot += 1;
+                    }
+                }
+            }
+        });
 }
+
+/// At most this many blocks of vertices (each reads every face).
+const MAX_BLOCKS: usize = 16;
 
 /// Every vertex's cost (as the bits of a non-negative f32, which order like the value) into
 /// `state.cost`, and whether it is on a boundary into `state.open`.
@@ -731,64 +797,145 @@ fn sort_by_high_half(keys: &mut Vec<u64>, buffer: &mut Vec<u64>) {
 
 /// The level after the pass's collapses: survivors keep their relative order, faces of removed
 /// vertices are relabelled to the targets, and those that degenerate disappear (recorded in
-/// `face_removed_in_pass`).
+/// `face_removed_in_pass`). `level.corners` is relabelled in place on the way.
+///
+/// In parallel over consecutive chunks of `chunk` vertices and of `chunk` faces (one chunk of
+/// each when `None`): each chunk first counts what it keeps, the running sums of the counts give each chunk its place in the next level, and each
+/// chunk then writes its part there, so the next level is the same for any number of threads.
 fn next_level(
-    level: &Level,
+    level: &mut Level,
     state: &mut PassState,
     pass: u32,
     removed: usize,
-    face_removed_in_pass: &mut [u32],
+    face_removed_in_pass: &[AtomicU32],
+    chunk: Option<usize>,
     next: &mut Level,
 ) {
-    // Every collapse removes one vertex and at least one face.
-    let (vertices, faces) = (level.points.len() - removed, level.corners.len() - removed);
-    next.points.clear();
-    next.points.reserve_exact(vertices);
-    next.vertex_id.clear();
-    next.vertex_id.reserve_exact(vertices);
-    next.corners.clear();
-    next.corners.reserve_exact(faces);
-    next.face_id.clear();
-    next.face_id.reserve_exact(faces);
-    next.crease.clear();
-    if !level.crease.is_empty() {
-        next.crease.reserve_exact(vertices);
-    }
+    let n = level.points.len();
+    let vertices = n - removed;
+    let chunk_len = |len: usize| chunk.unwrap_or(len).max(1);
+    let chunk = chunk_len(n);
     let (mark, label) = (&state.mark, &mut state.label);
-    let mark = || mark.iter().map(|m| m.load(Relaxed));
+    let survives = |m: &AtomicU32| m.load(Relaxed) >= LOCKED;
+    // Survivors, chunk by chunk: their labels, points and M0 ids.
+    let kept: Vec<u32> = mark
+        .par_chunks(chunk)
+        .map(|marks| marks.iter().filter(|m| survives(m)).count() as u32)
+        .collect();
     label.clear();
-    label.resize(level.points.len(), NEVER);
-    for (v, m) in mark().enumerate() {
-        if m >= LOCKED {
-            label[v] = next.points.len() as u32;
-            next.points.push(level.points[v]);
-            next.vertex_id.push(level.vertex_id[v]);
-        }
-    }
-    for (v, m) in mark().enumerate() {
-        if m < LOCKED {
-            label[v] = label[m as usize];
-        }
-    }
+    label.resize_with(n, || AtomicU32::new(NEVER));
+    next.points = vec![[0.0; 3]; vertices];
+    next.vertex_id = vec![0; vertices];
+    let starts = running_starts(&kept);
+    mark.par_chunks(chunk)
+        .zip(label.par_chunks(chunk))
+        .zip(split_by_lengths(&mut next.points, &kept))
+        .zip(split_by_lengths(&mut next.vertex_id, &kept))
+        .enumerate()
+        .for_each(|(c, (((marks, labels), points), ids))| {
+            let first = c * chunk;
+            let mut slot = 0;
+            for (i, (m, l)) in marks.iter().zip(labels).enumerate() {
+                if survives(m) {
+                    l.store(starts[c] + slot as u32, Relaxed);
+                    points[slot] = level.points[first + i];
+                    ids[slot] = level.vertex_id[first + i];
+                    slot += 1;
+                }
+            }
+        });
+    // A removed vertex takes its target's label (a target survives the pass).
+    let label_of = |v: u32| label[v as usize].load(Relaxed);
+    mark.par_chunks(chunk)
+        .zip(label.par_chunks(chunk))
+        .for_each(|(marks, labels)| {
+            for (m, l) in marks.iter().zip(labels) {
+                let m = m.load(Relaxed);
+                if m < LOCKED {
+                    l.store(label_of(m), Relaxed);
+                }
+            }
+        });
     // Crease neighbours were moved to survivors as the collapses happened.
-    for (&c, m) in level.crease.iter().zip(mark()) {
-        if m >= LOCKED {
-            next.crease.push(if c == NO_CREASE || c == CORNER {
-                c
-            } else {
-                c.map(|u| label[u as usize])
+    next.crease = Vec::new();
+    if !level.crease.is_empty() {
+        next.crease = vec![NO_CREASE; vertices];
+        level
+            .crease
+            .par_chunks(chunk)
+            .zip(mark.par_chunks(chunk))
+            .zip(split_by_lengths(&mut next.crease, &kept))
+            .for_each(|((creases, marks), out)| {
+                let kept = creases.iter().zip(marks).filter(|(_, m)| survives(m));
+                for ((&c, _), slot) in kept.zip(out) {
+                    *slot = if c == NO_CREASE || c == CORNER {
+                        c
+                    } else {
+                        c.map(label_of)
+                    };
+                }
             });
-        }
     }
-    for (t, &f) in level.corners.iter().zip(&level.face_id) {
-        let t = t.map(|c| label[c as usize]);
-        if t[0] == t[1] || t[1] == t[2] || t[0] == t[2] {
-            face_removed_in_pass[f as usize] = pass;
-        } else {
-            next.corners.push(t);
-            next.face_id.push(f);
-        }
-    }
+    // Faces, relabelled in place; those that degenerate are the removed ones.
+    let chunk = chunk_len(level.corners.len());
+    let degenerate = |t: &[u32; 3]| t[0] == t[1] || t[1] == t[2] || t[0] == t[2];
+    let kept: Vec<u32> = level
+        .corners
+        .par_chunks_mut(chunk)
+        .zip(level.face_id.par_chunks(chunk))
+        .map(|(corners, ids)| {
+            let mut kept = 0;
+            for (t, &f) in corners.iter_mut().zip(ids) {
+                *t = t.map(label_of);
+                if degenerate(t) {
+                    face_removed_in_pass[f as usize].store(pass, Relaxed);
+                } else {
+                    kept += 1;
+                }
+            }
+            kept
+        })
+        .collect();
+    let faces = kept.iter().map(|&k| k as usize).sum();
+    next.corners = vec![[0; 3]; faces];
+    next.face_id = vec![0; faces];
+    level
+        .corners
+        .par_chunks(chunk)
+        .zip(level.face_id.par_chunks(chunk))
+        .zip(split_by_lengths(&mut next.corners, &kept))
+        .zip(split_by_lengths(&mut next.face_id, &kept))
+        .for_each(|(((corners, ids), out_corners), out_ids)| {
+            let kept = corners.iter().zip(ids).filter(|(t, _)| !degenerate(t));
+            for (((t, &f), slot), id) in kept.zip(out_corners).zip(out_ids) {
+                *slot = *t;
+                *id = f;
+            }
+        });
+}
+
+/// Where each chunk's items start, for chunks of `lengths` items.
+fn running_starts(lengths: &[u32]) -> Vec<u32> {
+    lengths
+        .iter()
+        .scan(0u32, |sum, &len| {
+            let start = *sum;
+            *sum += len;
+            Some(start)
+        })
+        .collect()
+}
+
+/// `items` cut into consecutive pieces of `lengths` items (which add up to at most its length).
+fn split_by_lengths<'a, T>(mut items: &'a mut [T], lengths: &[u32]) -> Vec<&'a mut [T]> {
+    lengths
+        .iter()
+        .map(|&len| {
+            let (piece, rest) = std::mem::take(&mut items).split_at_mut(len as usize);
+            items = rest;
+            piece
+        })
+        .collect()
 }
 
 #[inline]

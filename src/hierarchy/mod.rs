@@ -39,7 +39,7 @@ use crate::mesh::{Topology, TriMesh};
 use crate::Progress;
 use decimate::NEVER;
 use rayon::prelude::*;
-use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::atomic::{AtomicU32, AtomicU64, Ordering};
 
 /// Options of [`build_hierarchy`]; build them with `HierarchyOptions::default()` and the
 /// `with_*` setters.
@@ -481,30 +481,17 @@ fn build(
     let finishing = std::time::Instant::now();
     let passes = built.pass_ms.len();
 
-    // Internal order: by pass of removal, latest (or never) first; ties by id. `bucket(p)` is 0
-    // for survivors, `passes - p` for vertices removed in pass p.
-    let bucket = |p: u32| if p == NEVER { 0 } else { passes - p as usize };
-    let order = counting_order(&built.removed_in_pass, passes + 1, bucket);
-    let mut rank = vec![0u32; n];
-    for (i, &v) in order.iter().enumerate() {
-        rank[v as usize] = i as u32;
-    }
-    let face_order = counting_order(&built.face_removed_in_pass, passes + 1, bucket);
-
-    // V_i = vertices not removed in passes 0..i (suffix sums of a histogram by pass).
-    let level_sizes = |removed_in_pass: &[u32]| {
-        let mut sizes = vec![0u32; passes + 2];
-        for &p in removed_in_pass {
-            sizes[if p == NEVER { passes } else { p as usize }] += 1;
-        }
-        for i in (0..=passes).rev() {
-            sizes[i] += sizes[i + 1];
-        }
-        sizes.truncate(passes + 1);
-        sizes
-    };
-    let level_vertices = level_sizes(&built.removed_in_pass);
-    let level_faces = level_sizes(&built.face_removed_in_pass);
+    // Internal order: by pass of removal, latest (or never) first; ties by id.
+    let ByPass {
+        order,
+        rank,
+        level_sizes: level_vertices,
+    } = by_pass(&built.removed_in_pass, passes, true);
+    let ByPass {
+        order: face_order,
+        level_sizes: level_faces,
+        ..
+    } = by_pass(&built.face_removed_in_pass, passes, false);
     // Gathers in M0's order (parallel, as they mostly wait on memory).
     let positions = order
         .par_iter()
@@ -566,22 +553,97 @@ fn build(
     })
 }
 
-/// Indices `0..keys.len()` sorted by `bucket(keys[i])` ascending, stable.
-fn counting_order(keys: &[u32], buckets: usize, bucket: impl Fn(u32) -> usize) -> Vec<u32> {
-    let mut starts = vec![0u32; buckets + 1];
-    for &k in keys {
-        starts[bucket(k) + 1] += 1;
+/// Vertices (or faces) ordered by the pass that removed them, latest first and those never
+/// removed before all; ties by id.
+struct ByPass {
+    /// Ids in that order.
+    order: Vec<u32>,
+    /// Place of each id in `order` (empty unless asked for).
+    rank: Vec<u32>,
+    /// `level_sizes[i]`: how many were not removed in passes `0..i`, for `i` in `0..=passes`.
+    level_sizes: Vec<u32>,
+}
+
+/// A stable counting sort of the ids by `removed_in_pass` (`NEVER`, or a pass below `passes`),
+/// in parallel over chunks of ids: each chunk counts its ids per pass, the counts give each chunk
+/// its places, and each chunk places its ids (and writes their ranks, which are its own), so the
+/// order is the same for any number of threads.
+fn by_pass(removed_in_pass: &[u32], passes: usize, with_rank: bool) -> ByPass {
+    const CHUNK: usize = 1 << 15;
+    // Bucket 0 for survivors, `passes - p` for ids removed in pass p.
+    let bucket = |p: u32| if p == NEVER { 0 } else { passes - p as usize };
+    let counts: Vec<Vec<u32>> = removed_in_pass
+        .par_chunks(CHUNK)
+        .map(|chunk| {
+            let mut count = vec![0u32; passes + 1];
+            for &p in chunk {
+                count[bucket(p)] += 1;
+            }
+            count
+        })
+        .collect();
+    // Each chunk's first place in each bucket.
+    let mut next = vec![0u32; passes + 1];
+    for count in &counts {
+        for (n, c) in next.iter_mut().zip(count) {
+            *n += c;
+        }
     }
-    for b in 0..buckets {
-        starts[b + 1] += starts[b];
+    let totals = next.clone();
+    let mut sum = 0;
+    for n in &mut next {
+        (*n, sum) = (sum, sum + *n);
     }
-    let mut order = vec![0u32; keys.len()];
-    for (i, &k) in keys.iter().enumerate() {
-        let slot = &mut starts[bucket(k)];
-        order[*slot as usize] = i as u32;
-        *slot += 1;
+    let starts: Vec<Vec<u32>> = counts
+        .iter()
+        .map(|count| {
+            let start = next.clone();
+            for (n, c) in next.iter_mut().zip(count) {
+                *n += c;
+            }
+            start
+        })
+        .collect();
+    let order: Vec<AtomicU32> = (0..removed_in_pass.len())
+        .map(|_| AtomicU32::new(0))
+        .collect();
+    let mut rank = if with_rank {
+        vec![0u32; removed_in_pass.len()]
+    } else {
+        Vec::new()
+    };
+    let rank_chunks: Vec<Option<&mut [u32]>> = if with_rank {
+        rank.chunks_mut(CHUNK).map(Some).collect()
+    } else {
+        (0..starts.len()).map(|_| None).collect()
+    };
+    removed_in_pass
+        .par_chunks(CHUNK)
+        .zip(starts)
+        .zip(rank_chunks)
+        .enumerate()
+        .for_each(|(c, ((chunk, mut slot), mut rank))| {
+            for (i, &p) in chunk.iter().enumerate() {
+                let slot = &mut slot[bucket(p)];
+                order[*slot as usize].store((c * CHUNK + i) as u32, Ordering::Relaxed);
+                if let Some(rank) = rank.as_mut() {
+                    rank[i] = *slot;
+                }
+                *slot += 1;
+            }
+        });
+    // Level i keeps the survivors and the ids removed in passes i and later: buckets
+    // `0..=passes - i`.
+    let level_sizes = (0..=passes)
+        .map(|i| totals[..=passes - i].iter().sum())
+        .collect();
+    ByPass {
+        // (Atomics only so that the chunks can place their ids at once; the same layout, so
+        // this reuses the memory.)
+        order: order.into_iter().map(AtomicU32::into_inner).collect(),
+        rank,
+        level_sizes,
     }
-    order
 }
 
 #[cfg(test)]
