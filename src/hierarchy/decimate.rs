@@ -86,12 +86,14 @@
 //! `min_vertices`, the pass is visited again one vertex at a time. Smaller levels are visited one
 //! vertex at a time, exactly as before regions.
 //!
-//! A level visited in regions also builds its fans and writes the next level in parallel: the
-//! fans in one block of consecutive vertices per thread (each block reads every face and places
-//! only its own corners, so every fan keeps face order), the next level in chunks of a region's
-//! least size (each chunk counts what it keeps, the running sums place it). Both give the same
-//! arrays for any number of threads. (Sorting each chunk of faces by block first, and ordered
-//! parallel filters that gather the labels twice, were tried before and were slower.)
+//! A level visited in regions also builds its fans and writes the next level in parallel, and M0
+//! is sorted in parallel when it is: every counting sort (M0's vertices by Morton code, its faces
+//! by first corner, every level's fans) runs as one block of consecutive buckets per thread,
+//! each block reading every item and placing only its own entries (`bucket_sort`), and the next
+//! level is written in chunks of a region's least size (each chunk counts what it keeps, the
+//! running sums place it). All give the same arrays for any number of threads. (Sorting each
+//! chunk of faces by block first, and ordered parallel filters that gather the labels twice,
+//! were tried before and were slower.)
 
 use super::{HierarchyError, HierarchyOptions};
 use crate::fairing::creases::{Creases, FeatureClass};
@@ -133,7 +135,15 @@ pub(super) fn build(
     options: &HierarchyOptions,
     progress: &mut dyn Progress,
 ) -> Result<BuildOutput, HierarchyError> {
-    passes(mesh, first_level(mesh, creases), options, progress).map_err(|e| match e {
+    // As a pass does (see `passes`), M0 is sorted in parallel when it is visited in regions.
+    let parallel = options.regions.for_level(mesh.vertex_count()).is_some();
+    passes(
+        mesh,
+        first_level(mesh, creases, parallel),
+        options,
+        progress,
+    )
+    .map_err(|e| match e {
         BuildFailure::Cancelled => HierarchyError::Cancelled,
     })
 }
@@ -168,8 +178,9 @@ const CORNER: [u32; 2] = [NEVER - 1; 2];
 /// M0 as the first level: the vertices that some face uses (isolated ones are never removed) in
 /// Morton order of their positions (quantized to 10 bits per axis in M0's bounding box; ties by
 /// id), the faces in order of their first corner's place in that order (ties by id); with the
-/// creases' classes and crease neighbours in the same order.
-fn first_level(mesh: &TriMesh, creases: Option<&Creases>) -> Level {
+/// creases' classes and crease neighbours in the same order. `parallel`: sort in blocks (the
+/// same order).
+fn first_level(mesh: &TriMesh, creases: Option<&Creases>, parallel: bool) -> Level {
     let n = mesh.vertex_count();
     let mut level_of = vec![NEVER; n];
     for t in &mesh.triangles {
@@ -179,7 +190,7 @@ fn first_level(mesh: &TriMesh, creases: Option<&Creases>) -> Level {
     }
     let (lo, hi) = crate::metrics::bounding_box(mesh).unwrap_or_default();
     let scale = (hi - lo).max_element().max(f64::MIN_POSITIVE);
-    let mut keys: Vec<u64> = (0..n)
+    let keys: Vec<u64> = (0..n)
         .into_par_iter()
         .with_min_len(4096)
         .filter(|&v| level_of[v] == 0)
@@ -188,26 +199,53 @@ fn first_level(mesh: &TriMesh, creases: Option<&Creases>) -> Level {
             crate::mesh::morton_code(p.into(), lo, scale) << 32 | v as u64
         })
         .collect();
-    sort_by_high_half(&mut keys, &mut Vec::new());
-    let vertex_id: Vec<u32> = keys.par_iter().map(|&k| k as u32).collect();
+    // Sorted by code (30 bits), ties by id (the keys come in id order and each pass is stable):
+    // the low 15 bits of the code, then the high 15.
+    let (mut offsets, mut cursor) = (Vec::new(), Vec::new());
+    let mut by_low = Vec::new();
+    let digit = |k: u64, shift: u32| (k >> (32 + shift)) as u32 & 0x7fff;
+    bucket_sort(
+        keys.len(),
+        1 << 15,
+        parallel,
+        |i| [(digit(keys[i], 0), keys[i])],
+        &mut offsets,
+        &mut cursor,
+        &mut by_low,
+    );
     drop(keys);
+    let mut vertex_id = Vec::new();
+    bucket_sort(
+        by_low.len(),
+        1 << 15,
+        parallel,
+        |i| [(digit(by_low[i], 15), by_low[i] as u32)],
+        &mut offsets,
+        &mut cursor,
+        &mut vertex_id,
+    );
+    drop(by_low);
     for (i, &v) in vertex_id.iter().enumerate() {
         level_of[v as usize] = i as u32;
     }
     // Faces by a counting sort on their first corner's place (stable, so ties stay by id).
-    let mut starts = vec![0u32; vertex_id.len() + 1];
-    for t in &mesh.triangles {
-        starts[level_of[t[0] as usize] as usize + 1] += 1;
-    }
-    for i in 1..starts.len() {
-        starts[i] += starts[i - 1];
-    }
-    let mut face_id = vec![0u32; mesh.face_count()];
-    for (f, t) in mesh.triangles.iter().enumerate() {
-        let slot = &mut starts[level_of[t[0] as usize] as usize];
-        face_id[*slot as usize] = f as u32;
-        *slot += 1;
-    }
+    let place: Vec<u32> = mesh
+        .triangles
+        .par_iter()
+        .with_min_len(4096)
+        .map(|t| level_of[t[0] as usize])
+        .collect();
+    let mut face_id = Vec::new();
+    bucket_sort(
+        place.len(),
+        vertex_id.len(),
+        parallel,
+        |f| [(place[f], f as u32)],
+        &mut offsets,
+        &mut cursor,
+        &mut face_id,
+    );
+    drop(place);
     let crease = creases.map_or_else(Vec::new, |creases| {
         let mut crease: Vec<[u32; 2]> = vertex_id
             .iter()
@@ -646,66 +684,93 @@ fn visit(v: u32, view: &PassView, scratch: &mut Scratch) -> Option<(u32, f32)> {
 /// The fans of a level with `vertex_count` vertices in CSR form, by a counting sort of the
 /// faces' corners (a vertex's pairs come in face order).
 fn build_fans(corners: &[[u32; 3]], vertex_count: usize, parallel: bool, state: &mut PassState) {
-    // In parallel: blocks of consecutive vertices, one per thread: each block reads every face
-    // and counts, then places, only the corners that fall in it, so every fan is still in face
-    // order and the fans are the same for any number of blocks. (Reading the faces once per
-    // block costs little next to the scattered writes, which are what the blocks share out.)
+    bucket_sort(
+        corners.len(),
+        vertex_count,
+        parallel,
+        |f| {
+            let [x, y, z] = corners[f];
+            [(x, [y, z]), (y, [z, x]), (z, [x, y])]
+        },
+        &mut state.fan_offsets,
+        &mut state.cursor,
+        &mut state.fans,
+    );
+}
+
+/// A stable counting sort: item `i` of `0..items` brings the `K` entries `entries(i)`, each a
+/// bucket in `0..buckets` and a value; `sorted` gets the values bucket by bucket, in item order
+/// within a bucket, and `offsets` (`buckets + 1` of them) where each bucket starts. `cursor` is
+/// scratch space.
+///
+/// In parallel: one block of consecutive buckets per thread. Each block reads every item and
+/// counts, then places, only the entries that fall in it, so the result is the same for any
+/// number of blocks. (Reading the items once per block costs little next to the scattered
+/// writes, which are what the blocks share out.)
+#[allow(clippy::too_many_arguments)]
+fn bucket_sort<T: Copy + Default + Send + Sync, const K: usize>(
+    items: usize,
+    buckets: usize,
+    parallel: bool,
+    entries: impl Fn(usize) -> [(u32, T); K] + Sync,
+    offsets: &mut Vec<u32>,
+    cursor: &mut Vec<u32>,
+    sorted: &mut Vec<T>,
+) {
     let blocks = if parallel {
         rayon::current_num_threads().clamp(1, MAX_BLOCKS)
     } else {
         1
     };
-    let block_len = vertex_count.div_ceil(blocks).max(1);
-    let offsets = &mut state.fan_offsets;
+    let block_len = buckets.div_ceil(blocks).max(1);
     offsets.clear();
-    offsets.resize(vertex_count + 1, 0);
+    offsets.resize(buckets + 1, 0);
     // Each block's counts, then their running sums within the block.
     offsets[1..]
         .par_chunks_mut(block_len)
         .enumerate()
         .for_each(|(b, ends)| {
             let (first, len) = ((b * block_len) as u32, ends.len() as u32);
-            for t in corners {
-                for &c in t {
-                    let i = c.wrapping_sub(first);
-                    if i < len {
-                        ends[i as usize] += 1;
+            for i in 0..items {
+                for (bucket, _) in entries(i) {
+                    let j = bucket.wrapping_sub(first);
+                    if j < len {
+                        ends[j as usize] += 1;
                     }
                 }
             }
-            for i in 1..ends.len() {
-                ends[i] += ends[i - 1];
+            for j in 1..ends.len() {
+                ends[j] += ends[j - 1];
             }
         });
     // Then each block's start added to its entries.
-    let block_fans: Vec<u32> = offsets[1..]
+    let block_entries: Vec<u32> = offsets[1..]
         .chunks(block_len)
         .map(|ends| ends.last().copied().unwrap_or(0))
         .collect();
-    let block_start = running_starts(&block_fans);
+    let block_start = running_starts(&block_entries);
     offsets[1..]
         .par_chunks_mut(block_len)
         .zip(&block_start)
         .for_each(|(ends, &start)| ends.iter_mut().for_each(|e| *e += start));
-    // Zeroed pages from the allocator: the blocks' writes fault them in, in parallel.
-    state.fans = vec![[0; 2]; 3 * corners.len()];
-    state.cursor.clear();
-    state.cursor.extend_from_slice(&offsets[..vertex_count]);
-    let fans_of_block = split_by_lengths(&mut state.fans, &block_fans);
-    state
-        .cursor
+    // Fresh zeroed pages from the allocator: the blocks' writes fault them in, in parallel.
+    *sorted = vec![T::default(); K * items];
+    cursor.clear();
+    cursor.extend_from_slice(&offsets[..buckets]);
+    let sorted_of_block = split_by_lengths(sorted, &block_entries);
+    cursor
         .par_chunks_mut(block_len)
-        .zip(fans_of_block)
+        .zip(sorted_of_block)
         .enumerate()
-        .for_each(|(b, (cursor, fans))| {
+        .for_each(|(b, (cursor, sorted))| {
             let (first, len) = ((b * block_len) as u32, cursor.len() as u32);
             let base = block_start[b];
-            for &[x, y, z] in corners {
-                for (v, pair) in [(x, [y, z]), (y, [z, x]), (z, [x, y])] {
-                    let i = v.wrapping_sub(first);
-                    if i < len {
-                        let slot = &mut cursor[i as usize];
-                        fans[(*slot - base) as usize] = pair;
+            for i in 0..items {
+                for (bucket, value) in entries(i) {
+                    let j = bucket.wrapping_sub(first);
+                    if j < len {
+                        let slot = &mut cursor[j as usize];
+                        sorted[(*slot - base) as usize] = value;
                         *slot += 1;
                     }
                 }
@@ -713,7 +778,7 @@ fn build_fans(corners: &[[u32; 3]], vertex_count: usize, parallel: bool, state: 
         });
 }
 
-/// At most this many blocks of vertices (each reads every face).
+/// At most this many blocks of [`bucket_sort`] (each reads every item).
 const MAX_BLOCKS: usize = 16;
 
 /// Every vertex's cost (as the bits of a non-negative f32, which order like the value) into
@@ -764,35 +829,6 @@ fn vertex_costs(level: &Level, options: &HierarchyOptions, state: &mut PassState
             };
             *key = bits;
         });
-}
-
-/// Stable LSD radix sort of `keys` by their upper 32 bits, a byte at a time (bytes that are the
-/// same in every key are skipped).
-fn sort_by_high_half(keys: &mut Vec<u64>, buffer: &mut Vec<u64>) {
-    let mut counts = [[0u32; 256]; 4];
-    for &k in keys.iter() {
-        for (digit, count) in counts.iter_mut().enumerate() {
-            count[(k >> (32 + 8 * digit)) as usize & 255] += 1;
-        }
-    }
-    buffer.resize(keys.len(), 0);
-    for (digit, count) in counts.iter().enumerate() {
-        if count.iter().any(|&c| c as usize == keys.len()) {
-            continue;
-        }
-        let mut starts = [0u32; 256];
-        let mut sum = 0;
-        for (start, &c) in starts.iter_mut().zip(count) {
-            *start = sum;
-            sum += c;
-        }
-        for &k in keys.iter() {
-            let slot = &mut starts[(k >> (32 + 8 * digit)) as usize & 255];
-            buffer[*slot as usize] = k;
-            *slot += 1;
-        }
-        std::mem::swap(keys, buffer);
-    }
 }
 
 /// The level after the pass's collapses: survivors keep their relative order, faces of removed
