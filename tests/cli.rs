@@ -796,3 +796,27 @@ fn bench_times_only_the_groups_asked_for() {
     assert!(!out.status.success());
     assert!(String::from_utf8_lossy(&out.stderr).contains("hierarchy"));
 }
+
+#[test]
+fn fair_and_the_hierarchy_keep_the_files_hard_edges_as_creases() {
+    // A sheet folded by 20 degrees (below the crease angle), each side with its own normal: the
+    // file's 12 fold edges are the only creases.
+    let dir = tempfile::tempdir().unwrap();
+    let output = dir.path().join("faired.obj");
+    let input = data("folded_sheet.obj");
+    let fair = |extra: &[&str]| {
+        let args = [
+            &["fair", &input, "-o", output.to_str().unwrap(), "--json"][..],
+            &["--rounds", "2", "--boundary", "fixed"],
+            extra,
+        ]
+        .concat();
+        json_of(&args)["crease_edges"].as_u64()
+    };
+    assert_eq!(fair(&[]), Some(12));
+    assert_eq!(fair(&["--no-creases"]), Some(0));
+    let hierarchy = json_of(&["hierarchy", &input, "--json", "--keep-creases"]);
+    assert_eq!(hierarchy["crease_edges"].as_u64(), Some(12), "{hierarchy}");
+    let plain = json_of(&["hierarchy", &input, "--json"]);
+    assert_eq!(plain["crease_edges"].as_u64().unwrap_or(0), 0, "{plain}");
+}

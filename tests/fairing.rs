@@ -942,3 +942,97 @@ fn automatic_strength_stops_before_the_rounds_wear_a_coarse_scans_detail_away() 
         distance(&input)
     );
 }
+
+#[test]
+fn the_files_hard_edges_are_kept_as_creases_however_shallow() {
+    use fairmesh::fairing::CreaseOptions;
+    // A sheet folded by 20 degrees, each side with its own normal in the file.
+    let loaded = fairmesh::io::load(
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/folded_sheet.obj"),
+    )
+    .unwrap();
+    let (mesh, topology) = (&loaded.mesh, &loaded.topology);
+    // The fold's 12 edges, and no other: both sides of every other edge share a normal.
+    let hard = loaded.source.hard_edges(mesh);
+    assert_eq!(hard.len(), 12, "{hard:?}");
+    let on_fold = |v: u32| {
+        let p = mesh.positions[v as usize];
+        p[1] == 0.0 && p[2] == 0.0
+    };
+    assert!(hard.iter().all(|&[a, b]| on_fold(a) && on_fold(b)));
+    // Faired with creases, with and without the file's: how far the fold's vertices leave the
+    // fold line.
+    let off_fold = |file_edges: Vec<[u32; 2]>| {
+        let mut faired = mesh.clone();
+        let options = FairOptions::default()
+            .with_rounds(3)
+            .with_boundary(BoundaryMode::Fixed)
+            .with_creases(Some(CreaseOptions::default().with_file_edges(file_edges)));
+        let report = fair_constrained(&mut faired, topology, &options);
+        let off = (0..mesh.positions.len() as u32)
+            .filter(|&v| on_fold(v))
+            .map(|v| {
+                let p = faired.positions[v as usize];
+                f64::from(p[1]).hypot(f64::from(p[2]))
+            })
+            .fold(0.0, f64::max);
+        (off, report.crease_edges)
+    };
+    let (kept, crease_edges) = off_fold(hard);
+    let (rounded, no_crease_edges) = off_fold(Vec::new());
+    // 20 degrees is below the crease angle: only the file says the fold is sharp.
+    assert_eq!((crease_edges, no_crease_edges), (12, 0));
+    let edge = mean_edge_length(mesh);
+    // (The volume correction moves crease vertices along their normals by a hair.)
+    assert!(kept < 1e-4 * edge, "the fold moved {kept} off its line");
+    assert!(
+        rounded > 1e-3 * edge,
+        "without the file's edges the fold moved only {rounded}"
+    );
+}
+
+#[test]
+fn flat_shading_says_nothing_of_sharp_edges_and_materials_meeting_do() {
+    use fairmesh::io::{load_from_bytes, Format, LoadOptions};
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/folded_sheet.obj");
+    let sheet = fairmesh::io::load(&path).unwrap().mesh;
+    let side_b = |t: &[u32; 3]| {
+        t.iter().all(|&v| sheet.positions[v as usize][2] >= 0.0)
+            && t.iter().any(|&v| sheet.positions[v as usize][1] > 0.0)
+    };
+    // The same sheet written again: every face with its own normal (flat shading), or the two
+    // sides with two materials and no normals.
+    let mut flat = String::new();
+    let mut two_materials = String::from("mtllib none.mtl\n");
+    for p in &sheet.positions {
+        let v = format!("v {} {} {}\n", p[0], p[1], p[2]);
+        flat += &v;
+        two_materials += &v;
+    }
+    for (f, t) in sheet.triangles.iter().enumerate() {
+        let p = t.map(|v| glam::Vec3::from(sheet.positions[v as usize]));
+        let n = (p[1] - p[0]).cross(p[2] - p[0]).normalize();
+        flat += &format!("vn {} {} {}\n", n.x, n.y, n.z);
+        let [a, b, c] = t.map(|v| v + 1);
+        flat += &format!("f {a}//{k} {b}//{k} {c}//{k}\n", k = f + 1);
+        let material = if side_b(t) { "b" } else { "a" };
+        two_materials += &format!("usemtl {material}\nf {a} {b} {c}\n");
+    }
+    let hard = |text: &str| {
+        let loaded = load_from_bytes(
+            text.as_bytes(),
+            Format::Obj,
+            "t.obj",
+            &LoadOptions::default(),
+        )
+        .unwrap();
+        loaded.source.hard_edges(&loaded.mesh)
+    };
+    assert!(hard(&flat).is_empty(), "flat shading marked edges hard");
+    let fold = hard(&two_materials);
+    assert_eq!(fold.len(), 12, "{fold:?}");
+    assert!(fold
+        .iter()
+        .flatten()
+        .all(|&v| sheet.positions[v as usize][1..] == [0.0, 0.0]));
+}

@@ -305,8 +305,9 @@ pub mod tips {
         which jitters the triangles too.";
     pub const KEEP_SHARP_EDGES: &str = "Keep the mesh's sharp edges (the edges of a machined \
         part, a fold, a rim) sharp: the coarse levels keep them and the smoothing runs along them, \
-        not across them. Turn it off for organic shapes if smoothing leaves ridges where there \
-        should be none.";
+        not across them. Edges your file marks as hard (where its normals split, or two of its \
+        materials meet) are kept too, however gentle the fold. Turn it off for organic shapes if \
+        smoothing leaves ridges where there should be none.";
     pub const SHARP_EDGE_ANGLE: &str = "How sharply the surface must fold at an edge for the edge \
         to be kept sharp. Lower: more edges are kept (gentle folds too). Higher: only the sharpest. \
         The kept edges are drawn over the mesh while you point here.";

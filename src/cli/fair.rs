@@ -183,7 +183,15 @@ pub fn run(args: FairArgs) -> anyhow::Result<()> {
     }
     let loaded = super::basic::load_shown(&args.input, true, args.stdio.format)?;
     let (mut mesh, topology, source) = (loaded.mesh, loaded.topology, loaded.source);
-    let options = args.method_options(fairmesh::metrics::mean_edge_length(&mesh));
+    let mut options = args.method_options(fairmesh::metrics::mean_edge_length(&mesh));
+    // The file's own sharp edges (split normals, material boundaries) are creases too.
+    if let MethodOptions::Constrained(FairOptions {
+        creases: Some(creases),
+        ..
+    }) = &mut options
+    {
+        *creases = creases.clone().with_file_edges(source.hard_edges(&mesh));
+    }
     let mask = super::mask::load_for(&args.mask, &source, &mesh, Some(&topology))?;
     let volume_before = fairmesh::metrics::signed_volume(&mesh);
     // The input is kept only to measure against it.

@@ -26,6 +26,9 @@
 //!   their ends) are dropped, and so are groups that zigzag (more than one corner per two edges):
 //!   noise and single spikes of a scan make those, while a crease runs straight between a few
 //!   corners (for this test a corner is where the edges themselves turn sharply).
+//! - Edges the input file marks as sharp ([`CreaseOptions::file_edges`]: split normals, material
+//!   boundaries, from [`crate::io::Source::hard_edges`]) are feature edges whatever
+//!   their angle, and are never dropped as a small or zigzagging group: the file's author said so.
 //! - A crease vertex has exactly two feature edges whose crease directions (the cross product of
 //!   each edge's two filtered face normals: on a noisy crease the vertices zigzag, the faces on
 //!   either side do not) turn by less than [`CreaseOptions::corner_turn_degrees`]; any other vertex with feature edges is a corner (the
@@ -66,6 +69,10 @@ pub struct CreaseOptions {
     pub min_edges: usize,
     /// A vertex whose two feature edges turn by more than this is a corner.
     pub corner_turn_degrees: f64,
+    /// Edges the input file marks as sharp (its normals split there, or two of its materials
+    /// meet: [`crate::io::Source::hard_edges`]), each `[a, b]` with `a < b`: feature edges
+    /// whatever their angle, never dropped as a small or zigzagging group. Empty: none.
+    pub file_edges: std::sync::Arc<[[u32; 2]]>,
 }
 
 with_setters!(CreaseOptions {
@@ -84,7 +91,17 @@ impl Default for CreaseOptions {
             normal_sigma: NORMAL_SIGMA,
             min_edges: 8,
             corner_turn_degrees: 70.0,
+            file_edges: std::sync::Arc::from([]),
         }
+    }
+}
+
+impl CreaseOptions {
+    /// `self` with [`file_edges`](Self::file_edges) set to `edges`.
+    #[must_use]
+    pub fn with_file_edges(mut self, edges: Vec<[u32; 2]>) -> Self {
+        self.file_edges = edges.into();
+        self
     }
 }
 
@@ -595,14 +612,14 @@ fn finish(
     options: &CreaseOptions,
 ) -> Creases {
     let vertex_count = mesh.positions.len();
-    if found.is_empty() {
+    if found.is_empty() && options.file_edges.is_empty() {
         return Creases {
             class: vec![FeatureClass::Smooth; vertex_count],
             ..Creases::default()
         };
     }
     let edges: Vec<[u32; 2]> = found.iter().map(|&(e, _)| e).collect();
-    let directions: HashMap<[u32; 2], Vec3A> = found.into_iter().collect();
+    let mut directions: HashMap<[u32; 2], Vec3A> = found.into_iter().collect();
     // Small groups are noise or spikes; so are groups that zigzag (more corners than one per two
     // edges: a true crease, even a noisy one, runs straight between few corners).
     let max_turn = options.corner_turn_degrees.to_radians().cos();
@@ -611,9 +628,24 @@ fn finish(
     // The zigzag test turns by the edges' positions: noise that lines up into a fake crease
     // zigzags there, while the faces' crease directions may still agree.
     let class = classify(topology, &edges, Turn::Positions(mesh), max_turn);
-    let edges = keep_groups(edges, vertex_count, Some(&class), |edges, corners| {
+    let mut edges = keep_groups(edges, vertex_count, Some(&class), |edges, corners| {
         2 * corners <= edges
     });
+    // The file's own sharp edges join whatever their angle and length; their crease direction is
+    // the edge's own (a crease direction lies along its edge).
+    if !options.file_edges.is_empty() {
+        for &[a, b] in options.file_edges.iter() {
+            if a < b && (b as usize) < vertex_count && topology.neighbors(a).contains(&b) {
+                edges.push([a, b]);
+                directions.entry([a, b]).or_insert_with(|| {
+                    let point = |v: u32| Vec3A::from_array(mesh.positions[v as usize]);
+                    (point(b) - point(a)).normalize_or_zero()
+                });
+            }
+        }
+        edges.sort_unstable();
+        edges.dedup();
+    }
     let class = classify(topology, &edges, Turn::Directions(&directions), max_turn);
     Creases::from_classified(edges, class)
 }

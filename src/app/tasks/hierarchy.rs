@@ -21,7 +21,8 @@ impl App {
         self.hierarchy_progress.set(0.0);
         let mesh = document.original.clone();
         let topology = document.topology.clone();
-        let options = self.settings.hierarchy_options();
+        let mut options = self.settings.hierarchy_options();
+        let source = document.source.clone();
         let document_generation = document.generation;
         let hierarchy_generation = self.hierarchy_generation.clone();
         let progress_out = self.hierarchy_progress.clone();
@@ -35,6 +36,11 @@ impl App {
                 progress_out.set(fraction);
                 hierarchy_generation.is_current(generation)
             };
+            // The file's own sharp edges (split normals, material boundaries) are kept
+            // too when sharp edges are.
+            if let Some(creases) = &mut options.creases {
+                *creases = creases.clone().with_file_edges(source.hard_edges(&mesh));
+            }
             let built =
                 hierarchy::build_hierarchy_with_topology(&mesh, &topology, &options, &mut progress);
             let result = built.map(|built| {
