@@ -803,7 +803,7 @@ fn fair_and_the_hierarchy_keep_the_files_hard_edges_as_creases() {
     // file's 12 fold edges are the only creases.
     let dir = tempfile::tempdir().unwrap();
     let output = dir.path().join("faired.obj");
-    let input = data("folded_sheet.obj");
+    let input = data("creases/folded_sheet.obj");
     let fair = |extra: &[&str]| {
         let args = [
             &["fair", &input, "-o", output.to_str().unwrap(), "--json"][..],

@@ -948,7 +948,8 @@ fn the_files_hard_edges_are_kept_as_creases_however_shallow() {
     use fairmesh::fairing::CreaseOptions;
     // A sheet folded by 20 degrees, each side with its own normal in the file.
     let loaded = fairmesh::io::load(
-        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/folded_sheet.obj"),
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("tests/data/creases/folded_sheet.obj"),
     )
     .unwrap();
     let (mesh, topology) = (&loaded.mesh, &loaded.topology);
@@ -994,7 +995,8 @@ fn the_files_hard_edges_are_kept_as_creases_however_shallow() {
 #[test]
 fn flat_shading_says_nothing_of_sharp_edges_and_materials_meeting_do() {
     use fairmesh::io::{load_from_bytes, Format, LoadOptions};
-    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/folded_sheet.obj");
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("tests/data/creases/folded_sheet.obj");
     let sheet = fairmesh::io::load(&path).unwrap().mesh;
     let side_b = |t: &[u32; 3]| {
         t.iter().all(|&v| sheet.positions[v as usize][2] >= 0.0)
