@@ -184,8 +184,9 @@ pub fn run_hierarchy(args: HierarchyArgs) -> anyhow::Result<()> {
         super::progress::Step::run(format!("loading {}", args.input.display()), || {
             super::basic::load(&args.input, true)
         })?;
-    // The file's own sharp edges are creases too, when creases are kept.
-    let file_edges = if args.subdivide == 0 && args.build.options().creases.is_some() {
+    // The file's own sharp edges, like the connectivity below, serve the crease detection only.
+    let keep_creases = args.subdivide == 0 && args.build.options().creases.is_some();
+    let file_edges = if keep_creases {
         loaded.source.hard_edges(&loaded.mesh)
     } else {
         Vec::new()
@@ -198,8 +199,7 @@ pub fn run_hierarchy(args: HierarchyArgs) -> anyhow::Result<()> {
     // The connectivity serves the crease detection only (as in `multires`); otherwise it goes
     // before the build (on 1.2M faces 36 MB of the build's 199 MB heap peak).
     let topology = std::mem::take(&mut loaded.topology);
-    let topology =
-        (args.subdivide == 0 && args.build.options().creases.is_some()).then_some(topology);
+    let topology = keep_creases.then_some(topology);
     for _ in 0..args.subdivide {
         loaded.mesh = fairmesh::mesh::subdivide_loop(&loaded.mesh);
     }

@@ -836,8 +836,9 @@ fn vertex_costs(level: &Level, options: &HierarchyOptions, state: &mut PassState
 /// `face_removed_in_pass`). `level.corners` is relabelled in place on the way.
 ///
 /// In parallel over consecutive chunks of `chunk` vertices and of `chunk` faces (one chunk of
-/// each when `None`): each chunk first counts what it keeps, the running sums of the counts give each chunk its place in the next level, and each
-/// chunk then writes its part there, so the next level is the same for any number of threads.
+/// each when `None`): each chunk first counts what it keeps, the running sums of the counts give
+/// each chunk its place in the next level, and each chunk then writes its part there, so the
+/// next level is the same for any number of threads.
 fn next_level(
     level: &mut Level,
     state: &mut PassState,

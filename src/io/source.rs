@@ -177,26 +177,12 @@ impl Source {
             })
             .count();
         let normals = scene.normals && 10 * own_normals < 9 * triangles().count();
-        // What a face says at one of its corners: its material and the normal there (as bits).
-        type Corner = (Option<usize>, Option<[u32; 3]>);
-        let corner = |material: Option<usize>, v: &super::scene::SceneVertex| -> Corner {
+        // Only an edge between two vertices where the faces disagree (about the material or the
+        // normal) can be sharp: those first (one pass, no table), so that a file with none costs
+        // no more.
+        let split = split_at_vertices(&scene, mesh.positions.len(), |material, v| {
             (material, normals.then(|| v.normal.map(f32::to_bits)))
-        };
-        // Only an edge between two vertices where the faces disagree can be sharp: those first
-        // (one pass, no table), so that a file with none costs no more.
-        let mut first_at: Vec<Option<Corner>> = vec![None; mesh.positions.len()];
-        let mut split = vec![false; mesh.positions.len()];
-        for (material, t) in triangles() {
-            for v in corners(t) {
-                let here = corner(material, v);
-                let w = v.welded as usize;
-                match first_at[w] {
-                    None => first_at[w] = Some(here),
-                    Some(first) => split[w] |= first != here,
-                }
-            }
-        }
-        drop(first_at);
+        });
         if !split.contains(&true) {
             return Vec::new();
         }
@@ -240,22 +226,10 @@ impl Source {
         let Some(scene) = self.scene(mesh).filter(|s| s.normals) else {
             return 0;
         };
-        let mut first: Vec<Option<[f32; 3]>> = vec![None; mesh.positions.len()];
-        let mut split = vec![false; mesh.positions.len()];
-        for part in &scene.parts {
-            for primitive in &part.primitives {
-                for &v in primitive.triangles.iter().flatten() {
-                    let vertex = &scene.vertices[v as usize];
-                    let w = vertex.welded as usize;
-                    match first[w] {
-                        None => first[w] = Some(vertex.normal),
-                        Some(n) if n != vertex.normal => split[w] = true,
-                        Some(_) => {}
-                    }
-                }
-            }
-        }
-        split.iter().filter(|&&s| s).count()
+        split_at_vertices(&scene, mesh.positions.len(), |_, v| v.normal)
+            .iter()
+            .filter(|&&s| s)
+            .count()
     }
 
     /// [`Source::contents`] without what `scene` brings into `format` (OBJ or glTF); the node
@@ -367,6 +341,29 @@ pub(crate) fn fingerprint(triangles: &[[u32; 3]]) -> u64 {
         hash = hash.rotate_left(7);
     }
     hash
+}
+
+/// Per loaded vertex (of `vertex_count`): whether the file's faces disagree there about `key`
+/// (of a face's material and its file vertex at that corner).
+fn split_at_vertices<K: PartialEq + Copy>(
+    scene: &Scene,
+    vertex_count: usize,
+    key: impl Fn(Option<usize>, &super::scene::SceneVertex) -> K,
+) -> Vec<bool> {
+    let mut first: Vec<Option<K>> = vec![None; vertex_count];
+    let mut split = vec![false; vertex_count];
+    for primitive in scene.parts.iter().flat_map(|part| &part.primitives) {
+        for &v in primitive.triangles.iter().flatten() {
+            let vertex = &scene.vertices[v as usize];
+            let here = key(primitive.material, vertex);
+            let w = vertex.welded as usize;
+            match first[w] {
+                None => first[w] = Some(here),
+                Some(seen) => split[w] |= seen != here,
+            }
+        }
+    }
+    split
 }
 
 /// How the normals of a file change when its vertices move. Each file normal (an OBJ `vn`, a PLY
