@@ -302,11 +302,15 @@ fn open_hemisphere_boundary_neither_shrinks_nor_grows() {
     for variant in VARIANTS {
         let options = FairOptions::default().with_variant(variant);
         let mut faired = interior_noise.clone();
-        fair_constrained(&mut faired, &topology, &options);
+        let report = fair_constrained(&mut faired, &topology, &options);
+        // The circle's length drifts by about 2.5e-5 a round (its radius grows: 1.1e-3 after the
+        // 40 rounds the default runs here, 2.4e-4 after 10; docs/measurements.md), so the bound
+        // is per round.
         let length_change = (loop_length(&faired, &boundary_loop) - clean_length) / clean_length;
         assert!(
-            length_change.abs() < 1e-3,
-            "{variant:?}: length {length_change}"
+            length_change.abs() < 3e-5 * report.rounds_run.max(1) as f64,
+            "{variant:?}: length {length_change} after {} rounds",
+            report.rounds_run
         );
 
         let mut faired = full_noise.clone();
@@ -917,29 +921,49 @@ fn the_default_gives_a_thin_plate_its_volume_back_after_every_round() {
 }
 
 #[test]
-fn automatic_strength_stops_before_the_rounds_wear_a_coarse_scans_detail_away() {
-    // The elephant is coarsely sampled for its detail: after 3-4 rounds the rounds move the
-    // vertices less than about twice the noise they leave, and each further round takes more
-    // detail than noise (`docs/measurements.md`). The automatic strength stops there.
+fn automatic_strength_stops_near_the_best_round_count_on_a_coarse_scan_and_on_a_fine_sphere() {
+    // The best number of rounds differs by an order of magnitude: the elephant is coarsely sampled
+    // for its detail (best after 3-4 rounds, every further round wears detail away), a finely
+    // sampled sphere keeps losing noise for twenty rounds and more. The risk estimate stops the
+    // elephant within 6 % of its best round count's distance, and runs the sphere far enough to
+    // end 10 % closer than after 8 rounds (where the previous rule, which watched the noise
+    // estimate fall, stopped both).
     let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/elephant.obj");
-    let clean = fairmesh::io::load(&path).unwrap().mesh;
-    let topology = Topology::build(&clean);
-    let input = noisy(clean.clone(), 0.3, 1);
-    let distance = |mesh: &TriMesh| {
-        fairmesh::metrics::compare(&clean, mesh).mean_surface_distance / mean_edge_length(&clean)
-    };
-    let mut automatic = input.clone();
-    let report = fair_constrained(&mut automatic, &topology, &FairOptions::default());
-    assert!((2..=5).contains(&report.rounds_run), "{report:?}");
-    let mut longer = input.clone();
-    let options = FairOptions::default().with_rounds(report.rounds_run + 3);
-    fair_constrained(&mut longer, &topology, &options);
-    let (stopped, went_on) = (distance(&automatic), distance(&longer));
+    let elephant = fairmesh::io::load(&path).unwrap().mesh;
+    let mut rounds = Vec::new();
+    for (name, clean) in [("elephant", elephant), ("sphere", icosphere(5))] {
+        let topology = Topology::build(&clean);
+        let input = noisy(clean.clone(), 0.3, 1);
+        let distance = |mesh: &TriMesh| {
+            fairmesh::metrics::compare(&clean, mesh).mean_surface_distance
+                / mean_edge_length(&clean)
+        };
+        let mut automatic = input.clone();
+        let report = fair_constrained(&mut automatic, &topology, &FairOptions::default());
+        let stopped = distance(&automatic);
+        let fixed = |rounds: usize| {
+            let mut faired = input.clone();
+            let options = FairOptions::default().with_rounds(rounds);
+            fair_constrained(&mut faired, &topology, &options);
+            distance(&faired)
+        };
+        let compared = if name == "elephant" {
+            (1..=10).map(fixed).fold(f64::INFINITY, f64::min) * 1.06
+        } else {
+            fixed(8) * 0.9
+        };
+        assert!(
+            stopped < compared && stopped < 0.7 * distance(&input),
+            "{name}: stopped after {} rounds at {stopped}, against {compared}",
+            report.rounds_run
+        );
+        rounds.push(report.rounds_run);
+    }
     assert!(
-        stopped < 0.95 * went_on && stopped < 0.7 * distance(&input),
-        "stopped after {} rounds: {stopped}; 3 more: {went_on}; input {}",
-        report.rounds_run,
-        distance(&input)
+        rounds[0] <= 6 && rounds[1] >= 3 * rounds[0],
+        "rounds: elephant {}, sphere {}",
+        rounds[0],
+        rounds[1]
     );
 }
 

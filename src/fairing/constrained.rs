@@ -62,8 +62,8 @@ use super::creases::{
     FeatureClass,
 };
 use super::strength::{
-    estimate_noise_away_from_edges, estimate_noise_with_fans, normal_filtering_for, CLEAN_NOISE,
-    MAX_AUTO_ROUNDS, MIN_MOVE_PER_NOISE, MIN_NOISE_FALL, NOISE_LEFT,
+    estimate_noise_away_from_edges, estimate_noise_with_fans, normal_filtering_for, RoundRisk,
+    CLEAN_NOISE, MAX_AUTO_ROUNDS, RISK_MIN_FALL, RISK_PATIENCE,
 };
 use super::volume::VolumeKeeper;
 use super::{BoundaryMode, FairOptions, FairReport, FairVariant, Strength};
@@ -1271,26 +1271,6 @@ fn split_into_vertex_blocks<'a, T>(
     blocks
 }
 
-/// Root mean square of the moves from `from` to `to` (same length), model units.
-fn rms_move(from: &[[f32; 3]], to: &[[f32; 3]]) -> f64 {
-    if from.is_empty() {
-        return 0.0;
-    }
-    let sum: f64 = from
-        .par_chunks(CHUNK)
-        .zip(to.par_chunks(CHUNK))
-        .map(|(a, b)| {
-            a.iter()
-                .zip(b)
-                .map(|(p, q)| (0..3).map(|k| f64::from(p[k] - q[k]).powi(2)).sum::<f64>())
-                .sum::<f64>()
-        })
-        .collect::<Vec<f64>>()
-        .iter()
-        .sum();
-    (sum / from.len() as f64).sqrt()
-}
-
 /// Constrained fairing of `mesh` in place (sections 3.2 and 3.3); `topology` must be built from
 /// `mesh`. Precomputes the operator (see [`ConstrainedFairing`] to reuse it) and runs
 /// `options.rounds` rounds of up to `options.iterations` iterations each.
@@ -1412,21 +1392,29 @@ pub fn fair_constrained(
         fairing
     };
     let mut fairing = build(mesh, creases.as_ref(), &fans);
-    // The fans serve the later rounds only to estimate the noise and find the creases again:
-    // otherwise they are freed before the iterations (the peak, while the operator is set up
-    // from them, stays: 277 MB for `fair --rounds 3 --no-creases` on 1.2M faces either way).
-    let fans = (redetect || auto_noise.is_some()).then_some(fans);
+    // The fans serve the later rounds only to find the creases again (and estimate the noise
+    // that sets the filtering for it): otherwise they are freed before the iterations (the peak,
+    // while the operator is set up from them, stays: 277 MB for `fair --rounds 3 --no-creases`
+    // on 1.2M faces either way).
+    let fans = redetect.then_some(fans);
     let volume = options
         .keep_volume
         .then(|| VolumeKeeper::new(mesh, topology, &pinned));
     let mut report = FairReport::default();
-    // Automatic strength: round by round until the noise left is a small part of the input's
-    // (or no longer falls): see [`super::strength`].
-    let mut noise_now = estimate;
-    // Automatic strength also watches how far each round moves the vertices, against the noise
-    // it leaves (see [`MIN_MOVE_PER_NOISE`]).
+    // Automatic strength: round by round while the estimated risk of the result falls (see
+    // [`super::strength`]): a copy of the input, moved a little along its normals, goes through
+    // the same rounds, and the mesh goes back to the round with the least risk.
+    let mut risk = auto_noise.map(|_| RoundRisk::new(mesh, topology));
     let edge = auto_noise.map(|_| crate::metrics::mean_edge_length(mesh));
-    let mut round_start = Vec::new();
+    // The round with the least risk so far: its number, its risk, its positions and crease count.
+    let mut least: Option<(usize, f64)> = None;
+    let mut least_positions = Vec::new();
+    let mut least_creases = 0;
+    let mut progress = 0;
+    let mut first_fall = 0.0;
+    let mut before_restore = Vec::new();
+    let mut noise_now = estimate;
+    let mut copy_report = FairReport::default();
     for round in 0..max_rounds {
         if let (true, Some(fans)) = (round > 0 && redetect, &fans) {
             let found = detect(mesh, noise_now);
@@ -1436,40 +1424,78 @@ pub fn fair_constrained(
                     fairing.for_other_creases(mesh, topology, fans, creases.as_ref(), &pinned);
             }
         }
-        if edge.is_some() {
-            round_start.clone_from(&mesh.positions);
-        }
+        let held = creases.as_ref().map(|c| c.class.as_slice()).unwrap_or(&[]);
+        let corner = |v: usize| held.get(v) == Some(&FeatureClass::Corner);
         // Imposes the constraints on the positions this round starts from.
         fairing.load(&mesh.positions);
         fairing.run_round(options, &mut report);
         fairing.store(&mut mesh.positions);
         if let Some(volume) = &volume {
-            let held = creases.as_ref().map(|c| c.class.as_slice()).unwrap_or(&[]);
-            volume.restore(mesh, topology, |v| {
-                held.get(v) == Some(&FeatureClass::Corner)
-            });
+            if risk.is_some() {
+                before_restore.clone_from(&mesh.positions);
+            }
+            volume.restore(mesh, topology, corner);
+        }
+        if let Some((risk, copy)) = &mut risk {
+            // The copy's round, with the same operator (and creases) as the mesh's.
+            fairing.load(copy);
+            fairing.run_round(options, &mut copy_report);
+            fairing.store(copy);
+            // The volume correction offsets every vertex by one distance per part along its
+            // normal; the copy takes the mesh's offsets (what its own correction would give, but
+            // for a change of the distance that sums a part's volume change, of order 1/N per
+            // vertex against the local response the risk reads).
+            if volume.is_some() {
+                copy.par_chunks_mut(CHUNK)
+                    .zip(mesh.positions.par_chunks(CHUNK))
+                    .zip(before_restore.par_chunks(CHUNK))
+                    .for_each(|((copy, after), before)| {
+                        for ((c, a), b) in copy.iter_mut().zip(after).zip(before) {
+                            for k in 0..3 {
+                                c[k] += a[k] - b[k];
+                            }
+                        }
+                    });
+            }
+            let fallback = auto_noise.unwrap_or(0.0) * edge.unwrap_or(1.0);
+            let now = risk.read(mesh, topology, copy, fallback);
+            let edges = creases.as_ref().map_or(0, |c| c.edges.len());
+            // A round that lowers the risk by less than RISK_MIN_FALL of what the second round
+            // lowered it by is kept if it is the least, but does not count as progress: the
+            // rounds stop RISK_PATIENCE rounds after the last that did.
+            if round == 1 {
+                if let Some((_, first)) = least {
+                    first_fall = (first - now).max(0.0);
+                }
+            }
+            if least.is_none_or(|(_, least_risk)| now < least_risk) {
+                if least.is_none_or(|(_, least_risk)| now < least_risk - RISK_MIN_FALL * first_fall)
+                {
+                    progress = round;
+                }
+                least = Some((round, now));
+                least_positions.clone_from(&mesh.positions);
+                least_creases = edges;
+            } else if now.is_nan() {
+                break;
+            }
+            if round - progress >= RISK_PATIENCE {
+                break;
+            }
         }
         if round + 1 == max_rounds {
             break;
         }
-        let Some(fans) = &fans else {
-            continue;
-        };
-        if let Some(noise) = auto_noise {
-            let Some(now) = estimate_noise_with_fans(mesh, topology, fans) else {
-                break;
-            };
-            let last = noise_now.unwrap_or(noise);
-            if now <= noise * NOISE_LEFT || now > last * MIN_NOISE_FALL {
-                break;
-            }
-            let moved = rms_move(&round_start, &mesh.positions) / edge.unwrap_or(1.0);
-            if round > 0 && moved < MIN_MOVE_PER_NOISE * now {
-                break;
-            }
-            noise_now = Some(now);
-        } else if redetect {
+        if let (Some(fans), true) = (&fans, redetect) {
             noise_now = estimate_noise_with_fans(mesh, topology, fans);
+        }
+    }
+    let mut crease_edges = creases.map_or(0, |c| c.edges.len());
+    if let Some((round, _)) = least {
+        if round + 1 != report.rounds_run {
+            mesh.positions = least_positions;
+            report.rounds_run = round + 1;
+            crease_edges = least_creases;
         }
     }
     // The operator held the pinned vertices; the blend fades the rest by their weights (and
@@ -1478,7 +1504,7 @@ pub fn fair_constrained(
         mask.blend(original, &mut mesh.positions);
     }
     report.noise_estimate = estimate;
-    report.crease_edges = creases.map_or(0, |c| c.edges.len());
+    report.crease_edges = crease_edges;
     report
 }
 

@@ -33,8 +33,9 @@
 //!
 //! # What the default adds to the projected operator
 //! [`FairOptions::default`] also
-//! - picks its number of rounds from the mesh's estimated noise and leaves a clean mesh as it is
-//!   ([`Strength::Auto`], [`strength`]);
+//! - leaves a clean mesh as it is and fairs a noisy one round by round while the estimated error
+//!   of the result falls (Stein's unbiased risk estimate, read from a slightly moved copy of the
+//!   input faired alongside), keeping the round with the least ([`Strength::Auto`], [`strength`]);
 //! - keeps sharp creases as curves with fixed corners ([`creases`]);
 //! - adds a small tangential relaxation (weight [`DEFAULT_TANGENTIAL_RELAXATION`]) so that noise
 //!   that moved vertices along the surface comes out too. This one does move vertices along the
@@ -200,8 +201,9 @@ pub const DEFAULT_TANGENTIAL_RELAXATION: f64 = 0.25;
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 #[non_exhaustive]
 pub enum Strength {
-    /// Estimate the mesh's noise and run rounds until most of it is gone: none on a clean mesh
-    /// ([`strength`]).
+    /// Estimate the mesh's noise (a clean mesh gets no round), then run rounds while the estimated
+    /// error of the result falls and keep the round with the least ([`strength`]). Every round
+    /// runs twice (the second time on the risk estimate's copy of the input).
     #[default]
     Auto,
     /// Exactly [`FairOptions::rounds`] rounds.
@@ -211,9 +213,11 @@ pub enum Strength {
 /// What a fairing run did.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct FairReport {
-    /// Iterations actually run, summed over rounds.
+    /// Iterations actually run, summed over rounds (with [`Strength::Auto`], also over the one or
+    /// two rounds run past the kept one; the risk estimate's copy not counted).
     pub iterations_run: usize,
-    /// Rounds run.
+    /// Rounds that made the result (with [`Strength::Auto`], the round with the least estimated
+    /// error; up to [`strength::RISK_PATIENCE`] more were run and undone).
     pub rounds_run: usize,
     /// Largest single-vertex move in the last iteration (model units).
     pub max_move: f64,
