@@ -4,9 +4,11 @@
 //! previous default (one round of 10 iterations, no creases) and to fixed round counts.
 //!
 //! Run: `cargo run --release --no-default-features --example fairing_default [-- --trace]`
-//! (`--only gear,cube` runs just those meshes; `--trace` also prints, per round, the noise estimate and the distance to the clean surface,
-//! the data the automatic rule was tuned on). `docs/measurements.md` holds what it printed and
-//! says which meshes the rule was tuned on and which were kept out.
+//! (`--only gear,cube` runs just those meshes; `--files a.obj,b.ply` adds meshes from files, named
+//! by their stem; `--sigma 0.15` changes the noise; `--default-only` prints the default's row
+//! alone; `--trace` also prints, per round, the noise estimate and the distance to the clean
+//! surface). `docs/measurements.md` holds what it printed and says which meshes the rules were
+//! tuned on and which were kept out.
 //!
 //! Measures (lengths in mean edge lengths of the clean mesh): `mean`, `hausdorff`: surface
 //! distance both ways (`metrics::compare`); `normal`: mean angle between corresponding face
@@ -19,24 +21,26 @@ use fairmesh::noise::{add_noise, NoiseMode, NoiseOptions};
 use fairmesh::{Topology, TriMesh};
 use std::path::Path;
 
-fn meshes() -> Vec<(String, TriMesh)> {
+fn meshes(files: &[String]) -> Vec<(String, TriMesh)> {
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
-    let mut list: Vec<(String, TriMesh)> = [
+    let bundled = [
         "assets/bunny00.obj",
         "tests/data/elephant.obj",
         "tests/data/bunny_npm.obj",
         "tests/data/mushroom_open.obj",
-    ]
-    .iter()
-    .map(|file| {
-        let path = root.join(file);
-        let mesh = fairmesh::io::load(&path)
-            .unwrap_or_else(|e| panic!("{}: {e}", path.display()))
-            .mesh;
-        let name = Path::new(file).file_stem().unwrap().to_string_lossy();
-        (name.into_owned(), mesh)
-    })
-    .collect();
+    ];
+    let mut list: Vec<(String, TriMesh)> = bundled
+        .iter()
+        .map(|file| root.join(file))
+        .chain(files.iter().map(|file| Path::new(file).to_path_buf()))
+        .map(|path| {
+            let mesh = fairmesh::io::load(&path)
+                .unwrap_or_else(|e| panic!("{}: {e}", path.display()))
+                .mesh;
+            let name = path.file_stem().unwrap().to_string_lossy();
+            (name.into_owned(), mesh)
+        })
+        .collect();
     list.extend([
         ("cube".to_string(), shapes::cuboid([1.0, 1.0, 1.0], 0.05)),
         (
@@ -81,28 +85,36 @@ fn main() {
     println!("|---|---|---|---:|---:|---:|---:|");
     // `--only NAME[,NAME]`: just those meshes.
     let args: Vec<String> = std::env::args().collect();
-    let only: Option<Vec<String>> = args
-        .iter()
-        .position(|a| a == "--only")
-        .and_then(|i| args.get(i + 1))
-        .map(|list| list.split(',').map(str::to_string).collect());
-    for (name, clean) in meshes() {
+    let value = |flag: &str| {
+        args.iter()
+            .position(|a| a == flag)
+            .and_then(|i| args.get(i + 1))
+    };
+    let list = |flag: &str| -> Option<Vec<String>> {
+        value(flag).map(|list| list.split(',').map(str::to_string).collect())
+    };
+    let only = list("--only");
+    let files = list("--files").unwrap_or_default();
+    let sigma: f64 = value("--sigma").map_or(0.3, |s| s.parse().expect("--sigma: a number"));
+    let default_only = args.iter().any(|a| a == "--default-only");
+    for (name, clean) in meshes(&files) {
         if only.as_ref().is_some_and(|only| !only.contains(&name)) {
             continue;
         }
         let topology = Topology::build(&clean);
         let edge = mean_edge_length(&clean);
         let inputs = [
-            ("clean", None),
-            ("normal 0.3", Some(NoiseMode::Normal)),
-            ("isotropic 0.3", Some(NoiseMode::Isotropic)),
+            ("clean".to_string(), None),
+            (format!("normal {sigma}"), Some(NoiseMode::Normal)),
+            (format!("isotropic {sigma}"), Some(NoiseMode::Isotropic)),
         ];
         for (label, mode) in inputs {
+            let label = label.as_str();
             let mut input = clean.clone();
             if let Some(mode) = mode {
                 add_noise(
                     &mut input,
-                    &NoiseOptions::default().with_sigma(0.3).with_mode(mode),
+                    &NoiseOptions::default().with_sigma(sigma).with_mode(mode),
                 );
             }
             let mut faired = input.clone();
@@ -118,6 +130,9 @@ fn main() {
                 ),
                 &measure(&clean, &input, &faired, edge),
             );
+            if default_only {
+                continue;
+            }
             let mut normal_only = input.clone();
             let options = FairOptions::default().with_tangential_relaxation(0.0);
             let report = fair_constrained(&mut normal_only, &topology, &options);
