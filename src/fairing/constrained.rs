@@ -1271,6 +1271,10 @@ fn split_into_vertex_blocks<'a, T>(
     blocks
 }
 
+/// Once two detections in a row found the creases unchanged, [`fair_constrained`] finds them
+/// again only in every this many rounds.
+const CREASE_RECHECK_ROUNDS: usize = 4;
+
 /// Constrained fairing of `mesh` in place (sections 3.2 and 3.3); `topology` must be built from
 /// `mesh`. Precomputes the operator (see [`ConstrainedFairing`] to reuse it) and runs
 /// `options.rounds` rounds of up to `options.iterations` iterations each.
@@ -1354,8 +1358,8 @@ pub fn fair_constrained(
         },
         _ => None,
     };
-    // Creases are found again before every round: the noise left after a round makes fewer
-    // false creases, and a crease found on the noisy input may turn out to be noise
+    // Creases are found again before every round (every CREASE_RECHECK_ROUNDS-th once they stop
+    // changing): the noise left after a round makes fewer false creases, and a crease found on the noisy input may turn out to be noise
     // (`docs/measurements.md`). The normals are filtered as much as the current noise asks for.
     let mut face_rings = FaceRingCache::default();
     let mut detect = |mesh: &TriMesh, noise: Option<f64>| {
@@ -1415,13 +1419,24 @@ pub fn fair_constrained(
     let mut before_restore = Vec::new();
     let mut noise_now = estimate;
     let mut copy_report = FairReport::default();
+    // Detections in a row that found the creases already kept: from two on, the creases are
+    // found again only every CREASE_RECHECK_ROUNDS rounds (once the noise is gone they change
+    // little: on the noisy 1.2M-face bunny 21 of 38 rounds detect, CPU time 41-42 -> 37-39 s,
+    // and the mean distance is 8.80e-5 instead of 8.85e-5).
+    let mut unchanged = 0usize;
+    let detect_in = |round: usize, unchanged: usize| {
+        redetect && (unchanged < 2 || round.is_multiple_of(CREASE_RECHECK_ROUNDS))
+    };
     for round in 0..max_rounds {
-        if let (true, Some(fans)) = (round > 0 && redetect, &fans) {
+        if let (true, Some(fans)) = (round > 0 && detect_in(round, unchanged), &fans) {
             let found = detect(mesh, noise_now);
             if found.as_ref().map(|c| &c.edges) != creases.as_ref().map(|c| &c.edges) {
                 creases = found;
+                unchanged = 0;
                 fairing =
                     fairing.for_other_creases(mesh, topology, fans, creases.as_ref(), &pinned);
+            } else {
+                unchanged += 1;
             }
         }
         let held = creases.as_ref().map(|c| c.class.as_slice()).unwrap_or(&[]);
@@ -1486,7 +1501,8 @@ pub fn fair_constrained(
         if round + 1 == max_rounds {
             break;
         }
-        if let (Some(fans), true) = (&fans, redetect) {
+        // The estimate only sets the next detection's filtering.
+        if let (Some(fans), true) = (&fans, detect_in(round + 1, unchanged)) {
             noise_now = estimate_noise_with_fans(mesh, topology, fans);
         }
     }

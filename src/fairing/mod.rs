@@ -40,7 +40,8 @@
 //! - adds a small tangential relaxation (weight [`DEFAULT_TANGENTIAL_RELAXATION`]) so that noise
 //!   that moved vertices along the surface comes out too. This one does move vertices along the
 //!   surface (unlike the projection alone); `with_tangential_relaxation(0.0)` turns it off;
-//! - finds the creases again before every round (the noise left makes fewer false ones);
+//! - finds the creases again before every round (the noise left makes fewer false ones; once two
+//!   detections in a row change nothing, before every fourth);
 //! - gives every connected part its volume back after every round with one uniform offset along
 //!   the normals ([`volume`]; `with_keep_volume(false)` turns it off).
 //!
