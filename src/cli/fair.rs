@@ -279,7 +279,8 @@ pub fn run(args: FairArgs) -> anyhow::Result<()> {
                 )
             } else {
                 format!(
-                    "noise estimate {noise:.3} edge lengths, {} rounds; ",
+                    "noise estimate {noise:.3} edge lengths, {} rounds (where the estimated \
+                     error of the result was least); ",
                     report.rounds_run
                 )
             }
