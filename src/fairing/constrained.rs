@@ -1408,8 +1408,8 @@ pub fn fair_constrained(
     // Automatic strength: round by round while the estimated risk of the result falls (see
     // [`super::strength`]): a copy of the input, moved a little along its normals, goes through
     // the same rounds, and the mesh goes back to the round with the least risk.
-    let mut risk = auto_noise.map(|_| RoundRisk::new(mesh, topology));
     let edge = auto_noise.map(|_| crate::metrics::mean_edge_length(mesh));
+    let mut risk = edge.map(|edge| RoundRisk::new(mesh, topology, edge));
     // The round with the least risk so far: its number, its risk, its positions and crease count.
     let mut least: Option<(usize, f64)> = None;
     let mut least_positions = Vec::new();

@@ -375,9 +375,14 @@ struct RiskSums {
 }
 
 impl RoundRisk {
-    /// The risk of fairing `mesh` (the input, before any round) and the copy to fair beside it.
-    pub(crate) fn new(mesh: &TriMesh, topology: &Topology) -> (RoundRisk, Vec<[f32; 3]>) {
-        let step = RISK_STEP * crate::metrics::mean_edge_length(mesh);
+    /// The risk of fairing `mesh` (the input, before any round; `edge` its mean edge length) and
+    /// the copy to fair beside it.
+    pub(crate) fn new(
+        mesh: &TriMesh,
+        topology: &Topology,
+        edge: f64,
+    ) -> (RoundRisk, Vec<[f32; 3]>) {
+        let step = RISK_STEP * edge;
         let directions = unit_vertex_normals(mesh, topology);
         let draw: Vec<f32> = (0..mesh.positions.len() as u32)
             .into_par_iter()
@@ -533,7 +538,8 @@ mod tests {
         for (v, p) in input.positions.iter_mut().enumerate() {
             p[2] += sigma * gaussian_draw(1_000_003 + v as u64);
         }
-        let (mut risk, copy) = RoundRisk::new(&input, &topology);
+        let edge = crate::metrics::mean_edge_length(&input);
+        let (mut risk, copy) = RoundRisk::new(&input, &topology, edge);
         // Each smoother applied to the input and to the risk's copy: p -> x + a·(p − x), x the
         // clean vertex (so that its derivative is a times the identity).
         let smooth = |mesh: &TriMesh, a: f32| {
