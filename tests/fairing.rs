@@ -475,6 +475,8 @@ fn bit_identical_for_one_and_two_threads() {
                     .with_rounds(2)
                     .with_boundary(boundary),
             ),
+            // The automatic strength: the risk estimate's copy, its sums and the rounds it picks.
+            MethodOptions::Constrained(FairOptions::default().with_boundary(boundary)),
             MethodOptions::Laplacian(LaplacianOptions {
                 boundary,
                 ..Default::default()
