@@ -1408,8 +1408,14 @@ pub fn fair_constrained(
     // Automatic strength: round by round while the estimated risk of the result falls (see
     // [`super::strength`]): a copy of the input, moved a little along its normals, goes through
     // the same rounds, and the mesh goes back to the round with the least risk.
-    let edge = auto_noise.map(|_| crate::metrics::mean_edge_length(mesh));
-    let mut risk = edge.map(|edge| RoundRisk::new(mesh, topology, edge));
+    let mut risk = auto_noise.map(|noise| {
+        RoundRisk::new(
+            mesh,
+            topology,
+            crate::metrics::mean_edge_length(mesh),
+            noise,
+        )
+    });
     // The round with the least risk so far: its number, its risk, its positions and crease count.
     let mut least: Option<(usize, f64)> = None;
     let mut least_positions = Vec::new();
@@ -1472,8 +1478,7 @@ pub fn fair_constrained(
                         }
                     });
             }
-            let fallback = auto_noise.unwrap_or(0.0) * edge.unwrap_or(1.0);
-            let now = risk.read(mesh, topology, copy, fallback);
+            let now = risk.read(mesh, topology, copy);
             let edges = creases.as_ref().map_or(0, |c| c.edges.len());
             // A round that lowers the risk by less than RISK_MIN_FALL of what the second round
             // lowered it by is kept if it is the least, but does not count as progress: the

@@ -359,6 +359,8 @@ pub(crate) struct RoundRisk {
     step: f64,
     /// σ², once the first round has been read.
     variance: Option<f64>,
+    /// The noise estimate's σ (absolute), for when the first round's reading cannot be made.
+    fallback: f64,
 }
 
 /// What one reading of [`RoundRisk`] sums over the vertices.
@@ -375,12 +377,13 @@ struct RiskSums {
 }
 
 impl RoundRisk {
-    /// The risk of fairing `mesh` (the input, before any round; `edge` its mean edge length) and
-    /// the copy to fair beside it.
+    /// The risk of fairing `mesh` (the input, before any round; `edge` its mean edge length,
+    /// `noise` its noise estimate in edge lengths) and the copy to fair beside it.
     pub(crate) fn new(
         mesh: &TriMesh,
         topology: &Topology,
         edge: f64,
+        noise: f64,
     ) -> (RoundRisk, Vec<[f32; 3]>) {
         let step = RISK_STEP * edge;
         let directions = unit_vertex_normals(mesh, topology);
@@ -403,21 +406,15 @@ impl RoundRisk {
             draw,
             step,
             variance: None,
+            fallback: noise * edge,
         };
         (risk, copy)
     }
 
     /// The estimated risk (per vertex, squared length) of `mesh` as the rounds' result, the
     /// input's copy having gone through the same rounds to `copy`. The first reading also fixes
-    /// σ (see the module docs); `fallback` (the noise estimate, absolute) stands in where that
-    /// reading cannot be made.
-    pub(crate) fn read(
-        &mut self,
-        mesh: &TriMesh,
-        topology: &Topology,
-        copy: &[[f32; 3]],
-        fallback: f64,
-    ) -> f64 {
+    /// σ (see the module docs); the noise estimate stands in where that reading cannot be made.
+    pub(crate) fn read(&mut self, mesh: &TriMesh, topology: &Topology, copy: &[[f32; 3]]) -> f64 {
         let normals = unit_vertex_normals(mesh, topology);
         let step = self.step;
         let sums = mesh
@@ -457,7 +454,7 @@ impl RoundRisk {
             let read = if read.is_finite() && read > 0.0 {
                 read
             } else {
-                fallback * fallback
+                self.fallback * self.fallback
             };
             RISK_NOISE_SCALE * RISK_NOISE_SCALE * read
         });
@@ -539,7 +536,7 @@ mod tests {
             p[2] += sigma * gaussian_draw(1_000_003 + v as u64);
         }
         let edge = crate::metrics::mean_edge_length(&input);
-        let (mut risk, copy) = RoundRisk::new(&input, &topology, edge);
+        let (mut risk, copy) = RoundRisk::new(&input, &topology, edge, 0.0);
         // Each smoother applied to the input and to the risk's copy: p -> x + a·(p − x), x the
         // clean vertex (so that its derivative is a times the identity).
         let smooth = |mesh: &TriMesh, a: f32| {
@@ -554,7 +551,7 @@ mod tests {
         let copy_mesh = TriMesh::new(copy, input.triangles.clone());
         let mut read = |a: f32| {
             let (result, moved) = (smooth(&input, a), smooth(&copy_mesh, a));
-            risk.read(&result, &topology, &moved.positions, 0.0)
+            risk.read(&result, &topology, &moved.positions)
         };
         // The clean plane first: it fixes sigma as what its residual reads (the noise itself).
         let (oracle, half, none) = (read(0.0), read(0.5), read(1.0));
