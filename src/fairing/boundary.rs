@@ -36,7 +36,7 @@ impl CurvePoint for [f32; 3] {
 }
 
 /// The boundary loops of a mesh, flattened for the curve operators.
-#[derive(Clone, Debug, Default)]
+#[derive(Clone, Debug, Default, PartialEq)]
 pub struct BoundaryCurves {
     /// Every loop occurrence of a boundary vertex: `[p_{i−2}, p_{i−1}, p_i, p_{i+1}, p_{i+2}]`
     /// (`NONE` beyond the end of an open chain).

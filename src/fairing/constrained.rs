@@ -197,6 +197,9 @@ macro_rules! with_stencil {
 /// memory; [`Self::load`] and [`Self::store`] map to and from the mesh's own numbering.
 #[derive(Clone, Debug)]
 pub struct ConstrainedFairing {
+    /// The vertices (mesh numbering) that bound the surface patches: boundary, crease and pinned
+    /// vertices. They get no local solution and their triangles are not solved.
+    held: Vec<bool>,
     variant: FairVariant,
     boundary: BoundaryMode,
     /// Internal vertex i is the mesh's vertex `order[i]`.
@@ -390,10 +393,17 @@ impl ConstrainedFairing {
 
     /// This operator set up again for other `creases` on the same connectivity (`mesh`,
     /// `topology` and `fans` those it was built from; the same variant, boundary mode, pinned
-    /// vertices and tangential relaxation): the same operator as [`Self::with_fans`] would give,
-    /// bit for bit, without computing again what does not depend on the creases (the locality
-    /// order and the one-rings renumbered in it, about 30 % of a set-up). Constrained fairing
-    /// sets its operator up again whenever the creases found before a round changed.
+    /// vertices and tangential relaxation): the same operator as [`Self::with_fans`] would give
+    /// (every entry's weights, the own weights, the fans and curves bit for bit; only the
+    /// numbering of the distinct weight rows may differ). Constrained fairing sets its operator
+    /// up again whenever the creases found before a round changed.
+    ///
+    /// Only the vertices whose held status changed (a crease vertex that is one no more, or a
+    /// new one) and their neighbours have other weights: a vertex's weights depend on which of
+    /// its triangles are solved, and that on its triangles' corners. Those are gathered again
+    /// and their rows looked up in (or added to) the distinct rows; the curves are made again.
+    /// When more than an eighth of the vertices changed, the set-up runs whole instead (still
+    /// keeping the locality order and the one-rings renumbered in it).
     pub(crate) fn for_other_creases(
         self,
         mesh: &TriMesh,
@@ -402,25 +412,113 @@ impl ConstrainedFairing {
         creases: Option<&Creases>,
         pinned: &[bool],
     ) -> Self {
-        let (variant, boundary, tangential) = (self.variant, self.boundary, self.tangential);
-        let layout = Layout {
-            order: self.order,
-            internal: self.internal,
-            offsets: self.ring_offsets,
-            ring: self.ring,
+        self.for_other_creases_within(mesh, topology, fans, creases, pinned, 8)
+    }
+
+    /// [`Self::for_other_creases`], updating in place while at most 1/`fraction` of the vertices
+    /// changed (0: never; the tests take both ways).
+    fn for_other_creases_within(
+        mut self,
+        mesh: &TriMesh,
+        topology: &Topology,
+        fans: &FanRings,
+        creases: Option<&Creases>,
+        pinned: &[bool],
+        fraction: usize,
+    ) -> Self {
+        let creases = creases.filter(|c| !c.is_empty());
+        let held = held_flags(topology, creases, pinned);
+        let changed: Vec<u32> = (0..held.len() as u32)
+            .filter(|&v| held[v as usize] != self.held[v as usize])
+            .collect();
+        if fraction == 0 || changed.len() * fraction > held.len() {
+            let (variant, boundary, tangential) = (self.variant, self.boundary, self.tangential);
+            let layout = Layout {
+                order: self.order,
+                internal: self.internal,
+                offsets: self.ring_offsets,
+                ring: self.ring,
+            };
+            let mut fairing = Self::set_up(
+                mesh,
+                topology,
+                fans,
+                variant,
+                boundary,
+                creases,
+                pinned,
+                Some(layout),
+            );
+            fairing.tangential = tangential;
+            return fairing;
+        }
+        let mut affected: Vec<u32> = changed
+            .iter()
+            .flat_map(|&v| std::iter::once(v).chain(topology.neighbors(v).iter().copied()))
+            .collect();
+        affected.sort_unstable();
+        affected.dedup();
+        let (ring_offsets, _) = topology.neighbor_csr();
+        let triangles = &mesh.triangles;
+        // A vertex's rows and whether it is solved, with the triangles solved as `held` says.
+        let gather = |v: usize, held: &[bool], rows: &mut Vec<[f32; 4]>, own: &mut [f32; 3]| {
+            let ring_v = &fans.ring[ring_offsets[v] as usize..ring_offsets[v + 1] as usize];
+            rows.resize(ring_v.len(), [0.0; 4]);
+            let operator = |f: u32| {
+                let t = &triangles[f as usize];
+                solved_triangle(t, held, topology)
+                    .then(|| corner_weights(t.map(|c| topology.valence(c))))
+            };
+            let mut solved = false;
+            gather_rows(
+                v,
+                ring_v,
+                topology,
+                triangles,
+                operator,
+                rows,
+                own,
+                &mut solved,
+            );
+            solved
         };
-        let mut fairing = Self::set_up(
-            mesh,
-            topology,
-            fans,
-            variant,
-            boundary,
-            creases,
-            pinned,
-            Some(layout),
-        );
-        fairing.tangential = tangential;
-        fairing
+        let mut row_of: RowMap = self
+            .entry_weights
+            .iter()
+            .enumerate()
+            .map(|(i, row)| (row_key(row), i as u32))
+            .collect();
+        let (mut rows, mut own) = (Vec::new(), [0.0f32; 3]);
+        for &v in &affected {
+            let v = v as usize;
+            let was_solved = gather(v, &self.held, &mut rows, &mut own);
+            let solved = gather(v, &held, &mut rows, &mut own);
+            self.solved_vertices =
+                self.solved_vertices + usize::from(solved) - usize::from(was_solved);
+            let i = self.internal[v] as usize;
+            self.self_weights[i] = own;
+            self.closed_fan[i] = fans.closed_fan[v] && solved;
+            let first = self.ring_offsets[i] as usize;
+            for (k, row) in rows.iter().enumerate() {
+                let index = *row_of.entry(row_key(row)).or_insert_with(|| {
+                    self.entry_weights.push(*row);
+                    (self.entry_weights.len() - 1) as u32
+                });
+                if let EntryWeightIndex::Narrow(narrow) = &self.entry_weight_index {
+                    if index > u32::from(u16::MAX) {
+                        let wide = narrow.iter().map(|&i| u32::from(i)).collect();
+                        self.entry_weight_index = EntryWeightIndex::Wide(wide);
+                    }
+                }
+                match &mut self.entry_weight_index {
+                    EntryWeightIndex::Narrow(narrow) => narrow[first + k] = index as u16,
+                    EntryWeightIndex::Wide(wide) => wide[first + k] = index,
+                }
+            }
+        }
+        self.curves = fairing_curves(topology, self.boundary, creases, &self.internal);
+        self.held = held;
+        self
     }
 
     #[allow(clippy::too_many_arguments)]
@@ -436,35 +534,16 @@ impl ConstrainedFairing {
     ) -> Self {
         let vertex_count = mesh.positions.len();
         let triangles = &mesh.triangles;
-        let on_boundary = topology.boundary_flags();
         // Crease vertices and corners, and pinned vertices, bound the surface patches like
         // boundary vertices do: they get no local solution and their triangles are not solved.
-        let with_features: Vec<bool>;
         let creases = creases.filter(|c| !c.is_empty());
-        let is_boundary: &[bool] = if creases.is_some() || !pinned.is_empty() {
-            with_features = (0..vertex_count)
-                .map(|v| {
-                    on_boundary[v]
-                        || creases.is_some_and(|c| c.is_feature(v as u32))
-                        || pinned.get(v).copied().unwrap_or(false)
-                })
-                .collect();
-            &with_features
-        } else {
-            on_boundary
-        };
+        let held = held_flags(topology, creases, pinned);
 
         let ring_offsets = topology.neighbor_csr().0.to_vec();
         let (ring, closed) = (&fans.ring, &fans.closed_fan);
 
         let valence = |v: u32| topology.valence(v);
-        let interior = |t: &[u32; 3]| {
-            t.iter()
-                .all(|&c| !is_boundary[c as usize] && valence(c) >= 3)
-                && t[0] != t[1]
-                && t[1] != t[2]
-                && t[0] != t[2]
-        };
+        let interior = |t: &[u32; 3]| solved_triangle(t, &held, topology);
 
         // Local operators of the valence triples that occur, in a dense table, and each triangle's
         // slot in it (u32::MAX: not an interior triangle), found once per triangle rather than
@@ -484,11 +563,7 @@ impl ConstrainedFairing {
                 return table_slot[table_index(n)];
             }
             let slot = operators.len() as u32;
-            let op = LocalOperator::umbrella(n).expect("valences are at least 3");
-            operators.push(std::array::from_fn(|r| {
-                let k_sum: f64 = (0..3).map(|c| op.g[r][c] / n[c] as f64).sum();
-                std::array::from_fn(|c| [op.g[r][c], op.g[r][c] / n[c] as f64 - k_sum, op.h[r]])
-            }));
+            operators.push(corner_weights(n));
             if in_table {
                 table_slot[table_index(n)] = slot;
             }
@@ -509,58 +584,20 @@ impl ConstrainedFairing {
                       own_out: &mut [f32; 3],
                       solved_out: &mut bool| {
             let ring_v = &ring[ring_offsets[v] as usize..ring_offsets[v + 1] as usize];
-            let mut own = [0.0f64; 3];
-            let mut stack_entries = [[0.0f64; 3]; 64];
-            let mut heap_entries = Vec::new();
-            let entries: &mut [[f64; 3]] = if ring_v.len() <= 64 {
-                &mut stack_entries[..ring_v.len()]
-            } else {
-                heap_entries.resize(ring_v.len(), [0.0f64; 3]);
-                &mut heap_entries
-            };
-            let mut count = 0usize;
-            for &f in topology.faces_of(v as u32) {
+            let operator = |f: u32| {
                 let slot = triangle_operator[f as usize];
-                if slot == u32::MAX {
-                    continue;
-                }
-                count += 1;
-                let t = &triangles[f as usize];
-                let r = t
-                    .iter()
-                    .position(|&c| c as usize == v)
-                    .expect("v is a corner");
-                for (c, weights) in operators[slot as usize][r].iter().enumerate() {
-                    let slot = if t[c] as usize == v {
-                        &mut own
-                    } else {
-                        let at = ring_v
-                            .iter()
-                            .position(|&u| u == t[c])
-                            .expect("a triangle's corners are one-ring neighbours");
-                        &mut entries[at]
-                    };
-                    for k in 0..3 {
-                        slot[k] += weights[k];
-                    }
-                }
-            }
-            if count == 0 {
-                // No local solution: the vertex keeps its position (ring weights stay 0).
-                *own_out = [0.0, 1.0, 0.0];
-                return;
-            }
-            let inv = 1.0 / count as f64;
-            *own_out = own.map(|w| (w * inv) as f32);
-            for (out, e) in ring_weights_v.iter_mut().zip(entries.iter()) {
-                *out = [
-                    (e[0] * inv) as f32,
-                    (e[1] * inv) as f32,
-                    (e[2] * inv) as f32,
-                    0.0,
-                ];
-            }
-            *solved_out = true;
+                (slot != u32::MAX).then(|| &operators[slot as usize])
+            };
+            gather_rows(
+                v,
+                ring_v,
+                topology,
+                triangles,
+                operator,
+                ring_weights_v,
+                own_out,
+                solved_out,
+            );
         };
         // In blocks of vertices, each block's rows deduplicated as soon as they are gathered:
         // the 16-byte rows of the whole mesh are never held at once (on the 1.2M-face mesh they
@@ -630,6 +667,7 @@ impl ConstrainedFairing {
             .collect();
         let curves = fairing_curves(topology, boundary, creases, &internal);
         ConstrainedFairing {
+            held,
             variant,
             boundary,
             order,
@@ -969,6 +1007,119 @@ impl<I: Copy + Into<u32> + Sync> Stencil<'_, I> {
             })
             .reduce(|| 0.0f32, f32::max)
     }
+}
+
+/// The vertices (mesh numbering) that bound the surface patches like boundary vertices do: the
+/// boundary's, the creases' (their vertices and corners) and the pinned ones.
+fn held_flags(topology: &Topology, creases: Option<&Creases>, pinned: &[bool]) -> Vec<bool> {
+    let on_boundary = topology.boundary_flags();
+    if creases.is_none() && pinned.is_empty() {
+        return on_boundary.to_vec();
+    }
+    (0..on_boundary.len())
+        .into_par_iter()
+        .with_min_len(VERTEX_BLOCK)
+        .map(|v| {
+            on_boundary[v]
+                || creases.is_some_and(|c| c.is_feature(v as u32))
+                || pinned.get(v).copied().unwrap_or(false)
+        })
+        .collect()
+}
+
+/// Whether triangle `t` gets a local solution: none of its corners is held (`held`: boundary,
+/// crease or pinned), every corner has valence three or more (so that A is invertible), and its
+/// corners are distinct.
+fn solved_triangle(t: &[u32; 3], held: &[bool], topology: &Topology) -> bool {
+    t.iter()
+        .all(|&c| !held[c as usize] && topology.valence(c) >= 3)
+        && t[0] != t[1]
+        && t[1] != t[2]
+        && t[0] != t[2]
+}
+
+/// For the valence triple `n` of a triangle's corners: per corner r, the weights its local
+/// solution gives each corner c's umbrella mean, position and anchor (G_rc,
+/// G_rc/n_c − Σ_c' G_rc'/n_c', h_r; see "How it is computed").
+fn corner_weights(n: [usize; 3]) -> [[[f64; 3]; 3]; 3] {
+    let op = LocalOperator::umbrella(n).expect("valences are at least 3");
+    std::array::from_fn(|r| {
+        let k_sum: f64 = (0..3).map(|c| op.g[r][c] / n[c] as f64).sum();
+        std::array::from_fn(|c| [op.g[r][c], op.g[r][c] / n[c] as f64 - k_sum, op.h[r]])
+    })
+}
+
+/// Vertex `v`'s weights: the mean of its solved triangles' corner weights (f64, then rounded),
+/// one row (mean, position, anchor, 0) per entry of its one-ring `ring_v` into
+/// `ring_weights_v`, its own into `own_out`; `operator(f)` gives face f's corner weights, `None`
+/// for a face that is not solved. A vertex with no solved face keeps its position (own weights
+/// (0, 1, 0), ring weights 0) and `solved_out` stays false.
+#[allow(clippy::too_many_arguments)]
+fn gather_rows<W>(
+    v: usize,
+    ring_v: &[u32],
+    topology: &Topology,
+    triangles: &[[u32; 3]],
+    operator: impl Fn(u32) -> Option<W>,
+    ring_weights_v: &mut [[f32; 4]],
+    own_out: &mut [f32; 3],
+    solved_out: &mut bool,
+) where
+    W: std::borrow::Borrow<[[[f64; 3]; 3]; 3]>,
+{
+    let mut own = [0.0f64; 3];
+    let mut stack_entries = [[0.0f64; 3]; 64];
+    let mut heap_entries = Vec::new();
+    let entries: &mut [[f64; 3]] = if ring_v.len() <= 64 {
+        &mut stack_entries[..ring_v.len()]
+    } else {
+        heap_entries.resize(ring_v.len(), [0.0f64; 3]);
+        &mut heap_entries
+    };
+    let mut count = 0usize;
+    for &f in topology.faces_of(v as u32) {
+        let Some(weights_of) = operator(f) else {
+            continue;
+        };
+        count += 1;
+        let t = &triangles[f as usize];
+        let r = t
+            .iter()
+            .position(|&c| c as usize == v)
+            .expect("v is a corner");
+        for (c, weights) in weights_of.borrow()[r].iter().enumerate() {
+            let slot = if t[c] as usize == v {
+                &mut own
+            } else {
+                let at = ring_v
+                    .iter()
+                    .position(|&u| u == t[c])
+                    .expect("a triangle's corners are one-ring neighbours");
+                &mut entries[at]
+            };
+            for k in 0..3 {
+                slot[k] += weights[k];
+            }
+        }
+    }
+    *solved_out = false;
+    if count == 0 {
+        // No local solution: the vertex keeps its position (ring weights stay 0).
+        *own_out = [0.0, 1.0, 0.0];
+        ring_weights_v.fill([0.0; 4]);
+        return;
+    }
+    let inv = 1.0 / count as f64;
+    *own_out = own.map(|w| (w * inv) as f32);
+    for (out, e) in ring_weights_v.iter_mut().zip(entries.iter()) {
+        *out = [
+            (e[0] * inv) as f32,
+            (e[1] * inv) as f32,
+            (e[2] * inv) as f32,
+            0.0,
+        ];
+    }
+    *solved_out = true;
 }
 
 /// The curves the curve operator moves (internal numbering): the boundary loops (when they are
@@ -2213,23 +2364,50 @@ mod tests {
                 fairing.set_tangential_relaxation(0.3);
                 fairing
             };
-            let mut again = set_up(Some(&sharp));
-            for creases in [Some(&faint), None, Some(&sharp)] {
-                let mut afresh = set_up(creases);
-                again = again.for_other_creases(&mesh, &topology, &fans, creases, &[]);
-                assert_eq!(again.order, afresh.order);
-                assert_eq!(again.ring_offsets, afresh.ring_offsets);
-                assert_eq!(again.ring, afresh.ring);
-                assert_eq!(again.entry_weight_index, afresh.entry_weight_index);
-                assert_eq!(again.entry_weights, afresh.entry_weights);
-                assert_eq!(again.self_weights, afresh.self_weights);
-                assert_eq!(again.closed_fan, afresh.closed_fan);
-                assert_eq!(again.solved_vertices, afresh.solved_vertices);
-                let (mut a, mut b) = (noisy.clone(), noisy.clone());
-                again.run(&mut a, &run_options);
-                afresh.run(&mut b, &run_options);
-                assert_eq!(a, b);
-                assert_ne!(a, noisy);
+            // Every entry's weight row, whatever the numbering of the distinct rows.
+            let entry_rows = |fairing: &ConstrainedFairing| -> Vec<[f32; 4]> {
+                let row = |i: usize| fairing.entry_weights[i];
+                match &fairing.entry_weight_index {
+                    EntryWeightIndex::Narrow(index) => {
+                        index.iter().map(|&i| row(i.into())).collect()
+                    }
+                    EntryWeightIndex::Wide(index) => {
+                        index.iter().map(|&i| row(i as usize)).collect()
+                    }
+                }
+            };
+            // Updated in place (fraction 1: whatever changed) and set up whole (0).
+            for fraction in [1, 0] {
+                let mut again = set_up(Some(&sharp));
+                for creases in [Some(&faint), None, Some(&sharp), Some(&faint)] {
+                    let mut afresh = set_up(creases);
+                    again = again.for_other_creases_within(
+                        &mesh,
+                        &topology,
+                        &fans,
+                        creases,
+                        &[],
+                        fraction,
+                    );
+                    assert_eq!(again.held, afresh.held);
+                    assert_eq!(again.order, afresh.order);
+                    assert_eq!(again.ring_offsets, afresh.ring_offsets);
+                    assert_eq!(again.ring, afresh.ring);
+                    assert_eq!(entry_rows(&again), entry_rows(&afresh));
+                    if fraction == 0 {
+                        assert_eq!(again.entry_weight_index, afresh.entry_weight_index);
+                        assert_eq!(again.entry_weights, afresh.entry_weights);
+                    }
+                    assert_eq!(again.self_weights, afresh.self_weights);
+                    assert_eq!(again.closed_fan, afresh.closed_fan);
+                    assert_eq!(again.solved_vertices, afresh.solved_vertices);
+                    assert_eq!(again.curves, afresh.curves);
+                    let (mut a, mut b) = (noisy.clone(), noisy.clone());
+                    again.run(&mut a, &run_options);
+                    afresh.run(&mut b, &run_options);
+                    assert_eq!(a, b);
+                    assert_ne!(a, noisy);
+                }
             }
         }
     }
