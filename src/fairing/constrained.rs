@@ -1504,8 +1504,8 @@ const LOCAL_ORDER_ROUNDS: usize = 3;
 /// and the noise estimate over the fans, the volume correction's normals, the risk's normals)
 /// gathers its neighbours' data; in a file's own order (a scan's, a subdivided mesh's) those sit
 /// megabytes apart, here a few breadth-first fronts apart. On the noisy 1.2M-face bunny, whose
-/// file order is poor, the whole default `fair` ran ~15 % faster for ~0.3 s of reordering and a
-/// second topology (`docs/measurements.md`). The operator renumbers its own vertices the same
+/// file order is poor, the whole default `fair` went from 23.3 to 19.9 s for ~0.2 s of
+/// reordering and a second topology (`docs/measurements.md`). The operator renumbers its own vertices the same
 /// way, so its iterations are unchanged. What `options` number by vertex (the file's hard edges)
 /// is renumbered too; `pinned` stands for the mask, which `fair` does not see.
 fn in_local_order(
