@@ -6,7 +6,7 @@
 //! Run: `cargo run --release --no-default-features --example fairing_default [-- --trace]`
 //! (`--only gear,cube` runs just those meshes; `--files a.obj,b.ply` adds meshes from files, named
 //! by their stem; `--sigma 0.15` changes the noise; `--default-only` prints the default's row
-//! alone; `--trace` also prints, per round, the noise estimate and the distance to the clean
+//! alone; `--tangential 0.1` gives the default another tangential relaxation weight; `--trace` also prints, per round, the noise estimate and the distance to the clean
 //! surface). `docs/measurements.md` holds what it printed and says which meshes the rules were
 //! tuned on and which were kept out.
 //!
@@ -97,6 +97,12 @@ fn main() {
     let files = list("--files").unwrap_or_default();
     let sigma: f64 = value("--sigma").map_or(0.3, |s| s.parse().expect("--sigma: a number"));
     let default_only = args.iter().any(|a| a == "--default-only");
+    // `--tangential W`: the default with another tangential relaxation weight.
+    let default_options = match value("--tangential") {
+        Some(w) => FairOptions::default()
+            .with_tangential_relaxation(w.parse().expect("--tangential: a number")),
+        None => FairOptions::default(),
+    };
     for (name, clean) in meshes(&files) {
         if only.as_ref().is_some_and(|only| !only.contains(&name)) {
             continue;
@@ -118,7 +124,7 @@ fn main() {
                 );
             }
             let mut faired = input.clone();
-            let report = fair_constrained(&mut faired, &topology, &FairOptions::default());
+            let report = fair_constrained(&mut faired, &topology, &default_options);
             print(
                 &name,
                 label,

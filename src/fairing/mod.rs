@@ -196,7 +196,7 @@ impl Default for FairOptions {
 }
 
 /// The default [`FairOptions::tangential_relaxation`] (`docs/measurements.md`).
-pub const DEFAULT_TANGENTIAL_RELAXATION: f64 = 0.25;
+pub const DEFAULT_TANGENTIAL_RELAXATION: f64 = 0.1;
 
 /// How many rounds constrained fairing runs.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
