@@ -175,6 +175,29 @@ pub fn change_of_positions(base: &TriMesh, positions: &[[f32; 3]]) -> (f64, f64)
     (volume_change, (sum_squared / positions.len() as f64).sqrt())
 }
 
+/// How far the vertices slid along the surface: the root mean square, over the vertices, of the
+/// part of each vertex's move from `before` (its position there) that is perpendicular to its
+/// normal in `after` (area-weighted), in model units. What a file's texture coordinates, which
+/// stay with their vertices, see of a smoothing: a slide moves the texture over the surface,
+/// while a move along the normal does not. NaN when the vertex counts differ or there are no
+/// vertices.
+pub fn tangential_slide(before: &[[f32; 3]], after: &TriMesh) -> f64 {
+    if before.len() != after.positions.len() || before.is_empty() {
+        return f64::NAN;
+    }
+    let point = |p: &[f32; 3]| DVec3::from(p.map(f64::from));
+    let sum_squared: f64 = before
+        .iter()
+        .zip(&after.positions)
+        .zip(after.vertex_normals())
+        .map(|((b, a), n)| {
+            let moved = point(a) - point(b);
+            (moved - n * moved.dot(n)).length_squared()
+        })
+        .sum();
+    (sum_squared / before.len() as f64).sqrt()
+}
+
 /// Per-vertex comparisons, when `other` has the same triangles as `reference`.
 pub fn compare_vertices(reference: &TriMesh, other: &TriMesh) -> Option<VertexComparison> {
     if reference.triangles != other.triangles || reference.positions.len() != other.positions.len()
@@ -533,6 +556,46 @@ pub fn closest_point_on_triangle(p: DVec3, a: DVec3, b: DVec3, c: DVec3) -> DVec
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn tangential_slide_is_the_move_along_the_surface_only() {
+        // A flat grid (normals +z): every vertex moved 0.3 up and 0.1 along x, one in four also
+        // 0.2 along y.
+        let mut grid = TriMesh::default();
+        for j in 0..4u32 {
+            for i in 0..4u32 {
+                grid.positions.push([i as f32, j as f32, 0.0]);
+            }
+        }
+        for j in 0..3u32 {
+            for i in 0..3u32 {
+                let v = j * 4 + i;
+                grid.triangles.push([v, v + 1, v + 5]);
+                grid.triangles.push([v, v + 5, v + 4]);
+            }
+        }
+        let mut moved = grid.clone();
+        for (v, p) in moved.positions.iter_mut().enumerate() {
+            p[0] += 0.1;
+            p[2] += 0.3;
+            if v % 4 == 0 {
+                p[1] += 0.2;
+            }
+        }
+        let expected = ((12.0 * 0.01 + 4.0 * 0.05) / 16.0f64).sqrt();
+        let slide = tangential_slide(&grid.positions, &moved);
+        assert!(
+            (slide - expected).abs() < 1e-6,
+            "{slide} against {expected}"
+        );
+        // Straight up: no slide at all.
+        let mut lifted = grid.clone();
+        for p in &mut lifted.positions {
+            p[2] += 0.5;
+        }
+        assert!(tangential_slide(&grid.positions, &lifted) < 1e-12);
+        assert!(tangential_slide(&grid.positions[1..], &lifted).is_nan());
+    }
 
     #[test]
     fn change_of_identical_or_translated_positions_keeps_the_volume() {

@@ -820,3 +820,73 @@ fn fair_and_the_hierarchy_keep_the_files_hard_edges_as_creases() {
     let plain = json_of(&["hierarchy", &input, "--json"]);
     assert_eq!(plain["crease_edges"].as_u64().unwrap_or(0), 0, "{plain}");
 }
+
+#[test]
+fn fair_warns_when_the_relaxation_slides_a_textured_files_vertices() {
+    let dir = tempfile::tempdir().unwrap();
+    let textured = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/roundtrip/textured.obj");
+    let noisy = dir.path().join("textured_noisy.obj");
+    let noisy = noisy.to_str().unwrap();
+    let out = fairmesh(&[
+        "noise",
+        textured.to_str().unwrap(),
+        "-o",
+        noisy,
+        "--mode",
+        "iso",
+    ]);
+    assert!(out.status.success());
+    let faired = dir.path().join("faired.obj");
+    let fair = |extra: &[&str]| {
+        let mut args = vec!["fair", noisy, "-o", faired.to_str().unwrap(), "--json"];
+        args.extend_from_slice(extra);
+        let out = fairmesh(&args);
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let json: Value = serde_json::from_slice(&out.stdout).unwrap();
+        (json, String::from_utf8_lossy(&out.stderr).into_owned())
+    };
+    // The default relaxes: the warning names the file and says how far the texture slid.
+    let (json, stderr) = fair(&[]);
+    assert!(json["rounds_run"].as_u64().unwrap() > 0);
+    let slide = json["texture_slide"]
+        .as_f64()
+        .expect("a textured file's slide");
+    assert!(slide > 0.05, "slide {slide}");
+    assert!(
+        stderr.contains("textured_noisy.obj") && stderr.contains("texture coordinates"),
+        "stderr: {stderr}"
+    );
+    assert!(
+        stderr.contains(&format!("{slide:.2} mean edge lengths")),
+        "stderr: {stderr}"
+    );
+    // Without the relaxation nothing slides, and nothing is said; nor for a file with no
+    // texture coordinates.
+    let (json, stderr) = fair(&["--tangential", "0"]);
+    assert!(
+        json["texture_slide"].is_null() && !stderr.contains("warning"),
+        "{stderr}"
+    );
+    let (json, stderr) = {
+        let out = fairmesh(&[
+            "fair",
+            &data("bunny_npm.obj"),
+            "-o",
+            faired.to_str().unwrap(),
+            "--rounds",
+            "2",
+            "--json",
+        ]);
+        assert!(out.status.success());
+        let json: Value = serde_json::from_slice(&out.stdout).unwrap();
+        (json, String::from_utf8_lossy(&out.stderr).into_owned())
+    };
+    assert!(
+        json["texture_slide"].is_null() && !stderr.contains("texture"),
+        "{stderr}"
+    );
+}

@@ -174,6 +174,10 @@ impl FairArgs {
     }
 }
 
+/// A textured file's vertices sliding along the surface by at least this many mean edge lengths
+/// (root mean square) is worth a warning: the texture moves with them.
+const TEXTURE_SLIDE_WARNING: f64 = 0.02;
+
 pub fn run(args: FairArgs) -> anyhow::Result<()> {
     anyhow::ensure!(
         !(args.json && super::is_stdio(&args.output)),
@@ -184,7 +188,8 @@ pub fn run(args: FairArgs) -> anyhow::Result<()> {
     }
     let loaded = super::basic::load_shown(&args.input, true, args.stdio.format)?;
     let (mut mesh, topology, source) = (loaded.mesh, loaded.topology, loaded.source);
-    let mut options = args.method_options(fairmesh::metrics::mean_edge_length(&mesh));
+    let edge = fairmesh::metrics::mean_edge_length(&mesh);
+    let mut options = args.method_options(edge);
     // The file's own sharp edges (split normals, material boundaries) are creases too.
     if let MethodOptions::Constrained(FairOptions {
         creases: Some(creases),
@@ -197,6 +202,12 @@ pub fn run(args: FairArgs) -> anyhow::Result<()> {
     let volume_before = fairmesh::metrics::signed_volume(&mesh);
     // The input is kept only to measure against it.
     let input = args.measure.then(|| mesh.clone());
+    // A file with texture coordinates: its positions are kept to say how far the tangential
+    // relaxation slid the vertices, and the texture with them.
+    let slides = matches!(&options, MethodOptions::Constrained(o) if o.tangential_relaxation > 0.0
+        && o.variant == fairmesh::fairing::FairVariant::NormalProjected);
+    let textured_input =
+        (slides && source.has_texture_coordinates()).then(|| mesh.positions.clone());
 
     let step = super::progress::Step::start("fairing");
     let start = Instant::now();
@@ -214,6 +225,20 @@ pub fn run(args: FairArgs) -> anyhow::Result<()> {
         0.0
     };
     super::save_kept(&args.output, &mesh, &source, args.stdio.format)?;
+    // In mean edge lengths of the input; none when no round ran.
+    let texture_slide = textured_input
+        .filter(|_| report.rounds_run > 0)
+        .map(|before| fairmesh::metrics::tangential_slide(&before, &mesh) / edge)
+        .filter(|slide| slide.is_finite());
+    if let Some(slide) = texture_slide.filter(|&slide| slide >= TEXTURE_SLIDE_WARNING) {
+        eprintln!(
+            "warning: {}: its texture coordinates stay with their vertices, and the tangential \
+             relaxation slid the vertices along the surface by {slide:.2} mean edge lengths \
+             (root mean square): the texture moved with them. `--tangential 0` keeps every \
+             vertex on its normal line (noise that moved vertices along the surface then stays).",
+            args.input.display()
+        );
+    }
     let measures = input.map(|input| {
         super::progress::Step::run("measuring against the input", || {
             fairmesh::metrics::compare(&input, &mesh)
@@ -242,6 +267,7 @@ pub fn run(args: FairArgs) -> anyhow::Result<()> {
             "volume_change_percent": volume_change_percent,
             "max_move": report.max_move,
             "masked_vertices": mask.as_ref().map(|m| m.painted_count()),
+            "texture_slide": texture_slide,
         });
         if let (Some(m), Some(map)) = (&measures, json.as_object_mut()) {
             map.insert(

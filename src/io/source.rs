@@ -115,6 +115,13 @@ impl Source {
         }
     }
 
+    /// Whether the file gives its vertices texture coordinates (OBJ `vt`, PLY `u`/`v` or
+    /// `s`/`t`, glTF `TEXCOORD_0`): they stay with their vertices, so whatever slides a vertex
+    /// along the surface moves the texture with it.
+    pub fn has_texture_coordinates(&self) -> bool {
+        self.vertex_attributes().uvs.is_some()
+    }
+
     /// The file's UVs and vertex colours per welded vertex (see [`super::carry`]), for writing
     /// another format.
     pub(crate) fn vertex_attributes(&self) -> VertexAttributes {
