@@ -84,7 +84,11 @@ impl VolumeKeeper {
             target: Vec::new(),
             movable,
         };
-        keeper.target = keeper.volumes(mesh);
+        keeper.target = keeper
+            .volume_cubics(mesh, None)
+            .iter()
+            .map(|c| c[0])
+            .collect();
         keeper
     }
 
@@ -93,30 +97,43 @@ impl VolumeKeeper {
         self.apex.len()
     }
 
-    /// The cone volume of each part about its apex (for a closed part, its enclosed volume).
-    fn volumes(&self, mesh: &TriMesh) -> Vec<f64> {
+    /// Per part, the coefficients (c0, c1, c2, c3) of its cone volume about its apex (for a
+    /// closed part, its enclosed volume) as a cubic in δ when every vertex moves by δ times its
+    /// `normals` entry (each face's triple product expanded in δ): c0 is the volume now. `None`:
+    /// no normals, only c0 (the other three are zero). One sum for both uses, so that a part that
+    /// did not change reads its target exactly and is not offset at all.
+    fn volume_cubics(&self, mesh: &TriMesh, normals: Option<&[Vec3A]>) -> Vec<[f64; 4]> {
         let parts = self.parts();
-        let blocks: Vec<Vec<f64>> = mesh
+        let normal = |v: u32| normals.map_or(DVec3::ZERO, |n| n[v as usize].as_dvec3());
+        let triple = |x: DVec3, y: DVec3, z: DVec3| x.dot(y.cross(z));
+        let blocks: Vec<Vec<[f64; 4]>> = mesh
             .triangles
             .par_chunks(BLOCK)
             .zip(self.face_part.par_chunks(BLOCK))
             .map(|(faces, owners)| {
-                let mut sums = vec![0.0; parts];
-                for (t, &p) in faces.iter().zip(owners) {
-                    let apex = self.apex[p as usize];
+                let mut sums = vec![[0.0; 4]; parts];
+                for (t, &part) in faces.iter().zip(owners) {
+                    let apex = self.apex[part as usize];
                     let [a, b, c] = t.map(|v| mesh.point(v) - apex);
-                    sums[p as usize] += a.dot(b.cross(c)) / 6.0;
+                    let [na, nb, nc] = t.map(normal);
+                    let sum = &mut sums[part as usize];
+                    sum[0] += triple(a, b, c) / 6.0;
+                    sum[1] += (triple(na, b, c) + triple(a, nb, c) + triple(a, b, nc)) / 6.0;
+                    sum[2] += (triple(na, nb, c) + triple(na, b, nc) + triple(a, nb, nc)) / 6.0;
+                    sum[3] += triple(na, nb, nc) / 6.0;
                 }
                 sums
             })
             .collect();
-        let mut total = vec![0.0; parts];
+        let mut cubic = vec![[0.0f64; 4]; parts];
         for block in blocks {
-            for (t, s) in total.iter_mut().zip(block) {
-                *t += s;
+            for (total, sum) in cubic.iter_mut().zip(block) {
+                for k in 0..4 {
+                    total[k] += sum[k];
+                }
             }
         }
-        total
+        cubic
     }
 
     /// Offsets the movable vertices of each part along their normals so that the part's volume
@@ -136,7 +153,6 @@ impl VolumeKeeper {
         topology: &Topology,
         held: impl Fn(usize) -> bool + Sync,
     ) -> f64 {
-        let parts = self.parts();
         let moves = |v: usize| self.movable[v] && !held(v);
         let positions = &mesh.positions;
         let point = |v: u32| Vec3A::from_array(positions[v as usize]);
@@ -166,36 +182,7 @@ impl VolumeKeeper {
             })
             .collect();
         // Per part, the coefficients of V(δ) = c0 + c1 δ + c2 δ² + c3 δ³.
-        let blocks: Vec<Vec<[f64; 4]>> = mesh
-            .triangles
-            .par_chunks(BLOCK)
-            .zip(self.face_part.par_chunks(BLOCK))
-            .map(|(faces, owners)| {
-                let mut sums = vec![[0.0; 4]; parts];
-                for (t, &part) in faces.iter().zip(owners) {
-                    let apex = self.apex[part as usize];
-                    let [a, b, c] = t.map(|v| mesh.point(v) - apex);
-                    let [na, nb, nc] = t.map(|v| normals[v as usize].as_dvec3());
-                    let triple = |x: DVec3, y: DVec3, z: DVec3| x.dot(y.cross(z));
-                    // Divided by 6 term by term as in `volumes`, so that a part that did not
-                    // change reads its target exactly and is not offset at all.
-                    let sum = &mut sums[part as usize];
-                    sum[0] += triple(a, b, c) / 6.0;
-                    sum[1] += (triple(na, b, c) + triple(a, nb, c) + triple(a, b, nc)) / 6.0;
-                    sum[2] += (triple(na, nb, c) + triple(na, b, nc) + triple(a, nb, nc)) / 6.0;
-                    sum[3] += triple(na, nb, nc) / 6.0;
-                }
-                sums
-            })
-            .collect();
-        let mut cubic = vec![[0.0f64; 4]; parts];
-        for block in blocks {
-            for (total, sum) in cubic.iter_mut().zip(block) {
-                for k in 0..4 {
-                    total[k] += sum[k];
-                }
-            }
-        }
+        let cubic = self.volume_cubics(mesh, Some(&normals));
         let offsets: Vec<f64> = cubic
             .iter()
             .zip(&self.target)
