@@ -1616,10 +1616,16 @@ fn decide_and_fair(
     // Automatic strength fairs only a noisy mesh, so its creases are always found on filtered
     // normals; a fixed strength finds the estimate and the faces' own feature edges in one
     // gather, and skips the filter when the mesh is clean.
+    let mut face_rings = FaceRingCache::default();
     let (estimate, found) = match (&options.creases, options.strength) {
         (Some(crease_options), Strength::Fixed) => {
-            let (estimate, creases) =
-                detect_creases_with_estimate(mesh, topology, &fans, crease_options);
+            let (estimate, creases) = detect_creases_with_estimate(
+                mesh,
+                topology,
+                &fans,
+                crease_options,
+                &mut face_rings,
+            );
             (estimate, Some(creases))
         }
         (_, Strength::Auto) => (estimate_noise_with_fans(mesh, topology, &fans), None),
@@ -1666,14 +1672,14 @@ fn decide_and_fair(
                     mesh,
                     topology,
                     fans,
-                    None,
+                    (None, FaceRingCache::in_mesh_order()),
                     options,
                     Rounds { pinned, ..rounds },
                 )
             },
         );
     }
-    fair_rounds(mesh, topology, fans, found, options, rounds)
+    fair_rounds(mesh, topology, fans, (found, face_rings), options, rounds)
 }
 
 /// What [`fair_rounds`] takes from the decision to fair.
@@ -1689,12 +1695,13 @@ struct Rounds<'a> {
 }
 
 /// The rounds of [`fair_constrained`], after the decision to fair: `fans` are `mesh`'s,
-/// `found` the creases found with the noise estimate (a fixed strength), if any.
+/// `found` the creases found with the noise estimate (a fixed strength), if any, with the faces
+/// around each face if that detection filtered the normals.
 fn fair_rounds(
     mesh: &mut TriMesh,
     topology: &Topology,
     fans: FanRings,
-    found: Option<Creases>,
+    (found, mut face_rings): (Option<Creases>, FaceRingCache),
     options: &FairOptions,
     rounds: Rounds,
 ) -> FairReport {
@@ -1704,19 +1711,20 @@ fn fair_rounds(
         pinned,
     } = rounds;
     // Creases are found again before every round (every CREASE_RECHECK_ROUNDS-th once they stop
-    // changing): the noise left after a round makes fewer false creases, and a crease found on the noisy input may turn out to be noise
-    // (`docs/measurements.md`). The normals are filtered as much as the current noise asks for.
-    let mut face_rings = FaceRingCache::default();
-    let mut detect = |mesh: &TriMesh, noise: Option<f64>| {
+    // changing): the noise left after a round makes fewer false creases, and a crease found on
+    // the noisy input may turn out to be noise (`docs/measurements.md`). The normals are filtered
+    // as much as the current noise asks for: the first time as the input's estimate says, later
+    // as the estimate made in the same gather as the faces' own feature edges says
+    // (`detect_creases_with_estimate`; once the noise is gone, that gather is the detection).
+    let mut creases = found.or_else(|| {
         options.creases.as_ref().map(|crease_options| {
             let mut crease_options = crease_options.clone();
             crease_options.normal_filtering = crease_options
                 .normal_filtering
-                .max(noise.map_or(0, normal_filtering_for));
+                .max(estimate.map_or(0, normal_filtering_for));
             detect_creases_cached(mesh, topology, &crease_options, &mut face_rings)
         })
-    };
-    let mut creases = found.or_else(|| detect(mesh, estimate));
+    });
     let max_rounds = match auto_noise {
         Some(_) => MAX_AUTO_ROUNDS,
         None => options.rounds,
@@ -1763,7 +1771,6 @@ fn fair_rounds(
     let mut progress = 0;
     let mut first_fall = 0.0;
     let mut before_restore = Vec::new();
-    let mut noise_now = estimate;
     let mut copy_report = FairReport::default();
     // Detections in a row that found the creases already kept (or changed in a few edges in
     // CREASE_SETTLED): from two on, the creases are found again only every
@@ -1775,8 +1782,14 @@ fn fair_rounds(
         redetect && (unchanged < 2 || round.is_multiple_of(CREASE_RECHECK_ROUNDS))
     };
     for round in 0..max_rounds {
-        if let (true, Some(fans)) = (round > 0 && detect_in(round, unchanged), &fans) {
-            let found = detect(mesh, noise_now);
+        if let (true, Some(fans), Some(crease_options)) = (
+            round > 0 && detect_in(round, unchanged),
+            &fans,
+            &options.creases,
+        ) {
+            let (_, found) =
+                detect_creases_with_estimate(mesh, topology, fans, crease_options, &mut face_rings);
+            let found = Some(found);
             fn edges(creases: &Option<Creases>) -> &[[u32; 2]] {
                 creases.as_ref().map_or(&[], |c| &c.edges)
             }
@@ -1850,13 +1863,6 @@ fn fair_rounds(
             if round - progress >= RISK_PATIENCE {
                 break;
             }
-        }
-        if round + 1 == max_rounds {
-            break;
-        }
-        // The estimate only sets the next detection's filtering.
-        if let (Some(fans), true) = (&fans, detect_in(round + 1, unchanged)) {
-            noise_now = estimate_noise_with_fans(mesh, topology, fans);
         }
     }
     let mut crease_edges = creases.map_or(0, |c| c.edges.len());

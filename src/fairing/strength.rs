@@ -175,6 +175,8 @@ fn gather(
             let mut edge_sum = 0.0f64;
             let mut edges = Vec::new();
             let mut d = [Vec3A::ZERO; 64];
+            // faces[k]: the area normal of face (v, x_(k−1), x_k).
+            let mut faces = [Vec3A::ZERO; 64];
             for (i, h) in out.iter_mut().enumerate() {
                 let v = (b * VERTEX_BLOCK + i) as u32;
                 let valence = topology.valence(v);
@@ -191,14 +193,15 @@ fn gather(
                         }
                         let d = &d[..valence];
                         let mut previous = d[valence - 1];
-                        for &dk in d {
+                        for (&dk, face) in d.iter().zip(&mut faces) {
                             offset += dk;
-                            normal += previous.cross(dk);
+                            *face = previous.cross(dk);
+                            normal += *face;
                             lengths += dk.length();
                             previous = dk;
                         }
                         if let Some(threshold) = threshold {
-                            fan_feature_edges(v, ring, d, threshold, &mut edges);
+                            fan_feature_edges(v, ring, &faces[..valence], threshold, &mut edges);
                         }
                     }
                     None => {
@@ -214,10 +217,8 @@ fn gather(
                             }
                         }
                         if let Some(threshold) = threshold {
-                            let unit = |f: u32| {
-                                area_normal(mesh, f).try_normalize().unwrap_or(Vec3A::ZERO)
-                            };
-                            vertex_feature_edges(mesh, topology, v, unit, threshold, &mut edges);
+                            let normal = |f: u32| area_normal(mesh, f);
+                            vertex_feature_edges(mesh, topology, v, normal, threshold, &mut edges);
                         }
                     }
                 }

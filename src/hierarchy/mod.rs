@@ -34,7 +34,9 @@
 mod decimate;
 
 use crate::fairing::constrained::FanRings;
-use crate::fairing::creases::{detect_creases_with_estimate, CreaseOptions, Creases, FeatureClass};
+use crate::fairing::creases::{
+    detect_creases_with_estimate, CreaseOptions, Creases, FaceRingCache, FeatureClass,
+};
 use crate::mesh::{Topology, TriMesh};
 use crate::Progress;
 use decimate::NEVER;
@@ -472,7 +474,14 @@ fn build(
                 std::borrow::Cow::Borrowed,
             );
             let fans = FanRings::new(&mesh.triangles, &topology);
-            detect_creases_with_estimate(mesh, &topology, &fans, crease_options).1
+            detect_creases_with_estimate(
+                mesh,
+                &topology,
+                &fans,
+                crease_options,
+                &mut FaceRingCache::default(),
+            )
+            .1
         })
         .filter(|creases| !creases.is_empty());
     let setup_ms = started.elapsed().as_secs_f64() * 1e3;
