@@ -836,8 +836,8 @@ fn fair_warns_when_the_relaxation_slides_a_textured_files_vertices() {
         "iso",
     ]);
     assert!(out.status.success());
-    let faired = dir.path().join("faired.obj");
-    let fair = |input: &str, extra: &[&str]| {
+    let fair = |input: &str, output: &str, extra: &[&str]| {
+        let faired = dir.path().join(output);
         let mut args = vec!["fair", input, "-o", faired.to_str().unwrap(), "--json"];
         args.extend_from_slice(extra);
         let out = fairmesh(&args);
@@ -849,13 +849,20 @@ fn fair_warns_when_the_relaxation_slides_a_textured_files_vertices() {
         let json: Value = serde_json::from_slice(&out.stdout).unwrap();
         (json, String::from_utf8_lossy(&out.stderr).into_owned())
     };
-    // The default relaxes: the warning names the file and says how far the texture slid.
-    let (json, stderr) = fair(noisy, &[]);
+    // The default relaxes. Written back into an OBJ the texture coordinates follow the slide:
+    // nothing to warn about.
+    let (json, stderr) = fair(noisy, "faired.obj", &[]);
     assert!(json["rounds_run"].as_u64().unwrap() > 0);
     let slide = json["texture_slide"]
         .as_f64()
         .expect("a textured file's slide");
     assert!(slide > 0.05, "slide {slide}");
+    assert_eq!(json["texture_follows"], true, "{json}");
+    assert!(!stderr.contains("warning"), "stderr: {stderr}");
+    // Into glTF the coordinates go per vertex and stay with their vertices: the warning names
+    // the file and says how far the texture slid.
+    let (json, stderr) = fair(noisy, "faired.glb", &[]);
+    assert_eq!(json["texture_follows"], false, "{json}");
     assert!(
         stderr.contains("textured_noisy.obj") && stderr.contains("texture coordinates"),
         "stderr: {stderr}"
@@ -866,14 +873,191 @@ fn fair_warns_when_the_relaxation_slides_a_textured_files_vertices() {
     );
     // Without the relaxation nothing slides, and nothing is said; nor for a file with no
     // texture coordinates.
-    let (json, stderr) = fair(noisy, &["--tangential", "0"]);
+    let (json, stderr) = fair(noisy, "faired.glb", &["--tangential", "0"]);
     assert!(
-        json["texture_slide"].is_null() && !stderr.contains("warning"),
+        json["texture_slide"].is_null() && !stderr.contains("relaxation slid"),
         "{stderr}"
     );
-    let (json, stderr) = fair(&data("bunny_npm.obj"), &["--rounds", "2"]);
+    let (json, stderr) = fair(&data("bunny_npm.obj"), "faired.obj", &["--rounds", "2"]);
     assert!(
         json["texture_slide"].is_null() && !stderr.contains("texture"),
         "{stderr}"
     );
+}
+
+/// A flat grid textured by an affine map of its positions, its inner vertices jittered in the
+/// plane: the relaxation slides them, and written back into an OBJ or a PLY each inner vertex's
+/// texture coordinate is the map's value at its new place (the texture stayed where it was);
+/// before this, they kept their old values.
+#[test]
+fn fair_written_back_moves_texture_coordinates_with_the_slide() {
+    const N: usize = 9;
+    let affine = |x: f64, y: f64| [0.1 + 0.05 * x - 0.02 * y, 0.3 + 0.01 * x + 0.04 * y];
+    let mut points = Vec::new();
+    for j in 0..N {
+        for i in 0..N {
+            let inner = i > 0 && j > 0 && i < N - 1 && j < N - 1;
+            // A fixed in-plane jitter of up to a quarter edge on the inner vertices.
+            let k = (i * 7 + j * 13) % 11;
+            let (dx, dy) = if inner {
+                (0.05 * (k as f64 - 5.0), 0.04 * ((k * 3 % 11) as f64 - 5.0))
+            } else {
+                (0.0, 0.0)
+            };
+            points.push((i as f64 + dx, j as f64 + dy, inner));
+        }
+    }
+    let mut triangles = Vec::new();
+    for j in 0..N - 1 {
+        for i in 0..N - 1 {
+            let v = j * N + i;
+            triangles.push([v, v + 1, v + N + 1]);
+            triangles.push([v, v + N + 1, v + N]);
+        }
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let mut obj = String::new();
+    let mut ply = format!(
+        "ply\nformat ascii 1.0\nelement vertex {}\nproperty float x\nproperty float y\n\
+         property float z\nproperty float u\nproperty float v\nelement face {}\n\
+         property list uchar int vertex_indices\nend_header\n",
+        points.len(),
+        triangles.len()
+    );
+    for &(x, y, _) in &points {
+        let [u, v] = affine(x, y);
+        obj += &format!("v {x} {y} 0\nvt {u} {v}\n");
+        ply += &format!("{x} {y} 0 {u} {v}\n");
+    }
+    for t in &triangles {
+        let [a, b, c] = t.map(|v| v + 1);
+        obj += &format!("f {a}/{a} {b}/{b} {c}/{c}\n");
+        ply += &format!("3 {} {} {}\n", t[0], t[1], t[2]);
+    }
+    for (name, text) in [("grid.obj", obj), ("grid.ply", ply)] {
+        let input = dir.path().join(name);
+        std::fs::write(&input, text).unwrap();
+        let output = dir.path().join(format!("faired_{name}"));
+        let out = fairmesh(&[
+            "fair",
+            input.to_str().unwrap(),
+            "-o",
+            output.to_str().unwrap(),
+            "--rounds",
+            "2",
+            "--json",
+        ]);
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let json: Value = serde_json::from_slice(&out.stdout).unwrap();
+        assert_eq!(json["texture_follows"], true, "{name}: {json}");
+        // (x, y, u, v) of every vertex as written.
+        let written = std::fs::read_to_string(&output).unwrap();
+        let numbers = |line: &str| -> Vec<f64> {
+            line.split_whitespace()
+                .skip(1)
+                .map(|w| w.parse().unwrap())
+                .collect()
+        };
+        let rows: Vec<[f64; 4]> = if name.ends_with(".obj") {
+            let v = written.lines().filter(|l| l.starts_with("v "));
+            let vt = written.lines().filter(|l| l.starts_with("vt "));
+            v.zip(vt)
+                .map(|(v, vt)| {
+                    let (p, t) = (numbers(v), numbers(vt));
+                    [p[0], p[1], t[0], t[1]]
+                })
+                .collect()
+        } else {
+            let body = written.split("end_header\n").nth(1).unwrap();
+            body.lines()
+                .take(points.len())
+                .map(|row| {
+                    let r: Vec<f64> = row.split_whitespace().map(|w| w.parse().unwrap()).collect();
+                    [r[0], r[1], r[3], r[4]]
+                })
+                .collect()
+        };
+        assert_eq!(rows.len(), points.len(), "{name}");
+        let mut slid = 0;
+        for (&(x, y, inner), &[nx, ny, u, v]) in points.iter().zip(&rows) {
+            if !inner {
+                continue;
+            }
+            if (nx - x).hypot(ny - y) > 0.01 {
+                slid += 1;
+            }
+            let expected = affine(nx, ny);
+            assert!(
+                (u - expected[0]).abs() < 2e-6 && (v - expected[1]).abs() < 2e-6,
+                "{name}: vertex at ({nx}, {ny}) has ({u}, {v}), the texture there is {expected:?}"
+            );
+        }
+        assert!(slid > 20, "{name}: only {slid} inner vertices slid");
+    }
+    // The same into a glTF (the grid converted to GLB, faired back into it), read back by the
+    // gltf crate.
+    let obj = dir.path().join("grid.obj");
+    let glb = dir.path().join("grid.glb");
+    let faired = dir.path().join("faired_grid.glb");
+    let out = fairmesh(&[
+        "convert",
+        obj.to_str().unwrap(),
+        "-o",
+        glb.to_str().unwrap(),
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let out = fairmesh(&[
+        "fair",
+        glb.to_str().unwrap(),
+        "-o",
+        faired.to_str().unwrap(),
+        "--rounds",
+        "2",
+        "--json",
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let json: Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(json["texture_follows"], true, "{json}");
+    let read = |path: &Path| {
+        let glb = gltf::Gltf::from_slice(&std::fs::read(path).unwrap()).unwrap();
+        let blob = glb.blob.clone();
+        let primitive = glb.meshes().next().unwrap().primitives().next().unwrap();
+        let reader = primitive.reader(|_| blob.as_deref());
+        let positions: Vec<[f32; 3]> = reader.read_positions().unwrap().collect();
+        let uvs: Vec<[f32; 2]> = reader.read_tex_coords(0).unwrap().into_f32().collect();
+        (positions, uvs)
+    };
+    let (before, _) = read(&glb);
+    let (after, uvs) = read(&faired);
+    assert_eq!(before.len(), after.len());
+    let inner = |p: &[f32; 3]| {
+        (0.5..N as f32 - 1.5).contains(&p[0]) && (0.5..N as f32 - 1.5).contains(&p[1])
+    };
+    let mut slid = 0;
+    for ((b, a), uv) in before.iter().zip(&after).zip(&uvs) {
+        if !inner(a) {
+            continue;
+        }
+        if (a[0] - b[0]).hypot(a[1] - b[1]) > 0.01 {
+            slid += 1;
+        }
+        let expected = affine(a[0] as f64, a[1] as f64);
+        assert!(
+            (uv[0] as f64 - expected[0]).abs() < 2e-6 && (uv[1] as f64 - expected[1]).abs() < 2e-6,
+            "glb: vertex at {a:?} has {uv:?}, the texture there is {expected:?}"
+        );
+    }
+    assert!(slid > 20, "glb: only {slid} inner vertices slid");
 }

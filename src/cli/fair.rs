@@ -224,17 +224,23 @@ pub fn run(args: FairArgs) -> anyhow::Result<()> {
     } else {
         0.0
     };
-    super::save_kept(&args.output, &mesh, &source, args.stdio.format)?;
+    let saved = super::save_kept(&args.output, &mesh, &source, args.stdio.format)?;
     // In mean edge lengths of the input; none when no round ran.
     let texture_slide = textured_input
         .filter(|_| report.rounds_run > 0)
         .map(|before| fairmesh::metrics::tangential_slide(&before, &mesh) / edge)
         .filter(|slide| slide.is_finite());
-    if let Some(slide) = texture_slide.filter(|&slide| slide >= TEXTURE_SLIDE_WARNING) {
+    // Written back into its own format, the file's texture coordinates followed the slide;
+    // into another, they stayed with their vertices.
+    let texture_follows = texture_slide.is_some() && saved.texture_coordinates_follow;
+    if let Some(slide) =
+        texture_slide.filter(|&slide| slide >= TEXTURE_SLIDE_WARNING && !texture_follows)
+    {
         eprintln!(
             "warning: {}: its texture coordinates stay with their vertices, and the tangential \
              relaxation slid the vertices along the surface by {slide:.2} mean edge lengths \
-             (root mean square): the texture moved with them. `--tangential 0` keeps every \
+             (root mean square): the texture moved with them. Written back into its own format, \
+             the texture coordinates follow the slide instead; `--tangential 0` keeps every \
              vertex on its normal line (noise that moved vertices along the surface then stays).",
             args.input.display()
         );
@@ -268,6 +274,7 @@ pub fn run(args: FairArgs) -> anyhow::Result<()> {
             "max_move": report.max_move,
             "masked_vertices": mask.as_ref().map(|m| m.painted_count()),
             "texture_slide": texture_slide,
+            "texture_follows": texture_slide.map(|_| texture_follows),
         });
         if let (Some(m), Some(map)) = (&measures, json.as_object_mut()) {
             map.insert(

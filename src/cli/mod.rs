@@ -139,7 +139,7 @@ pub(crate) fn save_kept(
     mesh: &fairmesh::TriMesh,
     source: &fairmesh::io::Source,
     format: Option<FormatArg>,
-) -> anyhow::Result<()> {
+) -> anyhow::Result<fairmesh::io::SaveReport> {
     let _step = progress::Step::start(format!("saving {}", display_output(path)));
     if is_stdio(path) {
         let format = stdio_format(format, "writing to standard output")?;
@@ -152,13 +152,13 @@ pub(crate) fn save_kept(
                 lost.join("; ")
             );
         }
-        return Ok(());
+        return Ok(Default::default());
     }
     let report = fairmesh::io::save_with_source(path, mesh, source)?;
     for warning in &report.warnings {
         eprintln!("warning: {}: {warning}", path.display());
     }
-    Ok(())
+    Ok(report)
 }
 
 /// An input path as messages show it: `-` is "standard input".

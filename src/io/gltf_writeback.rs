@@ -796,6 +796,8 @@ pub(crate) fn write(
     // Normals turn from the file's own positions (read from `gltf`, never from `joined`), so the
     // order of these two steps does not matter.
     let mut changed = turn_normals(gltf, source, &edits, &mut joined, report);
+    changed.extend(follow_texture(gltf, &edits, &mut joined, report));
+    report.texture_coordinates_follow = true;
     for (&a, edit) in &edits {
         for (k, after) in edit.after.iter().enumerate() {
             if let Some(p) = after {
@@ -949,6 +951,92 @@ fn position_edits(
     }
     edits.retain(|_, edit| edit.after.iter().any(Option::is_some));
     Ok(edits)
+}
+
+/// Move the texture coordinates (TEXCOORD_n) of every primitive whose positions moved so that
+/// the texture stays where it was on the surface ([`super::uv_follow`]), each accessor from the
+/// triangles of the primitives that use it with one POSITION accessor (a glTF splits vertices at
+/// UV seams, so there a slide stops at the seam). Returns the accessors written.
+fn follow_texture(
+    gltf: &GltfSource,
+    edits: &BTreeMap<usize, PositionEdit>,
+    joined: &mut Joined,
+    report: &mut SaveReport,
+) -> BTreeSet<usize> {
+    // Texture coordinate accessor -> its position accessor and the triangles of its primitives.
+    let mut uses: BTreeMap<usize, (usize, Vec<[u32; 3]>)> = BTreeMap::new();
+    let mut conflicting = BTreeSet::new();
+    for primitive in primitives(&gltf.json) {
+        let Some(p) = attribute(primitive, "POSITION").filter(|p| edits.contains_key(p)) else {
+            continue;
+        };
+        let Some(attributes) = primitive.get("attributes").and_then(Value::as_object) else {
+            continue;
+        };
+        for (name, accessor) in attributes {
+            let Some(t) = accessor.as_u64().map(|t| t as usize) else {
+                continue;
+            };
+            if !name.starts_with("TEXCOORD_") {
+                continue;
+            }
+            let triangles = gltf.triangles(primitive, edits[&p].layout.count);
+            match uses.get_mut(&t) {
+                Some((q, list)) if *q == p => list.extend(triangles),
+                Some(_) => {
+                    conflicting.insert(t);
+                }
+                None => {
+                    uses.insert(t, (p, triangles));
+                }
+            }
+        }
+    }
+    let mut changed = BTreeSet::new();
+    for (t, (p, triangles)) in uses {
+        let edit = &edits[&p];
+        let layout = match gltf.layout(t) {
+            Ok(layout)
+                if !conflicting.contains(&t)
+                    && layout.components == 2
+                    && layout.count == edit.layout.count =>
+            {
+                layout
+            }
+            _ => {
+                report.warnings.push(format!(
+                    "texture coordinate accessor {t} does not match one set of positions: its \
+                     texture coordinates stay with their vertices (the texture slides with them)"
+                ));
+                continue;
+            }
+        };
+        let read: Vec<[f32; 2]> = (0..layout.count)
+            .map(|k| [gltf.read(&layout, k, 0), gltf.read(&layout, k, 1)])
+            .collect();
+        let uvs: Vec<[f64; 2]> = read.iter().map(|uv| uv.map(f64::from)).collect();
+        let after: Vec<[f32; 3]> = edit
+            .before
+            .iter()
+            .zip(&edit.after)
+            .map(|(before, after)| after.unwrap_or(*before))
+            .collect();
+        let corners: Vec<super::uv_follow::UvTriangle> = triangles
+            .iter()
+            .map(|t| t.map(|v| (v as usize, Some(v as usize))))
+            .collect();
+        let followed = super::uv_follow::follow(&edit.before, &after, &corners, &uvs);
+        for (k, uv) in followed.moved.iter().enumerate() {
+            let Some(uv) = uv.map(|uv| uv.map(|c| c as f32)) else {
+                continue;
+            };
+            if uv != read[k] {
+                joined.put(&layout, k, &uv);
+                changed.insert(t);
+            }
+        }
+    }
+    changed
 }
 
 fn primitives(json: &Value) -> impl Iterator<Item = &Value> {
@@ -1269,11 +1357,11 @@ impl Joined {
         min.iter().all(|m| m.is_finite()).then_some((min, max))
     }
 
-    /// Write the first three components of element `k`.
-    fn put(&mut self, layout: &Layout, k: usize, values: &[f32; 3]) {
+    /// Write the first components of element `k` (as many as `values` holds).
+    fn put(&mut self, layout: &Layout, k: usize, values: &[f32]) {
         if layout.component == 5126 {
             let at = layout.start + k * layout.stride;
-            if let Some(range) = self.range(layout.buffer, at, 12) {
+            if let Some(range) = self.range(layout.buffer, at, 4 * values.len()) {
                 let out = &mut self.bytes[range];
                 for (c, value) in values.iter().enumerate() {
                     out[4 * c..4 * c + 4].copy_from_slice(&value.to_le_bytes());

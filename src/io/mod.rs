@@ -30,6 +30,7 @@ mod scene;
 mod source;
 mod stl;
 mod text;
+mod uv_follow;
 
 pub use error::{IoError, Location};
 pub use source::{SaveReport, Source};
@@ -499,10 +500,25 @@ pub fn save_with_source(
     if source.writes_back_as(format) && source.matches(mesh) {
         match &source.data {
             SourceData::Obj(bytes) => {
-                atomic::write(path, |w| obj::write_back(w, bytes, source, mesh))?
+                let mut shared = 0;
+                atomic::write(path, |w| {
+                    shared = obj::write_back(w, bytes, source, mesh)?;
+                    Ok(())
+                })?;
+                report.texture_coordinates_follow = true;
+                if shared > 0 {
+                    report.warnings.push(format!(
+                        "{shared} texture coordinates of {name} are each shared by several \
+                         vertices that moved, so they stay where they were (the texture slides \
+                         with those vertices)"
+                    ));
+                }
             }
             SourceData::Ply(bytes) => {
-                atomic::write(path, |w| ply::write_back(w, bytes, source, mesh))?
+                atomic::write(path, |w| {
+                    report.texture_coordinates_follow = ply::write_back(w, bytes, source, mesh)?;
+                    Ok(())
+                })?;
             }
             SourceData::Gltf(gltf) => {
                 gltf_writeback::write(path, format, gltf, source, mesh, &mut report)?

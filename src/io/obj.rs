@@ -952,23 +952,29 @@ pub(crate) fn write_scene(
 }
 
 /// Write the OBJ `source` back with `mesh`'s positions: every line but the `v` lines of moved
-/// vertices and the `vn` lines of normals whose faces moved comes back byte for byte. A moved
-/// vertex is written `v x y z` (shortest round-trip floats; a w is folded in), followed by the
-/// line's vertex colour if it had one. Normals turn with their faces (see [`super::source`]).
+/// vertices, the `vn` lines of normals whose faces moved and the `vt` lines of texture
+/// coordinates whose vertex slid comes back byte for byte. A moved vertex is written `v x y z`
+/// (shortest round-trip floats; a w is folded in), followed by the line's vertex colour if it had
+/// one. Normals turn with their faces (see [`super::source`]); texture coordinates follow their
+/// vertex's slide along the surface, so that the texture stays where it was
+/// ([`super::uv_follow`]), written `vt u v` (f32 shortest round-trip, a w kept as written).
+/// Returns how many texture coordinates several moved vertices share (those stay).
 pub(crate) fn write_back(
     out: &mut dyn Write,
     bytes: &[u8],
     source: &Source,
     mesh: &TriMesh,
-) -> std::io::Result<()> {
+) -> std::io::Result<usize> {
     // The file's own positions (as the reader read them), and each vertex's new position.
     let mut before: Vec<[f32; 3]> = Vec::with_capacity(source.raw_vertices);
     let mut normal_count = 0usize;
+    let mut uvs: Vec<[f64; 2]> = Vec::new();
     for line in bytes.split(|&b| b == b'\n') {
         let mut words = tokens(line);
         match words.next() {
             Some(b"v") => before.push(vertex_of(words).unwrap_or([f32::NAN; 3])),
             Some(b"vn") => normal_count += 1,
+            Some(b"vt") => uvs.push(texture_coordinate_of(words).unwrap_or([f64::NAN; 2])),
             _ => {}
         }
     }
@@ -976,11 +982,17 @@ pub(crate) fn write_back(
         .map(|k| source.welded(k).map_or(before[k], |w| mesh.positions[w]))
         .collect();
     let moved = |k: usize| before[k] != after[k] && !before[k][0].is_nan();
-    let turns = (normal_count > 0 && (0..before.len()).any(moved))
-        .then(|| normal_turns(bytes, &before, &after, normal_count));
+    let any_moved = (0..before.len()).any(moved);
+    let turns =
+        (normal_count > 0 && any_moved).then(|| normal_turns(bytes, &before, &after, normal_count));
+    let followed = (!uvs.is_empty() && any_moved).then(|| {
+        let triangles = uv_triangles(bytes, before.len(), uvs.len());
+        super::uv_follow::follow(&before, &after, &triangles, &uvs)
+    });
 
     let mut vertex = 0usize;
     let mut normal = 0usize;
+    let mut texture_coordinate = 0usize;
     for line in bytes.split_inclusive(|&b| b == b'\n') {
         let (text, ending) = split_ending(line);
         let mut words = tokens(text);
@@ -1014,11 +1026,82 @@ pub(crate) fn write_back(
                     continue;
                 }
             }
+            Some(b"vt") => {
+                let k = texture_coordinate;
+                texture_coordinate += 1;
+                let uv = followed
+                    .as_ref()
+                    .and_then(|f| f.moved.get(k).copied().flatten());
+                // Written as f32 (what the reader reads); unchanged values keep their text.
+                let as_read = uvs[k].map(|c| c as f32);
+                let written = uv.map(|uv| uv.map(|c| c as f32));
+                if let Some([u, v]) = written.filter(|&w| w != as_read) {
+                    write!(out, "vt {u} {v}")?;
+                    for w in words.skip(2) {
+                        out.write_all(b" ")?;
+                        out.write_all(w)?;
+                    }
+                    out.write_all(ending)?;
+                    continue;
+                }
+            }
             _ => {}
         }
         out.write_all(line)?;
     }
-    Ok(())
+    Ok(followed.map_or(0, |f| f.shared))
+}
+
+/// The (u, v) a `vt` line gives (a missing v reads 0, as the reader reads it); `None` if
+/// unreadable.
+fn texture_coordinate_of<'a>(mut words: impl Iterator<Item = &'a [u8]>) -> Option<[f64; 2]> {
+    let u = super::text::parse_f32(words.next()?)?;
+    let v = words.next().map_or(Some(0.0), super::text::parse_f32)?;
+    Some([u as f64, v as f64])
+}
+
+/// The file's faces as triangles (polygons as fans from their first corner) of (vertex, texture
+/// coordinate) corners, for [`super::uv_follow::follow`]; faces with a corner that names no
+/// vertex are left out.
+fn uv_triangles(
+    bytes: &[u8],
+    vertex_count: usize,
+    uv_count: usize,
+) -> Vec<super::uv_follow::UvTriangle> {
+    let mut triangles = Vec::new();
+    let (mut vertices, mut uvs) = (0usize, 0usize);
+    let mut corners: Vec<(usize, Option<usize>)> = Vec::with_capacity(8);
+    for line in bytes.split(|&b| b == b'\n') {
+        let mut words = tokens(line);
+        match words.next() {
+            Some(b"v") => vertices += 1,
+            Some(b"vt") => uvs += 1,
+            Some(b"f") => {
+                corners.clear();
+                for corner in words {
+                    let mut parts = corner.split(|&b| b == b'/');
+                    let v = parts.next().and_then(|t| resolve(t, vertices));
+                    let t = parts
+                        .next()
+                        .filter(|t| !t.is_empty())
+                        .and_then(|t| resolve(t, uvs))
+                        .filter(|&t| t < uv_count);
+                    match v {
+                        Some(v) if v < vertex_count => corners.push((v, t)),
+                        _ => {
+                            corners.clear();
+                            break;
+                        }
+                    }
+                }
+                for i in 1..corners.len().saturating_sub(1) {
+                    triangles.push([corners[0], corners[i], corners[i + 1]]);
+                }
+            }
+            _ => {}
+        }
+    }
+    triangles
 }
 
 /// The turns of the `vn` normals: every face corner `v//vn` or `v/vt/vn` adds the area of its

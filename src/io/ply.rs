@@ -900,6 +900,23 @@ fn normal_properties(element: &Element) -> Option<[usize; 3]> {
     Some([find(b"nx")?, find(b"ny")?, find(b"nz")?])
 }
 
+/// The vertex properties that hold texture coordinates: s t, u v or texture_u texture_v.
+fn uv_properties(element: &Element) -> Option<(usize, usize)> {
+    let find = |name: &[u8]| {
+        element
+            .properties
+            .iter()
+            .position(|p| matches!(p, Property::Scalar { name: n, .. } if n == name))
+    };
+    [
+        (b"s".as_slice(), b"t".as_slice()),
+        (b"u", b"v"),
+        (b"texture_u", b"texture_v"),
+    ]
+    .into_iter()
+    .find_map(|(u, v)| Some((find(u)?, find(v)?)))
+}
+
 /// A value in a property's type and the file's byte order.
 fn encode(kind: Scalar, big: bool, value: f32, out: &mut [u8]) {
     macro_rules! put {
@@ -937,14 +954,17 @@ fn ascii_value(kind: Scalar, value: f32) -> String {
 
 /// Write the PLY `source` back with `mesh`'s positions, in the file's own encoding: the header,
 /// every other element and every other property come back byte for byte; x, y, z of moved
-/// vertices are written in their declared types, and nx, ny, nz (when present) turn with their
-/// faces (see [`super::source`]).
+/// vertices are written in their declared types, nx, ny, nz (when present) turn with their
+/// faces (see [`super::source`]), and texture coordinates (s t, u v or texture_u texture_v)
+/// follow their vertex's slide along the surface ([`super::uv_follow`]; each vertex row is its
+/// own texture coordinate, so a seam's rows follow each in its own chart). Returns whether the
+/// file has texture coordinates per vertex (which then followed).
 pub(crate) fn write_back(
     out: &mut dyn Write,
     bytes: &[u8],
     source: &Source,
     mesh: &TriMesh,
-) -> std::io::Result<()> {
+) -> std::io::Result<bool> {
     let invalid =
         |what: &str| std::io::Error::new(std::io::ErrorKind::InvalidData, what.to_string());
     let path = Path::new("");
@@ -961,13 +981,29 @@ pub(crate) fn write_back(
     let after: Vec<[f32; 3]> = (0..before.len())
         .map(|k| source.welded(k).map_or(before[k], |w| mesh.positions[w]))
         .collect();
-    // The faces, only needed to turn normals.
-    let parsed = match normal_props {
-        Some(_) if before != &after => {
-            Some(parse(bytes, path).map_err(|e| invalid(&e.to_string()))?)
-        }
-        _ => None,
+    let uv_props = uv_properties(element);
+    // The faces, only needed to turn normals and move texture coordinates.
+    let parsed = if (normal_props.is_some() || uv_props.is_some()) && before != &after {
+        Some(parse(bytes, path).map_err(|e| invalid(&e.to_string()))?)
+    } else {
+        None
     };
+    // Each row's texture coordinate as read, and where it moves.
+    let followed = uv_props.zip(parsed.as_ref()).map(|((u, v), parsed)| {
+        let read: Vec<[f32; 2]> = vertex_triples(bytes, &header, &rows, element, [u, v, v])
+            .iter()
+            .map(|t| [t[0], t[1]])
+            .collect();
+        let uvs: Vec<[f64; 2]> = read.iter().map(|t| t.map(f64::from)).collect();
+        let triangles: Vec<super::uv_follow::UvTriangle> = parsed
+            .mesh
+            .triangles
+            .iter()
+            .map(|t| t.map(|v| (v as usize, Some(v as usize))))
+            .collect();
+        let moved = super::uv_follow::follow(before, &after, &triangles, &uvs).moved;
+        (read, moved)
+    });
     // Per vertex: the area sums of its faces before and after; then slots (see `SmoothGroups`)
     // and the sums of each slot. Only when the file has normals.
     let slotted: Option<(Vec<usize>, NormalTurns)> =
@@ -1008,6 +1044,16 @@ pub(crate) fn write_back(
                 list.extend(props.iter().copied().zip(turn.normal(normal)));
             }
         }
+        if let (Some((u, v)), Some((read, moved))) = (uv_props, &followed) {
+            let uv = moved
+                .get(k)
+                .copied()
+                .flatten()
+                .map(|uv| uv.map(|c| c as f32));
+            if let Some(uv) = uv.filter(|uv| Some(uv) != read.get(k)) {
+                list.extend([(u, uv[0]), (v, uv[1])]);
+            }
+        }
         list
     };
     match rows {
@@ -1040,7 +1086,7 @@ pub(crate) fn write_back(
             }
             out.write_all(&bytes[..start])?;
             out.write_all(&body)?;
-            out.write_all(&bytes[end..])
+            out.write_all(&bytes[end..])?;
         }
         VertexRows::Ascii { first_row } => {
             out.write_all(&bytes[..header.body_start])?;
@@ -1081,9 +1127,9 @@ pub(crate) fn write_back(
                 out.write_all(fields.join(" ").as_bytes())?;
                 out.write_all(&line[text.len()..])?;
             }
-            Ok(())
         }
     }
+    Ok(uv_props.is_some())
 }
 
 /// Three scalar properties (x y z, or nx ny nz) of every vertex row, read as the reader reads
@@ -1194,14 +1240,7 @@ pub(crate) fn vertex_attributes(bytes: &[u8], source: &Source) -> VertexAttribut
         out.colours = Some(values);
         out.colour_splits_merged = merged;
     }
-    let uv = [
-        (b"s".as_slice(), b"t".as_slice()),
-        (b"u", b"v"),
-        (b"texture_u", b"texture_v"),
-    ]
-    .into_iter()
-    .find_map(|(u, v)| Some((find(u)?, find(v)?)));
-    if let Some((u, v)) = uv {
+    if let Some((u, v)) = uv_properties(element) {
         let mut gather = Gather::<2>::new(source.welded_vertices, [0.0; 2]);
         for (k, uv) in vertex_triples(bytes, &header, &rows, element, [u, v, v])
             .iter()

@@ -16,8 +16,10 @@
 //! positions and what depends on them: normals (and glTF tangents) are turned by the rotation
 //! that takes the vertex's area-weighted normal before the change to the one after (so split
 //! normals stay split, smooth ones stay smooth, and a file's own custom normals keep their
-//! character), and the glTF POSITION accessor's min/max are recomputed. A vertex that did not
-//! move keeps its bytes (or its text) exactly, and so does a normal whose faces did not move.
+//! character), texture coordinates follow their vertex's slide along the surface so that the
+//! texture stays where it was ([`super::uv_follow`]), and the glTF POSITION accessor's min/max
+//! are recomputed. A vertex that did not move keeps its bytes (or its text) exactly, and so does
+//! a normal whose faces did not move.
 //! Saving to another format writes the mesh with what that format can hold per vertex (UVs and
 //! vertex colours into glTF and OBJ, see [`super::carry`]) and names, in the [`SaveReport`],
 //! everything else it cannot keep.
@@ -71,6 +73,11 @@ pub(crate) enum SourceData {
 #[non_exhaustive]
 pub struct SaveReport {
     pub warnings: Vec<String>,
+    /// The file was written back into its own format (OBJ, glTF/GLB, a PLY with per-vertex
+    /// texture coordinates), its texture coordinates following their vertices' slide along the
+    /// surface so that the texture stays where it was; otherwise texture coordinates stay with
+    /// their vertices.
+    pub texture_coordinates_follow: bool,
 }
 
 impl Source {
@@ -116,8 +123,9 @@ impl Source {
     }
 
     /// Whether the file gives its vertices texture coordinates (OBJ `vt`, PLY `u`/`v` or
-    /// `s`/`t`, glTF `TEXCOORD_0`): they stay with their vertices, so whatever slides a vertex
-    /// along the surface moves the texture with it.
+    /// `s`/`t`, glTF `TEXCOORD_0`). Written back into the file's own format they follow their
+    /// vertices' slide along the surface; written into another, they stay with their vertices,
+    /// so whatever slid a vertex along the surface moves the texture with it.
     pub fn has_texture_coordinates(&self) -> bool {
         self.vertex_attributes().uvs.is_some()
     }

@@ -1,0 +1,404 @@
+//! Texture coordinates that follow their vertices' slide along the surface, for the write-backs.
+//!
+//! Not from the paper: the default fairing's tangential relaxation (and the normal-projected
+//! iteration, a little) moves vertices *along* the surface, and a texture coordinate that stays
+//! with its vertex drags the texture with it (about a third of an edge length RMS on a noisy
+//! scan). Writing a file back, each texture coordinate of a moved vertex is therefore moved to
+//! what the texture holds where the vertex slid to, so that the texture stays where it was.
+//!
+//! How it reads the move. The vertex's displacement d = x' − x is split along the unit normal n
+//! of its faces *after* the move: the part along n is the smoothing proper (the surface came
+//! closer to where it should be: the texture point there is the same), the rest, d_t, is the
+//! slide. The slide's end x + d_t is located on the faces as they were before the move, all
+//! seen in the plane normal to n: starting from the face around the vertex (among those that use
+//! this texture coordinate: on a UV seam a vertex has one per side) that holds it best, and
+//! stepping, while it lies outside the face, across the edge it lies beyond to the face on the
+//! other side that continues the same texture chart (the same texture coordinates at the edge's
+//! two ends), a few faces at most. The face that holds it gives the texture coordinate by its
+//! barycentric coordinates. A slide that crosses a seam takes the last face's texture map on past
+//! it (a chart's texture continues beyond its seam, and the other side's coordinate follows in
+//! its own chart); one that leaves the surface (off a boundary) or goes too far stops at the
+//! nearest point of the last face reached. Working in the tangent plane of
+//! the result keeps the input's noise out: the noisy faces' tilt only shortens their projected
+//! edges a little, where projecting the new position on the noisy faces would read the noise
+//! itself as a slide.
+//!
+//! A texture coordinate several vertices share cannot follow them all: it is left as it is and
+//! counted, so that the caller can say so.
+
+use glam::DVec3;
+use rayon::prelude::*;
+
+/// Faces a slide may cross before it stops.
+const MAX_STEPS: usize = 12;
+
+/// A triangle of a file as the write-backs see it: per corner, the file's vertex and its texture
+/// coordinate (`None`: the corner has none).
+pub(crate) type UvTriangle = [(usize, Option<usize>); 3];
+
+/// What [`follow`] gives: the new value of every texture coordinate that moves.
+#[derive(Debug, Default)]
+pub(crate) struct FollowedUvs {
+    /// `moved[t]`: the new (u, v) of texture coordinate `t`, `None` where it stays.
+    pub moved: Vec<Option<[f64; 2]>>,
+    /// Texture coordinates left as they were because several moved vertices share them.
+    pub shared: usize,
+}
+
+/// The texture coordinates `uvs` of the triangles `triangles` (over the file's vertices, whose
+/// positions are `before` and `after` the move), moved to follow the vertices' slide along the
+/// surface (see the module docs).
+pub(crate) fn follow(
+    before: &[[f32; 3]],
+    after: &[[f32; 3]],
+    triangles: &[UvTriangle],
+    uvs: &[[f64; 2]],
+) -> FollowedUvs {
+    let point = |points: &[[f32; 3]], v: usize| DVec3::from(points[v].map(f64::from));
+    let moved = |v: usize| before[v] != after[v];
+    // Every vertex's area normal after the move (summed over all its faces).
+    let mut normals = vec![DVec3::ZERO; before.len()];
+    // The texture coordinate's vertex: NONE not seen yet, SHARED when several vertices use it.
+    const NONE: u32 = u32::MAX;
+    const SHARED: u32 = u32::MAX - 1;
+    let mut owner = vec![NONE; uvs.len()];
+    // Whether a vertex using the texture coordinate moved.
+    let mut any_moved = vec![false; uvs.len()];
+    // How many faces use each texture coordinate of a moved vertex (its wedge).
+    let mut wedge_sizes = vec![0u32; uvs.len() + 1];
+    for triangle in triangles {
+        let [a, b, c] = triangle.map(|(v, _)| point(after, v));
+        let area = (b - a).cross(c - a);
+        for &(v, t) in triangle {
+            normals[v] += area;
+            let Some(t) = t else { continue };
+            owner[t] = match owner[t] {
+                NONE => v as u32,
+                o if o == v as u32 => o,
+                _ => SHARED,
+            };
+            any_moved[t] |= moved(v);
+            wedge_sizes[t + 1] += u32::from(moved(v));
+        }
+    }
+    // The wedges, side by side: wedge_faces[wedge_sizes[t]..wedge_sizes[t + 1]] after the sums.
+    for t in 0..uvs.len() {
+        wedge_sizes[t + 1] += wedge_sizes[t];
+    }
+    let starts = wedge_sizes;
+    let mut fill = starts.clone();
+    let mut wedge_faces = vec![0u32; starts[uvs.len()] as usize];
+    for (f, triangle) in triangles.iter().enumerate() {
+        for &(v, t) in triangle {
+            if let (Some(t), true) = (t, moved(v)) {
+                wedge_faces[fill[t] as usize] = f as u32;
+                fill[t] += 1;
+            }
+        }
+    }
+    // Every edge of every face, by its ends (lower vertex first) and their texture coordinates
+    // (NONE where a corner has none), sorted: the faces across an edge within a chart have the
+    // same key; another key with the same ends is a face of another chart (a seam).
+    let mut edges: Vec<([u32; 4], u32)> = triangles
+        .par_iter()
+        .enumerate()
+        .flat_map_iter(|(f, triangle)| (0..3).map(move |k| (edge_key(triangle, k), f as u32)))
+        .collect();
+    edges.par_sort_unstable();
+    let edges = &edges;
+    let edge_range = |ends: [u32; 2]| {
+        let first = edges.partition_point(|(key, _)| [key[0], key[1]] < ends);
+        let last = first + edges[first..].partition_point(|(key, _)| [key[0], key[1]] == ends);
+        &edges[first..last]
+    };
+
+    let follow_one = |v: usize, wedge: &[u32]| -> Option<[f64; 2]> {
+        let n = normals[v].try_normalize()?;
+        let tangential = |d: DVec3| d - d.dot(n) * n;
+        let x = point(before, v);
+        let target = tangential(point(after, v) - x);
+        // The barycentric coordinates of the slide's end in face f seen in the plane (`None`
+        // for a face seen nearly edge-on there).
+        let projected =
+            |f: u32| triangles[f as usize].map(|(u, _)| tangential(point(before, u) - x));
+        let barycentric = |f: u32| -> Option<[f64; 3]> {
+            let p = projected(f);
+            let area = |a: DVec3, b: DVec3, c: DVec3| (b - a).cross(c - a).dot(n);
+            let whole = area(p[0], p[1], p[2]);
+            let scale = (p[1] - p[0]).length() * (p[2] - p[0]).length();
+            // (NaN fails the comparison too.)
+            if whole.abs().partial_cmp(&(MIN_SINE * scale)) != Some(std::cmp::Ordering::Greater) {
+                return None;
+            }
+            Some([
+                area(target, p[1], p[2]) / whole,
+                area(p[0], target, p[2]) / whole,
+                area(p[0], p[1], target) / whole,
+            ])
+        };
+        let least = |l: &[f64; 3]| l[0].min(l[1]).min(l[2]);
+        // The wedge's face that holds the end best.
+        let (mut face, mut weights) = wedge
+            .iter()
+            .filter_map(|&f| barycentric(f).map(|l| (f, l)))
+            .max_by(|a, b| least(&a.1).total_cmp(&least(&b.1)))?;
+        let mut previous = u32::MAX;
+        // Where the walk stops outside its face: across a seam the face's texture map goes on
+        // (a chart's texture continues past its seam), elsewhere (a boundary, too far, a fold)
+        // the nearest point of the face.
+        let mut extend = false;
+        for _ in 0..MAX_STEPS {
+            if least(&weights) >= -1e-9 {
+                break;
+            }
+            // Across the edge opposite the most negative weight, to the chart's face beyond.
+            let k = (0..3)
+                .min_by(|&i, &j| weights[i].total_cmp(&weights[j]))
+                .unwrap_or(0);
+            let triangle = &triangles[face as usize];
+            let key = edge_key(triangle, (k + 1) % 3);
+            let around = edge_range([key[0], key[1]]);
+            let across = around
+                .iter()
+                .find(|&&(other, g)| other == key && g != face && key[2] != NONE && key[3] != NONE);
+            let Some(&(_, next)) = across else {
+                // No face of this chart beyond: a seam if another chart's face is there.
+                extend = around.iter().any(|&(other, _)| other != key);
+                break;
+            };
+            let Some(l) = barycentric(next).filter(|_| next != previous) else {
+                break;
+            };
+            (previous, face, weights) = (face, next, l);
+        }
+        // Past a seam by at most about a face: the face's map goes on; else its nearest point.
+        let weights = if extend && least(&weights) >= -1.0 || least(&weights) >= 0.0 {
+            weights
+        } else {
+            nearest_on_boundary(projected(face), target)
+        };
+        let total: f64 = weights.iter().sum();
+        if total.is_nan() || total <= 0.0 {
+            return None;
+        }
+        let corners = triangles[face as usize];
+        let mut uv = [0.0; 2];
+        for (w, (_, corner)) in weights.iter().zip(corners) {
+            let Some(c) = corner else { continue };
+            for i in 0..2 {
+                uv[i] += w / total * uvs[c][i];
+            }
+        }
+        // A face of another chart's corner without a coordinate gives none.
+        (corners.iter().all(|(_, c)| c.is_some()) && uv.iter().all(|c| c.is_finite())).then_some(uv)
+    };
+
+    let moved_uvs: Vec<Option<[f64; 2]>> = (0..uvs.len())
+        .into_par_iter()
+        .with_min_len(1024)
+        .map(|t| {
+            let v = owner[t];
+            let wedge = &wedge_faces[starts[t] as usize..starts[t + 1] as usize];
+            if v >= SHARED || wedge.is_empty() {
+                return None;
+            }
+            follow_one(v as usize, wedge)
+        })
+        .collect();
+    let shared = (0..uvs.len())
+        .filter(|&t| owner[t] == SHARED && any_moved[t])
+        .count();
+    FollowedUvs {
+        moved: moved_uvs,
+        shared,
+    }
+}
+
+/// The least sine of the angle between a face's edges, seen in the tangent plane, for the face
+/// to locate a point (a face seen nearly edge-on, a fold of the noise, is passed over).
+const MIN_SINE: f64 = 0.01;
+
+/// The barycentric weights of the point of triangle `p`'s edges nearest to `q` (a point outside
+/// the triangle, all in one plane).
+fn nearest_on_boundary(p: [DVec3; 3], q: DVec3) -> [f64; 3] {
+    let mut best = (f64::INFINITY, [1.0, 0.0, 0.0]);
+    for k in 0..3 {
+        let (a, b) = (p[k], p[(k + 1) % 3]);
+        let along = b - a;
+        let t = ((q - a).dot(along) / along.length_squared()).clamp(0.0, 1.0);
+        let t = if t.is_finite() { t } else { 0.0 };
+        let distance = (a + t * along - q).length_squared();
+        if distance < best.0 {
+            let mut weights = [0.0; 3];
+            weights[k] = 1.0 - t;
+            weights[(k + 1) % 3] = t;
+            best = (distance, weights);
+        }
+    }
+    best.1
+}
+
+/// The edge from corner `k` of `triangle` to the next corner: both ends' vertices and texture
+/// coordinates (`u32::MAX` for none), the lower vertex first.
+fn edge_key(triangle: &UvTriangle, k: usize) -> [u32; 4] {
+    let (a, ta) = triangle[k];
+    let (b, tb) = triangle[(k + 1) % 3];
+    let [ta, tb] = [ta, tb].map(|t| t.map_or(u32::MAX, |t| t as u32));
+    let [a, b] = [a, b].map(|v| v as u32);
+    if a <= b {
+        [a, b, ta, tb]
+    } else {
+        [b, a, tb, ta]
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A flat n×n grid of points (z = 0), its triangles with one texture coordinate per vertex
+    /// (u, v) = A (x, y) + c, an affine map.
+    fn grid(n: usize) -> (Vec<[f32; 3]>, Vec<UvTriangle>, Vec<[f64; 2]>) {
+        let mut points = Vec::new();
+        let mut uvs = Vec::new();
+        for j in 0..n {
+            for i in 0..n {
+                let (x, y) = (i as f32, j as f32);
+                points.push([x, y, 0.0]);
+                uvs.push(affine(x as f64, y as f64));
+            }
+        }
+        let mut triangles = Vec::new();
+        for j in 0..n - 1 {
+            for i in 0..n - 1 {
+                let v = j * n + i;
+                let c = |v: usize| (v, Some(v));
+                triangles.push([c(v), c(v + 1), c(v + n + 1)]);
+                triangles.push([c(v), c(v + n + 1), c(v + n)]);
+            }
+        }
+        (points, triangles, uvs)
+    }
+
+    fn affine(x: f64, y: f64) -> [f64; 2] {
+        [0.1 + 0.05 * x - 0.02 * y, 0.3 + 0.01 * x + 0.04 * y]
+    }
+
+    /// On a flat, affinely textured grid, an interior vertex slid in the plane gets the texture
+    /// coordinate the texture has at its new place, whatever the direction (every sector); a move
+    /// along the normal alone leaves it; a vertex that did not move is not touched.
+    #[test]
+    fn a_slide_in_the_plane_takes_the_texture_of_the_new_place_and_a_normal_move_none() {
+        let (before, triangles, uvs) = grid(5);
+        let centre = 12;
+        for k in 0..16 {
+            let angle = k as f32 * std::f32::consts::TAU / 16.0;
+            let (dx, dy) = (0.37 * angle.cos(), 0.37 * angle.sin());
+            let mut after = before.clone();
+            after[centre] = [2.0 + dx, 2.0 + dy, 0.0];
+            let followed = follow(&before, &after, &triangles, &uvs);
+            let expected = affine(2.0 + dx as f64, 2.0 + dy as f64);
+            let got = followed.moved[centre].expect("the slid vertex's coordinate moves");
+            assert!(
+                (got[0] - expected[0]).abs() < 1e-7 && (got[1] - expected[1]).abs() < 1e-7,
+                "direction {k}: {got:?} instead of {expected:?}"
+            );
+            assert!(followed
+                .moved
+                .iter()
+                .enumerate()
+                .all(|(t, m)| t == centre || m.is_none()));
+            assert_eq!(followed.shared, 0);
+        }
+        let mut lifted = before.clone();
+        lifted[centre][2] = 0.3;
+        let followed = follow(&before, &lifted, &triangles, &uvs);
+        let got = followed.moved[centre].unwrap();
+        assert!((got[0] - uvs[centre][0]).abs() < 1e-12 && (got[1] - uvs[centre][1]).abs() < 1e-12);
+    }
+
+    /// A slide that leaves the surface over its boundary stops on it, at the boundary's point
+    /// nearest to where it went.
+    #[test]
+    fn a_slide_off_the_boundary_stops_on_it() {
+        let (before, triangles, uvs) = grid(5);
+        let edge = 2; // (2, 0), on the lower boundary
+        let mut after = before.clone();
+        after[edge] = [2.2, -0.3, 0.0];
+        let got = follow(&before, &after, &triangles, &uvs).moved[edge].unwrap();
+        // Back from (u, v) to (x, y) through the affine map.
+        let (a, b, c, d) = (0.05, -0.02, 0.01, 0.04);
+        let (u, v) = (got[0] - 0.1, got[1] - 0.3);
+        let det = a * d - b * c;
+        let (x, y) = ((d * u - b * v) / det, (a * v - c * u) / det);
+        // The boundary's point nearest to (2.2, −0.3) is (2.2, 0) (positions are f32).
+        assert!(y.abs() < 1e-9, "off the boundary line: ({x}, {y})");
+        assert!((x - 2.2).abs() < 1e-6, "({x}, {y}) instead of (2.2, 0)");
+    }
+
+    /// A slide longer than an edge crosses faces and still lands on the texture of its new
+    /// place.
+    #[test]
+    fn a_long_slide_walks_across_faces() {
+        let (before, triangles, uvs) = grid(7);
+        let centre = 3 * 7 + 3;
+        let mut after = before.clone();
+        after[centre] = [4.7, 1.6, 0.0];
+        let got = follow(&before, &after, &triangles, &uvs).moved[centre].unwrap();
+        let expected = affine(4.7, 1.6);
+        assert!((got[0] - expected[0]).abs() < 1e-7 && (got[1] - expected[1]).abs() < 1e-7);
+    }
+
+    /// A vertex on a seam has a texture coordinate per side; each follows the slide in its own
+    /// chart (here the right half's texture is the left's shifted by 0.5 in u), and a
+    /// coordinate two moved vertices share stays and is counted.
+    #[test]
+    fn each_side_of_a_seam_follows_in_its_own_chart_and_shared_coordinates_stay() {
+        let (before, mut triangles, mut uvs) = grid(5);
+        // Column i = 2 is the seam: faces right of it (x > 2) use copies shifted in u.
+        let mut copy = vec![None; before.len()];
+        for triangle in &mut triangles {
+            let right = triangle.iter().any(|&(v, _)| before[v][0] > 2.0);
+            if !right {
+                continue;
+            }
+            for corner in triangle.iter_mut() {
+                if before[corner.0][0] == 2.0 {
+                    let t = *copy[corner.0].get_or_insert_with(|| {
+                        let [u, v] = uvs[corner.0];
+                        uvs.push([u + 0.5, v]);
+                        uvs.len() - 1
+                    });
+                    corner.1 = Some(t);
+                } else {
+                    let [u, v] = uvs[corner.0];
+                    corner.1 = Some(uvs.len());
+                    uvs.push([u + 0.5, v]);
+                }
+            }
+        }
+        let centre = 12; // (2, 2), on the seam
+        let mut after = before.clone();
+        after[centre] = [2.25, 2.1, 0.0];
+        let followed = follow(&before, &after, &triangles, &uvs);
+        let left = followed.moved[centre].unwrap();
+        let right = followed.moved[copy[centre].unwrap()].unwrap();
+        let expected = affine(2.25, 2.1);
+        assert!((left[0] - expected[0]).abs() < 1e-7 && (left[1] - expected[1]).abs() < 1e-7);
+        assert!(
+            (right[0] - expected[0] - 0.5).abs() < 1e-7 && (right[1] - expected[1]).abs() < 1e-7
+        );
+
+        // Two vertices using one texture coordinate: it stays, counted once.
+        for triangle in &mut triangles {
+            for corner in triangle.iter_mut() {
+                if corner.0 == 13 {
+                    corner.1 = copy[centre];
+                }
+            }
+        }
+        let followed = follow(&before, &after, &triangles, &uvs);
+        assert_eq!(followed.moved[copy[centre].unwrap()], None);
+        assert_eq!(followed.shared, 1);
+    }
+}
