@@ -225,13 +225,19 @@ fn export_writes_an_artists_file_back_with_its_materials_groups_and_uvs() {
     assert!(!message.contains("Note"), "{message}");
     let before = std::fs::read_to_string(&input).unwrap();
     let after = std::fs::read_to_string(dir.path().join("textured_faired.obj")).unwrap();
+    // Every line but the positions, the normals (turned with their faces) and the texture
+    // coordinates (which follow their vertex's slide along the surface) comes back.
     let kept = |text: &str| -> Vec<String> {
         text.lines()
-            .filter(|l| !l.starts_with("v ") && !l.starts_with("vn "))
+            .filter(|l| !l.starts_with("v ") && !l.starts_with("vn ") && !l.starts_with("vt "))
             .map(str::to_owned)
             .collect()
     };
     assert_eq!(kept(&before), kept(&after));
+    let count = |text: &str, start: &str| text.lines().filter(|l| l.starts_with(start)).count();
+    for start in ["v ", "vn ", "vt "] {
+        assert_eq!(count(&before, start), count(&after, start), "{start}lines");
+    }
     assert_ne!(before, after, "the faired shape was written");
 
     // Exported as GLB, the editor says what it carried over (the UVs) and what it could not: only
