@@ -1069,38 +1069,19 @@ fn uv_triangles(
     uv_count: usize,
 ) -> Vec<super::uv_follow::UvTriangle> {
     let mut triangles = Vec::new();
-    let (mut vertices, mut uvs) = (0usize, 0usize);
     let mut corners: Vec<(usize, Option<usize>)> = Vec::with_capacity(8);
-    for line in bytes.split(|&b| b == b'\n') {
-        let mut words = tokens(line);
-        match words.next() {
-            Some(b"v") => vertices += 1,
-            Some(b"vt") => uvs += 1,
-            Some(b"f") => {
-                corners.clear();
-                for corner in words {
-                    let mut parts = corner.split(|&b| b == b'/');
-                    let v = parts.next().and_then(|t| resolve(t, vertices));
-                    let t = parts
-                        .next()
-                        .filter(|t| !t.is_empty())
-                        .and_then(|t| resolve(t, uvs))
-                        .filter(|&t| t < uv_count);
-                    match v {
-                        Some(v) if v < vertex_count => corners.push((v, t)),
-                        _ => {
-                            corners.clear();
-                            break;
-                        }
-                    }
-                }
-                for i in 1..corners.len().saturating_sub(1) {
-                    triangles.push([corners[0], corners[i], corners[i + 1]]);
-                }
+    for_each_face(bytes, |face| {
+        corners.clear();
+        for &[v, t, _] in face {
+            match v {
+                Some(v) if v < vertex_count => corners.push((v, t.filter(|&t| t < uv_count))),
+                _ => return,
             }
-            _ => {}
         }
-    }
+        for i in 1..corners.len().saturating_sub(1) {
+            triangles.push([corners[0], corners[i], corners[i + 1]]);
+        }
+    });
     triangles
 }
 
@@ -1113,40 +1094,56 @@ fn normal_turns(
     normal_count: usize,
 ) -> NormalTurns {
     let mut turns = NormalTurns::new(normal_count);
-    let (mut vertices, mut normals) = (0usize, 0usize);
     let mut corners: Vec<(usize, usize)> = Vec::with_capacity(8);
+    for_each_face(bytes, |face| {
+        corners.clear();
+        for &[v, _, n] in face {
+            match (v, n) {
+                (Some(v), Some(n)) if v < before.len() => corners.push((v, n)),
+                _ => return,
+            }
+        }
+        for i in 1..corners.len().saturating_sub(1) {
+            let fan = [corners[0], corners[i], corners[i + 1]];
+            turns.add(
+                fan.map(|(_, n)| n),
+                fan.map(|(v, _)| dvec(before[v])),
+                fan.map(|(v, _)| dvec(after[v])),
+            );
+        }
+    });
+    turns
+}
+
+/// Calls `visit` with the corners of every `f` line: per corner its vertex, texture coordinate
+/// and normal, as 0-based indices resolved against the items before the line (`None` where the
+/// corner has none or names none).
+fn for_each_face(bytes: &[u8], mut visit: impl FnMut(&[[Option<usize>; 3]])) {
+    let (mut vertices, mut uvs, mut normals) = (0usize, 0usize, 0usize);
+    let mut corners: Vec<[Option<usize>; 3]> = Vec::with_capacity(8);
     for line in bytes.split(|&b| b == b'\n') {
         let mut words = tokens(line);
         match words.next() {
             Some(b"v") => vertices += 1,
+            Some(b"vt") => uvs += 1,
             Some(b"vn") => normals += 1,
             Some(b"f") => {
                 corners.clear();
                 for corner in words {
                     let mut parts = corner.split(|&b| b == b'/');
-                    let v = parts.next().and_then(|t| resolve(t, vertices));
-                    let n = parts.nth(1).and_then(|t| resolve(t, normals));
-                    match (v, n) {
-                        (Some(v), Some(n)) if v < before.len() => corners.push((v, n)),
-                        _ => {
-                            corners.clear();
-                            break;
-                        }
-                    }
+                    let mut index = |count: usize| {
+                        parts
+                            .next()
+                            .filter(|t| !t.is_empty())
+                            .and_then(|t| resolve(t, count))
+                    };
+                    corners.push([index(vertices), index(uvs), index(normals)]);
                 }
-                for i in 1..corners.len().saturating_sub(1) {
-                    let fan = [corners[0], corners[i], corners[i + 1]];
-                    turns.add(
-                        fan.map(|(_, n)| n),
-                        fan.map(|(v, _)| dvec(before[v])),
-                        fan.map(|(v, _)| dvec(after[v])),
-                    );
-                }
+                visit(&corners);
             }
             _ => {}
         }
     }
-    turns
 }
 
 /// What an OBJ file holds beyond positions and triangles, in plain words.
