@@ -885,20 +885,14 @@ fn fair_warns_when_the_relaxation_slides_a_textured_files_vertices() {
     );
 }
 
-/// A flat grid textured by an affine map of its positions, its inner vertices jittered in the
-/// plane: the relaxation slides them, and written back into an OBJ or a PLY each inner vertex's
-/// texture coordinate is the map's value at its new place (the texture stayed where it was);
-/// before this, they kept their old values.
-#[test]
-fn fair_written_back_moves_texture_coordinates_with_the_slide() {
-    const N: usize = 9;
-    let affine = |x: f64, y: f64| [0.1 + 0.05 * x - 0.02 * y, 0.3 + 0.01 * x + 0.04 * y];
+/// A flat n×n grid of unit cells: every point's (x, y) and whether it is inner; the inner ones
+/// moved in the plane by a fixed pattern of up to a quarter edge (`salt` picks the pattern).
+fn jittered_grid(n: usize, salt: [usize; 2]) -> Vec<(f64, f64, bool)> {
     let mut points = Vec::new();
-    for j in 0..N {
-        for i in 0..N {
-            let inner = i > 0 && j > 0 && i < N - 1 && j < N - 1;
-            // A fixed in-plane jitter of up to a quarter edge on the inner vertices.
-            let k = (i * 7 + j * 13) % 11;
+    for j in 0..n {
+        for i in 0..n {
+            let inner = i > 0 && j > 0 && i < n - 1 && j < n - 1;
+            let k = (i * salt[0] + j * salt[1]) % 11;
             let (dx, dy) = if inner {
                 (0.05 * (k as f64 - 5.0), 0.04 * ((k * 3 % 11) as f64 - 5.0))
             } else {
@@ -907,6 +901,45 @@ fn fair_written_back_moves_texture_coordinates_with_the_slide() {
             points.push((i as f64 + dx, j as f64 + dy, inner));
         }
     }
+    points
+}
+
+/// `fair --rounds 2` (the default relaxation slides vertices) of `input` written back into
+/// `output`, whose texture coordinates followed the slide.
+fn relax_textured(input: &Path, output: &Path) {
+    let json = json_of(&[
+        "fair",
+        input.to_str().unwrap(),
+        "-o",
+        output.to_str().unwrap(),
+        "--rounds",
+        "2",
+        "--json",
+    ]);
+    assert_eq!(json["texture_follows"], true, "{}: {json}", input.display());
+}
+
+/// The positions and first texture coordinates of a GLB's first primitive, read by the gltf
+/// crate (another loader than ours).
+fn glb_positions_and_uvs(path: &Path) -> (Vec<[f32; 3]>, Vec<[f32; 2]>) {
+    let glb = gltf::Gltf::from_slice(&std::fs::read(path).unwrap()).unwrap();
+    let blob = glb.blob.clone();
+    let primitive = glb.meshes().next().unwrap().primitives().next().unwrap();
+    let reader = primitive.reader(|_| blob.as_deref());
+    let positions: Vec<[f32; 3]> = reader.read_positions().unwrap().collect();
+    let uvs: Vec<[f32; 2]> = reader.read_tex_coords(0).unwrap().into_f32().collect();
+    (positions, uvs)
+}
+
+/// A flat grid textured by an affine map of its positions, its inner vertices jittered in the
+/// plane: the relaxation slides them, and written back into an OBJ or a PLY each inner vertex's
+/// texture coordinate is the map's value at its new place (the texture stayed where it was);
+/// before this, they kept their old values.
+#[test]
+fn fair_written_back_moves_texture_coordinates_with_the_slide() {
+    const N: usize = 9;
+    let affine = |x: f64, y: f64| [0.1 + 0.05 * x - 0.02 * y, 0.3 + 0.01 * x + 0.04 * y];
+    let points = jittered_grid(N, [7, 13]);
     let mut triangles = Vec::new();
     for j in 0..N - 1 {
         for i in 0..N - 1 {
@@ -915,19 +948,6 @@ fn fair_written_back_moves_texture_coordinates_with_the_slide() {
             triangles.push([v, v + N + 1, v + N]);
         }
     }
-    // Two rounds with the default relaxation, written back: the coordinates followed.
-    let relax = |input: &Path, output: &Path| {
-        let json = json_of(&[
-            "fair",
-            input.to_str().unwrap(),
-            "-o",
-            output.to_str().unwrap(),
-            "--rounds",
-            "2",
-            "--json",
-        ]);
-        assert_eq!(json["texture_follows"], true, "{}: {json}", input.display());
-    };
     let dir = tempfile::tempdir().unwrap();
     let mut obj = String::new();
     let mut ply = format!(
@@ -951,7 +971,7 @@ fn fair_written_back_moves_texture_coordinates_with_the_slide() {
         let input = dir.path().join(name);
         std::fs::write(&input, text).unwrap();
         let output = dir.path().join(format!("faired_{name}"));
-        relax(&input, &output);
+        relax_textured(&input, &output);
         // (x, y, u, v) of every vertex as written.
         let written = std::fs::read_to_string(&output).unwrap();
         let numbers = |line: &str| -> Vec<f64> {
@@ -1012,18 +1032,9 @@ fn fair_written_back_moves_texture_coordinates_with_the_slide() {
         "{}",
         String::from_utf8_lossy(&out.stderr)
     );
-    relax(&glb, &faired);
-    let read = |path: &Path| {
-        let glb = gltf::Gltf::from_slice(&std::fs::read(path).unwrap()).unwrap();
-        let blob = glb.blob.clone();
-        let primitive = glb.meshes().next().unwrap().primitives().next().unwrap();
-        let reader = primitive.reader(|_| blob.as_deref());
-        let positions: Vec<[f32; 3]> = reader.read_positions().unwrap().collect();
-        let uvs: Vec<[f32; 2]> = reader.read_tex_coords(0).unwrap().into_f32().collect();
-        (positions, uvs)
-    };
-    let (before, _) = read(&glb);
-    let (after, uvs) = read(&faired);
+    relax_textured(&glb, &faired);
+    let (before, _) = glb_positions_and_uvs(&glb);
+    let (after, uvs) = glb_positions_and_uvs(&faired);
     assert_eq!(before.len(), after.len());
     let inner = |p: &[f32; 3]| {
         (0.5..N as f32 - 1.5).contains(&p[0]) && (0.5..N as f32 - 1.5).contains(&p[1])
@@ -1043,4 +1054,126 @@ fn fair_written_back_moves_texture_coordinates_with_the_slide() {
         );
     }
     assert!(slid > 20, "glb: only {slid} inner vertices slid");
+}
+
+/// The same flat grid with a UV seam down its middle (the right half's texture is the left's
+/// moved by 2 in u): the vertices on the seam slide into one side or the other, and each of their
+/// texture coordinates follows in its own chart, written back into an OBJ (one `vt` per side) and
+/// into a GLB (where the seam splits the vertices), so the texture stays continuous on both sides.
+#[test]
+fn texture_coordinates_follow_across_a_uv_seam_in_obj_and_glb() {
+    const N: usize = 9;
+    const SEAM: usize = 4;
+    let affine = |x: f64, y: f64, right: bool| {
+        let shift = if right { 2.0 } else { 0.0 };
+        [0.1 + 0.05 * x - 0.02 * y + shift, 0.3 + 0.01 * x + 0.04 * y]
+    };
+    let points = jittered_grid(N, [5, 7]);
+    // Left chart: vt k for vertex k; right chart: one more vt per vertex with i >= SEAM.
+    let right_vertices: Vec<usize> = (0..N * N).filter(|v| v % N >= SEAM).collect();
+    let right_vt = |v: usize| N * N + right_vertices.iter().position(|&r| r == v).unwrap();
+    let mut obj = String::new();
+    for &(x, y, _) in &points {
+        obj += &format!("v {x} {y} 0\n");
+    }
+    for &(x, y, _) in &points {
+        let [u, v] = affine(x, y, false);
+        obj += &format!("vt {u} {v}\n");
+    }
+    for &r in &right_vertices {
+        let [u, v] = affine(points[r].0, points[r].1, true);
+        obj += &format!("vt {u} {v}\n");
+    }
+    for j in 0..N - 1 {
+        for i in 0..N - 1 {
+            let v = j * N + i;
+            let corner = |v: usize| {
+                let t = if i >= SEAM { right_vt(v) } else { v };
+                format!("{}/{}", v + 1, t + 1)
+            };
+            for t in [[v, v + 1, v + N + 1], [v, v + N + 1, v + N]] {
+                obj += &format!("f {} {} {}\n", corner(t[0]), corner(t[1]), corner(t[2]));
+            }
+        }
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let input = dir.path().join("seam.obj");
+    std::fs::write(&input, obj).unwrap();
+    let close = |got: [f64; 2], expected: [f64; 2]| {
+        (got[0] - expected[0]).abs() < 2e-6 && (got[1] - expected[1]).abs() < 2e-6
+    };
+
+    // OBJ: each vt of an inner vertex is its chart's texture at the vertex's new place.
+    let faired = dir.path().join("faired_seam.obj");
+    relax_textured(&input, &faired);
+    let written = std::fs::read_to_string(&faired).unwrap();
+    let numbers = |line: &str| -> Vec<f64> {
+        line.split_whitespace()
+            .skip(1)
+            .map(|w| w.parse().unwrap())
+            .collect()
+    };
+    let positions: Vec<Vec<f64>> = written
+        .lines()
+        .filter(|l| l.starts_with("v "))
+        .map(numbers)
+        .collect();
+    let uvs: Vec<Vec<f64>> = written
+        .lines()
+        .filter(|l| l.starts_with("vt "))
+        .map(numbers)
+        .collect();
+    let mut seam_slid = 0;
+    for (t, uv) in uvs.iter().enumerate() {
+        let (v, right) = if t < N * N {
+            (t, false)
+        } else {
+            (right_vertices[t - N * N], true)
+        };
+        // Inner vertices only; the left chart's vt of a vertex right of the seam is unused.
+        if !points[v].2 || !right && v % N > SEAM {
+            continue;
+        }
+        let (x, y) = (positions[v][0], positions[v][1]);
+        if v % N == SEAM && (x - points[v].0).hypot(y - points[v].1) > 0.01 {
+            seam_slid += 1;
+        }
+        let expected = affine(x, y, right);
+        assert!(
+            close([uv[0], uv[1]], expected),
+            "obj: vt {t} of vertex {v} at ({x}, {y}) is {uv:?}, the texture there is {expected:?}"
+        );
+    }
+    assert!(seam_slid > 3, "only {seam_slid} seam vertices slid");
+
+    // GLB (converted from the OBJ: the seam splits its vertices), faired back into a GLB.
+    let glb = dir.path().join("seam.glb");
+    let faired = dir.path().join("faired_seam.glb");
+    assert!(fairmesh(&[
+        "convert",
+        input.to_str().unwrap(),
+        "-o",
+        glb.to_str().unwrap()
+    ])
+    .status
+    .success());
+    relax_textured(&glb, &faired);
+    let (_, uvs_before) = glb_positions_and_uvs(&glb);
+    let (after, uvs) = glb_positions_and_uvs(&faired);
+    let inner = |p: &[f32; 3]| {
+        (0.5..N as f32 - 1.5).contains(&p[0]) && (0.5..N as f32 - 1.5).contains(&p[1])
+    };
+    let mut checked = 0;
+    for ((p, uv), was) in after.iter().zip(&uvs).zip(&uvs_before) {
+        if !inner(p) {
+            continue;
+        }
+        checked += 1;
+        let expected = affine(p[0] as f64, p[1] as f64, was[0] > 1.0);
+        assert!(
+            close([uv[0] as f64, uv[1] as f64], expected),
+            "glb: element at {p:?} has {uv:?}, the texture there is {expected:?}"
+        );
+    }
+    assert!(checked > (N - 2) * (N - 2), "{checked} inner elements");
 }

@@ -796,7 +796,7 @@ pub(crate) fn write(
     // Normals turn from the file's own positions (read from `gltf`, never from `joined`), so the
     // order of these two steps does not matter.
     let mut changed = turn_normals(gltf, source, &edits, &mut joined, report);
-    changed.extend(follow_texture(gltf, &edits, &mut joined, report));
+    changed.extend(follow_texture(gltf, source, &edits, &mut joined, report));
     report.texture_coordinates_follow = true;
     for (&a, edit) in &edits {
         for (k, after) in edit.after.iter().enumerate() {
@@ -955,10 +955,13 @@ fn position_edits(
 
 /// Move the texture coordinates (TEXCOORD_n) of every primitive whose positions moved so that
 /// the texture stays where it was on the surface ([`super::uv_follow`]), each accessor from the
-/// triangles of the primitives that use it with one POSITION accessor (a glTF splits vertices at
-/// UV seams, so there a slide stops at the seam). Returns the accessors written.
+/// triangles of the primitives that use it with one POSITION accessor. A glTF splits a vertex at
+/// a UV seam into elements with the same position; those walk as the one welded vertex they are,
+/// so a slide across the seam goes on in each side's own chart, as in an OBJ. Returns the
+/// accessors written.
 fn follow_texture(
     gltf: &GltfSource,
+    source: &Source,
     edits: &BTreeMap<usize, PositionEdit>,
     joined: &mut Joined,
     report: &mut SaveReport,
@@ -1015,17 +1018,33 @@ fn follow_texture(
             .map(|k| [gltf.read(&layout, k, 0), gltf.read(&layout, k, 1)])
             .collect();
         let uvs: Vec<[f64; 2]> = read.iter().map(|uv| uv.map(f64::from)).collect();
-        let after: Vec<[f32; 3]> = edit
-            .before
+        // The elements' welded vertices, numbered in order of first appearance, with their
+        // positions before and after (the elements of one welded vertex share them).
+        let start = gltf
+            .reads
             .iter()
-            .zip(&edit.after)
-            .map(|(before, after)| after.unwrap_or(*before))
+            .find(|read| read.accessor == p)
+            .map(|read| read.raw_start);
+        let mut number: BTreeMap<usize, u32> = BTreeMap::new();
+        let (mut before, mut after) = (Vec::new(), Vec::new());
+        let vertex_of: Vec<usize> = (0..layout.count)
+            .map(|k| {
+                // An element that became no welded vertex stands alone.
+                let welded = start
+                    .and_then(|s| source.welded(s + k))
+                    .unwrap_or(usize::MAX - k);
+                *number.entry(welded).or_insert_with(|| {
+                    before.push(edit.before[k]);
+                    after.push(edit.after[k].unwrap_or(edit.before[k]));
+                    before.len() as u32 - 1
+                }) as usize
+            })
             .collect();
         let corners: Vec<super::uv_follow::UvTriangle> = triangles
             .iter()
-            .map(|t| t.map(|v| (v as usize, Some(v as usize))))
+            .map(|t| t.map(|k| (vertex_of[k as usize], Some(k as usize))))
             .collect();
-        let followed = super::uv_follow::follow(&edit.before, &after, &corners, &uvs);
+        let followed = super::uv_follow::follow(&before, &after, &corners, &uvs);
         for (k, uv) in followed.moved.iter().enumerate() {
             let Some(uv) = uv.map(|uv| uv.map(|c| c as f32)) else {
                 continue;
