@@ -983,12 +983,24 @@ pub(crate) fn write_back(
         .collect();
     let moved = |k: usize| before[k] != after[k] && !before[k][0].is_nan();
     let any_moved = (0..before.len()).any(moved);
-    let turns =
-        (normal_count > 0 && any_moved).then(|| normal_turns(bytes, &before, &after, normal_count));
-    let followed = (!uvs.is_empty() && any_moved).then(|| {
-        let triangles = uv_triangles(bytes, before.len(), uvs.len());
-        super::uv_follow::follow(&before, &after, &triangles, &uvs)
-    });
+    // One pass over the faces: the normals' turns and the triangles the texture coordinates
+    // follow on, each where the file has them.
+    let mut turns = (normal_count > 0 && any_moved).then(|| NormalTurns::new(normal_count));
+    let mut triangles = (!uvs.is_empty() && any_moved).then(Vec::new);
+    if turns.is_some() || triangles.is_some() {
+        let (mut normal_corners, mut uv_corners) = (Vec::new(), Vec::new());
+        for_each_face(bytes, |face| {
+            if let Some(turns) = &mut turns {
+                add_turns(turns, face, &before, &after, &mut normal_corners);
+            }
+            if let Some(triangles) = &mut triangles {
+                let counts = (before.len(), uvs.len());
+                add_uv_triangles(triangles, face, counts, &mut uv_corners);
+            }
+        });
+    }
+    let followed =
+        triangles.map(|triangles| super::uv_follow::follow(&before, &after, &triangles, &uvs));
 
     let mut vertex = 0usize;
     let mut normal = 0usize;
@@ -1060,59 +1072,51 @@ fn texture_coordinate_of<'a>(mut words: impl Iterator<Item = &'a [u8]>) -> Optio
     Some([u as f64, v as f64])
 }
 
-/// The file's faces as triangles (polygons as fans from their first corner) of (vertex, texture
-/// coordinate) corners, for [`super::uv_follow::follow`]; faces with a corner that names no
-/// vertex are left out.
-fn uv_triangles(
-    bytes: &[u8],
-    vertex_count: usize,
-    uv_count: usize,
-) -> Vec<super::uv_follow::UvTriangle> {
-    let mut triangles = Vec::new();
-    let mut corners: Vec<(usize, Option<usize>)> = Vec::with_capacity(8);
-    for_each_face(bytes, |face| {
-        corners.clear();
-        for &[v, t, _] in face {
-            match v {
-                Some(v) if v < vertex_count => corners.push((v, t.filter(|&t| t < uv_count))),
-                _ => return,
-            }
+/// Adds a face's triangles (a polygon as a fan from its first corner) of (vertex, texture
+/// coordinate) corners, for [`super::uv_follow::follow`]; a face with a corner that names no
+/// vertex (of `counts.0`) is left out, a coordinate past `counts.1` is none.
+fn add_uv_triangles(
+    triangles: &mut Vec<super::uv_follow::UvTriangle>,
+    face: &[[Option<usize>; 3]],
+    (vertex_count, uv_count): (usize, usize),
+    corners: &mut Vec<(usize, Option<usize>)>,
+) {
+    corners.clear();
+    for &[v, t, _] in face {
+        match v {
+            Some(v) if v < vertex_count => corners.push((v, t.filter(|&t| t < uv_count))),
+            _ => return,
         }
-        for i in 1..corners.len().saturating_sub(1) {
-            triangles.push([corners[0], corners[i], corners[i + 1]]);
-        }
-    });
-    triangles
+    }
+    for i in 1..corners.len().saturating_sub(1) {
+        triangles.push([corners[0], corners[i], corners[i + 1]]);
+    }
 }
 
-/// The turns of the `vn` normals: every face corner `v//vn` or `v/vt/vn` adds the area of its
-/// fan triangles to its normal.
-fn normal_turns(
-    bytes: &[u8],
+/// Adds a face to the turns of the `vn` normals: every corner `v//vn` or `v/vt/vn` adds the area
+/// of its fan triangles to its normal (a face with a corner without both is left out).
+fn add_turns(
+    turns: &mut NormalTurns,
+    face: &[[Option<usize>; 3]],
     before: &[[f32; 3]],
     after: &[[f32; 3]],
-    normal_count: usize,
-) -> NormalTurns {
-    let mut turns = NormalTurns::new(normal_count);
-    let mut corners: Vec<(usize, usize)> = Vec::with_capacity(8);
-    for_each_face(bytes, |face| {
-        corners.clear();
-        for &[v, _, n] in face {
-            match (v, n) {
-                (Some(v), Some(n)) if v < before.len() => corners.push((v, n)),
-                _ => return,
-            }
+    corners: &mut Vec<(usize, usize)>,
+) {
+    corners.clear();
+    for &[v, _, n] in face {
+        match (v, n) {
+            (Some(v), Some(n)) if v < before.len() => corners.push((v, n)),
+            _ => return,
         }
-        for i in 1..corners.len().saturating_sub(1) {
-            let fan = [corners[0], corners[i], corners[i + 1]];
-            turns.add(
-                fan.map(|(_, n)| n),
-                fan.map(|(v, _)| dvec(before[v])),
-                fan.map(|(v, _)| dvec(after[v])),
-            );
-        }
-    });
-    turns
+    }
+    for i in 1..corners.len().saturating_sub(1) {
+        let fan = [corners[0], corners[i], corners[i + 1]];
+        turns.add(
+            fan.map(|(_, n)| n),
+            fan.map(|(v, _)| dvec(before[v])),
+            fan.map(|(v, _)| dvec(after[v])),
+        );
+    }
 }
 
 /// Calls `visit` with the corners of every `f` line: per corner its vertex, texture coordinate
