@@ -87,6 +87,15 @@ fn index(value: &Value, key: &str) -> Option<usize> {
 }
 
 impl GltfSource {
+    /// Where the first read of POSITION accessor `accessor` starts among the parser's vertices
+    /// (its elements' welded vertices are `source.welded(start + k)`).
+    fn first_raw_start(&self, accessor: usize) -> Option<usize> {
+        self.reads
+            .iter()
+            .find(|read| read.accessor == accessor)
+            .map(|read| read.raw_start)
+    }
+
     fn array(&self, key: &str) -> &[Value] {
         self.json
             .get(key)
@@ -1020,11 +1029,7 @@ fn follow_texture(
         let uvs: Vec<[f64; 2]> = read.iter().map(|uv| uv.map(f64::from)).collect();
         // The elements' welded vertices, numbered in order of first appearance, with their
         // positions before and after (the elements of one welded vertex share them).
-        let start = gltf
-            .reads
-            .iter()
-            .find(|read| read.accessor == p)
-            .map(|read| read.raw_start);
+        let start = gltf.first_raw_start(p);
         let mut number: BTreeMap<usize, u32> = BTreeMap::new();
         let (mut before, mut after) = (Vec::new(), Vec::new());
         let vertex_of: Vec<usize> = (0..layout.count)
@@ -1089,10 +1094,6 @@ fn turn_normals(
         .filter(|p| attribute(p, "POSITION").is_some_and(|a| edits.contains_key(&a)))
         .filter_map(|p| attribute(p, "NORMAL"))
         .collect();
-    let mut first_read: BTreeMap<usize, usize> = BTreeMap::new();
-    for read in &gltf.reads {
-        first_read.entry(read.accessor).or_insert(read.raw_start);
-    }
     // Normal accessor -> its layout, its primitives' triangles with their position accessor, and
     // its tangent accessors.
     type Uses = Vec<(usize, Layout, Vec<[u32; 3]>)>;
@@ -1161,7 +1162,7 @@ fn turn_normals(
             }
             block
         });
-        let start = first_read.get(&uses[0].0).copied();
+        let start = gltf.first_raw_start(uses[0].0);
         let mut slots = Vec::new();
         for &(k, sums) in blocks.iter().flat_map(|block| &block.shared) {
             let welded = start.and_then(|s| source.welded(s + k));

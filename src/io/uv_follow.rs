@@ -62,9 +62,8 @@ pub(crate) fn follow(
     const NONE: u32 = u32::MAX;
     const SHARED: u32 = u32::MAX - 1;
     let mut owner = vec![NONE; uvs.len()];
-    // Whether a vertex using the texture coordinate moved.
-    let mut any_moved = vec![false; uvs.len()];
-    // How many faces use each texture coordinate of a moved vertex (its wedge).
+    // How many faces use each texture coordinate at a moved vertex (its wedge; empty where no
+    // vertex using it moved).
     let mut wedge_sizes = vec![0u32; uvs.len() + 1];
     for triangle in triangles {
         let [a, b, c] = triangle.map(|(v, _)| point(after, v));
@@ -77,7 +76,6 @@ pub(crate) fn follow(
                 o if o == v as u32 => o,
                 _ => SHARED,
             };
-            any_moved[t] |= moved(v);
             wedge_sizes[t + 1] += u32::from(moved(v));
         }
     }
@@ -158,9 +156,11 @@ pub(crate) fn follow(
             let triangle = &triangles[face as usize];
             let key = edge_key(triangle, (k + 1) % 3);
             let around = edge_range([key[0], key[1]]);
+            // (An edge with a corner without a coordinate belongs to no chart.)
+            let charted = key[2] != NONE && key[3] != NONE;
             let across = around
                 .iter()
-                .find(|&&(other, g)| other == key && g != face && key[2] != NONE && key[3] != NONE);
+                .find(|&&(other, g)| charted && other == key && g != face);
             let Some(&(_, next)) = across else {
                 // No face of this chart beyond: a seam if another chart's face is there.
                 extend = around.iter().any(|&(other, _)| other != key);
@@ -206,7 +206,7 @@ pub(crate) fn follow(
         })
         .collect();
     let shared = (0..uvs.len())
-        .filter(|&t| owner[t] == SHARED && any_moved[t])
+        .filter(|&t| owner[t] == SHARED && starts[t + 1] > starts[t])
         .count();
     FollowedUvs {
         moved: moved_uvs,
