@@ -245,6 +245,16 @@ pub fn run(args: FairArgs) -> anyhow::Result<()> {
             args.input.display()
         );
     }
+    if report.loose_triangles > 0 {
+        eprintln!(
+            "note: {}: {} triangles lie loose at non-manifold edges (over other triangles, or \
+             hanging from an edge as fins) and were left out of the smoothing, which would have \
+             held their corners with their noise; they are kept in the output, their corners on \
+             the surface smoothed with it and a fin's own tip left where it was",
+            args.input.display(),
+            report.loose_triangles
+        );
+    }
     let measures = input.map(|input| {
         super::progress::Step::run("measuring against the input", || {
             fairmesh::metrics::compare(&input, &mesh)
@@ -269,6 +279,7 @@ pub fn run(args: FairArgs) -> anyhow::Result<()> {
             "rounds_run": report.rounds_run,
             "noise_estimate": report.noise_estimate,
             "crease_edges": report.crease_edges,
+            "loose_triangles": report.loose_triangles,
             "time_ms": time_ms,
             "volume_change_percent": volume_change_percent,
             "max_move": report.max_move,

@@ -227,6 +227,10 @@ pub struct FairReport {
     pub noise_estimate: Option<f64>,
     /// Feature edges kept as creases (0 without creases).
     pub crease_edges: usize,
+    /// Triangles left out of the smoothing because they lie loose at a non-manifold edge
+    /// ([`crate::mesh::loose_triangles`]; the default variant only): their corners move with
+    /// the rest of the surface.
+    pub loose_triangles: usize,
 }
 
 /// The smoothing methods offered by the CLI and the editor.

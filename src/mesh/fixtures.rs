@@ -41,3 +41,21 @@ pub(crate) fn three_triangles_on_one_edge() -> TriMesh {
         vec![[0, 1, 2], [1, 0, 3], [0, 1, 4]],
     )
 }
+
+/// A closed hexagonal bipyramid, outward oriented: apex 0 above the hexagon 1..=6 (vertex k at
+/// angle (k − 1)·60°), apex 8 below, and vertex 7, above apex 0, used by no triangle; its twelve
+/// triangles (apex 0's fan first: (0, k, k + 1)), then `extra`.
+pub(crate) fn bipyramid_with(extra: &[[u32; 3]]) -> TriMesh {
+    let mut positions = vec![[0.0, 0.0, 1.0]];
+    for k in 0..6 {
+        let a = k as f32 * std::f32::consts::PI / 3.0;
+        positions.push([a.cos(), a.sin(), 0.0]);
+    }
+    positions.extend([[0.5, 0.5, 2.0], [0.0, 0.0, -1.0]]);
+    let mut triangles: Vec<[u32; 3]> = (0..6u32)
+        .map(|k| [0, k + 1, (k + 1) % 6 + 1])
+        .chain((0..6u32).map(|k| [8, (k + 1) % 6 + 1, k + 1]))
+        .collect();
+    triangles.extend_from_slice(extra);
+    TriMesh::new(positions, triangles)
+}

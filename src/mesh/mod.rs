@@ -6,6 +6,8 @@
 //! - [`weld`] and [`clean`]: merge vertices with identical positions, drop triangles that repeat a
 //!   vertex and vertices no triangle uses, keeping the first-occurrence order of the input so that
 //!   output files keep the input's vertex order.
+//! - [`loose_triangles`]: triangles lying over a fan or hanging from a non-manifold edge, which
+//!   the default fairing leaves out.
 //! - [`breadth_first_order`]: a locality order for the gather kernels, which keep their own
 //!   internal numbering and map back on output.
 
@@ -13,6 +15,7 @@ mod clean;
 #[cfg(test)]
 pub(crate) mod fixtures;
 mod orient;
+mod overlay;
 mod reorder;
 pub mod shapes;
 mod subdivide;
@@ -23,6 +26,7 @@ pub(crate) use clean::{
     clean_with_map_but_repeats, remove_triangles, repeats_among, weld_with_map, PositionHasher,
 };
 pub use orient::{orient_consistently, OrientReport};
+pub use overlay::loose_triangles;
 pub(crate) use reorder::morton_code;
 pub use reorder::{breadth_first_order, inverse_permutation};
 pub use subdivide::subdivide_loop;
