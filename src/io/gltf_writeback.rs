@@ -1047,7 +1047,7 @@ fn follow_texture(
             .collect();
         let corners: Vec<super::uv_follow::UvTriangle> = triangles
             .iter()
-            .map(|t| t.map(|k| (vertex_of[k as usize], Some(k as usize))))
+            .map(|t| t.map(|k| [vertex_of[k as usize] as u32, k]))
             .collect();
         let followed = super::uv_follow::follow(&before, &after, &corners, &uvs);
         for (k, uv) in followed.moved.iter().enumerate() {

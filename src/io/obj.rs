@@ -1079,12 +1079,16 @@ fn add_uv_triangles(
     triangles: &mut Vec<super::uv_follow::UvTriangle>,
     face: &[[Option<usize>; 3]],
     (vertex_count, uv_count): (usize, usize),
-    corners: &mut Vec<(usize, Option<usize>)>,
+    corners: &mut Vec<[u32; 2]>,
 ) {
     corners.clear();
     for &[v, t, _] in face {
         match v {
-            Some(v) if v < vertex_count => corners.push((v, t.filter(|&t| t < uv_count))),
+            Some(v) if v < vertex_count => corners.push([
+                v as u32,
+                t.filter(|&t| t < uv_count)
+                    .map_or(super::uv_follow::NO_UV, |t| t as u32),
+            ]),
             _ => return,
         }
     }

@@ -999,7 +999,7 @@ pub(crate) fn write_back(
             .mesh
             .triangles
             .iter()
-            .map(|t| t.map(|v| (v as usize, Some(v as usize))))
+            .map(|t| t.map(|v| [v, v]))
             .collect();
         let moved = super::uv_follow::follow(before, &after, &triangles, &uvs).moved;
         (read, moved)
