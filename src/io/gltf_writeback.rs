@@ -288,6 +288,29 @@ impl GltfSource {
             .collect()
     }
 
+    /// The layout of a read primitive's attribute `name`, where it has one element per position.
+    fn read_attribute(&self, read: &PrimitiveRead, name: &str) -> Option<Layout> {
+        let primitive = self
+            .array("meshes")
+            .get(read.mesh)
+            .and_then(|m| m.get("primitives"))
+            .and_then(Value::as_array)?
+            .iter()
+            .find(|p| attribute(p, "POSITION") == Some(read.accessor))?;
+        attribute(primitive, name)
+            .and_then(|a| self.layout(a).ok())
+            .filter(|l| l.count == read.count)
+    }
+
+    /// Whether a read primitive has TEXCOORD_0 (what makes [`Self::vertex_attributes`]' `uvs`
+    /// `Some`), without reading it.
+    pub(crate) fn has_texture_coordinates(&self) -> bool {
+        self.reads.iter().any(|read| {
+            self.read_attribute(read, "TEXCOORD_0")
+                .is_some_and(|l| l.components == 2)
+        })
+    }
+
     /// TEXCOORD_0 and COLOR_0 per welded vertex, for saving in another format: each read
     /// primitive's elements go to the welded vertices its positions became.
     pub(crate) fn vertex_attributes(&self, source: &Source) -> VertexAttributes {
@@ -295,23 +318,7 @@ impl GltfSource {
         let mut colours = Gather::<4>::new(source.welded_vertices, [1.0; 4]);
         let (mut any_uv, mut any_colour) = (false, false);
         for read in &self.reads {
-            let meshes = self.array("meshes");
-            let primitives = meshes
-                .get(read.mesh)
-                .and_then(|m| m.get("primitives"))
-                .and_then(Value::as_array)
-                .map_or(&[][..], Vec::as_slice);
-            let Some(primitive) = primitives
-                .iter()
-                .find(|p| attribute(p, "POSITION") == Some(read.accessor))
-            else {
-                continue;
-            };
-            let layout_of = |name: &str| {
-                attribute(primitive, name)
-                    .and_then(|a| self.layout(a).ok())
-                    .filter(|l| l.count == read.count)
-            };
+            let layout_of = |name: &str| self.read_attribute(read, name);
             if let Some(layout) = layout_of("TEXCOORD_0").filter(|l| l.components == 2) {
                 any_uv = true;
                 for k in 0..read.count {

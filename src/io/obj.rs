@@ -427,6 +427,36 @@ fn resolve(token: &[u8], before: usize) -> Option<usize> {
     }
 }
 
+/// Whether a face corner of the OBJ file names a texture coordinate (`v/vt`, `v/vt/vn`) that a
+/// `vt` line before it gives: what makes [`vertex_attributes`]' `uvs` `Some`, found without
+/// reading them all (it stops at the first such corner, usually in the first face).
+pub(crate) fn has_texture_coordinates(bytes: &[u8]) -> bool {
+    let (mut vertices, mut texture_coordinates) = (0usize, 0usize);
+    for line in bytes.split(|&b| b == b'\n') {
+        let mut words = tokens(line);
+        match words.next() {
+            Some(b"v") => vertices += 1,
+            Some(b"vt") => texture_coordinates += 1,
+            Some(b"f") => {
+                for corner in words {
+                    let mut parts = corner.split(|&b| b == b'/');
+                    let vertex = parts.next().and_then(|t| resolve(t, vertices));
+                    let uv = parts
+                        .next()
+                        .filter(|t| !t.is_empty())
+                        .and_then(|t| resolve(t, texture_coordinates))
+                        .filter(|&t| t < texture_coordinates);
+                    if vertex.is_some() && uv.is_some() {
+                        return true;
+                    }
+                }
+            }
+            _ => {}
+        }
+    }
+    false
+}
+
 /// The vertex colours (`v x y z r g b`) and texture coordinates (`vt`, through the faces'
 /// `v/vt` corners) of an OBJ file, per welded vertex, for saving it in another format.
 pub(crate) fn vertex_attributes(bytes: &[u8], source: &Source) -> VertexAttributes {

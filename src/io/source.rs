@@ -127,7 +127,12 @@ impl Source {
     /// vertices' slide along the surface; written into another, they stay with their vertices,
     /// so whatever slid a vertex along the surface moves the texture with it.
     pub fn has_texture_coordinates(&self) -> bool {
-        self.vertex_attributes().uvs.is_some()
+        match &self.data {
+            SourceData::Obj(bytes) => super::obj::has_texture_coordinates(bytes),
+            SourceData::Ply(bytes) => super::ply::has_texture_coordinates(bytes),
+            SourceData::Gltf(gltf) => gltf.has_texture_coordinates(),
+            _ => false,
+        }
     }
 
     /// The file's UVs and vertex colours per welded vertex (see [`super::carry`]), for writing
@@ -620,6 +625,79 @@ pub(crate) fn dvec(p: [f32; 3]) -> DVec3 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The quick answer agrees with reading every texture coordinate, in each format, with
+    /// and without them.
+    #[test]
+    fn has_texture_coordinates_agrees_with_the_texture_coordinates_read() {
+        let roundtrip = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/roundtrip/");
+        let file = |name: &str| std::fs::read(format!("{roundtrip}{name}")).unwrap();
+        let square = "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nvn 0 0 1\n";
+        let uv = "vt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\n";
+        let ply = |props: &str, rows: &str| {
+            format!(
+                "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n\
+                 property float z\n{props}element face 1\nproperty list uchar int vertex_indices\n\
+                 end_header\n{rows}3 0 1 2\n"
+            )
+            .into_bytes()
+        };
+        let cases: Vec<(&str, Format, Vec<u8>, bool)> = vec![
+            ("textured.obj", Format::Obj, file("textured.obj"), true),
+            ("scene.glb", Format::Glb, file("scene.glb"), true),
+            ("colored.ply", Format::Ply, file("colored.ply"), false),
+            (
+                "v/vt faces",
+                Format::Obj,
+                format!("{square}{uv}f 1/1 2/2 3/3\nf 1/1 3/3 4/4\n").into_bytes(),
+                true,
+            ),
+            (
+                "vt lines no face uses",
+                Format::Obj,
+                format!("{square}{uv}f 1//1 2//1 3//1\nf 1//1 3//1 4//1\n").into_bytes(),
+                false,
+            ),
+            (
+                "a vt index past the vt lines",
+                Format::Obj,
+                format!("{square}vt 0 0\nf 1/2 2/2 3/2\n").into_bytes(),
+                false,
+            ),
+            (
+                "relative v/vt",
+                Format::Obj,
+                format!("{square}{uv}f -4/-4 -3/-3 -2/-2\n").into_bytes(),
+                true,
+            ),
+            (
+                "PLY u v",
+                Format::Ply,
+                ply(
+                    "property float u\nproperty float v\n",
+                    "0 0 0 0 0\n1 0 0 1 0\n0 1 0 0 1\n",
+                ),
+                true,
+            ),
+            (
+                "PLY none",
+                Format::Ply,
+                ply("", "0 0 0\n1 0 0\n0 1 0\n"),
+                false,
+            ),
+        ];
+        for (name, format, bytes, expected) in cases {
+            let loaded = crate::io::load_from_bytes(&bytes, format, name, &Default::default())
+                .unwrap_or_else(|e| panic!("{name}: {e}"));
+            let source = &loaded.source;
+            assert_eq!(source.has_texture_coordinates(), expected, "{name}");
+            assert_eq!(
+                source.vertex_attributes().uvs.is_some(),
+                expected,
+                "{name}: read in full"
+            );
+        }
+    }
 
     #[test]
     fn fingerprint_sees_order_and_values() {
