@@ -490,6 +490,52 @@ fn fair_leaves_a_clean_mesh_alone_and_says_how_noisy_the_input_was() {
     assert_eq!(paper["crease_edges"], 0, "{paper}");
 }
 
+#[test]
+fn info_counts_the_loose_triangles_fair_leaves_out_and_fair_keeps_them_in_the_file() {
+    // Noisy bunny00 with a triangle (v, a, c) laid over two fan triangles (v, a, b), (v, b, c)
+    // at a few far-apart vertices, as a scan's reconstruction leaves them.
+    let dir = tempfile::tempdir().unwrap();
+    let path = |name: &str| dir.path().join(name).to_string_lossy().into_owned();
+    let loaded = fairmesh::io::load(data("bunny00.obj")).unwrap();
+    let (mut mesh, topology) = (loaded.mesh, loaded.topology);
+    fairmesh::noise::add_noise(&mut mesh, &Default::default());
+    let mut overlays = Vec::new();
+    for v in (0..mesh.vertex_count() as u32).step_by(5000) {
+        let turned = |f: u32| {
+            let t = mesh.triangles[f as usize];
+            let k = t.iter().position(|&c| c == v).unwrap();
+            [t[(k + 1) % 3], t[(k + 2) % 3]]
+        };
+        let faces = topology.faces_of(v);
+        let [a, b] = turned(faces[0]);
+        let c = faces
+            .iter()
+            .map(|&f| turned(f))
+            .find(|&[x, _]| x == b)
+            .unwrap()[1];
+        overlays.push([v, a, c]);
+    }
+    mesh.triangles.extend_from_slice(&overlays);
+    fairmesh::io::save(path("overlaid.obj"), &mesh).unwrap();
+
+    let info = json_of(&["info", &path("overlaid.obj"), "--json"]);
+    assert_eq!(info["loose_triangles"], overlays.len(), "{info}");
+    let faired = json_of(&[
+        "fair",
+        &path("overlaid.obj"),
+        "-o",
+        &path("f.obj"),
+        "--json",
+    ]);
+    assert_eq!(faired["loose_triangles"], overlays.len(), "{faired}");
+    assert!(faired["rounds_run"].as_u64().unwrap() > 0, "{faired}");
+    let out = fairmesh::io::load(path("f.obj")).unwrap().mesh;
+    assert_eq!(out.triangles, mesh.triangles);
+    // A clean manifold has none.
+    let clean = json_of(&["info", &data("bunny00.obj"), "--json"]);
+    assert_eq!(clean["loose_triangles"], 0, "{clean}");
+}
+
 /// The `v` lines of an OBJ file, in the file's order.
 fn obj_vertices(path: &Path) -> Vec<[f32; 3]> {
     std::fs::read_to_string(path)

@@ -133,6 +133,9 @@ pub fn info(args: InfoArgs) -> anyhow::Result<()> {
     let volume = closed.then(|| metrics::signed_volume(mesh));
     let bbox = metrics::bounding_box(mesh);
     let genus: Vec<Option<i64>> = topology.components.iter().map(|c| c.genus).collect();
+    // What the default `fair` leaves out (`mesh::without_loose_triangles`).
+    let loose_triangles = fairmesh::mesh::without_loose_triangles(mesh, topology)
+        .map_or(0, |(loose, ..)| loose.len());
     // What the file holds beyond the mesh: kept when saving to the same format.
     let contents = loaded.source.contents();
     let summary = json!({
@@ -150,6 +153,7 @@ pub fn info(args: InfoArgs) -> anyhow::Result<()> {
         "oriented": topology.inconsistent_edges == 0,
         "non_manifold_edges": topology.non_manifold_edges.len(),
         "non_manifold_vertices": topology.non_manifold_vertices.len(),
+        "loose_triangles": loose_triangles,
         "inconsistently_oriented_edges": topology.inconsistent_edges,
         "volume": volume,
         "area": metrics::area(mesh),
@@ -195,6 +199,13 @@ pub fn info(args: InfoArgs) -> anyhow::Result<()> {
         topology.non_manifold_vertices.len(),
         topology.inconsistent_edges
     )?;
+    if loose_triangles > 0 {
+        writeln!(
+            out,
+            "  loose triangles     {loose_triangles} (over other triangles, or fins hanging from an \
+             edge: the default fair smooths the surface without them)"
+        )?;
+    }
     match volume {
         Some(v) => writeln!(out, "  volume              {v:.6e}")?,
         None => writeln!(out, "  volume              n/a (open mesh)")?,

@@ -1500,8 +1500,9 @@ pub fn fair_constrained(
     // On the noisy Stanford dragon (vrip) the vertices at non-manifold edges went from twice
     // the others' distance to the clean surface to about theirs (`docs/measurements.md`).
     if options.variant == FairVariant::NormalProjected && !topology.non_manifold_edges.is_empty() {
-        let loose = crate::mesh::loose_triangles(&mesh.triangles, topology);
-        if !loose.is_empty() {
+        if let Some((loose, mut kept, kept_topology)) =
+            crate::mesh::without_loose_triangles(mesh, topology)
+        {
             // The volume kept is the file's, loose triangles included: they follow their
             // corners, and their own (cone) volume changes with them; one more uniform offset
             // takes that back (about a thousandth of an edge length on the dragon, which moved
@@ -1514,9 +1515,6 @@ pub fn fair_constrained(
             let volume = options
                 .keep_volume
                 .then(|| VolumeKeeper::new(mesh, topology, &pinned));
-            let mut kept = mesh.clone();
-            crate::mesh::remove_triangles(&mut kept, &loose);
-            let kept_topology = Topology::build(&kept);
             let mut report = fair_constrained(&mut kept, &kept_topology, options);
             mesh.positions = kept.positions;
             if let Some(volume) = volume.filter(|_| report.rounds_run > 0) {

@@ -26,7 +26,7 @@ pub(crate) use clean::{
     clean_with_map_but_repeats, remove_triangles, repeats_among, weld_with_map, PositionHasher,
 };
 pub use orient::{orient_consistently, OrientReport};
-pub use overlay::loose_triangles;
+pub use overlay::{loose_triangles, without_loose_triangles};
 pub(crate) use reorder::morton_code;
 pub use reorder::{breadth_first_order, inverse_permutation};
 pub use subdivide::subdivide_loop;

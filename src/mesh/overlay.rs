@@ -24,7 +24,7 @@
 //! surface (the base's move takes out the base's noise, not the tip's), Hausdorff distance up
 //! by a tenth to a fifth.
 
-use super::Topology;
+use super::{Topology, TriMesh};
 use std::collections::HashMap;
 
 /// Faces in a loose patch, at most: a reconstruction's overlays are a triangle or a short strip;
@@ -70,6 +70,41 @@ pub fn loose_triangles(triangles: &[[u32; 3]], topology: &Topology) -> Vec<u32> 
     }
     loose.sort_unstable();
     loose
+}
+
+/// [`loose_triangles`] until none is left (removing a patch can leave another loose): the loose
+/// triangles' indices in `mesh` (ascending), `mesh` without them and its topology; `None` when
+/// it has none. Same vertices: nothing is renumbered.
+pub fn without_loose_triangles(
+    mesh: &TriMesh,
+    topology: &Topology,
+) -> Option<(Vec<u32>, TriMesh, Topology)> {
+    let first = loose_triangles(&mesh.triangles, topology);
+    if first.is_empty() {
+        return None;
+    }
+    // Which of `mesh`'s triangles each of `kept`'s is.
+    let mut index: Vec<u32> = (0..mesh.triangles.len() as u32).collect();
+    let mut all = Vec::new();
+    let mut kept = mesh.clone();
+    let mut loose = first;
+    loop {
+        all.extend(loose.iter().map(|&f| index[f as usize]));
+        super::remove_triangles(&mut kept, &loose);
+        let mut next = loose.iter().copied().peekable();
+        let mut at = 0u32;
+        index.retain(|_| {
+            let gone = next.next_if_eq(&at).is_some();
+            at += 1;
+            !gone
+        });
+        let kept_topology = Topology::build(&kept);
+        loose = loose_triangles(&kept.triangles, &kept_topology);
+        if loose.is_empty() {
+            all.sort_unstable();
+            return Some((all, kept, kept_topology));
+        }
+    }
 }
 
 fn key(a: u32, b: u32) -> (u32, u32) {
@@ -207,6 +242,29 @@ mod tests {
         // as a manifold neighbour, and together they meet the rest only at edges with three
         // triangles (0-1, 0-3, 3-4) and at their own edge 1-4.
         assert_eq!(loose(&[[0, 1, 3], [1, 4, 3]]), vec![12, 13]);
+    }
+
+    #[test]
+    fn without_loose_triangles_names_them_in_the_mesh_and_leaves_none() {
+        // An overlay on each apex's fan and a fin: all go, the rest is the bipyramid again.
+        let extra = [[0, 1, 3], [8, 5, 3], [2, 1, 7]];
+        let mut mesh = bipyramid_with(&extra);
+        mesh.positions.extend([[2.0, 2.0, 2.0], [2.0, 3.0, 2.0]]);
+        mesh.triangles.push([7, 9, 10]);
+        let topology = Topology::build(&mesh);
+        let (loose, kept, kept_topology) = without_loose_triangles(&mesh, &topology).unwrap();
+        assert_eq!(loose, vec![12, 13, 14]);
+        let expected: Vec<[u32; 3]> = mesh
+            .triangles
+            .iter()
+            .enumerate()
+            .filter(|(f, _)| !loose.contains(&(*f as u32)))
+            .map(|(_, t)| *t)
+            .collect();
+        assert_eq!(kept.triangles, expected);
+        assert_eq!(kept.positions, mesh.positions);
+        assert!(loose_triangles(&kept.triangles, &kept_topology).is_empty());
+        assert!(without_loose_triangles(&kept, &kept_topology).is_none());
     }
 
     #[test]
