@@ -492,42 +492,27 @@ fn fair_leaves_a_clean_mesh_alone_and_says_how_noisy_the_input_was() {
 
 #[test]
 fn info_counts_the_loose_triangles_fair_leaves_out_and_fair_keeps_them_in_the_file() {
-    // Noisy bunny00 with a triangle (v, a, c) laid over two fan triangles (v, a, b), (v, b, c)
-    // at a few far-apart vertices, as a scan's reconstruction leaves them.
+    // Noisy bunny00 with one-triangle fins hanging from a few far-apart edges (each face's
+    // first edge, to a new tip above it), as a scan's reconstruction leaves them.
     let dir = tempfile::tempdir().unwrap();
     let path = |name: &str| dir.path().join(name).to_string_lossy().into_owned();
-    let loaded = fairmesh::io::load(data("bunny00.obj")).unwrap();
-    let (mut mesh, topology) = (loaded.mesh, loaded.topology);
+    let mut mesh = fairmesh::io::load(data("bunny00.obj")).unwrap().mesh;
     fairmesh::noise::add_noise(&mut mesh, &Default::default());
-    let mut overlays = Vec::new();
-    for v in (0..mesh.vertex_count() as u32).step_by(5000) {
-        let turned = |f: u32| {
-            let t = mesh.triangles[f as usize];
-            let k = t.iter().position(|&c| c == v).unwrap();
-            [t[(k + 1) % 3], t[(k + 2) % 3]]
-        };
-        let faces = topology.faces_of(v);
-        let [a, b] = turned(faces[0]);
-        let c = faces
-            .iter()
-            .map(|&f| turned(f))
-            .find(|&[x, _]| x == b)
-            .unwrap()[1];
-        overlays.push([v, a, c]);
+    let mut fins = Vec::new();
+    for f in (0..mesh.face_count()).step_by(10_000) {
+        let [a, b, _] = mesh.triangles[f];
+        let tip = mesh.positions.len() as u32;
+        let p = (mesh.point(a) + mesh.point(b)) * 0.5 + glam::DVec3::Z * 0.01;
+        mesh.positions.push(p.as_vec3().to_array());
+        fins.push([a, b, tip]);
     }
-    mesh.triangles.extend_from_slice(&overlays);
-    fairmesh::io::save(path("overlaid.obj"), &mesh).unwrap();
+    mesh.triangles.extend_from_slice(&fins);
+    fairmesh::io::save(path("finned.obj"), &mesh).unwrap();
 
-    let info = json_of(&["info", &path("overlaid.obj"), "--json"]);
-    assert_eq!(info["loose_triangles"], overlays.len(), "{info}");
-    let faired = json_of(&[
-        "fair",
-        &path("overlaid.obj"),
-        "-o",
-        &path("f.obj"),
-        "--json",
-    ]);
-    assert_eq!(faired["loose_triangles"], overlays.len(), "{faired}");
+    let info = json_of(&["info", &path("finned.obj"), "--json"]);
+    assert_eq!(info["loose_triangles"], fins.len(), "{info}");
+    let faired = json_of(&["fair", &path("finned.obj"), "-o", &path("f.obj"), "--json"]);
+    assert_eq!(faired["loose_triangles"], fins.len(), "{faired}");
     assert!(faired["rounds_run"].as_u64().unwrap() > 0, "{faired}");
     let out = fairmesh::io::load(path("f.obj")).unwrap().mesh;
     assert_eq!(out.triangles, mesh.triangles);

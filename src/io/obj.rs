@@ -427,6 +427,24 @@ fn resolve(token: &[u8], before: usize) -> Option<usize> {
     }
 }
 
+/// A face corner's vertex and texture coordinate (`v/vt`, `v/vt/vn`; relative indices resolved
+/// against the `vertices` and `texture_coordinates` read so far), the coordinate only when it
+/// is one of those.
+fn vertex_and_uv(
+    corner: &[u8],
+    vertices: usize,
+    texture_coordinates: usize,
+) -> (Option<usize>, Option<usize>) {
+    let mut parts = corner.split(|&b| b == b'/');
+    let vertex = parts.next().and_then(|t| resolve(t, vertices));
+    let uv = parts
+        .next()
+        .filter(|t| !t.is_empty())
+        .and_then(|t| resolve(t, texture_coordinates))
+        .filter(|&t| t < texture_coordinates);
+    (vertex, uv)
+}
+
 /// Whether a face corner of the OBJ file names a texture coordinate (`v/vt`, `v/vt/vn`) that a
 /// `vt` line before it gives: what makes [`vertex_attributes`]' `uvs` `Some`, found without
 /// reading them all (it stops at the first such corner, usually in the first face).
@@ -437,19 +455,15 @@ pub(crate) fn has_texture_coordinates(bytes: &[u8]) -> bool {
         match words.next() {
             Some(b"v") => vertices += 1,
             Some(b"vt") => texture_coordinates += 1,
-            Some(b"f") => {
-                for corner in words {
-                    let mut parts = corner.split(|&b| b == b'/');
-                    let vertex = parts.next().and_then(|t| resolve(t, vertices));
-                    let uv = parts
-                        .next()
-                        .filter(|t| !t.is_empty())
-                        .and_then(|t| resolve(t, texture_coordinates))
-                        .filter(|&t| t < texture_coordinates);
-                    if vertex.is_some() && uv.is_some() {
-                        return true;
-                    }
-                }
+            Some(b"f")
+                if words.any(|corner| {
+                    matches!(
+                        vertex_and_uv(corner, vertices, texture_coordinates),
+                        (Some(_), Some(_))
+                    )
+                }) =>
+            {
+                return true;
             }
             _ => {}
         }
@@ -484,16 +498,11 @@ pub(crate) fn vertex_attributes(bytes: &[u8], source: &Source) -> VertexAttribut
             }
             Some(b"f") => {
                 for corner in words {
-                    let mut parts = corner.split(|&b| b == b'/');
-                    let vertex = parts.next().and_then(|t| resolve(t, vertices));
-                    let uv = parts
-                        .next()
-                        .filter(|t| !t.is_empty())
-                        .and_then(|t| resolve(t, texture_coordinates.len()))
-                        .and_then(|t| texture_coordinates.get(t));
-                    if let (Some(vertex), Some(uv)) = (vertex, uv) {
+                    if let (Some(vertex), Some(t)) =
+                        vertex_and_uv(corner, vertices, texture_coordinates.len())
+                    {
                         any_uv = true;
-                        uvs.put(source.welded(vertex), *uv);
+                        uvs.put(source.welded(vertex), texture_coordinates[t]);
                     }
                 }
             }
