@@ -13,10 +13,11 @@
 //! triangle or a short strip, a fin a triangle or two), meets the rest only at edges with more
 //! than two triangles (at least one) or at its own boundary, and leaves each of those edges at
 //! least two triangles. Removing it then takes nothing from the rest of the surface: its edges
-//! with others stay manifold or better, its boundary edges go with it. Patches are taken in
-//! order of their lowest candidate triangle and the counts updated as each goes, so where two
-//! loose patches lie on the same edge the first goes and the second, now with a manifold
-//! neighbour there, joins the surface.
+//! with others stay manifold or better, its boundary edges go with it. Patches are taken
+//! smallest first (then by their lowest triangle) and the counts updated as each goes, so where
+//! two loose patches lie on the same edge the first goes and the second, now with a manifold
+//! neighbour there, joins the surface; and where two overlays lie on a piece of surface of 16
+//! triangles or fewer, the overlays go, not the piece.
 //!
 //! A corner that only loose triangles use (a fin's tip) has nothing left to smooth it and stays
 //! where it is. Moving it with its base (by the mean of the base's moves) was tried and measured
@@ -55,15 +56,22 @@ pub fn loose_triangles(triangles: &[[u32; 3]], topology: &Topology) -> Vec<u32> 
         triangles,
         topology,
         edge: HashMap::new(),
-        removed: Vec::new(),
+        removed: vec![false; triangles.len()],
     };
-    let mut loose = Vec::new();
+    // Smallest patches first: where overlays lie on a small piece of surface (16 triangles or
+    // fewer), that piece reads as a patch too, and the overlays must go before it is looked at
+    // (their going leaves its edges manifold). Ties by the lowest triangle.
     let mut patch: Vec<u32> = Vec::new();
+    let mut order: Vec<(usize, u32)> = Vec::new();
     for &f in &candidates {
-        if counts.removed.binary_search(&f).is_ok() {
-            continue;
-        }
         if counts.loose_patch(f, &mut patch) {
+            order.push((patch.len(), f));
+        }
+    }
+    order.sort_unstable();
+    let mut loose = Vec::new();
+    for (_, f) in order {
+        if !counts.removed[f as usize] && counts.loose_patch(f, &mut patch) {
             counts.remove(&patch);
             loose.extend_from_slice(&patch);
         }
@@ -125,9 +133,8 @@ struct Counts<'a> {
     triangles: &'a [[u32; 3]],
     topology: &'a Topology,
     edge: HashMap<(u32, u32), u32>,
-    /// Triangles removed so far (ascending: patches are found in ascending order of their
-    /// first triangle, but a patch's own triangles are not; kept sorted on insertion).
-    removed: Vec<u32>,
+    /// Per triangle: removed so far.
+    removed: Vec<bool>,
 }
 
 impl Counts<'_> {
@@ -137,9 +144,7 @@ impl Counts<'_> {
             topology
                 .faces_of(e.0)
                 .iter()
-                .filter(|&&g| {
-                    triangles[g as usize].contains(&e.1) && removed.binary_search(&g).is_err()
-                })
+                .filter(|&&g| triangles[g as usize].contains(&e.1) && !removed[g as usize])
                 .count() as u32
         })
     }
@@ -158,18 +163,15 @@ impl Counts<'_> {
             for e in edges(self.triangles[g as usize]) {
                 match self.edge(e) {
                     2 => {
-                        // The other triangle on e (not removed, so counted in the two).
-                        let other = self
-                            .topology
-                            .faces_of(e.0)
-                            .iter()
-                            .copied()
-                            .find(|&h| {
-                                h != g
-                                    && self.triangles[h as usize].contains(&e.1)
-                                    && self.removed.binary_search(&h).is_err()
-                            })
-                            .expect("an edge with two triangles");
+                        // The other triangle on e (not removed, so counted in the two; none
+                        // only where a triangle repeats a corner, which is no patch to take).
+                        let Some(other) = self.topology.faces_of(e.0).iter().copied().find(|&h| {
+                            h != g
+                                && self.triangles[h as usize].contains(&e.1)
+                                && !self.removed[h as usize]
+                        }) else {
+                            return false;
+                        };
                         if !patch.contains(&other) {
                             if patch.len() == MAX_PATCH {
                                 return false;
@@ -201,11 +203,13 @@ impl Counts<'_> {
     fn remove(&mut self, patch: &[u32]) {
         for &g in patch {
             let t = self.triangles[g as usize];
+            // (Every edge of the patch was counted while it was gathered.)
             for e in edges(t) {
-                *self.edge.get_mut(&e).expect("counted in loose_patch") -= 1;
+                if let Some(count) = self.edge.get_mut(&e) {
+                    *count = count.saturating_sub(1);
+                }
             }
-            let at = self.removed.partition_point(|&r| r < g);
-            self.removed.insert(at, g);
+            self.removed[g as usize] = true;
         }
     }
 }
@@ -265,6 +269,17 @@ mod tests {
         assert_eq!(kept.positions, mesh.positions);
         assert!(loose_triangles(&kept.triangles, &kept_topology).is_empty());
         assert!(without_loose_triangles(&kept, &kept_topology).is_none());
+    }
+
+    #[test]
+    fn triangles_that_repeat_a_corner_or_another_triangle_are_taken_without_a_panic() {
+        // The loader drops both kinds; a library caller may not have.
+        let degenerate = loose(&[[0, 1, 3], [0, 1, 1]]);
+        assert!(degenerate.contains(&12), "{degenerate:?}");
+        // Two copies of one overlay: each has the other as its manifold neighbour across all
+        // three edges, and together they are one loose patch. (The bipyramid, 12 triangles
+        // meeting them at edges with four, reads as a patch too: the smaller goes first.)
+        assert_eq!(loose(&[[0, 1, 3], [0, 1, 3]]), vec![12, 13]);
     }
 
     #[test]
