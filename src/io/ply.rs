@@ -1190,8 +1190,6 @@ fn vertex_triples(
     }
 }
 
-/// The vertex colours (red green blue [alpha]) and UVs (s t, u v or texture_u texture_v) of a
-/// PLY file, per welded vertex, for saving it in another format.
 /// Whether the PLY file's vertices have texture coordinates ([`uv_properties`]): what makes
 /// [`vertex_attributes`]' `uvs` `Some`, read from the header alone.
 pub(crate) fn has_texture_coordinates(bytes: &[u8]) -> bool {
@@ -1205,6 +1203,8 @@ pub(crate) fn has_texture_coordinates(bytes: &[u8]) -> bool {
     uv_properties(&header.elements[layout.vertex_element]).is_some()
 }
 
+/// The vertex colours (red green blue [alpha]) and UVs (s t, u v or texture_u texture_v) of a
+/// PLY file, per welded vertex, for saving it in another format.
 pub(crate) fn vertex_attributes(bytes: &[u8], source: &Source) -> VertexAttributes {
     let path = Path::new("");
     let mut out = VertexAttributes::default();
