@@ -31,7 +31,10 @@
 //!      (with no fairing, a clean mesh then keeps its volume exactly). On a noisy mesh `t_v` also
 //!      holds the vertex's own noise, so it is low-passed before use: each split vertex takes the
 //!      `|A|`-weighted mean of the `t` of the split vertices within two rings of it (its own
-//!      included).
+//!      included). The result is held to twice the vertex's longest edge: where a level's
+//!      fairing shrank a ring to a sliver (a spike's base on a noisy scan), `|A_v|` is nearly
+//!      zero and the exact restoration would put the vertex far out (on the noisy Stanford
+//!      dragon, one vertex 83 edge lengths).
 //!
 //!   The repository's `docs/measurements.md` has what these corrections gain over the paper's
 //!   recipe, level by level, and how to re-run the comparison.
@@ -159,9 +162,10 @@ pub struct MultiresWorkspace {
     /// Umbrella Laplacian of every vertex of the level being refined, from the placed positions.
     laplacians: Vec<Vec3A>,
     /// Per split vertex of the level being refined: Kobbelt displacement, then (Improved) the
-    /// unit normal and the height that would restore the split's volume.
+    /// unit normal, the height that would restore the split's volume, its weight `|A|` and the
+    /// most height the split may take (twice its longest edge).
     displacements: Vec<Vec3A>,
-    heights: Vec<(Vec3A, f64, f64)>,
+    heights: Vec<(Vec3A, f64, f64, f64)>,
     /// Per vertex of the finer level: weighted sum of heights of adjacent split vertices, weights.
     height_sums: Vec<[f64; 2]>,
     /// Positions of the level before its fairing, vertex normals and areas, normal displacement
@@ -737,15 +741,15 @@ fn refine_positions(
             .with_min_len(PARALLEL_GRAIN)
             .map(|v| {
                 let Some(k) = hierarchy.collapse_target(v as u32) else {
-                    return (Vec3A::ZERO, 0.0, 0.0);
+                    return (Vec3A::ZERO, 0.0, 0.0, 0.0);
                 };
-                let xk = at(k);
+                let (xv, xk) = (at(v as u32), at(k));
                 let mut area = Vec3A::ZERO;
+                // The longest edge at `v` now (every neighbour is some face's `a`, or on an open
+                // fan the last face's `b`).
+                let mut spoke_squared = 0f32;
                 for &f in &vertex_faces[face_offsets[v] as usize..face_offsets[v + 1] as usize] {
                     let t = triangles[f as usize];
-                    if t.contains(&k) {
-                        continue;
-                    }
                     let (a, b) = if t[0] == v as u32 {
                         (t[1], t[2])
                     } else if t[1] == v as u32 {
@@ -753,17 +757,29 @@ fn refine_positions(
                     } else {
                         (t[0], t[1])
                     };
-                    area += (at(a) - xk).cross(at(b) - xk);
+                    let (xa, xb) = (at(a), at(b));
+                    spoke_squared = spoke_squared
+                        .max(xa.distance_squared(xv))
+                        .max(xb.distance_squared(xv));
+                    if a != k && b != k {
+                        area += (xa - xk).cross(xb - xk);
+                    }
                 }
                 let weight = area.length();
                 if weight <= 0.0 || !weight.is_finite() {
-                    return (Vec3A::ZERO, 0.0, 0.0);
+                    return (Vec3A::ZERO, 0.0, 0.0, 0.0);
                 }
                 let normal = area / weight;
-                let current = area.dot(at(v as u32) - xk) as f64;
+                let current = area.dot(xv - xk) as f64;
                 let weight = weight as f64;
                 let height = (hierarchy.six_split_volume(v as u32) as f64 - current) / weight;
-                (normal, height, weight)
+                // The most height a split may take (after the low-pass): twice its longest edge
+                // now. Where the fairing has shrunk its ring to a sliver (a spike's base on a
+                // noisy scan), the volume over that sliver asks for a tower (one vertex of the
+                // noisy Stanford dragon went 83 edge lengths out). Bounding by its height in M0
+                // instead cost a tenth of a multires run (a second position array to read).
+                let bound = 2.0 * spoke_squared.sqrt() as f64;
+                (normal, height, weight, bound)
             })
             .collect_into_vec(heights);
     }
@@ -772,14 +788,14 @@ fn refine_positions(
         // sorted one-ring: the same sums, in the same order, as scattering from the split
         // vertices).
         {
-            let heights: &[(Vec3A, f64, f64)] = heights;
+            let heights: &[(Vec3A, f64, f64, f64)] = heights;
             (0..fine_count)
                 .into_par_iter()
                 .with_min_len(PARALLEL_GRAIN)
                 .map(|u| {
                     let mut sum = [0.0; 2];
                     for &v in topology.neighbors(u as u32) {
-                        if let Some(&(_, height, weight)) =
+                        if let Some(&(_, height, weight, _)) =
                             (v as usize).checked_sub(coarse_count).map(|i| &heights[i])
                         {
                             sum[0] += height * weight;
@@ -810,7 +826,54 @@ fn refine_positions(
     positions[coarse_count..]
         .par_iter_mut()
         .zip(heights.par_iter())
-        .for_each(|(p, &(normal, height, _))| {
+        .for_each(|(p, &(normal, height, _, bound))| {
+            let height = height.clamp(-bound, bound);
             *p = (Vec3A::from_array(*p) + normal * height as f32).to_array()
         });
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::hierarchy::{build_hierarchy, HierarchyOptions};
+
+    #[test]
+    fn a_split_over_a_shrunken_ring_rises_no_more_than_twice_its_longest_edge() {
+        // A level's fairing can shrink a split vertex's ring to a sliver (a spike's base on a
+        // noisy scan); the volume the split adds back, spread over that sliver, asks for a
+        // tower. Stand-in: level 1 shrunk a thousandfold about its centre, then refined.
+        // Without the bound the splits went 500 times the level's size out.
+        let mesh = crate::bundled::load_bunny(&Default::default())
+            .unwrap()
+            .mesh;
+        let hierarchy =
+            build_hierarchy(&mesh, &HierarchyOptions::default(), &mut crate::NoProgress).unwrap();
+        let mut workspace = MultiresWorkspace::default();
+        workspace.prepare_levels(&hierarchy, 0..=1, |_| None);
+        let coarse = hierarchy.level_positions(1);
+        let centre =
+            coarse.iter().map(|&p| Vec3A::from_array(p)).sum::<Vec3A>() / coarse.len() as f32;
+        let size = coarse
+            .iter()
+            .map(|&p| Vec3A::from_array(p).distance(centre))
+            .fold(0f32, f32::max);
+        workspace.positions = coarse
+            .iter()
+            .map(|&p| (centre + (Vec3A::from_array(p) - centre) * 1e-3).to_array())
+            .collect();
+        refine_positions(&hierarchy, &mut workspace, 0, MultiresVariant::Improved);
+        let split = hierarchy.level_info(1).vertices..hierarchy.level_info(0).vertices;
+        assert!(split.len() > 1000, "{split:?}");
+        // Placed in the shrunken ring (within its size, 1e-3 of the level's), then at most
+        // twice an edge of it higher.
+        let farthest = split
+            .map(|v| Vec3A::from_array(workspace.positions[v]).distance(centre))
+            .fold(0f32, f32::max);
+        assert!(farthest.is_finite());
+        assert!(
+            farthest <= 4e-3 * size,
+            "a split went {farthest} from the centre of a level shrunk to {}",
+            1e-3 * size
+        );
+    }
 }

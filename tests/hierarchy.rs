@@ -427,3 +427,157 @@ fn a_workspace_for_one_run_gives_the_same_result_and_keeps_no_level() {
         }
     }
 }
+
+/// `mesh` with what a scan's surface reconstruction leaves at non-manifold edges (the Stanford
+/// dragon's vrip mesh has hundreds): triangles `(v, a, c)` lying over two triangles `(v, a, b)`,
+/// `(v, b, c)` of a fan, and one-triangle fins `(v, a, tip)` with a tip of their own. Returns
+/// the mesh and the added triangles' indices (ascending).
+fn with_loose_triangles(mesh: &TriMesh) -> (TriMesh, Vec<u32>) {
+    let topology = Topology::build(mesh);
+    let n = mesh.vertex_count();
+    let mut taken = vec![false; n];
+    let mut out = mesh.clone();
+    let mut added = Vec::new();
+    for (i, v) in (0..n as u32).step_by(9).enumerate() {
+        if topology
+            .neighbors(v)
+            .iter()
+            .chain([&v])
+            .any(|&u| taken[u as usize])
+        {
+            continue;
+        }
+        for &u in topology.neighbors(v).iter().chain([&v]) {
+            taken[u as usize] = true;
+        }
+        // (a, b) of v's first face and the face after it around v, (b, c).
+        let turned = |f: u32| {
+            let t = mesh.triangles[f as usize];
+            let k = t.iter().position(|&c| c == v).unwrap();
+            [t[(k + 1) % 3], t[(k + 2) % 3]]
+        };
+        let [a, b] = turned(topology.faces_of(v)[0]);
+        added.push(out.triangles.len() as u32);
+        if i % 2 == 0 {
+            let c = topology
+                .faces_of(v)
+                .iter()
+                .map(|&f| turned(f))
+                .find(|&[first, _]| first == b)
+                .unwrap()[1];
+            out.triangles.push([v, a, c]);
+        } else {
+            let tip = out.positions.len() as u32;
+            let p = mesh.point(v) + (mesh.point(v) - mesh.point(b)) * 0.5;
+            out.positions.push([p.x as f32, p.y as f32, p.z as f32]);
+            out.triangles.push([v, a, tip]);
+        }
+    }
+    (out, added)
+}
+
+#[test]
+fn loose_triangles_at_non_manifold_edges_stay_in_m0_and_out_of_the_levels() {
+    // They pinned their corners and those corners' neighbours in every level: the noisy
+    // Stanford dragon's levels stopped at 9997 of its 22982 vertices.
+    let mesh = load("assets/bunny00.obj");
+    let (scan, added) = with_loose_triangles(&mesh);
+    assert!(added.len() > 500, "{}", added.len());
+    let tips = scan.vertex_count() - mesh.vertex_count();
+    let plain = build(&mesh);
+    let h = build(&scan);
+    assert!(
+        h.loose_triangles() == added,
+        "{} loose",
+        h.loose_triangles().len()
+    );
+    assert!(h.base_mesh() == &scan);
+    // Level 0 is the mesh without them: each of its faces is the M0 face it names.
+    let level0 = h.level_mesh(0);
+    let (vertex_origin, face_origin) = h.level_origins(0);
+    assert_eq!(level0.face_count(), mesh.face_count());
+    for (t, &f) in level0.triangles.iter().zip(&face_origin) {
+        assert_eq!(
+            t.map(|c| vertex_origin[c as usize]),
+            scan.triangles[f as usize]
+        );
+    }
+    // The levels go as far as the mesh's own (a fin's tip, used by nothing left, stays in
+    // every level), and every level is an oriented manifold.
+    let coarsest = h.level_info(h.coarsest_level()).vertices;
+    let plain_coarsest = plain.level_info(plain.coarsest_level()).vertices;
+    assert!(
+        coarsest <= plain_coarsest + tips + plain_coarsest / 4,
+        "coarsest level {coarsest} vertices; without the loose triangles {plain_coarsest} + {tips} tips"
+    );
+    for level in 0..h.level_count() {
+        assert!(
+            Topology::build(&h.level_mesh(level)).is_oriented_manifold(),
+            "level {level}"
+        );
+    }
+    // Kept in the levels, they hold their corners with their neighbours.
+    let pinned = build_hierarchy(
+        &scan,
+        &HierarchyOptions::default().with_leave_out_loose_triangles(false),
+        &mut NoProgress,
+    )
+    .unwrap();
+    assert!(pinned.loose_triangles().is_empty());
+    let pinned_coarsest = pinned.level_info(pinned.coarsest_level()).vertices;
+    assert!(
+        pinned_coarsest > 3 * coarsest,
+        "{pinned_coarsest} against {coarsest}"
+    );
+    // The same found from a loaded topology, and with creases kept.
+    let with_topology = build_hierarchy_with_topology(
+        &scan,
+        &Topology::build(&scan),
+        &HierarchyOptions::default(),
+        &mut NoProgress,
+    )
+    .unwrap();
+    assert_eq!(with_topology.vertex_order(), h.vertex_order());
+    assert!(with_topology.loose_triangles() == added);
+    assert!(build_with_creases(&scan).loose_triangles() == added);
+}
+
+#[test]
+fn multires_of_a_noisy_scan_with_loose_triangles_smooths_it_as_well_as_without_them() {
+    let (clean, noisy) = noisy_bunny();
+    let (scan, added) = with_loose_triangles(&noisy);
+    let (clean_scan, _) = with_loose_triangles(&clean);
+    let plain = build(&noisy);
+    let h = build(&scan);
+    let options = MultiresOptions::default().with_start_level(4);
+    let result = |h: &Hierarchy, triangles: &[[u32; 3]]| {
+        let positions =
+            fair_multires(h, &options, &mut MultiresWorkspace::new(), &mut NoProgress).unwrap();
+        assert!(positions.iter().flatten().all(|c| c.is_finite()));
+        TriMesh::new(positions, triangles.to_vec())
+    };
+    let faired = result(&h, &scan.triangles);
+    let faired_plain = result(&plain, &noisy.triangles);
+    // The bunny's own vertices end as close to the clean surface as without the loose
+    // triangles (both hierarchies are a little different, so not equal).
+    let own = TriMesh::new(
+        faired.positions[..noisy.vertex_count()].to_vec(),
+        noisy.triangles.clone(),
+    );
+    let distance = metrics::compare(&clean, &own).mean_surface_distance;
+    let plain_distance = metrics::compare(&clean, &faired_plain).mean_surface_distance;
+    assert!(
+        distance < 1.15 * plain_distance,
+        "{distance} against {plain_distance} without the loose triangles"
+    );
+    // A fin's tip, used by nothing else, stays where it was; the volume is kept.
+    assert_eq!(
+        &faired.positions[noisy.vertex_count()..],
+        &scan.positions[noisy.vertex_count()..]
+    );
+    let change = metrics::volume_change_percent(&clean_scan, &faired).unwrap();
+    assert!(change.abs() < 0.2, "volume change {change}%");
+    assert!(added
+        .iter()
+        .all(|&f| faired.triangles[f as usize] == scan.triangles[f as usize]));
+}

@@ -325,9 +325,21 @@ fn hierarchy_section(ui: &mut egui::Ui, view: &PanelView, commands: &mut Command
                 commands.push(Command::RebuildHierarchy);
             }
         }
-        HierarchyState::Ready { levels, .. } => {
+        HierarchyState::Ready {
+            levels, hierarchy, ..
+        } => {
             top_level = levels.len().saturating_sub(1);
             ui.label(format!("{} levels (M0 … M{top_level})", levels.len()));
+            let loose = hierarchy.loose_triangles().len();
+            if loose > 0 {
+                ui.label(format!("{loose} loose triangles left out of the levels"))
+                    .on_hover_text(
+                        "These triangles lie over other triangles or hang from an edge as fins \
+                         (a scan's reconstruction leaves them). The levels are built without \
+                         them, so M0 here has fewer faces than the mesh; the smoothed result \
+                         keeps them, following their corners.",
+                    );
+            }
             egui::CollapsingHeader::new("Level sizes")
                 .default_open(levels.len() <= 12)
                 .show(ui, |ui| {

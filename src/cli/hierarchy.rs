@@ -253,6 +253,7 @@ pub fn run_hierarchy(args: HierarchyArgs) -> anyhow::Result<()> {
             "total_ms": total_ms,
             "crease_edges": hierarchy.crease_edge_count(),
             "non_manifold_vertices": hierarchy.non_manifold_vertices().len(),
+            "loose_triangles": hierarchy.loose_triangles().len(),
             "record_bytes_per_vertex":
                 hierarchy.record_bytes() as f64 / loaded.mesh.vertex_count().max(1) as f64,
         });
@@ -262,13 +263,7 @@ pub fn run_hierarchy(args: HierarchyArgs) -> anyhow::Result<()> {
         0 => String::new(),
         edges => format!(", {edges} crease edges kept sharp"),
     };
-    if let [first, ..] = hierarchy.non_manifold_vertices() {
-        eprintln!(
-            "note: {}: {} vertices where the mesh is not an oriented 2-manifold (e.g. vertex {first}) stay in every level, with their neighbours",
-            args.input.display(),
-            hierarchy.non_manifold_vertices().len()
-        );
-    }
+    print_notes(&hierarchy, &args.input);
     let mut out = format!(
         "{}: {} levels in {:.1} ms ({:.1} bytes of collapse records per vertex{creases})\nlevel  vertices     faces   time ms\n",
         args.input.display(),
@@ -287,6 +282,26 @@ pub fn run_hierarchy(args: HierarchyArgs) -> anyhow::Result<()> {
         )?;
     }
     super::emit(&out)
+}
+
+/// What the build did with a mesh that is not an oriented 2-manifold, on stderr.
+fn print_notes(hierarchy: &Hierarchy, input: &std::path::Path) {
+    if !hierarchy.loose_triangles().is_empty() {
+        eprintln!(
+            "note: {}: {} triangles lie loose at non-manifold edges (over other triangles, or \
+             hanging from an edge as fins): the levels are built without them (level 0 is the \
+             mesh without them), and they stay in a multires result",
+            input.display(),
+            hierarchy.loose_triangles().len()
+        );
+    }
+    if let [first, ..] = hierarchy.non_manifold_vertices() {
+        eprintln!(
+            "note: {}: {} vertices where the mesh is not an oriented 2-manifold (e.g. vertex {first}) stay in every level, with their neighbours",
+            input.display(),
+            hierarchy.non_manifold_vertices().len()
+        );
+    }
 }
 
 pub fn run_multires(args: MultiresArgs) -> anyhow::Result<()> {
@@ -338,6 +353,7 @@ pub fn run_multires(args: MultiresArgs) -> anyhow::Result<()> {
     let started = Instant::now();
     let hierarchy = build(&input, topology.as_ref(), &args.build, file_edges)?;
     drop(topology);
+    print_notes(&hierarchy, &args.input);
     // The hierarchy keeps its own copy of the (noisy) input as M0: the input goes, and the
     // results take their triangles from M0 (18 bytes per face less at the peak).
     drop(input);

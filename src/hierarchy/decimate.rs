@@ -129,27 +129,34 @@ const MIN_PASS_SHARE: usize = 20;
 /// Visits between two progress reports.
 const REPORT_EVERY: usize = 4096;
 
+/// `Ok(None)`: `stop_if_non_manifold` was set and the first pass found a vertex whose faces are
+/// not one oriented fan (the caller looks for loose triangles and builds again).
 pub(super) fn build(
     mesh: &TriMesh,
     creases: Option<&Creases>,
     options: &HierarchyOptions,
+    stop_if_non_manifold: bool,
     progress: &mut dyn Progress,
-) -> Result<BuildOutput, HierarchyError> {
+) -> Result<Option<BuildOutput>, HierarchyError> {
     // As a pass does (see `passes`), M0 is sorted in parallel when it is visited in regions.
     let parallel = options.regions.for_level(mesh.vertex_count()).is_some();
-    passes(
+    match passes(
         mesh,
         first_level(mesh, creases, parallel),
         options,
+        stop_if_non_manifold,
         progress,
-    )
-    .map_err(|e| match e {
-        BuildFailure::Cancelled => HierarchyError::Cancelled,
-    })
+    ) {
+        Ok(built) => Ok(Some(built)),
+        Err(BuildFailure::NonManifold) => Ok(None),
+        Err(BuildFailure::Cancelled) => Err(HierarchyError::Cancelled),
+    }
 }
 
 enum BuildFailure {
     Cancelled,
+    /// Non-manifold vertices, and the caller asked to stop there.
+    NonManifold,
 }
 
 /// One level during the build, compact: its vertices are `0..V` and its faces `0..F`. M0's
@@ -322,6 +329,7 @@ fn passes(
     mesh: &TriMesh,
     mut level: Level,
     options: &HierarchyOptions,
+    stop_if_non_manifold: bool,
     progress: &mut dyn Progress,
 ) -> Result<BuildOutput, BuildFailure> {
     let n = mesh.vertex_count();
@@ -364,6 +372,9 @@ fn passes(
         build_fans(&level.corners, level_vertices, chunk.is_some(), &mut state);
         if pass == 0 {
             let non_manifold = non_manifold_vertices(&state.fan_offsets, &state.fans);
+            if stop_if_non_manifold && !non_manifold.is_empty() {
+                return Err(BuildFailure::NonManifold);
+            }
             if !non_manifold.is_empty() {
                 pinned = vec![false; n];
                 for &v in &non_manifold {

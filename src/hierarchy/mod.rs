@@ -28,6 +28,13 @@
 //! the noise estimate and the feature edges together (the guided normal filter only on a noisy
 //! mesh); figures in `docs/measurements.md`.
 //!
+//! Loose triangles (not in the paper): on a mesh with non-manifold edges, the triangles a scan's
+//! reconstruction left lying over a fan or hanging as fins ([`crate::mesh::loose_triangles`])
+//! are left out of the levels ([`HierarchyOptions::leave_out_loose_triangles`]): level 0 is M0
+//! without them, M0 itself stays whole, and `face_order` maps into M0's faces. Kept in, their
+//! corners were non-manifold and pinned with their neighbours in every level (the Stanford
+//! dragon's levels stopped at 9997 of its 22982 vertices; without them they reach 627).
+//!
 //! Storage per M0 vertex: target 4 bytes, cone volume 4, the vertex order both ways 8, and the
 //! face order (about two faces per vertex) 8: 24 bytes, besides M0 itself in internal order.
 
@@ -41,6 +48,7 @@ use crate::mesh::{Topology, TriMesh};
 use crate::Progress;
 use decimate::NEVER;
 use rayon::prelude::*;
+use std::borrow::Cow;
 use std::sync::atomic::{AtomicU32, AtomicU64, Ordering};
 
 /// Options of [`build_hierarchy`]; build them with `HierarchyOptions::default()` and the
@@ -63,6 +71,11 @@ pub struct HierarchyOptions {
     /// into one of its two neighbours along the crease, and corners never collapse, so every
     /// level keeps M0's creases and corners ([`Hierarchy::level_creases`]). `None`: no creases.
     pub creases: Option<CreaseOptions>,
+    /// Decimate a non-manifold mesh without the triangles that lie loose at its non-manifold
+    /// edges (overlays on a fan, fins; [`crate::mesh::loose_triangles`]), as the default fairing
+    /// leaves them out; they stay in M0 ([`Hierarchy::loose_triangles`]). Otherwise their
+    /// corners, being non-manifold, stay in every level with their neighbours.
+    pub leave_out_loose_triangles: bool,
     /// How a level is cut into regions visited in parallel (tests make them small).
     regions: decimate::RegionSize,
 }
@@ -74,6 +87,7 @@ with_setters!(HierarchyOptions {
     with_max_levels => max_levels: usize,
     with_keep_boundary => keep_boundary: bool,
     with_creases => creases: Option<CreaseOptions>,
+    with_leave_out_loose_triangles => leave_out_loose_triangles: bool,
 });
 
 impl Default for HierarchyOptions {
@@ -85,6 +99,7 @@ impl Default for HierarchyOptions {
             max_levels: 64,
             keep_boundary: false,
             creases: None,
+            leave_out_loose_triangles: true,
             regions: decimate::RegionSize::DEFAULT,
         }
     }
@@ -148,6 +163,8 @@ pub struct Hierarchy {
     crease_edges: Vec<[u32; 2]>,
     /// M0 ids of the vertices whose faces are not one oriented fan (ascending).
     non_manifold: Vec<u32>,
+    /// M0 faces left out of the levels (ascending; see [`Hierarchy::loose_triangles`]).
+    loose: Vec<u32>,
 }
 
 impl Hierarchy {
@@ -176,7 +193,8 @@ impl Hierarchy {
     pub fn level_build_ms(&self, level: usize) -> f64 {
         self.level_ms.get(level).copied().unwrap_or(0.0)
     }
-    /// M0, the mesh the hierarchy was built from.
+    /// M0, the mesh the hierarchy was built from (all of it: level 0 leaves out its
+    /// [`Hierarchy::loose_triangles`], when it has any).
     pub fn base_mesh(&self) -> &TriMesh {
         &self.base
     }
@@ -290,6 +308,15 @@ impl Hierarchy {
         &self.non_manifold
     }
 
+    /// M0's faces (ascending indices) that lie loose at its non-manifold edges
+    /// ([`crate::mesh::loose_triangles`]) and were left out of the levels
+    /// ([`HierarchyOptions::leave_out_loose_triangles`]): level 0 is M0 without them, and the
+    /// result of multiresolution fairing, on M0's triangles, has them following their corners
+    /// (a corner only they use stays where it is).
+    pub fn loose_triangles(&self) -> &[u32] {
+        &self.loose
+    }
+
     /// M0's feature edges the build kept, in M0's own vertex ids (the input mesh's), lower id
     /// first; empty without creases.
     pub fn crease_edges(&self) -> Vec<[u32; 2]> {
@@ -401,9 +428,10 @@ impl LevelCursor {
 
 /// Builds the decimation hierarchy of `mesh` (section 4.1): M0 is `mesh`, each further level
 /// removes an independent set of vertices by volume-preserving half-edge collapses. `progress`
-/// may cancel the build ([`HierarchyError::Cancelled`]). Where the mesh is not an oriented
-/// 2-manifold, those vertices and their neighbours stay in every level
-/// ([`Hierarchy::non_manifold_vertices`]).
+/// may cancel the build ([`HierarchyError::Cancelled`]). Triangles lying loose at non-manifold
+/// edges (a scan's overlays and fins) are left out of the levels by default
+/// ([`Hierarchy::loose_triangles`]); where the rest is still not an oriented 2-manifold, those
+/// vertices and their neighbours stay in every level ([`Hierarchy::non_manifold_vertices`]).
 ///
 /// ```
 /// use fairmesh::hierarchy::{build_hierarchy, HierarchyOptions};
@@ -465,18 +493,38 @@ fn build(
             "face {f} {t:?} repeats a vertex or refers to a missing one"
         )));
     }
+    // A non-manifold scan is decimated without the triangles its reconstruction left lying loose
+    // at its non-manifold edges (`crate::mesh::loose_triangles`, as the default fairing leaves
+    // them out): they pinned their corners and neighbours in every level, so the Stanford
+    // dragon's levels stopped at 9997 of its 22982 vertices. They stay in M0; the levels are
+    // those of the mesh without them. With a topology at hand (given, or needed for the creases)
+    // they are looked for at once; otherwise only when the first pass finds a non-manifold
+    // vertex, so a manifold mesh pays nothing.
+    let mut topology = topology.map(Cow::Borrowed);
+    if options.creases.is_some() && topology.is_none() {
+        topology = Some(Cow::Owned(Topology::build(mesh)));
+    }
+    let mut loose_out = match &topology {
+        Some(topology) if options.leave_out_loose_triangles => {
+            crate::mesh::without_loose_triangles(mesh, topology)
+        }
+        _ => None,
+    };
     let creases = options
         .creases
         .as_ref()
         .map(|crease_options| {
-            let topology = topology.map_or_else(
-                || std::borrow::Cow::Owned(Topology::build(mesh)),
-                std::borrow::Cow::Borrowed,
-            );
-            let fans = FanRings::new(&mesh.triangles, &topology);
+            let (levels_mesh, levels_topology) = match &loose_out {
+                Some((_, kept, kept_topology)) => (kept, kept_topology),
+                None => (
+                    mesh,
+                    topology.as_deref().expect("built above for the creases"),
+                ),
+            };
+            let fans = FanRings::new(&levels_mesh.triangles, levels_topology);
             detect_creases_with_estimate(
-                mesh,
-                &topology,
+                levels_mesh,
+                levels_topology,
                 &fans,
                 crease_options,
                 &mut FaceRingCache::default(),
@@ -486,7 +534,24 @@ fn build(
         .filter(|creases| !creases.is_empty());
     let setup_ms = started.elapsed().as_secs_f64() * 1e3;
 
-    let built = decimate::build(mesh, creases.as_ref(), options, progress)?;
+    let look_later = options.leave_out_loose_triangles && topology.is_none();
+    let levels_mesh = loose_out.as_ref().map_or(mesh, |(_, kept, _)| kept);
+    let built = match decimate::build(levels_mesh, creases.as_ref(), options, look_later, progress)?
+    {
+        Some(built) => built,
+        None => {
+            // Non-manifold, and no topology was at hand (nor creases asked for).
+            loose_out = crate::mesh::without_loose_triangles(mesh, &Topology::build(mesh));
+            let levels_mesh = loose_out.as_ref().map_or(mesh, |(_, kept, _)| kept);
+            decimate::build(levels_mesh, None, options, false, progress)?
+                .expect("only asked to stop when told to")
+        }
+    };
+    drop(topology);
+    let (loose, levels_mesh) = match loose_out {
+        Some((loose, kept, _)) => (loose, Cow::Owned(kept)),
+        None => (Vec::new(), Cow::Borrowed(mesh)),
+    };
     let finishing = std::time::Instant::now();
     let passes = built.pass_ms.len();
 
@@ -510,8 +575,21 @@ fn build(
     let triangles = face_order
         .par_iter()
         .with_min_len(4096)
-        .map(|&f| mesh.triangles[f as usize].map(|c| rank[c as usize]))
+        .map(|&f| levels_mesh.triangles[f as usize].map(|c| rank[c as usize]))
         .collect();
+    // The levels mesh's faces are M0's without the loose ones, in M0's order.
+    let face_order = if loose.is_empty() {
+        face_order
+    } else {
+        let mut is_loose = vec![false; mesh.face_count()];
+        for &f in &loose {
+            is_loose[f as usize] = true;
+        }
+        let kept: Vec<u32> = (0..mesh.face_count() as u32)
+            .filter(|&f| !is_loose[f as usize])
+            .collect();
+        face_order.iter().map(|&f| kept[f as usize]).collect()
+    };
     let target = order
         .par_iter()
         .with_min_len(4096)
@@ -559,6 +637,7 @@ fn build(
         feature_class,
         crease_edges,
         non_manifold: built.non_manifold,
+        loose,
     })
 }
 

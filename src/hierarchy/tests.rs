@@ -221,11 +221,21 @@ fn non_manifold_vertices_and_their_neighbours_stay_and_the_rest_is_decimated() {
             assert!(kept.contains(&v), "vertex {v} left at level {level}");
         }
     }
-    // The three triangles on one edge: every vertex is on it or beside it, nothing collapses.
+    // The three triangles on one edge, kept whole: every vertex is on it or beside it, nothing
+    // collapses.
     let fin = crate::mesh::fixtures::three_triangles_on_one_edge();
-    let h = build_hierarchy(&fin, &HierarchyOptions::default(), &mut NoProgress).unwrap();
+    let whole = HierarchyOptions::default().with_leave_out_loose_triangles(false);
+    let h = build_hierarchy(&fin, &whole, &mut NoProgress).unwrap();
     assert_eq!(h.coarsest_level(), 0);
     assert_eq!(h.non_manifold_vertices().len(), 2);
+    assert!(h.loose_triangles().is_empty());
+    // By default one of them is a loose fin, left out of the levels: the other two are a
+    // manifold strip.
+    let h = build_hierarchy(&fin, &HierarchyOptions::default(), &mut NoProgress).unwrap();
+    assert_eq!(h.loose_triangles().len(), 1);
+    assert!(h.non_manifold_vertices().is_empty());
+    assert_eq!(h.level_info(0).faces, 2);
+    assert_eq!(h.base_mesh(), &fin);
 }
 
 #[test]
