@@ -491,7 +491,7 @@ fn fair_leaves_a_clean_mesh_alone_and_says_how_noisy_the_input_was() {
 }
 
 #[test]
-fn info_counts_the_loose_triangles_fair_leaves_out_and_fair_keeps_them_in_the_file() {
+fn loose_triangles_are_counted_left_out_of_the_smoothing_and_the_levels_and_kept_in_the_results() {
     // Noisy bunny00 with one-triangle fins hanging from a few far-apart edges (each face's
     // first edge, to a new tip above it), as a scan's reconstruction leaves them.
     let dir = tempfile::tempdir().unwrap();
@@ -515,6 +515,38 @@ fn info_counts_the_loose_triangles_fair_leaves_out_and_fair_keeps_them_in_the_fi
     assert_eq!(faired["loose_triangles"], fins.len(), "{faired}");
     assert!(faired["rounds_run"].as_u64().unwrap() > 0, "{faired}");
     let out = fairmesh::io::load(path("f.obj")).unwrap().mesh;
+    assert_eq!(out.triangles, mesh.triangles);
+    // The hierarchy leaves them out of its levels, says so, and multires keeps them.
+    let levels = json_of(&["hierarchy", &path("finned.obj"), "--json"]);
+    assert_eq!(levels["loose_triangles"], fins.len(), "{levels}");
+    assert_eq!(levels["non_manifold_vertices"], 0, "{levels}");
+    let written = fairmesh(&[
+        "hierarchy",
+        &path("finned.obj"),
+        "--write-levels",
+        &path("levels"),
+    ]);
+    assert!(written.status.success());
+    let stderr = String::from_utf8_lossy(&written.stderr);
+    assert!(
+        stderr.contains(&format!("{} triangles lie loose", fins.len())),
+        "{stderr}"
+    );
+    assert!(stderr.contains("are in no level, M0 included"), "{stderr}");
+    let level0 = fairmesh::io::load(path("levels/level_00.obj"))
+        .unwrap()
+        .mesh;
+    assert_eq!(level0.face_count(), mesh.face_count() - fins.len());
+    let multires = fairmesh(&[
+        "multires",
+        &path("finned.obj"),
+        "--level",
+        "6",
+        "-o",
+        &path("m.obj"),
+    ]);
+    assert!(multires.status.success());
+    let out = fairmesh::io::load(path("m.obj")).unwrap().mesh;
     assert_eq!(out.triangles, mesh.triangles);
     // A clean manifold has none.
     let clean = json_of(&["info", &data("bunny00.obj"), "--json"]);

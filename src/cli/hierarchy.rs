@@ -232,6 +232,7 @@ pub fn run_hierarchy(args: HierarchyArgs) -> anyhow::Result<()> {
         }
         // Every coarse level loses the same things: say it once.
         lost.dedup();
+        lost.extend(hierarchy.levels_warning());
         for warning in lost {
             eprintln!("warning: {}: {warning}", dir.display());
         }

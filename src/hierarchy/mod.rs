@@ -317,6 +317,18 @@ impl Hierarchy {
         &self.loose
     }
 
+    /// What a level written to a file lacks of M0, as a warning (`None` when nothing): the
+    /// [`Hierarchy::loose_triangles`], which no level has.
+    pub fn levels_warning(&self) -> Option<String> {
+        (!self.loose.is_empty()).then(|| {
+            format!(
+                "{} triangles lying loose at non-manifold edges (over other triangles, or fins) \
+                 are in no level, M0 included: the levels are built without them",
+                self.loose.len()
+            )
+        })
+    }
+
     /// M0's feature edges the build kept, in M0's own vertex ids (the input mesh's), lower id
     /// first; empty without creases.
     pub fn crease_edges(&self) -> Vec<[u32; 2]> {

@@ -148,6 +148,7 @@ impl App {
                         .collect();
                     // Every coarse level loses the same things: say it once.
                     warnings.dedup();
+                    warnings.extend(hierarchy.levels_warning());
                     (
                         written.into_iter().map(|(path, _)| path).collect(),
                         warnings,
