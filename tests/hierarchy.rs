@@ -516,6 +516,26 @@ fn loose_triangles_at_non_manifold_edges_stay_in_m0_and_out_of_the_levels() {
             "level {level}"
         );
     }
+    // Written to a file, a level leaves out the tips (no face of it uses them) and keeps its
+    // faces, each naming its M0 face.
+    let top = h.coarsest_level();
+    let (file, vertex_origin, face_origin) = h.level_for_export(top);
+    let mut used = vec![false; file.vertex_count()];
+    for &c in file.triangles.iter().flatten() {
+        used[c as usize] = true;
+    }
+    assert!(
+        used.iter().all(|&u| u),
+        "a level file holds a vertex no face uses"
+    );
+    assert_eq!(file.vertex_count(), h.level_info(top).vertices - tips);
+    assert_eq!(file.face_count(), h.level_info(top).faces);
+    let (_, level_faces) = h.level_origins(top);
+    assert_eq!(face_origin, level_faces);
+    for (t, level_face) in file.triangles.iter().zip(h.level_triangles(top)) {
+        let m0 = t.map(|c| vertex_origin[c as usize]);
+        assert_eq!(m0, level_face.map(|c| h.original_vertex(c)));
+    }
     // Kept in the levels, they hold their corners with their neighbours.
     let pinned = build_hierarchy(
         &scan,

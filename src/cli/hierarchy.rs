@@ -217,8 +217,7 @@ pub fn run_hierarchy(args: HierarchyArgs) -> anyhow::Result<()> {
         let mut lost = Vec::new();
         for level in 0..hierarchy.level_count() {
             let path = dir.join(format!("level_{level:02}.{extension}"));
-            let mesh = hierarchy.level_mesh(level);
-            let (vertex_origin, face_origin) = hierarchy.level_origins(level);
+            let (mesh, vertex_origin, face_origin) = hierarchy.level_for_export(level);
             let derivation = io::Derivation {
                 base: hierarchy.base_mesh(),
                 vertex_origin: &vertex_origin,

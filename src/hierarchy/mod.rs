@@ -225,6 +225,36 @@ impl Hierarchy {
             self.face_order[..info.faces].to_vec(),
         )
     }
+    /// A level as a file should hold it: [`Hierarchy::level_mesh`] without the vertices none of
+    /// its faces uses (the tips of fins left out as loose triangles, which never collapse), and
+    /// [`Hierarchy::level_origins`] to match (per vertex its M0 vertex, per face its M0 face).
+    pub fn level_for_export(&self, level: usize) -> (TriMesh, Vec<u32>, Vec<u32>) {
+        let mut mesh = self.level_mesh(level);
+        let (vertex_origin, face_origin) = self.level_origins(level);
+        let mut new_id = vec![u32::MAX; mesh.vertex_count()];
+        for t in &mesh.triangles {
+            for &c in t {
+                new_id[c as usize] = 0;
+            }
+        }
+        if new_id.iter().all(|&id| id == 0) {
+            return (mesh, vertex_origin, face_origin);
+        }
+        let mut kept_origin = Vec::with_capacity(vertex_origin.len());
+        let mut positions = Vec::with_capacity(mesh.positions.len());
+        for (v, id) in new_id.iter_mut().enumerate() {
+            if *id == 0 {
+                *id = positions.len() as u32;
+                positions.push(mesh.positions[v]);
+                kept_origin.push(vertex_origin[v]);
+            }
+        }
+        for t in &mut mesh.triangles {
+            *t = t.map(|c| new_id[c as usize]);
+        }
+        mesh.positions = positions;
+        (mesh, kept_origin, face_origin)
+    }
     /// M0 positions of the vertices of `level`, in internal order.
     pub fn level_positions(&self, level: usize) -> &[[f32; 3]] {
         &self.positions[..self.level_info(level).vertices]

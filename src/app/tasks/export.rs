@@ -124,7 +124,8 @@ impl App {
                     (from..=to)
                         .map(|level| {
                             let path = folder.join(format!("{stem}_L{level:02}.glb"));
-                            let (vertex_origin, face_origin) = hierarchy.level_origins(level);
+                            let (mesh, vertex_origin, face_origin) =
+                                hierarchy.level_for_export(level);
                             let derivation = crate::io::Derivation {
                                 base: hierarchy.base_mesh(),
                                 vertex_origin: &vertex_origin,
@@ -132,7 +133,7 @@ impl App {
                             };
                             crate::io::save_derived_with_source(
                                 &path,
-                                &hierarchy.level_mesh(level),
+                                &mesh,
                                 &derivation,
                                 &file_source,
                             )
