@@ -377,13 +377,15 @@ impl Hierarchy {
     pub fn crease_edge_count(&self) -> usize {
         self.crease_edges.len()
     }
-    /// Heap bytes of the collapse records (targets, cone volumes, vertex and face orders).
+    /// Heap bytes of the collapse records (targets, cone volumes, vertex and face orders, the
+    /// loose triangles' indices).
     pub fn record_bytes(&self) -> usize {
         4 * (self.target.len() + self.six_split_volume.len())
             + 4 * (self.order.len() + self.rank.len())
             + 4 * self.face_order.len()
             + self.feature_class.len() * std::mem::size_of::<FeatureClass>()
             + 8 * self.crease_edges.len()
+            + 4 * self.loose.len()
     }
     pub(crate) fn id(&self) -> u64 {
         self.id
