@@ -8,7 +8,7 @@
 //! default measures the noise before fairing (at or below [`CLEAN_NOISE`] it does nothing; nor
 //! when the mesh reads that clean once the vertices on its sharp edges are left out,
 //! `estimate_noise_away_from_edges`), and a noisy mesh is faired round by round while Stein's
-//! unbiased risk estimate of the result goes down ([`RoundRisk`]).
+//! unbiased risk estimate of the result goes down (`RoundRisk`).
 //!
 //! # The noise estimate
 //! Per vertex v with a closed fan: h_v = n_v · (m_v − x_v), the normal component of
