@@ -544,8 +544,11 @@ fn loose_triangles_are_counted_left_out_of_the_smoothing_and_the_levels_and_kept
         "6",
         "-o",
         &path("m.obj"),
+        "--json",
     ]);
     assert!(multires.status.success());
+    let report: serde_json::Value = serde_json::from_slice(&multires.stdout).unwrap();
+    assert_eq!(report["loose_triangles"], fins.len(), "{report}");
     let out = fairmesh::io::load(path("m.obj")).unwrap().mesh;
     assert_eq!(out.triangles, mesh.triangles);
     // A clean manifold has none.

@@ -403,6 +403,7 @@ pub fn run_multires(args: MultiresArgs) -> anyhow::Result<()> {
                 "variant": format!("{variant:?}").to_lowercase(),
                 "time_ms": time_ms,
                 "hierarchy_ms": hierarchy_ms,
+                "loose_triangles": hierarchy.loose_triangles().len(),
                 "volume_change_percent": volume_change_percent,
             });
             if let (Some(reference), Some(map)) = (reference, row.as_object_mut()) {
