@@ -231,29 +231,20 @@ impl Hierarchy {
     pub fn level_for_export(&self, level: usize) -> (TriMesh, Vec<u32>, Vec<u32>) {
         let mut mesh = self.level_mesh(level);
         let (vertex_origin, face_origin) = self.level_origins(level);
-        let mut new_id = vec![u32::MAX; mesh.vertex_count()];
-        for t in &mesh.triangles {
-            for &c in t {
-                new_id[c as usize] = 0;
-            }
-        }
-        if new_id.iter().all(|&id| id == 0) {
-            return (mesh, vertex_origin, face_origin);
-        }
-        let mut kept_origin = Vec::with_capacity(vertex_origin.len());
-        let mut positions = Vec::with_capacity(mesh.positions.len());
-        for (v, id) in new_id.iter_mut().enumerate() {
-            if *id == 0 {
-                *id = positions.len() as u32;
-                positions.push(mesh.positions[v]);
-                kept_origin.push(vertex_origin[v]);
-            }
-        }
-        for t in &mut mesh.triangles {
-            *t = t.map(|c| new_id[c as usize]);
-        }
-        mesh.positions = positions;
-        (mesh, kept_origin, face_origin)
+        let faces = mesh.face_count();
+        // A level has no face that repeats a vertex, so only vertices go.
+        let (_, map) = crate::mesh::clean_with_map_but_repeats(&mut mesh);
+        debug_assert_eq!(mesh.face_count(), faces);
+        let vertex_origin = match map {
+            Some(map) => vertex_origin
+                .iter()
+                .zip(&map)
+                .filter(|&(_, &to)| to != u32::MAX)
+                .map(|(&from, _)| from)
+                .collect(),
+            None => vertex_origin,
+        };
+        (mesh, vertex_origin, face_origin)
     }
     /// M0 positions of the vertices of `level`, in internal order.
     pub fn level_positions(&self, level: usize) -> &[[f32; 3]] {
