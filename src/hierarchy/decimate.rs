@@ -87,13 +87,17 @@
 //! vertex at a time, exactly as before regions.
 //!
 //! A level visited in regions also builds its fans and writes the next level in parallel, and M0
-//! is sorted in parallel when it is: every counting sort (M0's vertices by Morton code, its faces
-//! by first corner, every level's fans) runs as one block of consecutive buckets per thread,
-//! each block reading every item and placing only its own entries (`bucket_sort`), and the next
-//! level is written in chunks of a region's least size (each chunk counts what it keeps, the
-//! running sums place it). All give the same arrays for any number of threads. (Sorting each
-//! chunk of faces by block first, and ordered parallel filters that gather the labels twice,
-//! were tried before and were slower.)
+//! is sorted in parallel when it is. The counting sorts with many buckets (M0's faces by first
+//! corner, every level's fans) run as one block of consecutive buckets per thread, each block
+//! reading every item and placing only its own entries (`bucket_sort`); M0's vertices, by the
+//! two 15-bit digits of their Morton codes, as one chunk of items per thread, each counting its
+//! own digits (`digit_sort`: the keys are in no order, so blocks reading every key mispredicted
+//! half their branches); the next level is written in chunks of a region's least size (each
+//! chunk counts what it keeps, the running sums place it); the per-pass arrays are filled and
+//! the removals recorded in parallel too. All give the same arrays for any number of threads.
+//! (Sorting each chunk of faces by block first, ordered parallel filters that gather the labels
+//! twice, and giving each block of the fans' sort only the range of faces that reach it (faces
+//! across the jumps of the Morton order span nearly every range) were tried and were slower.)
 
 use super::{HierarchyError, HierarchyOptions};
 use crate::fairing::creases::{Creases, FeatureClass};
@@ -101,7 +105,7 @@ use crate::mesh::TriMesh;
 use crate::Progress;
 use glam::DVec3;
 use rayon::prelude::*;
-use std::sync::atomic::{AtomicU32, Ordering::Relaxed};
+use std::sync::atomic::{AtomicU32, AtomicU64, Ordering::Relaxed};
 use std::time::Instant;
 
 pub(super) const NEVER: u32 = u32::MAX;
@@ -185,56 +189,65 @@ const CORNER: [u32; 2] = [NEVER - 1; 2];
 /// M0 as the first level: the vertices that some face uses (isolated ones are never removed) in
 /// Morton order of their positions (quantized to 10 bits per axis in M0's bounding box; ties by
 /// id), the faces in order of their first corner's place in that order (ties by id); with the
-/// creases' classes and crease neighbours in the same order. `parallel`: sort in blocks (the
-/// same order).
+/// creases' classes and crease neighbours in the same order. `parallel`: sort in chunks and
+/// blocks (the same order).
 fn first_level(mesh: &TriMesh, creases: Option<&Creases>, parallel: bool) -> Level {
     let n = mesh.vertex_count();
-    let mut level_of = vec![NEVER; n];
-    for t in &mesh.triangles {
-        for &c in t {
-            level_of[c as usize] = 0;
-        }
-    }
     let (lo, hi) = crate::metrics::bounding_box(mesh).unwrap_or_default();
     let scale = (hi - lo).max_element().max(f64::MIN_POSITIVE);
+    // Every vertex's key (isolated ones are taken out after the sort, which leaves the others'
+    // order as it is: a filtered parallel collect cost more than the codes).
     let keys: Vec<u64> = (0..n)
         .into_par_iter()
         .with_min_len(4096)
-        .filter(|&v| level_of[v] == 0)
         .map(|v| {
             let p = mesh.positions[v].map(f64::from);
             crate::mesh::morton_code(p.into(), lo, scale) << 32 | v as u64
         })
         .collect();
     // Sorted by code (30 bits), ties by id (the keys come in id order and each pass is stable):
-    // the low 15 bits of the code, then the high 15.
-    let (mut offsets, mut cursor) = (Vec::new(), Vec::new());
-    let mut by_low = Vec::new();
-    let digit = |k: u64, shift: u32| (k >> (32 + shift)) as u32 & 0x7fff;
-    bucket_sort(
-        keys.len(),
-        1 << 15,
+    // the low 15 bits of the code, then the high 15; the second pass writes each vertex's
+    // place too.
+    let digit = |k: u64, shift: u32| (k >> (32 + shift)) as usize & 0x7fff;
+    let by_low: Vec<AtomicU64> = (0..n).into_par_iter().map(|_| AtomicU64::new(0)).collect();
+    digit_sort(
+        &keys,
+        |&k| digit(k, 0),
         parallel,
-        |i| [(digit(keys[i], 0), keys[i])],
-        &mut offsets,
-        &mut cursor,
-        &mut by_low,
+        |slot, &k| {
+            by_low[slot].store(k, Relaxed);
+        },
     );
     drop(keys);
-    let mut vertex_id = Vec::new();
-    bucket_sort(
-        by_low.len(),
-        1 << 15,
+    let by_low: Vec<u64> = by_low.into_iter().map(AtomicU64::into_inner).collect();
+    let (vertex_id, place_of) = (atomics(n, 0), atomics(n, 0));
+    digit_sort(
+        &by_low,
+        |&k| digit(k, 15),
         parallel,
-        |i| [(digit(by_low[i], 15), by_low[i] as u32)],
-        &mut offsets,
-        &mut cursor,
-        &mut vertex_id,
+        |slot, &k| {
+            vertex_id[slot].store(k as u32, Relaxed);
+            place_of[k as u32 as usize].store(slot as u32, Relaxed);
+        },
     );
     drop(by_low);
-    for (i, &v) in vertex_id.iter().enumerate() {
-        level_of[v as usize] = i as u32;
+    let mut vertex_id = into_inner(vertex_id);
+    let mut level_of = into_inner(place_of);
+    let mut used = vec![false; n];
+    for t in &mesh.triangles {
+        for &c in t {
+            used[c as usize] = true;
+        }
     }
+    if used.contains(&false) {
+        vertex_id.retain(|&v| used[v as usize]);
+        level_of.fill(NEVER);
+        for (i, &v) in vertex_id.iter().enumerate() {
+            level_of[v as usize] = i as u32;
+        }
+    }
+    drop(used);
+    let (mut offsets, mut cursor) = (Vec::new(), Vec::new());
     // Faces by a counting sort on their first corner's place (stable, so ties stay by id).
     let place: Vec<u32> = mesh
         .triangles
@@ -334,20 +347,23 @@ fn passes(
 ) -> Result<BuildOutput, BuildFailure> {
     let n = mesh.vertex_count();
     let mut out = BuildOutput {
-        removed_in_pass: vec![NEVER; n],
-        target: vec![NEVER; n],
-        six_split_volume: vec![0.0; n],
+        removed_in_pass: Vec::new(),
+        target: Vec::new(),
+        six_split_volume: Vec::new(),
         face_removed_in_pass: Vec::new(),
         pass_ms: Vec::new(),
         non_manifold: Vec::new(),
     };
+    // Written by the removals of a pass at once (each vertex is removed once), then moved into
+    // `out`; the six split volumes as f32 bits.
+    let removed_in_pass = atomics(n, NEVER);
+    let target = atomics(n, NEVER);
+    let six_split_volume = atomics(n, 0f32.to_bits());
     // M0 ids of the vertices that stay: those whose faces are not one oriented fan, and their
     // neighbours (so no face at such a vertex ever changes, and every collapse is between
     // manifold vertices).
     let mut pinned: Vec<bool> = Vec::new();
-    let face_removed_in_pass: Vec<AtomicU32> = (0..mesh.face_count())
-        .map(|_| AtomicU32::new(NEVER))
-        .collect();
+    let face_removed_in_pass = atomics(mesh.face_count(), NEVER);
     let isolated = n - level.points.len();
     let mut next = Level::default();
     let mut state = PassState::default();
@@ -423,12 +439,15 @@ fn passes(
             // can still collapse, a few per pass, and multires from such levels lost volume.)
             break;
         }
-        for &(v, k, six_volume) in &removals {
-            let id = level.vertex_id[v as usize] as usize;
-            out.removed_in_pass[id] = pass;
-            out.target[id] = level.vertex_id[k as usize];
-            out.six_split_volume[id] = six_volume;
-        }
+        removals
+            .par_iter()
+            .with_min_len(4096)
+            .for_each(|&(v, k, six_volume)| {
+                let id = level.vertex_id[v as usize] as usize;
+                removed_in_pass[id].store(pass, Relaxed);
+                target[id].store(level.vertex_id[k as usize], Relaxed);
+                six_split_volume[id].store(six_volume.to_bits(), Relaxed);
+            });
         vertex_count -= removed;
         // The next level is written without the fans: they go first, so the two levels' arrays
         // and the fans are never held at once (the next pass builds its own, smaller fans).
@@ -451,11 +470,89 @@ fn passes(
     }
     // (Atomics only so that the next level's chunks can record their faces at once; the same
     // layout, so this reuses the memory.)
-    out.face_removed_in_pass = face_removed_in_pass
+    out.face_removed_in_pass = into_inner(face_removed_in_pass);
+    out.removed_in_pass = into_inner(removed_in_pass);
+    out.target = into_inner(target);
+    out.six_split_volume = into_inner(six_split_volume)
         .into_iter()
-        .map(AtomicU32::into_inner)
+        .map(f32::from_bits)
         .collect();
     Ok(out)
+}
+
+/// `n` atomics holding `value`, written in parallel.
+fn atomics(n: usize, value: u32) -> Vec<AtomicU32> {
+    (0..n)
+        .into_par_iter()
+        .with_min_len(1 << 14)
+        .map(|_| AtomicU32::new(value))
+        .collect()
+}
+
+/// `cells` as `n` atomics holding `value`: in place, in parallel, where it has room (the levels
+/// shrink from pass to pass), as [`atomics`] otherwise.
+fn refill(cells: &mut Vec<AtomicU32>, n: usize, value: u32) {
+    if cells.len() < n {
+        *cells = atomics(n, value);
+    } else {
+        cells.truncate(n);
+        cells
+            .par_iter()
+            .with_min_len(1 << 14)
+            .for_each(|c| c.store(value, Relaxed));
+    }
+}
+
+/// The values of `cells` (the same layout, so the memory is reused).
+fn into_inner(cells: Vec<AtomicU32>) -> Vec<u32> {
+    cells.into_iter().map(AtomicU32::into_inner).collect()
+}
+
+/// A stable counting sort of `items` by a 15-bit `digit`: `place(slot, item)` is called once per
+/// item with its place in the sorted order. In parallel (when `parallel`) over one chunk of
+/// consecutive items per thread: each chunk counts its digits, the counts give each chunk its
+/// first place per digit (digits in order, chunks in order within a digit), and each chunk
+/// places its items, so the order is the same for any number of chunks. (Unlike `bucket_sort`,
+/// whose blocks each read every item: on random keys half of a block's branches mispredict.)
+fn digit_sort<T: Sync>(
+    items: &[T],
+    digit: impl Fn(&T) -> usize + Sync,
+    parallel: bool,
+    place: impl Fn(usize, &T) + Sync,
+) {
+    const DIGITS: usize = 1 << 15;
+    let chunks = if parallel {
+        rayon::current_num_threads().clamp(1, MAX_BLOCKS)
+    } else {
+        1
+    };
+    let chunk_len = items.len().div_ceil(chunks).max(1);
+    let mut next: Vec<Vec<u32>> = items
+        .par_chunks(chunk_len)
+        .map(|chunk| {
+            let mut count = vec![0u32; DIGITS];
+            for item in chunk {
+                count[digit(item)] += 1;
+            }
+            count
+        })
+        .collect();
+    let mut sum = 0;
+    for d in 0..DIGITS {
+        for count in &mut next {
+            (count[d], sum) = (sum, sum + count[d]);
+        }
+    }
+    items
+        .par_chunks(chunk_len)
+        .zip(next)
+        .for_each(|(chunk, mut next)| {
+            for item in chunk {
+                let slot = &mut next[digit(item)];
+                place(*slot as usize, item);
+                *slot += 1;
+            }
+        });
 }
 
 /// How a level is cut into regions that are visited at the same time: consecutive ranges of its
@@ -521,10 +618,12 @@ fn visit_level(
             find_inside(state, size, offset);
             let view = PassView::new(level, state, pinned, options.keep_boundary);
             let region_count = (n + offset).div_ceil(size);
+            let range =
+                |r: usize| (r * size).saturating_sub(offset)..((r + 1) * size - offset).min(n);
             let per_region: Vec<(Vec<u32>, Vec<Removal>)> = (0..region_count)
                 .into_par_iter()
                 .map_init(Scratch::default, |scratch, r| {
-                    let range = (r * size).saturating_sub(offset)..((r + 1) * size - offset).min(n);
+                    let range = range(r);
                     let mut order = Vec::new();
                     let interior = range.filter(|&v| {
                         !state.visited[v]
@@ -542,10 +641,19 @@ fn visit_level(
                     (order, removed)
                 })
                 .collect();
-            for (visited, removed) in per_region {
-                for v in visited {
-                    state.visited[v as usize] = true;
-                }
+            // Each region marks its own range as visited.
+            let lengths: Vec<u32> = (0..region_count).map(|r| range(r).len() as u32).collect();
+            split_by_lengths(&mut state.visited, &lengths)
+                .into_par_iter()
+                .zip(&per_region)
+                .enumerate()
+                .for_each(|(r, (visited, (order, _)))| {
+                    let first = range(r).start;
+                    for &v in order {
+                        visited[v as usize - first] = true;
+                    }
+                });
+            for (_, removed) in per_region {
                 removals.extend(removed);
             }
         }
@@ -619,13 +727,9 @@ fn find_inside(state: &mut PassState, size: usize, offset: usize) {
 /// Every vertex free, no absorbed lists, the crease neighbours as the level has them.
 fn reset_pass(level: &Level, state: &mut PassState) {
     let n = level.points.len();
-    let fill = |cells: &mut Vec<AtomicU32>, value: u32| {
-        cells.clear();
-        cells.resize_with(n, || AtomicU32::new(value));
-    };
-    fill(&mut state.mark, FREE);
-    fill(&mut state.absorbed_head, NEVER);
-    fill(&mut state.absorbed_next, NEVER);
+    refill(&mut state.mark, n, FREE);
+    refill(&mut state.absorbed_head, n, NEVER);
+    refill(&mut state.absorbed_next, n, NEVER);
     state.crease.clear();
     state
         .crease
@@ -870,8 +974,8 @@ fn next_level(
         .par_chunks(chunk)
         .map(|marks| marks.iter().filter(|m| survives(m)).count() as u32)
         .collect();
-    label.clear();
-    label.resize_with(n, || AtomicU32::new(NEVER));
+    // (Every entry is written below: survivors get theirs, removed vertices their target's.)
+    refill(label, n, NEVER);
     next.points = vec![[0.0; 3]; vertices];
     next.vertex_id = vec![0; vertices];
     let starts = running_starts(&kept);
@@ -1262,4 +1366,79 @@ fn choose_collapse(
         return Some((k, cone));
     }
     None
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// M0's order: the vertices some face uses by Morton code, ties by id, isolated ones left
+    /// out; the faces by their first corner's place, ties by id; the same whether sorted in
+    /// chunks on several threads or on one.
+    #[test]
+    fn first_level_orders_used_vertices_by_code_then_id_on_any_thread_count() {
+        // Positions from a few values, so many vertices share a code; every seventh vertex is
+        // isolated (some share their code with used ones). The faces need no shape here.
+        let mut state = 12345u64;
+        let mut next = move |below: u64| {
+            state = state
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (state >> 33) % below
+        };
+        let n = 6000u32;
+        let positions: Vec<[f32; 3]> = (0..n)
+            .map(|_| [0; 3].map(|_| next(5) as f32 * 0.25))
+            .collect();
+        let used: Vec<u32> = (0..n).filter(|v| v % 7 != 3).collect();
+        let triangles: Vec<[u32; 3]> = (0..9000)
+            .map(|_| loop {
+                let t = [0; 3].map(|_| used[next(used.len() as u64) as usize]);
+                if t[0] != t[1] && t[1] != t[2] && t[0] != t[2] {
+                    break t;
+                }
+            })
+            .collect();
+        let mesh = TriMesh::new(positions, triangles);
+        let (lo, hi) = crate::metrics::bounding_box(&mesh).unwrap();
+        let scale = (hi - lo).max_element();
+        let code = |v: u32| {
+            let p = mesh.positions[v as usize].map(f64::from);
+            crate::mesh::morton_code(p.into(), lo, scale)
+        };
+        // (A few of `used` may have been drawn by no face.)
+        let mut in_faces = vec![false; n as usize];
+        for &c in mesh.triangles.iter().flatten() {
+            in_faces[c as usize] = true;
+        }
+        let mut expected: Vec<u32> = (0..n).filter(|&v| in_faces[v as usize]).collect();
+        expected.sort_by_key(|&v| (code(v), v));
+        let mut place = vec![NEVER; n as usize];
+        for (i, &v) in expected.iter().enumerate() {
+            place[v as usize] = i as u32;
+        }
+        let mut faces: Vec<u32> = (0..mesh.face_count() as u32).collect();
+        faces.sort_by_key(|&f| (place[mesh.triangles[f as usize][0] as usize], f));
+
+        let serial = first_level(&mesh, None, false);
+        assert_eq!(serial.vertex_id, expected);
+        assert_eq!(serial.face_id, faces);
+        for (corners, &f) in serial.corners.iter().zip(&faces) {
+            assert_eq!(
+                *corners,
+                mesh.triangles[f as usize].map(|c| place[c as usize])
+            );
+        }
+        for threads in [1, 2, 3, 5] {
+            let level = rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .unwrap()
+                .install(|| first_level(&mesh, None, true));
+            assert_eq!(level.vertex_id, serial.vertex_id, "{threads} threads");
+            assert_eq!(level.face_id, serial.face_id, "{threads} threads");
+            assert_eq!(level.corners, serial.corners, "{threads} threads");
+            assert_eq!(level.points, serial.points, "{threads} threads");
+        }
+    }
 }
