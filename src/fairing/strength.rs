@@ -254,12 +254,16 @@ impl Heights {
                 beside && topology.neighbors(v).iter().any(|&u| on_edge[u as usize])
             })
         };
+        // Every vertex's |r_v|, a positive NaN where it is not read (left out, no neighbour
+        // counted, or no h at it or a neighbour). (A filtered parallel collect of the read ones
+        // cost more than the residuals themselves; `total_cmp` orders positive NaNs after every
+        // number, so the median of the read ones is the element at half their count.)
         let mut residuals: Vec<f32> = (0..heights.len() as u32)
             .into_par_iter()
             .with_min_len(VERTEX_BLOCK)
-            .filter_map(|v| {
+            .map(|v| {
                 if skip(v) || beside(v) {
-                    return None;
+                    return f32::NAN;
                 }
                 let own = heights[v as usize];
                 let mut sum = 0.0;
@@ -271,21 +275,24 @@ impl Heights {
                     }
                 }
                 if count == 0 {
-                    return None;
+                    return f32::NAN;
                 }
-                // NaN (a vertex or a neighbour without h) fails the comparison.
-                let residual = (own - sum / count as f32).abs();
-                (residual >= 0.0).then_some(residual)
+                // (abs clears the sign of a NaN too.)
+                (own - sum / count as f32).abs()
             })
             .collect();
+        let read = residuals
+            .par_iter()
+            .with_min_len(VERTEX_BLOCK)
+            .filter(|r| !r.is_nan())
+            .count();
         // Only a reading away from the edges needs the count (the per-round estimate skips it).
-        if residuals.len() < 16
-            || away.is_some()
-                && 4 * residuals.len() < heights.par_iter().filter(|h| h.is_finite()).count()
+        if read < 16
+            || away.is_some() && 4 * read < heights.par_iter().filter(|h| h.is_finite()).count()
         {
             return None;
         }
-        let middle = residuals.len() / 2;
+        let middle = read / 2;
         let (_, median, _) = residuals.select_nth_unstable_by(middle, f32::total_cmp);
         Some(1.4826 * *median as f64 / NOISE_GAIN / self.edge)
     }
