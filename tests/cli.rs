@@ -294,6 +294,43 @@ fn multires_json_times_one_run_and_measures_only_when_asked() {
 }
 
 #[test]
+fn multires_says_when_a_level_is_beyond_the_coarsest_and_prints_no_nan() {
+    let dir = tempfile::tempdir().unwrap();
+    // One flat triangle: a hierarchy of one level and no volume to change.
+    let triangle = dir.path().join("triangle.obj");
+    std::fs::write(&triangle, "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n").unwrap();
+    let out = fairmesh(&["multires", triangle.to_str().unwrap(), "--level", "1"]);
+    assert!(out.status.success());
+    let (stdout, stderr) = (
+        String::from_utf8_lossy(&out.stdout),
+        String::from_utf8_lossy(&out.stderr),
+    );
+    assert!(stdout.contains("hierarchy of 1 level in"), "{stdout}");
+    assert!(!stdout.contains("NaN"), "{stdout}");
+    let row = stdout.lines().last().unwrap();
+    assert!(row.trim_end().ends_with(" -"), "{row}");
+    assert!(
+        stderr.contains("levels 0 to 0, so level 1 starts from level 0"),
+        "{stderr}"
+    );
+    let json = json_of(&[
+        "multires",
+        triangle.to_str().unwrap(),
+        "--level",
+        "1",
+        "--json",
+    ]);
+    assert_eq!(json["level"], 0);
+    assert!(json["volume_change_percent"].is_null(), "{json}");
+
+    // A level that exists: no note.
+    let input = data("elephant.obj");
+    let out = fairmesh(&["multires", &input, "--level", "2"]);
+    assert!(out.status.success());
+    assert!(!String::from_utf8_lossy(&out.stderr).contains("note:"));
+}
+
+#[test]
 fn fair_measures_distances_only_when_asked() {
     let dir = tempfile::tempdir().unwrap();
     let output = dir.path().join("faired.ply");

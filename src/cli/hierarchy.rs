@@ -265,9 +265,10 @@ pub fn run_hierarchy(args: HierarchyArgs) -> anyhow::Result<()> {
     };
     print_notes(&hierarchy, &args.input);
     let mut out = format!(
-        "{}: {} levels in {:.1} ms ({:.1} bytes of collapse records per vertex{creases})\nlevel  vertices     faces   time ms\n",
+        "{}: {} level{} in {:.1} ms ({:.1} bytes of collapse records per vertex{creases})\nlevel  vertices     faces   time ms\n",
         args.input.display(),
         hierarchy.level_count(),
+        if hierarchy.level_count() == 1 { "" } else { "s" },
         total_ms,
         hierarchy.record_bytes() as f64 / loaded.mesh.vertex_count().max(1) as f64
     );
@@ -368,6 +369,26 @@ pub fn run_multires(args: MultiresArgs) -> anyhow::Result<()> {
     };
     let mut results = Vec::new();
     let mut last = None;
+    let coarsest = hierarchy.coarsest_level();
+    let mut beyond: Vec<usize> = args
+        .level
+        .iter()
+        .copied()
+        .filter(|&l| l > coarsest)
+        .collect();
+    beyond.sort_unstable();
+    beyond.dedup();
+    if !beyond.is_empty() {
+        let levels: Vec<String> = beyond.iter().map(usize::to_string).collect();
+        eprintln!(
+            "note: {}: the hierarchy has levels 0 to {coarsest}, so {} {} {} from level {coarsest}, \
+             its coarsest",
+            args.input.display(),
+            if beyond.len() == 1 { "level" } else { "levels" },
+            levels.join(", "),
+            if beyond.len() == 1 { "starts" } else { "start" }
+        );
+    }
     for &variant in &args.variant {
         for &level in &args.level {
             let options = MultiresOptions::default()
@@ -384,7 +405,7 @@ pub fn run_multires(args: MultiresArgs) -> anyhow::Result<()> {
                     VariantArg::Paper => MultiresVariant::Paper,
                     VariantArg::Improved => MultiresVariant::Improved,
                 });
-            let start = level.min(hierarchy.coarsest_level());
+            let start = level.min(coarsest);
             // One run, timed whole: with the per-level set-up a first run on this workspace does.
             let mut step =
                 super::progress::Step::start(format!("multiresolution fairing from level {start}"));
@@ -444,9 +465,10 @@ pub fn run_multires(args: MultiresArgs) -> anyhow::Result<()> {
         return super::emit(&format!("{}\n", serde_json::to_string_pretty(&value)?));
     }
     let mut out = format!(
-        "{}: hierarchy of {} levels in {:.1} ms{}\nlevel  vertices  variant   time ms   volume %{}\n",
+        "{}: hierarchy of {} level{} in {:.1} ms{}\nlevel  vertices  variant   time ms   volume %{}\n",
         args.input.display(),
         hierarchy.level_count(),
+        if hierarchy.level_count() == 1 { "" } else { "s" },
         hierarchy_ms,
         match args.noise {
             Some(s) => format!(", noise {s} mean edge lengths (seed {})", args.seed),
@@ -458,26 +480,29 @@ pub fn run_multires(args: MultiresArgs) -> anyhow::Result<()> {
             ""
         }
     );
+    // A value the row does not have (no volume to change on a flat or open patch of zero volume,
+    // a measure that could not be made) prints as "-", as in JSON it is null.
+    let cell = |value: &serde_json::Value, width: usize, format: fn(f64) -> String| {
+        let text = value
+            .as_f64()
+            .filter(|v| v.is_finite())
+            .map_or_else(|| "-".to_string(), format);
+        format!(" {text:>width$}")
+    };
     for r in &results {
         write!(
             out,
-            "{:>5} {:>9}  {:<8} {:>8.2} {:>+10.4}",
+            "{:>5} {:>9}  {:<8} {:>8.2}",
             // as numbers: a JSON value ignores the column width
             r["level"].as_u64().unwrap_or(0),
             r["level_vertices"].as_u64().unwrap_or(0),
             r["variant"].as_str().unwrap_or(""),
             r["time_ms"].as_f64().unwrap_or(0.0),
-            r["volume_change_percent"].as_f64().unwrap_or(f64::NAN),
         )?;
+        out += &cell(&r["volume_change_percent"], 10, |v| format!("{v:+.4}"));
         if measure {
-            write!(
-                out,
-                " {:>18.5} {:>15.3}",
-                r["mean_surface_distance_edges"]
-                    .as_f64()
-                    .unwrap_or(f64::NAN),
-                r["normal_error_deg"].as_f64().unwrap_or(f64::NAN),
-            )?;
+            out += &cell(&r["mean_surface_distance_edges"], 18, |v| format!("{v:.5}"));
+            out += &cell(&r["normal_error_deg"], 15, |v| format!("{v:.3}"));
         }
         out.push('\n');
     }
