@@ -294,7 +294,7 @@ fn multires_json_times_one_run_and_measures_only_when_asked() {
 }
 
 #[test]
-fn multires_says_when_a_level_is_beyond_the_coarsest_and_prints_no_nan() {
+fn multires_says_when_a_level_is_beyond_the_coarsest_and_no_volume_prints_as_no_number() {
     let dir = tempfile::tempdir().unwrap();
     // One flat triangle: a hierarchy of one level and no volume to change.
     let triangle = dir.path().join("triangle.obj");
@@ -322,6 +322,23 @@ fn multires_says_when_a_level_is_beyond_the_coarsest_and_prints_no_nan() {
     ]);
     assert_eq!(json["level"], 0);
     assert!(json["volume_change_percent"].is_null(), "{json}");
+    // `fair` says the same: no volume, no change of it (it printed +0.0000 %).
+    let faired = dir.path().join("faired.obj");
+    let fair = [
+        "fair",
+        triangle.to_str().unwrap(),
+        "-o",
+        faired.to_str().unwrap(),
+    ];
+    let json = json_of(&[&fair[..], &["--json"]].concat());
+    assert!(json["volume_change_percent"].is_null(), "{json}");
+    let out = fairmesh(&fair);
+    assert!(out.status.success());
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        text.contains("volume change n/a (the mesh encloses no volume)"),
+        "{text}"
+    );
 
     // A level that exists: no note.
     let input = data("elephant.obj");

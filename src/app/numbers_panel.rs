@@ -71,7 +71,15 @@ fn measures(ui: &mut egui::Ui, view: &PanelView) {
             let fresh = |name: &str| -> Option<(String, String)> {
                 let f = faired?;
                 match name {
-                    "Volume change" => Some((percent(f.volume_change * 100.0), String::new())),
+                    "Volume change" if f.volume_change.is_finite() => {
+                        Some((percent(f.volume_change * 100.0), String::new()))
+                    }
+                    "Volume change" => Some((
+                        "–".into(),
+                        "The input mesh encloses no volume (a flat patch), so there is none to \
+                         change"
+                            .into(),
+                    )),
                     "RMS displacement" => Some((
                         format!("{:.3e}", f.rms_displacement),
                         format!(

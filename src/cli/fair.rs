@@ -219,11 +219,10 @@ pub fn run(args: FairArgs) -> anyhow::Result<()> {
     drop(step);
 
     let volume_after = fairmesh::metrics::signed_volume(&mesh);
-    let volume_change_percent = if volume_before != 0.0 {
-        100.0 * (volume_after - volume_before) / volume_before.abs()
-    } else {
-        0.0
-    };
+    // None (JSON null, "n/a" in words) when the input encloses no volume to change.
+    let volume_change_percent = (volume_before != 0.0)
+        .then(|| 100.0 * (volume_after - volume_before) / volume_before.abs())
+        .filter(|change| change.is_finite());
     let saved = super::save_kept(&args.output, &mesh, &source, args.stdio.format)?;
     // In mean edge lengths of the input; none when no round ran.
     let texture_slide = textured_input
@@ -300,10 +299,10 @@ pub fn run(args: FairArgs) -> anyhow::Result<()> {
         }
         return super::emit(&format!("{json}\n"));
     }
-    let closed_note = if topology.is_closed() {
-        ""
-    } else {
-        " (the mesh is open: volume is only indicative)"
+    let volume = match volume_change_percent {
+        Some(change) if topology.is_closed() => format!("{change:+.4}%"),
+        Some(change) => format!("{change:+.4}% (the mesh is open: volume is only indicative)"),
+        None => "n/a (the mesh encloses no volume)".to_string(),
     };
     let measured = measures
         .map(|m| {
@@ -336,15 +335,13 @@ pub fn run(args: FairArgs) -> anyhow::Result<()> {
         n => format!("{n} crease edges kept sharp; "),
     };
     let sentence = format!(
-        "{}{}: {}{strength}{creases}{} iterations in {:.1} ms, volume change {:+.4}%{}, last \
+        "{}{}: {}{strength}{creases}{} iterations in {:.1} ms, volume change {volume}, last \
          largest move {:.3e}{}; wrote {}\n",
         method,
         variant.map(|v| format!(" ({v})")).unwrap_or_default(),
         super::mask::describe(mask.as_ref()),
         report.iterations_run,
         time_ms,
-        volume_change_percent,
-        closed_note,
         report.max_move,
         measured,
         super::display_output(&args.output)
