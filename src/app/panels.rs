@@ -228,10 +228,14 @@ fn mesh_section(ui: &mut egui::Ui, view: &PanelView) {
         .unwrap_or_else(|| document.path.display().to_string());
     ui.label(name)
         .on_hover_text(document.path.display().to_string());
-    ui.label(format!(
-        "Input mesh: {} vertices, {} faces",
+    let (vertices, faces) = (
         document.original.vertex_count(),
-        document.original.face_count()
+        document.original.face_count(),
+    );
+    ui.label(format!(
+        "Input mesh: {vertices} {}, {faces} {}",
+        if vertices == 1 { "vertex" } else { "vertices" },
+        if faces == 1 { "face" } else { "faces" }
     ));
     let report = &document.report;
     if report.welded_vertices
@@ -329,7 +333,13 @@ fn hierarchy_section(ui: &mut egui::Ui, view: &PanelView, commands: &mut Command
             levels, hierarchy, ..
         } => {
             top_level = levels.len().saturating_sub(1);
-            ui.label(format!("{} levels (M0 … M{top_level})", levels.len()));
+            if top_level == 0 {
+                ui.label("1 level (M0 only)").on_hover_text(
+                    "The mesh is too small to decimate: the hierarchy holds only the input mesh",
+                );
+            } else {
+                ui.label(format!("{} levels (M0 … M{top_level})", levels.len()));
+            }
             let loose = hierarchy.loose_triangles().len();
             if loose > 0 {
                 ui.label(format!("{loose} loose triangles left out of the levels"))
