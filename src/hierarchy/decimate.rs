@@ -481,7 +481,7 @@ fn passes(
 }
 
 /// `n` atomics holding `value`, written in parallel.
-fn atomics(n: usize, value: u32) -> Vec<AtomicU32> {
+pub(super) fn atomics(n: usize, value: u32) -> Vec<AtomicU32> {
     (0..n)
         .into_par_iter()
         .with_min_len(1 << 14)
@@ -504,7 +504,7 @@ fn refill(cells: &mut Vec<AtomicU32>, n: usize, value: u32) {
 }
 
 /// The values of `cells` (the same layout, so the memory is reused).
-fn into_inner(cells: Vec<AtomicU32>) -> Vec<u32> {
+pub(super) fn into_inner(cells: Vec<AtomicU32>) -> Vec<u32> {
     cells.into_iter().map(AtomicU32::into_inner).collect()
 }
 

@@ -49,7 +49,7 @@ use crate::Progress;
 use decimate::NEVER;
 use rayon::prelude::*;
 use std::borrow::Cow;
-use std::sync::atomic::{AtomicU32, AtomicU64, Ordering};
+use std::sync::atomic::{AtomicU64, Ordering};
 
 /// Options of [`build_hierarchy`]; build them with `HierarchyOptions::default()` and the
 /// `with_*` setters.
@@ -727,9 +727,7 @@ fn by_pass(removed_in_pass: &[u32], passes: usize, with_rank: bool) -> ByPass {
             start
         })
         .collect();
-    let order: Vec<AtomicU32> = (0..removed_in_pass.len())
-        .map(|_| AtomicU32::new(0))
-        .collect();
+    let order = decimate::atomics(removed_in_pass.len(), 0);
     let mut rank = if with_rank {
         vec![0u32; removed_in_pass.len()]
     } else {
@@ -763,7 +761,7 @@ fn by_pass(removed_in_pass: &[u32], passes: usize, with_rank: bool) -> ByPass {
     ByPass {
         // (Atomics only so that the chunks can place their ids at once; the same layout, so
         // this reuses the memory.)
-        order: order.into_iter().map(AtomicU32::into_inner).collect(),
+        order: decimate::into_inner(order),
         rank,
         level_sizes,
     }
