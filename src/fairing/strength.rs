@@ -258,7 +258,7 @@ impl Heights {
         // counted, or no h at it or a neighbour). (A filtered parallel collect of the read ones
         // cost more than the residuals themselves; `total_cmp` orders positive NaNs after every
         // number, so the median of the read ones is the element at half their count.)
-        let mut residuals: Vec<f32> = (0..heights.len() as u32)
+        let residuals: Vec<f32> = (0..heights.len() as u32)
             .into_par_iter()
             .with_min_len(VERTEX_BLOCK)
             .map(|v| {
@@ -292,10 +292,56 @@ impl Heights {
         {
             return None;
         }
-        let middle = read / 2;
-        let (_, median, _) = residuals.select_nth_unstable_by(middle, f32::total_cmp);
-        Some(1.4826 * *median as f64 / NOISE_GAIN / self.edge)
+        let median = select_non_negative(&residuals, read / 2)?;
+        Some(1.4826 * median as f64 / NOISE_GAIN / self.edge)
     }
+}
+
+/// The value of rank `rank` (from 0) of `values`, all of them positive or zero or positive NaNs,
+/// in `f32::total_cmp`'s order (`None` when there are no more than `rank` values). For such values that order is the order
+/// of their bits as unsigned integers, so the rank is found by counting the values' top 12 bits
+/// (sign, exponent and 3 bits of the mantissa) in parallel, then selecting among the few values
+/// that share the top bits of the one sought. The same value as `select_nth_unstable_by` with
+/// `total_cmp`, in about a quarter of its time on 600k residuals (2 threads).
+fn select_non_negative(values: &[f32], rank: usize) -> Option<f32> {
+    const SHIFT: u32 = 20;
+    const BINS: usize = 1 << (32 - SHIFT);
+    let histogram = values
+        .par_chunks(4 * VERTEX_BLOCK)
+        .fold(
+            || vec![0usize; BINS],
+            |mut histogram, chunk| {
+                for v in chunk {
+                    histogram[(v.to_bits() >> SHIFT) as usize] += 1;
+                }
+                histogram
+            },
+        )
+        .reduce_with(|mut a, b| {
+            for (a, b) in a.iter_mut().zip(b) {
+                *a += b;
+            }
+            a
+        })
+        .unwrap_or_default();
+    // The bin holding the rank, and the rank within it.
+    let mut below = 0;
+    let bin = histogram.iter().position(|&count| {
+        below += count;
+        below > rank
+    })?;
+    below -= histogram[bin];
+    let mut candidates: Vec<f32> = values
+        .par_iter()
+        .with_min_len(VERTEX_BLOCK)
+        .copied()
+        .filter(|v| (v.to_bits() >> SHIFT) as usize == bin)
+        .collect();
+    Some(
+        *candidates
+            .select_nth_unstable_by(rank - below, f32::total_cmp)
+            .1,
+    )
 }
 
 /// The area normal of face `f`, (x_b − x_a) × (x_c − x_a) (twice its area long), in f32.
@@ -507,6 +553,40 @@ fn unit_vertex_normals(mesh: &TriMesh, topology: &Topology) -> Vec<Vec3A> {
 mod tests {
     use super::*;
     use crate::noise::{add_noise, NoiseMode, NoiseOptions};
+
+    #[test]
+    fn the_selected_rank_is_the_sorted_values_at_that_rank() {
+        // Zeros, ties, NaNs, values over many exponents and many within one bin of the top
+        // bits: every rank against a plain sort (and one past the end).
+        let mut state = 7u64;
+        let mut next = || {
+            state = state
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (state >> 33) as u32
+        };
+        let mut values = Vec::new();
+        for i in 0..20_000 {
+            values.push(match i % 7 {
+                0 => 0.0,
+                1 => f32::NAN,
+                2 => 1.0 + (next() % 64) as f32 * 1e-6,
+                3 => 0.25,
+                _ => f32::from_bits(next() % 0x7f00_0000),
+            });
+        }
+        let mut sorted = values.clone();
+        sorted.sort_by(f32::total_cmp);
+        for rank in (0..values.len())
+            .step_by(97)
+            .chain([0, 9_999, values.len() - 1])
+        {
+            let selected = select_non_negative(&values, rank).unwrap();
+            assert_eq!(selected.to_bits(), sorted[rank].to_bits(), "rank {rank}");
+        }
+        assert_eq!(select_non_negative(&values, values.len()), None);
+        assert_eq!(select_non_negative(&[], 0), None);
+    }
 
     /// A flat grid of `n`×`n` squares of side 1, each cut into two triangles (valence 6 inside).
     fn grid(n: usize) -> TriMesh {
