@@ -520,6 +520,9 @@ fn fair_leaves_a_clean_mesh_alone_and_says_how_noisy_the_input_was() {
     assert!((0.2..0.4).contains(&estimate), "{faired}");
     let rounds = faired["rounds_run"].as_u64().unwrap();
     assert!((2..60).contains(&rounds), "{faired}");
+    // The time spent estimating and finding creases is part of the whole.
+    let detection = faired["detection_ms"].as_f64().unwrap();
+    assert!(detection > 0.0 && detection < faired["time_ms"].as_f64().unwrap(), "{faired}");
     // Explicit rounds are exactly what they say; the paper's variant is one round, no creases.
     let two = json_of(&[
         "fair",

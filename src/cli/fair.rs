@@ -280,6 +280,7 @@ pub fn run(args: FairArgs) -> anyhow::Result<()> {
             "crease_edges": report.crease_edges,
             "loose_triangles": report.loose_triangles,
             "time_ms": time_ms,
+            "detection_ms": report.detection_ms,
             "volume_change_percent": volume_change_percent,
             "max_move": report.max_move,
             "masked_vertices": mask.as_ref().map(|m| m.painted_count()),

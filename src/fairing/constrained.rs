@@ -62,8 +62,8 @@ use super::creases::{
     FeatureClass,
 };
 use super::strength::{
-    estimate_noise_away_from_edges, estimate_noise_with_fans, normal_filtering_for, RoundRisk,
-    CLEAN_NOISE, MAX_AUTO_ROUNDS, RISK_MIN_FALL, RISK_PATIENCE,
+    normal_filtering_for, read_noise, RoundRisk, CLEAN_NOISE, MAX_AUTO_ROUNDS, RISK_MIN_FALL,
+    RISK_PATIENCE,
 };
 use super::volume::VolumeKeeper;
 use super::{BoundaryMode, FairOptions, FairReport, FairVariant, Strength};
@@ -1641,7 +1641,7 @@ fn decide_and_fair(
     may_reorder: bool,
 ) -> FairReport {
     // The fan-ordered one-rings the operator is built from serve the noise estimate and the
-    // crease detection first (`estimate_noise_with_fans`, `detect_creases_with_estimate`).
+    // crease detection first (`read_noise`, `detect_creases_with_estimate`).
     let fans = FanRings::new(&mesh.triangles, topology);
     // The noise estimate decides the strength (automatic) and how much the normals are filtered
     // before creases are detected (raw normals of a noisy mesh make creases of the noise).
@@ -1649,7 +1649,9 @@ fn decide_and_fair(
     // normals; a fixed strength finds the estimate and the faces' own feature edges in one
     // gather, and skips the filter when the mesh is clean.
     let mut face_rings = FaceRingCache::default();
-    let (estimate, found) = match (&options.creases, options.strength) {
+    let started = std::time::Instant::now();
+    // Automatic strength reads, in the same gather, which vertices lie on sharp edges.
+    let (estimate, found, reading) = match (&options.creases, options.strength) {
         (Some(crease_options), Strength::Fixed) => {
             let (estimate, creases) = detect_creases_with_estimate(
                 mesh,
@@ -1658,20 +1660,25 @@ fn decide_and_fair(
                 crease_options,
                 &mut face_rings,
             );
-            (estimate, Some(creases))
+            (estimate, Some(creases), None)
         }
-        (_, Strength::Auto) => (estimate_noise_with_fans(mesh, topology, &fans), None),
-        (None, _) => (None, None),
+        (_, Strength::Auto) => {
+            let angle = options
+                .creases
+                .as_ref()
+                .map_or(CreaseOptions::default().angle_degrees, |c| c.angle_degrees);
+            let reading = read_noise(mesh, topology, &fans, angle);
+            (reading.noise(topology), None, Some(reading))
+        }
+        (None, _) => (None, None, None),
     };
     // Automatic strength: a clean mesh is left as it is, and so is one that reads noisy only
     // because of its sharp edges (a coarse CAD part: most of its vertices lie on or beside an
     // edge, and those make the median read noise; away from the edges it reads clean).
     let clean_away_from_edges = || {
-        let angle = options
-            .creases
+        reading
             .as_ref()
-            .map_or(CreaseOptions::default().angle_degrees, |c| c.angle_degrees);
-        estimate_noise_away_from_edges(mesh, topology, &fans, angle)
+            .and_then(|reading| reading.away_from_edges(topology))
             .is_some_and(|away| away <= CLEAN_NOISE)
     };
     let auto_noise = match options.strength {
@@ -1680,20 +1687,23 @@ fn decide_and_fair(
             _ => {
                 return FairReport {
                     noise_estimate: estimate,
+                    detection_ms: milliseconds(started),
                     ..FairReport::default()
                 }
             }
         },
         _ => None,
     };
+    drop(reading);
+    let decided_ms = milliseconds(started);
     let rounds = Rounds {
         estimate,
         auto_noise,
         pinned,
     };
-    if may_reorder && auto_noise.is_some() {
+    let mut report = if may_reorder && auto_noise.is_some() {
         drop(fans);
-        return in_local_order(
+        in_local_order(
             mesh,
             topology,
             options,
@@ -1709,9 +1719,17 @@ fn decide_and_fair(
                     Rounds { pinned, ..rounds },
                 )
             },
-        );
-    }
-    fair_rounds(mesh, topology, fans, (found, face_rings), options, rounds)
+        )
+    } else {
+        fair_rounds(mesh, topology, fans, (found, face_rings), options, rounds)
+    };
+    report.detection_ms += decided_ms;
+    report
+}
+
+/// Milliseconds since `start`.
+fn milliseconds(start: std::time::Instant) -> f64 {
+    start.elapsed().as_secs_f64() * 1e3
 }
 
 /// What [`fair_rounds`] takes from the decision to fair.
@@ -1748,6 +1766,7 @@ fn fair_rounds(
     // as much as the current noise asks for: the first time as the input's estimate says, later
     // as the estimate made in the same gather as the faces' own feature edges says
     // (`detect_creases_with_estimate`; once the noise is gone, that gather is the detection).
+    let started = std::time::Instant::now();
     let mut creases = found.or_else(|| {
         options.creases.as_ref().map(|crease_options| {
             let mut crease_options = crease_options.clone();
@@ -1757,6 +1776,7 @@ fn fair_rounds(
             detect_creases_cached(mesh, topology, &crease_options, &mut face_rings)
         })
     });
+    let first_detection_ms = milliseconds(started);
     let max_rounds = match auto_noise {
         Some(_) => MAX_AUTO_ROUNDS,
         None => options.rounds,
@@ -1784,7 +1804,10 @@ fn fair_rounds(
     let volume = options
         .keep_volume
         .then(|| VolumeKeeper::new(mesh, topology, pinned));
-    let mut report = FairReport::default();
+    let mut report = FairReport {
+        detection_ms: first_detection_ms,
+        ..FairReport::default()
+    };
     // Automatic strength: round by round while the estimated risk of the result falls (see
     // [`super::strength`]): a copy of the input, moved a little along its normals, goes through
     // the same rounds, and the mesh goes back to the round with the least risk.
@@ -1819,6 +1842,7 @@ fn fair_rounds(
             &fans,
             &options.creases,
         ) {
+            let started = std::time::Instant::now();
             let (_, found) =
                 detect_creases_with_estimate(mesh, topology, fans, crease_options, &mut face_rings);
             let found = Some(found);
@@ -1833,8 +1857,10 @@ fn fair_rounds(
                     CREASE_SETTLED * edges_changed(before, after) <= before.len().max(after.len());
                 creases = found;
                 unchanged = if settled { unchanged + 1 } else { 0 };
+                report.detection_ms += milliseconds(started);
                 fairing = fairing.for_other_creases(mesh, topology, fans, creases.as_ref(), pinned);
             } else {
+                report.detection_ms += milliseconds(started);
                 unchanged += 1;
             }
         }

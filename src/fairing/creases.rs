@@ -716,9 +716,15 @@ pub(crate) fn fan_feature_edges(
 /// normal makes none).
 #[inline]
 fn feature(na: Vec3A, nb: Vec3A, threshold: f32) -> Option<Vec3A> {
+    is_feature(na, nb, threshold).then(|| na.cross(nb).normalize_or_zero())
+}
+
+/// Whether an edge whose faces have the normals `na` and `nb` is a feature edge ([`feature`]
+/// without the direction).
+#[inline]
+pub(crate) fn is_feature(na: Vec3A, nb: Vec3A, threshold: f32) -> bool {
     let (la, lb) = (na.length(), nb.length());
-    (la > 0.0 && lb > 0.0 && (la * lb).is_finite() && na.dot(nb) < threshold * la * lb)
-        .then(|| na.cross(nb).normalize_or_zero())
+    la > 0.0 && lb > 0.0 && (la * lb).is_finite() && na.dot(nb) < threshold * la * lb
 }
 
 /// The creases from the feature edges: small and zigzagging groups dropped, vertices classified,

@@ -231,6 +231,9 @@ pub struct FairReport {
     /// ([`crate::mesh::loose_triangles`]; the default variant only): their corners move with
     /// the rest of the surface.
     pub loose_triangles: usize,
+    /// Milliseconds of the run spent estimating the noise and finding creases (constrained
+    /// fairing; before the first round and again between rounds), part of its whole time.
+    pub detection_ms: f64,
 }
 
 /// The smoothing methods offered by the CLI and the editor.

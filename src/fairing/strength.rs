@@ -7,7 +7,7 @@
 //! finely sampled ones and on CAD parts), while a clean mesh should not be touched at all. So the
 //! default measures the noise before fairing (at or below [`CLEAN_NOISE`] it does nothing; nor
 //! when the mesh reads that clean once the vertices on its sharp edges are left out,
-//! `estimate_noise_away_from_edges`), and a noisy mesh is faired round by round while Stein's
+//! `NoiseReading::away_from_edges`), and a noisy mesh is faired round by round while Stein's
 //! unbiased risk estimate of the result goes down (`RoundRisk`).
 //!
 //! # The noise estimate
@@ -44,10 +44,11 @@
 //! part's creases found again after a few rounds lower it again), or after [`MAX_AUTO_ROUNDS`].
 
 use super::constrained::FanRings;
-use super::creases::{fan_feature_edges, vertex_feature_edges, FeatureEdge};
+use super::creases::{fan_feature_edges, is_feature, vertex_feature_edges, FeatureEdge};
 use crate::mesh::{Topology, TriMesh};
 use glam::Vec3A;
 use rayon::prelude::*;
+use std::sync::atomic::{AtomicBool, Ordering};
 
 /// The spread of r_v (see the module docs) for unit Gaussian noise along the normals: measured
 /// on flat and gently curved valence-6 meshes, and on `bunny00` with σ = 0.3 (the estimate then
@@ -63,43 +64,62 @@ pub const NOISE_GAIN: f64 = 1.5;
 /// vertices; each vertex is computed by the same operations whatever the thread count, and the
 /// median does not depend on the order, so neither does the result.
 pub fn estimate_noise(mesh: &TriMesh, topology: &Topology) -> Option<f64> {
-    estimate(mesh, topology, None, None).0
+    let (heights, _) = gather(mesh, topology, None, None, None);
+    heights.and_then(|h| h.spread(topology, None))
 }
 
 /// [`estimate_noise`] for a caller that has the fan-ordered one-rings (constrained fairing builds
-/// them anyway): see [`scan_fans`].
-pub(crate) fn estimate_noise_with_fans(
-    mesh: &TriMesh,
-    topology: &Topology,
-    fans: &FanRings,
-) -> Option<f64> {
-    estimate(mesh, topology, Some(fans), None).0
-}
-
-/// [`estimate_noise_with_fans`] with the vertices on sharp edges left out (edges where the faces'
-/// own normals turn by more than `crease_angle` degrees; such a vertex is neither counted nor
-/// taken into its neighbours' means), the less of two readings: with the vertices beside those
-/// edges counted, and without them (where a curved surface meets a sharp feature its curvature
-/// does not cancel in the neighbours' mean); `None` when both leave fewer than a quarter of the
-/// vertices. On a coarse CAD part most vertices lie on or beside its edges, and those make the
-/// median read noise where there is none.
-pub(crate) fn estimate_noise_away_from_edges(
+/// them anyway), with, from the same gather, which vertices lie on a sharp edge (an edge where
+/// the faces' own normals turn by more than `crease_angle` degrees), for
+/// [`NoiseReading::away_from_edges`]. On the noisy 1.2M-face bunny (500k such edges) the reading
+/// away from the edges took a gather of its own that listed every edge with its direction: 68 ms,
+/// now a few (the flags are set as the edges are found).
+pub(crate) fn read_noise(
     mesh: &TriMesh,
     topology: &Topology,
     fans: &FanRings,
     crease_angle: f64,
-) -> Option<f64> {
-    let (heights, edges) = gather(mesh, topology, Some(fans), Some(crease_angle));
-    let heights = heights?;
-    let mut on_edge = vec![false; mesh.positions.len()];
-    for ([a, b], _) in &edges {
-        on_edge[*a as usize] = true;
-        on_edge[*b as usize] = true;
+) -> NoiseReading {
+    let flags: Vec<AtomicBool> = (0..mesh.positions.len())
+        .into_par_iter()
+        .with_min_len(VERTEX_BLOCK)
+        .map(|_| AtomicBool::new(false))
+        .collect();
+    let (heights, _) = gather(mesh, topology, Some(fans), Some(crease_angle), Some(&flags));
+    let on_edge = flags
+        .into_par_iter()
+        .with_min_len(VERTEX_BLOCK)
+        .map(AtomicBool::into_inner)
+        .collect();
+    NoiseReading { heights, on_edge }
+}
+
+/// What [`read_noise`] gathered.
+pub(crate) struct NoiseReading {
+    heights: Option<Heights>,
+    /// Whether each vertex is an end of a sharp edge.
+    on_edge: Vec<bool>,
+}
+
+impl NoiseReading {
+    /// [`estimate_noise`].
+    pub fn noise(&self, topology: &Topology) -> Option<f64> {
+        self.heights.as_ref()?.spread(topology, None)
     }
-    [false, true]
-        .into_iter()
-        .filter_map(|beside| heights.spread(topology, Some((&on_edge, beside))))
-        .reduce(f64::min)
+
+    /// The estimate with the vertices on sharp edges left out (such a vertex is neither counted
+    /// nor taken into its neighbours' means), the less of two readings: with the vertices beside
+    /// those edges counted, and without them (where a curved surface meets a sharp feature its
+    /// curvature does not cancel in the neighbours' mean); `None` when both leave fewer than a
+    /// quarter of the vertices. On a coarse CAD part most vertices lie on or beside its edges,
+    /// and those make the median read noise where there is none.
+    pub fn away_from_edges(&self, topology: &Topology) -> Option<f64> {
+        let heights = self.heights.as_ref()?;
+        [false, true]
+            .into_iter()
+            .filter_map(|beside| heights.spread(topology, Some((&self.on_edge, beside))))
+            .reduce(f64::min)
+    }
 }
 
 /// What [`scan_fans`] finds.
@@ -124,25 +144,16 @@ pub(crate) fn scan_fans(
     fans: &FanRings,
     crease_angle: f64,
 ) -> FanScan {
-    let (noise, edges) = estimate(mesh, topology, Some(fans), Some(crease_angle));
-    FanScan { noise, edges }
+    let (heights, edges) = gather(mesh, topology, Some(fans), Some(crease_angle), None);
+    FanScan {
+        noise: heights.and_then(|h| h.spread(topology, None)),
+        edges,
+    }
 }
 
 /// Vertices per block of the estimate's gather (each block's edge-length sum and feature edges
 /// are kept apart and joined in order, so nothing depends on the thread count).
 const VERTEX_BLOCK: usize = 4096;
-
-/// The estimate (with the mean edge length summed in the same gather, as
-/// [`crate::metrics::mean_edge_length`] defines it) and, with a crease angle, the feature edges.
-fn estimate(
-    mesh: &TriMesh,
-    topology: &Topology,
-    fans: Option<&FanRings>,
-    crease_angle: Option<f64>,
-) -> (Option<f64>, Vec<FeatureEdge>) {
-    let (heights, edges) = gather(mesh, topology, fans, crease_angle);
-    (heights.and_then(|h| h.spread(topology, None)), edges)
-}
 
 /// Every vertex's h_v and the mean edge length, from one gather (see the module docs).
 struct Heights {
@@ -152,13 +163,16 @@ struct Heights {
     edge: f64,
 }
 
-/// The gather behind [`estimate`]: [`Heights`] (`None` when the mean edge length is not
-/// positive and finite) and, with a crease angle, the feature edges.
+/// The gather behind the estimates: [`Heights`] (`None` when the mean edge length is not
+/// positive and finite; the mean edge length is summed in the same gather, as
+/// [`crate::metrics::mean_edge_length`] defines it) and, with a crease angle, the feature edges,
+/// or, with `on_edge` too, no list but both ends of every feature edge marked there.
 fn gather(
     mesh: &TriMesh,
     topology: &Topology,
     fans: Option<&FanRings>,
     crease_angle: Option<f64>,
+    on_edge: Option<&[AtomicBool]>,
 ) -> (Option<Heights>, Vec<FeatureEdge>) {
     let n = mesh.positions.len();
     let point = |v: u32| Vec3A::from_array(mesh.positions[v as usize]);
@@ -200,8 +214,22 @@ fn gather(
                             lengths += dk.length();
                             previous = dk;
                         }
-                        if let Some(threshold) = threshold {
-                            fan_feature_edges(v, ring, &faces[..valence], threshold, &mut edges);
+                        match (threshold, on_edge) {
+                            (Some(threshold), Some(on_edge)) => {
+                                let faces = &faces[..valence];
+                                for (k, &u) in ring.iter().enumerate() {
+                                    if u > v
+                                        && is_feature(faces[k], faces[(k + 1) % valence], threshold)
+                                    {
+                                        on_edge[v as usize].store(true, Ordering::Relaxed);
+                                        on_edge[u as usize].store(true, Ordering::Relaxed);
+                                    }
+                                }
+                            }
+                            (Some(threshold), None) => {
+                                fan_feature_edges(v, ring, &faces[..valence], threshold, &mut edges)
+                            }
+                            (None, _) => {}
                         }
                     }
                     None => {
@@ -218,7 +246,14 @@ fn gather(
                         }
                         if let Some(threshold) = threshold {
                             let normal = |f: u32| area_normal(mesh, f);
+                            let first = edges.len();
                             vertex_feature_edges(mesh, topology, v, normal, threshold, &mut edges);
+                            if let Some(on_edge) = on_edge {
+                                for ([a, b], _) in edges.drain(first..) {
+                                    on_edge[a as usize].store(true, Ordering::Relaxed);
+                                    on_edge[b as usize].store(true, Ordering::Relaxed);
+                                }
+                            }
                         }
                     }
                 }
