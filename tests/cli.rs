@@ -522,7 +522,10 @@ fn fair_leaves_a_clean_mesh_alone_and_says_how_noisy_the_input_was() {
     assert!((2..60).contains(&rounds), "{faired}");
     // The time spent estimating and finding creases is part of the whole.
     let detection = faired["detection_ms"].as_f64().unwrap();
-    assert!(detection > 0.0 && detection < faired["time_ms"].as_f64().unwrap(), "{faired}");
+    assert!(
+        detection > 0.0 && detection < faired["time_ms"].as_f64().unwrap(),
+        "{faired}"
+    );
     // Explicit rounds are exactly what they say; the paper's variant is one round, no creases.
     let two = json_of(&[
         "fair",

@@ -585,15 +585,18 @@ pub(crate) fn detect_creases_cached(
 /// fan-ordered one-rings (constrained fairing builds them anyway; the hierarchy builds them for
 /// this). The estimate's gather finds the feature edges of the faces' own normals at once
 /// ([`super::strength::scan_fans`]); when the estimate says the mesh is clean (no filtering),
-/// those are the creases' edges, and the guided filter is skipped entirely.
+/// those are the creases' edges, and the guided filter is skipped entirely. Without `estimate`
+/// no estimate is made (`None`) and the normals are filtered as `options` say: for a caller that
+/// has read the mesh clean and only smooths it further.
 pub(crate) fn detect_creases_with_estimate(
     mesh: &TriMesh,
     topology: &Topology,
     fans: &FanRings,
     options: &CreaseOptions,
     cache: &mut FaceRingCache,
+    estimate: bool,
 ) -> (Option<f64>, Creases) {
-    let scan = scan_fans(mesh, topology, fans, options.angle_degrees);
+    let scan = scan_fans(mesh, topology, fans, options.angle_degrees, estimate);
     let mut options = options.clone();
     options.normal_filtering = options
         .normal_filtering
@@ -1114,6 +1117,7 @@ mod tests {
                 &fans,
                 &options,
                 &mut FaceRingCache::default(),
+                true,
             );
             let general_estimate = estimate_noise(&mesh, &topology).unwrap();
             let estimate = estimate.unwrap();
@@ -1130,7 +1134,11 @@ mod tests {
             assert!(!creases.is_empty());
             assert_eq!(creases, general, "filtering {filtering}");
             // And without filtering the scan's raw edges are the general path's.
-            let raw = scan_fans(&mesh, &topology, &fans, options.angle_degrees).edges;
+            let raw = scan_fans(&mesh, &topology, &fans, options.angle_degrees, true).edges;
+            // The same without the estimate.
+            let alone = scan_fans(&mesh, &topology, &fans, options.angle_degrees, false);
+            assert_eq!(alone.noise, None);
+            assert_eq!(alone.edges, raw);
             let general: Vec<[u32; 2]> = {
                 let unit = filter_face_normals(
                     &mesh,

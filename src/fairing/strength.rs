@@ -64,7 +64,7 @@ pub const NOISE_GAIN: f64 = 1.5;
 /// vertices; each vertex is computed by the same operations whatever the thread count, and the
 /// median does not depend on the order, so neither does the result.
 pub fn estimate_noise(mesh: &TriMesh, topology: &Topology) -> Option<f64> {
-    let (heights, _) = gather(mesh, topology, None, None, None);
+    let (heights, _) = gather(mesh, topology, None, None, None, true);
     heights.and_then(|h| h.spread(topology, None))
 }
 
@@ -85,7 +85,14 @@ pub(crate) fn read_noise(
         .with_min_len(VERTEX_BLOCK)
         .map(|_| AtomicBool::new(false))
         .collect();
-    let (heights, _) = gather(mesh, topology, Some(fans), Some(crease_angle), Some(&flags));
+    let (heights, _) = gather(
+        mesh,
+        topology,
+        Some(fans),
+        Some(crease_angle),
+        Some(&flags),
+        true,
+    );
     let on_edge = flags
         .into_par_iter()
         .with_min_len(VERTEX_BLOCK)
@@ -138,13 +145,25 @@ pub(crate) struct FanScan {
 /// the umbrella, Σ (x_k − x) × (x_(k+1) − x) (the sum of its faces' area normals), and its faces'
 /// normals from consecutive offsets, so it reads no face at all. The other vertices (on a
 /// boundary, or whose faces are no single oriented fan) read their faces.
+///
+/// Without `estimate` only the feature edges are found (`noise` is `None`): a caller that has
+/// read the mesh clean once and only smooths it further (constrained fairing's later rounds)
+/// saves the estimate's share, about a fifth of the gather and its median.
 pub(crate) fn scan_fans(
     mesh: &TriMesh,
     topology: &Topology,
     fans: &FanRings,
     crease_angle: f64,
+    estimate: bool,
 ) -> FanScan {
-    let (heights, edges) = gather(mesh, topology, Some(fans), Some(crease_angle), None);
+    let (heights, edges) = gather(
+        mesh,
+        topology,
+        Some(fans),
+        Some(crease_angle),
+        None,
+        estimate,
+    );
     FanScan {
         noise: heights.and_then(|h| h.spread(topology, None)),
         edges,
@@ -166,13 +185,15 @@ struct Heights {
 /// The gather behind the estimates: [`Heights`] (`None` when the mean edge length is not
 /// positive and finite; the mean edge length is summed in the same gather, as
 /// [`crate::metrics::mean_edge_length`] defines it) and, with a crease angle, the feature edges,
-/// or, with `on_edge` too, no list but both ends of every feature edge marked there.
+/// or, with `on_edge` too, no list but both ends of every feature edge marked there. Without
+/// `want_heights` no heights are taken (`None`).
 fn gather(
     mesh: &TriMesh,
     topology: &Topology,
     fans: Option<&FanRings>,
     crease_angle: Option<f64>,
     on_edge: Option<&[AtomicBool]>,
+    want_heights: bool,
 ) -> (Option<Heights>, Vec<FeatureEdge>) {
     let n = mesh.positions.len();
     let point = |v: u32| Vec3A::from_array(mesh.positions[v as usize]);
@@ -211,7 +232,9 @@ fn gather(
                             offset += dk;
                             *face = previous.cross(dk);
                             normal += *face;
-                            lengths += dk.length();
+                            if want_heights {
+                                lengths += dk.length();
+                            }
                             previous = dk;
                         }
                         match (threshold, on_edge) {
@@ -239,7 +262,7 @@ fn gather(
                         for &f in topology.faces_of(v) {
                             normal += area_normal(mesh, f);
                             for c in mesh.triangles[f as usize] {
-                                if c != v {
+                                if c != v && want_heights {
                                     lengths += 0.5 * (point(c) - x).length();
                                 }
                             }
@@ -258,7 +281,7 @@ fn gather(
                     }
                 }
                 edge_sum += lengths as f64;
-                *h = match normal.try_normalize() {
+                *h = match normal.try_normalize().filter(|_| want_heights) {
                     Some(normal) if !topology.is_boundary_vertex(v) && valence >= 3 => {
                         normal.dot(offset) / valence as f32
                     }

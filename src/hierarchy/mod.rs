@@ -563,6 +563,7 @@ fn build(
                 &fans,
                 crease_options,
                 &mut FaceRingCache::default(),
+                true,
             )
             .1
         })
