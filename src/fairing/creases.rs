@@ -43,7 +43,7 @@
 //! Every vertex and face is computed by the same operations whatever the thread count.
 
 use super::constrained::FanRings;
-use super::strength::{face_normals, normal_filtering_for, scan_fans};
+use super::strength::{area_normal, normal_filtering_for, scan_fans};
 use crate::mesh::{Topology, TriMesh};
 use glam::{Mat4, Vec3A, Vec4};
 use rayon::prelude::*;
@@ -176,14 +176,11 @@ pub fn filtered_face_normals(
     passes: usize,
     sigma: f64,
 ) -> Vec<Vec3A> {
-    filter_face_normals(
-        mesh,
-        topology,
-        &face_normals(mesh),
-        passes,
-        sigma,
-        &mut FaceRingCache::default(),
-    )
+    filter_face_normals(mesh, topology, passes, sigma, &mut FaceRingCache::default())
+        .into_par_iter()
+        .with_min_len(4096)
+        .map(xyz)
+        .collect()
 }
 
 /// The faces around each face, built the first time the guided filter runs and kept for later
@@ -210,8 +207,8 @@ impl FaceRingCache {
     }
 }
 
-/// [`filtered_face_normals`] from the faces' area normals (`area_normals[f]`: (x_b − x_a) ×
-/// (x_c − x_a) of face f).
+/// [`filtered_face_normals`], each unit normal with its face's doubled area in w (the area of
+/// the input's face), by face id.
 ///
 /// How it is computed: in f32 (normals are directions; a pass averages a dozen of them), with the
 /// faces around each face (those sharing a vertex with it, each with the number of vertices it
@@ -222,17 +219,19 @@ impl FaceRingCache {
 /// weights' exponentials by [`exp_of_negative`]): on the noisy 1.2M-face bunny a pass went from
 /// 90 to 74 ms (2 threads), with the same creases on every mesh of `fairing_default`'s table.
 /// Each face is computed by the same operations whatever the thread count. No pass (a clean
-/// mesh) builds nothing: the normals are the faces' own.
+/// mesh) builds nothing: the normals are the faces' own. Three arrays of the faces' size are
+/// written (the normals, the patches and then the filtered normals over them, the guidance);
+/// there were six, and a detection's first touch of their pages cost ~30 ms on 1.2M faces.
 fn filter_face_normals(
     mesh: &TriMesh,
     topology: &Topology,
-    area_normals: &[Vec3A],
     passes: usize,
     sigma: f64,
     cache: &mut FaceRingCache,
-) -> Vec<Vec3A> {
-    // Unit normal and area (twice the area: only ratios matter) of a face.
-    let unit = |n: Vec3A| {
+) -> Vec<Vec4> {
+    // Unit normal and area (twice the area: only ratios matter) of face f.
+    let unit = |f: u32| {
+        let n = area_normal(mesh, f);
         let length = n.length();
         if length > 0.0 && length.is_finite() {
             (n / length).extend(length)
@@ -240,11 +239,12 @@ fn filter_face_normals(
             Vec4::ZERO
         }
     };
+    let face_count = mesh.triangles.len();
     if passes == 0 {
-        return area_normals
-            .par_iter()
+        return (0..face_count as u32)
+            .into_par_iter()
             .with_min_len(4096)
-            .map(|&n| xyz(unit(n)))
+            .map(unit)
             .collect();
     }
     let mesh_order = cache.mesh_order;
@@ -256,19 +256,19 @@ fn filter_face_normals(
         Some(order) => order
             .par_iter()
             .with_min_len(4096)
-            .map(|&f| unit(area_normals[f as usize]))
+            .map(|&f| unit(f))
             .collect(),
-        None => area_normals
-            .par_iter()
+        None => (0..face_count as u32)
+            .into_par_iter()
             .with_min_len(4096)
-            .map(|&n| unit(n))
+            .map(unit)
             .collect(),
     };
     let inverse = (1.0 / (2.0 * sigma * sigma)) as f32;
-    let face_count = current.len();
+    // Three arrays: the patches are no longer read once the guidance is taken, so the filtered
+    // normals are written over them.
     let mut patches = vec![Vec4::ZERO; face_count];
     let mut guidance = vec![Vec4::ZERO; face_count];
-    let mut next = vec![Vec4::ZERO; face_count];
     for _ in 0..passes {
         // Each patch (the faces around a face, with their multiplicities): its area-weighted
         // mean normal and how much its normals disagree (the largest squared difference from
@@ -310,7 +310,8 @@ fn filter_face_normals(
             }
             *guide = xyz(best).extend(0.0);
         });
-        rings.for_each_face(&mut next, |f, around, shared, out| {
+        let next = &mut patches;
+        rings.for_each_face(next, |f, around, shared, out| {
             let own = guidance[f];
             let mut sum = [Vec4::ZERO; 3];
             for k in (0..around.len()).step_by(4) {
@@ -332,21 +333,17 @@ fn filter_face_normals(
             let area = current[f].w;
             *out = sum.try_normalize().unwrap_or(xyz(current[f])).extend(area);
         });
-        std::mem::swap(&mut current, &mut next);
+        std::mem::swap(&mut current, next);
     }
     match &rings.order {
         Some(order) => {
-            let mut normals = vec![Vec3A::ZERO; current.len()];
+            let mut normals = vec![Vec4::ZERO; current.len()];
             for (&f, n) in order.iter().zip(&current) {
-                normals[f as usize] = xyz(*n);
+                normals[f as usize] = *n;
             }
             normals
         }
-        None => current
-            .par_iter()
-            .with_min_len(4096)
-            .map(|&n| xyz(n))
-            .collect(),
+        None => current,
     }
 }
 
@@ -567,7 +564,6 @@ pub(crate) fn detect_creases_cached(
     let normals = filter_face_normals(
         mesh,
         topology,
-        &face_normals(mesh),
         options.normal_filtering,
         options.normal_sigma,
         cache,
@@ -618,7 +614,7 @@ pub(crate) type FeatureEdge = ([u32; 2], Vec3A);
 fn feature_edges(
     mesh: &TriMesh,
     topology: &Topology,
-    normals: &[Vec3A],
+    normals: &[Vec4],
     options: &CreaseOptions,
 ) -> Vec<FeatureEdge> {
     let threshold = options.angle_degrees.to_radians().cos() as f32;
@@ -631,7 +627,7 @@ fn feature_edges(
                 mesh,
                 topology,
                 v,
-                |f| normals[f as usize],
+                |f| xyz(normals[f as usize]),
                 threshold,
                 &mut edges,
             );
@@ -1083,9 +1079,8 @@ mod tests {
         let mut mesh = cuboid([1.0, 1.0, 1.0], 0.05);
         add_noise(&mut mesh, &NoiseOptions::default().with_sigma(0.3));
         let topology = Topology::build(&mesh);
-        let area = face_normals(&mesh);
         let filter =
-            |cache: &mut FaceRingCache| filter_face_normals(&mesh, &topology, &area, 3, 0.5, cache);
+            |cache: &mut FaceRingCache| filter_face_normals(&mesh, &topology, 3, 0.5, cache);
         let (mut morton, mut own) = (FaceRingCache::default(), FaceRingCache::in_mesh_order());
         let expected = filter(&mut morton);
         assert!(morton.rings.as_ref().unwrap().order.is_some());
@@ -1094,8 +1089,8 @@ mod tests {
         assert!(own.rings.as_ref().unwrap().order.is_none());
         assert_eq!(got, expected);
         // The filter moved the normals (a pass that did nothing would pass the comparison).
-        let raw = filter_face_normals(&mesh, &topology, &area, 0, 0.5, &mut own);
-        assert!(raw.iter().zip(&got).filter(|(a, b)| a != b).count() > area.len() / 2);
+        let raw = filter_face_normals(&mesh, &topology, 0, 0.5, &mut own);
+        assert!(raw.iter().zip(&got).filter(|(a, b)| a != b).count() > raw.len() / 2);
     }
 
     /// The path constrained fairing and the hierarchy take (the estimate's gather over the fans
@@ -1140,14 +1135,8 @@ mod tests {
             assert_eq!(alone.noise, None);
             assert_eq!(alone.edges, raw);
             let general: Vec<[u32; 2]> = {
-                let unit = filter_face_normals(
-                    &mesh,
-                    &topology,
-                    &face_normals(&mesh),
-                    0,
-                    0.5,
-                    &mut FaceRingCache::default(),
-                );
+                let unit =
+                    filter_face_normals(&mesh, &topology, 0, 0.5, &mut FaceRingCache::default());
                 feature_edges(&mesh, &topology, &unit, &options)
                     .into_iter()
                     .map(|(e, _)| e)
