@@ -747,11 +747,13 @@ fn finish(
     // edges: a true crease, even a noisy one, runs straight between few corners).
     let max_turn = options.corner_turn_degrees.to_radians().cos();
     let min_edges = options.min_edges;
-    let edges = keep_groups(edges, None, |edges, _| edges >= min_edges);
+    let edges = keep_groups(edges, vertex_count, None, |edges, _| edges >= min_edges);
     // The zigzag test turns by the edges' positions: noise that lines up into a fake crease
     // zigzags there, while the faces' crease directions may still agree.
     let class = classify(topology, &edges, Turn::Positions(mesh), max_turn);
-    let mut edges = keep_groups(edges, Some(&class), |edges, corners| 2 * corners <= edges);
+    let mut edges = keep_groups(edges, vertex_count, Some(&class), |edges, corners| {
+        2 * corners <= edges
+    });
     // The file's own sharp edges join whatever their angle and length; their crease direction is
     // the edge's own (a crease direction lies along its edge).
     if !options.file_edges.is_empty() {
@@ -777,7 +779,7 @@ impl Creases {
     /// closed loops of crease vertices that remain. A vertex classed `Crease` must have exactly
     /// two feature edges (one with another number is taken as a corner).
     pub fn from_classified(edges: Vec<[u32; 2]>, mut class: Vec<FeatureClass>) -> Creases {
-        let graph = FeatureGraph::new(&edges);
+        let graph = FeatureGraph::new(&edges, class.len());
         let feature_neighbors = |v: u32| graph.neighbors(v);
         // A vertex with no feature edge is smooth; one with two may be a crease vertex; any
         // other is a corner.
@@ -786,7 +788,7 @@ impl Creases {
                 *c = FeatureClass::Smooth;
             }
         }
-        for (i, &v) in graph.vertices.iter().enumerate() {
+        for (i, &v) in graph.vertices.list.iter().enumerate() {
             let c = &mut class[v as usize];
             *c = match (*c, graph.neighbors_at(i).len()) {
                 (FeatureClass::Crease, 2) => FeatureClass::Crease,
@@ -834,14 +836,14 @@ impl Creases {
             }
         };
         let mut chains = Vec::new();
-        for (i, &v) in graph.vertices.iter().enumerate() {
+        for (i, &v) in graph.vertices.list.iter().enumerate() {
             if class[v as usize] == FeatureClass::Corner {
                 for &u in graph.neighbors_at(i) {
                     chains.extend(walk(v, u, &mut used));
                 }
             }
         }
-        for (i, &v) in graph.vertices.iter().enumerate() {
+        for (i, &v) in graph.vertices.list.iter().enumerate() {
             if class[v as usize] == FeatureClass::Crease {
                 let first = graph.neighbors_at(i)[0];
                 chains.extend(walk(v, first, &mut used));
@@ -875,52 +877,104 @@ impl Creases {
 /// Closed creases with fewer vertices than this are held in place.
 pub const MIN_FAIRED_LOOP: usize = 8;
 
-/// The vertices on feature edges and their feature neighbours, kept apart from the mesh's
-/// numbering (a detection on a mesh of 600k vertices with a hundred feature edges touches a few
-/// hundred entries, not arrays of the mesh's size).
+/// The vertices on feature edges, each with a place of its own (0, 1, …), so that what is kept
+/// per vertex need not be of the mesh's size (a detection on a mesh of 600k vertices with a
+/// hundred feature edges touches a few hundred entries).
+struct FeatureVertices {
+    /// The vertices with a feature edge, ascending: `list[place]`.
+    list: Vec<u32>,
+    /// With many edges, every vertex's place (`u32::MAX`: none).
+    table: Option<Vec<u32>>,
+}
+
+impl FeatureVertices {
+    /// The ends of `edges`, between vertices numbered below `vertex_count`.
+    fn new(edges: &[[u32; 2]], vertex_count: usize) -> FeatureVertices {
+        // Few edges (a detection on a clean or faired mesh): the vertices sorted, found by
+        // bisection. Many (the faces' own normals of a noisy scan make an edge of a quarter of
+        // its edges): a table of the mesh's size finds them at once.
+        if 32 * edges.len() < vertex_count {
+            let mut list: Vec<u32> = edges.iter().flatten().copied().collect();
+            list.sort_unstable();
+            list.dedup();
+            FeatureVertices { list, table: None }
+        } else {
+            let mut table = vec![u32::MAX; vertex_count];
+            for &v in edges.iter().flatten() {
+                table[v as usize] = 0;
+            }
+            let mut list = Vec::new();
+            for (v, place) in table.iter_mut().enumerate() {
+                if *place == 0 {
+                    *place = list.len() as u32;
+                    list.push(v as u32);
+                }
+            }
+            FeatureVertices {
+                list,
+                table: Some(table),
+            }
+        }
+    }
+
+    /// The place of vertex `v`, if it has a feature edge.
+    fn place(&self, v: u32) -> Option<usize> {
+        match &self.table {
+            Some(table) => table
+                .get(v as usize)
+                .filter(|&&place| place != u32::MAX)
+                .map(|&place| place as usize),
+            None => self.list.binary_search(&v).ok(),
+        }
+    }
+
+    /// The places of both ends of an edge whose ends are listed.
+    fn ends(&self, [a, b]: [u32; 2]) -> [usize; 2] {
+        [a, b].map(|v| self.place(v).expect("an edge's ends are listed"))
+    }
+}
+
+/// The vertices on feature edges and their feature neighbours.
 struct FeatureGraph {
-    /// The vertices with a feature edge, ascending.
-    vertices: Vec<u32>,
-    /// `adjacent[offsets[i]..offsets[i + 1]]`: the feature neighbours of `vertices[i]`, in the
-    /// order of the edges.
+    vertices: FeatureVertices,
+    /// `adjacent[offsets[i]..offsets[i + 1]]`: the feature neighbours of the vertex at place i,
+    /// in the order of the edges.
     offsets: Vec<u32>,
     adjacent: Vec<u32>,
 }
 
 impl FeatureGraph {
-    fn new(edges: &[[u32; 2]]) -> FeatureGraph {
-        let mut vertices: Vec<u32> = edges.iter().flatten().copied().collect();
-        vertices.sort_unstable();
-        vertices.dedup();
-        let mut graph = FeatureGraph {
-            offsets: vec![0; vertices.len() + 1],
-            adjacent: vec![0; 2 * edges.len()],
-            vertices,
-        };
-        let ends: Vec<[usize; 2]> = edges
-            .iter()
-            .map(|e| e.map(|v| graph.index(v).expect("an edge's ends are listed")))
-            .collect();
-        for &[a, b] in &ends {
-            graph.offsets[a + 1] += 1;
-            graph.offsets[b + 1] += 1;
+    /// The graph of `edges` between vertices numbered below `vertex_count`.
+    fn new(edges: &[[u32; 2]], vertex_count: usize) -> FeatureGraph {
+        let vertices = FeatureVertices::new(edges, vertex_count);
+        let mut offsets = vec![0u32; vertices.list.len() + 1];
+        for &e in edges {
+            for end in vertices.ends(e) {
+                offsets[end + 1] += 1;
+            }
         }
-        for i in 0..graph.vertices.len() {
-            graph.offsets[i + 1] += graph.offsets[i];
+        for i in 0..vertices.list.len() {
+            offsets[i + 1] += offsets[i];
         }
-        let mut fill = graph.offsets.clone();
-        for (&[a, b], &[ia, ib]) in edges.iter().zip(&ends) {
-            graph.adjacent[fill[ia] as usize] = b;
+        let mut fill = offsets.clone();
+        let mut adjacent = vec![0; 2 * edges.len()];
+        for &[a, b] in edges {
+            let [ia, ib] = vertices.ends([a, b]);
+            adjacent[fill[ia] as usize] = b;
             fill[ia] += 1;
-            graph.adjacent[fill[ib] as usize] = a;
+            adjacent[fill[ib] as usize] = a;
             fill[ib] += 1;
         }
-        graph
+        FeatureGraph {
+            vertices,
+            offsets,
+            adjacent,
+        }
     }
 
-    /// The place of vertex `v` in [`Self::vertices`], if it has a feature edge.
+    /// The place of vertex `v`, if it has a feature edge.
     fn index(&self, v: u32) -> Option<usize> {
-        self.vertices.binary_search(&v).ok()
+        self.vertices.place(v)
     }
 
     /// The feature neighbours of the `i`-th listed vertex.
@@ -949,9 +1003,9 @@ fn classify(
     turn: Turn,
     max_turn: f64,
 ) -> Vec<FeatureClass> {
-    let graph = FeatureGraph::new(edges);
+    let graph = FeatureGraph::new(edges, topology.vertex_count());
     let mut class = vec![FeatureClass::Smooth; topology.vertex_count()];
-    for (i, &v) in graph.vertices.iter().enumerate() {
+    for (i, &v) in graph.vertices.list.iter().enumerate() {
         class[v as usize] = match graph.neighbors_at(i) {
             _ if topology.is_boundary_vertex(v) => FeatureClass::Corner,
             &[a, b] => {
@@ -984,40 +1038,40 @@ fn classify(
 /// corners are counted from `class` when given.
 fn keep_groups(
     edges: Vec<[u32; 2]>,
+    vertex_count: usize,
     class: Option<&[FeatureClass]>,
     keep: impl Fn(usize, usize) -> bool,
 ) -> Vec<[u32; 2]> {
     if edges.is_empty() {
         return edges;
     }
-    // Union-find over the feature vertices' places in the graph.
-    let graph = FeatureGraph::new(&edges);
-    let place = |v: u32| graph.index(v).expect("an edge's ends are listed");
-    let mut parent: Vec<usize> = (0..graph.vertices.len()).collect();
-    fn root(parent: &mut [usize], mut v: usize) -> usize {
-        while parent[v] != v {
-            parent[v] = parent[parent[v]];
-            v = parent[v];
+    // Union-find over the feature vertices' places.
+    let vertices = FeatureVertices::new(&edges, vertex_count);
+    let mut parent: Vec<u32> = (0..vertices.list.len() as u32).collect();
+    fn root(parent: &mut [u32], mut v: usize) -> usize {
+        while parent[v] as usize != v {
+            parent[v] = parent[parent[v] as usize];
+            v = parent[v] as usize;
         }
         v
     }
-    for &[a, b] in &edges {
-        let (ra, rb) = (root(&mut parent, place(a)), root(&mut parent, place(b)));
+    let mut roots = Vec::with_capacity(edges.len());
+    for &e in &edges {
+        let [a, b] = vertices.ends(e);
+        let (ra, rb) = (root(&mut parent, a), root(&mut parent, b));
         if ra != rb {
-            parent[ra.max(rb)] = ra.min(rb);
+            parent[ra.max(rb)] = ra.min(rb) as u32;
         }
+        roots.push(a);
     }
-    let mut edge_count = vec![0usize; graph.vertices.len()];
-    let mut corner_count = vec![0usize; graph.vertices.len()];
-    let roots: Vec<usize> = edges
-        .iter()
-        .map(|e| root(&mut parent, place(e[0])))
-        .collect();
-    for &r in &roots {
-        edge_count[r] += 1;
+    let mut edge_count = vec![0u32; vertices.list.len()];
+    let mut corner_count = vec![0u32; vertices.list.len()];
+    for r in &mut roots {
+        *r = root(&mut parent, *r);
+        edge_count[*r] += 1;
     }
     if let Some(class) = class {
-        for (i, &v) in graph.vertices.iter().enumerate() {
+        for (i, &v) in vertices.list.iter().enumerate() {
             if class[v as usize] == FeatureClass::Corner {
                 corner_count[root(&mut parent, i)] += 1;
             }
@@ -1026,7 +1080,7 @@ fn keep_groups(
     edges
         .into_iter()
         .zip(roots)
-        .filter(|&(_, r)| keep(edge_count[r], corner_count[r]))
+        .filter(|&(_, r)| keep(edge_count[r] as usize, corner_count[r] as usize))
         .map(|(e, _)| e)
         .collect()
 }
