@@ -648,43 +648,49 @@ pub(crate) fn vertex_feature_edges(
     threshold: f32,
     edges: &mut Vec<FeatureEdge>,
 ) {
-    let first = edges.len();
     let faces_v = topology.faces_of(v);
-    let mut buffer = [[0u32; 3]; 32];
-    let heap: Vec<[u32; 3]>;
-    let corners: &[[u32; 3]] = if faces_v.len() <= buffer.len() {
-        for (slot, &f) in buffer.iter_mut().zip(faces_v) {
-            *slot = mesh.triangles[f as usize];
+    // Every (u, i) with u > v a corner of v's i-th face (each face once per u), sorted: the
+    // faces of an edge v–u are then side by side, in the order of v's list.
+    let mut buffer = [(0u32, 0u32); 64];
+    let mut heap = Vec::new();
+    let pairs: &mut [(u32, u32)] = if 2 * faces_v.len() <= buffer.len() {
+        let mut count = 0;
+        for (i, &f) in faces_v.iter().enumerate() {
+            let [a, b, c] = mesh.triangles[f as usize];
+            // (Each face of v's list has v for a corner, so at most two others.)
+            for (u, repeated) in [(a, false), (b, b == a), (c, c == a || c == b)] {
+                if u > v && !repeated {
+                    buffer[count] = (u, i as u32);
+                    count += 1;
+                }
+            }
         }
-        &buffer[..faces_v.len()]
+        &mut buffer[..count]
     } else {
-        heap = faces_v
-            .iter()
-            .map(|&f| mesh.triangles[f as usize])
-            .collect();
-        &heap
+        for (i, &f) in faces_v.iter().enumerate() {
+            let [a, b, c] = mesh.triangles[f as usize];
+            for (u, repeated) in [(a, false), (b, b == a), (c, c == a || c == b)] {
+                if u > v && !repeated {
+                    heap.push((u, i as u32));
+                }
+            }
+        }
+        &mut heap
     };
-    for (i, &t) in corners.iter().enumerate() {
-        for u in t {
-            if u <= v {
-                continue;
-            }
-            // Each edge once: from the first of its faces in v's list; an edge with other than
-            // two faces is no feature edge.
-            let has_u = |t: &[u32; 3]| t.contains(&u);
-            if corners[..i].iter().any(has_u) {
-                continue;
-            }
-            let mut others = (i + 1..corners.len()).filter(|&j| has_u(&corners[j]));
-            let (Some(j), None) = (others.next(), others.next()) else {
-                continue;
-            };
-            if let Some(direction) = feature(normal(faces_v[i]), normal(faces_v[j]), threshold) {
+    pairs.sort_unstable();
+    // An edge with other than two faces is no feature edge.
+    let mut rest = &*pairs;
+    while let Some(&(u, i)) = rest.first() {
+        let run = rest.iter().take_while(|&&(w, _)| w == u).count();
+        if run == 2 {
+            let j = rest[1].1;
+            let (fi, fj) = (faces_v[i as usize], faces_v[j as usize]);
+            if let Some(direction) = feature(normal(fi), normal(fj), threshold) {
                 edges.push(([v, u], direction));
             }
         }
+        rest = &rest[run..];
     }
-    edges[first..].sort_unstable_by_key(|&([_, u], _)| u);
 }
 
 /// [`vertex_feature_edges`] for a vertex with a closed fan, from its ring (`ring[k]` = x_k, at
@@ -1108,6 +1114,54 @@ mod tests {
             let e = exp_of_negative(Vec4::splat(x))[0];
             assert!((0.0..=1.2e-7).contains(&e), "x = {x}: {e}");
         }
+    }
+
+    /// The feature edges against every edge's faces counted over the whole mesh: an edge with
+    /// three faces (a non-manifold spine) is none however sharp, a folded edge with two is one.
+    #[test]
+    fn feature_edges_are_the_sharp_edges_with_exactly_two_faces() {
+        // Vertices 0-1 the spine; pages to 2, 3, 4 (three faces on the spine); page 0-1-2 folds
+        // sharply onto face 1-2-5 along 1-2.
+        let mesh = TriMesh {
+            positions: vec![
+                [0.0, 0.0, 0.0],
+                [1.0, 0.0, 0.0],
+                [0.5, 1.0, 0.0],
+                [0.5, -1.0, 0.0],
+                [0.5, 0.0, 1.0],
+                [1.5, 1.0, 0.9],
+            ],
+            triangles: vec![[0, 1, 2], [1, 0, 3], [0, 1, 4], [2, 1, 5]],
+        };
+        let topology = Topology::build(&mesh);
+        let normals: Vec<Vec4> = mesh
+            .triangles
+            .iter()
+            .enumerate()
+            .map(|(f, _)| area_normal(&mesh, f as u32).normalize().extend(1.0))
+            .collect();
+        let options = CreaseOptions::default().with_angle_degrees(30.0);
+        let found: Vec<[u32; 2]> = feature_edges(&mesh, &topology, &normals, &options)
+            .into_iter()
+            .map(|(e, _)| e)
+            .collect();
+        // By brute force: each edge's faces, over all faces.
+        let threshold = options.angle_degrees.to_radians().cos() as f32;
+        let mut expected = Vec::new();
+        for v in 0..6u32 {
+            for &u in topology.neighbors(v).iter().filter(|&&u| u > v) {
+                let faces: Vec<usize> = (0..mesh.triangles.len())
+                    .filter(|&f| mesh.triangles[f].contains(&v) && mesh.triangles[f].contains(&u))
+                    .collect();
+                if let [a, b] = faces[..] {
+                    if xyz(normals[a]).dot(xyz(normals[b])) < threshold {
+                        expected.push([v, u]);
+                    }
+                }
+            }
+        }
+        assert_eq!(found, expected);
+        assert_eq!(found, vec![[1, 2]], "the fold, not the spine");
     }
 
     #[test]
