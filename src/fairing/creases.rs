@@ -277,7 +277,7 @@ fn filter_face_normals(
             let own = xyz(current[f]);
             let mut sum = [Vec4::ZERO; 3];
             for k in (0..around.len()).step_by(4) {
-                let (n, m) = four(&current, around, shared, k, f);
+                let ([n], m) = four([&current], around, shared, k, f);
                 let weight = n.w_axis * m;
                 for (s, n) in sum.iter_mut().zip([n.x_axis, n.y_axis, n.z_axis]) {
                     *s += n * weight;
@@ -291,7 +291,7 @@ fn filter_face_normals(
             let mean = sum.try_normalize().unwrap_or(own);
             let mut spread = Vec4::ZERO;
             for k in (0..around.len()).step_by(4) {
-                let (n, _) = four(&current, around, shared, k, f);
+                let ([n], _) = four([&current], around, shared, k, f);
                 let d = [(n.x_axis, mean.x), (n.y_axis, mean.y), (n.z_axis, mean.z)]
                     .map(|(n, m)| n - Vec4::splat(m));
                 spread = spread.max(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
@@ -315,8 +315,7 @@ fn filter_face_normals(
             let own = guidance[f];
             let mut sum = [Vec4::ZERO; 3];
             for k in (0..around.len()).step_by(4) {
-                let (g, _) = four(&guidance, around, shared, k, f);
-                let (n, m) = four(&current, around, shared, k, f);
+                let ([g, n], m) = four([&guidance, &current], around, shared, k, f);
                 let d = [(g.x_axis, own.x), (g.y_axis, own.y), (g.z_axis, own.z)]
                     .map(|(g, o)| g - Vec4::splat(o));
                 let d = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
@@ -347,30 +346,35 @@ fn filter_face_normals(
     }
 }
 
-/// The four values `values[around[k..k + 4]]` as the columns of a matrix, transposed (so its
-/// x axis holds their x, and so on), and their shared-vertex counts; past the end of the list,
-/// face `own` (always in its own list) with a count of 0.
+/// For each array of `values`, its four values at `around[k..k + 4]` as the columns of a matrix,
+/// transposed (so its x axis holds their x, and so on), and their shared-vertex counts; past the
+/// end of the list, face `own` (always in its own list) with a count of 0.
 #[inline(always)]
-fn four(values: &[Vec4], around: &[u32], shared: &[u8], k: usize, own: usize) -> (Mat4, Vec4) {
-    let (columns, counts) = match (around.get(k..k + 4), shared.get(k..k + 4)) {
+fn four<const N: usize>(
+    values: [&[Vec4]; N],
+    around: &[u32],
+    shared: &[u8],
+    k: usize,
+    own: usize,
+) -> ([Mat4; N], Vec4) {
+    let (faces, counts) = match (around.get(k..k + 4), shared.get(k..k + 4)) {
         (Some(&[a, b, c, d]), Some(&[ma, mb, mc, md])) => (
-            [a, b, c, d].map(|g| values[g as usize]),
+            [a, b, c, d].map(|g| g as usize),
             [ma, mb, mc, md].map(f32::from),
         ),
         _ => {
             let at = |i: usize| match around.get(k + i) {
-                Some(&g) => (values[g as usize], f32::from(shared[k + i])),
-                None => (values[own], 0.0),
+                Some(&g) => (g as usize, f32::from(shared[k + i])),
+                None => (own, 0.0),
             };
             let [(a, ma), (b, mb), (c, mc), (d, md)] = [at(0), at(1), at(2), at(3)];
             ([a, b, c, d], [ma, mb, mc, md])
         }
     };
+    let [a, b, c, d] = faces;
     (
-        {
-            let [a, b, c, d] = columns;
-            Mat4::from_cols(a, b, c, d).transpose()
-        },
+        values
+            .map(|values| Mat4::from_cols(values[a], values[b], values[c], values[d]).transpose()),
         Vec4::from_array(counts),
     )
 }
