@@ -1864,6 +1864,7 @@ fn fair_rounds(
                 &mut face_rings,
                 !read_clean,
             );
+            report.detection_ms += milliseconds(started);
             read_clean |= noise.is_some_and(|noise| normal_filtering_for(noise) == 0);
             let found = Some(found);
             fn edges(creases: &Option<Creases>) -> &[[u32; 2]] {
@@ -1877,10 +1878,8 @@ fn fair_rounds(
                     CREASE_SETTLED * edges_changed(before, after) <= before.len().max(after.len());
                 creases = found;
                 unchanged = if settled { unchanged + 1 } else { 0 };
-                report.detection_ms += milliseconds(started);
                 fairing = fairing.for_other_creases(mesh, topology, fans, creases.as_ref(), pinned);
             } else {
-                report.detection_ms += milliseconds(started);
                 unchanged += 1;
             }
         }

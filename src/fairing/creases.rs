@@ -709,15 +709,26 @@ pub(crate) fn fan_feature_edges(
     edges: &mut Vec<FeatureEdge>,
 ) {
     let first = edges.len();
-    let n = ring.len();
-    for (k, &u) in ring.iter().enumerate() {
-        if u > v {
-            if let Some(direction) = feature(faces[k], faces[(k + 1) % n], threshold) {
-                edges.push(([v, u], direction));
-            }
-        }
-    }
+    edges.extend(
+        fan_feature_neighbors(v, ring, faces, threshold)
+            .map(|(u, [a, b])| ([v, u], a.cross(b).normalize_or_zero())),
+    );
     edges[first..].sort_unstable_by_key(|&([_, u], _)| u);
+}
+
+/// The neighbours u > v of [`fan_feature_edges`] (in the ring's order), each with the normals of
+/// its edge's two faces.
+pub(crate) fn fan_feature_neighbors<'a>(
+    v: u32,
+    ring: &'a [u32],
+    faces: &'a [Vec3A],
+    threshold: f32,
+) -> impl Iterator<Item = (u32, [Vec3A; 2])> + 'a {
+    let n = ring.len();
+    ring.iter().enumerate().filter_map(move |(k, &u)| {
+        let pair = [faces[k], faces[(k + 1) % n]];
+        (u > v && is_feature(pair[0], pair[1], threshold)).then_some((u, pair))
+    })
 }
 
 /// The crease direction of an edge whose faces have the normals `na` and `nb` (of any length),
@@ -731,7 +742,7 @@ fn feature(na: Vec3A, nb: Vec3A, threshold: f32) -> Option<Vec3A> {
 /// Whether an edge whose faces have the normals `na` and `nb` is a feature edge ([`feature`]
 /// without the direction).
 #[inline]
-pub(crate) fn is_feature(na: Vec3A, nb: Vec3A, threshold: f32) -> bool {
+fn is_feature(na: Vec3A, nb: Vec3A, threshold: f32) -> bool {
     let (la, lb) = (na.length(), nb.length());
     la > 0.0 && lb > 0.0 && (la * lb).is_finite() && na.dot(nb) < threshold * la * lb
 }

@@ -44,7 +44,7 @@
 //! part's creases found again after a few rounds lower it again), or after [`MAX_AUTO_ROUNDS`].
 
 use super::constrained::FanRings;
-use super::creases::{fan_feature_edges, is_feature, vertex_feature_edges, FeatureEdge};
+use super::creases::{fan_feature_edges, fan_feature_neighbors, vertex_feature_edges, FeatureEdge};
 use crate::mesh::{Topology, TriMesh};
 use glam::Vec3A;
 use rayon::prelude::*;
@@ -240,13 +240,9 @@ fn gather(
                         match (threshold, on_edge) {
                             (Some(threshold), Some(on_edge)) => {
                                 let faces = &faces[..valence];
-                                for (k, &u) in ring.iter().enumerate() {
-                                    if u > v
-                                        && is_feature(faces[k], faces[(k + 1) % valence], threshold)
-                                    {
-                                        on_edge[v as usize].store(true, Ordering::Relaxed);
-                                        on_edge[u as usize].store(true, Ordering::Relaxed);
-                                    }
+                                for (u, _) in fan_feature_neighbors(v, ring, faces, threshold) {
+                                    on_edge[v as usize].store(true, Ordering::Relaxed);
+                                    on_edge[u as usize].store(true, Ordering::Relaxed);
                                 }
                             }
                             (Some(threshold), None) => {
