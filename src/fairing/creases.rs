@@ -217,7 +217,7 @@ impl FaceRingCache {
 /// face's guidance (the least spread among the patches around it), the filtered normal. The first
 /// and the last take the faces around four at a time (their x, y, z and area in four lanes, the
 /// weights' exponentials by [`exp_of_negative`]): on the noisy 1.2M-face bunny a pass went from
-/// 90 to 74 ms (2 threads), with the same creases on every mesh of `fairing_default`'s table.
+/// 90 to ~68 ms (2 threads), with the same creases on every mesh of `fairing_default`'s table.
 /// Each face is computed by the same operations whatever the thread count. No pass (a clean
 /// mesh) builds nothing: the normals are the faces' own. Three arrays of the faces' size are
 /// written (the normals, the patches and then the filtered normals over them, the guidance);
