@@ -6,7 +6,7 @@
 //! Run: `cargo run --release --no-default-features --example fairing_default [-- --trace]`
 //! (`--only gear,cube` runs just those meshes; `--files a.obj,b.ply` adds meshes from files, named
 //! by their stem; `--sigma 0.15` changes the noise; `--default-only` prints the default's row
-//! alone; `--tangential 0.1` gives the default another tangential relaxation weight; `--trace` also prints, per round, the noise estimate and the distance to the clean
+//! alone; `--save DIR` writes the clean meshes as PLY files and stops; `--tangential 0.1` gives the default another tangential relaxation weight; `--trace` also prints, per round, the noise estimate and the distance to the clean
 //! surface). `docs/measurements.md` holds what it printed and says which meshes the rules were
 //! tuned on and which were kept out.
 //!
@@ -103,8 +103,18 @@ fn main() {
             .with_tangential_relaxation(w.parse().expect("--tangential: a number")),
         None => FairOptions::default(),
     };
+    // `--save DIR`: write each clean mesh as DIR/NAME.ply (for `scripts/peers/compare_peers.py`,
+    // which takes files) and stop.
+    let save = value("--save");
     for (name, clean) in meshes(&files) {
         if only.as_ref().is_some_and(|only| !only.contains(&name)) {
+            continue;
+        }
+        if let Some(dir) = save {
+            let path = Path::new(dir).join(format!("{}.ply", name.replace(' ', "_")));
+            fairmesh::io::save(&path, &clean)
+                .unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+            println!("wrote {}", path.display());
             continue;
         }
         let topology = Topology::build(&clean);

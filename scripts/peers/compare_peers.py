@@ -15,7 +15,11 @@ HC Laplacian), Open3D (Taubin). Install them in a virtual environment:
 
 Run from the repository root after `cargo build --release`:
     venv/bin/python scripts/peers/compare_peers.py MESH [MESH ...] [--modes normal,iso]
-Prints a Markdown table per mesh and noise mode.
+Prints a Markdown table per mesh and noise mode, then a summary: for each, `fair`'s mean distance
+against the best peer's, and in how many cases `fair` ends closer. The set of clean meshes the
+project measures on (the repository's, the CAD-like parts, and those `docs/measurements.md` names)
+is written as PLY files by
+    cargo run --release --no-default-features --example fairing_default -- --save DIR --files ...
 """
 
 import argparse
@@ -52,7 +56,9 @@ def measure(clean, result):
 
 def load(path):
     # process=False keeps fairmesh's vertex order (the noisy file is already welded).
-    return trimesh.load(path, process=False, force="mesh")
+    # Positions and triangles only: a textured mesh's visuals would need Pillow.
+    mesh = trimesh.load(path, process=False, force="mesh")
+    return trimesh.Trimesh(np.asarray(mesh.vertices), np.asarray(mesh.faces), process=False)
 
 
 def peers():
@@ -125,6 +131,8 @@ def main():
     parser.add_argument("--modes", default="normal,iso")
     args = parser.parse_args()
     smoothers = peers()
+    # (mesh, mode, fair's row, (best peer's name, its iterations, its row) or None)
+    summary = []
     with tempfile.TemporaryDirectory() as tmp:
         for path in args.meshes:
             clean = os.path.join(tmp, "clean.ply")
@@ -142,20 +150,59 @@ def main():
                     f"default (noise {report['noise_estimate']:.3f}, "
                     f"{report['rounds_run']} rounds, {report['crease_edges']} crease edges)"
                 )
-                print(row("fairmesh fair", setting, measure(clean, ours)), flush=True)
+                ours_measured = measure(clean, ours)
+                print(row("fairmesh fair", setting, ours_measured), flush=True)
+                best_peer = None
                 mesh = load(noisy)
-                v = np.asarray(mesh.vertices, dtype=np.float64)
-                f = np.asarray(mesh.faces, dtype=np.int32)
+                v_all = np.asarray(mesh.vertices, dtype=np.float64)
+                f_all = np.asarray(mesh.faces, dtype=np.int32)
+                # Some peers (trimesh's filters) need every vertex used by a face: they smooth
+                # the used vertices, and the unused ones are written back where they were.
+                used = np.unique(f_all)
+                index = np.full(len(v_all), -1, dtype=np.int32)
+                index[used] = np.arange(len(used), dtype=np.int32)
+                v, f = v_all[used], index[f_all]
                 out = os.path.join(tmp, "peer.ply")
                 for name, smooth in smoothers:
                     best = None
                     for k in ITERATIONS:
-                        trimesh.Trimesh(smooth(v, f, k), f, process=False).export(out)
+                        smoothed = v_all.copy()
+                        smoothed[used] = smooth(v, f, k)
+                        trimesh.Trimesh(smoothed, f_all, process=False).export(out)
                         m = measure(clean, out)
                         if best is None or m["mean"] < best[1]["mean"]:
                             best = (k, m)
                     print(row(name, f"best of {ITERATIONS}: {best[0]} iterations", best[1]),
                           flush=True)
+                    if best_peer is None or best[1]["mean"] < best_peer[2]["mean"]:
+                        best_peer = (name, best[0], best[1])
+                summary.append((os.path.basename(path), mode, ours_measured, best_peer))
+    print_summary(summary)
+
+
+def print_summary(summary):
+    """fair against the best peer (the least mean distance over every peer and iteration count)
+    for each mesh and noise mode, and the count of cases where fair ends closer."""
+    print("\nSummary: default `fair` against the best peer at its best iteration count\n")
+    print("| mesh | noise | fair: mean dist / normal ° | best peer | its mean dist / normal ° "
+          "| fair / best |")
+    print("|---|---|---:|---|---:|---:|")
+    closer = 0
+    for mesh, mode, ours, best in summary:
+        if best is None:
+            print(f"| {mesh} | {mode} | {ours['mean']:.4f} | (no peer installed) | - | - |")
+            continue
+        name, k, theirs = best
+        ratio = ours["mean"] / theirs["mean"]
+        closer += ratio < 1.0
+
+        def normal(m):
+            return "-" if m["normal"] is None else f"{m['normal']:.1f}"
+
+        print(f"| {mesh} | {mode} | {ours['mean']:.4f} / {normal(ours)} | {name}, {k} iterations "
+              f"| {theirs['mean']:.4f} / {normal(theirs)} | {ratio:.3f} |")
+    compared = sum(1 for *_, best in summary if best is not None)
+    print(f"\nfair ends closer than the best peer in {closer} of {compared} cases")
 
 
 if __name__ == "__main__":
