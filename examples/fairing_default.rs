@@ -112,8 +112,7 @@ fn main() {
         }
         if let Some(dir) = save {
             let path = Path::new(dir).join(format!("{}.ply", name.replace(' ', "_")));
-            fairmesh::io::save(&path, &clean)
-                .unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+            fairmesh::io::save(&path, &clean).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
             println!("wrote {}", path.display());
             continue;
         }
