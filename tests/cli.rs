@@ -507,6 +507,7 @@ fn fair_leaves_a_clean_mesh_alone_and_says_how_noisy_the_input_was() {
     // Clean: no round, the positions as they were.
     let clean = json_of(&["fair", &input, "-o", &path("clean.obj"), "--json"]);
     assert_eq!(clean["rounds_run"], 0, "{clean}");
+    assert_eq!(clean["risk_by_round"], serde_json::json!([]), "{clean}");
     let estimate = clean["noise_estimate"].as_f64().unwrap();
     assert!(estimate < 0.04, "{clean}");
     let before = fairmesh::io::load(&input).unwrap().mesh;
@@ -520,6 +521,21 @@ fn fair_leaves_a_clean_mesh_alone_and_says_how_noisy_the_input_was() {
     assert!((0.2..0.4).contains(&estimate), "{faired}");
     let rounds = faired["rounds_run"].as_u64().unwrap();
     assert!((2..60).contains(&rounds), "{faired}");
+    // Every round run has its estimated risk, the kept one the least; at most RISK_PATIENCE
+    // rounds ran past it.
+    let risks: Vec<f64> = faired["risk_by_round"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|r| r.as_f64().unwrap())
+        .collect();
+    assert!(risks.len() >= rounds as usize, "{faired}");
+    assert!(
+        risks.len() <= rounds as usize + fairmesh::fairing::strength::RISK_PATIENCE,
+        "{faired}"
+    );
+    let kept = risks[rounds as usize - 1];
+    assert!(risks.iter().all(|&r| r > 0.0 && r >= kept), "{faired}");
     // The time spent estimating and finding creases is part of the whole.
     let detection = faired["detection_ms"].as_f64().unwrap();
     assert!(
@@ -537,6 +553,7 @@ fn fair_leaves_a_clean_mesh_alone_and_says_how_noisy_the_input_was() {
         "2",
     ]);
     assert_eq!(two["rounds_run"], 2, "{two}");
+    assert_eq!(two["risk_by_round"], serde_json::json!([]), "{two}");
     let paper = json_of(&[
         "fair",
         &path("noisy.obj"),

@@ -281,6 +281,7 @@ pub fn run(args: FairArgs) -> anyhow::Result<()> {
             "loose_triangles": report.loose_triangles,
             "time_ms": time_ms,
             "detection_ms": report.detection_ms,
+            "risk_by_round": report.risk_by_round,
             "volume_change_percent": volume_change_percent,
             "max_move": report.max_move,
             "masked_vertices": mask.as_ref().map(|m| m.painted_count()),

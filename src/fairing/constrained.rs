@@ -1917,6 +1917,7 @@ fn fair_rounds(
                     });
             }
             let now = risk.read(mesh, topology, copy);
+            report.risk_by_round.push(now);
             let edges = creases.as_ref().map_or(0, |c| c.edges.len());
             // A round that lowers the risk by less than RISK_MIN_FALL of what the second round
             // lowered it by is kept if it is the least, but does not count as progress: the

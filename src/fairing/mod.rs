@@ -212,7 +212,7 @@ pub enum Strength {
 }
 
 /// What a fairing run did.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
+#[derive(Clone, Debug, Default, PartialEq)]
 pub struct FairReport {
     /// Iterations actually run, summed over rounds (with [`Strength::Auto`], also over the one or
     /// two rounds run past the kept one; the risk estimate's copy not counted).
@@ -234,6 +234,11 @@ pub struct FairReport {
     /// Milliseconds of the run spent estimating the noise and finding creases (constrained
     /// fairing; before the first round and again between rounds), part of its whole time.
     pub detection_ms: f64,
+    /// With [`Strength::Auto`], the estimated risk of each round run, in order (mean squared
+    /// error along the normals plus σ², squared model units: [`strength`]); the kept round is the
+    /// one with the least. Empty otherwise. For studying the stopping rule: `fair --json` prints
+    /// it as `risk_by_round`.
+    pub risk_by_round: Vec<f64>,
 }
 
 /// The smoothing methods offered by the CLI and the editor.
