@@ -15,7 +15,9 @@ HC Laplacian), Open3D (Taubin). Install them in a virtual environment:
 
 Run from the repository root after `cargo build --release`:
     venv/bin/python scripts/peers/compare_peers.py MESH [MESH ...] [--modes normal,iso]
-Prints a Markdown table per mesh and noise mode, then a summary: for each, `fair`'s mean distance
+        [--fair-flags "--no-creases --rounds 3"] [--no-peers]
+`--fair-flags` gives `fair` other flags than its defaults; `--no-peers` runs `fair` alone (to
+compare settings of `fair` on a set of meshes). Prints a Markdown table per mesh and noise mode, then a summary: for each, `fair`'s mean distance
 against the best peer's, and in how many cases `fair` ends closer. The set of clean meshes the
 project measures on (the repository's, the CAD-like parts, and those `docs/measurements.md` names)
 is written as PLY files by
@@ -25,6 +27,7 @@ is written as PLY files by
 import argparse
 import json
 import os
+import shlex
 import subprocess
 import sys
 import tempfile
@@ -117,10 +120,14 @@ def peers():
     return found
 
 
+def normal_error(m):
+    """A measure's mean face-normal error, or "-" where the vertices do not correspond."""
+    return "-" if m["normal"] is None else f"{m['normal']:.1f}"
+
+
 def row(name, setting, m):
-    normal = "-" if m["normal"] is None else f"{m['normal']:.1f}"
     return (
-        f"| {name} | {setting} | {m['mean']:.4f} | {m['hausdorff']:.3f} | {normal} "
+        f"| {name} | {setting} | {m['mean']:.4f} | {m['hausdorff']:.3f} | {normal_error(m)} "
         f"| {m['volume']:+.3f} |"
     )
 
@@ -129,8 +136,11 @@ def main():
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("meshes", nargs="+")
     parser.add_argument("--modes", default="normal,iso")
+    parser.add_argument("--fair-flags", default="", help="flags for `fair` (default: none)")
+    parser.add_argument("--no-peers", action="store_true", help="run `fair` alone")
     args = parser.parse_args()
-    smoothers = peers()
+    fair_flags = shlex.split(args.fair_flags)
+    smoothers = [] if args.no_peers else peers()
     # (mesh, mode, fair's row, (best peer's name, its iterations, its row) or None)
     summary = []
     with tempfile.TemporaryDirectory() as tmp:
@@ -145,9 +155,11 @@ def main():
                 print("|---|---|---:|---:|---:|---:|")
                 print(row("noisy input", "", measure(clean, noisy)))
                 ours = os.path.join(tmp, "ours.ply")
-                report = json.loads(run("fair", noisy, "-o", ours, "--json"))
+                report = json.loads(run("fair", noisy, "-o", ours, "--json", *fair_flags))
+                noise = report["noise_estimate"]
                 setting = (
-                    f"default (noise {report['noise_estimate']:.3f}, "
+                    f"{args.fair_flags or 'default'} (noise "
+                    f"{'-' if noise is None else f'{noise:.3f}'}, "
                     f"{report['rounds_run']} rounds, {report['crease_edges']} crease edges)"
                 )
                 ours_measured = measure(clean, ours)
@@ -190,19 +202,17 @@ def print_summary(summary):
     closer = 0
     for mesh, mode, ours, best in summary:
         if best is None:
-            print(f"| {mesh} | {mode} | {ours['mean']:.4f} | (no peer installed) | - | - |")
+            print(f"| {mesh} | {mode} | {ours['mean']:.4f} / {normal_error(ours)} | (no peer run) "
+                  "| - | - |")
             continue
         name, k, theirs = best
         ratio = ours["mean"] / theirs["mean"]
         closer += ratio < 1.0
-
-        def normal(m):
-            return "-" if m["normal"] is None else f"{m['normal']:.1f}"
-
-        print(f"| {mesh} | {mode} | {ours['mean']:.4f} / {normal(ours)} | {name}, {k} iterations "
-              f"| {theirs['mean']:.4f} / {normal(theirs)} | {ratio:.3f} |")
+        print(f"| {mesh} | {mode} | {ours['mean']:.4f} / {normal_error(ours)} | {name}, {k} "
+              f"iterations | {theirs['mean']:.4f} / {normal_error(theirs)} | {ratio:.3f} |")
     compared = sum(1 for *_, best in summary if best is not None)
-    print(f"\nfair ends closer than the best peer in {closer} of {compared} cases")
+    if compared:
+        print(f"\nfair ends closer than the best peer in {closer} of {compared} cases")
 
 
 if __name__ == "__main__":
