@@ -29,25 +29,19 @@ the clean vertex of each result vertex is known. Needs numpy and trimesh (requir
 import argparse
 import json
 import os
-import subprocess
 import sys
 import tempfile
 
 import numpy as np
 import trimesh
 
-FAIRMESH = os.environ.get("FAIRMESH", "target/release/fairmesh")
-
-
-def run(*args):
-    out = subprocess.run([FAIRMESH, *args], capture_output=True, text=True)
-    if out.returncode != 0:
-        sys.exit(f"fairmesh {' '.join(args)} failed: {out.stderr.strip()}")
-    return out.stdout
+# The same `fairmesh` runner and loader as the peer tables (FAIRMESH names the binary).
+import compare_peers
+from compare_peers import run
 
 
 def load(path):
-    mesh = trimesh.load(path, process=False, force="mesh")
+    mesh = compare_peers.load(path)
     return np.asarray(mesh.vertices, dtype=np.float64), np.asarray(mesh.faces)
 
 
