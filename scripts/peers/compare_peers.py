@@ -189,13 +189,15 @@ def main():
                     if best_peer is None or best[1]["mean"] < best_peer[2]["mean"]:
                         best_peer = (name, best[0], best[1])
                 summary.append((os.path.basename(path), mode, ours_measured, best_peer))
-    print_summary(summary)
+    print_summary(summary, args.fair_flags)
 
 
-def print_summary(summary):
-    """fair against the best peer (the least mean distance over every peer and iteration count)
-    for each mesh and noise mode, and the count of cases where fair ends closer."""
-    print("\nSummary: default `fair` against the best peer at its best iteration count\n")
+def print_summary(summary, fair_flags):
+    """fair (with `fair_flags`, or its defaults) against the best peer (the least mean distance
+    over every peer and iteration count) for each mesh and noise mode, and the count of cases
+    where fair ends closer."""
+    fair = f"`fair {fair_flags}`" if fair_flags else "default `fair`"
+    print(f"\nSummary: {fair} against the best peer at its best iteration count\n")
     print("| mesh | noise | fair: mean dist / normal ° | best peer | its mean dist / normal ° "
           "| fair / best |")
     print("|---|---|---:|---|---:|---:|")
