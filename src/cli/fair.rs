@@ -71,7 +71,9 @@ pub struct FairArgs {
     #[arg(long)]
     pub no_creases: bool,
     /// Constrained normal-projected only: how much each iteration also evens out the triangles
-    /// along the surface (0 to 1; 0 moves vertices only along their normals).
+    /// along the surface (0 to 1; 0 moves vertices only along their normals). The default removes
+    /// noise that moved vertices along the surface too and keeps flat faces flat; on a scan
+    /// sampled densest where it curves, with noise across the surface only, 0 keeps more shape.
     #[arg(long, default_value_t = fairmesh::fairing::DEFAULT_TANGENTIAL_RELAXATION)]
     pub tangential: f64,
     /// Constrained normal-projected only: do not give each part back its volume after every
