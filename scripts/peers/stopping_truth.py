@@ -91,18 +91,18 @@ def main():
         default = json.loads(run("fair", noisy, "-o", out, "--json"))
         read = default.get("risk_by_round") or []
 
-        def result(path):
+        def along_normals(path, target):
+            """The mean squared distance of the result in `path` from `target` (per vertex)
+            along the result's normals."""
             v, f = load(path)
             if len(v) != len(x):
                 sys.exit(f"{path}: fair changed the vertex count")
-            return v, f
+            return np.mean(np.sum(vertex_normals(v, f) * (v - target), axis=1) ** 2)
 
         true_risk, distance = [], []
         for k in range(1, args.rounds + 1):
             run("fair", noisy, "-o", out, "--rounds", str(k))
-            v, f = result(out)
-            n = vertex_normals(v, f)
-            true_risk.append(np.mean(np.sum(n * (v - x), axis=1) ** 2) + sigma**2)
+            true_risk.append(along_normals(out, x) + sigma**2)
             m = json.loads(run("compare", clean, out, "--json"))
             distance.append(m["mean_surface_distance"] / m["reference_mean_edge_length"])
 
@@ -120,10 +120,7 @@ def main():
                 target = y - s * z / alpha
                 for k in range(1, args.rounds + 1):
                     run("fair", more, "-o", out, "--rounds", str(k))
-                    v, f = result(out)
-                    n = vertex_normals(v, f)
-                    residual = np.mean(np.sum(n * (v - target), axis=1) ** 2)
-                    recorrupted[k - 1] += residual / args.draws
+                    recorrupted[k - 1] += along_normals(out, target) / args.draws
 
     print(f"{args.clean}, noise {args.sigma} mode {args.mode}: default `fair` stops after "
           f"{default.get('rounds_run')} rounds (risk read for {len(read)})")
