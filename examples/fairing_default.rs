@@ -6,15 +6,18 @@
 //! Run: `cargo run --release --no-default-features --example fairing_default [-- --trace]`
 //! (`--only gear,cube` runs just those meshes; `--files a.obj,b.ply` adds meshes from files, named
 //! by their stem; `--sigma 0.15` changes the noise; `--default-only` prints the default's row
-//! alone; `--save DIR` writes the clean meshes as PLY files and stops; `--tangential 0.1` gives the default another tangential relaxation weight; `--trace` also prints, per round, the noise estimate and the distance to the clean
-//! surface). `docs/measurements.md` holds what it printed and says which meshes the rules were
+//! alone; `--save DIR` writes the clean meshes as PLY files and stops; `--tangential 0.1` gives the
+//! default that tangential relaxation weight at every vertex, as `fair --tangential` does;
+//! `--trace` also prints, per round, the noise estimate and the distance to the clean surface). `docs/measurements.md` holds what it printed and says which meshes the rules were
 //! tuned on and which were kept out.
 //!
 //! Measures (lengths in mean edge lengths of the clean mesh): `mean`, `hausdorff`: surface
 //! distance both ways (`metrics::compare`); `normal`: mean angle between corresponding face
 //! normals, degrees; `vol`: volume change against the mesh that was faired, percent.
 
-use fairmesh::fairing::{estimate_noise, fair_constrained, ConstrainedFairing, FairOptions};
+use fairmesh::fairing::{
+    estimate_noise, fair_constrained, ConstrainedFairing, FairOptions, Relaxation,
+};
 use fairmesh::mesh::shapes;
 use fairmesh::metrics::{compare, mean_edge_length, signed_volume};
 use fairmesh::noise::{add_noise, NoiseMode, NoiseOptions};
@@ -97,10 +100,11 @@ fn main() {
     let files = list("--files").unwrap_or_default();
     let sigma: f64 = value("--sigma").map_or(0.3, |s| s.parse().expect("--sigma: a number"));
     let default_only = args.iter().any(|a| a == "--default-only");
-    // `--tangential W`: the default with another tangential relaxation weight.
+    // `--tangential W`: the default with that tangential relaxation weight at every vertex.
     let default_options = match value("--tangential") {
         Some(w) => FairOptions::default()
-            .with_tangential_relaxation(w.parse().expect("--tangential: a number")),
+            .with_tangential_relaxation(w.parse().expect("--tangential: a number"))
+            .with_relaxation(Relaxation::Everywhere),
         None => FairOptions::default(),
     };
     // `--save DIR`: write each clean mesh as DIR/NAME.ply (for `scripts/peers/compare_peers.py`,
@@ -159,6 +163,18 @@ fn main() {
                     report.rounds_run
                 ),
                 &measure(&clean, &input, &normal_only, edge),
+            );
+            let mut everywhere = input.clone();
+            let options = FairOptions::default().with_relaxation(Relaxation::Everywhere);
+            let report = fair_constrained(&mut everywhere, &topology, &options);
+            print(
+                &name,
+                label,
+                &format!(
+                    "default with the relaxation everywhere (until 2026-11-26): {} rounds",
+                    report.rounds_run
+                ),
+                &measure(&clean, &input, &everywhere, edge),
             );
             let mut no_volume = input.clone();
             let options = FairOptions::default().with_keep_volume(false);

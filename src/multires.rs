@@ -342,6 +342,7 @@ fn level_fair_options(options: &MultiresOptions) -> FairOptions {
         strength: crate::fairing::Strength::Fixed,
         creases: None,
         tangential_relaxation: 0.0,
+        relaxation: crate::fairing::Relaxation::Everywhere,
         boundary: options.boundary,
         tolerance: 0.0,
         mask: None,

@@ -744,8 +744,10 @@ fn a_noisy_cube_keeps_straight_edges_and_its_corners_with_creases() {
     // Corners stay on the cube's corners: the vertex at each corner ends within the noise's
     // size of it (σ = 0.3 edge lengths: the input put them 0.02-0.41 off; a detected corner is
     // held, and as creases are found again while the noise goes, a corner found one vertex off on
-    // the noisy input may be released and the true one held), while fairing without creases
-    // rounds every corner off by about two edge lengths.
+    // the noisy input may be released and the true one held; 0.23 on average), while fairing
+    // without creases rounds the corners off (0.66 edge lengths on average; 1.18 when the
+    // tangential relaxation acted everywhere and pulled the corners in too, before it was kept
+    // to where the noise or thin triangles need it).
     let edge = mean_edge_length(&clean);
     let corner_offsets = |mesh: &TriMesh| -> Vec<f64> {
         (0..8)
@@ -772,7 +774,7 @@ fn a_noisy_cube_keeps_straight_edges_and_its_corners_with_creases() {
     }
     let mean = |offsets: &[f64]| offsets.iter().sum::<f64>() / offsets.len() as f64;
     assert!(
-        mean(&rounded_at) > 4.0 * mean(&kept_at),
+        mean(&rounded_at) > 2.5 * mean(&kept_at),
         "corners {} edge lengths off with creases, {} without",
         mean(&kept_at),
         mean(&rounded_at)
@@ -927,12 +929,13 @@ fn automatic_strength_stops_near_the_best_round_count_on_a_coarse_scan_and_on_a_
     // The best number of rounds differs by an order of magnitude: the elephant is coarsely sampled
     // for its detail (best after 3-4 rounds, every further round wears detail away), a finely
     // sampled sphere keeps losing noise for twenty rounds and more. The risk estimate stops the
-    // elephant within 6 % of its best round count's distance, and runs the sphere far enough to
-    // end 10 % closer than after 8 rounds (where the previous rule, which watched the noise
-    // estimate fall, stopped both).
+    // elephant within 6 % of its best round count's distance and within three rounds of that
+    // count, and runs the sphere far enough to end 10 % closer than after 8 rounds (where the
+    // previous rule, which watched the noise estimate fall, stopped both).
     let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/elephant.obj");
     let elephant = fairmesh::io::load(&path).unwrap().mesh;
     let mut rounds = Vec::new();
+    let mut best_rounds_elephant = 0;
     for (name, clean) in [("elephant", elephant), ("sphere", icosphere(5))] {
         let topology = Topology::build(&clean);
         let input = noisy(clean.clone(), 0.3, 1);
@@ -950,7 +953,11 @@ fn automatic_strength_stops_near_the_best_round_count_on_a_coarse_scan_and_on_a_
             distance(&faired)
         };
         let compared = if name == "elephant" {
-            (1..=10).map(fixed).fold(f64::INFINITY, f64::min) * 1.06
+            let (best_rounds, best) = (1..=10)
+                .map(|rounds| (rounds, fixed(rounds)))
+                .fold((0, f64::INFINITY), |a, b| if b.1 < a.1 { b } else { a });
+            best_rounds_elephant = best_rounds;
+            best * 1.06
         } else {
             fixed(8) * 0.9
         };
@@ -962,8 +969,8 @@ fn automatic_strength_stops_near_the_best_round_count_on_a_coarse_scan_and_on_a_
         rounds.push(report.rounds_run);
     }
     assert!(
-        rounds[0] <= 6 && rounds[1] >= 3 * rounds[0],
-        "rounds: elephant {}, sphere {}",
+        rounds[0].abs_diff(best_rounds_elephant) <= 3 && rounds[1] >= 3 * rounds[0],
+        "rounds: elephant {} (its best {best_rounds_elephant}), sphere {}",
         rounds[0],
         rounds[1]
     );

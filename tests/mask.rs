@@ -60,15 +60,19 @@ fn constrained_fairing_moves_only_the_painted_region_and_removes_its_noise() {
     let report = fair_constrained(&mut faired, &topology, &options);
     assert!(report.iterations_run > 0);
     check_only_painted_moved(&noisy, &faired.positions, &mask);
-    // The painted half came closer to the clean bunny's surface, as close as fairing the whole
-    // mesh brings it (the pinned edge costs little). Distances to the surface, not to each
-    // vertex's clean position: the default's tangential relaxation slides vertices along the
-    // surface as it evens the triangles, which over the twenty-odd rounds it runs here is
-    // farther than the noise moved them.
+    // The painted half came much closer to the clean bunny's surface (the squared distances
+    // summed fall to 7 % of the input's), and about as close as fairing the whole mesh for as
+    // many rounds brings it (the automatic stop may pick another round for either, 26 against 28
+    // here). Not quite: along the pinned edge the noise of the pinned neighbours stays in the
+    // averages (1-2 rings from it the painted vertices end 58 % farther than in the whole mesh's
+    // fairing, 3-4 rings 9 %), and farther away the two runs differ by a few percent either way
+    // as the creases found and the volume offsets differ; the whole painted half ends 5 % farther
+    // (measured in this test's set-up). Distances to the surface, not to each vertex's clean
+    // position: the default's tangential relaxation may slide vertices along the surface.
     let surface = fairmesh::metrics::ClosestPointIndex::new(&clean);
-    let error = |positions: &[[f32; 3]]| -> f64 {
+    let squared_distances = |positions: &[[f32; 3]], inside: &dyn Fn(usize) -> bool| -> f64 {
         (0..positions.len())
-            .filter(|&v| mask.weight(v) > 0.0)
+            .filter(|&v| inside(v))
             .map(|v| {
                 surface
                     .distance(glam::DVec3::from(positions[v].map(f64::from)))
@@ -76,14 +80,23 @@ fn constrained_fairing_moves_only_the_painted_region_and_removes_its_noise() {
             })
             .sum()
     };
-    let (before, after) = (error(&noisy.positions), error(&faired.positions));
-    let mut whole = noisy.clone();
-    fair_constrained(&mut whole, &topology, &FairOptions::default());
-    let unmasked = error(&whole.positions);
-    assert!(after < 0.95 * before, "{after} against {before}");
+    let painted = |v: usize| mask.weight(v) > 0.0;
+    let (before, after) = (
+        squared_distances(&noisy.positions, &painted),
+        squared_distances(&faired.positions, &painted),
+    );
+    assert!(after < 0.1 * before, "{after} against {before}");
+    let rounds = report.rounds_run;
+    let fixed = |mask: Option<fairmesh::fairing::Mask>| {
+        let mut mesh = noisy.clone();
+        let options = FairOptions::default().with_rounds(rounds).with_mask(mask);
+        fair_constrained(&mut mesh, &topology, &options);
+        squared_distances(&mesh.positions, &painted)
+    };
+    let (masked, unmasked) = (fixed(Some(mask.clone())), fixed(None));
     assert!(
-        after < 1.05 * unmasked,
-        "{after} against {unmasked} unmasked"
+        masked < 1.1 * unmasked,
+        "{masked} against {unmasked} unmasked, {rounds} rounds each"
     );
 }
 

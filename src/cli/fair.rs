@@ -3,7 +3,7 @@
 use clap::{Args, ValueEnum};
 use fairmesh::fairing::{
     self, baseline::UmbrellaStencil, BoundaryMode, ConstrainedFairing, CreaseOptions, FairOptions,
-    FairVariant, HcOptions, LaplacianOptions, MethodOptions, Strength, TaubinOptions,
+    FairVariant, HcOptions, LaplacianOptions, MethodOptions, Relaxation, Strength, TaubinOptions,
 };
 use std::path::PathBuf;
 use std::time::Instant;
@@ -71,11 +71,13 @@ pub struct FairArgs {
     #[arg(long)]
     pub no_creases: bool,
     /// Constrained normal-projected only: how much each iteration also evens out the triangles
-    /// along the surface (0 to 1; 0 moves vertices only along their normals). The default removes
-    /// noise that moved vertices along the surface too and keeps flat faces flat; on a scan
-    /// sampled densest where it curves, with noise across the surface only, 0 keeps more shape.
-    #[arg(long, default_value_t = fairmesh::fairing::DEFAULT_TANGENTIAL_RELAXATION)]
-    pub tangential: f64,
+    /// along the surface, at every vertex (0 to 1; 0 moves vertices only along their normals).
+    /// Without it, 0.1 where needed: everywhere when the noise moved vertices along the surface
+    /// too (it reads how much: `tangential_noise` in --json), and around thin triangles, which
+    /// moving along the normals alone leaves folded; elsewhere the vertices move along their
+    /// normals only, which keeps a scan's denser sampling where it curves.
+    #[arg(long)]
+    pub tangential: Option<f64>,
     /// Constrained normal-projected only: do not give each part back its volume after every
     /// round (by default a uniform offset along the normals undoes the little each round loses).
     #[arg(long)]
@@ -128,15 +130,20 @@ impl FairArgs {
                 // creases, no tangential relaxation, no volume correction; --crease-angle,
                 // --no-creases, --tangential and --no-volume-correction do not apply to it,
                 // --rounds does.
-                let base = match self.variant {
-                    VariantArg::Paper => FairOptions::paper(),
-                    VariantArg::NormalProjected => FairOptions::default()
-                        .with_tangential_relaxation(self.tangential)
+                let base =
+                    match self.variant {
+                        VariantArg::Paper => FairOptions::paper(),
+                        VariantArg::NormalProjected => match self.tangential {
+                            Some(weight) => FairOptions::default()
+                                .with_tangential_relaxation(weight)
+                                .with_relaxation(Relaxation::Everywhere),
+                            None => FairOptions::default(),
+                        }
                         .with_keep_volume(!self.no_volume_correction)
                         .with_creases((!self.no_creases).then(|| {
                             CreaseOptions::default().with_angle_degrees(self.crease_angle)
                         })),
-                };
+                    };
                 let mut options = base
                     .with_iterations(self.iterations)
                     .with_tolerance(self.tolerance * mean_edge_length)
@@ -279,6 +286,7 @@ pub fn run(args: FairArgs) -> anyhow::Result<()> {
             "iterations_run": report.iterations_run,
             "rounds_run": report.rounds_run,
             "noise_estimate": report.noise_estimate,
+            "tangential_noise": report.tangential_noise,
             "crease_edges": report.crease_edges,
             "loose_triangles": report.loose_triangles,
             "time_ms": time_ms,

@@ -61,12 +61,13 @@ use super::creases::{
     detect_creases_cached, detect_creases_with_estimate, CreaseOptions, Creases, FaceRingCache,
     FeatureClass,
 };
+use super::relaxation::{self, read_tangential_noise};
 use super::strength::{
     normal_filtering_for, read_noise, RoundRisk, CLEAN_NOISE, MAX_AUTO_ROUNDS, RISK_MIN_FALL,
     RISK_PATIENCE,
 };
 use super::volume::VolumeKeeper;
-use super::{BoundaryMode, FairOptions, FairReport, FairVariant, Strength};
+use super::{BoundaryMode, FairOptions, FairReport, FairVariant, Relaxation, Strength};
 use crate::mesh::{breadth_first_order, inverse_permutation, PositionHasher, Topology, TriMesh};
 use glam::{Vec3A, Vec3Swizzles};
 use rayon::prelude::*;
@@ -228,6 +229,9 @@ pub struct ConstrainedFairing {
     /// Normal-projected only: the weight of the tangential relaxation added to each move (0: none;
     /// see [`Self::set_tangential_relaxation`]).
     tangential: f32,
+    /// Per vertex (internal numbering), the share of `tangential` it gets; empty: all of it,
+    /// everywhere ([`Self::relax_where_needed`]).
+    relaxation_share: Vec<f32>,
     /// Number of vertices that get at least one local solution.
     solved_vertices: usize,
     workspace: Workspace,
@@ -681,6 +685,7 @@ impl ConstrainedFairing {
             closed_fan,
             curves,
             tangential: 0.0,
+            relaxation_share: Vec::new(),
             solved_vertices,
             // Allocated by the first load.
             workspace: Workspace::default(),
@@ -699,6 +704,51 @@ impl ConstrainedFairing {
         } else {
             0.0
         };
+    }
+
+    /// Gives the tangential relaxation ([`Self::set_tangential_relaxation`]) only where it is
+    /// needed ([`super::relaxation`]): `everywhere` (0 to 1) of its weight at every vertex, and all
+    /// of it at the vertices with a thin triangle among theirs in the current state (the positions
+    /// of the last [`Self::load`]; [`super::relaxation::sliver_share`] of the least quality among
+    /// its fan's triangles). Holds until called again; `everywhere` 1 (or no state loaded yet)
+    /// gives every vertex the whole weight again.
+    pub fn relax_where_needed(&mut self, everywhere: f32) {
+        let everywhere = if everywhere.is_nan() {
+            1.0
+        } else {
+            everywhere.clamp(0.0, 1.0)
+        };
+        let x = &self.workspace.current;
+        if everywhere >= 1.0 || x.len() != self.vertex_count() {
+            self.relaxation_share = Vec::new();
+            return;
+        }
+        let (offsets, ring, closed_fan) = (&self.ring_offsets, &self.ring, &self.closed_fan);
+        let mut share = std::mem::take(&mut self.relaxation_share);
+        share.resize(x.len(), 0.0);
+        share
+            .par_chunks_mut(CHUNK)
+            .enumerate()
+            .for_each(|(chunk, out)| {
+                let start = chunk * CHUNK;
+                for (i, share) in out.iter_mut().enumerate() {
+                    let v = start + i;
+                    let ring_v = &ring[offsets[v] as usize..offsets[v + 1] as usize];
+                    *share = match ring_v.last() {
+                        // Only a closed fan is projected (and relaxed), and it is in fan order.
+                        Some(&last) if closed_fan[v] => {
+                            let p = x[v];
+                            let least = relaxation::least_fan_quality(
+                                x[last as usize] - p,
+                                ring_v.iter().map(|&u| x[u as usize] - p),
+                            );
+                            everywhere.max(relaxation::sliver_share(least))
+                        }
+                        _ => everywhere,
+                    };
+                }
+            });
+        self.relaxation_share = share;
     }
 
     pub fn variant(&self) -> FairVariant {
@@ -875,6 +925,7 @@ impl ConstrainedFairing {
                 &ws.anchor_terms,
                 closed_fan,
                 self.tangential,
+                &self.relaxation_share,
                 &mut ws.current
             ))
         } else {
@@ -883,6 +934,7 @@ impl ConstrainedFairing {
                 &ws.anchor_terms,
                 closed_fan,
                 0.0,
+                &[],
                 &mut ws.current
             ))
         };
@@ -927,13 +979,16 @@ impl<I: Copy + Into<u32> + Sync> Stencil<'_, I> {
     /// one-ring, into `next` (the iterate itself: pass 2 reads the previous positions from
     /// `pairs`, so no second position buffer is needed). With `PROJECT`, vertices with a closed fan keep only the part of
     /// the move x̃_v − x_v along the normal of their fan of umbrella means (centre m_v, ring m_u,
-    /// gathered anyway for the update). Returns the largest squared move.
+    /// gathered anyway for the update), plus `tangential` (times the vertex's `share` unless that
+    /// is empty) of the tangential part of its umbrella vector. Returns the largest squared move.
+    #[allow(clippy::too_many_arguments)]
     fn averaged_solutions<const PROJECT: bool>(
         &self,
         pairs: &[PositionAndMean],
         anchor_terms: &[Vec3A],
         closed_fan: &[bool],
         tangential: f32,
+        share: &[f32],
         next: &mut [Vec3A],
     ) -> f32 {
         next.par_chunks_mut(CHUNK)
@@ -986,6 +1041,10 @@ impl<I: Copy + Into<u32> + Sync> Stencil<'_, I> {
                         let length_squared = normal.length_squared();
                         step = if length_squared > 0.0 && length_squared.is_finite() {
                             let along = normal * (normal.dot(step) / length_squared);
+                            let tangential = match share.get(v) {
+                                Some(share) => tangential * share,
+                                None => tangential,
+                            };
                             if tangential > 0.0 {
                                 let umbrella = m - p;
                                 let across = normal * (normal.dot(umbrella) / length_squared);
@@ -1804,6 +1863,16 @@ fn fair_rounds(
         fairing
     };
     let mut fairing = build(mesh, creases.as_ref(), &fans);
+    // The relaxation where it is needed: the share every vertex gets, from how much of the
+    // input's noise lies along its surface ([`relaxation`]); the slivers' before every round.
+    let started = std::time::Instant::now();
+    let tangential_noise = (options.variant == FairVariant::NormalProjected
+        && options.tangential_relaxation > 0.0
+        && options.relaxation == Relaxation::WhereNeeded)
+        .then(|| read_tangential_noise(mesh, topology, &fans));
+    let everywhere =
+        tangential_noise.map(|reading| relaxation::everywhere_share(reading, estimate));
+    let reading_ms = milliseconds(started);
     // The fans serve the later rounds only to find the creases again (and estimate the noise
     // that sets the filtering for it): otherwise they are freed before the iterations (the peak,
     // while the operator is set up from them, stays: 277 MB for `fair --rounds 3 --no-creases`
@@ -1813,7 +1882,8 @@ fn fair_rounds(
         .keep_volume
         .then(|| VolumeKeeper::new(mesh, topology, pinned));
     let mut report = FairReport {
-        detection_ms: first_detection_ms,
+        detection_ms: first_detection_ms + reading_ms,
+        tangential_noise: tangential_noise.flatten(),
         ..FairReport::default()
     };
     // Automatic strength: round by round while the estimated risk of the result falls (see
@@ -1887,6 +1957,10 @@ fn fair_rounds(
         let corner = |v: usize| held.get(v) == Some(&FeatureClass::Corner);
         // Imposes the constraints on the positions this round starts from.
         fairing.load(&mesh.positions);
+        if let Some(everywhere) = everywhere {
+            // From the mesh's state: the risk's copy is faired with the same shares.
+            fairing.relax_where_needed(everywhere);
+        }
         fairing.run_round(options, &mut report);
         fairing.store(&mut mesh.positions);
         if let Some(volume) = &volume {

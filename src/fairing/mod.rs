@@ -37,9 +37,11 @@
 //!   of the result falls (Stein's unbiased risk estimate, read from a slightly moved copy of the
 //!   input faired alongside), keeping the round with the least ([`Strength::Auto`], [`strength`]);
 //! - keeps sharp creases as curves with fixed corners ([`creases`]);
-//! - adds a small tangential relaxation (weight [`DEFAULT_TANGENTIAL_RELAXATION`]) so that noise
-//!   that moved vertices along the surface comes out too. This one does move vertices along the
-//!   surface (unlike the projection alone); `with_tangential_relaxation(0.0)` turns it off;
+//! - adds a small tangential relaxation (weight [`DEFAULT_TANGENTIAL_RELAXATION`]) where it is
+//!   needed ([`Relaxation::WhereNeeded`], [`relaxation`]): everywhere when the input's noise
+//!   moved its vertices along the surface too, and at the vertices beside thin triangles, whose
+//!   normals the projection alone leaves folded. This one does move vertices along the surface
+//!   (unlike the projection alone); `with_tangential_relaxation(0.0)` turns it off;
 //! - finds the creases again before every round (the noise left makes fewer false ones; once two
 //!   detections in a row change nothing, before every fourth);
 //! - gives every connected part its volume back after every round with one uniform offset along
@@ -56,6 +58,7 @@ pub mod boundary;
 pub mod constrained;
 pub mod creases;
 pub mod mask;
+pub mod relaxation;
 pub mod strength;
 pub mod volume;
 
@@ -136,6 +139,8 @@ pub struct FairOptions {
     /// Normal-projected only: weight (0 to 1) of the tangential relaxation that evens out
     /// triangles jittered along the surface ([`ConstrainedFairing::set_tangential_relaxation`]).
     pub tangential_relaxation: f64,
+    /// Normal-projected only: which vertices get the tangential relaxation.
+    pub relaxation: Relaxation,
     /// Where to fair ([`mask`]): `None` fairs every vertex; with a mask, weight-0 vertices are
     /// held like fixed boundary vertices and the rest blended by their weights. A mask that does
     /// not fit the mesh leaves it unchanged.
@@ -154,6 +159,7 @@ with_setters!(FairOptions {
     with_variant => variant: FairVariant,
     with_creases => creases: Option<CreaseOptions>,
     with_tangential_relaxation => tangential_relaxation: f64,
+    with_relaxation => relaxation: Relaxation,
     with_mask => mask: Option<Mask>,
     with_keep_volume => keep_volume: bool,
 });
@@ -189,6 +195,7 @@ impl Default for FairOptions {
             variant: FairVariant::NormalProjected,
             creases: Some(CreaseOptions::default()),
             tangential_relaxation: DEFAULT_TANGENTIAL_RELAXATION,
+            relaxation: Relaxation::WhereNeeded,
             mask: None,
             keep_volume: true,
         }
@@ -197,6 +204,20 @@ impl Default for FairOptions {
 
 /// The default [`FairOptions::tangential_relaxation`] (`docs/measurements.md`).
 pub const DEFAULT_TANGENTIAL_RELAXATION: f64 = 0.1;
+
+/// Which vertices the tangential relaxation ([`FairOptions::tangential_relaxation`]) moves.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[non_exhaustive]
+pub enum Relaxation {
+    /// Every vertex, with the whole weight.
+    Everywhere,
+    /// The default ([`relaxation`]): every vertex by the share of the weight that the input's
+    /// noise along the surface asks for (all of it for noise in every direction, none for noise
+    /// across the surface only), and, before every round, the whole weight at the vertices that
+    /// have a thin triangle (a sliver) among their triangles.
+    #[default]
+    WhereNeeded,
+}
 
 /// How many rounds constrained fairing runs.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -225,6 +246,9 @@ pub struct FairReport {
     /// The input's estimated noise in mean edge lengths ([`strength::estimate_noise`]), when the
     /// run estimated it ([`Strength::Auto`], or creases kept).
     pub noise_estimate: Option<f64>,
+    /// With [`Relaxation::WhereNeeded`], how much of the input's noise lies along its surface, in
+    /// mean edge lengths ([`relaxation::estimate_tangential_noise`]); `None` otherwise.
+    pub tangential_noise: Option<f64>,
     /// Feature edges kept as creases (0 without creases).
     pub crease_edges: usize,
     /// Triangles left out of the smoothing because they lie loose at a non-manifold edge

@@ -1,0 +1,268 @@
+//! Where the default's tangential relaxation acts ([`super::Relaxation::WhereNeeded`]).
+//!
+//! Not from the paper. The normal-projected operator moves every vertex along its normal only;
+//! the relaxation ([`super::FairOptions::tangential_relaxation`]) adds a share of the tangential
+//! part of its umbrella vector, which evens the triangles out along the surface. Measured on the
+//! sixteen meshes of `docs/measurements.md` ("The relaxation where it is needed"), it is needed in
+//! two cases and costs shape in a third:
+//! - noise that moved the vertices along the surface (every scanner's has some; the set's
+//!   isotropic noise): only the relaxation takes it out (the elephant ends 0.0942 mean edge
+//!   lengths from its clean surface with it, 0.1036 without);
+//! - slivers: a triangle whose smallest height is a fraction of an edge has its normal decided
+//!   by how its corners move across that height, and moving them along their own (noisy)
+//!   normals leaves it folded. The generated CAD parts' fans of thin triangles (the cube's faces,
+//!   the gear's) end with their face normals 2-4 times as far off without relaxation (cube 3.2° →
+//!   10.2°), and all of that on the triangles with an angle below 10-20°: on the others the two
+//!   are alike;
+//! - noise across the surface only, on a scan sampled densest where it curves: the relaxation
+//!   evens the sampling out and so cuts the curves as chords (bunny10k ends 0.0852 from its
+//!   clean surface with it, 0.0780 without).
+//!
+//! So the default reads once, before the first round, how much of the input's noise lies along
+//! the surface ([`estimate_tangential_noise`]) and relaxes every vertex by the share
+//! [`everywhere_share`] of the weight, and before every round also fully the vertices with a
+//! sliver among their triangles ([`sliver_share`]).
+//!
+//! # The tangential noise reading
+//! Per vertex v with a closed fan: t_v, the tangential part of its umbrella vector (the mean of
+//! its neighbours minus x_v, less its part along the area-weighted normal). On a clean mesh t_v
+//! says how unevenly the ring is spread, and changes slowly from vertex to vertex; noise along
+//! the surface makes it jump. The reading is the robust spread 1.4826·median|r_v| of r_v = t_v −
+//! the mean of t over v's neighbours (its part in v's tangent plane), in mean edge lengths, as
+//! the noise estimate ([`super::strength`]) reads the normal part. On the set: clean meshes read
+//! 0.00-0.38 (a CAD part's regular grid 0.00, bunny10k's uneven sampling 0.38); with noise 0.3
+//! along the normals 0.08-0.38 (the clean mesh's own unevenness, and on CAD parts the normals'
+//! tilt leaking into the tangent plane); with isotropic noise 0.3 per coordinate 0.57-0.68, at
+//! 0.5 0.75-0.81, at 0.1 0.24-0.44. It is read on at most [`TANGENTIAL_SAMPLES`] vertices spread
+//! over the numbering, which a median of that many reads to about a percent.
+
+use super::constrained::FanRings;
+use crate::mesh::{Topology, TriMesh};
+use glam::Vec3A;
+use rayon::prelude::*;
+
+/// At or below this tangential noise reading (mean edge lengths) the relaxation acts on slivers
+/// only, unless the reading against the normal one says otherwise ([`TANGENTIAL_RATIO_NONE`]);
+/// from [`TANGENTIAL_NOISE_FULL`] on everywhere, and in between on every vertex with the share of
+/// the way from one to the other. Between the reading of noise 0.3 along the normals (at most
+/// 0.38 on the set) and of isotropic noise 0.3 (at least 0.57).
+pub const TANGENTIAL_NOISE_NONE: f64 = 0.40;
+
+/// See [`TANGENTIAL_NOISE_NONE`].
+pub const TANGENTIAL_NOISE_FULL: f64 = 0.55;
+
+/// Weak isotropic noise reads low (0.24 on the CAD parts at 0.1 per coordinate), but in every
+/// direction alike: its tangential reading is 2.4-4.5 times the normal one ([`super::strength`])
+/// on the set at 0.1, 0.3 and 0.5, while noise along the normals reads at most 1.6 times at 0.3
+/// and 0.5 (at 0.1 the uneven scans read their own unevenness, up to 3.8 times: they then get
+/// the relaxation everywhere as before). At or below this ratio it adds nothing; from
+/// [`TANGENTIAL_RATIO_FULL`] on, the relaxation acts everywhere.
+pub const TANGENTIAL_RATIO_NONE: f64 = 1.7;
+
+/// See [`TANGENTIAL_RATIO_NONE`].
+pub const TANGENTIAL_RATIO_FULL: f64 = 2.3;
+
+/// The normal reading the ratio of [`TANGENTIAL_RATIO_NONE`] is taken against is at least this
+/// (mean edge lengths): a mesh with no noise across its surface but some along it (a flat grid
+/// jittered in its plane) gets the relaxation everywhere, a clean one with an even sampling (a
+/// CAD part's grid, 0.00-0.02) does not, and where there is no normal reading (a fixed strength
+/// without creases) a tangential one above 0.085-0.115 gives the relaxation everywhere, as before.
+pub const TANGENTIAL_RATIO_FLOOR: f64 = 0.05;
+
+/// A triangle counts as a sliver below this quality 4√3·area / (sum of the squared edges) (1 for
+/// an equilateral triangle, 0 for a degenerate one); the vertices around one are relaxed by the
+/// share of the way from here down to [`SLIVER_QUALITY_FULL`], fully below that. (A right
+/// isosceles triangle is 0.87; one with a 10° angle between two equal edges about 0.2.)
+pub const SLIVER_QUALITY: f32 = 0.5;
+
+/// See [`SLIVER_QUALITY`].
+pub const SLIVER_QUALITY_FULL: f32 = 0.3;
+
+/// At most this many vertices are read for [`estimate_tangential_noise`].
+pub const TANGENTIAL_SAMPLES: usize = 1 << 15;
+
+/// The share of the relaxation's weight every vertex gets for a tangential noise reading and the
+/// normal one (the noise estimate, when there is one; see [`TANGENTIAL_NOISE_NONE`],
+/// [`TANGENTIAL_RATIO_NONE`] and [`TANGENTIAL_RATIO_FLOOR`]): 1 (everywhere, as with
+/// [`super::Relaxation::Everywhere`]) when there is no tangential reading.
+pub fn everywhere_share(reading: Option<f64>, normal_noise: Option<f64>) -> f32 {
+    let ramp = |value: f64, none: f64, full: f64| ((value - none) / (full - none)).clamp(0.0, 1.0);
+    let Some(reading) = reading else {
+        return 1.0;
+    };
+    let normal_noise = normal_noise
+        .filter(|noise| noise.is_finite())
+        .map_or(TANGENTIAL_RATIO_FLOOR, |noise| {
+            noise.max(TANGENTIAL_RATIO_FLOOR)
+        });
+    let by_ratio = ramp(
+        reading / normal_noise,
+        TANGENTIAL_RATIO_NONE,
+        TANGENTIAL_RATIO_FULL,
+    );
+    ramp(reading, TANGENTIAL_NOISE_NONE, TANGENTIAL_NOISE_FULL).max(by_ratio) as f32
+}
+
+/// The share of the relaxation's weight a vertex gets for the least quality among its triangles
+/// (see [`SLIVER_QUALITY`]).
+#[inline]
+pub fn sliver_share(least_quality: f32) -> f32 {
+    ((SLIVER_QUALITY - least_quality) / (SLIVER_QUALITY - SLIVER_QUALITY_FULL)).clamp(0.0, 1.0)
+}
+
+/// The quality 4√3·area / (|a|² + |b|² + |b − a|²) of the triangle with edges a and b from one
+/// corner (see [`SLIVER_QUALITY`]); 1 for a degenerate triangle with no length, which is no sliver
+/// to even out.
+pub fn triangle_quality(a: Vec3A, b: Vec3A) -> f32 {
+    least_fan_quality(a, std::iter::once(b))
+}
+
+/// The least [`triangle_quality`] among the triangles of a fan around a point: `edges` its edges
+/// from the point in fan order, each making a triangle with the one before it, the first with
+/// `last` (the fan's last edge, for a closed fan). The triangles are compared by their squared
+/// quality over 12, |a × b|² / (sum of squares)², so a fan costs one root (this runs over every
+/// vertex before every round).
+#[inline]
+pub(crate) fn least_fan_quality(last: Vec3A, edges: impl Iterator<Item = Vec3A>) -> f32 {
+    let mut previous = last;
+    let mut previous_squared = last.length_squared();
+    // That of an equilateral triangle to start with.
+    let mut least = 1.0f32 / 12.0;
+    for current in edges {
+        let current_squared = current.length_squared();
+        let sum = previous_squared + current_squared + (current - previous).length_squared();
+        // (A triangle with no length is skipped; dividing twice keeps the terms near the squared
+        // edge lengths, far from f32's range.)
+        if sum > 0.0 {
+            least = least.min(previous.cross(current).length_squared() / sum / sum);
+        }
+        previous = current;
+        previous_squared = current_squared;
+    }
+    (12.0 * least).sqrt()
+}
+
+/// How much of `mesh`'s noise lies along its surface, in mean edge lengths (see the module
+/// docs); `None` when fewer than 16 vertices can be read (a vertex and all its neighbours need a
+/// closed fan). The same value for any thread count.
+pub fn estimate_tangential_noise(mesh: &TriMesh, topology: &Topology) -> Option<f64> {
+    read_tangential_noise(mesh, topology, &FanRings::new(&mesh.triangles, topology))
+}
+
+/// [`estimate_tangential_noise`] with the fan-ordered one-rings the caller has.
+pub(crate) fn read_tangential_noise(
+    mesh: &TriMesh,
+    topology: &Topology,
+    fans: &FanRings,
+) -> Option<f64> {
+    let offsets = topology.neighbor_csr().0;
+    let point = |v: u32| Vec3A::from_array(mesh.positions[v as usize]);
+    // A vertex's tangential umbrella part, unit normal and the summed lengths of its ring edges.
+    let fan = |v: u32| -> Option<(Vec3A, Vec3A, f32, usize)> {
+        if !fans.closed_fan[v as usize] {
+            return None;
+        }
+        let ring = &fans.ring[offsets[v as usize] as usize..offsets[v as usize + 1] as usize];
+        let x = point(v);
+        let mut previous = point(*ring.last()?) - x;
+        let (mut offset, mut normal, mut lengths) = (Vec3A::ZERO, Vec3A::ZERO, 0.0f32);
+        for &u in ring {
+            let d = point(u) - x;
+            offset += d;
+            normal += previous.cross(d);
+            lengths += d.length();
+            previous = d;
+        }
+        let normal = normal.try_normalize()?;
+        let umbrella = offset / ring.len() as f32;
+        Some((
+            umbrella - normal * normal.dot(umbrella),
+            normal,
+            lengths,
+            ring.len(),
+        ))
+    };
+    let n = mesh.positions.len();
+    let stride = n.div_ceil(TANGENTIAL_SAMPLES).max(1);
+    // Per sampled vertex: |r_v| and its ring's edge lengths, when it can be read.
+    let read: Vec<(f32, f32, usize)> = (0..n.div_ceil(stride))
+        .into_par_iter()
+        .with_min_len(256)
+        .filter_map(|i| {
+            let v = (i * stride) as u32;
+            let (t, normal, lengths, valence) = fan(v)?;
+            let ring = &fans.ring[offsets[v as usize] as usize..offsets[v as usize + 1] as usize];
+            let mut sum = Vec3A::ZERO;
+            for &u in ring {
+                sum += fan(u)?.0;
+            }
+            let r = t - sum / ring.len() as f32;
+            let r = r - normal * normal.dot(r);
+            Some((r.length(), lengths, valence))
+        })
+        .collect();
+    if read.len() < 16 {
+        return None;
+    }
+    let edge = read.iter().map(|&(_, l, _)| l as f64).sum::<f64>()
+        / read.iter().map(|&(_, _, k)| k).sum::<usize>() as f64;
+    let mut residuals: Vec<f32> = read.iter().map(|&(r, _, _)| r).collect();
+    let middle = residuals.len() / 2;
+    let median = *residuals.select_nth_unstable_by(middle, f32::total_cmp).1 as f64;
+    let reading = 1.4826 * median / edge;
+    (edge > 0.0 && reading.is_finite()).then_some(reading)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::mesh::shapes;
+
+    use crate::noise::{add_noise, NoiseMode, NoiseOptions};
+
+    fn reading(mesh: &TriMesh) -> f64 {
+        estimate_tangential_noise(mesh, &Topology::build(mesh)).unwrap()
+    }
+
+    #[test]
+    fn the_reading_tells_noise_along_the_surface_from_noise_across_it() {
+        let clean = shapes::cylinder(0.5, 1.5, 0.05);
+        let noisy = |mode| {
+            let mut mesh = clean.clone();
+            add_noise(&mut mesh, &NoiseOptions::default().with_mode(mode));
+            reading(&mesh)
+        };
+        let (clean_reading, across, along) = (
+            reading(&clean),
+            noisy(NoiseMode::Normal),
+            noisy(NoiseMode::Isotropic),
+        );
+        assert!(clean_reading < 0.05, "{clean_reading}");
+        assert!(across < TANGENTIAL_NOISE_NONE, "{across}");
+        assert!(along > TANGENTIAL_NOISE_FULL, "{along}");
+        assert_eq!(everywhere_share(Some(across), Some(0.3)), 0.0);
+        assert_eq!(everywhere_share(Some(along), Some(0.3)), 1.0);
+        assert_eq!(everywhere_share(None, Some(0.3)), 1.0);
+        // Weak noise in every direction: low, but high against the normal part.
+        assert_eq!(everywhere_share(Some(0.24), Some(0.3)), 0.0);
+        assert_eq!(everywhere_share(Some(0.24), Some(0.1)), 1.0);
+        // No noise across the surface: any along it is noise to even out, but a clean mesh's
+        // even sampling is not.
+        assert_eq!(everywhere_share(Some(0.24), Some(0.0)), 1.0);
+        assert_eq!(everywhere_share(Some(0.24), None), 1.0);
+        assert_eq!(everywhere_share(Some(0.02), Some(0.0)), 0.0);
+    }
+
+    #[test]
+    fn slivers_get_the_relaxation_and_fair_triangles_do_not() {
+        let equilateral = triangle_quality(Vec3A::X, Vec3A::new(0.5, 0.75f32.sqrt(), 0.0));
+        assert!((equilateral - 1.0).abs() < 1e-6, "{equilateral}");
+        assert_eq!(sliver_share(equilateral), 0.0);
+        let sliver = triangle_quality(Vec3A::X, Vec3A::new(0.5, 0.05, 0.0));
+        assert!(sliver < SLIVER_QUALITY_FULL, "{sliver}");
+        assert_eq!(sliver_share(sliver), 1.0);
+        let between = (SLIVER_QUALITY + SLIVER_QUALITY_FULL) / 2.0;
+        assert!((sliver_share(between) - 0.5).abs() < 1e-6);
+        assert_eq!(triangle_quality(Vec3A::ZERO, Vec3A::ZERO), 1.0);
+    }
+}
