@@ -1870,14 +1870,15 @@ fn fair_rounds(
         && options.tangential_relaxation > 0.0
         && options.relaxation == Relaxation::WhereNeeded)
         .then(|| read_tangential_noise(mesh, topology, &fans));
-    let everywhere =
+    let mut everywhere =
         tangential_noise.map(|reading| relaxation::everywhere_share(reading, estimate));
     let reading_ms = milliseconds(started);
     // The fans serve the later rounds only to find the creases again (and estimate the noise
-    // that sets the filtering for it): otherwise they are freed before the iterations (the peak,
+    // that sets the filtering for it) and to read the noise along the surface again while the
+    // relaxation acts everywhere: otherwise they are freed before the iterations (the peak,
     // while the operator is set up from them, stays: 277 MB for `fair --rounds 3 --no-creases`
     // on 1.2M faces either way).
-    let fans = redetect.then_some(fans);
+    let fans = (redetect || everywhere.is_some_and(|share| share > 0.0)).then_some(fans);
     let volume = options
         .keep_volume
         .then(|| VolumeKeeper::new(mesh, topology, pinned));
@@ -1957,9 +1958,19 @@ fn fair_rounds(
         let corner = |v: usize| held.get(v) == Some(&FeatureClass::Corner);
         // Imposes the constraints on the positions this round starts from.
         fairing.load(&mesh.positions);
-        if let Some(everywhere) = everywhere {
+        if let Some(share) = &mut everywhere {
+            // Once the noise along the surface is gone (the mesh reads as even as a relaxed one),
+            // the relaxation keeps to the thin triangles (`relaxation::still_needed_share`).
+            if round > 0 && *share > 0.0 {
+                if let Some(fans) = &fans {
+                    let started = std::time::Instant::now();
+                    let reading = read_tangential_noise(mesh, topology, fans);
+                    *share = share.min(relaxation::still_needed_share(reading));
+                    report.detection_ms += milliseconds(started);
+                }
+            }
             // From the mesh's state: the risk's copy is faired with the same shares.
-            fairing.relax_where_needed(everywhere);
+            fairing.relax_where_needed(*share);
         }
         fairing.run_round(options, &mut report);
         fairing.store(&mut mesh.positions);
