@@ -73,9 +73,10 @@ pub struct FairArgs {
     /// Constrained normal-projected only: how much each iteration also evens out the triangles
     /// along the surface, at every vertex (0 to 1; 0 moves vertices only along their normals).
     /// Without it, 0.1 where needed: everywhere when the noise moved vertices along the surface
-    /// too (it reads how much: `tangential_noise` in --json), and around thin triangles, which
-    /// moving along the normals alone leaves folded; elsewhere the vertices move along their
-    /// normals only, which keeps a scan's denser sampling where it curves.
+    /// too (it reads how much: `tangential_noise` in --json), until the mesh reads even, and
+    /// around thin triangles, which moving along the normals alone leaves folded; elsewhere the
+    /// vertices move along their normals only, which keeps a scan's denser sampling where it
+    /// curves.
     #[arg(long)]
     pub tangential: Option<f64>,
     /// Constrained normal-projected only: do not give each part back its volume after every
