@@ -39,7 +39,8 @@
 //! - keeps sharp creases as curves with fixed corners ([`creases`]);
 //! - adds a small tangential relaxation (weight [`DEFAULT_TANGENTIAL_RELAXATION`]) where it is
 //!   needed ([`Relaxation::WhereNeeded`], [`relaxation`]): everywhere when the input's noise
-//!   moved its vertices along the surface too, and at the vertices beside thin triangles, whose
+//!   moved its vertices along the surface too, until the mesh reads as even as a relaxed one,
+//!   and at the vertices beside thin triangles, whose
 //!   normals the projection alone leaves folded. This one does move vertices along the surface
 //!   (unlike the projection alone); `with_tangential_relaxation(0.0)` turns it off;
 //! - finds the creases again before every round (the noise left makes fewer false ones; once two
@@ -213,8 +214,9 @@ pub enum Relaxation {
     Everywhere,
     /// The default ([`relaxation`]): every vertex by the share of the weight that the input's
     /// noise along the surface asks for (all of it for noise in every direction, none for noise
-    /// across the surface only), and, before every round, the whole weight at the vertices that
-    /// have a thin triangle (a sliver) among their triangles.
+    /// across the surface only) until the mesh reads as even as a relaxed one, and, before every
+    /// round, the whole weight at the vertices that have a thin triangle (a sliver) among their
+    /// triangles.
     #[default]
     WhereNeeded,
 }
