@@ -40,9 +40,9 @@
 //! - adds a small tangential relaxation (weight [`DEFAULT_TANGENTIAL_RELAXATION`]) where it is
 //!   needed ([`Relaxation::WhereNeeded`], [`relaxation`]): everywhere when the input's noise
 //!   moved its vertices along the surface too, until the mesh reads as even as a relaxed one,
-//!   and at the vertices beside thin triangles, whose
-//!   normals the projection alone leaves folded. This one does move vertices along the surface
-//!   (unlike the projection alone); `with_tangential_relaxation(0.0)` turns it off;
+//!   and at the vertices beside thin triangles, whose normals the projection alone leaves
+//!   folded. This one does move vertices along the surface (unlike the projection alone);
+//!   `with_tangential_relaxation(0.0)` turns it off;
 //! - finds the creases again before every round (the noise left makes fewer false ones; once two
 //!   detections in a row change nothing, before every fourth);
 //! - gives every connected part its volume back after every round with one uniform offset along
