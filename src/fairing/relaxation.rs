@@ -99,7 +99,6 @@ pub const TANGENTIAL_SAMPLES: usize = 1 << 15;
 /// [`TANGENTIAL_RATIO_NONE`] and [`TANGENTIAL_RATIO_FLOOR`]): 1 (everywhere, as with
 /// [`super::Relaxation::Everywhere`]) when there is no tangential reading.
 pub fn everywhere_share(reading: Option<f64>, normal_noise: Option<f64>) -> f32 {
-    let ramp = |value: f64, none: f64, full: f64| ((value - none) / (full - none)).clamp(0.0, 1.0);
     let Some(reading) = reading else {
         return 1.0;
     };
@@ -119,16 +118,24 @@ pub fn everywhere_share(reading: Option<f64>, normal_noise: Option<f64>) -> f32 
 /// The share of the relaxation's weight every vertex still gets for the tangential noise read
 /// before a later round (see [`RELAXED`]; 1 when there is no reading).
 pub fn still_needed_share(reading: Option<f64>) -> f32 {
-    reading.map_or(1.0, |reading| {
-        ((reading - RELAXED) / (RELAXED_FULL - RELAXED)).clamp(0.0, 1.0) as f32
-    })
+    reading.map_or(1.0, |reading| ramp(reading, RELAXED, RELAXED_FULL) as f32)
 }
 
 /// The share of the relaxation's weight a vertex gets for the least quality among its triangles
 /// (see [`SLIVER_QUALITY`]).
 #[inline]
 pub fn sliver_share(least_quality: f32) -> f32 {
-    ((SLIVER_QUALITY - least_quality) / (SLIVER_QUALITY - SLIVER_QUALITY_FULL)).clamp(0.0, 1.0)
+    ramp(
+        least_quality as f64,
+        SLIVER_QUALITY as f64,
+        SLIVER_QUALITY_FULL as f64,
+    ) as f32
+}
+
+/// 0 at `none`, 1 at `full` and beyond, linear in between (`full` may lie below `none`).
+#[inline]
+fn ramp(value: f64, none: f64, full: f64) -> f64 {
+    ((value - none) / (full - none)).clamp(0.0, 1.0)
 }
 
 /// The quality 4√3·area / (|a|² + |b|² + |b − a|²) of the triangle with edges a and b from one
