@@ -62,8 +62,9 @@
 //!   still has exactly its pass-start fan; the current faces of a collapse target `k` are its
 //!   pass-start fan relabelled through this pass's removals (a face that degenerates is gone) plus
 //!   the fans of the vertices collapsed into it, chained in `absorbed` lists. The cone volume of
-//!   every candidate is summed over all of `v`'s faces in fan order (those that contain the
-//!   candidate add an exact zero), and candidates are taken least first rather than sorted, since
+//!   a candidate `k` is `-N . (x_k - x_v)`, with `N` the sum of `v`'s faces' normals taken from
+//!   `x_v` (the same as the sum over the faces above: see `choose_collapse`), so the fan is read
+//!   once for all candidates, and candidates are taken least first rather than sorted, since
 //!   the first is nearly always valid. The fan and link checks compare without early exits, which
 //!   would be mispredicted;
 //! - writes the next level: survivors keep their order, faces are relabelled, and those that
@@ -1239,8 +1240,11 @@ impl PassView<'_> {
 #[derive(Default)]
 struct Scratch {
     neighbors: Vec<u32>,
-    /// Positions of `a` and `b` for each face `(v, a, b)` of the vertex being tried.
+    /// Positions of `a` and `b` relative to `v` for each face `(v, a, b)` of the vertex being
+    /// tried.
     positions: Vec<[DVec3; 2]>,
+    /// The normal (x_a - x_v) x (x_b - x_v) of each of those faces.
+    normals: Vec<DVec3>,
     /// `(|cone|, k, signed cone)`.
     candidates: Vec<(f64, u32, f64)>,
 }
@@ -1276,20 +1280,30 @@ fn choose_collapse(
             }
         }
     }
+    // Positions relative to `x_v` (exact: differences of f32 values are f64 values), and the
+    // fan's area vector N = sum over v's faces of (x_a - x_v) x (x_b - x_v), each term kept as
+    // the face's normal before the collapse.
+    let xv = p(v);
     scratch.neighbors.clear();
     scratch.positions.clear();
+    scratch.normals.clear();
+    let mut area = DVec3::ZERO;
     for &[a, b] in fan {
         scratch.neighbors.push(a);
-        scratch.positions.push([p(a), p(b)]);
+        let (xa, xb) = (p(a) - xv, p(b) - xv);
+        let normal = xa.cross(xb);
+        area += normal;
+        scratch.positions.push([xa, xb]);
+        scratch.normals.push(normal);
     }
     if on_boundary {
         scratch.neighbors.push(fan_end);
     }
-    let xv = p(v);
 
-    // Cone volumes, summed in fan order. A face that contains `k` adds exactly zero (one of its
-    // edge vectors from `k` is the zero vector), and the sum starts at +0 so it is never -0:
-    // adding that zero changes nothing, so no face needs to be skipped.
+    // Cone volumes. With x_v at the origin a face's term is ((a - k) x (b - k)) . (-k), and
+    // (a - k) x (b - k) = a x b - a x k - k x b, whose last two parts are orthogonal to k; so
+    // the cone is -N . (x_k - x_v) for every candidate (faces containing `k` add zero, as they
+    // should), one dot product each instead of a sum over the fan.
     scratch.candidates.clear();
     for &k in &scratch.neighbors {
         if on_boundary && k != fan_start && k != fan_end {
@@ -1298,10 +1312,7 @@ fn choose_collapse(
         if along.is_some_and(|along| !along.contains(&k)) {
             continue;
         }
-        let xk = p(k);
-        let cone = scratch.positions.iter().fold(0.0, |cone, &[xa, xb]| {
-            cone + (xa - xk).cross(xb - xk).dot(xv - xk)
-        });
+        let cone = -area.dot(p(k) - xv);
         scratch.candidates.push((cone.abs(), k, cone));
     }
 
@@ -1314,10 +1325,11 @@ fn choose_collapse(
             .then_with(|| m0_id[x.1 as usize].cmp(&m0_id[y.1 as usize]))
     }) {
         let (_, k, cone) = scratch.candidates.swap_remove(best);
-        let xk = p(k);
+        let xk = p(k) - xv;
         // No surviving face may flip or degenerate.
         let mut opposite = [NEVER; 2];
-        for (&[a, b], &[xa, xb]) in fan.iter().zip(&scratch.positions) {
+        for ((&[a, b], &[xa, xb]), &old) in fan.iter().zip(&scratch.positions).zip(&scratch.normals)
+        {
             if a == k {
                 opposite[0] = b;
                 continue;
@@ -1326,7 +1338,6 @@ fn choose_collapse(
                 opposite[1] = a;
                 continue;
             }
-            let old = (xa - xv).cross(xb - xv);
             let new = (xa - xk).cross(xb - xk);
             if old.dot(new) <= 0.0 {
                 continue 'candidate;
