@@ -21,7 +21,7 @@ raised by a factor sqrt(1 + ALPHA^2).
 
 Run from the repository root after `cargo build --release`:
     venv/bin/python scripts/peers/stopping_truth.py CLEAN [--mode normal|iso] [--rounds 12]
-        [--r2r 0.5 --draws 4]
+        [--r2r 0.5 --draws 4] [--fair-flags="--no-creases"]
 CLEAN is any mesh fairmesh reads; the noisy mesh keeps its vertices (the noise moves them), so
 the clean vertex of each result vertex is known. Needs numpy and trimesh (requirements.txt).
 """
@@ -73,7 +73,10 @@ def main():
     parser.add_argument("--rounds", type=int, default=12)
     parser.add_argument("--r2r", type=float, help="also the recorrupted estimate, this alpha")
     parser.add_argument("--draws", type=int, default=4)
+    parser.add_argument("--fair-flags", default="",
+                        help='more flags for every `fair` run, written with = (--fair-flags="--no-creases")')
     args = parser.parse_args()
+    flags = args.fair_flags.split()
 
     with tempfile.TemporaryDirectory() as tmp:
         clean = os.path.join(tmp, "clean.ply")
@@ -88,7 +91,7 @@ def main():
             sys.exit(f"{args.clean}: the noisy mesh has other vertices than the clean one")
         edge = mean_edge(x, faces)
         sigma = args.sigma * edge
-        default = json.loads(run("fair", noisy, "-o", out, "--json"))
+        default = json.loads(run("fair", noisy, "-o", out, "--json", *flags))
         read = default.get("risk_by_round") or []
 
         def along_normals(path, target):
@@ -101,7 +104,7 @@ def main():
 
         true_risk, distance = [], []
         for k in range(1, args.rounds + 1):
-            run("fair", noisy, "-o", out, "--rounds", str(k))
+            run("fair", noisy, "-o", out, "--rounds", str(k), *flags)
             true_risk.append(along_normals(out, x) + sigma**2)
             m = json.loads(run("compare", clean, out, "--json"))
             distance.append(m["mean_surface_distance"] / m["reference_mean_edge_length"])
@@ -119,10 +122,11 @@ def main():
                 write_ply(more, y + alpha * s * z, noisy_faces)
                 target = y - s * z / alpha
                 for k in range(1, args.rounds + 1):
-                    run("fair", more, "-o", out, "--rounds", str(k))
+                    run("fair", more, "-o", out, "--rounds", str(k), *flags)
                     recorrupted[k - 1] += along_normals(out, target) / args.draws
 
-    print(f"{args.clean}, noise {args.sigma} mode {args.mode}: default `fair` stops after "
+    print(f"{args.clean}, noise {args.sigma} mode {args.mode}"
+          f"{', flags ' + args.fair_flags if flags else ''}: default `fair` stops after "
           f"{default.get('rounds_run')} rounds (risk read for {len(read)})")
     header = "| round | risk read | true risk | mean distance |"
     rule = "|---:|---:|---:|---:|"
