@@ -185,48 +185,47 @@ pub(crate) fn read_tangential_noise(
 ) -> Option<f64> {
     let offsets = topology.neighbor_csr().0;
     let point = |v: u32| Vec3A::from_array(mesh.positions[v as usize]);
-    // A vertex's tangential umbrella part, unit normal and the summed lengths of its ring edges.
-    let fan = |v: u32| -> Option<(Vec3A, Vec3A, f32, usize)> {
+    let ring = |v: u32| &fans.ring[offsets[v as usize] as usize..offsets[v as usize + 1] as usize];
+    // A vertex's tangential umbrella part and unit normal.
+    let fan = |v: u32| -> Option<(Vec3A, Vec3A)> {
         if !fans.closed_fan[v as usize] {
             return None;
         }
-        let ring = &fans.ring[offsets[v as usize] as usize..offsets[v as usize + 1] as usize];
+        let ring = ring(v);
         let x = point(v);
         let mut previous = point(*ring.last()?) - x;
-        let (mut offset, mut normal, mut lengths) = (Vec3A::ZERO, Vec3A::ZERO, 0.0f32);
+        let (mut offset, mut normal) = (Vec3A::ZERO, Vec3A::ZERO);
         for &u in ring {
             let d = point(u) - x;
             offset += d;
             normal += previous.cross(d);
-            lengths += d.length();
             previous = d;
         }
         let normal = normal.try_normalize()?;
         let umbrella = offset / ring.len() as f32;
-        Some((
-            umbrella - normal * normal.dot(umbrella),
-            normal,
-            lengths,
-            ring.len(),
-        ))
+        Some((umbrella - normal * normal.dot(umbrella), normal))
     };
     let n = mesh.positions.len();
     let stride = n.div_ceil(TANGENTIAL_SAMPLES).max(1);
-    // Per sampled vertex: |r_v| and its ring's edge lengths, when it can be read.
+    // Per sampled vertex: |r_v| and its ring's edge lengths (summed) and count, when it can be
+    // read. (Only the sampled vertex's own ring lengths count for the mean edge length, so they
+    // are not summed for each of its neighbours.)
     let read: Vec<(f32, f32, usize)> = (0..n.div_ceil(stride))
         .into_par_iter()
         .with_min_len(256)
         .filter_map(|i| {
             let v = (i * stride) as u32;
-            let (t, normal, lengths, valence) = fan(v)?;
-            let ring = &fans.ring[offsets[v as usize] as usize..offsets[v as usize + 1] as usize];
+            let (t, normal) = fan(v)?;
+            let ring = ring(v);
             let mut sum = Vec3A::ZERO;
             for &u in ring {
                 sum += fan(u)?.0;
             }
             let r = t - sum / ring.len() as f32;
             let r = r - normal * normal.dot(r);
-            Some((r.length(), lengths, valence))
+            let x = point(v);
+            let lengths = ring.iter().map(|&u| (point(u) - x).length()).sum::<f32>();
+            Some((r.length(), lengths, ring.len()))
         })
         .collect();
     if read.len() < 16 {
