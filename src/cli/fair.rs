@@ -131,20 +131,23 @@ impl FairArgs {
                 // creases, no tangential relaxation, no volume correction; --crease-angle,
                 // --no-creases, --tangential and --no-volume-correction do not apply to it,
                 // --rounds does.
-                let base =
-                    match self.variant {
-                        VariantArg::Paper => FairOptions::paper(),
-                        VariantArg::NormalProjected => match self.tangential {
-                            Some(weight) => FairOptions::default()
+                let base = match self.variant {
+                    VariantArg::Paper => FairOptions::paper(),
+                    VariantArg::NormalProjected => {
+                        let options = FairOptions::default()
+                            .with_keep_volume(!self.no_volume_correction)
+                            .with_creases((!self.no_creases).then(|| {
+                                CreaseOptions::default().with_angle_degrees(self.crease_angle)
+                            }));
+                        // --tangential W: that weight at every vertex.
+                        match self.tangential {
+                            Some(weight) => options
                                 .with_tangential_relaxation(weight)
                                 .with_relaxation(Relaxation::Everywhere),
-                            None => FairOptions::default(),
+                            None => options,
                         }
-                        .with_keep_volume(!self.no_volume_correction)
-                        .with_creases((!self.no_creases).then(|| {
-                            CreaseOptions::default().with_angle_degrees(self.crease_angle)
-                        })),
-                    };
+                    }
+                };
                 let mut options = base
                     .with_iterations(self.iterations)
                     .with_tolerance(self.tolerance * mean_edge_length)

@@ -1041,10 +1041,7 @@ impl<I: Copy + Into<u32> + Sync> Stencil<'_, I> {
                         let length_squared = normal.length_squared();
                         step = if length_squared > 0.0 && length_squared.is_finite() {
                             let along = normal * (normal.dot(step) / length_squared);
-                            let tangential = match share.get(v) {
-                                Some(share) => tangential * share,
-                                None => tangential,
-                            };
+                            let tangential = share.get(v).map_or(tangential, |s| tangential * s);
                             if tangential > 0.0 {
                                 let umbrella = m - p;
                                 let across = normal * (normal.dot(umbrella) / length_squared);
