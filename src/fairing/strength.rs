@@ -427,11 +427,12 @@ pub const CLEAN_NOISE: f64 = 0.04;
 /// from those by the noise itself (16° on average on the noisy cylinder, mean cos² 0.90), and a
 /// divergence read along them comes out short by about that cos², less so as the rounds smooth
 /// the mesh, so the risk falls too slowly and the rounds stopped early on the CAD parts. Averaged
-/// twice, the draw's directions lie within a few degrees of the clean normals on finely sampled
-/// meshes (the cylinder's cos² 0.98 after five averagings) and blur little of a coarse scan's
-/// bends (the elephant's cos² stays 0.90 after five, so more do not help there); one averaging
-/// leaves the thin plate and the gear stopping early (`docs/measurements.md`).
-pub const RISK_DRAW_AVERAGING: usize = 2;
+/// a few times, the draw's directions lie within a few degrees of the clean normals on finely
+/// sampled meshes (the cylinder's cos² 0.98 after five averagings) while a coarse scan's bends
+/// blur (the elephant's cos² stays 0.90 after five). Measured on the 32-row peer table of
+/// `docs/measurements.md`: one or two averagings leave the gear stopping early (its faces
+/// 18.9° / 18.0° off against 16.0° with three), four stop the cow and the dragon late.
+pub const RISK_DRAW_AVERAGING: usize = 3;
 
 /// A face whose least altitude is under this fraction of its longest edge is a sliver; σ is read
 /// over the vertices with no sliver among their faces. On slivers the faces' normals turn with a
