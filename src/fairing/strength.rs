@@ -474,8 +474,8 @@ pub fn normal_filtering_for(noise: f64) -> usize {
 }
 
 /// Stein's unbiased risk estimate of the rounds' result (see the module docs): made from the
-/// input before the first round, it holds the input, the Gaussian draw b_v and the input's unit
-/// normals, and gives the perturbed copy to fair beside it.
+/// input before the first round, it holds the input, the Gaussian draw b_v and its directions
+/// (the input's unit normals, averaged), and gives the perturbed copy to fair beside it.
 pub(crate) struct RoundRisk {
     input: Vec<[f32; 3]>,
     /// The input's unit normals (area-weighted) averaged [`RISK_DRAW_AVERAGING`] times over the
@@ -760,8 +760,8 @@ mod tests {
         // (error 0), a = 1/2 the halfway blend (error sigma²/4 per vertex), a = 1 the input left
         // as it is (error sigma²). Per vertex the risk reads the residual (1 − a)²·sigma² plus
         // twice the divergence a times the variance the first reading found: with the variance
-        // exact, that is each error plus sigma². A wrong
-        // sign or scale of the divergence would rank the input first or the blend last.
+        // exact, that is each error plus sigma². A wrong sign or scale of the divergence would
+        // rank the input first or the blend last.
         let clean = grid(80);
         let topology = Topology::build(&clean);
         let sigma = 0.3f32;
@@ -814,9 +814,9 @@ mod tests {
 
     #[test]
     fn the_draw_lies_along_the_clean_normals_not_the_noisy_ones() {
-        // On a plane with noise of 0.3 edge lengths the input's own normals tilt by ~20°; the
-        // draw's directions, averaged over the one-rings, must lie much closer to the plane's
-        // normal (unaveraged they would read as tilted as the input's).
+        // On a plane with noise of sigma 0.3 (a quarter of its mean edge) the input's own normals
+        // tilt by ~14° (mean cos² 0.94); the draw's directions, averaged over the one-rings, must
+        // lie much closer to the plane's normal (unaveraged they would be the input's).
         let clean = grid(60);
         let topology = Topology::build(&clean);
         let input = noisy_plane(&clean, 0.3);
