@@ -881,6 +881,31 @@ mod tests {
     }
 
     #[test]
+    fn a_mesh_of_slivers_reads_sigma_over_every_vertex() {
+        // The whole plane squeezed to a twentieth of its width, with noise small enough
+        // (sigma 0.01 against the faces' 0.05) to leave every face a sliver: with no vertex free
+        // of slivers, sigma² is read over all of them (the clean plane as the result), not left
+        // to the noise estimate (0 here).
+        let mut clean = grid(40);
+        for p in &mut clean.positions {
+            p[0] *= 0.05;
+        }
+        let topology = Topology::build(&clean);
+        let sigma = 0.01f32;
+        let input = noisy_plane(&clean, sigma);
+        let edge = crate::metrics::mean_edge_length(&input);
+        let (mut risk, _) = RoundRisk::new(&input, &topology, edge, 0.0);
+        assert!(risk.sliver_free.iter().all(|&free| !free));
+        risk.read(&clean, &topology, &clean.positions);
+        let variance = risk.variance.unwrap();
+        let truth = (sigma * sigma) as f64;
+        assert!(
+            (variance / truth - 1.0).abs() < 0.15,
+            "sigma² read {variance}, truth {truth}"
+        );
+    }
+
+    #[test]
     fn a_clean_plane_has_no_noise_and_a_noisy_one_reads_its_sigma() {
         let clean = grid(60);
         let topology = Topology::build(&clean);
