@@ -440,7 +440,10 @@ pub const RISK_DRAW_AVERAGING: usize = 3;
 /// linear response the copy reads there, and σ reads low where they crowd: over every vertex the
 /// gear (a fan-triangulated cap, 87 % of its faces, half of them slivers) reads 0.92 of the
 /// noise, its cap's centre 0.68; without the sliver fans 0.99. Meshes without slivers read as
-/// before (`docs/measurements.md`).
+/// before (`docs/measurements.md`). A narrower bound than the relaxation's slivers
+/// ([`super::relaxation::SLIVER_QUALITY`], quality under 0.5): a triangle whose least altitude is
+/// a tenth of its longest edge has a quality of 0.17-0.23. Whether one bound could serve both is
+/// not measured.
 pub const SLIVER_ALTITUDE: f32 = 0.1;
 
 /// The rounds stop once this many rounds in a row have not lowered the risk below the least seen
@@ -553,7 +556,9 @@ impl RoundRisk {
     pub(crate) fn read(&mut self, mesh: &TriMesh, topology: &Topology, copy: &[[f32; 3]]) -> f64 {
         let normals = unit_vertex_normals(mesh, topology);
         let step = self.step;
-        // Every vertex's sums, and those of the vertices without slivers (for σ).
+        // Every vertex's sums, and, while σ is not yet read, those of the vertices without
+        // slivers.
+        let reading_sigma = self.variance.is_none();
         let (all, sliver_free) = mesh
             .positions
             .par_chunks(VERTEX_BLOCK)
@@ -571,7 +576,7 @@ impl RoundRisk {
                     let moved = n.dot(f - Vec3A::from_array(self.input[v])) as f64;
                     let response = n0.dot(Vec3A::from_array(copy[v]) - f) as f64 / step;
                     all.add(moved, self.draw[v] as f64 * response, response);
-                    if self.sliver_free[v] {
+                    if reading_sigma && self.sliver_free[v] {
                         sliver_free.add(moved, self.draw[v] as f64 * response, response);
                     }
                 }
