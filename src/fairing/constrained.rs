@@ -11,6 +11,19 @@
 //!   are computed once per distinct triple.
 //! - "Interior triangle" = none of its corners is a boundary vertex (and every corner has valence
 //!   three or more, so that A is invertible). Only interior triangles are solved.
+//! - Not in the paper: a triangle with exactly one corner on a crease (the default variant's
+//!   sharp edges, [`super::creases`]) is solved too, with that corner held where it is: its two
+//!   other corners minimise the same energy ‖AP − Q‖² with their own midpoint kept
+//!   (P_a + P_b = P⁰_a + P⁰_b), while the crease corner moves along its curve. Writing P_a = s and
+//!   P_b = K − s with K = P⁰_a + P⁰_b, the residual is d·s + e with d = A_a − A_b (columns of A)
+//!   and e = A_b·K + A_h·x_h − Q, so s = −dᵀe / dᵀd ([`held_corner_weights`]). Left unsolved, as
+//!   the paper leaves the boundary's triangles, they left every vertex beside a crease with
+//!   fewer solutions to average, and on coarse scans (where crease vertices are many) a third of
+//!   the vertices with one or two and some with none, so the noise stayed there
+//!   (`docs/measurements.md`, "Triangles beside a crease solved"). Keeping the triangle's own
+//!   centroid instead (the free pair making up for the crease corner's move along its curve)
+//!   pushed the pair against that move: the open mushroom's rim folded. The boundary's triangles
+//!   stay unsolved, as the paper has them.
 //! - Jacobi: every local solve of one iteration reads the previous iterate. The new position of a
 //!   vertex is the mean of its triangles' solutions; a vertex with no solution (all its triangles
 //!   touch the boundary, or it is unreferenced) keeps its position (the paper's pseudocode would
@@ -199,7 +212,8 @@ macro_rules! with_stencil {
 #[derive(Clone, Debug)]
 pub struct ConstrainedFairing {
     /// The vertices (mesh numbering) that bound the surface patches: boundary, crease and pinned
-    /// vertices. They get no local solution and their triangles are not solved.
+    /// vertices. They get no local solution and their triangles are not solved, but for those
+    /// with one crease corner and no other held one ([`held_corner`]).
     held: Vec<bool>,
     variant: FairVariant,
     boundary: BoundaryMode,
@@ -470,8 +484,15 @@ impl ConstrainedFairing {
             rows.resize(ring_v.len(), [0.0; 4]);
             let operator = |f: u32| {
                 let t = &triangles[f as usize];
-                solved_triangle(t, held, topology)
-                    .then(|| corner_weights(t.map(|c| topology.valence(c))))
+                let valences = t.map(|c| topology.valence(c));
+                if solved_triangle(t, held, topology) {
+                    Some(corner_weights(valences))
+                } else {
+                    // v itself, when it is the held corner, gets no solution from the triangle.
+                    held_corner(t, held, topology, pinned)
+                        .filter(|&h| t[h] as usize != v)
+                        .map(|h| held_corner_weights(valences, h))
+                }
             };
             let mut solved = false;
             gather_rows(
@@ -539,7 +560,8 @@ impl ConstrainedFairing {
         let vertex_count = mesh.positions.len();
         let triangles = &mesh.triangles;
         // Crease vertices and corners, and pinned vertices, bound the surface patches like
-        // boundary vertices do: they get no local solution and their triangles are not solved.
+        // boundary vertices do: they get no local solution and their triangles are not solved,
+        // but for those with a single crease corner, solved with it held ([`held_corner`]).
         let creases = creases.filter(|c| !c.is_empty());
         let held = held_flags(topology, creases, pinned);
 
@@ -550,24 +572,42 @@ impl ConstrainedFairing {
         let interior = |t: &[u32; 3]| solved_triangle(t, &held, topology);
 
         // Local operators of the valence triples that occur, in a dense table, and each triangle's
-        // slot in it (u32::MAX: not an interior triangle), found once per triangle rather than
-        // once per corner. Triples with a valence beyond the table get an operator of their own.
+        // slot in it (u32::MAX: not solved), found once per triangle rather than once per
+        // corner. Triples with a valence beyond the table get an operator of their own, and so
+        // do the (few) triangles solved with a crease corner held, per triple and held corner.
         let table_index = |n: [usize; 3]| (n[0] * TABLE_VALENCE + n[1]) * TABLE_VALENCE + n[2];
-        let triangle_valences: Vec<Option<[usize; 3]>> = triangles
+        let triangle_valences: Vec<Option<([usize; 3], Option<usize>)>> = triangles
             .par_iter()
-            .map(|t| interior(t).then(|| t.map(valence)))
+            .map(|t| {
+                if interior(t) {
+                    Some((t.map(valence), None))
+                } else {
+                    held_corner(t, &held, topology, pinned).map(|h| (t.map(valence), Some(h)))
+                }
+            })
             .collect();
         let mut table_slot = vec![u32::MAX; TABLE_VALENCE * TABLE_VALENCE * TABLE_VALENCE];
+        let mut held_corner_slot: HashMap<([usize; 3], usize), u32> = HashMap::new();
         // Per operator, the weights corner r's solution gives corner c's umbrella mean, position
-        // and anchor: G_rc, G_rc/n_c − Σ_c' G_rc'/n_c' and h_r (see "How it is computed").
+        // and anchor: G_rc, G_rc/n_c − Σ_c' G_rc'/n_c' and h_r (see "How it is computed"); and
+        // which corner it holds (3: none).
         let mut operators: Vec<[[[f64; 3]; 3]; 3]> = Vec::new();
-        let mut operator_slot = |n: [usize; 3]| -> u32 {
+        let mut operator_held: Vec<u8> = Vec::new();
+        let mut operator_slot = |(n, held_at): ([usize; 3], Option<usize>)| -> u32 {
+            if let Some(h) = held_at {
+                return *held_corner_slot.entry((n, h)).or_insert_with(|| {
+                    operators.push(held_corner_weights(n, h));
+                    operator_held.push(h as u8);
+                    (operators.len() - 1) as u32
+                });
+            }
             let in_table = n.iter().all(|&k| k < TABLE_VALENCE);
             if in_table && table_slot[table_index(n)] != u32::MAX {
                 return table_slot[table_index(n)];
             }
             let slot = operators.len() as u32;
             operators.push(corner_weights(n));
+            operator_held.push(3);
             if in_table {
                 table_slot[table_index(n)] = slot;
             }
@@ -590,7 +630,11 @@ impl ConstrainedFairing {
             let ring_v = &ring[ring_offsets[v] as usize..ring_offsets[v + 1] as usize];
             let operator = |f: u32| {
                 let slot = triangle_operator[f as usize];
-                (slot != u32::MAX).then(|| &operators[slot as usize])
+                // v itself, when it is the held corner, gets no solution from the triangle.
+                (slot != u32::MAX
+                    && triangles[f as usize].get(operator_held[slot as usize] as usize)
+                        != Some(&(v as u32)))
+                .then(|| &operators[slot as usize])
             };
             gather_rows(
                 v,
@@ -1092,6 +1136,64 @@ fn solved_triangle(t: &[u32; 3], held: &[bool], topology: &Topology) -> bool {
         && t[0] != t[1]
         && t[1] != t[2]
         && t[0] != t[2]
+}
+
+/// Which corner of triangle `t` is held when it is solved with a crease corner held (see the
+/// module docs): the one corner held by a crease when exactly one is held (not by the boundary,
+/// which the paper leaves unsolved, nor pinned), its corners distinct and of valence three or
+/// more; `None` for any other triangle.
+fn held_corner(t: &[u32; 3], held: &[bool], topology: &Topology, pinned: &[bool]) -> Option<usize> {
+    let distinct = t[0] != t[1] && t[1] != t[2] && t[0] != t[2];
+    if !distinct || t.iter().any(|&c| topology.valence(c) < 3) {
+        return None;
+    }
+    let mut held_at = (0..3).filter(|&k| held[t[k] as usize]);
+    let (Some(h), None) = (held_at.next(), held_at.next()) else {
+        return None;
+    };
+    let c = t[h];
+    (!topology.is_boundary_vertex(c) && !pinned.get(c as usize).copied().unwrap_or(false))
+        .then_some(h)
+}
+
+/// [`corner_weights`] for a triangle solved with corner `held` held where it is (see the module
+/// docs): per free corner r, the weights its solution gives each corner c's umbrella mean,
+/// position and anchor (the held corner's rows are zero). Built as coefficient vectors over
+/// (m_0, m_1, m_2, x_0, x_1, x_2, anchor_0, anchor_1, anchor_2).
+fn held_corner_weights(n: [usize; 3], held: usize) -> [[[f64; 3]; 3]; 3] {
+    type Coefficients = [f64; 9];
+    let unit = |i: usize| -> Coefficients { std::array::from_fn(|k| f64::from(u8::from(k == i))) };
+    let plus = |a: Coefficients, b: Coefficients, scale: f64| -> Coefficients {
+        std::array::from_fn(|k| a[k] + scale * b[k])
+    };
+    let a_matrix = umbrella_local_matrix(n);
+    // q_r = m_r − Σ_{c ≠ r} x_c / n_r.
+    let q: [Coefficients; 3] = std::array::from_fn(|r| {
+        (0..3)
+            .filter(|&c| c != r)
+            .fold(unit(r), |q, c| plus(q, unit(3 + c), -1.0 / n[r] as f64))
+    });
+    let (a, b) = match held {
+        0 => (1, 2),
+        1 => (0, 2),
+        _ => (0, 1),
+    };
+    // The free pair's anchors sum: P_a + P_b = K.
+    let k = plus(unit(6 + a), unit(6 + b), 1.0);
+    let d: [f64; 3] = std::array::from_fn(|r| a_matrix[r][a] - a_matrix[r][b]);
+    let e: [Coefficients; 3] = std::array::from_fn(|r| {
+        let e = plus([0.0; 9], k, a_matrix[r][b]);
+        let e = plus(e, unit(3 + held), a_matrix[r][held]);
+        plus(e, q[r], -1.0)
+    });
+    let d_squared: f64 = d.iter().map(|x| x * x).sum();
+    let p_a = (0..3).fold([0.0; 9], |s, r| plus(s, e[r], -d[r] / d_squared));
+    let p_b = plus(k, p_a, -1.0);
+    let mut weights = [[[0.0; 3]; 3]; 3];
+    for (r, p) in [(a, p_a), (b, p_b)] {
+        weights[r] = std::array::from_fn(|c| [p[c], p[3 + c], p[6 + c]]);
+    }
+    weights
 }
 
 /// For the valence triple `n` of a triangle's corners: per corner r, the weights its local
@@ -2128,6 +2230,129 @@ mod tests {
                 assert!(barycentre_error < 1e-12, "case {case}: {barycentre_error}");
             }
         }
+    }
+
+    #[test]
+    fn a_triangle_with_a_crease_corner_held_is_the_least_squares_solution_keeping_its_pairs_midpoint(
+    ) {
+        // The free corners a, b of a triangle whose corner h is held at x_h minimise ‖AP − Q‖²
+        // with P_a + P_b = anchor_a + anchor_b; solved directly (Lagrange) against the weights.
+        let mut rng = Rng(0x2545f4914f6cdd1d);
+        for case in 0..600 {
+            let n = [0; 3].map(|_| 3 + (rng.next() * 12.0) as usize);
+            let held = case % 3;
+            let weights = held_corner_weights(n, held);
+            let a = umbrella_local_matrix(n);
+            let (fa, fb) = match held {
+                0 => (1, 2),
+                1 => (0, 2),
+                _ => (0, 1),
+            };
+            let m: [f64; 3] = std::array::from_fn(|_| rng.range(-5.0, 5.0));
+            let x: [f64; 3] = std::array::from_fn(|_| rng.range(-5.0, 5.0));
+            let anchor: [f64; 3] = std::array::from_fn(|_| rng.range(-5.0, 5.0));
+            let q: [f64; 3] = std::array::from_fn(|r| {
+                m[r] - (0..3).filter(|&c| c != r).map(|c| x[c]).sum::<f64>() / n[r] as f64
+            });
+            // Unknowns P_a, P_b, λ: 2·MᵀM·P + λ·1 = 2·Mᵀ(Q − A_h·x_h), P_a + P_b = K.
+            let column = |c: usize| [a[0][c], a[1][c], a[2][c]];
+            let (ma, mb, mh) = (column(fa), column(fb), column(held));
+            let rest: [f64; 3] = std::array::from_fn(|k| q[k] - mh[k] * x[held]);
+            let dot = |u: [f64; 3], v: [f64; 3]| (0..3).map(|k| u[k] * v[k]).sum::<f64>();
+            let system = [
+                [2.0 * dot(ma, ma), 2.0 * dot(ma, mb), 1.0],
+                [2.0 * dot(mb, ma), 2.0 * dot(mb, mb), 1.0],
+                [1.0, 1.0, 0.0],
+            ];
+            let rhs = [
+                2.0 * dot(ma, rest),
+                2.0 * dot(mb, rest),
+                anchor[fa] + anchor[fb],
+            ];
+            let direct = gauss_solve(system, rhs);
+            for (r, expected) in [(fa, direct[0]), (fb, direct[1])] {
+                let solved: f64 = (0..3)
+                    .map(|c| {
+                        weights[r][c][0] * m[c]
+                            + weights[r][c][1] * x[c]
+                            + weights[r][c][2] * anchor[c]
+                    })
+                    .sum();
+                let error = (solved - expected).abs() / expected.abs().max(1.0);
+                assert!(
+                    error < 1e-9,
+                    "case {case}, corner {r}: {solved} against {expected}"
+                );
+            }
+            // The held corner gets no solution from the triangle.
+            assert_eq!(weights[held], [[0.0; 3]; 3]);
+        }
+    }
+
+    #[test]
+    fn a_row_between_two_creases_is_smoothed_with_its_triangles_solved_beside_them() {
+        // A flat grid with noise along z, and two straight creases along the rows y = 4 and
+        // y = 6. Every triangle of row 5 touches one of them: left unsolved (as the boundary's
+        // are) they would leave row 5's noise as it is.
+        let n = 10usize;
+        let mut positions = Vec::new();
+        for y in 0..=n {
+            for x in 0..=n {
+                let bump = (((x * 7 + y * 13) % 11) as f32 - 5.0) * 0.04;
+                positions.push([x as f32, y as f32, bump]);
+            }
+        }
+        let at = |x: usize, y: usize| (y * (n + 1) + x) as u32;
+        let mut triangles = Vec::new();
+        for y in 0..n {
+            for x in 0..n {
+                triangles.push([at(x, y), at(x + 1, y), at(x + 1, y + 1)]);
+                triangles.push([at(x, y), at(x + 1, y + 1), at(x, y + 1)]);
+            }
+        }
+        let mesh = TriMesh::new(positions, triangles);
+        let topology = Topology::build(&mesh);
+        let mut class = vec![FeatureClass::Smooth; mesh.positions.len()];
+        let mut edges = Vec::new();
+        for y in [4, 6] {
+            for x in 0..=n {
+                let end = x == 0 || x == n;
+                class[at(x, y) as usize] = if end {
+                    FeatureClass::Corner
+                } else {
+                    FeatureClass::Crease
+                };
+                if x < n {
+                    edges.push([at(x, y), at(x + 1, y)]);
+                }
+            }
+        }
+        let creases = Creases::from_classified(edges, class);
+        let row_noise = |positions: &[[f32; 3]]| -> f32 {
+            (1..n)
+                .map(|x| positions[at(x, 5) as usize][2].abs())
+                .sum::<f32>()
+                / (n - 1) as f32
+        };
+        let mut positions = mesh.positions.clone();
+        let before = row_noise(&positions);
+        let mut fairing = ConstrainedFairing::with_creases(
+            &mesh,
+            &topology,
+            FairVariant::NormalProjected,
+            BoundaryMode::Fixed,
+            &creases,
+        );
+        let options = FairOptions {
+            iterations: 10,
+            rounds: 5,
+            variant: FairVariant::NormalProjected,
+            ..Default::default()
+        };
+        fairing.run(&mut positions, &options);
+        let after = row_noise(&positions);
+        assert!(before > 0.05, "the row starts noisy: {before}");
+        assert!(after < 0.5 * before, "row 5: mean |z| {before} -> {after}");
     }
 
     #[test]
