@@ -1990,11 +1990,19 @@ fn fair_rounds(
     // [`super::strength`]): a copy of the input, moved a little along its normals, goes through
     // the same rounds, and the mesh goes back to the round with the least risk.
     let mut risk = auto_noise.map(|noise| {
+        // σ is read away from the first detection's creases and the boundary.
+        let held: Vec<bool> = (0..mesh.positions.len() as u32)
+            .into_par_iter()
+            .map(|v| {
+                topology.is_boundary_vertex(v) || creases.as_ref().is_some_and(|c| c.is_feature(v))
+            })
+            .collect();
         RoundRisk::new(
             mesh,
             topology,
             crate::metrics::mean_edge_length(mesh),
             noise,
+            &held,
         )
     });
     // The round with the least risk so far: its number, its risk, its positions and crease count.

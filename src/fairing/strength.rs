@@ -36,11 +36,16 @@
 //! the input, a copy of it moved by ε b_v along the input's normals (b_v a fixed Gaussian draw;
 //! the normals averaged over the one-rings [`RISK_DRAW_AVERAGING`] times, so that they stand for
 //! the clean surface's): Σ b_v n_v · (f_v(y + ε b n) − f_v(y)) / ε. The copy goes through the
-//! same operator, round for round, so every round costs its iterations twice. σ itself comes
-//! from the first round: E Σ (n · (f − y))² = bias + σ² (N − 2 div + Σ |n · ∂f n|²), the last
-//! sum again from the copy (the squared differences), taken with the bias as zero, over the
-//! vertices without slivers among their faces ([`SLIVER_ALTITUDE`]), and used as it is read.
-//! The rounds stop once [`RISK_PATIENCE`] rounds in a row have not lowered the risk by
+//! same operator, round for round, so every round costs its iterations twice. σ itself is read
+//! from the input by second differences ([`second_difference_variance`]): with L the umbrella
+//! operator (the mean of the neighbours), r_v = n_v · ((I − L)² y)_v is, on a smooth surface,
+//! the change of the curvature term across two rings (small) plus the noise filtered by a row of
+//! (I − L)², whose squared norm g_v is known; so σ² = Σ r_v² / Σ g_v over the vertices whose two
+//! rings hold no crease and no boundary vertex (there the surface is not smooth). It replaced a
+//! reading from the first round's residual, E Σ (n · (f − y))² = bias + σ² (N − 2 div +
+//! Σ |n · ∂f n|²) taken with the bias as zero, which read 0-9 % high (the shape the round removes
+//! counts as noise) and so stopped the coarse scans a round late (`docs/measurements.md`, "σ by
+//! second differences"). The rounds stop once [`RISK_PATIENCE`] rounds in a row have not lowered the risk by
 //! [`RISK_MIN_FALL`] of what the second round lowered it by, and the mesh
 //! goes back to the round with the least (the risk is not always convex in the rounds: a CAD
 //! part's creases found again after a few rounds lower it again), or after [`MAX_AUTO_ROUNDS`].
@@ -434,18 +439,6 @@ pub const CLEAN_NOISE: f64 = 0.04;
 /// 18.9° / 18.0° off against 16.0° with three), four stop the cow and the dragon late.
 pub const RISK_DRAW_AVERAGING: usize = 3;
 
-/// A face whose least altitude is under this fraction of its longest edge is a sliver; σ is read
-/// over the vertices with no sliver among their faces. On slivers the faces' normals turn with a
-/// small fraction of the noise, so the constrained rounds' response to the noise is far from the
-/// linear response the copy reads there, and σ reads low where they crowd: over every vertex the
-/// gear (a fan-triangulated cap, 87 % of its faces, half of them slivers) reads 0.92 of the
-/// noise, its cap's centre 0.68; without the sliver fans 0.99. Meshes without slivers read as
-/// before (`docs/measurements.md`). A narrower bound than the relaxation's slivers
-/// ([`super::relaxation::SLIVER_QUALITY`], quality under 0.5): a triangle whose least altitude is
-/// a tenth of its longest edge has a quality of 0.17-0.23. Whether one bound could serve both is
-/// not measured.
-pub const SLIVER_ALTITUDE: f32 = 0.1;
-
 /// The rounds stop once this many rounds in a row have not lowered the risk below the least seen
 /// (near its least the risk is flat, and on a CAD part it may rise for a round before the creases
 /// found again lower it further).
@@ -485,15 +478,11 @@ pub(crate) struct RoundRisk {
     /// one-rings, the directions of the draw.
     directions: Vec<Vec3A>,
     draw: Vec<f32>,
-    /// Whether none of the vertex's faces is a sliver ([`SLIVER_ALTITUDE`]) in the input: σ is
-    /// read over these.
-    sliver_free: Vec<bool>,
     /// The copy's step, absolute.
     step: f64,
-    /// σ², once the first round has been read.
-    variance: Option<f64>,
-    /// The noise estimate's σ (absolute), for when the first round's reading cannot be made.
-    fallback: f64,
+    /// σ² (absolute): [`second_difference_variance`], or the noise estimate's where that
+    /// reading cannot be made.
+    variance: f64,
 }
 
 /// What one reading of [`RoundRisk`] sums over the vertices.
@@ -503,20 +492,21 @@ struct RiskSums {
     residual: f64,
     /// Σ b_v n⁰_v · (f̃_v − f_v) / ε: the divergence along the normals.
     divergence: f64,
-    /// Σ (n⁰_v · (f̃_v − f_v) / ε)².
-    spread: f64,
     /// Vertices summed (those with a normal).
     count: usize,
 }
 
 impl RoundRisk {
     /// The risk of fairing `mesh` (the input, before any round; `edge` its mean edge length,
-    /// `noise` its noise estimate in edge lengths) and the copy to fair beside it.
+    /// `noise` its noise estimate in edge lengths; `held` flags the vertices on creases or the
+    /// boundary, whose two rings σ is not read over, empty for none) and the copy to fair beside
+    /// it.
     pub(crate) fn new(
         mesh: &TriMesh,
         topology: &Topology,
         edge: f64,
         noise: f64,
+        held: &[bool],
     ) -> (RoundRisk, Vec<[f32; 3]>) {
         let step = RISK_STEP * edge;
         let mut directions = unit_vertex_normals(mesh, topology);
@@ -536,36 +526,32 @@ impl RoundRisk {
             .with_min_len(VERTEX_BLOCK)
             .map(|((p, n), &b)| (Vec3A::from_array(*p) + *n * (b * step as f32)).to_array())
             .collect();
+        let fallback = noise * edge;
+        let variance = second_difference_variance(mesh, topology, &directions, held)
+            .filter(|variance| *variance > 0.0 && variance.is_finite())
+            .unwrap_or(fallback * fallback);
         let risk = RoundRisk {
             input: mesh.positions.clone(),
             directions,
             draw,
-            sliver_free: sliver_free_vertices(mesh, topology),
             step,
-            variance: None,
-            fallback: noise * edge,
+            variance,
         };
         (risk, copy)
     }
 
     /// The estimated risk (per vertex, squared length) of `mesh` as the rounds' result, the
-    /// input's copy having gone through the same rounds to `copy`. The first reading also fixes
-    /// σ (see the module docs), over the vertices without slivers ([`SLIVER_ALTITUDE`]; over all
-    /// where fewer than a tenth are); the noise estimate stands in where that reading cannot be
-    /// made.
-    pub(crate) fn read(&mut self, mesh: &TriMesh, topology: &Topology, copy: &[[f32; 3]]) -> f64 {
+    /// input's copy having gone through the same rounds to `copy`.
+    pub(crate) fn read(&self, mesh: &TriMesh, topology: &Topology, copy: &[[f32; 3]]) -> f64 {
         let normals = unit_vertex_normals(mesh, topology);
         let step = self.step;
-        // Every vertex's sums, and, while σ is not yet read, those of the vertices without
-        // slivers.
-        let reading_sigma = self.variance.is_none();
-        let (all, sliver_free) = mesh
+        let sums = mesh
             .positions
             .par_chunks(VERTEX_BLOCK)
             .enumerate()
             .map(|(b, block)| {
                 let start = b * VERTEX_BLOCK;
-                let (mut all, mut sliver_free) = (RiskSums::default(), RiskSums::default());
+                let mut sums = RiskSums::default();
                 for (i, p) in block.iter().enumerate() {
                     let v = start + i;
                     let (n, n0) = (normals[v], self.directions[v]);
@@ -575,43 +561,22 @@ impl RoundRisk {
                     let f = Vec3A::from_array(*p);
                     let moved = n.dot(f - Vec3A::from_array(self.input[v])) as f64;
                     let response = n0.dot(Vec3A::from_array(copy[v]) - f) as f64 / step;
-                    all.add(moved, self.draw[v] as f64 * response, response);
-                    if reading_sigma && self.sliver_free[v] {
-                        sliver_free.add(moved, self.draw[v] as f64 * response, response);
-                    }
+                    sums.add(moved, self.draw[v] as f64 * response);
                 }
-                (all, sliver_free)
+                sums
             })
-            .collect::<Vec<(RiskSums, RiskSums)>>()
+            .collect::<Vec<RiskSums>>()
             .into_iter()
-            .fold(
-                (RiskSums::default(), RiskSums::default()),
-                |(a, b), (c, d)| (a.sum(c), b.sum(d)),
-            );
-        let variance = *self.variance.get_or_insert_with(|| {
-            let basis = if 10 * sliver_free.count >= all.count {
-                sliver_free
-            } else {
-                all
-            };
-            let count = basis.count as f64;
-            let read = basis.residual / (count - 2.0 * basis.divergence + basis.spread);
-            if read.is_finite() && read > 0.0 {
-                read
-            } else {
-                self.fallback * self.fallback
-            }
-        });
-        (all.residual + 2.0 * variance * all.divergence) / all.count.max(1) as f64
+            .fold(RiskSums::default(), RiskSums::sum);
+        (sums.residual + 2.0 * self.variance * sums.divergence) / sums.count.max(1) as f64
     }
 }
 
 impl RiskSums {
-    /// Adds one vertex: its residual along the normal, b_v times its response, and its response.
-    fn add(&mut self, moved: f64, divergence: f64, response: f64) {
+    /// Adds one vertex: its residual along the normal and b_v times its response.
+    fn add(&mut self, moved: f64, divergence: f64) {
         self.residual += moved * moved;
         self.divergence += divergence;
-        self.spread += response * response;
         self.count += 1;
     }
 
@@ -619,7 +584,6 @@ impl RiskSums {
         RiskSums {
             residual: self.residual + other.residual,
             divergence: self.divergence + other.divergence,
-            spread: self.spread + other.spread,
             count: self.count + other.count,
         }
     }
@@ -643,29 +607,124 @@ fn averaged_over_rings(topology: &Topology, directions: &[Vec3A]) -> Vec<Vec3A> 
         .collect()
 }
 
-/// Whether each vertex has no sliver among its faces: no face whose least altitude is under
-/// [`SLIVER_ALTITUDE`] times its longest edge (twice its area under that times the longest
-/// edge's square), in parallel.
-fn sliver_free_vertices(mesh: &TriMesh, topology: &Topology) -> Vec<bool> {
-    let sliver: Vec<bool> = (0..mesh.triangles.len() as u32)
-        .into_par_iter()
-        .with_min_len(4096)
-        .map(|f| {
-            let [a, b, c] =
-                mesh.triangles[f as usize].map(|v| Vec3A::from_array(mesh.positions[v as usize]));
-            let longest = (b - a)
-                .length_squared()
-                .max((c - b).length_squared())
-                .max((a - c).length_squared());
-            (b - a).cross(c - a).length() < SLIVER_ALTITUDE * longest
-        })
-        .collect();
-    (0..mesh.positions.len() as u32)
+/// σ² of noise along the normals of `mesh`, read by second differences (see the module docs):
+/// Σ r_v² / Σ g_v with r_v = n_v · ((I − L)² y)_v (`directions`: unit normals of the clean
+/// surface as well as the input tells them) and g_v the squared norm of row v of (I − L)², the
+/// variance r_v would have for unit noise; over the vertices with no `held` vertex within two
+/// rings (over all where fewer than a tenth are such; `held` empty: none). `None` where no vertex
+/// can be read. On big meshes g_v is averaged over every [`GAIN_STRIDE`]-th vertex read (its
+/// row's listing is most of the cost: 150 ms of the 1.2M-face mesh on two threads, taken for
+/// every vertex).
+///
+/// Measured on the 16 meshes of the peer table with noise of 0.15, 0.3 and 0.5 edge lengths along
+/// the normals and per coordinate (`docs/measurements.md`): the reading over the truth has a mean
+/// |log| of 0.043, 0.031 and 0.037, against 0.059, 0.037 and 0.043 for the first round's
+/// residual, and 0.068, 0.034 and 0.037 with the creases' and the boundary's rings read too (a
+/// CAD part's edges read as noise: the cube 13 % high at 0.15). In parallel; every vertex is
+/// computed alike and the blocks' sums are joined in order, so the result does not depend on the
+/// thread count.
+fn second_difference_variance(
+    mesh: &TriMesh,
+    topology: &Topology,
+    directions: &[Vec3A],
+    held: &[bool],
+) -> Option<f64> {
+    let n = mesh.positions.len();
+    let position = |v: u32| Vec3A::from_array(mesh.positions[v as usize]);
+    // (I − L) y: every vertex less the mean of its neighbours.
+    let first: Vec<Vec3A> = (0..n as u32)
         .into_par_iter()
         .with_min_len(VERTEX_BLOCK)
-        .map(|v| !topology.faces_of(v).iter().any(|&f| sliver[f as usize]))
-        .collect()
+        .map(|v| {
+            let ring = topology.neighbors(v);
+            if ring.is_empty() {
+                return Vec3A::ZERO;
+            }
+            position(v) - ring.iter().map(|&u| position(u)).sum::<Vec3A>() / ring.len() as f32
+        })
+        .collect();
+    // The held vertices grown by a ring.
+    let grown = |flags: &[bool]| -> Vec<bool> {
+        (0..n as u32)
+            .into_par_iter()
+            .with_min_len(VERTEX_BLOCK)
+            .map(|v| flags[v as usize] || topology.neighbors(v).iter().any(|&u| flags[u as usize]))
+            .collect()
+    };
+    let excluded = if held.len() == n {
+        grown(&grown(held))
+    } else {
+        vec![false; n]
+    };
+    let readable = |v: u32| topology.valence(v) > 0 && directions[v as usize] != Vec3A::ZERO;
+    let away = (0..n as u32)
+        .into_par_iter()
+        .with_min_len(VERTEX_BLOCK)
+        .filter(|&v| readable(v) && !excluded[v as usize])
+        .count();
+    let everywhere = 10 * away < n;
+    let stride = if away > GAIN_STRIDE * GAIN_STRIDE_FROM {
+        GAIN_STRIDE
+    } else {
+        1
+    } as u32;
+    let (residual, read, gain, gained) = (0..n.div_ceil(VERTEX_BLOCK))
+        .into_par_iter()
+        .map(|b| {
+            let (mut residual, mut read, mut gain, mut gained) = (0.0f64, 0usize, 0.0f64, 0usize);
+            let mut row: Vec<(u32, f64)> = Vec::new();
+            for v in (b * VERTEX_BLOCK..n.min((b + 1) * VERTEX_BLOCK)).map(|v| v as u32) {
+                if !readable(v) || (excluded[v as usize] && !everywhere) {
+                    continue;
+                }
+                let ring = topology.neighbors(v);
+                let mean =
+                    ring.iter().map(|&u| first[u as usize]).sum::<Vec3A>() / ring.len() as f32;
+                let r = directions[v as usize].dot(first[v as usize] - mean) as f64;
+                residual += r * r;
+                read += 1;
+                if v % stride != 0 {
+                    continue;
+                }
+                gained += 1;
+                // Row v of (I − L)² = e_v − 2·L_v + Σ_u L_vu·L_u: its entries listed, sorted by
+                // vertex, and each vertex's summed before it is squared.
+                row.clear();
+                row.push((v, 1.0));
+                let own = 1.0 / ring.len() as f64;
+                for &u in ring {
+                    row.push((u, -2.0 * own));
+                    let theirs = topology.neighbors(u);
+                    let weight = own / theirs.len() as f64;
+                    row.extend(theirs.iter().map(|&w| (w, weight)));
+                }
+                row.sort_unstable_by_key(|&(w, _)| w);
+                let mut at = 0;
+                while at < row.len() {
+                    let (w, mut entry) = row[at];
+                    at += 1;
+                    while at < row.len() && row[at].0 == w {
+                        entry += row[at].1;
+                        at += 1;
+                    }
+                    gain += entry * entry;
+                }
+            }
+            (residual, read, gain, gained)
+        })
+        .collect::<Vec<(f64, usize, f64, usize)>>()
+        .into_iter()
+        .fold((0.0, 0, 0.0, 0), |(a, b, c, d), (e, f, g, h)| {
+            (a + e, b + f, c + g, d + h)
+        });
+    (gain > 0.0).then(|| (residual / read as f64) / (gain / gained as f64))
 }
+
+/// [`second_difference_variance`] takes the gains of every this-many-th vertex on meshes with
+/// more than this times [`GAIN_STRIDE_FROM`] vertices read.
+const GAIN_STRIDE: usize = 8;
+/// See [`GAIN_STRIDE`]: the gains are averaged over at least this many vertices.
+const GAIN_STRIDE_FROM: usize = 16384;
 
 /// A standard normal draw for vertex `v`, the same on every run and for any thread count
 /// (Box-Muller from two uniforms of a SplitMix64 hash of `v`).
@@ -772,7 +831,7 @@ mod tests {
         let sigma = 0.3f32;
         let input = noisy_plane(&clean, sigma);
         let edge = crate::metrics::mean_edge_length(&input);
-        let (mut risk, copy) = RoundRisk::new(&input, &topology, edge, 0.0);
+        let (risk, copy) = RoundRisk::new(&input, &topology, edge, 0.0, &[]);
         // Each smoother applied to the input and to the risk's copy: p -> x + a·(p − x), x the
         // clean vertex (so that its derivative is a times the identity).
         let smooth = |mesh: &TriMesh, a: f32| {
@@ -785,13 +844,13 @@ mod tests {
             out
         };
         let copy_mesh = TriMesh::new(copy, input.triangles.clone());
-        let mut read = |a: f32| {
+        let read = |a: f32| {
             let (result, moved) = (smooth(&input, a), smooth(&copy_mesh, a));
             risk.read(&result, &topology, &moved.positions)
         };
-        // The clean plane first: it fixes sigma as what its residual reads (the noise itself).
+        // Sigma as read from the input by second differences: the noise itself.
         let (oracle, half, none) = (read(0.0), read(0.5), read(1.0));
-        let variance = risk.variance.unwrap();
+        let variance = risk.variance;
         let truth = (sigma * sigma) as f64;
         assert!(
             (variance / truth - 1.0).abs() < 0.1,
@@ -826,7 +885,7 @@ mod tests {
         let topology = Topology::build(&clean);
         let input = noisy_plane(&clean, 0.3);
         let edge = crate::metrics::mean_edge_length(&input);
-        let (risk, _) = RoundRisk::new(&input, &topology, edge, 0.0);
+        let (risk, _) = RoundRisk::new(&input, &topology, edge, 0.0, &[]);
         let mean_cos2 = |normals: &[Vec3A]| {
             normals.iter().map(|n| (n.z * n.z) as f64).sum::<f64>() / normals.len() as f64
         };
@@ -839,75 +898,81 @@ mod tests {
         );
     }
 
-    #[test]
-    fn sigma_is_read_without_the_vertices_on_slivers() {
-        // A plane whose right half is squeezed to a twentieth of its width (its faces 0.05 by 1:
-        // slivers), with noise of sigma 0.3 left of the squeezed half (noise across a sliver
-        // would make it a thick triangle in space). The "result" is the clean plane on the left,
-        // and on the slivers' vertices something no linear response explains (moved 5 along the
-        // normal, the copy with them): sigma² must read as the left half's noise. Read over every
-        // vertex it would be hundreds of times too large.
-        let n = 40;
-        let mut clean = grid(n);
-        let half = (n / 2) as f32;
-        for p in &mut clean.positions {
-            if p[0] > half {
-                p[0] = half + (p[0] - half) * 0.05;
-            }
-        }
-        let topology = Topology::build(&clean);
-        let sigma = 0.3f32;
-        let mut input = noisy_plane(&clean, sigma);
-        for (p, x) in input.positions.iter_mut().zip(&clean.positions) {
-            if x[0] >= half {
-                *p = *x;
-            }
-        }
-        let edge = crate::metrics::mean_edge_length(&input);
-        let (mut risk, _) = RoundRisk::new(&input, &topology, edge, 0.0);
-        let free = risk.sliver_free.iter().filter(|&&free| free).count();
-        // The columns left of the squeezed half (its first column touches slivers): 20 of 41.
-        assert_eq!(free, (n / 2) * (n + 1), "vertices without slivers");
-        // The clean plane, and the copy as the same smoother (p -> x) leaves it; the slivers'
-        // vertices 5 off, the copy with them.
-        let mut result = clean.clone();
-        for (p, &free) in result.positions.iter_mut().zip(&risk.sliver_free) {
-            if !free {
-                p[2] += 5.0;
-            }
-        }
-        assert_reads_sigma(&mut risk, &result, &topology, sigma);
+    /// The noise `noisy` holds over `clean`: the root mean square of the vertices' moves (the
+    /// drawn σ for noise along the normals, whatever the draw's own spread came to).
+    fn drawn_sigma(noisy: &TriMesh, clean: &TriMesh) -> f64 {
+        let squares: f64 = noisy
+            .positions
+            .iter()
+            .zip(&clean.positions)
+            .map(|(p, q)| (Vec3A::from_array(*p) - Vec3A::from_array(*q)).length_squared() as f64)
+            .sum();
+        (squares / clean.positions.len() as f64).sqrt()
     }
 
-    /// Reads `result` as the first round (its copy left where it is) and asserts that σ² comes
-    /// out within 15 % of `sigma`².
-    fn assert_reads_sigma(risk: &mut RoundRisk, result: &TriMesh, topology: &Topology, sigma: f32) {
-        risk.read(result, topology, &result.positions);
-        let variance = risk.variance.unwrap();
-        let truth = (sigma * sigma) as f64;
+    /// σ (absolute) as [`RoundRisk`] reads it from `input`, away from `held`.
+    fn sigma_read(input: &TriMesh, topology: &Topology, held: &[bool]) -> f64 {
+        let edge = crate::metrics::mean_edge_length(input);
+        let (risk, _) = RoundRisk::new(input, topology, edge, 0.0, held);
+        risk.variance.sqrt()
+    }
+
+    #[test]
+    fn sigma_by_second_differences_reads_a_coarse_bumpy_surface_clean_and_its_noise_right() {
+        // A grid bent into bumps eight edges wide, 0.8 high: its curvature changes within a few
+        // rings, so one ring of differences (the umbrella's normal part) reads it as noise of
+        // 0.12 edge lengths; two rings of differences read 0.05. With noise of 0.3 edge lengths
+        // along the normals on top, σ must read within 4 % of the noise drawn (one ring would
+        // read 7 % high).
+        let n = 60;
+        let mut clean = grid(n);
+        for p in &mut clean.positions {
+            let wave = |c: f32| (std::f32::consts::TAU * c / 8.0).sin();
+            p[2] = 0.8 * wave(p[0]) * wave(p[1]);
+        }
+        let topology = Topology::build(&clean);
+        let edge = crate::metrics::mean_edge_length(&clean);
+        let boundary = topology.boundary_flags();
+        let clean_reading = sigma_read(&clean, &topology, boundary) / edge;
         assert!(
-            (variance / truth - 1.0).abs() < 0.15,
-            "sigma² read {variance}, truth {truth}"
+            clean_reading < 0.06,
+            "the clean surface reads {clean_reading} edge lengths"
+        );
+        let mut noisy = clean.clone();
+        add_noise(&mut noisy, &NoiseOptions::default().with_sigma(0.3));
+        let drawn = drawn_sigma(&noisy, &clean);
+        let reading = sigma_read(&noisy, &topology, boundary);
+        assert!(
+            (reading / drawn - 1.0).abs() < 0.04,
+            "sigma read {reading}, drawn {drawn}"
         );
     }
 
     #[test]
-    fn a_mesh_of_slivers_reads_sigma_over_every_vertex() {
-        // The whole plane squeezed to a twentieth of its width, with noise small enough
-        // (sigma 0.01 against the faces' 0.05) to leave every face a sliver: with no vertex free
-        // of slivers, sigma² is read over all of them (the clean plane as the result), not left
-        // to the noise estimate (0 here).
-        let mut clean = grid(40);
-        for p in &mut clean.positions {
-            p[0] *= 0.05;
-        }
+    fn sigma_is_read_away_from_the_creases() {
+        // A cube with noise of 0.15 edge lengths along the normals: its edges, where the
+        // surface is not smooth, read as noise unless their two rings are left out.
+        use crate::fairing::creases::{detect_creases, CreaseOptions};
+        let clean = crate::mesh::shapes::cuboid([1.0, 1.0, 1.0], 0.05);
         let topology = Topology::build(&clean);
-        let sigma = 0.01f32;
-        let input = noisy_plane(&clean, sigma);
-        let edge = crate::metrics::mean_edge_length(&input);
-        let (mut risk, _) = RoundRisk::new(&input, &topology, edge, 0.0);
-        assert!(risk.sliver_free.iter().all(|&free| !free));
-        assert_reads_sigma(&mut risk, &clean, &topology, sigma);
+        let creases = detect_creases(&clean, &topology, &CreaseOptions::default());
+        let held: Vec<bool> = (0..clean.positions.len() as u32)
+            .map(|v| creases.is_feature(v))
+            .collect();
+        assert!(held.iter().any(|&h| h));
+        let mut noisy = clean.clone();
+        add_noise(&mut noisy, &NoiseOptions::default().with_sigma(0.15));
+        let drawn = drawn_sigma(&noisy, &clean);
+        let away = sigma_read(&noisy, &topology, &held);
+        let everywhere = sigma_read(&noisy, &topology, &[]);
+        assert!(
+            (away / drawn - 1.0).abs() < 0.04,
+            "away from the creases {away}, drawn {drawn}"
+        );
+        assert!(
+            everywhere / drawn > 1.08,
+            "over every vertex {everywhere}, drawn {drawn}"
+        );
     }
 
     #[test]
