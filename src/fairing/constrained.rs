@@ -2241,8 +2241,7 @@ mod tests {
     }
 
     #[test]
-    fn a_triangle_with_a_crease_corner_held_is_the_least_squares_solution_keeping_its_pairs_midpoint(
-    ) {
+    fn a_triangle_solved_with_a_crease_corner_held_keeps_its_free_pairs_midpoint() {
         // The free corners a, b of a triangle whose corner h is held at x_h minimise ‖AP − Q‖²
         // with P_a + P_b = anchor_a + anchor_b; solved directly (Lagrange) against the weights.
         let mut rng = Rng(0x2545f4914f6cdd1d);

@@ -5,9 +5,9 @@
 //! CAD part. The reading here: a crease is a boundary between two surface patches. Each patch is
 //! faired with the crease as its boundary (a triangle with one crease corner is solved with that
 //! corner held, its other two keeping their midpoint; one with two is not solved, as a triangle
-//! touching the boundary is not: [`super::constrained`]), each chain of crease edges is faired as a curve with
-//! the paper's edge-centre constraints of section 3.3 (open chains between two fixed ends, closed
-//! loops like boundary loops), and the corners stay where they are.
+//! touching the boundary is not: [`super::constrained`]), each chain of crease edges is faired
+//! as a curve with the paper's edge-centre constraints of section 3.3 (open chains between two
+//! fixed ends, closed loops like boundary loops), and the corners stay where they are.
 //!
 //! Detection:
 //! - A feature edge is an edge with exactly two faces whose normals differ by more than

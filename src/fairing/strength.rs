@@ -45,10 +45,10 @@
 //! reading from the first round's residual, E Σ (n · (f − y))² = bias + σ² (N − 2 div +
 //! Σ |n · ∂f n|²) taken with the bias as zero, which read 0-9 % high (the shape the round removes
 //! counts as noise) and so stopped the coarse scans a round late (`docs/measurements.md`, "σ by
-//! second differences"). The rounds stop once [`RISK_PATIENCE`] rounds in a row have not lowered the risk by
-//! [`RISK_MIN_FALL`] of what the second round lowered it by, and the mesh
-//! goes back to the round with the least (the risk is not always convex in the rounds: a CAD
-//! part's creases found again after a few rounds lower it again), or after [`MAX_AUTO_ROUNDS`].
+//! second differences"). The rounds stop once [`RISK_PATIENCE`] rounds in a row have not lowered
+//! the risk by [`RISK_MIN_FALL`] of what the second round lowered it by, and the mesh goes back
+//! to the round with the least (the risk is not always convex in the rounds: a CAD part's
+//! creases found again after a few rounds lower it again), or after [`MAX_AUTO_ROUNDS`].
 
 use super::constrained::FanRings;
 use super::creases::{fan_feature_edges, fan_feature_neighbors, vertex_feature_edges, FeatureEdge};
@@ -435,8 +435,9 @@ pub const CLEAN_NOISE: f64 = 0.04;
 /// a few times, the draw's directions lie within a few degrees of the clean normals on finely
 /// sampled meshes (the cylinder's cos² 0.98 after five averagings) while a coarse scan's bends
 /// blur (the elephant's cos² stays 0.90 after five). Measured on the 32-row peer table of
-/// `docs/measurements.md`: one or two averagings leave the gear stopping early (its faces
-/// 18.9° / 18.0° off against 16.0° with three), four stop the cow and the dragon late.
+/// `docs/measurements.md` (with σ then read from the first round): one or two averagings leave
+/// the gear stopping early (its faces 18.9° / 18.0° off against 16.0° with three), four stop the
+/// cow and the dragon late.
 pub const RISK_DRAW_AVERAGING: usize = 3;
 
 /// The rounds stop once this many rounds in a row have not lowered the risk below the least seen
