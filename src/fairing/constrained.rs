@@ -2302,22 +2302,12 @@ mod tests {
         // y = 6. Every triangle of row 5 touches one of them: left unsolved (as the boundary's
         // are) they would leave row 5's noise as it is.
         let n = 10usize;
-        let mut positions = Vec::new();
-        for y in 0..=n {
-            for x in 0..=n {
-                let bump = (((x * 7 + y * 13) % 11) as f32 - 5.0) * 0.04;
-                positions.push([x as f32, y as f32, bump]);
-            }
-        }
         let at = |x: usize, y: usize| (y * (n + 1) + x) as u32;
-        let mut triangles = Vec::new();
-        for y in 0..n {
-            for x in 0..n {
-                triangles.push([at(x, y), at(x + 1, y), at(x + 1, y + 1)]);
-                triangles.push([at(x, y), at(x + 1, y + 1), at(x, y + 1)]);
-            }
+        let mut mesh = crate::mesh::fixtures::grid(n);
+        for (v, p) in mesh.positions.iter_mut().enumerate() {
+            let (x, y) = (v % (n + 1), v / (n + 1));
+            p[2] = (((x * 7 + y * 13) % 11) as f32 - 5.0) * 0.04;
         }
-        let mesh = TriMesh::new(positions, triangles);
         let topology = Topology::build(&mesh);
         let mut class = vec![FeatureClass::Smooth; mesh.positions.len()];
         let mut edges = Vec::new();

@@ -799,24 +799,7 @@ mod tests {
         assert_eq!(select_non_negative(&[], 0), None);
     }
 
-    /// A flat grid of `n`×`n` squares of side 1, each cut into two triangles (valence 6 inside).
-    fn grid(n: usize) -> TriMesh {
-        let mut positions = Vec::new();
-        for y in 0..=n {
-            for x in 0..=n {
-                positions.push([x as f32, y as f32, 0.0]);
-            }
-        }
-        let at = |x: usize, y: usize| (y * (n + 1) + x) as u32;
-        let mut triangles = Vec::new();
-        for y in 0..n {
-            for x in 0..n {
-                triangles.push([at(x, y), at(x + 1, y), at(x + 1, y + 1)]);
-                triangles.push([at(x, y), at(x + 1, y + 1), at(x, y + 1)]);
-            }
-        }
-        TriMesh::new(positions, triangles)
-    }
+    use crate::mesh::fixtures::grid;
 
     #[test]
     fn the_risk_ranks_smoothers_of_a_noisy_plane_by_their_true_error() {
