@@ -213,7 +213,7 @@ macro_rules! with_stencil {
 pub struct ConstrainedFairing {
     /// The vertices (mesh numbering) that bound the surface patches: boundary, crease and pinned
     /// vertices. They get no local solution and their triangles are not solved, but for those
-    /// with one crease corner and no other held one ([`held_corner`]).
+    /// with one crease corner and no other held one ([`triangle_solve`]).
     held: Vec<bool>,
     variant: FairVariant,
     boundary: BoundaryMode,
@@ -485,13 +485,10 @@ impl ConstrainedFairing {
             let operator = |f: u32| {
                 let t = &triangles[f as usize];
                 let valences = t.map(|c| topology.valence(c));
-                if solved_triangle(t, held, topology) {
-                    Some(corner_weights(valences))
-                } else {
+                match triangle_solve(t, held, topology, pinned)? {
+                    None => Some(corner_weights(valences)),
                     // v itself, when it is the held corner, gets no solution from the triangle.
-                    held_corner(t, held, topology, pinned)
-                        .filter(|&h| t[h] as usize != v)
-                        .map(|h| held_corner_weights(valences, h))
+                    Some(h) => (t[h] as usize != v).then(|| held_corner_weights(valences, h)),
                 }
             };
             let mut solved = false;
@@ -561,7 +558,7 @@ impl ConstrainedFairing {
         let triangles = &mesh.triangles;
         // Crease vertices and corners, and pinned vertices, bound the surface patches like
         // boundary vertices do: they get no local solution and their triangles are not solved,
-        // but for those with a single crease corner, solved with it held ([`held_corner`]).
+        // but for those with a single crease corner, solved with it held ([`triangle_solve`]).
         let creases = creases.filter(|c| !c.is_empty());
         let held = held_flags(topology, creases, pinned);
 
@@ -569,7 +566,6 @@ impl ConstrainedFairing {
         let (ring, closed) = (&fans.ring, &fans.closed_fan);
 
         let valence = |v: u32| topology.valence(v);
-        let interior = |t: &[u32; 3]| solved_triangle(t, &held, topology);
 
         // Local operators of the valence triples that occur, in a dense table, and each triangle's
         // slot in it (u32::MAX: not solved), found once per triangle rather than once per
@@ -578,13 +574,7 @@ impl ConstrainedFairing {
         let table_index = |n: [usize; 3]| (n[0] * TABLE_VALENCE + n[1]) * TABLE_VALENCE + n[2];
         let triangle_valences: Vec<Option<([usize; 3], Option<usize>)>> = triangles
             .par_iter()
-            .map(|t| {
-                if interior(t) {
-                    Some((t.map(valence), None))
-                } else {
-                    held_corner(t, &held, topology, pinned).map(|h| (t.map(valence), Some(h)))
-                }
-            })
+            .map(|t| triangle_solve(t, &held, topology, pinned).map(|h| (t.map(valence), h)))
             .collect();
         let mut table_slot = vec![u32::MAX; TABLE_VALENCE * TABLE_VALENCE * TABLE_VALENCE];
         let mut held_corner_slot: HashMap<([usize; 3], usize), u32> = HashMap::new();
@@ -1127,33 +1117,33 @@ fn held_flags(topology: &Topology, creases: Option<&Creases>, pinned: &[bool]) -
         .collect()
 }
 
-/// Whether triangle `t` gets a local solution: none of its corners is held (`held`: boundary,
-/// crease or pinned), every corner has valence three or more (so that A is invertible), and its
-/// corners are distinct.
-fn solved_triangle(t: &[u32; 3], held: &[bool], topology: &Topology) -> bool {
-    t.iter()
-        .all(|&c| !held[c as usize] && topology.valence(c) >= 3)
-        && t[0] != t[1]
-        && t[1] != t[2]
-        && t[0] != t[2]
-}
-
-/// Which corner of triangle `t` is held when it is solved with a crease corner held (see the
-/// module docs): the one corner held by a crease when exactly one is held (not by the boundary,
-/// which the paper leaves unsolved, nor pinned), its corners distinct and of valence three or
-/// more; `None` for any other triangle.
-fn held_corner(t: &[u32; 3], held: &[bool], topology: &Topology, pinned: &[bool]) -> Option<usize> {
+/// How triangle `t` gets a local solution: `Some(None)` with every corner free (none held:
+/// `held` flags the boundary, crease and pinned vertices), `Some(Some(h))` with corner h held
+/// where it is (see the module docs: the one held corner, held by a crease, not by the boundary,
+/// which the paper leaves unsolved, nor pinned), `None` for no solution (two or three corners
+/// held, or the one held by the boundary or pinned). Only a triangle whose corners are distinct
+/// and of valence three or more (so that A is invertible) is solved.
+fn triangle_solve(
+    t: &[u32; 3],
+    held: &[bool],
+    topology: &Topology,
+    pinned: &[bool],
+) -> Option<Option<usize>> {
     let distinct = t[0] != t[1] && t[1] != t[2] && t[0] != t[2];
     if !distinct || t.iter().any(|&c| topology.valence(c) < 3) {
         return None;
     }
     let mut held_at = (0..3).filter(|&k| held[t[k] as usize]);
-    let (Some(h), None) = (held_at.next(), held_at.next()) else {
-        return None;
-    };
-    let c = t[h];
-    (!topology.is_boundary_vertex(c) && !pinned.get(c as usize).copied().unwrap_or(false))
-        .then_some(h)
+    match (held_at.next(), held_at.next()) {
+        (None, _) => Some(None),
+        (Some(h), None) => {
+            let c = t[h];
+            let by_crease = !topology.is_boundary_vertex(c)
+                && !pinned.get(c as usize).copied().unwrap_or(false);
+            by_crease.then_some(Some(h))
+        }
+        _ => None,
+    }
 }
 
 /// [`corner_weights`] for a triangle solved with corner `held` held where it is (see the module
@@ -1991,12 +1981,7 @@ fn fair_rounds(
     // the same rounds, and the mesh goes back to the round with the least risk.
     let mut risk = auto_noise.map(|noise| {
         // σ is read away from the first detection's creases and the boundary.
-        let held: Vec<bool> = (0..mesh.positions.len() as u32)
-            .into_par_iter()
-            .map(|v| {
-                topology.is_boundary_vertex(v) || creases.as_ref().is_some_and(|c| c.is_feature(v))
-            })
-            .collect();
+        let held = held_flags(topology, creases.as_ref(), &[]);
         RoundRisk::new(
             mesh,
             topology,

@@ -807,7 +807,7 @@ mod tests {
         // error is known, p -> x + a·(p − x) with x the clean vertex: a = 0 the clean plane itself
         // (error 0), a = 1/2 the halfway blend (error sigma²/4 per vertex), a = 1 the input left
         // as it is (error sigma²). Per vertex the risk reads the residual (1 − a)²·sigma² plus
-        // twice the divergence a times the variance the first reading found: with the variance
+        // twice the divergence a times the variance read from the input: with the variance
         // exact, that is each error plus sigma². A wrong sign or scale of the divergence would
         // rank the input first or the blend last.
         let clean = grid(80);
