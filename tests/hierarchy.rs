@@ -294,8 +294,8 @@ fn fixed_boundary_stays_fixed_in_multires_from_every_level() {
 }
 
 fn build_with_creases(mesh: &TriMesh) -> Hierarchy {
-    let options =
-        HierarchyOptions::default().with_creases(Some(fairmesh::fairing::CreaseOptions::default()));
+    let options = HierarchyOptions::default()
+        .with_creases(Some(fairmesh::fairing::CreaseOptions::for_hierarchy()));
     build_hierarchy(mesh, &options, &mut NoProgress).unwrap()
 }
 
@@ -303,7 +303,7 @@ fn build_with_creases(mesh: &TriMesh) -> Hierarchy {
 /// built with or without creases.
 fn multires_distance(reference: &TriMesh, mesh: &TriMesh, creases: bool, level: usize) -> f64 {
     let options = HierarchyOptions::default()
-        .with_creases(creases.then(fairmesh::fairing::CreaseOptions::default));
+        .with_creases(creases.then(fairmesh::fairing::CreaseOptions::for_hierarchy));
     let h = build_hierarchy(mesh, &options, &mut NoProgress).unwrap();
     let positions = fair_multires(
         &h,
@@ -319,8 +319,8 @@ fn multires_distance(reference: &TriMesh, mesh: &TriMesh, creases: bool, level: 
 #[test]
 fn a_hierarchy_from_the_loaded_topology_is_the_one_built_alone() {
     let clean = fairmesh::mesh::shapes::cuboid([2.0, 1.0, 0.5], 0.05);
-    let options =
-        HierarchyOptions::default().with_creases(Some(fairmesh::fairing::CreaseOptions::default()));
+    let options = HierarchyOptions::default()
+        .with_creases(Some(fairmesh::fairing::CreaseOptions::for_hierarchy()));
     let alone = build_hierarchy(&clean, &options, &mut NoProgress).unwrap();
     let same = |h: &Hierarchy| {
         assert_eq!(h.coarsest_level(), alone.coarsest_level());
@@ -401,7 +401,7 @@ fn a_workspace_for_one_run_gives_the_same_result_and_keeps_no_level() {
         build(&mushroom),
         build_hierarchy(
             &elephant,
-            &HierarchyOptions::default().with_creases(Some(CreaseOptions::default())),
+            &HierarchyOptions::default().with_creases(Some(CreaseOptions::for_hierarchy())),
             &mut NoProgress,
         )
         .unwrap(),

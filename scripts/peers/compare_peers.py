@@ -2,7 +2,7 @@
 """fairmesh's default `fair` against the smoothers users would pick instead, on meshes nobody
 tuned fairmesh for.
 
-For each mesh and noise mode: `fairmesh noise` (sigma 0.3 mean edge lengths, seed 1), then
+For each mesh and noise mode: `fairmesh noise` (sigma 0.3 mean edge lengths, seed 1 or `--seed`), then
 `fairmesh fair` with its defaults (no flags), and each peer at every iteration count of a scan;
 each result is measured with `fairmesh compare CLEAN RESULT --json` (one metric for all: mean
 surface distance both ways, in mean edge lengths of the clean mesh; mean face-normal error in
@@ -138,6 +138,12 @@ def main():
     parser.add_argument("--modes", default="normal,iso")
     parser.add_argument("--fair-flags", default="", help="flags for `fair` (default: none)")
     parser.add_argument("--no-peers", action="store_true", help="run `fair` alone")
+    parser.add_argument(
+        "--seed",
+        default="1",
+        help="the noise's seed (one seed's rows differ from another's by a few per cent, as much "
+        "as fair and the best peer differ on the closest rows: compare over several)",
+    )
     args = parser.parse_args()
     fair_flags = shlex.split(args.fair_flags)
     smoothers = [] if args.no_peers else peers()
@@ -149,7 +155,7 @@ def main():
             run("convert", path, "-o", clean)
             for mode in args.modes.split(","):
                 noisy = os.path.join(tmp, "noisy.ply")
-                run("noise", clean, "-o", noisy, "--sigma", "0.3", "--seed", "1", "--mode", mode)
+                run("noise", clean, "-o", noisy, "--sigma", "0.3", "--seed", args.seed, "--mode", mode)
                 print(f"\n{os.path.basename(path)}, noise 0.3 mean edge lengths, mode {mode}\n")
                 print("| smoother | setting | mean dist | Hausdorff | normal ° | volume % |")
                 print("|---|---|---:|---:|---:|---:|")

@@ -26,7 +26,12 @@
 //! - Feature edges that form small groups (fewer than [`CreaseOptions::min_edges`] edges joined at
 //!   their ends) are dropped, and so are groups that zigzag (more than one corner per two edges):
 //!   noise and single spikes of a scan make those, while a crease runs straight between a few
-//!   corners (for this test a corner is where the edges themselves turn sharply).
+//!   corners. For this test a corner is where the edges themselves turn by more than
+//!   [`CreaseOptions::zigzag_turn_degrees`] ([`ZIGZAG_TURN`], 55°, lower than the classes'
+//!   70°): the bends of a coarse scan that the filter sharpens into feature edges wander, and
+//!   fairing them as creases costs the scan more than it keeps. The hierarchy keeps them
+//!   ([`HIERARCHY_ZIGZAG_TURN`], 70°): there they hold a coarse level's shape
+//!   (`docs/measurements.md`, "Wandering groups are no creases").
 //! - Edges the input file marks as sharp ([`CreaseOptions::file_edges`]: split normals, material
 //!   boundaries, from [`crate::io::Source::hard_edges`]) are feature edges whatever
 //!   their angle, and are never dropped as a small or zigzagging group: the file's author said so.
@@ -70,6 +75,10 @@ pub struct CreaseOptions {
     pub min_edges: usize,
     /// A vertex whose two feature edges turn by more than this is a corner.
     pub corner_turn_degrees: f64,
+    /// For dropping groups that zigzag: a vertex whose two feature edges' positions turn by more
+    /// than this counts as a corner, and a group with more than one such corner per two edges is
+    /// no crease ([`ZIGZAG_TURN`]; the hierarchy's [`HIERARCHY_ZIGZAG_TURN`]).
+    pub zigzag_turn_degrees: f64,
     /// Edges the input file marks as sharp (its normals split there, or two of its materials
     /// meet: [`crate::io::Source::hard_edges`]), each `[a, b]` with `a < b`: feature edges
     /// whatever their angle, never dropped as a small or zigzagging group. Empty: none.
@@ -82,6 +91,7 @@ with_setters!(CreaseOptions {
     with_normal_sigma => normal_sigma: f64,
     with_min_edges => min_edges: usize,
     with_corner_turn_degrees => corner_turn_degrees: f64,
+    with_zigzag_turn_degrees => zigzag_turn_degrees: f64,
 });
 
 impl Default for CreaseOptions {
@@ -92,12 +102,27 @@ impl Default for CreaseOptions {
             normal_sigma: NORMAL_SIGMA,
             min_edges: 8,
             corner_turn_degrees: 70.0,
+            zigzag_turn_degrees: ZIGZAG_TURN,
             file_edges: std::sync::Arc::from([]),
         }
     }
 }
 
+/// [`CreaseOptions::zigzag_turn_degrees`] for fairing (the default): holding the wandering
+/// bends a coarse scan's filtered normals show costs its fairing more than it keeps.
+pub const ZIGZAG_TURN: f64 = 55.0;
+
+/// [`CreaseOptions::zigzag_turn_degrees`] for the hierarchy ([`CreaseOptions::for_hierarchy`]):
+/// there the same bends keep a coarse level's shape (multires from level 9 of the noisy
+/// elephant ends 0.35 edge lengths from the clean surface with them, 0.44 without them).
+pub const HIERARCHY_ZIGZAG_TURN: f64 = 70.0;
+
 impl CreaseOptions {
+    /// The default options with the hierarchy's zigzag test ([`HIERARCHY_ZIGZAG_TURN`]).
+    pub fn for_hierarchy() -> Self {
+        Self::default().with_zigzag_turn_degrees(HIERARCHY_ZIGZAG_TURN)
+    }
+
     /// `self` with [`file_edges`](Self::file_edges) set to `edges`.
     #[must_use]
     pub fn with_file_edges(mut self, edges: Vec<[u32; 2]>) -> Self {
@@ -772,7 +797,8 @@ fn finish(
     let edges = keep_groups(edges, vertex_count, None, |edges, _| edges >= min_edges);
     // The zigzag test turns by the edges' positions: noise that lines up into a fake crease
     // zigzags there, while the faces' crease directions may still agree.
-    let class = classify(topology, &edges, Turn::Positions(mesh), max_turn);
+    let zigzag_turn = options.zigzag_turn_degrees.to_radians().cos();
+    let class = classify(topology, &edges, Turn::Positions(mesh), zigzag_turn);
     let mut edges = keep_groups(edges, vertex_count, Some(&class), |edges, corners| {
         2 * corners <= edges
     });
@@ -1284,5 +1310,67 @@ mod tests {
         // The side's own edges turn by 360/63 degrees: smooth.
         let sharper = CreaseOptions::default().with_angle_degrees(3.0);
         assert!(detect_creases(&mesh, &topology, &sharper).edges.len() > 2 * 63);
+    }
+
+    /// A group of feature edges that turns by 60° at every vertex (a bend of a coarse scan that
+    /// the filter sharpened wanders so) is no crease, while a straight one beside it is; with
+    /// the classes' 70° as the zigzag test's corner turn, the wandering group would be kept.
+    #[test]
+    fn a_group_that_turns_sixty_degrees_at_every_vertex_is_no_crease() {
+        // A flat lattice of equilateral triangles, n × n cells.
+        let n = 16;
+        let at = |x: usize, y: usize| (y * (n + 1) + x) as u32;
+        let mut positions = Vec::new();
+        for y in 0..=n {
+            for x in 0..=n {
+                let h = 3f32.sqrt() / 2.0;
+                positions.push([x as f32 + 0.5 * y as f32, y as f32 * h, 0.0]);
+            }
+        }
+        let mut triangles = Vec::new();
+        for y in 0..n {
+            for x in 0..n {
+                triangles.push([at(x, y), at(x + 1, y), at(x, y + 1)]);
+                triangles.push([at(x + 1, y), at(x + 1, y + 1), at(x, y + 1)]);
+            }
+        }
+        let mesh = TriMesh::new(positions, triangles);
+        let topology = Topology::build(&mesh);
+        // Straight: along row 2, 12 edges. Wandering: up from (8, 4), alternately to (x, y + 1)
+        // and (x − 1, y + 1), 12 edges, each turning 60° from the last.
+        let straight: Vec<u32> = (2..=14).map(|x| at(x, 2)).collect();
+        let mut wandering = vec![at(8, 4)];
+        let (mut x, mut y) = (8, 4);
+        for step in 0..12 {
+            if step % 2 == 1 {
+                x -= 1;
+            }
+            y += 1;
+            wandering.push(at(x, y));
+        }
+        let point = |v: u32| Vec3A::from_array(mesh.positions[v as usize]);
+        let mut found: Vec<FeatureEdge> = [&straight, &wandering]
+            .iter()
+            .flat_map(|path| path.windows(2))
+            .map(|w| {
+                assert!(topology.neighbors(w[0]).contains(&w[1]));
+                let direction = (point(w[1]) - point(w[0])).normalize();
+                ([w[0].min(w[1]), w[0].max(w[1])], direction)
+            })
+            .collect();
+        found.sort_unstable_by_key(|&(e, _)| e);
+        let on = |creases: &Creases, path: &[u32]| {
+            path.windows(2)
+                .filter(|w| creases.edges.contains(&[w[0].min(w[1]), w[0].max(w[1])]))
+                .count()
+        };
+        let options = CreaseOptions::default();
+        let creases = finish(&mesh, &topology, found.clone(), &options);
+        assert_eq!(on(&creases, &straight), 12);
+        assert_eq!(on(&creases, &wandering), 0);
+        let seventy = options.with_zigzag_turn_degrees(70.0);
+        let creases = finish(&mesh, &topology, found, &seventy);
+        assert_eq!(on(&creases, &straight), 12);
+        assert_eq!(on(&creases, &wandering), 12);
     }
 }

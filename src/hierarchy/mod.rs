@@ -70,6 +70,7 @@ pub struct HierarchyOptions {
     /// normals filtered as much as the mesh's noise estimate asks): a crease vertex collapses only
     /// into one of its two neighbours along the crease, and corners never collapse, so every
     /// level keeps M0's creases and corners ([`Hierarchy::level_creases`]). `None`: no creases.
+    /// [`CreaseOptions::for_hierarchy`] are the options the CLI and the editor give.
     pub creases: Option<CreaseOptions>,
     /// Decimate a non-manifold mesh without the triangles that lie loose at its non-manifold
     /// edges (overlays on a fan, fins; [`crate::mesh::loose_triangles`]), as the default fairing
