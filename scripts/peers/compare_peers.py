@@ -2,7 +2,8 @@
 """fairmesh's default `fair` against the smoothers users would pick instead, on meshes nobody
 tuned fairmesh for.
 
-For each mesh and noise mode: `fairmesh noise` (sigma 0.3 mean edge lengths, seed 1 or `--seed`), then
+For each mesh, noise mode and seed: `fairmesh noise` (sigma 0.3 mean edge lengths, seed 1 or
+`--seed S[,S...]`), then
 `fairmesh fair` with its defaults (no flags), and each peer at every iteration count of a scan;
 each result is measured with `fairmesh compare CLEAN RESULT --json` (one metric for all: mean
 surface distance both ways, in mean edge lengths of the clean mesh; mean face-normal error in
@@ -15,9 +16,10 @@ HC Laplacian), Open3D (Taubin). Install them in a virtual environment:
 
 Run from the repository root after `cargo build --release`:
     venv/bin/python scripts/peers/compare_peers.py MESH [MESH ...] [--modes normal,iso]
-        [--fair-flags "--no-creases --rounds 3"] [--no-peers]
+        [--fair-flags "--no-creases --rounds 3"] [--no-peers] [--seed 1,2,3]
 `--fair-flags` gives `fair` other flags than its defaults; `--no-peers` runs `fair` alone (to
-compare settings of `fair` on a set of meshes). Prints a Markdown table per mesh and noise mode, then a summary: for each, `fair`'s mean distance
+compare settings of `fair` on a set of meshes); `--seed` noises with other seeds, and with
+several it ends with each mesh and mode over the seeds. Prints a Markdown table per mesh and noise mode, then a summary: for each, `fair`'s mean distance
 against the best peer's, and in how many cases `fair` ends closer. The set of clean meshes the
 project measures on (the repository's, the CAD-like parts, and those `docs/measurements.md` names)
 is written as PLY files by
@@ -141,10 +143,15 @@ def main():
     parser.add_argument(
         "--seed",
         default="1",
-        help="the noise's seed (one seed's rows differ from another's by a few per cent, as much "
-        "as fair and the best peer differ on the closest rows: compare over several)",
+        help="the noise's seed, or several separated by commas (one seed's rows differ from "
+        "another's by a few per cent, as much as fair and the best peer differ on the closest "
+        "rows: compare over several; the summary then ends with each row over the seeds)",
     )
     args = parser.parse_args()
+    seeds = [seed.strip() for seed in args.seed.split(",") if seed.strip()]
+    for seed in seeds:
+        if not seed.isdigit():
+            sys.exit(f"--seed: {seed!r} is not a whole number")
     fair_flags = shlex.split(args.fair_flags)
     smoothers = [] if args.no_peers else peers()
     # (mesh, mode, fair's row, (best peer's name, its iterations, its row) or None)
@@ -153,10 +160,11 @@ def main():
         for path in args.meshes:
             clean = os.path.join(tmp, "clean.ply")
             run("convert", path, "-o", clean)
-            for mode in args.modes.split(","):
+            for mode, seed in ((mode, seed) for mode in args.modes.split(",") for seed in seeds):
                 noisy = os.path.join(tmp, "noisy.ply")
-                run("noise", clean, "-o", noisy, "--sigma", "0.3", "--seed", args.seed, "--mode", mode)
-                print(f"\n{os.path.basename(path)}, noise 0.3 mean edge lengths, mode {mode}\n")
+                run("noise", clean, "-o", noisy, "--sigma", "0.3", "--seed", seed, "--mode", mode)
+                print(f"\n{os.path.basename(path)}, noise 0.3 mean edge lengths, mode {mode}, "
+                      f"seed {seed}\n")
                 print("| smoother | setting | mean dist | Hausdorff | normal ° | volume % |")
                 print("|---|---|---:|---:|---:|---:|")
                 print(row("noisy input", "", measure(clean, noisy)))
@@ -194,8 +202,10 @@ def main():
                           flush=True)
                     if best_peer is None or best[1]["mean"] < best_peer[2]["mean"]:
                         best_peer = (name, best[0], best[1])
-                summary.append((os.path.basename(path), mode, ours_measured, best_peer))
+                summary.append((os.path.basename(path), mode, seed, ours_measured, best_peer))
     print_summary(summary, args.fair_flags)
+    if len(seeds) > 1:
+        print_over_seeds(summary, seeds)
 
 
 def print_summary(summary, fair_flags):
@@ -204,23 +214,44 @@ def print_summary(summary, fair_flags):
     where fair ends closer."""
     fair = f"`fair {fair_flags}`" if fair_flags else "default `fair`"
     print(f"\nSummary: {fair} against the best peer at its best iteration count\n")
-    print("| mesh | noise | fair: mean dist / normal ° | best peer | its mean dist / normal ° "
-          "| fair / best |")
-    print("|---|---|---:|---|---:|---:|")
+    print("| mesh | noise | seed | fair: mean dist / normal ° | best peer | its mean dist / normal "
+          "° | fair / best |")
+    print("|---|---|---:|---:|---|---:|---:|")
     closer = 0
-    for mesh, mode, ours, best in summary:
+    for mesh, mode, seed, ours, best in summary:
         if best is None:
-            print(f"| {mesh} | {mode} | {ours['mean']:.4f} / {normal_error(ours)} | (no peer run) "
-                  "| - | - |")
+            print(f"| {mesh} | {mode} | {seed} | {ours['mean']:.4f} / {normal_error(ours)} | (no "
+                  "peer run) | - | - |")
             continue
         name, k, theirs = best
         ratio = ours["mean"] / theirs["mean"]
         closer += ratio < 1.0
-        print(f"| {mesh} | {mode} | {ours['mean']:.4f} / {normal_error(ours)} | {name}, {k} "
-              f"iterations | {theirs['mean']:.4f} / {normal_error(theirs)} | {ratio:.3f} |")
+        print(f"| {mesh} | {mode} | {seed} | {ours['mean']:.4f} / {normal_error(ours)} | {name}, "
+              f"{k} iterations | {theirs['mean']:.4f} / {normal_error(theirs)} | {ratio:.3f} |")
     compared = sum(1 for *_, best in summary if best is not None)
     if compared:
         print(f"\nfair ends closer than the best peer in {closer} of {compared} cases")
+
+
+def print_over_seeds(summary, seeds):
+    """Each mesh and noise mode over the seeds: fair's mean distance over the best peer's on each
+    seed (each seed's own best peer), their geometric mean, and on how many seeds fair is closer."""
+    print(f"\nOver the seeds {', '.join(seeds)}: fair / best peer on each, geometric mean\n")
+    print("| mesh | noise | fair / best, each seed | geometric mean | seeds closer |")
+    print("|---|---|---|---:|---:|")
+    rows = {}
+    for mesh, mode, seed, ours, best in summary:
+        if best is not None:
+            rows.setdefault((mesh, mode), []).append(ours["mean"] / best[2]["mean"])
+    closer = 0
+    for (mesh, mode), ratios in rows.items():
+        mean = float(np.exp(np.mean(np.log(ratios))))
+        ahead = sum(ratio < 1.0 for ratio in ratios)
+        closer += mean < 1.0
+        each = " / ".join(f"{ratio:.3f}" for ratio in ratios)
+        print(f"| {mesh} | {mode} | {each} | {mean:.3f} | {ahead} of {len(ratios)} |")
+    print(f"\nfair ends closer than the best peer on average over the seeds in {closer} of "
+          f"{len(rows)} cases")
 
 
 if __name__ == "__main__":
