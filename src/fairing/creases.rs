@@ -1317,33 +1317,24 @@ mod tests {
     /// the classes' 70° as the zigzag test's corner turn, the wandering group would be kept.
     #[test]
     fn a_group_that_turns_sixty_degrees_at_every_vertex_is_no_crease() {
-        // A flat lattice of equilateral triangles, n × n cells.
+        // A flat lattice of equilateral triangles: the grid fixture sheared (its diagonals from
+        // (x, y) to (x + 1, y + 1) then have unit length too).
         let n = 16;
         let at = |x: usize, y: usize| (y * (n + 1) + x) as u32;
-        let mut positions = Vec::new();
-        for y in 0..=n {
-            for x in 0..=n {
-                let h = 3f32.sqrt() / 2.0;
-                positions.push([x as f32 + 0.5 * y as f32, y as f32 * h, 0.0]);
-            }
+        let mut mesh = crate::mesh::fixtures::grid(n);
+        for p in &mut mesh.positions {
+            p[0] -= 0.5 * p[1];
+            p[1] *= 3f32.sqrt() / 2.0;
         }
-        let mut triangles = Vec::new();
-        for y in 0..n {
-            for x in 0..n {
-                triangles.push([at(x, y), at(x + 1, y), at(x, y + 1)]);
-                triangles.push([at(x + 1, y), at(x + 1, y + 1), at(x, y + 1)]);
-            }
-        }
-        let mesh = TriMesh::new(positions, triangles);
         let topology = Topology::build(&mesh);
         // Straight: along row 2, 12 edges. Wandering: up from (8, 4), alternately to (x, y + 1)
-        // and (x − 1, y + 1), 12 edges, each turning 60° from the last.
+        // (at 120°) and (x + 1, y + 1) (at 60°), 12 edges, each turning 60° from the last.
         let straight: Vec<u32> = (2..=14).map(|x| at(x, 2)).collect();
         let mut wandering = vec![at(8, 4)];
         let (mut x, mut y) = (8, 4);
         for step in 0..12 {
             if step % 2 == 1 {
-                x -= 1;
+                x += 1;
             }
             y += 1;
             wandering.push(at(x, y));
