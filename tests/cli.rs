@@ -521,21 +521,23 @@ fn fair_leaves_a_clean_mesh_alone_and_says_how_noisy_the_input_was() {
     assert!((0.2..0.4).contains(&estimate), "{faired}");
     let rounds = faired["rounds_run"].as_u64().unwrap();
     assert!((2..60).contains(&rounds), "{faired}");
-    // Every round run has its estimated risk, the kept one the least; at most RISK_PATIENCE
-    // rounds ran past it.
+    // Every round run has its estimated risk. The kept one is lower than every round before it,
+    // and no round after it is lower by RISK_MIN_FALL of the second round's fall; the run
+    // stopped RISK_PATIENCE rounds after it.
+    use fairmesh::fairing::strength::{RISK_MIN_FALL, RISK_PATIENCE};
     let risks: Vec<f64> = faired["risk_by_round"]
         .as_array()
         .unwrap()
         .iter()
         .map(|r| r.as_f64().unwrap())
         .collect();
-    assert!(risks.len() >= rounds as usize, "{faired}");
-    assert!(
-        risks.len() <= rounds as usize + fairmesh::fairing::strength::RISK_PATIENCE,
-        "{faired}"
-    );
-    let kept = risks[rounds as usize - 1];
-    assert!(risks.iter().all(|&r| r > 0.0 && r >= kept), "{faired}");
+    assert_eq!(risks.len(), rounds as usize + RISK_PATIENCE, "{faired}");
+    assert!(risks.iter().all(|&r| r > 0.0), "{faired}");
+    let (before, after) = risks.split_at(rounds as usize - 1);
+    let kept = after[0];
+    assert!(before.iter().all(|&r| r > kept), "{faired}");
+    let margin = RISK_MIN_FALL * (risks[0] - risks[1]);
+    assert!(after[1..].iter().all(|&r| r >= kept - margin), "{faired}");
     // The time spent estimating and finding creases is part of the whole.
     let detection = faired["detection_ms"].as_f64().unwrap();
     assert!(

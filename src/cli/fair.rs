@@ -59,7 +59,7 @@ pub struct FairArgs {
     /// Constrained only: rounds; each round re-anchors the triangle centres at the current
     /// positions, so more rounds smooth more (and drift further from the input). Without it the
     /// noise is estimated (a clean mesh is left as it is) and rounds run while the estimated
-    /// error of the result falls; the round with the least is kept.
+    /// error of the result falls; the last round that lowered it clearly is kept.
     #[arg(long)]
     pub rounds: Option<usize>,
     /// Constrained normal-projected only: edges where the surface folds by more than this many

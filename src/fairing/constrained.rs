@@ -1978,7 +1978,8 @@ fn fair_rounds(
     };
     // Automatic strength: round by round while the estimated risk of the result falls (see
     // [`super::strength`]): a copy of the input, moved a little along its normals, goes through
-    // the same rounds, and the mesh goes back to the round with the least risk.
+    // the same rounds, and the mesh goes back to the last round that lowered the risk clearly
+    // (RISK_MIN_FALL).
     let mut risk = auto_noise.map(|noise| {
         // σ is read away from the first detection's creases and the boundary.
         let held = held_flags(topology, creases.as_ref(), &[]);
@@ -1990,11 +1991,11 @@ fn fair_rounds(
             &held,
         )
     });
-    // The round with the least risk so far: its number, its risk, its positions and crease count.
-    let mut least: Option<(usize, f64)> = None;
-    let mut least_positions = Vec::new();
-    let mut least_creases = 0;
-    let mut progress = 0;
+    // The last round kept (see RISK_MIN_FALL): its number, its risk, its positions and crease
+    // count.
+    let mut kept_round: Option<(usize, f64)> = None;
+    let mut kept_positions = Vec::new();
+    let mut kept_creases = 0;
     let mut first_fall = 0.0;
     let mut before_restore = Vec::new();
     let mut copy_report = FairReport::default();
@@ -2096,36 +2097,33 @@ fn fair_rounds(
             let now = risk.read(mesh, topology, copy);
             report.risk_by_round.push(now);
             let edges = creases.as_ref().map_or(0, |c| c.edges.len());
-            // A round that lowers the risk by less than RISK_MIN_FALL of what the second round
-            // lowered it by is kept if it is the least, but does not count as progress: the
-            // rounds stop RISK_PATIENCE rounds after the last that did.
+            // A round is kept when it lowers the risk below the last kept round's by
+            // RISK_MIN_FALL of what the second round lowered it by (the falls after a kept round
+            // add up until they pass that); the rounds stop RISK_PATIENCE rounds after the last
+            // kept one.
             if round == 1 {
-                if let Some((_, first)) = least {
+                if let Some((_, first)) = kept_round {
                     first_fall = (first - now).max(0.0);
                 }
             }
-            if least.is_none_or(|(_, least_risk)| now < least_risk) {
-                if least.is_none_or(|(_, least_risk)| now < least_risk - RISK_MIN_FALL * first_fall)
-                {
-                    progress = round;
-                }
-                least = Some((round, now));
-                least_positions.clone_from(&mesh.positions);
-                least_creases = edges;
+            if kept_round.is_none_or(|(_, risk)| now < risk - RISK_MIN_FALL * first_fall) {
+                kept_round = Some((round, now));
+                kept_positions.clone_from(&mesh.positions);
+                kept_creases = edges;
             } else if now.is_nan() {
                 break;
             }
-            if round - progress >= RISK_PATIENCE {
+            if kept_round.is_some_and(|(kept, _)| round - kept >= RISK_PATIENCE) {
                 break;
             }
         }
     }
     let mut crease_edges = creases.map_or(0, |c| c.edges.len());
-    if let Some((round, _)) = least {
+    if let Some((round, _)) = kept_round {
         if round + 1 != report.rounds_run {
-            mesh.positions = least_positions;
+            mesh.positions = kept_positions;
             report.rounds_run = round + 1;
-            crease_edges = least_creases;
+            crease_edges = kept_creases;
         }
     }
     report.noise_estimate = estimate;

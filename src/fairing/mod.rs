@@ -35,7 +35,8 @@
 //! [`FairOptions::default`] also
 //! - leaves a clean mesh as it is and fairs a noisy one round by round while the estimated error
 //!   of the result falls (Stein's unbiased risk estimate, read from a slightly moved copy of the
-//!   input faired alongside), keeping the round with the least ([`Strength::Auto`], [`strength`]);
+//!   input faired alongside), keeping the last round that lowered it clearly ([`Strength::Auto`],
+//!   [`strength`]);
 //! - keeps sharp creases as curves with fixed corners ([`creases`]);
 //! - adds a small tangential relaxation (weight [`DEFAULT_TANGENTIAL_RELAXATION`]) where it is
 //!   needed ([`Relaxation::WhereNeeded`], [`relaxation`]): everywhere when the input's noise
@@ -226,8 +227,9 @@ pub enum Relaxation {
 #[non_exhaustive]
 pub enum Strength {
     /// Estimate the mesh's noise (a clean mesh gets no round), then run rounds while the estimated
-    /// error of the result falls and keep the round with the least ([`strength`]). Every round
-    /// runs twice (the second time on the risk estimate's copy of the input).
+    /// error of the result falls and keep the last round that lowered it clearly
+    /// ([`strength::RISK_MIN_FALL`]). Every round runs twice (the second time on the risk
+    /// estimate's copy of the input).
     #[default]
     Auto,
     /// Exactly [`FairOptions::rounds`] rounds.
@@ -240,8 +242,9 @@ pub struct FairReport {
     /// Iterations actually run, summed over rounds (with [`Strength::Auto`], also over the one or
     /// two rounds run past the kept one; the risk estimate's copy not counted).
     pub iterations_run: usize,
-    /// Rounds that made the result (with [`Strength::Auto`], the round with the least estimated
-    /// error; up to [`strength::RISK_PATIENCE`] more were run and undone).
+    /// Rounds that made the result (with [`Strength::Auto`], the last round kept: the last that
+    /// lowered the estimated error by [`strength::RISK_MIN_FALL`] of the second round's fall;
+    /// up to [`strength::RISK_PATIENCE`] more were run and undone).
     pub rounds_run: usize,
     /// Largest single-vertex move in the last iteration (model units).
     pub max_move: f64,
@@ -261,8 +264,9 @@ pub struct FairReport {
     /// fairing; before the first round and again between rounds), part of its whole time.
     pub detection_ms: f64,
     /// With [`Strength::Auto`], the estimated risk of each round run, in order (mean squared
-    /// error along the normals plus σ², squared model units: [`strength`]); the kept round is the
-    /// one with the least. Empty otherwise. For studying the stopping rule: `fair --json` prints
+    /// error along the normals plus σ², squared model units: [`strength`]); the kept round reads
+    /// no more than [`strength::RISK_MIN_FALL`] of the second round's fall above the least, and
+    /// every round before it higher. Empty otherwise. For studying the stopping rule: `fair --json` prints
     /// it as `risk_by_round`.
     pub risk_by_round: Vec<f64>,
 }
