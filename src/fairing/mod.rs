@@ -266,8 +266,8 @@ pub struct FairReport {
     /// With [`Strength::Auto`], the estimated risk of each round run, in order (mean squared
     /// error along the normals plus σ², squared model units: [`strength`]); the kept round reads
     /// no more than [`strength::RISK_MIN_FALL`] of the second round's fall above the least, and
-    /// every round before it higher. Empty otherwise. For studying the stopping rule: `fair --json` prints
-    /// it as `risk_by_round`.
+    /// every round before it higher. Empty otherwise. For studying the stopping rule:
+    /// `fair --json` prints it as `risk_by_round`.
     pub risk_by_round: Vec<f64>,
 }
 

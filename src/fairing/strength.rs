@@ -39,11 +39,10 @@
 //! Hutchinson's estimate of a trace, bᵀ J b for E[bᵀ J b] = tr J; with b_v = ±1 (Rademacher)
 //! its variance is 2 Σ_{u≠v} J_uv², the least of any draw of independent b_v, where a Gaussian
 //! draw adds 2 Σ J_vv² from b_v² ≠ 1 (measured on the noisy elephant, eight draws: the first
-//! round's divergence spreads 0.39-0.42 with ±1 against 0.39-0.43 from a Gaussian draw, and
-//! the stop's choice moves with the draw less; `docs/measurements.md`, "The stop: small falls
-//! add up, a draw of ±1"). The copy goes through the same operator, round for round, so every
-//! round costs its iterations twice. σ itself is read
-//! from the input by second differences ([`second_difference_variance`]): with L the umbrella
+//! round's divergence spreads 0.39-0.42 with ±1 against 0.39-0.43 from a Gaussian draw;
+//! `docs/measurements.md`, "The stop: small falls add up, a draw of ±1"). The copy goes through
+//! the same operator, round for round, so every round costs its iterations twice. σ itself is
+//! read from the input by second differences ([`second_difference_variance`]): with L the umbrella
 //! operator (the mean of the neighbours), r_v = n_v · ((I − L)² y)_v is, on a smooth surface,
 //! the change of the curvature term across two rings (small) plus the noise filtered by a row of
 //! (I − L)², whose squared norm g_v is known; so σ² = Σ r_v² / Σ g_v over the vertices whose two
@@ -460,6 +459,7 @@ pub const RISK_PATIENCE: usize = 2;
 /// reads lower by less is not kept: its extra smoothing is within the estimate's own scatter
 /// (the elephant with isotropic noise reads rounds 4 and 5 within 0.04 % of each other; round
 /// 4 is the closer).
+///
 /// Measured on the 32-row peer table over three noise seeds, against the rule it replaced (the
 /// least always kept; only a round's own fall of this fraction counting towards
 /// [`RISK_PATIENCE`]): closer on every seed's geometric mean, the noisy 1.2M-face bunny 43 → 59
@@ -780,6 +780,7 @@ fn unit_vertex_normals(mesh: &TriMesh, topology: &Topology) -> Vec<Vec3A> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::noise::{add_noise, NoiseMode, NoiseOptions};
 
     /// A standard normal draw for vertex `v`, the same on every run (Box-Muller from two uniforms
     /// of a SplitMix64 hash of `v`).
@@ -789,7 +790,6 @@ mod tests {
         let u2 = ((mix(h) >> 11) as f64) / (1u64 << 53) as f64;
         ((-2.0 * u1.ln()).sqrt() * (std::f64::consts::TAU * u2).cos()) as f32
     }
-    use crate::noise::{add_noise, NoiseMode, NoiseOptions};
 
     #[test]
     fn the_selected_rank_is_the_sorted_values_at_that_rank() {
