@@ -211,7 +211,7 @@ fn end_to_end(clean: &TriMesh, noisy: &TriMesh, topology: &Topology, runs: usize
         );
     }
     let without = HierarchyOptions::default();
-    let with = HierarchyOptions::default().with_creases(Some(CreaseOptions::for_hierarchy()));
+    let with = HierarchyOptions::default().with_creases(Some(CreaseOptions::default()));
     // With the loaded connectivity, as `fairmesh hierarchy` and `multires` build it (creases
     // read it; without them it is not read).
     let build = |options: &HierarchyOptions| {

@@ -294,8 +294,8 @@ fn fixed_boundary_stays_fixed_in_multires_from_every_level() {
 }
 
 fn build_with_creases(mesh: &TriMesh) -> Hierarchy {
-    let options = HierarchyOptions::default()
-        .with_creases(Some(fairmesh::fairing::CreaseOptions::for_hierarchy()));
+    let options =
+        HierarchyOptions::default().with_creases(Some(fairmesh::fairing::CreaseOptions::default()));
     build_hierarchy(mesh, &options, &mut NoProgress).unwrap()
 }
 
@@ -303,7 +303,7 @@ fn build_with_creases(mesh: &TriMesh) -> Hierarchy {
 /// built with or without creases.
 fn multires_distance(reference: &TriMesh, mesh: &TriMesh, creases: bool, level: usize) -> f64 {
     let options = HierarchyOptions::default()
-        .with_creases(creases.then(fairmesh::fairing::CreaseOptions::for_hierarchy));
+        .with_creases(creases.then(fairmesh::fairing::CreaseOptions::default));
     let h = build_hierarchy(mesh, &options, &mut NoProgress).unwrap();
     let positions = fair_multires(
         &h,
@@ -319,8 +319,8 @@ fn multires_distance(reference: &TriMesh, mesh: &TriMesh, creases: bool, level: 
 #[test]
 fn a_hierarchy_from_the_loaded_topology_is_the_one_built_alone() {
     let clean = fairmesh::mesh::shapes::cuboid([2.0, 1.0, 0.5], 0.05);
-    let options = HierarchyOptions::default()
-        .with_creases(Some(fairmesh::fairing::CreaseOptions::for_hierarchy()));
+    let options =
+        HierarchyOptions::default().with_creases(Some(fairmesh::fairing::CreaseOptions::default()));
     let alone = build_hierarchy(&clean, &options, &mut NoProgress).unwrap();
     let same = |h: &Hierarchy| {
         assert_eq!(h.coarsest_level(), alone.coarsest_level());
@@ -401,7 +401,7 @@ fn a_workspace_for_one_run_gives_the_same_result_and_keeps_no_level() {
         build(&mushroom),
         build_hierarchy(
             &elephant,
-            &HierarchyOptions::default().with_creases(Some(CreaseOptions::for_hierarchy())),
+            &HierarchyOptions::default().with_creases(Some(CreaseOptions::default())),
             &mut NoProgress,
         )
         .unwrap(),
@@ -600,4 +600,32 @@ fn multires_of_a_noisy_scan_with_loose_triangles_smooths_it_as_well_as_without_t
     assert!(added
         .iter()
         .all(|&f| faired.triangles[f as usize] == scan.triangles[f as usize]));
+}
+
+/// With the zigzag test's angle left unset, the hierarchy drops wandering crease groups only at
+/// its own, higher angle (`HIERARCHY_ZIGZAG_TURN`), not at fairing's (`ZIGZAG_TURN`): the noisy
+/// elephant's bends that fairing lets go hold a coarse level's shape.
+#[test]
+fn the_hierarchy_takes_its_own_zigzag_angle_when_none_is_given() {
+    use fairmesh::fairing::creases::{CreaseOptions, HIERARCHY_ZIGZAG_TURN, ZIGZAG_TURN};
+    let mut elephant = load("tests/data/elephant.obj");
+    add_noise(&mut elephant, &NoiseOptions::default().with_sigma(0.3));
+    let creases = |options: CreaseOptions| {
+        let options = HierarchyOptions::default().with_creases(Some(options));
+        build_hierarchy(&elephant, &options, &mut NoProgress)
+            .unwrap()
+            .crease_edges()
+            .to_vec()
+    };
+    let unset = creases(CreaseOptions::default());
+    let hierarchy =
+        creases(CreaseOptions::default().with_zigzag_turn_degrees(Some(HIERARCHY_ZIGZAG_TURN)));
+    let fairing = creases(CreaseOptions::default().with_zigzag_turn_degrees(Some(ZIGZAG_TURN)));
+    assert_eq!(unset, hierarchy);
+    assert!(
+        unset.len() > fairing.len(),
+        "{} against {}",
+        unset.len(),
+        fairing.len()
+    );
 }

@@ -54,7 +54,7 @@ impl BuildArgs {
             .with_max_levels(self.max_levels)
             .with_keep_boundary(self.keep_boundary)
             .with_creases((self.keep_creases || self.crease_angle.is_some()).then(|| {
-                CreaseOptions::for_hierarchy().with_angle_degrees(
+                CreaseOptions::default().with_angle_degrees(
                     self.crease_angle
                         .unwrap_or(fairmesh::fairing::creases::DEFAULT_CREASE_ANGLE),
                 )
@@ -526,8 +526,8 @@ pub fn bench_rows(mesh: &TriMesh, topology: &Topology) -> Vec<(String, f64)> {
     let mut rows = vec![("hierarchy build".to_string(), build_ms)];
     // With `--keep-creases` (detection on the mesh, then the collapses kept along the creases),
     // from the loaded connectivity as the commands do.
-    let with_creases = HierarchyOptions::default()
-        .with_creases(Some(fairmesh::fairing::CreaseOptions::for_hierarchy()));
+    let with_creases =
+        HierarchyOptions::default().with_creases(Some(fairmesh::fairing::CreaseOptions::default()));
     rows.push((
         "hierarchy build keeping creases".to_string(),
         super::bench::median_ms(runs, || {

@@ -77,8 +77,9 @@ pub struct CreaseOptions {
     pub corner_turn_degrees: f64,
     /// For dropping groups that zigzag: a vertex whose two feature edges' positions turn by more
     /// than this counts as a corner, and a group with more than one such corner per two edges is
-    /// no crease ([`ZIGZAG_TURN`]; the hierarchy's [`HIERARCHY_ZIGZAG_TURN`]).
-    pub zigzag_turn_degrees: f64,
+    /// no crease. `None` (the default): the angle of the use, [`ZIGZAG_TURN`] for fairing and
+    /// [`detect_creases`], [`HIERARCHY_ZIGZAG_TURN`] for the hierarchy.
+    pub zigzag_turn_degrees: Option<f64>,
     /// Edges the input file marks as sharp (its normals split there, or two of its materials
     /// meet: [`crate::io::Source::hard_edges`]), each `[a, b]` with `a < b`: feature edges
     /// whatever their angle, never dropped as a small or zigzagging group. Empty: none.
@@ -91,7 +92,7 @@ with_setters!(CreaseOptions {
     with_normal_sigma => normal_sigma: f64,
     with_min_edges => min_edges: usize,
     with_corner_turn_degrees => corner_turn_degrees: f64,
-    with_zigzag_turn_degrees => zigzag_turn_degrees: f64,
+    with_zigzag_turn_degrees => zigzag_turn_degrees: Option<f64>,
 });
 
 impl Default for CreaseOptions {
@@ -102,27 +103,22 @@ impl Default for CreaseOptions {
             normal_sigma: NORMAL_SIGMA,
             min_edges: 8,
             corner_turn_degrees: 70.0,
-            zigzag_turn_degrees: ZIGZAG_TURN,
+            zigzag_turn_degrees: None,
             file_edges: std::sync::Arc::from([]),
         }
     }
 }
 
-/// [`CreaseOptions::zigzag_turn_degrees`] for fairing (the default): holding the wandering
+/// [`CreaseOptions::zigzag_turn_degrees`] for fairing (where it is `None`): holding the wandering
 /// bends a coarse scan's filtered normals show costs its fairing more than it keeps.
 pub const ZIGZAG_TURN: f64 = 55.0;
 
-/// [`CreaseOptions::zigzag_turn_degrees`] for the hierarchy ([`CreaseOptions::for_hierarchy`]):
-/// there the same bends keep a coarse level's shape (multires from level 9 of the noisy
+/// [`CreaseOptions::zigzag_turn_degrees`] for the hierarchy (where it is `None`): there the same
+/// bends keep a coarse level's shape (multires from level 9 of the noisy
 /// elephant ends 0.35 edge lengths from the clean surface with them, 0.44 without them).
 pub const HIERARCHY_ZIGZAG_TURN: f64 = 70.0;
 
 impl CreaseOptions {
-    /// The default options with the hierarchy's zigzag test ([`HIERARCHY_ZIGZAG_TURN`]).
-    pub fn for_hierarchy() -> Self {
-        Self::default().with_zigzag_turn_degrees(HIERARCHY_ZIGZAG_TURN)
-    }
-
     /// `self` with [`file_edges`](Self::file_edges) set to `edges`.
     #[must_use]
     pub fn with_file_edges(mut self, edges: Vec<[u32; 2]>) -> Self {
@@ -797,7 +793,11 @@ fn finish(
     let edges = keep_groups(edges, vertex_count, None, |edges, _| edges >= min_edges);
     // The zigzag test turns by the edges' positions: noise that lines up into a fake crease
     // zigzags there, while the faces' crease directions may still agree.
-    let zigzag_turn = options.zigzag_turn_degrees.to_radians().cos();
+    let zigzag_turn = options
+        .zigzag_turn_degrees
+        .unwrap_or(ZIGZAG_TURN)
+        .to_radians()
+        .cos();
     let class = classify(topology, &edges, Turn::Positions(mesh), zigzag_turn);
     let mut edges = keep_groups(edges, vertex_count, Some(&class), |edges, corners| {
         2 * corners <= edges
@@ -1359,7 +1359,7 @@ mod tests {
         let creases = finish(&mesh, &topology, found.clone(), &options);
         assert_eq!(on(&creases, &straight), 12);
         assert_eq!(on(&creases, &wandering), 0);
-        let seventy = options.with_zigzag_turn_degrees(70.0);
+        let seventy = options.with_zigzag_turn_degrees(Some(70.0));
         let creases = finish(&mesh, &topology, found, &seventy);
         assert_eq!(on(&creases, &straight), 12);
         assert_eq!(on(&creases, &wandering), 12);

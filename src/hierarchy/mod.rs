@@ -21,8 +21,10 @@
 //!
 //! Creases ([`HierarchyOptions::creases`], off by default for now; not in the paper): M0's creases are
 //! found as [`crate::fairing::detect_creases`] finds them (normals filtered as much as the noise
-//! estimate asks), corners never collapse and crease vertices collapse only along their crease
-//! (see `decimate.rs`), so every level's creases are M0's feature edges with their ends followed
+//! estimate asks; groups that wander are dropped only where their edges turn by more than
+//! [`HIERARCHY_ZIGZAG_TURN`] unless the options say otherwise, since a coarse level keeps its
+//! shape by those bends), corners never collapse and crease vertices collapse only along their
+//! crease (see `decimate.rs`), so every level's creases are M0's feature edges with their ends followed
 //! along `target` ([`Hierarchy::level_creases`]); multiresolution fairing fairs them as curves.
 //! The detection costs a topology, the fan-ordered one-rings and one gather over them that gives
 //! the noise estimate and the feature edges together (the guided normal filter only on a noisy
@@ -43,6 +45,7 @@ mod decimate;
 use crate::fairing::constrained::FanRings;
 use crate::fairing::creases::{
     detect_creases_with_estimate, CreaseOptions, Creases, FaceRingCache, FeatureClass,
+    HIERARCHY_ZIGZAG_TURN,
 };
 use crate::mesh::{Topology, TriMesh};
 use crate::Progress;
@@ -70,7 +73,6 @@ pub struct HierarchyOptions {
     /// normals filtered as much as the mesh's noise estimate asks): a crease vertex collapses only
     /// into one of its two neighbours along the crease, and corners never collapse, so every
     /// level keeps M0's creases and corners ([`Hierarchy::level_creases`]). `None`: no creases.
-    /// [`CreaseOptions::for_hierarchy`] are the options the CLI and the editor give.
     pub creases: Option<CreaseOptions>,
     /// Decimate a non-manifold mesh without the triangles that lie loose at its non-manifold
     /// edges (overlays on a fan, fins; [`crate::mesh::loose_triangles`]), as the default fairing
@@ -558,11 +560,19 @@ fn build(
                 ),
             };
             let fans = FanRings::new(&levels_mesh.triangles, levels_topology);
+            let crease_options = CreaseOptions {
+                zigzag_turn_degrees: Some(
+                    crease_options
+                        .zigzag_turn_degrees
+                        .unwrap_or(HIERARCHY_ZIGZAG_TURN),
+                ),
+                ..crease_options.clone()
+            };
             detect_creases_with_estimate(
                 levels_mesh,
                 levels_topology,
                 &fans,
-                crease_options,
+                &crease_options,
                 &mut FaceRingCache::default(),
                 true,
             )

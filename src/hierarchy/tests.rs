@@ -342,8 +342,7 @@ fn levels_visited_in_regions_are_valid_and_the_same_on_any_thread_count() {
 fn creases_survive_every_level_visited_in_regions() {
     let mesh = crate::mesh::shapes::cuboid([2.0, 1.0, 0.5], 0.04);
     let options = in_small_regions(
-        HierarchyOptions::default()
-            .with_creases(Some(crate::fairing::CreaseOptions::for_hierarchy())),
+        HierarchyOptions::default().with_creases(Some(crate::fairing::CreaseOptions::default())),
     );
     let h = check_levels(&mesh, &options);
     assert!(h.crease_edges().len() > 100);

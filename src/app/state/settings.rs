@@ -303,7 +303,7 @@ impl Settings {
         };
         HierarchyOptions::default().with_creases(
             self.keep_sharp_edges
-                .then(|| CreaseOptions::for_hierarchy().with_angle_degrees(angle)),
+                .then(|| CreaseOptions::default().with_angle_degrees(angle)),
         )
     }
 
