@@ -605,6 +605,26 @@ fn other_formats_and_other_connectivity_say_what_is_not_kept() {
         finer.triangles.len()
     );
 
+    // An OBJ whose only extra is something it cannot carry (texture coordinates no face uses)
+    // is written as a bare mesh, and the warning says so in words (it once read "with its ;").
+    let unused_uvs = dir.path().join("unused_uvs.obj");
+    std::fs::write(
+        &unused_uvs,
+        "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nvt 0 0\nvt 1 0\nf 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n",
+    )
+    .unwrap();
+    let obj = io::load(&unused_uvs).unwrap();
+    for name in ["u.glb", "u.gltf"] {
+        let report = io::save_with_source(dir.path().join(name), &obj.mesh, &obj.source).unwrap();
+        let text = report.warnings.join("\n");
+        assert!(
+            text.contains("texture coordinates (2 vt)"),
+            "{name}: {text}"
+        );
+        assert!(text.contains("written as a bare"), "{name}: {text}");
+        assert!(!text.contains("with its ;"), "{name}: {text}");
+    }
+
     // A bare mesh has nothing to lose.
     let bare = io::load(PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/data/elephant.obj"))
         .unwrap();

@@ -548,8 +548,8 @@ pub fn save_with_source(
             lost.append(&mut scene.warnings);
             if !lost.is_empty() {
                 report.warnings.push(format!(
-                    "it is written as {format} with its {}; not kept from {name}: {}",
-                    and_list(&scene.carried()),
+                    "{}; not kept from {name}: {}",
+                    written_as(format, &scene.carried()),
                     lost.join("; ")
                 ));
             }
@@ -600,10 +600,8 @@ pub fn save_with_source(
     if !lost.is_empty() {
         let why = if source.writes_back_as(format) {
             "the mesh no longer has its connectivity (a level of the hierarchy or a changed copy), so it is written as a bare mesh".to_string()
-        } else if kept.is_empty() {
-            format!("it is written as a bare {format} mesh")
         } else {
-            format!("it is written as {format} with its {}", and_list(&kept))
+            written_as(format, &kept)
         };
         report
             .warnings
@@ -754,6 +752,15 @@ pub fn save_derived_with_source(
 }
 
 /// "a", "a and b", "a, b and c".
+/// How a warning says what a written file holds besides the bare mesh.
+fn written_as(format: Format, kept: &[&str]) -> String {
+    if kept.is_empty() {
+        format!("it is written as a bare {format} mesh")
+    } else {
+        format!("it is written as {format} with its {}", and_list(kept))
+    }
+}
+
 fn and_list(items: &[&str]) -> String {
     match items {
         [] => String::new(),
