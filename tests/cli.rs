@@ -215,6 +215,44 @@ fn errors_name_the_file_and_exit_with_code_1() {
     assert!(!dir.path().join("x.obj").exists());
 }
 
+#[test]
+fn commands_that_write_a_mesh_say_what_the_loader_skipped() {
+    // A PLY face with two corners is skipped on load: `info` lists the warning in its report,
+    // and every command that writes a mesh says it on stderr, since the face is not in what it
+    // writes (before, only `info` told).
+    let dir = tempfile::tempdir().unwrap();
+    let input = dir.path().join("short_face.ply");
+    std::fs::write(
+        &input,
+        "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\n\
+         property float z\nelement face 5\nproperty list uchar int vertex_indices\nend_header\n\
+         0 0 0\n1 0 0\n0 1 0\n0 0 1\n3 0 2 1\n3 0 1 3\n3 0 3 2\n3 1 2 3\n2 0 1\n",
+    )
+    .unwrap();
+    let input = input.to_str().unwrap();
+    let output = dir.path().join("out.ply");
+    let output = output.to_str().unwrap();
+    let warning = format!("warning: {input}: 1 face with fewer than 3 corners was skipped");
+    for args in [
+        vec!["fair", input, "-o", output],
+        vec!["multires", input, "-o", output, "--level", "0"],
+        vec!["convert", input, "-o", output],
+        vec!["noise", input, "-o", output],
+        vec!["hierarchy", input],
+    ] {
+        let out = fairmesh(&args);
+        assert!(out.status.success(), "{args:?}: {out:?}");
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert!(stderr.contains(&warning), "{args:?}: {stderr}");
+    }
+    let info = fairmesh(&["info", input]);
+    let stdout = String::from_utf8_lossy(&info.stdout);
+    assert!(
+        stdout.contains("warning: 1 face with fewer than 3 corners was skipped"),
+        "{stdout}"
+    );
+}
+
 /// Runs `fairmesh args` with `stdin` on standard input.
 fn fairmesh_with_input(args: &[&str], stdin: &[u8]) -> Output {
     use std::io::Write;

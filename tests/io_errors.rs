@@ -277,6 +277,35 @@ fn broken_ply_files() {
         b"ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\nproperty float z\nend_header\n0 0 0\n",
         &["no triangles"],
     );
+    // A line that is no PLY keyword before the first element (old Blender exports write
+    // "Created by Blender3D 247 ..." there) is read as a comment, with a warning that names it;
+    // the same line among the elements could be a misspelt element or property, which would
+    // misplace every value after it, so there it stays an error.
+    let tetrahedron = "element vertex 4\nproperty float x\nproperty float y\nproperty float z\n\
+                       element face 4\nproperty list uchar int vertex_indices\nend_header\n\
+                       0 0 0\n1 0 0\n0 1 0\n0 0 1\n3 0 2 1\n3 0 1 3\n3 0 3 2\n3 1 2 3\n";
+    let stray = d.join("stray.ply");
+    std::fs::write(
+        &stray,
+        format!("ply\nformat ascii 1.0\nCreated by Blender3D 247 - www.blender.org\n{tetrahedron}"),
+    )
+    .unwrap();
+    let loaded = io::load(&stray).unwrap();
+    assert_eq!(loaded.mesh.face_count(), 4);
+    assert_eq!(
+        loaded.report.warnings,
+        [
+            "header line 3 (\"Created by Blender3D 247 - www.blender.o...\") is not a PLY keyword \
+          line: read as a comment"
+        ]
+    );
+    let (first, rest) = tetrahedron.split_at(tetrahedron.find("element face").unwrap());
+    expect_error(
+        d,
+        "stray_among_elements.ply",
+        format!("ply\nformat ascii 1.0\n{first}elemnt face 4\n{rest}").as_bytes(),
+        &["line 7", "unknown header keyword \"elemnt\""],
+    );
     expect_error(
         d,
         "noxyz.ply",
@@ -462,6 +491,27 @@ fn broken_gltf_and_glb_files() {
     let mut short = good.clone();
     short[8..12].copy_from_slice(&4u32.to_le_bytes());
     expect_error(d, "length.glb", &short, &["byte 8", "less than the header"]);
+    // glTF 1.0's binary container is version 1; the error says which glTF it is, not where
+    // its other layout first fails to parse.
+    let mut version_1 = good.clone();
+    version_1[4..8].copy_from_slice(&1u32.to_le_bytes());
+    expect_error(
+        d,
+        "version1.glb",
+        &version_1,
+        &[
+            "byte 4",
+            "GLB container version 1 (glTF 1.0)",
+            "reads glTF 2.0",
+        ],
+    );
+    // A glTF 1.0 JSON (objects keyed by name where 2.0 has arrays).
+    expect_error(
+        d,
+        "v1.gltf",
+        br#"{"asset": {"version": "1.0"}, "accessors": {"a": {"bufferView": "b", "count": 3}}, "meshes": {}}"#,
+        &["asset.version", "glTF 1.0", "reads glTF 2.0"],
+    );
     let mut chunk = good.clone();
     chunk[12..16].copy_from_slice(&100_000u32.to_le_bytes());
     expect_error(d, "chunk.glb", &chunk, &["GLB container", "invalid GLB"]);
@@ -529,6 +579,25 @@ fn broken_gltf_and_glb_files() {
         &[
             "no triangles",
             "only point and line primitives (0 point, 1 line)",
+        ],
+    );
+    // A Draco-compressed file: its accessors have no buffer views, but the error names the
+    // extension the file needs rather than the first accessor.
+    expect_error(
+        d,
+        "draco.glb",
+        &edit(&|j| {
+            j["extensionsUsed"] = serde_json::json!(["KHR_draco_mesh_compression"]);
+            j["extensionsRequired"] = serde_json::json!(["KHR_draco_mesh_compression"]);
+            j["accessors"][0]
+                .as_object_mut()
+                .unwrap()
+                .remove("bufferView");
+        }),
+        &[
+            "extensionsRequired[0]",
+            "KHR_draco_mesh_compression (Draco-compressed geometry)",
+            "does not support",
         ],
     );
     expect_error(

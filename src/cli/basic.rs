@@ -102,6 +102,27 @@ pub(crate) fn load_shown(
     })
 }
 
+/// [`load_shown`], then what the loader skipped or read leniently (faces with fewer than three
+/// corners, point and line primitives, a stray header line, ...) as warnings on standard error,
+/// for the commands that write a mesh: those parts are not in the output, and the user is told.
+/// (`info` lists them in its report instead.)
+pub(crate) fn load_input(
+    path: &Path,
+    weld: bool,
+    format: Option<super::FormatArg>,
+) -> anyhow::Result<Loaded> {
+    let loaded = load_shown(path, weld, format)?;
+    print_load_warnings(path, &loaded);
+    Ok(loaded)
+}
+
+/// Each of the loader's warnings on standard error, with the input's name.
+pub(crate) fn print_load_warnings(path: &Path, loaded: &Loaded) {
+    for warning in &loaded.report.warnings {
+        eprintln!("warning: {}: {warning}", super::display_input(path));
+    }
+}
+
 /// Loads an input mesh: a file, `@bunny` (the bunny compiled into the binary), or `-`, standard
 /// input in the format `format` names.
 pub(crate) fn load_from(
@@ -256,7 +277,7 @@ pub fn noise(args: NoiseArgs) -> anyhow::Result<()> {
     if super::is_stdio(&args.output) {
         super::stdio_format(args.stdio.format, "writing to standard output")?;
     }
-    let mut loaded = load_shown(&args.input, true, args.stdio.format)?;
+    let mut loaded = load_input(&args.input, true, args.stdio.format)?;
     let mode = match args.mode {
         ModeArg::Direction => NoiseMode::Direction,
         ModeArg::Iso => NoiseMode::Isotropic,
@@ -289,7 +310,7 @@ pub fn convert(args: ConvertArgs) -> anyhow::Result<()> {
     if super::is_stdio(&args.output) {
         super::stdio_format(args.stdio.format, "writing to standard output")?;
     }
-    let mut loaded = load_shown(&args.input, !args.no_weld, args.stdio.format)?;
+    let mut loaded = load_input(&args.input, !args.no_weld, args.stdio.format)?;
     for _ in 0..args.subdivide {
         loaded.mesh = fairmesh::mesh::subdivide_loop(&loaded.mesh);
     }

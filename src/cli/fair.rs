@@ -199,7 +199,7 @@ pub fn run(args: FairArgs) -> anyhow::Result<()> {
     if super::is_stdio(&args.output) {
         super::stdio_format(args.stdio.format, "writing to standard output")?;
     }
-    let loaded = super::basic::load_shown(&args.input, true, args.stdio.format)?;
+    let loaded = super::basic::load_input(&args.input, true, args.stdio.format)?;
     let (mut mesh, topology, source) = (loaded.mesh, loaded.topology, loaded.source);
     let edge = fairmesh::metrics::mean_edge_length(&mesh);
     let mut options = args.method_options(edge);

@@ -184,6 +184,7 @@ pub fn run_hierarchy(args: HierarchyArgs) -> anyhow::Result<()> {
         super::progress::Step::run(format!("loading {}", args.input.display()), || {
             super::basic::load(&args.input, true)
         })?;
+    super::basic::print_load_warnings(&args.input, &loaded);
     // The file's own sharp edges, like the connectivity below, serve the crease detection only.
     let keep_creases = args.subdivide == 0 && args.build.options().creases.is_some();
     let file_edges = if keep_creases {
@@ -315,7 +316,7 @@ pub fn run_multires(args: MultiresArgs) -> anyhow::Result<()> {
         super::stdio_format(args.stdio.format, "writing to standard output")?;
     }
     let measure = args.measure || args.reference.is_some();
-    let loaded = super::basic::load_shown(&args.input, true, args.stdio.format)?;
+    let loaded = super::basic::load_input(&args.input, true, args.stdio.format)?;
     let source = loaded.source;
     let mask = super::mask::load_for(&args.mask, &source, &loaded.mesh, Some(&loaded.topology))?;
     // The connectivity serves the crease detection only; otherwise it goes before the build.

@@ -44,8 +44,8 @@ use std::path::Path;
 
 pub(crate) fn parse(bytes: &[u8], path: &Path, base_dir: Option<&Path>) -> Result<Parsed, IoError> {
     check_glb_header(bytes, path)?;
-    let document =
-        ::gltf::Gltf::from_slice_without_validation(bytes).map_err(|e| describe(e, path))?;
+    let document = ::gltf::Gltf::from_slice_without_validation(bytes)
+        .map_err(|e| older_gltf(bytes, path).unwrap_or_else(|| describe(e, path)))?;
     validate(document.as_json(), path)?;
     let buffers = load_buffers(&document, path, base_dir)?;
     let mut reader = SceneReader {
@@ -155,6 +155,19 @@ fn check_glb_header(bytes: &[u8], path: &Path) -> Result<(), IoError> {
             ),
         ));
     };
+    // Version 1 is glTF 1.0's container (KHR_binary_glTF), with another chunk layout.
+    let version = u32::from_le_bytes(bytes[4..8].try_into().expect("4 bytes"));
+    if version != 2 {
+        return Err(IoError::at_byte(
+            path,
+            4,
+            format!(
+                "GLB container version {version}{}: fairmesh reads glTF 2.0 (GLB version 2); save \
+                 the file again as glTF 2.0",
+                if version == 1 { " (glTF 1.0)" } else { "" }
+            ),
+        ));
+    }
     if declared < 12 {
         return Err(IoError::at_byte(
             path,
@@ -175,11 +188,70 @@ fn check_glb_header(bytes: &[u8], path: &Path) -> Result<(), IoError> {
     Ok(())
 }
 
+/// When glTF 2.0's JSON does not fit a file, whether it is a glTF 1.0 file (whose JSON holds
+/// objects keyed by name where 2.0 has arrays): the error says so rather than where the first
+/// array was not one.
+fn older_gltf(bytes: &[u8], path: &Path) -> Option<IoError> {
+    let json: serde_json::Value = serde_json::from_slice(json_text(bytes)?).ok()?;
+    let version = json.get("asset")?.get("version")?.as_str()?;
+    version.starts_with("1.").then(|| {
+        IoError::at_element(
+            path,
+            "asset.version",
+            format!(
+                "glTF {version}: fairmesh reads glTF 2.0 (1.0 files are laid out differently); \
+                 save the file again as glTF 2.0"
+            ),
+        )
+    })
+}
+
+/// What a required extension that fairmesh cannot read holds, and what to do, for the error
+/// that names it.
+fn extension_content(name: &str) -> (&'static str, &'static str) {
+    match name {
+        "KHR_draco_mesh_compression" => (
+            " (Draco-compressed geometry)",
+            ": save the file again without mesh compression",
+        ),
+        "EXT_meshopt_compression" => (
+            " (meshoptimizer-compressed buffers)",
+            ": save the file again without compression",
+        ),
+        "KHR_mesh_quantization" => (" (positions stored as quantized integers)", ""),
+        "KHR_technique_webgl" | "KHR_materials_common" => (" (glTF 1.0 materials)", ""),
+        _ => ("", ""),
+    }
+}
+
 /// What `gltf::Gltf::from_slice` validates, after a check that its validation needs: gltf-json
 /// 1.4 looks up every primitive's POSITION accessor by index without a bounds check (a panic,
-/// found by fuzzing).
+/// found by fuzzing). A required extension fairmesh cannot read is named first: its data (a
+/// Draco-compressed mesh's accessors have no buffer views) fails the other checks too, which
+/// would otherwise be the error.
 fn validate(root: &json::Root, path: &Path) -> Result<(), IoError> {
     use json::validation::{Checked, Validate};
+    let unsupported: Vec<(usize, &String)> = root
+        .extensions_required
+        .iter()
+        .enumerate()
+        .filter(|(_, name)| !json::extensions::ENABLED_EXTENSIONS.contains(&name.as_str()))
+        .collect();
+    if let Some(&(i, name)) = unsupported.first() {
+        let others = match unsupported.len() {
+            1 => String::new(),
+            n => format!(" ({} more required extensions fairmesh cannot read)", n - 1),
+        };
+        let (content, advice) = extension_content(name);
+        return Err(IoError::at_element(
+            path,
+            format!("extensionsRequired[{i}]"),
+            format!(
+                "the file needs the extension {name}{content}, which fairmesh does not \
+                 support{others}{advice}"
+            ),
+        ));
+    }
     for (m, mesh) in root.meshes.iter().enumerate() {
         for (p, primitive) in mesh.primitives.iter().enumerate() {
             let position = primitive

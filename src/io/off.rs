@@ -198,9 +198,9 @@ pub(crate) fn parse(bytes: &[u8], path: &Path) -> Result<Parsed, IoError> {
         )]);
     }
     if short_faces > 0 {
-        parsed.warnings.push(format!(
-            "{short_faces} faces with fewer than 3 corners were skipped"
-        ));
+        parsed
+            .warnings
+            .push(super::text::short_faces_skipped(short_faces));
     }
     Ok(parsed)
 }

@@ -122,11 +122,15 @@ struct Header {
     body_start: usize,
     /// Line number of the first body line (for ASCII).
     body_line: usize,
+    /// Lines before the first element that are no PLY keyword (old Blender exports write
+    /// "Created by Blender3D 247 ..." there), read as comments: line number and text.
+    stray_lines: Vec<(usize, String)>,
 }
 
 fn parse_header(bytes: &[u8], path: &Path) -> Result<Header, IoError> {
     let mut encoding = None;
     let mut elements: Vec<Element> = Vec::new();
+    let mut stray_lines = Vec::new();
     let mut offset = 0usize;
     for (number, line) in lines(bytes) {
         // `lines` removed the '\n' (and maybe a '\r'): find where the next line starts.
@@ -219,7 +223,14 @@ fn parse_header(bytes: &[u8], path: &Path) -> Result<Header, IoError> {
                     elements,
                     body_start: offset.min(bytes.len()),
                     body_line: number + 1,
+                    stray_lines,
                 });
+            }
+            // Before the first element such a line cannot change how the body is laid out, so
+            // it is read as a comment (with a warning); among the elements it might be a
+            // misspelt element or property, and reading on could misplace every value.
+            Some(_) if elements.is_empty() => {
+                stray_lines.push((number, String::from_utf8_lossy(line).trim().to_string()));
             }
             Some(other) => {
                 return Err(at(format!("unknown header keyword {}", quote(other))));
@@ -329,11 +340,20 @@ pub(crate) fn parse(bytes: &[u8], path: &Path) -> Result<Parsed, IoError> {
         ));
     }
     let mut parsed = Parsed::new(builder.mesh);
-    if builder.short_faces > 0 {
+    if let Some((first, text)) = header.stray_lines.first() {
+        let more = match header.stray_lines.len() {
+            1 => String::new(),
+            n => format!(" (and {} more such lines)", n - 1),
+        };
         parsed.warnings.push(format!(
-            "{} faces with fewer than 3 corners were skipped",
-            builder.short_faces
+            "header line {first} ({}) is not a PLY keyword line: read as a comment{more}",
+            quote(text.as_bytes())
         ));
+    }
+    if builder.short_faces > 0 {
+        parsed
+            .warnings
+            .push(super::text::short_faces_skipped(builder.short_faces));
     }
     Ok(parsed)
 }

@@ -58,6 +58,14 @@ pub(crate) fn quote(token: &[u8]) -> String {
     }
 }
 
+/// The warning for faces a reader skipped because they have fewer than three corners.
+pub(crate) fn short_faces_skipped(count: usize) -> String {
+    match count {
+        1 => "1 face with fewer than 3 corners was skipped".into(),
+        n => format!("{n} faces with fewer than 3 corners were skipped"),
+    }
+}
+
 /// "NaN" or "infinite", for messages about a non-finite coordinate.
 pub(crate) fn non_finite_kind(value: f32) -> &'static str {
     if value.is_nan() {
