@@ -60,6 +60,39 @@ fn broken_obj_files() {
     let d = dir.path();
     let tri = "v 0 0 0\nv 1 0 0\nv 0 1 0\n";
     expect_error(d, "empty.obj", b"", &["the file is empty"]);
+    // A UTF-8 byte order mark (Windows editors write one) is skipped: the first vertex is
+    // read (before, its line's keyword was not recognised and face 1 pointed past the end).
+    // UTF-16 is refused with an error that says so, not "line 1 is not valid UTF-8".
+    for (name, text) in [
+        ("bom.obj", format!("{tri}f 1 2 3\n")),
+        (
+            "bom.off",
+            "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n".to_string(),
+        ),
+    ] {
+        let path = d.join(name);
+        std::fs::write(&path, [&b"\xEF\xBB\xBF"[..], text.as_bytes()].concat()).unwrap();
+        let loaded = io::load(&path).unwrap();
+        assert_eq!(
+            (loaded.mesh.vertex_count(), loaded.mesh.face_count()),
+            (3, 1),
+            "{name}"
+        );
+    }
+    let utf16: Vec<u8> = [0xFE, 0xFF]
+        .into_iter()
+        .chain(
+            format!("{tri}f 1 2 3\n")
+                .encode_utf16()
+                .flat_map(u16::to_be_bytes),
+        )
+        .collect();
+    expect_error(
+        d,
+        "utf16.obj",
+        &utf16,
+        &["UTF-16", "save it again as UTF-8"],
+    );
     let message = expect_error(
         d,
         "nan.obj",
@@ -127,7 +160,9 @@ fn broken_obj_files() {
     expect_error(
         d,
         "garbage.obj",
-        &[0xff, 0xfe, 0x00, 0x13, b'\n', 0x80, 0x81],
+        // (Not starting with 0xff 0xfe: that is UTF-16's byte order mark, which has its own
+        // error, tested above.)
+        &[0x80, 0xfe, 0x00, 0x13, b'\n', 0x80, 0x81],
         &["line 1", "UTF-8"],
     );
 }

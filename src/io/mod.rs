@@ -231,6 +231,7 @@ fn load_bytes_impl(
     if bytes.is_empty() {
         return Err(IoError::invalid(path, "the file is empty"));
     }
+    let bytes = without_byte_order_mark(bytes, format, path)?;
     let mut parsed = match format {
         Format::Obj => obj::parse(&bytes, path)?,
         Format::Gltf | Format::Glb => gltf::parse(&bytes, path, base_dir.as_deref())?,
@@ -752,6 +753,41 @@ pub fn save_derived_with_source(
 }
 
 /// "a", "a and b", "a, b and c".
+/// A text file (OBJ, OFF, glTF JSON, a PLY header) that starts with a UTF-8 byte order mark, as
+/// Windows editors write, is read without it (in an OBJ the first line's keyword would not be
+/// recognised, and a vertex would be lost); one in UTF-16 is refused with an error saying so
+/// (every line would read as not UTF-8). Binary STL and GLB are not text: their first bytes are
+/// data.
+fn without_byte_order_mark<'a>(
+    bytes: Cow<'a, [u8]>,
+    format: Format,
+    path: &Path,
+) -> Result<Cow<'a, [u8]>, IoError> {
+    const UTF8: &[u8] = b"\xEF\xBB\xBF";
+    if !matches!(
+        format,
+        Format::Obj | Format::Off | Format::Gltf | Format::Ply
+    ) {
+        return Ok(bytes);
+    }
+    if bytes.starts_with(b"\xFE\xFF") || bytes.starts_with(b"\xFF\xFE") {
+        return Err(IoError::invalid(
+            path,
+            "the file is UTF-16 text (it starts with a UTF-16 byte order mark); fairmesh reads \
+             UTF-8 or ASCII: save it again as UTF-8",
+        ));
+    }
+    Ok(match bytes {
+        Cow::Borrowed(b) => Cow::Borrowed(b.strip_prefix(UTF8).unwrap_or(b)),
+        Cow::Owned(mut b) => {
+            if b.starts_with(UTF8) {
+                b.drain(..UTF8.len());
+            }
+            Cow::Owned(b)
+        }
+    })
+}
+
 /// How a warning says what a written file holds besides the bare mesh.
 fn written_as(format: Format, kept: &[&str]) -> String {
     if kept.is_empty() {
