@@ -341,6 +341,17 @@ fn broken_ply_files() {
         format!("ply\nformat ascii 1.0\n{first}elemnt face 4\n{rest}").as_bytes(),
         &["line 7", "unknown header keyword \"elemnt\""],
     );
+    // A vertex element that declares a list its rows do not have (a Blender 2.77 export).
+    expect_error(
+        d,
+        "vertex_list.ply",
+        b"ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\n\
+          property float z\nproperty list uchar uint vertex_indices\nend_header\n0 0 0\n",
+        &[
+            "line 9",
+            "vertex 0: missing value for the list vertex_indices",
+        ],
+    );
     expect_error(
         d,
         "noxyz.ply",

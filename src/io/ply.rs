@@ -449,8 +449,14 @@ fn read_ascii(
                             }
                         }
                     }
-                    Property::List { .. } => {
-                        let count_token = words.next().unwrap_or_default();
+                    Property::List { name, .. } => {
+                        let count_token = words.next().ok_or_else(|| {
+                            at(format!(
+                                "{} {row}: missing value for the list {}",
+                                element.label(),
+                                String::from_utf8_lossy(name)
+                            ))
+                        })?;
                         let count = parse_i64(count_token)
                             .and_then(|c| usize::try_from(c).ok())
                             .ok_or_else(|| {
