@@ -298,6 +298,49 @@ fn a_broken_file_shows_an_error_and_keeps_the_mesh() {
     }
 }
 
+/// A long error (a deep path, what is wrong, what to do) wraps inside the window: its end and
+/// the Dismiss button stay on screen.
+#[test]
+fn a_long_error_wraps_inside_the_window() {
+    let dir = tempfile::tempdir().unwrap();
+    let deep = dir
+        .path()
+        .join("a folder with a long name/and another one inside it/and a third");
+    std::fs::create_dir_all(&deep).unwrap();
+    let draco = deep.join("compressed.gltf");
+    std::fs::write(
+        &draco,
+        r#"{"asset": {"version": "2.0"}, "extensionsUsed": ["KHR_draco_mesh_compression"],
+            "extensionsRequired": ["KHR_draco_mesh_compression"]}"#,
+    )
+    .unwrap();
+    let mut harness = harness_for(bunny());
+    settle(&mut harness);
+    harness
+        .state_mut()
+        .push_command(fairmesh::app::Command::Open(draco));
+    settle(&mut harness);
+    let error = harness.state().status().error.expect("an error is shown");
+    assert!(
+        error.ends_with("save the file again without mesh compression"),
+        "{error}"
+    );
+    let width = 1200.0;
+    let message = harness.get_by_label_contains("Could not open the file");
+    assert!(message.rect().right() <= width, "{:?}", message.rect());
+    assert!(
+        message.rect().height() > 20.0,
+        "one line: {:?}",
+        message.rect()
+    );
+    let dismiss = harness.get_by_role_and_label(Role::Button, "Dismiss");
+    assert!(dismiss.rect().right() <= width, "{:?}", dismiss.rect());
+    dismiss.click();
+    harness.step();
+    harness.step();
+    assert!(harness.state().status().error.is_none());
+}
+
 /// A path pasted into the Path field opens with Load. In the window Ctrl+V becomes this paste
 /// event from the system clipboard (eframe's `clipboard` feature); without that feature egui
 /// only pastes what was copied inside the editor.

@@ -166,11 +166,24 @@ fn status_bar(ui: &mut egui::Ui, view: &PanelView, commands: &mut Commands) {
             .inner_margin(6.0)
             .corner_radius(4.0)
             .show(ui, |ui| {
+                // The button first and the message wrapped in the width left: a long message
+                // (a path, then what is wrong and what to do) once ran past the window's
+                // edge, taking its end and the button with it.
                 ui.horizontal(|ui| {
-                    ui.colored_label(egui::Color32::WHITE, format!("Error: {error}"));
-                    if ui.button("Dismiss").clicked() {
+                    if ui
+                        .button("Dismiss")
+                        .on_hover_text("Hide this message")
+                        .clicked()
+                    {
                         commands.push(Command::DismissError);
                     }
+                    ui.add(
+                        egui::Label::new(
+                            egui::RichText::new(format!("Error: {error}"))
+                                .color(egui::Color32::WHITE),
+                        )
+                        .wrap(),
+                    );
                 });
             });
     }
