@@ -605,12 +605,14 @@ fn other_formats_and_other_connectivity_say_what_is_not_kept() {
         finer.triangles.len()
     );
 
-    // An OBJ whose only extra is something it cannot carry (texture coordinates no face uses)
-    // is written as a bare mesh, and the warning says so in words (it once read "with its ;").
+    // An OBJ whose only extras are things it cannot carry (texture coordinates no face uses,
+    // statements fairmesh does not read) is written as a bare mesh, and the warning says so in
+    // words (it once read "with its ;") and names those statements (once silently dropped).
     let unused_uvs = dir.path().join("unused_uvs.obj");
     std::fs::write(
         &unused_uvs,
-        "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nvt 0 0\nvt 1 0\nf 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n",
+        "# a comment\nv 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nvt 0 0\nvt 1 0\nvp 0.5\nvp 0.7\n\
+         cstype bspline\nf 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n",
     )
     .unwrap();
     let obj = io::load(&unused_uvs).unwrap();
@@ -619,6 +621,10 @@ fn other_formats_and_other_connectivity_say_what_is_not_kept() {
         let text = report.warnings.join("\n");
         assert!(
             text.contains("texture coordinates (2 vt)"),
+            "{name}: {text}"
+        );
+        assert!(
+            text.contains("3 statements fairmesh does not read (vp, cstype)"),
             "{name}: {text}"
         );
         assert!(text.contains("written as a bare"), "{name}: {text}");

@@ -1199,6 +1199,9 @@ pub(crate) fn contents(bytes: &[u8]) -> Vec<String> {
         (0usize, 0usize, 0usize, 0usize, 0usize, false);
     let mut materials: Vec<String> = Vec::new();
     let mut libraries: Vec<String> = Vec::new();
+    // Statements fairmesh does not read (free-form curves and surfaces, `vp`, `lod`, ...), by
+    // keyword; polylines and points are said when the file is read.
+    let mut other: Vec<(String, usize)> = Vec::new();
     for line in bytes.split(|&b| b == b'\n') {
         let mut words = tokens(line);
         match words.next() {
@@ -1216,6 +1219,15 @@ pub(crate) fn contents(bytes: &[u8]) -> Vec<String> {
             }
             Some(b"mtllib") => {
                 libraries.extend(words.map(|w| String::from_utf8_lossy(w).into_owned()))
+            }
+            Some(b"v" | b"f" | b"l" | b"p") => {}
+            Some(keyword) if !keyword.starts_with(b"#") => {
+                let keyword = String::from_utf8_lossy(keyword).into_owned();
+                if let Some((_, count)) = other.iter_mut().find(|(k, _)| *k == keyword) {
+                    *count += 1;
+                } else if other.len() < 64 {
+                    other.push((keyword, 1));
+                }
             }
             _ => {}
         }
@@ -1247,6 +1259,15 @@ pub(crate) fn contents(bytes: &[u8]) -> Vec<String> {
     if polygons > 0 {
         out.push(format!(
             "{polygons} quads and polygons (written as triangles)"
+        ));
+    }
+    if !other.is_empty() {
+        let count: usize = other.iter().map(|(_, n)| n).sum();
+        let keywords: Vec<&str> = other.iter().take(8).map(|(k, _)| k.as_str()).collect();
+        let more = if other.len() > 8 { ", ..." } else { "" };
+        out.push(format!(
+            "{count} statements fairmesh does not read ({}{more})",
+            keywords.join(", ")
         ));
     }
     out
