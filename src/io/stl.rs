@@ -2,7 +2,8 @@
 //!
 //! Detection: a file is binary when its size is exactly `84 + 50 * n`, `n` being the triangle
 //! count at byte 80, whatever its first bytes say (many binary writers start the header with
-//! "solid"). Otherwise a file that starts with "solid" and holds no NUL byte is ASCII; anything
+//! "solid"). Otherwise a file that starts with "solid" (in any case, as its keywords may be)
+//! and holds no NUL byte is ASCII; anything
 //! else is a binary file of the wrong size, reported as truncated (or, if longer, read with a
 //! warning about the trailing bytes).
 //!
@@ -33,7 +34,7 @@ pub(crate) fn parse(bytes: &[u8], path: &Path) -> Result<Parsed, IoError> {
         .iter()
         .position(|b| !b.is_ascii_whitespace())
         .and_then(|start| bytes.get(start..start + 5))
-        == Some(&b"solid"[..]);
+        .is_some_and(|word| word.eq_ignore_ascii_case(b"solid"));
     if starts_solid && !bytes.contains(&0) {
         return read_ascii(bytes, path);
     }
@@ -150,7 +151,8 @@ fn read_ascii(bytes: &[u8], path: &Path) -> Result<Parsed, IoError> {
         let Some(keyword) = words.next() else {
             continue;
         };
-        match keyword {
+        // Keywords in any case: some writers use capitals ("SOLID", "FACET NORMAL").
+        match keyword.to_ascii_lowercase().as_slice() {
             b"solid" | b"endsolid" | b"facet" | b"endfacet" => {}
             b"outer" => {
                 in_loop = true;
@@ -190,8 +192,8 @@ fn read_ascii(bytes: &[u8], path: &Path) -> Result<Parsed, IoError> {
                 }
                 in_loop = false;
             }
-            other => {
-                return Err(at(format!("unexpected {} in an ASCII STL", quote(other))));
+            _ => {
+                return Err(at(format!("unexpected {} in an ASCII STL", quote(keyword))));
             }
         }
     }
@@ -311,6 +313,15 @@ mod tests {
             }
             other => panic!("{other:?}"),
         }
+    }
+
+    #[test]
+    fn ascii_keywords_in_capitals() {
+        let text = "SOLID X\r\n  FACET NORMAL 0 0 1\r\n    OUTER LOOP\r\n      VERTEX 0 0 0\r\n      \
+                    VERTEX 1 0 0\r\n      VERTEX 0 1 0\r\n    ENDLOOP\r\n  ENDFACET\r\nENDSOLID X\r\n";
+        let parsed = parse(text.as_bytes(), Path::new("a.stl")).unwrap();
+        assert_eq!(parsed.mesh.triangles, vec![[0, 1, 2]]);
+        assert_eq!(parsed.mesh.positions[1], [1.0, 0.0, 0.0]);
     }
 
     #[test]
