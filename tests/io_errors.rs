@@ -93,6 +93,12 @@ fn broken_obj_files() {
         &utf16,
         &["UTF-16", "save it again as UTF-8"],
     );
+    expect_error(
+        d,
+        "continued.obj",
+        format!("{tri}f 1 \\\n 2 3\n").as_bytes(),
+        &["line 4", "ends with a backslash", "join the two lines"],
+    );
     let message = expect_error(
         d,
         "nan.obj",

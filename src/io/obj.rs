@@ -243,6 +243,14 @@ fn locate(bytes: &[u8], path: &Path) -> Option<IoError> {
         if std::str::from_utf8(line).is_err() {
             return at("the line is not valid UTF-8".into());
         }
+        // OBJ allows a long line to go on after a backslash at its end; fairmesh does not.
+        if tokens(line).last() == Some(&b"\\"[..]) && !line.trim_ascii_start().starts_with(b"#") {
+            return at(
+                "the line ends with a backslash, continuing on the next line, which fairmesh \
+                 does not read: join the two lines"
+                    .into(),
+            );
+        }
         let mut words = tokens(line);
         match words.next() {
             Some(b"v") => {
