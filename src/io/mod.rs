@@ -752,7 +752,6 @@ pub fn save_derived_with_source(
     Ok(report)
 }
 
-/// "a", "a and b", "a, b and c".
 /// A text file (OBJ, OFF, glTF JSON, a PLY header) that starts with a UTF-8 byte order mark, as
 /// Windows editors write, is read without it (in an OBJ the first line's keyword would not be
 /// recognised, and a vertex would be lost); one in UTF-16 is refused with an error saying so
@@ -797,6 +796,7 @@ fn written_as(format: Format, kept: &[&str]) -> String {
     }
 }
 
+/// "a", "a and b", "a, b and c".
 fn and_list(items: &[&str]) -> String {
     match items {
         [] => String::new(),

@@ -151,8 +151,18 @@ fn read_ascii(bytes: &[u8], path: &Path) -> Result<Parsed, IoError> {
         let Some(keyword) = words.next() else {
             continue;
         };
-        // Keywords in any case: some writers use capitals ("SOLID", "FACET NORMAL").
-        match keyword.to_ascii_lowercase().as_slice() {
+        // Keywords in any case: some writers use capitals ("SOLID", "FACET NORMAL"). (Lowered
+        // in a buffer as long as the longest keyword, "endsolid": no allocation per line.)
+        let mut lowered = [0u8; 8];
+        let keyword_lowered = match lowered.get_mut(..keyword.len()) {
+            Some(buffer) => {
+                buffer.copy_from_slice(keyword);
+                buffer.make_ascii_lowercase();
+                &*buffer
+            }
+            None => keyword,
+        };
+        match keyword_lowered {
             b"solid" | b"endsolid" | b"facet" | b"endfacet" => {}
             b"outer" => {
                 in_loop = true;
