@@ -501,6 +501,14 @@ fn glb_parts() -> (serde_json::Value, Vec<u8>) {
     (json, bin)
 }
 
+/// Faces of a GLB that loads.
+fn good_faces(glb: &[u8]) -> usize {
+    io::load_from_bytes(glb, Format::Glb, "good.glb", &LoadOptions::default())
+        .unwrap()
+        .mesh
+        .face_count()
+}
+
 fn make_glb(json: &serde_json::Value, bin: &[u8]) -> Vec<u8> {
     let mut json_bytes = serde_json::to_vec(json).unwrap();
     while !json_bytes.len().is_multiple_of(4) {
@@ -632,6 +640,33 @@ fn broken_gltf_and_glb_files() {
             "no triangles",
             "only point and line primitives (0 point, 1 line)",
         ],
+    );
+    // Not an error: a line primitive beside the triangles is skipped with a warning that counts
+    // it in words ("1 line primitive was skipped"; it once read "0 point and 1 line
+    // primitives were skipped").
+    let with_lines = edit(&|j| {
+        let mut lines = j["meshes"][0]["primitives"][0].clone();
+        lines["mode"] = 1.into();
+        j["meshes"][0]["primitives"]
+            .as_array_mut()
+            .unwrap()
+            .push(lines);
+    });
+    let loaded = io::load_from_bytes(
+        &with_lines,
+        Format::Glb,
+        "lines.glb",
+        &LoadOptions::default(),
+    )
+    .unwrap();
+    assert_eq!(loaded.mesh.face_count(), good_faces(&good));
+    assert!(
+        loaded
+            .report
+            .warnings
+            .contains(&"1 line primitive was skipped".to_string()),
+        "{:?}",
+        loaded.report.warnings
     );
     // A Draco-compressed file: its accessors have no buffer views, but the error names the
     // extension the file needs rather than the first accessor.

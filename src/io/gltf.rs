@@ -86,10 +86,19 @@ pub(crate) fn parse(bytes: &[u8], path: &Path, base_dir: Option<&Path>) -> Resul
         return Err(IoError::invalid(path, format!("no triangles{detail}")));
     }
     if skipped > 0 {
-        reader.warnings.push(format!(
-            "{} point and {} line primitives were skipped",
-            reader.skipped_points, reader.skipped_lines
-        ));
+        // "1 point primitive was skipped", "2 line primitives were skipped", or both.
+        let parts: Vec<String> = [
+            (reader.skipped_points, "point primitive"),
+            (reader.skipped_lines, "line primitive"),
+        ]
+        .into_iter()
+        .filter(|&(n, _)| n > 0)
+        .map(|(n, what)| format!("{n} {what}{}", if n == 1 { "" } else { "s" }))
+        .collect();
+        let verb = if skipped == 1 { "was" } else { "were" };
+        reader
+            .warnings
+            .push(format!("{} {verb} skipped", parts.join(" and ")));
     }
     let json = json_text(bytes)
         .and_then(|text| serde_json::from_slice(text).ok())

@@ -112,19 +112,23 @@ pub(crate) fn parse(bytes: &[u8], path: &Path) -> Result<Parsed, IoError> {
     }
     let mut parsed = Parsed::new(mesh);
     if polylines > 0 {
-        parsed
-            .warnings
-            .push(format!("{polylines} polylines (l) were skipped"));
+        parsed.warnings.push(super::text::skipped(
+            polylines,
+            "polyline (l)",
+            "polylines (l)",
+        ));
     }
     if points > 0 {
-        parsed
-            .warnings
-            .push(format!("{points} point elements (p) were skipped"));
+        parsed.warnings.push(super::text::skipped(
+            points,
+            "point element (p)",
+            "point elements (p)",
+        ));
     }
     if short_faces > 0 {
-        parsed.warnings.push(format!(
-            "{short_faces} faces with fewer than 3 vertices were skipped"
-        ));
+        parsed
+            .warnings
+            .push(super::text::short_faces_skipped(short_faces));
     }
     Ok(parsed)
 }

@@ -58,12 +58,22 @@ pub(crate) fn quote(token: &[u8]) -> String {
     }
 }
 
+/// "1 polyline (l) was skipped", "3 polylines (l) were skipped": a reader's warning about what
+/// it left out, `one` and `many` naming one and several of them.
+pub(crate) fn skipped(count: usize, one: &str, many: &str) -> String {
+    match count {
+        1 => format!("1 {one} was skipped"),
+        n => format!("{n} {many} were skipped"),
+    }
+}
+
 /// The warning for faces a reader skipped because they have fewer than three corners.
 pub(crate) fn short_faces_skipped(count: usize) -> String {
-    match count {
-        1 => "1 face with fewer than 3 corners was skipped".into(),
-        n => format!("{n} faces with fewer than 3 corners were skipped"),
-    }
+    skipped(
+        count,
+        "face with fewer than 3 corners",
+        "faces with fewer than 3 corners",
+    )
 }
 
 /// "NaN" or "infinite", for messages about a non-finite coordinate.
