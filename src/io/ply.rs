@@ -5,8 +5,10 @@
 //! and `z` of any numeric type (doubles and integers are converted to f32; floats are taken bit for
 //! bit); `face` must have a list property `vertex_indices` (or `vertex_index`, or its only list)
 //! with any integer count and index type. Polygons are fan-triangulated; faces with fewer than
-//! three corners are skipped with a warning. Other properties and elements are skipped (binary
-//! lists are walked to find where the next row starts).
+//! three corners are skipped with a warning. A file with no `face` element but a `tristrips`
+//! one (older scans) is read as triangle strips (see `strips`). Other properties and elements
+//! are skipped (binary lists are walked to find where the next row starts). A header line that
+//! is no keyword, before the first element, is read as a comment with a warning.
 //!
 //! Robustness: every length is checked before it is read; a binary element of fixed row size is
 //! checked against the remaining file size before anything is allocated, and preallocation of
@@ -248,9 +250,13 @@ struct Layout {
     vertex_element: usize,
     /// Property indices of x, y, z in the vertex element.
     xyz: [usize; 3],
+    /// The `face` element, or else a `tristrips` element (older scans, Stanford's tools).
     face_element: Option<usize>,
     /// Property index of the index list in the face element.
     face_list: usize,
+    /// The face element is `tristrips`: each row is triangle strips, a negative index
+    /// (-1) ending one strip and starting the next.
+    strips: bool,
 }
 
 fn find_layout(header: &Header, path: &Path) -> Result<Layout, IoError> {
@@ -276,7 +282,17 @@ fn find_layout(header: &Header, path: &Path) -> Result<Layout, IoError> {
                 )
             })?;
     }
-    let face_element = header.elements.iter().position(|e| e.name == b"face");
+    let face = header.elements.iter().position(|e| e.name == b"face");
+    let strips = face.is_none()
+        && header
+            .elements
+            .iter()
+            .any(|e| e.name == b"tristrips" && e.count > 0);
+    let face_element = face.or_else(|| {
+        strips
+            .then(|| header.elements.iter().position(|e| e.name == b"tristrips"))
+            .flatten()
+    });
     let mut face_list = 0;
     if let Some(f) = face_element {
         let face = &header.elements[f];
@@ -303,6 +319,7 @@ fn find_layout(header: &Header, path: &Path) -> Result<Layout, IoError> {
         xyz,
         face_element,
         face_list,
+        strips,
     })
 }
 
@@ -478,9 +495,17 @@ fn read_ascii(
                                         quote(token)
                                     ))
                                 })?;
-                                corners.push(builder.index(row as usize, value).map_err(&at)?);
+                                corners.push(if layout.strips && value < 0 {
+                                    STRIP_RESTART
+                                } else {
+                                    builder.index(row as usize, value).map_err(&at)?
+                                });
                             }
-                            fan(&corners, builder);
+                            if layout.strips {
+                                strips(&corners, builder);
+                            } else {
+                                fan(&corners, builder);
+                            }
                         } else {
                             for _ in 0..count {
                                 words.next().ok_or_else(|| {
@@ -507,6 +532,25 @@ fn ascii_coordinate(kind: Scalar, token: &[u8]) -> Option<f32> {
         Scalar::F32 => parse_f32(token),
         Scalar::F64 => parse_f64(token).map(|v| v as f32),
         _ => parse_i64(token).map(|v| v as f32),
+    }
+}
+
+/// A `tristrips` row's negative index, which ends one strip and starts the next.
+const STRIP_RESTART: u32 = u32::MAX;
+
+/// The triangles of a `tristrips` row: in each strip (between restarts) the triangle at
+/// position `i` is `(s[i], s[i+1], s[i+2])`, its two first corners swapped at odd `i` so that
+/// all keep one orientation (as OpenGL draws strips). Triangles that repeat a corner only join
+/// two strips, and are left out; so are strips of fewer than three corners.
+fn strips(corners: &[u32], builder: &mut Builder) {
+    for strip in corners.split(|&c| c == STRIP_RESTART) {
+        for (i, t) in strip.windows(3).enumerate() {
+            let [a, b, c] = [t[0], t[1], t[2]];
+            if a != b && b != c && a != c {
+                let triangle = if i % 2 == 0 { [a, b, c] } else { [b, a, c] };
+                builder.mesh.triangles.push(triangle);
+            }
+        }
     }
 }
 
@@ -707,12 +751,20 @@ fn read_binary<const BIG: bool>(
                                             ),
                                         )
                                     })?;
-                                let index = builder
-                                    .index(row as usize, value)
-                                    .map_err(|m| IoError::at_byte(path, at, m))?;
+                                let index = if layout.strips && value < 0 {
+                                    STRIP_RESTART
+                                } else {
+                                    builder
+                                        .index(row as usize, value)
+                                        .map_err(|m| IoError::at_byte(path, at, m))?
+                                };
                                 corners.push(index);
                             }
-                            fan(&corners, builder);
+                            if layout.strips {
+                                strips(&corners, builder);
+                            } else {
+                                fan(&corners, builder);
+                            }
                         }
                         pos += list_len;
                     }
@@ -1334,6 +1386,40 @@ mod tests {
 
     fn parse_bytes(bytes: &[u8]) -> Result<Parsed, IoError> {
         parse(bytes, Path::new("t.ply"))
+    }
+
+    /// A `tristrips` element (older scans) as triangles: one strip around a tetrahedron, a
+    /// restart (-1), and a strip of two corners, which holds no triangle; ASCII and binary.
+    #[test]
+    fn reads_triangle_strips() {
+        let header = |format: &str| {
+            format!(
+                "ply\nformat {format} 1.0\nelement vertex 4\nproperty float x\nproperty float y\n\
+                 property float z\nelement tristrips 1\nproperty list int int vertex_indices\n\
+                 end_header\n"
+            )
+        };
+        let strip: [i32; 9] = [0, 1, 2, 3, 0, 1, -1, 3, 2];
+        let points = [[0f32, 0., 0.], [1., 0., 0.], [0., 1., 0.], [0., 0., 1.]];
+        let ascii = format!(
+            "{}0 0 0\n1 0 0\n0 1 0\n0 0 1\n9 {}\n",
+            header("ascii"),
+            strip.map(|i| i.to_string()).join(" ")
+        );
+        let mut binary = header("binary_little_endian").into_bytes();
+        binary.extend(points.iter().flatten().flat_map(|c| c.to_le_bytes()));
+        binary.extend(9i32.to_le_bytes());
+        binary.extend(strip.iter().flat_map(|i| i.to_le_bytes()));
+        for bytes in [ascii.into_bytes(), binary] {
+            let parsed = parse_bytes(&bytes).unwrap();
+            assert_eq!(parsed.mesh.positions, points.to_vec());
+            // Even positions as they come, odd ones with their first two corners swapped.
+            assert_eq!(
+                parsed.mesh.triangles,
+                vec![[0, 1, 2], [2, 1, 3], [2, 3, 0], [0, 3, 1]]
+            );
+            assert!(parsed.warnings.is_empty(), "{:?}", parsed.warnings);
+        }
     }
 
     #[test]
