@@ -2106,7 +2106,8 @@ fn fair_rounds(
                     first_fall = (first - now).max(0.0);
                 }
             }
-            if kept_round.is_none_or(|(_, risk)| now < risk - RISK_MIN_FALL * first_fall) {
+            if kept_round.is_none_or(|(_, kept_risk)| now < kept_risk - RISK_MIN_FALL * first_fall)
+            {
                 kept_round = Some((round, now));
                 kept_positions.clone_from(&mesh.positions);
                 kept_creases = edges;

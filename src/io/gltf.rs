@@ -88,12 +88,12 @@ pub(crate) fn parse(bytes: &[u8], path: &Path, base_dir: Option<&Path>) -> Resul
     if skipped > 0 {
         // "1 point primitive was skipped", "2 line primitives were skipped", or both.
         let parts: Vec<String> = [
-            (reader.skipped_points, "point primitive"),
-            (reader.skipped_lines, "line primitive"),
+            (reader.skipped_points, "point primitive", "point primitives"),
+            (reader.skipped_lines, "line primitive", "line primitives"),
         ]
         .into_iter()
-        .filter(|&(n, _)| n > 0)
-        .map(|(n, what)| format!("{n} {what}{}", if n == 1 { "" } else { "s" }))
+        .filter(|&(n, _, _)| n > 0)
+        .map(|(n, one, many)| super::text::counted(n, one, many))
         .collect();
         let verb = if skipped == 1 { "was" } else { "were" };
         reader
@@ -240,16 +240,12 @@ fn extension_content(name: &str) -> (&'static str, &'static str) {
 /// would otherwise be the error.
 fn validate(root: &json::Root, path: &Path) -> Result<(), IoError> {
     use json::validation::{Checked, Validate};
-    let unsupported: Vec<(usize, &String)> = root
-        .extensions_required
-        .iter()
-        .enumerate()
-        .filter(|(_, name)| !json::extensions::ENABLED_EXTENSIONS.contains(&name.as_str()))
-        .collect();
-    if let Some(&(i, name)) = unsupported.first() {
-        let others = match unsupported.len() {
-            1 => String::new(),
-            n => format!(" ({} more required extensions fairmesh cannot read)", n - 1),
+    let mut unsupported = (root.extensions_required.iter().enumerate())
+        .filter(|(_, name)| !json::extensions::ENABLED_EXTENSIONS.contains(&name.as_str()));
+    if let Some((i, name)) = unsupported.next() {
+        let others = match unsupported.count() {
+            0 => String::new(),
+            n => format!(" ({n} more required extensions fairmesh cannot read)"),
         };
         let (content, advice) = extension_content(name);
         return Err(IoError::at_element(

@@ -283,16 +283,9 @@ fn find_layout(header: &Header, path: &Path) -> Result<Layout, IoError> {
             })?;
     }
     let face = header.elements.iter().position(|e| e.name == b"face");
-    let strips = face.is_none()
-        && header
-            .elements
-            .iter()
-            .any(|e| e.name == b"tristrips" && e.count > 0);
-    let face_element = face.or_else(|| {
-        strips
-            .then(|| header.elements.iter().position(|e| e.name == b"tristrips"))
-            .flatten()
-    });
+    let tristrips = (header.elements.iter()).position(|e| e.name == b"tristrips" && e.count > 0);
+    let strips = face.is_none() && tristrips.is_some();
+    let face_element = face.or(tristrips);
     let mut face_list = 0;
     if let Some(f) = face_element {
         let face = &header.elements[f];

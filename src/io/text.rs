@@ -58,13 +58,19 @@ pub(crate) fn quote(token: &[u8]) -> String {
     }
 }
 
+/// "1 polyline (l)", "3 polylines (l)": `count` things, `one` and `many` naming one and several.
+pub(crate) fn counted(count: usize, one: &str, many: &str) -> String {
+    match count {
+        1 => format!("1 {one}"),
+        n => format!("{n} {many}"),
+    }
+}
+
 /// "1 polyline (l) was skipped", "3 polylines (l) were skipped": a reader's warning about what
 /// it left out, `one` and `many` naming one and several of them.
 pub(crate) fn skipped(count: usize, one: &str, many: &str) -> String {
-    match count {
-        1 => format!("1 {one} was skipped"),
-        n => format!("{n} {many} were skipped"),
-    }
+    let verb = if count == 1 { "was" } else { "were" };
+    format!("{} {verb} skipped", counted(count, one, many))
 }
 
 /// The warning for faces a reader skipped because they have fewer than three corners.
