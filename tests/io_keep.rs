@@ -168,6 +168,13 @@ impl Gltf {
             .collect()
     }
 
+    /// Attribute `name` of the first primitive of the first mesh.
+    fn attribute_of_first_mesh(&self, name: &str) -> usize {
+        self.json["meshes"][0]["primitives"][0]["attributes"][name]
+            .as_u64()
+            .unwrap() as usize
+    }
+
     fn attribute(&self, mesh_name: &str, name: &str) -> usize {
         let mesh = self.json["meshes"]
             .as_array()
@@ -1589,4 +1596,104 @@ fn tangents_turn_with_their_normals_and_keep_length_and_handedness() {
         "only {turned} of {} tangents turned",
         before.len()
     );
+}
+
+#[test]
+fn a_quantized_gltf_is_written_back_in_its_own_integer_types_or_as_floats_past_their_range() {
+    // gltfpack's default output (KHR_mesh_quantization): positions as unsigned 16-bit integers on
+    // a 14-bit grid over the bounding box (so the grid starts at 0 on every axis), placed by the
+    // node's scale and translation; normals as normalized signed bytes.
+    let dir = tempfile::tempdir().unwrap();
+    let input = read_gltf(&data("quantized.glb"));
+    assert_eq!(input.json["extensionsRequired"][0], "KHR_mesh_quantization");
+    let position = input.attribute_of_first_mesh("POSITION");
+    let normal = input.attribute_of_first_mesh("NORMAL");
+    assert_eq!(input.json["accessors"][position]["componentType"], 5123);
+    assert_eq!(input.json["accessors"][normal]["componentType"], 5120);
+    let node = &input.json["nodes"][0];
+    let step = node["scale"][0].as_f64().unwrap();
+    let shift: Vec<f64> = (0..3)
+        .map(|c| node["translation"][c].as_f64().unwrap())
+        .collect();
+
+    // Read through the node: every position is a grid point.
+    let loaded = io::load(data("quantized.glb")).unwrap();
+    for p in &loaded.mesh.positions {
+        for c in 0..3 {
+            let q = (p[c] as f64 - shift[c]) / step;
+            assert!((q - q.round()).abs() < 1e-3, "{p:?} is off the grid");
+        }
+    }
+
+    // Faired, then pulled 2 % towards the middle so that every vertex stays on the grid's range:
+    // the file keeps its types, each vertex goes to the grid point nearest it, and every normal
+    // that turned is still of unit length as a validator measures it.
+    let mut mesh = faired(&loaded);
+    let (lo, hi) = fairmesh::metrics::bounding_box(&mesh).unwrap();
+    let middle = (lo + hi) * 0.5;
+    for p in &mut mesh.positions {
+        let q = middle + (glam::DVec3::from(p.map(f64::from)) - middle) * 0.98;
+        *p = q.as_vec3().to_array();
+    }
+    let inside = dir.path().join("inside.glb");
+    let report = io::save_with_source(&inside, &mesh, &loaded.source).unwrap();
+    assert!(
+        report.warnings.iter().all(|w| !w.contains("32-bit floats")),
+        "{:?}",
+        report.warnings
+    );
+    let output = read_gltf(&inside);
+    assert_eq!(
+        output.json["extensionsRequired"],
+        input.json["extensionsRequired"]
+    );
+    assert_eq!(output.json["accessors"][position]["componentType"], 5123);
+    assert_eq!(output.json["accessors"][normal]["componentType"], 5120);
+    assert_reloads_as(&inside, &mesh, (step * 0.5 * 1.001) as f32);
+    let unit_bytes = |gltf: &Gltf| -> Vec<[f64; 3]> {
+        (gltf.elements(normal).iter())
+            .map(|e| [0, 1, 2].map(|c| (e[c] as i8 as f64 / 127.0).max(-1.0)))
+            .collect()
+    };
+    let (before, after) = (unit_bytes(&input), unit_bytes(&output));
+    let turned = before.iter().zip(&after).filter(|(a, b)| a != b).count();
+    assert!(
+        turned > before.len() / 2,
+        "{turned} of {} normals turned",
+        before.len()
+    );
+    for (k, n) in after.iter().enumerate() {
+        let length = glam::DVec3::from(*n).length();
+        // The Khronos validator's tolerance for unit vectors.
+        assert!(
+            (length - 1.0).abs() < 0.00465,
+            "normal {k} {n:?}: length {length}, was {:?}",
+            before[k]
+        );
+    }
+
+    // One vertex pulled below the grid's low corner, where no unsigned integer reaches: the
+    // positions are written as floats (in a buffer view of their own), with a warning, and
+    // reload where they were put; the normals keep their bytes' type.
+    let lowest = (0..mesh.positions.len())
+        .min_by(|&a, &b| mesh.positions[a][0].total_cmp(&mesh.positions[b][0]))
+        .unwrap();
+    mesh.positions[lowest][0] -= 0.1 * (hi - lo).x as f32;
+    let outside = dir.path().join("outside.glb");
+    let report = io::save_with_source(&outside, &mesh, &loaded.source).unwrap();
+    assert!(
+        report.warnings.iter().any(|w| w.contains(
+            "1 vertex moved past what its quantized positions (unsigned 16-bit integers, \
+             KHR_mesh_quantization) can hold, so its positions are written as 32-bit floats"
+        )),
+        "{:?}",
+        report.warnings
+    );
+    let output = read_gltf(&outside);
+    let accessor = &output.json["accessors"][position];
+    assert_eq!(accessor["componentType"], 5126);
+    assert!(accessor.get("normalized").is_none() && accessor.get("byteOffset").is_none());
+    assert_eq!(output.json["accessors"][normal]["componentType"], 5120);
+    assert_reloads_as(&outside, &mesh, 1e-5);
+    validate(&[inside, outside]);
 }

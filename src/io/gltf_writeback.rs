@@ -16,7 +16,12 @@
 //! [`super::source`]); a tangent's w (handedness) is kept. Morph target deltas are kept as they
 //! are. Values are written in the accessor's own component type (floats, or normalized integers
 //! under KHR_mesh_quantization); integer `min`/`max` are in the accessor's integer type, as the
-//! specification asks.
+//! specification asks. A normal or tangent written as integers takes, of the roundings of its
+//! components down or up, one that keeps it of unit length within the validators' tolerance
+//! (plain rounding does not, in 8 bits). A POSITION accessor in an integer type with a moved
+//! vertex past the type's range (gltfpack quantizes over the bounding box, so its grid starts at
+//! the lowest vertex) is written as floats in a new buffer view instead of being clamped, with a
+//! warning; its old buffer view stays, unused.
 //!
 //! Buffers: all buffers are joined into one (each starting at a multiple of 16 bytes, buffer views
 //! moved accordingly), which becomes the GLB's BIN chunk or the `.gltf`'s `<stem>.bin`. Images
@@ -187,7 +192,7 @@ impl GltfSource {
     /// The first three components of every element ([`Self::read3`] of each), read straight
     /// from the bytes for plain floats.
     fn read3_all(&self, layout: &Layout) -> Vec<[f32; 3]> {
-        if layout.component != 5126 || layout.count == 0 {
+        if layout.component != FLOAT || layout.count == 0 {
             return (0..layout.count).map(|k| self.read3(layout, k)).collect();
         }
         let bytes = &self.buffers[layout.buffer][layout.start..];
@@ -722,38 +727,134 @@ fn decode(layout: &Layout, b: &[u8]) -> f32 {
     }
 }
 
-/// The stored (integer) value for `value` in an integer component type.
-fn quantize(layout: &Layout, value: f32) -> f64 {
-    let scale = match (layout.normalized, layout.component) {
+/// What a stored integer of an integer component type is multiplied by to give its value (1
+/// unless normalized).
+fn integer_scale(layout: &Layout) -> f64 {
+    match (layout.normalized, layout.component) {
         (false, _) => 1.0,
         (true, 5120) => 127.0,
         (true, 5121) => 255.0,
         (true, 5122) => 32767.0,
         (true, 5123) => 65535.0,
         (true, _) => u32::MAX as f64,
-    };
-    let (lo, hi) = match layout.component {
+    }
+}
+
+/// The least and greatest stored integer of an integer component type.
+fn integer_range(layout: &Layout) -> (f64, f64) {
+    match layout.component {
         5120 => (i8::MIN as f64, i8::MAX as f64),
         5121 => (0.0, u8::MAX as f64),
         5122 => (i16::MIN as f64, i16::MAX as f64),
         5123 => (0.0, u16::MAX as f64),
         _ => (0.0, u32::MAX as f64),
-    };
-    (value as f64 * scale).round().clamp(lo, hi)
+    }
 }
 
+/// The stored (integer) value for `value` in an integer component type.
+fn quantize(layout: &Layout, value: f32) -> f64 {
+    let (lo, hi) = integer_range(layout);
+    (value as f64 * integer_scale(layout)).round().clamp(lo, hi)
+}
+
+/// Whether `value` can be stored in the layout's component type without being clamped.
+fn fits(layout: &Layout, value: f32) -> bool {
+    if layout.component == FLOAT {
+        return true;
+    }
+    let (lo, hi) = integer_range(layout);
+    (lo..=hi).contains(&(value as f64 * integer_scale(layout)).round())
+}
+
+/// The stored integers for a direction (a normal, a tangent's first three components) in a
+/// normalized integer type: of the roundings of each component down or up, one whose decoded
+/// length is within [`LENGTH_TOLERANCE`] of the length it should have and whose direction is
+/// nearest, or the one with the nearest length if none is. The length it should have is 1 for
+/// a direction within 0.01 of it (a unit vector as integers store it: the file's own normal,
+/// turned, keeps the few thousandths its integers were off), its own otherwise (a file that
+/// stores longer or shorter vectors keeps them so). (Rounding each component to the nearest
+/// integer leaves unit normals up to 0.007 off unit length in 8 bits, which glTF validators
+/// reject: their tolerance is 0.00465.)
+fn quantize_direction(layout: &Layout, direction: [f32; 3]) -> [f64; 3] {
+    let scale = integer_scale(layout);
+    let (lo, hi) = integer_range(layout);
+    let wanted = DVec3::from(direction.map(f64::from));
+    let length = match wanted.length() {
+        unit if (unit - 1.0).abs() < 0.01 => 1.0,
+        other => other,
+    };
+    let mut best = ([0.0; 3], (true, f64::INFINITY, f64::INFINITY));
+    for corner in 0..8 {
+        let q: [f64; 3] = std::array::from_fn(|c| {
+            let x = wanted[c] * scale;
+            let q = if corner >> c & 1 == 0 {
+                x.floor()
+            } else {
+                x.ceil()
+            };
+            q.clamp(lo, hi)
+        });
+        // As a reader decodes it (a signed -128 reads as -1, like -127).
+        let decoded = DVec3::from(q.map(|q| (q / scale).max(-1.0)));
+        let length_off = (decoded.length() - length).abs();
+        let turn = 1.0 - decoded.normalize_or_zero().dot(wanted.normalize_or_zero());
+        // Lexicographic: within the tolerance first, then the nearer direction, then length.
+        let score = (length_off > LENGTH_TOLERANCE, turn, length_off);
+        let better = match (score.0, best.1 .0) {
+            (false, true) => true,
+            (true, false) => false,
+            (false, false) => score.1 < best.1 .1,
+            (true, true) => score.2 < best.1 .2,
+        };
+        if better {
+            best = (q, score);
+        }
+    }
+    best.0
+}
+
+/// How far a direction written as integers may be from its own length (a normal's is 1; the
+/// glTF validator accepts 0.00465).
+const LENGTH_TOLERANCE: f64 = 0.004;
+
+/// The component type of 32-bit floats.
+const FLOAT: u64 = 5126;
+
 fn encode(layout: &Layout, value: f32, out: &mut [u8]) {
-    if layout.component == 5126 {
+    if layout.component == FLOAT {
         out.copy_from_slice(&value.to_le_bytes());
         return;
     }
-    let q = quantize(layout, value);
+    store(layout, quantize(layout, value), out);
+}
+
+/// Writes the stored integer `q` (already in the type's range) in the layout's component type.
+fn store(layout: &Layout, q: f64, out: &mut [u8]) {
     match layout.component {
         5120 => out.copy_from_slice(&(q as i8).to_le_bytes()),
         5121 => out.copy_from_slice(&(q as u8).to_le_bytes()),
         5122 => out.copy_from_slice(&(q as i16).to_le_bytes()),
         5123 => out.copy_from_slice(&(q as u16).to_le_bytes()),
         _ => out.copy_from_slice(&(q as u32).to_le_bytes()),
+    }
+}
+
+/// How the specification names a layout's component type, for messages.
+fn component_name(layout: &Layout) -> String {
+    let kind = match layout.component {
+        5120 => "signed 8-bit",
+        5121 => "unsigned 8-bit",
+        5122 => "signed 16-bit",
+        5123 => "unsigned 16-bit",
+        5125 => "unsigned 32-bit",
+        _ => "32-bit float",
+    };
+    if layout.normalized {
+        format!("normalized {kind} integers")
+    } else if layout.component == FLOAT {
+        format!("{kind}s")
+    } else {
+        format!("{kind} integers")
     }
 }
 
@@ -805,7 +906,7 @@ pub(crate) fn write(
         path: path.to_owned(),
         message,
     };
-    let edits = position_edits(gltf, source, mesh, report).map_err(&fail)?;
+    let mut edits = position_edits(gltf, source, mesh, report).map_err(&fail)?;
     let mut json = gltf.json.clone();
     // The buffers are copied once, into the joined output buffer, and edited there.
     let mut joined = join_buffers(&mut json, &gltf.buffers);
@@ -814,6 +915,37 @@ pub(crate) fn write(
     let mut changed = turn_normals(gltf, source, &edits, &mut joined, report);
     changed.extend(follow_texture(gltf, source, &edits, &mut joined, report));
     report.texture_coordinates_follow = true;
+    // Positions stored as integers (KHR_mesh_quantization) that moved past what their type can
+    // hold (a vertex below the least stored value, as gltfpack quantizes from the bounding box)
+    // would be clamped: such an accessor is written as floats instead, in a new buffer view
+    // (its old one stays, unused, as the rest of the buffer does).
+    let mut converted: BTreeMap<usize, Layout> = BTreeMap::new();
+    for (&a, edit) in &mut edits {
+        let outside = (edit.after.iter().flatten())
+            .filter(|p| !p.iter().all(|&c| fits(&edit.layout, c)))
+            .count();
+        if outside == 0 {
+            continue;
+        }
+        let (layout, view) = joined.append_float3(&mut json, edit.layout.count);
+        for (k, before) in edit.before.iter().enumerate() {
+            joined.put(&layout, k, before);
+        }
+        if let Some(accessor) = json["accessors"][a].as_object_mut() {
+            accessor.remove("byteOffset");
+            accessor.remove("normalized");
+            accessor.insert("bufferView".into(), json!(view));
+            accessor.insert("componentType".into(), json!(FLOAT));
+        }
+        report.warnings.push(format!(
+            "{}: {} moved past what its quantized positions ({}, KHR_mesh_quantization) can hold, so its positions are written as 32-bit floats",
+            mesh_label(&gltf.json, edit.mesh),
+            super::text::counted(outside, "vertex", "vertices"),
+            component_name(&edit.layout),
+        ));
+        edit.layout = layout;
+        converted.insert(a, layout);
+    }
     for (&a, edit) in &edits {
         for (k, after) in edit.after.iter().enumerate() {
             if let Some(p) = after {
@@ -832,7 +964,9 @@ pub(crate) fn write(
         {
             continue;
         }
-        let Ok(layout) = gltf.layout(a) else { continue };
+        let Some(layout) = converted.get(&a).copied().or_else(|| gltf.layout(a).ok()) else {
+            continue;
+        };
         if let Some((min, max)) = joined.bounds(&layout) {
             accessor["min"] = json!(min);
             accessor["max"] = json!(max);
@@ -1198,13 +1332,13 @@ fn turn_normals(
         let own = normal.blocks.iter().flat_map(|block| &block.normals);
         for (k, value) in own.enumerate() {
             if let Some(value) = value {
-                joined.put(layout, k, value);
+                joined.put_direction(layout, k, value);
                 any = true;
             }
         }
         for &(k, turn) in &shared_turns {
             if let Some(turn) = turn {
-                joined.put(layout, k, &turn.normal(normal.values[k]));
+                joined.put_direction(layout, k, &turn.normal(normal.values[k]));
                 any = true;
             }
         }
@@ -1219,7 +1353,7 @@ fn turn_normals(
                     for (k, turn) in turns {
                         if let Some(turn) = turn {
                             let direction = turn.direction(gltf.read3(&tangent, k));
-                            joined.put(&tangent, k, &direction);
+                            joined.put_direction(&tangent, k, &direction);
                         }
                     }
                     if any {
@@ -1372,7 +1506,7 @@ impl Joined {
                     continue;
                 };
                 let bytes = &self.bytes[range];
-                let value = if layout.component == 5126 {
+                let value = if layout.component == FLOAT {
                     f32::from_le_bytes([bytes[0], bytes[1], bytes[2], bytes[3]]) as f64
                 } else {
                     decode(&raw, bytes) as f64
@@ -1384,9 +1518,57 @@ impl Joined {
         min.iter().all(|m| m.is_finite()).then_some((min, max))
     }
 
+    /// Write the direction of element `k` (a normal, or a tangent's first three components):
+    /// as [`Self::put`] does, but a normalized integer type gets the rounding that keeps it a
+    /// unit vector ([`quantize_direction`]).
+    fn put_direction(&mut self, layout: &Layout, k: usize, direction: &[f32; 3]) {
+        if layout.component == FLOAT || !layout.normalized {
+            return self.put(layout, k, direction);
+        }
+        let q = quantize_direction(layout, *direction);
+        for (c, q) in q.iter().enumerate() {
+            let at = layout.start + k * layout.stride + c * layout.size;
+            if let Some(range) = self.range(layout.buffer, at, layout.size) {
+                store(layout, *q, &mut self.bytes[range]);
+            }
+        }
+    }
+
+    /// A new buffer view of `count` float VEC3 elements at the end of the bytes (zeroed, at a
+    /// multiple of 16 bytes), added to the document; its layout and its index.
+    fn append_float3(&mut self, json: &mut Value, count: usize) -> (Layout, usize) {
+        while !self.bytes.len().is_multiple_of(16) {
+            self.bytes.push(0);
+        }
+        let start = self.bytes.len();
+        self.bytes.resize(start + 12 * count, 0);
+        self.starts.push((start, 12 * count));
+        let view =
+            json!({"buffer": 0, "byteOffset": start, "byteLength": 12 * count, "target": 34962});
+        let views = &mut json["bufferViews"];
+        if !views.is_array() {
+            *views = json!([]);
+        }
+        let views = views.as_array_mut().expect("made an array above");
+        views.push(view);
+        let index = views.len() - 1;
+        set_buffer_length(json, self.bytes.len());
+        let layout = Layout {
+            buffer: self.starts.len() - 1,
+            start: 0,
+            stride: 12,
+            component: FLOAT,
+            size: 4,
+            components: 3,
+            normalized: false,
+            count,
+        };
+        (layout, index)
+    }
+
     /// Write the first components of element `k` (as many as `values` holds).
     fn put(&mut self, layout: &Layout, k: usize, values: &[f32]) {
-        if layout.component == 5126 {
+        if layout.component == FLOAT {
             let at = layout.start + k * layout.stride;
             if let Some(range) = self.range(layout.buffer, at, 4 * values.len()) {
                 let out = &mut self.bytes[range];
