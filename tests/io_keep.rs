@@ -1697,3 +1697,59 @@ fn a_quantized_gltf_is_written_back_in_its_own_integer_types_or_as_floats_past_t
     assert_reloads_as(&outside, &mesh, 1e-5);
     validate(&[inside, outside]);
 }
+
+#[test]
+fn texture_coordinates_that_follow_past_their_quantized_range_are_written_as_floats() {
+    // gltfpack's output of scene.glb: two primitives of one mesh sharing one buffer view of
+    // unsigned 16-bit positions, the ball's texture coordinates as normalized unsigned 16-bit
+    // integers over their bounding box (KHR_texture_transform scales them back), normals as
+    // signed bytes.
+    let dir = tempfile::tempdir().unwrap();
+    let input = read_gltf(&data("scene_quantized.glb"));
+    let uv = input.attribute_of_first_mesh("TEXCOORD_0");
+    assert_eq!(input.json["accessors"][uv]["componentType"], 5123);
+    assert_eq!(input.json["accessors"][uv]["normalized"], true);
+    let decode =
+        |e: &[u8]| [0, 1].map(|c| u16::from_le_bytes([e[2 * c], e[2 * c + 1]]) as f32 / 65535.0);
+    let before: Vec<[f32; 2]> = input.elements(uv).iter().map(|e| decode(e)).collect();
+
+    let loaded = io::load(data("scene_quantized.glb")).unwrap();
+    let mesh = faired(&loaded);
+    let out = dir.path().join("faired.glb");
+    let report = io::save_with_source(&out, &mesh, &loaded.source).unwrap();
+    let output = read_gltf(&out);
+    // Where the ball's seam runs along the chart's outline, coordinates walk past the grid's
+    // range: stored as integers they would be clamped to [0, 1].
+    assert!(
+        report.warnings.iter().any(|w| w
+            .starts_with(&format!("texture coordinate accessor {uv}: "))
+            && w.ends_with("so its texture coordinates are written as 32-bit floats")),
+        "{:?}",
+        report.warnings
+    );
+    let after = output.floats(uv);
+    let outside = after
+        .iter()
+        .flatten()
+        .filter(|c| !(0.0..=1.0).contains(*c))
+        .count();
+    assert!(outside > 0, "no coordinate left the grid's range");
+    // The rest are the file's own values; many moved.
+    let moved = before
+        .iter()
+        .zip(&after)
+        .filter(|(b, a)| b[..] != a[..])
+        .count();
+    assert!(
+        moved > before.len() / 4,
+        "{moved} of {} moved",
+        before.len()
+    );
+    for (b, a) in before.iter().zip(&after) {
+        assert!(
+            (b[0] - a[0]).abs() < 0.05 && (b[1] - a[1]).abs() < 0.05,
+            "{b:?} -> {a:?}"
+        );
+    }
+    validate(&[out]);
+}

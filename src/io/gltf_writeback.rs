@@ -18,10 +18,11 @@
 //! under KHR_mesh_quantization); integer `min`/`max` are in the accessor's integer type, as the
 //! specification asks. A normal or tangent written as integers takes, of the roundings of its
 //! components down or up, one that keeps it of unit length within the validators' tolerance
-//! (plain rounding does not, in 8 bits). A POSITION accessor in an integer type with a moved
-//! vertex past the type's range (gltfpack quantizes over the bounding box, so its grid starts at
-//! the lowest vertex) is written as floats in a new buffer view instead of being clamped, with a
-//! warning; its old buffer view stays, unused.
+//! (plain rounding does not, in 8 bits). A POSITION or TEXCOORD accessor in an integer type with
+//! a value moved past the type's range (gltfpack quantizes over the values' bounding box, so a
+//! vertex below the lowest, or a texture coordinate that follows its vertex past its chart's
+//! edge, leaves the grid) is written as floats in a new buffer view instead of being clamped,
+//! with a warning; its old buffer view stays, unused if nothing else reads it.
 //!
 //! Buffers: all buffers are joined into one (each starting at a multiple of 16 bytes, buffer views
 //! moved accordingly), which becomes the GLB's BIN chunk or the `.gltf`'s `<stem>.bin`. Images
@@ -913,13 +914,20 @@ pub(crate) fn write(
     // Normals turn from the file's own positions (read from `gltf`, never from `joined`), so the
     // order of these two steps does not matter.
     let mut changed = turn_normals(gltf, source, &edits, &mut joined, report);
-    changed.extend(follow_texture(gltf, source, &edits, &mut joined, report));
+    // Accessors rewritten as floats (see below), with their new layouts.
+    let mut converted: BTreeMap<usize, Layout> = BTreeMap::new();
+    changed.extend(follow_texture(
+        gltf,
+        source,
+        &edits,
+        (&mut joined, &mut json, &mut converted),
+        report,
+    ));
     report.texture_coordinates_follow = true;
     // Positions stored as integers (KHR_mesh_quantization) that moved past what their type can
     // hold (a vertex below the least stored value, as gltfpack quantizes from the bounding box)
     // would be clamped: such an accessor is written as floats instead, in a new buffer view
     // (its old one stays, unused, as the rest of the buffer does).
-    let mut converted: BTreeMap<usize, Layout> = BTreeMap::new();
     for (&a, edit) in &mut edits {
         let outside = (edit.after.iter().flatten())
             .filter(|p| !p.iter().all(|&c| fits(&edit.layout, c)))
@@ -927,16 +935,7 @@ pub(crate) fn write(
         if outside == 0 {
             continue;
         }
-        let (layout, view) = joined.append_float3(&mut json, edit.layout.count);
-        for (k, before) in edit.before.iter().enumerate() {
-            joined.put(&layout, k, before);
-        }
-        if let Some(accessor) = json["accessors"][a].as_object_mut() {
-            accessor.remove("byteOffset");
-            accessor.remove("normalized");
-            accessor.insert("bufferView".into(), json!(view));
-            accessor.insert("componentType".into(), json!(FLOAT));
-        }
+        let layout = joined.as_floats(&mut json, a, &edit.layout, |k| edit.before[k].to_vec());
         report.warnings.push(format!(
             "{}: {} moved past what its quantized positions ({}, KHR_mesh_quantization) can hold, so its positions are written as 32-bit floats",
             mesh_label(&gltf.json, edit.mesh),
@@ -1113,7 +1112,7 @@ fn follow_texture(
     gltf: &GltfSource,
     source: &Source,
     edits: &BTreeMap<usize, PositionEdit>,
-    joined: &mut Joined,
+    (joined, json, converted): (&mut Joined, &mut Value, &mut BTreeMap<usize, Layout>),
     report: &mut SaveReport,
 ) -> BTreeSet<usize> {
     // Texture coordinate accessor -> its position accessor and the triangles of its primitives.
@@ -1191,14 +1190,33 @@ fn follow_texture(
             .map(|t| t.map(|k| [vertex_of[k as usize] as u32, k]))
             .collect();
         let followed = super::uv_follow::follow(&before, &after, &corners, &uvs);
-        for (k, uv) in followed.moved.iter().enumerate() {
-            let Some(uv) = uv.map(|uv| uv.map(|c| c as f32)) else {
-                continue;
-            };
-            if uv != read[k] {
-                joined.put(&layout, k, &uv);
-                changed.insert(t);
-            }
+        let moved: Vec<(usize, [f32; 2])> = (followed.moved.iter().enumerate())
+            .filter_map(|(k, uv)| Some((k, uv.as_ref()?.map(|c| c as f32))))
+            .filter(|(k, uv)| *uv != read[*k])
+            .collect();
+        // Stored as integers (KHR_mesh_quantization, over the coordinates' bounding box as
+        // gltfpack stores them), a coordinate that followed its vertex past the range would be
+        // clamped (a few on most moved seams): the accessor is written as floats instead.
+        let outside = (moved.iter())
+            .filter(|(_, uv)| !uv.iter().all(|&c| fits(&layout, c)))
+            .count();
+        let layout = if outside > 0 {
+            report.warnings.push(format!(
+                "texture coordinate accessor {t}: {} followed past what its quantized type ({}, \
+                 KHR_mesh_quantization) can hold, so its texture coordinates are written as \
+                 32-bit floats",
+                super::text::counted(outside, "coordinate", "coordinates"),
+                component_name(&layout),
+            ));
+            let floats = joined.as_floats(json, t, &layout, |k| read[k].to_vec());
+            converted.insert(t, floats);
+            floats
+        } else {
+            layout
+        };
+        for (k, uv) in moved {
+            joined.put(&layout, k, &uv);
+            changed.insert(t);
         }
     }
     changed
@@ -1534,36 +1552,52 @@ impl Joined {
         }
     }
 
-    /// A new buffer view of `count` float VEC3 elements at the end of the bytes (zeroed, at a
-    /// multiple of 16 bytes), added to the document; its layout and its index.
-    fn append_float3(&mut self, json: &mut Value, count: usize) -> (Layout, usize) {
+    /// Accessor `a` (of `layout`) rewritten as 32-bit floats: a new buffer view at the end of
+    /// the bytes (at a multiple of 16 bytes) holding `values` (each element's components), which
+    /// the accessor now points at; its old buffer view stays as it was. Returns the new layout.
+    fn as_floats(
+        &mut self,
+        json: &mut Value,
+        a: usize,
+        layout: &Layout,
+        values: impl Fn(usize) -> Vec<f32>,
+    ) -> Layout {
         while !self.bytes.len().is_multiple_of(16) {
             self.bytes.push(0);
         }
         let start = self.bytes.len();
-        self.bytes.resize(start + 12 * count, 0);
-        self.starts.push((start, 12 * count));
-        let view =
-            json!({"buffer": 0, "byteOffset": start, "byteLength": 12 * count, "target": 34962});
+        let length = 4 * layout.components * layout.count;
+        self.bytes.resize(start + length, 0);
+        self.starts.push((start, length));
+        let floats = Layout {
+            buffer: self.starts.len() - 1,
+            start: 0,
+            stride: 4 * layout.components,
+            component: FLOAT,
+            size: 4,
+            normalized: false,
+            ..*layout
+        };
+        for k in 0..layout.count {
+            self.put(&floats, k, &values(k));
+        }
         let views = &mut json["bufferViews"];
         if !views.is_array() {
             *views = json!([]);
         }
         let views = views.as_array_mut().expect("made an array above");
-        views.push(view);
-        let index = views.len() - 1;
+        // (A vertex attribute's buffer view.)
+        views
+            .push(json!({"buffer": 0, "byteOffset": start, "byteLength": length, "target": 34962}));
+        let view = views.len() - 1;
         set_buffer_length(json, self.bytes.len());
-        let layout = Layout {
-            buffer: self.starts.len() - 1,
-            start: 0,
-            stride: 12,
-            component: FLOAT,
-            size: 4,
-            components: 3,
-            normalized: false,
-            count,
-        };
-        (layout, index)
+        if let Some(accessor) = json["accessors"][a].as_object_mut() {
+            accessor.remove("byteOffset");
+            accessor.remove("normalized");
+            accessor.insert("bufferView".into(), json!(view));
+            accessor.insert("componentType".into(), json!(FLOAT));
+        }
+        floats
     }
 
     /// Write the first components of element `k` (as many as `values` holds).
