@@ -1753,3 +1753,72 @@ fn texture_coordinates_that_follow_past_their_quantized_range_are_written_as_flo
     }
     validate(&[out]);
 }
+
+/// A 2 x 2 checker as a lossless WebP (written by Pillow 12).
+const WEBP_CHECKER: [u8; 42] = [
+    82, 73, 70, 70, 34, 0, 0, 0, 87, 69, 66, 80, 86, 80, 56, 76, 22, 0, 0, 0, 47, 1, 64, 0, 0, 15,
+    112, 33, 243, 11, 153, 95, 200, 124, 254, 227, 1, 43, 16, 209, 255, 8,
+];
+
+#[test]
+fn a_texture_whose_image_is_webp_only_is_loaded_and_carried() {
+    // scene.glb with the checker material's texture given only as EXT_texture_webp (as web
+    // pipelines write KTX2 or WebP textures with no PNG fallback; the extension is then
+    // required). fairmesh decodes no image, so it reads the file and carries the image.
+    let dir = tempfile::tempdir().unwrap();
+    let mut input = read_gltf(&data("scene.glb"));
+    let buffer = &mut input.buffers[0];
+    while !buffer.len().is_multiple_of(4) {
+        buffer.push(0);
+    }
+    let offset = buffer.len();
+    buffer.extend_from_slice(&WEBP_CHECKER);
+    let length = buffer.len();
+    let json = &mut input.json;
+    json["buffers"][0]["byteLength"] = length.into();
+    let views = json["bufferViews"].as_array_mut().unwrap();
+    views.push(
+        serde_json::json!({"buffer": 0, "byteOffset": offset, "byteLength": WEBP_CHECKER.len()}),
+    );
+    let view = views.len() - 1;
+    let images = json["images"].as_array_mut().unwrap();
+    images.push(
+        serde_json::json!({"bufferView": view, "mimeType": "image/webp", "name": "checker_webp"}),
+    );
+    let image = images.len() - 1;
+    let texture = &mut json["textures"][0];
+    texture.as_object_mut().unwrap().remove("source");
+    texture["extensions"] = serde_json::json!({"EXT_texture_webp": {"source": image}});
+    for key in ["extensionsUsed", "extensionsRequired"] {
+        json[key] = serde_json::json!(["EXT_texture_webp"]);
+    }
+    let webp = dir.path().join("webp.glb");
+    write_glb(&input, &webp);
+
+    let loaded = io::load(&webp).unwrap();
+    let mesh = faired(&loaded);
+    // Written back: the texture and its image as they were.
+    let out = dir.path().join("faired.glb");
+    io::save_with_source(&out, &mesh, &loaded.source).unwrap();
+    let output = read_gltf(&out);
+    assert_eq!(output.json["textures"], input.json["textures"]);
+    assert_eq!(
+        output.json["extensionsRequired"],
+        input.json["extensionsRequired"]
+    );
+    let image_view = &output.json["bufferViews"]
+        [output.json["images"][image]["bufferView"].as_u64().unwrap() as usize];
+    let at = image_view["byteOffset"].as_u64().unwrap() as usize;
+    assert_eq!(output.buffers[0][at..at + WEBP_CHECKER.len()], WEBP_CHECKER);
+    validate(&[webp, out]);
+    // As OBJ: the material's texture is the WebP file, beside the MTL.
+    let obj = dir.path().join("faired.obj");
+    io::save_with_source(&obj, &mesh, &loaded.source).unwrap();
+    let mtl = std::fs::read_to_string(dir.path().join("faired.mtl")).unwrap();
+    let map = mtl
+        .lines()
+        .find_map(|l| l.trim().strip_prefix("map_Kd "))
+        .unwrap_or_else(|| panic!("no texture in\n{mtl}"));
+    assert!(map.ends_with(".webp"), "{map}");
+    assert_eq!(std::fs::read(dir.path().join(map)).unwrap(), WEBP_CHECKER);
+}

@@ -47,7 +47,12 @@ pub(crate) fn parse(bytes: &[u8], path: &Path, base_dir: Option<&Path>) -> Resul
     check_glb_header(bytes, path)?;
     let document = ::gltf::Gltf::from_slice_without_validation(bytes)
         .map_err(|e| older_gltf(bytes, path).unwrap_or_else(|| describe(e, path)))?;
-    validate(document.as_json(), path)?;
+    // (The document as plain JSON: the write-back keeps all of it, and `validate` reads the
+    // extensions, which the `gltf` crate is built here without.)
+    let json: serde_json::Value = json_text(bytes)
+        .and_then(|text| serde_json::from_slice(text).ok())
+        .ok_or_else(|| IoError::invalid(path, "the glTF JSON cannot be read again"))?;
+    validate(document.as_json(), &json, path)?;
     let buffers = load_buffers(&document, path, base_dir)?;
     let mut reader = SceneReader {
         path,
@@ -101,9 +106,6 @@ pub(crate) fn parse(bytes: &[u8], path: &Path, base_dir: Option<&Path>) -> Resul
             .warnings
             .push(format!("{} {verb} skipped", parts.join(" and ")));
     }
-    let json = json_text(bytes)
-        .and_then(|text| serde_json::from_slice(text).ok())
-        .ok_or_else(|| IoError::invalid(path, "the glTF JSON cannot be read again"))?;
     let SceneReader {
         mesh,
         warnings,
@@ -216,11 +218,29 @@ fn older_gltf(bytes: &[u8], path: &Path) -> Option<IoError> {
     })
 }
 
-/// Required extensions fairmesh reads itself (the `gltf` crate does not know them):
+/// Required extensions fairmesh reads itself (the `gltf` crate, as built here, refuses them):
 /// KHR_mesh_quantization only lets attributes be stored as integers, which the accessor reading
-/// decodes (and the write-back encodes again).
+/// decodes (and the write-back encodes again); the others give a texture an image in another
+/// format (KTX2, WebP, AVIF, DDS), and fairmesh never decodes images: it carries their bytes.
 fn read_here(extension: &str) -> bool {
-    extension == "KHR_mesh_quantization"
+    extension == "KHR_mesh_quantization" || IMAGE_FORMATS.contains(&extension)
+}
+
+/// Texture extensions whose `source` names a texture's image in their format (the texture's own
+/// `source`, when it has one, is a PNG or JPEG fallback).
+pub(crate) const IMAGE_FORMATS: [&str; 4] = [
+    "KHR_texture_basisu",
+    "EXT_texture_webp",
+    "EXT_texture_avif",
+    "MSFT_texture_dds",
+];
+
+/// The texture of the validation path `textures[i].source`.
+fn texture_without_source(at: &str) -> Option<usize> {
+    at.strip_prefix("textures[")?
+        .strip_suffix("].source")?
+        .parse()
+        .ok()
 }
 
 /// What a required extension that fairmesh cannot read holds, and what to do, for the error
@@ -245,7 +265,7 @@ fn extension_content(name: &str) -> (&'static str, &'static str) {
 /// found by fuzzing). A required extension fairmesh cannot read is named first: its data (a
 /// Draco-compressed mesh's accessors have no buffer views) fails the other checks too, which
 /// would otherwise be the error.
-fn validate(root: &json::Root, path: &Path) -> Result<(), IoError> {
+fn validate(root: &json::Root, plain: &serde_json::Value, path: &Path) -> Result<(), IoError> {
     use json::validation::{Checked, Validate};
     let mut unsupported = (root.extensions_required.iter().enumerate()).filter(|(_, name)| {
         !read_here(name) && !json::extensions::ENABLED_EXTENSIONS.contains(&name.as_str())
@@ -291,7 +311,14 @@ fn validate(root: &json::Root, path: &Path) -> Result<(), IoError> {
         let handled = matches!(what, json::validation::Error::Unsupported)
             && at.as_str().starts_with("extensionsRequired[")
             && (root.extensions_required.iter())
-                .any(|name| read_here(name) && at.as_str().ends_with(&format!("= \"{name}\"")));
+                .any(|name| read_here(name) && at.as_str().ends_with(&format!("= \"{name}\"")))
+            // A texture whose only image is in another format has it in its extension.
+            || matches!(what, json::validation::Error::Missing)
+                && texture_without_source(at.as_str())
+                    .and_then(|t| plain["textures"][t]["extensions"].as_object())
+                    .is_some_and(|extensions| {
+                        (extensions.keys()).any(|name| IMAGE_FORMATS.contains(&name.as_str()))
+                    });
         if !handled {
             errors.push((at, what))
         }

@@ -512,7 +512,14 @@ impl GltfSource {
                     .and_then(|p| p.get("baseColorTexture"))
                     .and_then(|t| index(t, "index"))
                     .and_then(|t| self.array("textures").get(t))
-                    .and_then(|t| index(t, "source"))
+                    .and_then(|t| {
+                        // Its own image (a PNG or JPEG) where it has one, which other tools read
+                        // more widely; otherwise the one in another format (KTX2, WebP, ...).
+                        index(t, "source").or_else(|| {
+                            (super::gltf::IMAGE_FORMATS.iter())
+                                .find_map(|e| index(t.get("extensions")?.get(e)?, "source"))
+                        })
+                    })
                     .and_then(|image| self.image(image, &name, source, warnings));
                 let mut unkept: Vec<&str> = [
                     ("normalTexture", "normal map"),
