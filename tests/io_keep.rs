@@ -168,6 +168,23 @@ impl Gltf {
             .collect()
     }
 
+    /// `bytes` appended to the first buffer (at a multiple of 4 bytes) as a new buffer view; its
+    /// index.
+    fn append_view(&mut self, bytes: &[u8]) -> usize {
+        let buffer = &mut self.buffers[0];
+        while !buffer.len().is_multiple_of(4) {
+            buffer.push(0);
+        }
+        let offset = buffer.len();
+        buffer.extend_from_slice(bytes);
+        self.json["buffers"][0]["byteLength"] = buffer.len().into();
+        let views = self.json["bufferViews"].as_array_mut().unwrap();
+        views.push(
+            serde_json::json!({"buffer": 0, "byteOffset": offset, "byteLength": bytes.len()}),
+        );
+        views.len() - 1
+    }
+
     /// Attribute `name` of the first primitive of the first mesh.
     fn attribute_of_first_mesh(&self, name: &str) -> usize {
         self.json["meshes"][0]["primitives"][0]["attributes"][name]
@@ -1532,18 +1549,8 @@ fn tangents_turn_with_their_normals_and_keep_length_and_handedness() {
             bytes.extend_from_slice(&c.to_le_bytes());
         }
     }
-    let buffer = &mut input.buffers[0];
-    while !buffer.len().is_multiple_of(4) {
-        buffer.push(0);
-    }
-    let offset = buffer.len();
-    buffer.extend_from_slice(&bytes);
-    let length = buffer.len();
+    let view = input.append_view(&bytes);
     let json = &mut input.json;
-    json["buffers"][0]["byteLength"] = length.into();
-    let views = json["bufferViews"].as_array_mut().unwrap();
-    views.push(serde_json::json!({"buffer": 0, "byteOffset": offset, "byteLength": bytes.len()}));
-    let view = views.len() - 1;
     let accessors = json["accessors"].as_array_mut().unwrap();
     accessors.push(serde_json::json!({
         "bufferView": view, "componentType": 5126, "count": normals.len(), "type": "VEC4"
@@ -1767,20 +1774,8 @@ fn a_texture_whose_image_is_webp_only_is_loaded_and_carried() {
     // required). fairmesh decodes no image, so it reads the file and carries the image.
     let dir = tempfile::tempdir().unwrap();
     let mut input = read_gltf(&data("scene.glb"));
-    let buffer = &mut input.buffers[0];
-    while !buffer.len().is_multiple_of(4) {
-        buffer.push(0);
-    }
-    let offset = buffer.len();
-    buffer.extend_from_slice(&WEBP_CHECKER);
-    let length = buffer.len();
+    let view = input.append_view(&WEBP_CHECKER);
     let json = &mut input.json;
-    json["buffers"][0]["byteLength"] = length.into();
-    let views = json["bufferViews"].as_array_mut().unwrap();
-    views.push(
-        serde_json::json!({"buffer": 0, "byteOffset": offset, "byteLength": WEBP_CHECKER.len()}),
-    );
-    let view = views.len() - 1;
     let images = json["images"].as_array_mut().unwrap();
     images.push(
         serde_json::json!({"bufferView": view, "mimeType": "image/webp", "name": "checker_webp"}),

@@ -1436,17 +1436,22 @@ fn choose_collapse(
 mod tests {
     use super::*;
 
-    /// The radix sort and its tie-breaking give (cost, M0 id) order: costs with many ties, with
-    /// digits all share (skipped) and with every digit in use, including infinity.
-    #[test]
-    fn cost_order_is_by_cost_then_m0_id() {
-        let mut state = 99u64;
-        let mut next = move |below: u64| {
+    /// Pseudo-random draws below a bound, from `seed` (a linear congruential generator).
+    fn draws(seed: u64) -> impl FnMut(u64) -> u64 {
+        let mut state = seed;
+        move |below| {
             state = state
                 .wrapping_mul(6364136223846793005)
                 .wrapping_add(1442695040888963407);
             (state >> 33) % below
-        };
+        }
+    }
+
+    /// The radix sort and its tie-breaking give (cost, M0 id) order: costs with many ties, with
+    /// digits all share (skipped) and with every digit in use, including infinity.
+    #[test]
+    fn cost_order_is_by_cost_then_m0_id() {
+        let mut next = draws(99);
         let n = 5000;
         let costs: [Vec<u32>; 3] = [
             // Few values: long runs of ties.
@@ -1489,13 +1494,7 @@ mod tests {
     fn first_level_orders_used_vertices_by_code_then_id_on_any_thread_count() {
         // Positions from a few values, so many vertices share a code; every seventh vertex is
         // isolated (some share their code with used ones). The faces need no shape here.
-        let mut state = 12345u64;
-        let mut next = move |below: u64| {
-            state = state
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            (state >> 33) % below
-        };
+        let mut next = draws(12345);
         let n = 6000u32;
         let positions: Vec<[f32; 3]> = (0..n)
             .map(|_| [0; 3].map(|_| next(5) as f32 * 0.25))
