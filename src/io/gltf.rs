@@ -235,12 +235,12 @@ pub(crate) const IMAGE_FORMATS: [&str; 4] = [
     "MSFT_texture_dds",
 ];
 
-/// The texture of the validation path `textures[i].source`.
-fn texture_without_source(at: &str) -> Option<usize> {
-    at.strip_prefix("textures[")?
-        .strip_suffix("].source")?
-        .parse()
-        .ok()
+/// A validation path `array[i]rest` (`textures[3].source`, `extensionsRequired[0] = "name"`) as
+/// its top-level array, the index and the rest.
+fn element(at: &str) -> Option<(&str, usize, &str)> {
+    let (array, rest) = at.split_once('[')?;
+    let (index, rest) = rest.split_once(']')?;
+    Some((array, index.parse().ok()?, rest))
 }
 
 /// What a required extension that fairmesh cannot read holds, and what to do, for the error
@@ -308,17 +308,18 @@ fn validate(root: &json::Root, plain: &serde_json::Value, path: &Path) -> Result
         let at = where_();
         // The `gltf` crate calls every required extension it does not handle unsupported,
         // including those read here.
-        let handled = matches!(what, json::validation::Error::Unsupported)
-            && at.as_str().starts_with("extensionsRequired[")
-            && (root.extensions_required.iter())
-                .any(|name| read_here(name) && at.as_str().ends_with(&format!("= \"{name}\"")))
+        let handled = match (what, element(at.as_str())) {
+            (json::validation::Error::Unsupported, Some(("extensionsRequired", i, _))) => {
+                (root.extensions_required.get(i)).is_some_and(|name| read_here(name))
+            }
             // A texture whose only image is in another format has it in its extension.
-            || matches!(what, json::validation::Error::Missing)
-                && texture_without_source(at.as_str())
-                    .and_then(|t| plain["textures"][t]["extensions"].as_object())
-                    .is_some_and(|extensions| {
-                        (extensions.keys()).any(|name| IMAGE_FORMATS.contains(&name.as_str()))
-                    });
+            (json::validation::Error::Missing, Some(("textures", t, ".source"))) => {
+                (plain["textures"][t]["extensions"].as_object()).is_some_and(|extensions| {
+                    (extensions.keys()).any(|name| IMAGE_FORMATS.contains(&name.as_str()))
+                })
+            }
+            _ => false,
+        };
         if !handled {
             errors.push((at, what))
         }

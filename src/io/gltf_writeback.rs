@@ -759,19 +759,22 @@ fn integer_range(layout: &Layout) -> (f64, f64) {
     }
 }
 
+/// The integer nearest `value` in an integer component type, before it is held to the type's
+/// range.
+fn unclamped(layout: &Layout, value: f32) -> f64 {
+    (value as f64 * integer_scale(layout)).round()
+}
+
 /// The stored (integer) value for `value` in an integer component type.
 fn quantize(layout: &Layout, value: f32) -> f64 {
     let (lo, hi) = integer_range(layout);
-    (value as f64 * integer_scale(layout)).round().clamp(lo, hi)
+    unclamped(layout, value).clamp(lo, hi)
 }
 
 /// Whether `value` can be stored in the layout's component type without being clamped.
 fn fits(layout: &Layout, value: f32) -> bool {
-    if layout.component == FLOAT {
-        return true;
-    }
     let (lo, hi) = integer_range(layout);
-    (lo..=hi).contains(&(value as f64 * integer_scale(layout)).round())
+    layout.component == FLOAT || (lo..=hi).contains(&unclamped(layout, value))
 }
 
 /// The stored integers for a direction (a normal, a tangent's first three components) in a
@@ -791,7 +794,7 @@ fn quantize_direction(layout: &Layout, direction: [f32; 3]) -> [f64; 3] {
         unit if (unit - 1.0).abs() < 0.01 => 1.0,
         other => other,
     };
-    let mut best = ([0.0; 3], (true, f64::INFINITY, f64::INFINITY));
+    let mut best = ([0.0; 3], (true, f64::INFINITY));
     for corner in 0..8 {
         let q: [f64; 3] = std::array::from_fn(|c| {
             let x = wanted[c] * scale;
@@ -806,15 +809,11 @@ fn quantize_direction(layout: &Layout, direction: [f32; 3]) -> [f64; 3] {
         let decoded = DVec3::from(q.map(|q| (q / scale).max(-1.0)));
         let length_off = (decoded.length() - length).abs();
         let turn = 1.0 - decoded.normalize_or_zero().dot(wanted.normalize_or_zero());
-        // Lexicographic: within the tolerance first, then the nearer direction, then length.
-        let score = (length_off > LENGTH_TOLERANCE, turn, length_off);
-        let better = match (score.0, best.1 .0) {
-            (false, true) => true,
-            (true, false) => false,
-            (false, false) => score.1 < best.1 .1,
-            (true, true) => score.2 < best.1 .2,
-        };
-        if better {
+        // Within the tolerance first (false orders before true), then the nearer direction; of
+        // those outside it, the nearer length.
+        let outside = length_off > LENGTH_TOLERANCE;
+        let score = (outside, if outside { length_off } else { turn });
+        if score < best.1 {
             best = (q, score);
         }
     }
@@ -934,7 +933,7 @@ pub(crate) fn write(
     // Positions stored as integers (KHR_mesh_quantization) that moved past what their type can
     // hold (a vertex below the least stored value, as gltfpack quantizes from the bounding box)
     // would be clamped: such an accessor is written as floats instead, in a new buffer view
-    // (its old one stays, unused, as the rest of the buffer does).
+    // (its old one stays, as the rest of the buffer does).
     for (&a, edit) in &mut edits {
         let outside = (edit.after.iter().flatten())
             .filter(|p| !p.iter().all(|&c| fits(&edit.layout, c)))
@@ -1551,12 +1550,7 @@ impl Joined {
             return self.put(layout, k, direction);
         }
         let q = quantize_direction(layout, *direction);
-        for (c, q) in q.iter().enumerate() {
-            let at = layout.start + k * layout.stride + c * layout.size;
-            if let Some(range) = self.range(layout.buffer, at, layout.size) {
-                store(layout, *q, &mut self.bytes[range]);
-            }
-        }
+        self.put_components(layout, k, 3, |c, out| store(layout, q[c], out));
     }
 
     /// Accessor `a` (of `layout`) rewritten as 32-bit floats: a new buffer view at the end of
@@ -1619,10 +1613,24 @@ impl Joined {
                 return;
             }
         }
-        for (c, value) in values.iter().enumerate() {
+        self.put_components(layout, k, values.len(), |c, out| {
+            encode(layout, values[c], out)
+        });
+    }
+
+    /// Calls `write` with the bytes of each of the first `components` components of element
+    /// `k` (those inside the buffer).
+    fn put_components(
+        &mut self,
+        layout: &Layout,
+        k: usize,
+        components: usize,
+        write: impl Fn(usize, &mut [u8]),
+    ) {
+        for c in 0..components {
             let at = layout.start + k * layout.stride + c * layout.size;
             if let Some(range) = self.range(layout.buffer, at, layout.size) {
-                encode(layout, *value, &mut self.bytes[range]);
+                write(c, &mut self.bytes[range]);
             }
         }
     }
