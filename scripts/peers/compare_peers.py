@@ -10,8 +10,9 @@ surface distance both ways, in mean edge lengths of the clean mesh; mean face-no
 degrees; volume change against the clean mesh in percent). A peer's row is its best iteration
 count by mean distance, picked knowing the clean mesh (an advantage no user has).
 
-Peers (those installed are run): trimesh (Taubin, Humphrey, Laplacian), PyMeshLab (Taubin,
-HC Laplacian), Open3D (Taubin). Install them in a virtual environment:
+Peers: fairmesh's own baselines (`fair --method laplacian|taubin|hc`, the "Laplacian, Taubin and
+HC baselines" issue 12's targets name), and those installed of trimesh (Taubin, Humphrey,
+Laplacian), PyMeshLab (Taubin, HC Laplacian), Open3D (Taubin). Install them in a virtual environment:
     python3 -m venv venv && venv/bin/pip install -r scripts/peers/requirements.txt
 
 Run from the repository root after `cargo build --release`:
@@ -66,9 +67,31 @@ def load(path):
     return trimesh.Trimesh(np.asarray(mesh.vertices), np.asarray(mesh.faces), process=False)
 
 
+def fairmesh_baseline(method):
+    """fairmesh's own baseline `method` (`fair --method laplacian|taubin|hc`) as a peer: the
+    issue that set the default's targets names these three at their best iteration count."""
+
+    def smooth(v, f, k):
+        with tempfile.TemporaryDirectory() as tmp:
+            given, smoothed = os.path.join(tmp, "in.ply"), os.path.join(tmp, "out.ply")
+            trimesh.Trimesh(v, f, process=False).export(given)
+            run("fair", given, "-o", smoothed, "--method", method, "--iterations", str(k))
+            result = np.asarray(load(smoothed).vertices)
+            if len(result) != len(v):
+                sys.exit(f"fair --method {method} wrote {len(result)} vertices for {len(v)}")
+            return result
+
+    return smooth
+
+
 def peers():
-    """(name, function(vertices, faces, iterations) -> vertices) for the installed peers."""
-    found = []
+    """(name, function(vertices, faces, iterations) -> vertices) for fairmesh's own baselines and
+    the installed peers."""
+    found = [
+        ("fairmesh Laplacian", fairmesh_baseline("laplacian")),
+        ("fairmesh Taubin", fairmesh_baseline("taubin")),
+        ("fairmesh HC", fairmesh_baseline("hc")),
+    ]
 
     def trimesh_filter(kind):
         def smooth(v, f, k):
