@@ -87,6 +87,10 @@ pub struct VertexComparison {
     pub barycenter_drift: f64,
 }
 
+/// An edge counts in [`sharpened_edges`] when the angle between its two triangles' normals
+/// exceeds the reference's by more than this, in degrees.
+pub const SHARPENED_DEGREES: f64 = 30.0;
+
 /// OTHER measured against REFERENCE.
 #[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize)]
 pub struct Comparison {
@@ -235,6 +239,49 @@ pub fn compare_vertices(reference: &TriMesh, other: &TriMesh) -> Option<VertexCo
         },
         barycenter_drift: drift_sum / faces,
     })
+}
+
+/// How many edges of `other` bend by more than [`SHARPENED_DEGREES`] beyond the same edge of
+/// `reference` (the angle between the normals of the two triangles that share it): the folds and
+/// ridges a smoothing added, or the noise it left. Against the clean mesh, a good smoothing of a
+/// noisy copy leaves next to none. Over the edges exactly two triangles share, not counting those
+/// beside a degenerate triangle; `None` unless the two meshes have the same triangles.
+pub fn sharpened_edges(reference: &TriMesh, other: &TriMesh) -> Option<usize> {
+    if reference.triangles != other.triangles || reference.positions.len() != other.positions.len()
+    {
+        return None;
+    }
+    // (lower corner, higher corner, triangle) for every edge of every triangle, sorted so that
+    // an edge's triangles sit side by side.
+    let mut edges: Vec<(u32, u32, u32)> = reference
+        .triangles
+        .iter()
+        .enumerate()
+        .flat_map(|(t, tri)| {
+            (0..3).map(move |k| {
+                let (a, b) = (tri[k], tri[(k + 1) % 3]);
+                (a.min(b), a.max(b), t as u32)
+            })
+        })
+        .collect();
+    edges.sort_unstable();
+    let bend = |mesh: &TriMesh, s: u32, t: u32| {
+        let (a, b) = (mesh.face_normal(s as usize), mesh.face_normal(t as usize));
+        (a.length_squared() > 0.0 && b.length_squared() > 0.0)
+            .then(|| a.angle_between(b).to_degrees())
+    };
+    edges
+        .chunk_by(|x, y| (x.0, x.1) == (y.0, y.1))
+        .filter(|shared| shared.len() == 2)
+        .filter(|shared| {
+            let (s, t) = (shared[0].2, shared[1].2);
+            matches!(
+                (bend(reference, s, t), bend(other, s, t)),
+                (Some(before), Some(after)) if after - before > SHARPENED_DEGREES
+            )
+        })
+        .count()
+        .into()
 }
 
 /// Closest-point queries against a mesh's surface: a bounding volume hierarchy over its triangles
@@ -595,6 +642,43 @@ mod tests {
         }
         assert!(tangential_slide(&grid.positions, &lifted) < 1e-12);
         assert!(tangential_slide(&grid.positions[1..], &lifted).is_nan());
+    }
+
+    #[test]
+    fn sharpened_edges_are_the_bends_grown_past_the_reference() {
+        // A 4×4 grid folded up along the column x = 1 by `degrees`: exactly its three edges on
+        // that column bend, by `degrees`; every other edge stays flat.
+        let folded = |degrees: f64| {
+            let rise = degrees.to_radians().tan();
+            let mut grid = TriMesh::default();
+            for j in 0..4u32 {
+                for i in 0..4u32 {
+                    let z = (i as f64 - 1.0).max(0.0) * rise;
+                    grid.positions.push([i as f32, j as f32, z as f32]);
+                }
+            }
+            for j in 0..3u32 {
+                for i in 0..3u32 {
+                    let v = j * 4 + i;
+                    grid.triangles.push([v, v + 1, v + 5]);
+                    grid.triangles.push([v, v + 5, v + 4]);
+                }
+            }
+            grid
+        };
+        let sharpened = |reference: &TriMesh, other: &TriMesh| {
+            sharpened_edges(reference, other).expect("same triangles")
+        };
+        let flat = folded(0.0);
+        assert_eq!(sharpened(&flat, &flat), 0);
+        assert_eq!(sharpened(&flat, &folded(20.0)), 0);
+        assert_eq!(sharpened(&flat, &folded(50.0)), 3);
+        // Measured against the reference's own bend: 50° → 70° grows by 20° only.
+        assert_eq!(sharpened(&folded(50.0), &folded(70.0)), 0);
+        assert_eq!(sharpened(&folded(50.0), &flat), 0);
+        let mut other_triangles = flat.clone();
+        other_triangles.triangles.swap(0, 1);
+        assert_eq!(sharpened_edges(&flat, &other_triangles), None);
     }
 
     #[test]

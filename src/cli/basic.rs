@@ -350,6 +350,10 @@ pub fn compare(args: CompareArgs) -> anyhow::Result<()> {
         map.insert("normal_error_deg".into(), json!(v.normal_error_deg));
         map.insert("barycenter_drift".into(), json!(v.barycenter_drift));
     }
+    let sharpened = metrics::sharpened_edges(&reference.mesh, &other.mesh);
+    if let (Some(count), Some(map)) = (sharpened, object.as_object_mut()) {
+        map.insert("sharpened_edges".into(), json!(count));
+    }
     if args.json {
         return super::emit(&format!("{}\n", serde_json::to_string_pretty(&object)?));
     }
@@ -383,6 +387,13 @@ pub fn compare(args: CompareArgs) -> anyhow::Result<()> {
                 v.normal_error_deg
             )?;
             writeln!(out, "  barycenter drift       {:.6e}", v.barycenter_drift)?;
+            if let Some(count) = sharpened {
+                writeln!(
+                    out,
+                    "  sharpened edges        {count} (bent over {}° beyond the reference)",
+                    metrics::SHARPENED_DEGREES
+                )?;
+            }
         }
         None => writeln!(out, "  (different connectivity: no per-vertex measures)")?,
     }
