@@ -7,8 +7,10 @@ For each mesh, noise mode and seed: `fairmesh noise` (sigma 0.3 mean edge length
 `fairmesh fair` with its defaults (no flags), and each peer at every iteration count of a scan;
 each result is measured with `fairmesh compare CLEAN RESULT --json` (one metric for all: mean
 surface distance both ways, in mean edge lengths of the clean mesh; mean face-normal error in
-degrees; volume change against the clean mesh in percent). A peer's row is its best iteration
-count by mean distance, picked knowing the clean mesh (an advantage no user has).
+degrees; volume change against the clean mesh in percent; sharpened edges: how many edges bend
+over 30° beyond the clean mesh's, the ridges a smoothing added or the noise it left). A peer's
+row is its best iteration count by mean distance, picked knowing the clean mesh (an advantage no
+user has).
 
 Peers: fairmesh's own baselines (`fair --method laplacian|taubin|hc`, the "Laplacian, Taubin and
 HC baselines" issue 12's targets name), and those installed of trimesh (Taubin, Humphrey,
@@ -57,6 +59,7 @@ def measure(clean, result):
         "hausdorff": m["hausdorff"] / edge,
         "normal": m.get("normal_error_deg"),
         "volume": m["volume_change_percent"],
+        "sharpened": m.get("sharpened_edges"),
     }
 
 
@@ -150,10 +153,15 @@ def normal_error(m):
     return "-" if m["normal"] is None else f"{m['normal']:.1f}"
 
 
+def sharpened(m):
+    """A measure's count of edges bent over 30° beyond the clean mesh's, or "-"."""
+    return "-" if m["sharpened"] is None else str(m["sharpened"])
+
+
 def row(name, setting, m):
     return (
         f"| {name} | {setting} | {m['mean']:.4f} | {m['hausdorff']:.3f} | {normal_error(m)} "
-        f"| {m['volume']:+.3f} |"
+        f"| {m['volume']:+.3f} | {sharpened(m)} |"
     )
 
 
@@ -188,8 +196,9 @@ def main():
                 run("noise", clean, "-o", noisy, "--sigma", "0.3", "--seed", seed, "--mode", mode)
                 print(f"\n{os.path.basename(path)}, noise 0.3 mean edge lengths, mode {mode}, "
                       f"seed {seed}\n")
-                print("| smoother | setting | mean dist | Hausdorff | normal ° | volume % |")
-                print("|---|---|---:|---:|---:|---:|")
+                print("| smoother | setting | mean dist | Hausdorff | normal ° | volume % "
+                      "| sharpened edges |")
+                print("|---|---|---:|---:|---:|---:|---:|")
                 print(row("noisy input", "", measure(clean, noisy)))
                 ours = os.path.join(tmp, "ours.ply")
                 report = json.loads(run("fair", noisy, "-o", ours, "--json", *fair_flags))
