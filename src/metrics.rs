@@ -204,8 +204,7 @@ pub fn tangential_slide(before: &[[f32; 3]], after: &TriMesh) -> f64 {
 
 /// Per-vertex comparisons, when `other` has the same triangles as `reference`.
 pub fn compare_vertices(reference: &TriMesh, other: &TriMesh) -> Option<VertexComparison> {
-    if reference.triangles != other.triangles || reference.positions.len() != other.positions.len()
-    {
+    if !same_connectivity(reference, other) {
         return None;
     }
     let n = reference.positions.len().max(1) as f64;
@@ -241,14 +240,18 @@ pub fn compare_vertices(reference: &TriMesh, other: &TriMesh) -> Option<VertexCo
     })
 }
 
+/// Whether `other` has the same triangles over as many vertices as `reference`.
+fn same_connectivity(reference: &TriMesh, other: &TriMesh) -> bool {
+    reference.triangles == other.triangles && reference.positions.len() == other.positions.len()
+}
+
 /// How many edges of `other` bend by more than [`SHARPENED_DEGREES`] beyond the same edge of
 /// `reference` (the angle between the normals of the two triangles that share it): the folds and
 /// ridges a smoothing added, or the noise it left. Against the clean mesh, a good smoothing of a
 /// noisy copy leaves next to none. Over the edges exactly two triangles share, not counting those
 /// beside a degenerate triangle; `None` unless the two meshes have the same triangles.
 pub fn sharpened_edges(reference: &TriMesh, other: &TriMesh) -> Option<usize> {
-    if reference.triangles != other.triangles || reference.positions.len() != other.positions.len()
-    {
+    if !same_connectivity(reference, other) {
         return None;
     }
     // (lower corner, higher corner, triangle) for every edge of every triangle, sorted so that

@@ -14,7 +14,8 @@ user has).
 
 Peers: fairmesh's own baselines (`fair --method laplacian|taubin|hc`, the "Laplacian, Taubin and
 HC baselines" issue 12's targets name), and those installed of trimesh (Taubin, Humphrey,
-Laplacian), PyMeshLab (Taubin, HC Laplacian), Open3D (Taubin). Install them in a virtual environment:
+Laplacian), PyMeshLab (Taubin, HC Laplacian), Open3D (Taubin). Install them in a virtual
+environment:
     python3 -m venv venv && venv/bin/pip install -r scripts/peers/requirements.txt
 
 Run from the repository root after `cargo build --release`:
