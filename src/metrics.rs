@@ -273,7 +273,7 @@ pub fn sharpened_edges(reference: &TriMesh, other: &TriMesh) -> Option<usize> {
         (a.length_squared() > 0.0 && b.length_squared() > 0.0)
             .then(|| a.angle_between(b).to_degrees())
     };
-    edges
+    let sharpened = edges
         .chunk_by(|x, y| (x.0, x.1) == (y.0, y.1))
         .filter(|shared| shared.len() == 2)
         .filter(|shared| {
@@ -283,8 +283,8 @@ pub fn sharpened_edges(reference: &TriMesh, other: &TriMesh) -> Option<usize> {
                 (Some(before), Some(after)) if after - before > SHARPENED_DEGREES
             )
         })
-        .count()
-        .into()
+        .count();
+    Some(sharpened)
 }
 
 /// Closest-point queries against a mesh's surface: a bounding volume hierarchy over its triangles
