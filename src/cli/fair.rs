@@ -67,7 +67,8 @@ pub struct FairArgs {
     #[arg(long, default_value_t = fairmesh::fairing::creases::DEFAULT_CREASE_ANGLE,
           conflicts_with = "no_creases")]
     pub crease_angle: f64,
-    /// Constrained normal-projected only: fair across sharp edges too, as the paper does.
+    /// Constrained normal-projected only: fair across sharp edges too, as the paper does (for
+    /// smooth shapes: thin triangles are then relaxed only where they fold, not along bends).
     #[arg(long)]
     pub no_creases: bool,
     /// Constrained normal-projected only: how much each iteration also evens out the triangles

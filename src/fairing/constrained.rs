@@ -742,11 +742,11 @@ impl ConstrainedFairing {
 
     /// Gives the tangential relaxation ([`Self::set_tangential_relaxation`]) only where it is
     /// needed ([`super::relaxation`]): `everywhere` (0 to 1) of its weight at every vertex, and all
-    /// of it at the vertices with a thin triangle among theirs in the current state (the positions
-    /// of the last [`Self::load`]; [`super::relaxation::sliver_share`] of the least quality among
-    /// its fan's triangles). Holds until called again; `everywhere` 1 (or no state loaded yet)
+    /// of it at the vertices with a thin triangle among theirs (every one, or only the folded ones:
+    /// `slivers`) in the current state (the positions of the last [`Self::load`];
+    /// [`super::relaxation::fan_sliver_share`] of its fan). Holds until called again; `everywhere` 1 (or no state loaded yet)
     /// gives every vertex the whole weight again.
-    pub fn relax_where_needed(&mut self, everywhere: f32) {
+    pub fn relax_where_needed(&mut self, everywhere: f32, slivers: relaxation::Slivers) {
         let everywhere = if everywhere.is_nan() {
             1.0
         } else {
@@ -772,11 +772,11 @@ impl ConstrainedFairing {
                         // Only a closed fan is projected (and relaxed), and it is in fan order.
                         Some(&last) if closed_fan[v] => {
                             let p = x[v];
-                            let least = relaxation::least_fan_quality(
+                            everywhere.max(relaxation::fan_sliver_share(
                                 x[last as usize] - p,
                                 ring_v.iter().map(|&u| x[u as usize] - p),
-                            );
-                            everywhere.max(relaxation::sliver_share(least))
+                                slivers,
+                            ))
                         }
                         _ => everywhere,
                     };
@@ -1961,6 +1961,12 @@ fn fair_rounds(
         .then(|| read_tangential_noise(mesh, topology, &fans));
     let mut everywhere =
         tangential_noise.map(|reading| relaxation::everywhere_share(reading, estimate));
+    // Without creases the surface is taken for a smooth one, whose thin triangles may lie along a
+    // bend: only the folded ones are relaxed ([`relaxation::Slivers`]).
+    let slivers = match options.creases {
+        Some(_) => relaxation::Slivers::All,
+        None => relaxation::Slivers::Folded,
+    };
     let reading_ms = milliseconds(started);
     // The fans serve the later rounds only to find the creases again (and estimate the noise
     // that sets the filtering for it) and to read the noise along the surface again while the
@@ -2063,7 +2069,7 @@ fn fair_rounds(
                 }
             }
             // From the mesh's state: the risk's copy is faired with the same shares.
-            fairing.relax_where_needed(*share);
+            fairing.relax_where_needed(*share, slivers);
         }
         fairing.run_round(options, &mut report);
         fairing.store(&mut mesh.positions);

@@ -13,7 +13,9 @@
 //!   normals leaves it folded. The generated CAD parts' fans of thin triangles (the cube's faces,
 //!   the gear's) end with their face normals 2-4 times as far off without relaxation (cube 3.2° →
 //!   10.2°), and all of that on the triangles with an angle below 10-20°: on the others the two
-//!   are alike;
+//!   are alike. On a smooth surface (fairing without creases) only a folded one needs it: a
+//!   thin triangle that lies in its fan (the open mushroom's band of thin triangles round a
+//!   tight bend) is left as it is, as relaxing it cuts the bend ([`Slivers`]);
 //! - noise across the surface only, on a scan sampled densest where it curves: the relaxation
 //!   evens the sampling out and so cuts the curves as chords (bunny10k ends 0.0852 from its
 //!   clean surface with it, 0.0780 without).
@@ -23,7 +25,8 @@
 //! [`everywhere_share`] of the weight, reads it again before every later round until the mesh is
 //! as even as a relaxed one ([`still_needed_share`]: relaxing on from there only evens the
 //! sampling out, as above), and before every round also relaxes fully the vertices with a sliver
-//! among their triangles ([`sliver_share`]).
+//! among their triangles ([`fan_sliver_share`]: [`sliver_share`] of its quality; without creases
+//! times [`fold_share`] of its turn from the fan).
 //!
 //! # The tangential noise reading
 //! Per vertex v with a closed fan: t_v, the tangential part of its umbrella vector (the mean of
@@ -80,6 +83,16 @@ pub const SLIVER_QUALITY: f32 = 0.5;
 /// See [`SLIVER_QUALITY`].
 pub const SLIVER_QUALITY_FULL: f32 = 0.3;
 
+/// Without creases ([`Slivers::Folded`]), a thin triangle is relaxed only where it is folded: by
+/// the share of the way from here to [`SLIVER_FOLD_FULL_DEGREES`] that its normal turns away from
+/// its corner's fan normal (the sum of the fan's area normals), fully beyond. A thin triangle
+/// lying in its fan, as the long thin triangles round a smooth scan's tight bend do, is left as it
+/// is: relaxing it cuts the bend (`docs/measurements.md`, "Thin triangles along a smooth bend").
+pub const SLIVER_FOLD_DEGREES: f32 = 20.0;
+
+/// See [`SLIVER_FOLD_DEGREES`].
+pub const SLIVER_FOLD_FULL_DEGREES: f32 = 45.0;
+
 /// Before every later round the tangential noise is read again while the relaxation acts
 /// everywhere: at or below this reading the mesh is as even as a relaxed one and the relaxation
 /// keeps to the thin triangles from then on; from [`RELAXED_FULL`] on it goes on everywhere. With
@@ -132,6 +145,81 @@ pub fn sliver_share(least_quality: f32) -> f32 {
     ) as f32
 }
 
+/// The share of the relaxation's weight a thin triangle's fold gives it (see
+/// [`SLIVER_FOLD_DEGREES`]), from the cosine of the angle between its normal and its corner's fan
+/// normal.
+#[inline]
+pub fn fold_share(cos_angle: f32) -> f32 {
+    let degrees = cos_angle.clamp(-1.0, 1.0).acos().to_degrees();
+    ramp(
+        degrees as f64,
+        SLIVER_FOLD_DEGREES as f64,
+        SLIVER_FOLD_FULL_DEGREES as f64,
+    ) as f32
+}
+
+/// Which thin triangles the relaxation acts on ([`fan_sliver_share`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Slivers {
+    /// Every one: on the flat faces of a CAD part every degree a thin triangle tilts is an error
+    /// (the default, with creases).
+    All,
+    /// Only the folded ones ([`SLIVER_FOLD_DEGREES`]): on a smooth surface a thin triangle may
+    /// lie along a bend (without creases).
+    Folded,
+}
+
+/// The share of the relaxation's weight the point of a fan gets for its thin triangles: the
+/// largest, over the fan's triangles, of [`sliver_share`] of its quality, times, with
+/// [`Slivers::Folded`], [`fold_share`] of its turn from the fan's normal. `edges` are the fan's
+/// edges from the point in fan order, each making a triangle with the one before it, the first
+/// with `last` (the fan's last edge, for a closed fan). A triangle with no area, or a fan whose
+/// normal vanishes, counts as folded. Runs over every vertex before every round: a fan with no
+/// thin triangle costs (its normal and) one division per triangle, no root.
+#[inline]
+pub(crate) fn fan_sliver_share(
+    last: Vec3A,
+    edges: impl Iterator<Item = Vec3A> + Clone,
+    slivers: Slivers,
+) -> f32 {
+    // Squared quality over 12 below which a triangle is thin: |a × b|² / (sum of squares)².
+    const THIN: f32 = SLIVER_QUALITY * SLIVER_QUALITY / 12.0;
+    let normal = match slivers {
+        Slivers::All => None,
+        Slivers::Folded => {
+            let mut previous = last;
+            let mut normal = Vec3A::ZERO;
+            for current in edges.clone() {
+                normal += previous.cross(current);
+                previous = current;
+            }
+            Some(normal.normalize_or_zero())
+        }
+    };
+    let mut share = 0.0f32;
+    let mut previous = last;
+    for current in edges {
+        let sum = previous.length_squared()
+            + current.length_squared()
+            + (current - previous).length_squared();
+        let own = previous.cross(current);
+        // (A triangle with no length is no sliver; dividing twice keeps the terms near the
+        // squared edge lengths, far from f32's range.)
+        if sum > 0.0 {
+            let squared = own.length_squared() / sum / sum;
+            if squared < THIN {
+                let thin = sliver_share((12.0 * squared).sqrt());
+                if thin > share {
+                    let fold = normal.map_or(1.0, |n| fold_share(own.normalize_or_zero().dot(n)));
+                    share = share.max(thin * fold);
+                }
+            }
+        }
+        previous = current;
+    }
+    share
+}
+
 /// 0 at `none`, 1 at `full` and beyond, linear in between (`full` may lie below `none`).
 #[inline]
 fn ramp(value: f64, none: f64, full: f64) -> f64 {
@@ -142,32 +230,12 @@ fn ramp(value: f64, none: f64, full: f64) -> f64 {
 /// corner (see [`SLIVER_QUALITY`]); 1 for a degenerate triangle with no length, which is no sliver
 /// to even out.
 pub fn triangle_quality(a: Vec3A, b: Vec3A) -> f32 {
-    least_fan_quality(a, std::iter::once(b))
-}
-
-/// The least [`triangle_quality`] among the triangles of a fan around a point: `edges` its edges
-/// from the point in fan order, each making a triangle with the one before it, the first with
-/// `last` (the fan's last edge, for a closed fan). The triangles are compared by their squared
-/// quality over 12, |a × b|² / (sum of squares)², so a fan costs one root (this runs over every
-/// vertex before every round).
-#[inline]
-pub(crate) fn least_fan_quality(last: Vec3A, edges: impl Iterator<Item = Vec3A>) -> f32 {
-    let mut previous = last;
-    let mut previous_squared = last.length_squared();
-    // That of an equilateral triangle to start with.
-    let mut least = 1.0f32 / 12.0;
-    for current in edges {
-        let current_squared = current.length_squared();
-        let sum = previous_squared + current_squared + (current - previous).length_squared();
-        // (A triangle with no length is skipped; dividing twice keeps the terms near the squared
-        // edge lengths, far from f32's range.)
-        if sum > 0.0 {
-            least = least.min(previous.cross(current).length_squared() / sum / sum);
-        }
-        previous = current;
-        previous_squared = current_squared;
+    let sum = a.length_squared() + b.length_squared() + (b - a).length_squared();
+    if sum > 0.0 {
+        (12.0 * (a.cross(b).length_squared() / sum / sum)).sqrt()
+    } else {
+        1.0
     }
-    (12.0 * least).sqrt()
 }
 
 /// How much of `mesh`'s noise lies along its surface, in mean edge lengths (see the module
@@ -295,5 +363,48 @@ mod tests {
         let between = (SLIVER_QUALITY + SLIVER_QUALITY_FULL) / 2.0;
         assert!((sliver_share(between) - 0.5).abs() < 1e-6);
         assert_eq!(triangle_quality(Vec3A::ZERO, Vec3A::ZERO), 1.0);
+    }
+
+    #[test]
+    fn without_creases_thin_triangles_get_the_relaxation_only_where_they_fold() {
+        use Slivers::Folded;
+        assert_eq!(
+            fold_share(SLIVER_FOLD_DEGREES.to_radians().cos() + 1e-4),
+            0.0
+        );
+        assert_eq!(
+            fold_share(SLIVER_FOLD_FULL_DEGREES.to_radians().cos() - 1e-4),
+            1.0
+        );
+        let middle = (SLIVER_FOLD_DEGREES + SLIVER_FOLD_FULL_DEGREES) / 2.0;
+        assert!((fold_share(middle.to_radians().cos()) - 0.5).abs() < 1e-3);
+        // A flat fan around the origin, its second triangle (between x and `thin`) a sliver.
+        let fan = |thin: Vec3A| [Vec3A::X, thin, Vec3A::Y, -Vec3A::X, -Vec3A::Y];
+        let share = |edges: [Vec3A; 5]| fan_sliver_share(edges[4], edges.into_iter(), Folded);
+        let with_creases =
+            |edges: [Vec3A; 5]| fan_sliver_share(edges[4], edges.into_iter(), Slivers::All);
+        let flat = fan(Vec3A::new(1.0, 0.05, 0.0));
+        assert!(triangle_quality(flat[0], flat[1]) < SLIVER_QUALITY_FULL);
+        assert_eq!(share(flat), 0.0, "a sliver lying in its fan is left alone");
+        assert_eq!(
+            with_creases(flat),
+            1.0,
+            "with creases every sliver is relaxed"
+        );
+        // The sliver's far corner lifted: still as thin, its normal 63° off the fan's.
+        let folded = fan(Vec3A::new(1.0, 0.05, 0.1));
+        assert!(triangle_quality(folded[0], folded[1]) < SLIVER_QUALITY_FULL);
+        assert_eq!(share(folded), 1.0, "a folded sliver is relaxed");
+        // Lifted less, its normal turns ~27°: part of the weight.
+        let tilted = share(fan(Vec3A::new(1.0, 0.05, 0.025)));
+        assert!(tilted > 0.0 && tilted < 1.0, "{tilted}");
+        // A fan of fair triangles gets nothing however bent.
+        let bent = [Vec3A::X, Vec3A::new(0.0, 1.0, 0.8), -Vec3A::X, -Vec3A::Y];
+        for slivers in [Folded, Slivers::All] {
+            assert_eq!(fan_sliver_share(bent[3], bent.into_iter(), slivers), 0.0);
+        }
+        // A triangle with no area is a fold.
+        let collapsed = fan(Vec3A::new(2.0, 0.0, 0.0));
+        assert_eq!(share(collapsed), 1.0);
     }
 }
