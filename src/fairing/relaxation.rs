@@ -175,49 +175,62 @@ pub enum Slivers {
 /// edges from the point in fan order, each making a triangle with the one before it, the first
 /// with `last` (the fan's last edge, for a closed fan). A triangle with no area, or a fan whose
 /// normal vanishes, counts as folded. Runs over every vertex before every round: a fan with no
-/// thin triangle costs (its normal and) one division per triangle, no root.
+/// thin triangle costs one division per triangle, no root, and its normal is summed only for a
+/// thin triangle.
 #[inline]
 pub(crate) fn fan_sliver_share(
     last: Vec3A,
     edges: impl Iterator<Item = Vec3A> + Clone,
     slivers: Slivers,
 ) -> f32 {
-    // Squared quality over 12 below which a triangle is thin: |a × b|² / (sum of squares)².
+    // Squared quality over 12 below which a triangle is thin.
     const THIN: f32 = SLIVER_QUALITY * SLIVER_QUALITY / 12.0;
-    let normal = match slivers {
-        Slivers::All => None,
-        Slivers::Folded => {
-            let mut previous = last;
-            let mut normal = Vec3A::ZERO;
-            for current in edges.clone() {
-                normal += previous.cross(current);
-                previous = current;
-            }
-            Some(normal.normalize_or_zero())
-        }
-    };
+    // The fan's unit normal, summed only once a thin triangle asks for it (most fans have none).
+    let mut normal = None;
     let mut share = 0.0f32;
     let mut previous = last;
-    for current in edges {
-        let sum = previous.length_squared()
-            + current.length_squared()
-            + (current - previous).length_squared();
-        let own = previous.cross(current);
-        // (A triangle with no length is no sliver; dividing twice keeps the terms near the
-        // squared edge lengths, far from f32's range.)
-        if sum > 0.0 {
-            let squared = own.length_squared() / sum / sum;
-            if squared < THIN {
-                let thin = sliver_share((12.0 * squared).sqrt());
-                if thin > share {
-                    let fold = normal.map_or(1.0, |n| fold_share(own.normalize_or_zero().dot(n)));
-                    share = share.max(thin * fold);
-                }
+    for current in edges.clone() {
+        if let Some(squared) = squared_quality_over_12(previous, current) {
+            let thin = if squared < THIN {
+                sliver_share((12.0 * squared).sqrt())
+            } else {
+                0.0
+            };
+            if thin > share {
+                let fold = match slivers {
+                    Slivers::All => 1.0,
+                    Slivers::Folded => {
+                        let normal = *normal.get_or_insert_with(|| fan_normal(last, edges.clone()));
+                        fold_share(previous.cross(current).normalize_or_zero().dot(normal))
+                    }
+                };
+                share = share.max(thin * fold);
             }
         }
         previous = current;
     }
     share
+}
+
+/// The unit normal of a fan (the sum of its triangles' area normals; zero if that vanishes), its
+/// edges as [`fan_sliver_share`] takes them.
+fn fan_normal(last: Vec3A, edges: impl Iterator<Item = Vec3A>) -> Vec3A {
+    let mut previous = last;
+    let mut normal = Vec3A::ZERO;
+    for current in edges {
+        normal += previous.cross(current);
+        previous = current;
+    }
+    normal.normalize_or_zero()
+}
+
+/// |a × b|² / (|a|² + |b|² + |b − a|²)², the squared [`triangle_quality`] over 12 of the triangle
+/// with edges a and b from one corner (no root); `None` for a triangle with no length. (Dividing
+/// twice keeps the terms near the squared edge lengths, far from f32's range.)
+#[inline]
+fn squared_quality_over_12(a: Vec3A, b: Vec3A) -> Option<f32> {
+    let sum = a.length_squared() + b.length_squared() + (b - a).length_squared();
+    (sum > 0.0).then(|| a.cross(b).length_squared() / sum / sum)
 }
 
 /// 0 at `none`, 1 at `full` and beyond, linear in between (`full` may lie below `none`).
@@ -230,12 +243,7 @@ fn ramp(value: f64, none: f64, full: f64) -> f64 {
 /// corner (see [`SLIVER_QUALITY`]); 1 for a degenerate triangle with no length, which is no sliver
 /// to even out.
 pub fn triangle_quality(a: Vec3A, b: Vec3A) -> f32 {
-    let sum = a.length_squared() + b.length_squared() + (b - a).length_squared();
-    if sum > 0.0 {
-        (12.0 * (a.cross(b).length_squared() / sum / sum)).sqrt()
-    } else {
-        1.0
-    }
+    squared_quality_over_12(a, b).map_or(1.0, |squared| (12.0 * squared).sqrt())
 }
 
 /// How much of `mesh`'s noise lies along its surface, in mean edge lengths (see the module
