@@ -1,0 +1,18 @@
+#!/usr/bin/env bash
+# The checks that keep the code as it is meant to be, run by CI after the tests (it reuses the
+# test build): clippy with no warning, with and without the editor (the lints of Cargo.toml's
+# `[lints]` table); no import cycle between the files of a module (scripts/import_cycles.py);
+# every file the `fairmesh` binary writes on the repository's meshes byte-identical to
+# scripts/output_sums.txt (scripts/check_outputs.sh).
+set -euo pipefail
+cd "$(dirname "$0")/.."
+if cargo clippy --version >/dev/null 2>&1; then
+  cargo clippy --all-targets -- -D warnings
+  cargo clippy --no-default-features --features cli --all-targets -- -D warnings
+else
+  echo "check_code: cargo clippy is not installed (rustup component add clippy); lints not checked" >&2
+fi
+python3 scripts/import_cycles.py
+# The test build's binary (default features); built here when the tests did not build it.
+cargo build --quiet --bin fairmesh
+scripts/check_outputs.sh target/debug/fairmesh --check scripts/output_sums.txt
