@@ -1,5 +1,5 @@
 //! The default fairing on clean meshes: a smoother should leave a mesh with no noise on it (nearly)
-//! as it is. Issue 12's targets for default `fair` on every clean mesh of a set of at least 20:
+//! as it is. The targets for default `fair` on every clean mesh of a set of at least 20:
 //! mean surface distance (both ways) at most 0.02 mean edge lengths, Hausdorff distance at most
 //! 0.25 mean edge lengths, |volume change| at most 0.1 %.
 //!

@@ -1,5 +1,5 @@
 //! Speed of what the default fairing and the crease-keeping hierarchy add before their own work
-//! (issue 12's speed target: crease detection and the noise estimate add at most 10 % to a
+//! (the speed target: crease detection and the noise estimate add at most 10 % to a
 //! default `fair` round on the 1.2M-face mesh, and at most 10 % to the hierarchy build), phase by
 //! phase, against the memory floor of each phase.
 //!

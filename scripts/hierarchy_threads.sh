@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# The hierarchy build on one thread against two (issue 14's yardstick: two threads at least
+# The hierarchy build on one thread against two (the yardstick: two threads at least
 # 1.7x faster than one), for one or more fairmesh binaries side by side.
 #
 #   scripts/hierarchy_threads.sh MESH RUNS [BINARY...]

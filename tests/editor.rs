@@ -544,7 +544,7 @@ fn meshes_too_big_for_the_gpu_buffers_are_refused_with_a_reason() {
 }
 
 /// Undo and redo across an Open bring back the camera of the document they bring back: the
-/// view shows that mesh, not the place where the other one was (issue 13).
+/// view shows that mesh, not the place where the other one was.
 #[test]
 fn undo_and_redo_across_open_bring_the_documents_camera_back() {
     let dir = tempfile::tempdir().unwrap();
@@ -596,7 +596,7 @@ fn undo_and_redo_across_open_bring_the_documents_camera_back() {
 
 /// After a slider step the new result is on screen at once while its distances are measured a
 /// moment later: until then the rows that still hold the previous result's numbers are greyed
-/// and say so (issue 13: they sat beside the fresh ones unmarked).
+/// and say so (rather than beside the fresh ones, unmarked).
 #[test]
 fn numbers_of_the_previous_result_are_greyed_until_the_new_ones_arrive() {
     let mut harness = harness_for(bunny());
@@ -642,7 +642,7 @@ fn numbers_of_the_previous_result_are_greyed_until_the_new_ones_arrive() {
 }
 
 /// At 800×600 every toolbar control is inside the window (the toolbar wraps), and a status
-/// message or an error does not move the controls under the pointer (issue 13).
+/// message or an error does not move the controls under the pointer.
 #[test]
 fn small_window_keeps_the_toolbar_and_messages_do_not_move_the_controls() {
     let mut harness = harness_sized(bunny(), egui::vec2(800.0, 600.0));
@@ -674,7 +674,7 @@ fn small_window_keeps_the_toolbar_and_messages_do_not_move_the_controls() {
 }
 
 /// The side-by-side halves are narrower than tall: switching to them fits the mesh into each
-/// half (while the user has not moved the camera), and so does F (issue 13: both meshes were
+/// half (while the user has not moved the camera), and so does F (once both meshes were
 /// cropped and F did not fit them).
 #[test]
 fn side_by_side_halves_show_the_whole_mesh() {
@@ -717,7 +717,7 @@ fn side_by_side_halves_show_the_whole_mesh() {
 
 /// Every fairing control explains itself in its tooltip (read here as its accessible
 /// description); the ones a baseline method does not use are disabled and say why, and the
-/// numbers name the method instead of a start level it did not use (issue 13).
+/// numbers name the method instead of a start level it did not use.
 #[test]
 fn fairing_controls_explain_themselves_and_say_why_they_are_off() {
     // Tall enough that the whole side panel is on screen.
@@ -804,7 +804,7 @@ fn a_file_opens_at_a_middle_level_then_at_the_last_one_chosen() {
     assert_eq!(reopened.faired_level, Some(2));
 }
 
-/// Opening the Performance section does not widen the side panel (issue 13: it widened it for
+/// Opening the Performance section does not widen the side panel (it once widened it for
 /// good, taking the viewport's room).
 #[test]
 fn performance_section_keeps_the_side_panel_width() {

@@ -1,4 +1,4 @@
-//! Headless tests of what an artist expects of an editor (issue 13): a question before Export
+//! Headless tests of what an artist expects of an editor: a question before Export
 //! replaces a file, a PNG of the 3D view, recent files, smooth shading.
 #![cfg(feature = "gui")]
 

@@ -1,4 +1,4 @@
-//! Headless tests of the editor's compare-and-experiment tools (issue 6), driving the real app
+//! Headless tests of the editor's compare-and-experiment tools, driving the real app
 //! through egui_kittest on a software wgpu adapter: noise injection with a clean reference, the
 //! live numbers, the heat map and its legend, undo and redo of document changes, the baseline
 //! methods, the before/after views (snapshot images compared with a tolerance;
@@ -179,7 +179,7 @@ fn undo_restores_the_noisy_mesh_exactly_and_redo_brings_the_result_back() {
 
 /// "Apply result" makes the result the document, and the view keeps showing exactly that mesh
 /// until a setting changes: the applied mesh is not faired again with the same settings, so
-/// Export writes the mesh the user applied (issue 13: it wrote a mesh faired twice).
+/// Export writes the mesh the user applied (it once wrote a mesh faired twice).
 #[test]
 fn an_applied_result_stays_on_screen_and_is_what_export_writes() {
     let dir = tempfile::tempdir().unwrap();

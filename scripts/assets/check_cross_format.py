@@ -10,7 +10,7 @@ Usage (from the repository root, after building fairmesh):
     target/release/fairmesh fair tests/data/roundtrip/scene.glb -o $OUT/scene.ply
     /work/venv/bin/python scripts/assets/check_cross_format.py $OUT
 
-It asserts what issue 11 asks the outputs to keep: glTF -> OBJ: the node names as objects, the
+It asserts what the outputs must keep: glTF -> OBJ: the node names as objects, the
 two materials with the texture image beside the .mtl, UVs; OBJ -> glTF: named nodes and meshes,
 one primitive per material, pbrMetallicRoughness with the texture, UVs and normals; glTF -> PLY:
 colours, UVs and normals. Prints what it checked; exits non-zero on the first failure.

@@ -13,7 +13,7 @@ row is its best iteration count by mean distance, picked knowing the clean mesh 
 user has).
 
 Peers: fairmesh's own baselines (`fair --method laplacian|taubin|hc`, the "Laplacian, Taubin and
-HC baselines" issue 12's targets name), and those installed of trimesh (Taubin, Humphrey,
+HC baselines" the default's targets name), and those installed of trimesh (Taubin, Humphrey,
 Laplacian), PyMeshLab (Taubin, HC Laplacian), Open3D (Taubin). Install them in a virtual
 environment:
     python3 -m venv venv && venv/bin/pip install -r scripts/peers/requirements.txt
@@ -73,7 +73,7 @@ def load(path):
 
 def fairmesh_baseline(method):
     """fairmesh's own baseline `method` (`fair --method laplacian|taubin|hc`) as a peer: the
-    issue that set the default's targets names these three at their best iteration count."""
+    default's targets name these three at their best iteration count (Laplacian, Taubin, HC)."""
 
     def smooth(v, f, k):
         with tempfile.TemporaryDirectory() as tmp:

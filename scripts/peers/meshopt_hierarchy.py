@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """fairmesh's whole decimation hierarchy against one meshoptimizer simplification, side by side.
 
-Issue 14's yardstick: building every level of the hierarchy of a mesh should take well under
+The yardstick: building every level of the hierarchy of a mesh should take well under
 one `meshopt_simplify` of the same mesh to 1 % of its faces (meshoptimizer is the fast,
 widely used simplifier; it builds one level, we build all of them). The runs alternate, so a
 busy machine slows both alike.
