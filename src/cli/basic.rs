@@ -2,12 +2,16 @@
 
 use anyhow::Context;
 use clap::{Args, ValueEnum};
-use fairmesh::io::{self, LoadOptions, Loaded};
 use fairmesh::metrics;
 use fairmesh::noise::{self, NoiseMode, NoiseOptions};
 use serde_json::json;
 use std::fmt::Write as _;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
+
+use super::args::StdioFormat;
+use super::common::{
+    display_output, emit, is_stdio, load, load_input, load_shown, save_kept, stdio_format,
+};
 
 #[derive(Args, Debug)]
 pub struct InfoArgs {
@@ -20,7 +24,7 @@ pub struct InfoArgs {
     #[arg(long)]
     pub no_weld: bool,
     #[command(flatten)]
-    pub stdio: super::StdioFormat,
+    pub stdio: StdioFormat,
 }
 
 #[derive(Clone, Copy, Debug, ValueEnum)]
@@ -50,7 +54,7 @@ pub struct NoiseArgs {
     #[arg(long, value_enum, default_value_t = ModeArg::Normal)]
     pub mode: ModeArg,
     #[command(flatten)]
-    pub stdio: super::StdioFormat,
+    pub stdio: StdioFormat,
 }
 
 #[derive(Args, Debug)]
@@ -68,7 +72,7 @@ pub struct ConvertArgs {
     #[arg(long, default_value_t = 0)]
     pub subdivide: usize,
     #[command(flatten)]
-    pub stdio: super::StdioFormat,
+    pub stdio: StdioFormat,
 }
 
 #[derive(Args, Debug)]
@@ -80,71 +84,6 @@ pub struct CompareArgs {
     /// Print one JSON object instead of text.
     #[arg(long)]
     pub json: bool,
-}
-
-/// Loads an input mesh; `@bunny` is the bunny compiled into the binary. `-` is refused (the
-/// command has no `--format`); see [`load_from`].
-pub(crate) fn load(path: &Path, weld: bool) -> anyhow::Result<Loaded> {
-    if super::is_stdio(path) {
-        anyhow::bail!("this command reads files only, not standard input (`-`)");
-    }
-    load_from(path, weld, None)
-}
-
-/// [`load_from`] with a progress line on a terminal (see `progress`).
-pub(crate) fn load_shown(
-    path: &Path,
-    weld: bool,
-    format: Option<super::FormatArg>,
-) -> anyhow::Result<Loaded> {
-    super::progress::Step::run(format!("loading {}", super::display_input(path)), || {
-        load_from(path, weld, format)
-    })
-}
-
-/// [`load_shown`], then what the loader skipped or read leniently (faces with fewer than three
-/// corners, point and line primitives, a stray header line, ...) as warnings on standard error,
-/// for the commands that write a mesh: those parts are not in the output, and the user is told.
-/// (`info` lists them in its report instead.)
-pub(crate) fn load_input(
-    path: &Path,
-    weld: bool,
-    format: Option<super::FormatArg>,
-) -> anyhow::Result<Loaded> {
-    let loaded = load_shown(path, weld, format)?;
-    print_load_warnings(path, &loaded);
-    Ok(loaded)
-}
-
-/// Each of the loader's warnings on standard error, with the input's name.
-pub(crate) fn print_load_warnings(path: &Path, loaded: &Loaded) {
-    for warning in &loaded.report.warnings {
-        eprintln!("warning: {}: {warning}", super::display_input(path));
-    }
-}
-
-/// Loads an input mesh: a file, `@bunny` (the bunny compiled into the binary), or `-`, standard
-/// input in the format `format` names.
-pub(crate) fn load_from(
-    path: &Path,
-    weld: bool,
-    format: Option<super::FormatArg>,
-) -> anyhow::Result<Loaded> {
-    let options = LoadOptions { weld };
-    if fairmesh::bundled::is_bunny_pseudo_path(path) {
-        return Ok(fairmesh::bundled::load_bunny(&options)?);
-    }
-    if super::is_stdio(path) {
-        let format = super::stdio_format(format, "reading from standard input")?;
-        let stdin = std::io::stdin().lock();
-        return Ok(io::load_from_reader(
-            stdin,
-            format,
-            "standard input",
-            &options,
-        )?);
-    }
-    Ok(io::load_with(path, &options)?)
 }
 
 pub fn info(args: InfoArgs) -> anyhow::Result<()> {
@@ -188,7 +127,7 @@ pub fn info(args: InfoArgs) -> anyhow::Result<()> {
         "file_contents": contents,
     });
     if args.json {
-        return super::emit(&format!("{}\n", serde_json::to_string_pretty(&summary)?));
+        return emit(&format!("{}\n", serde_json::to_string_pretty(&summary)?));
     }
     let mut out = String::new();
     writeln!(out, "{}", args.file.display())?;
@@ -265,7 +204,7 @@ pub fn info(args: InfoArgs) -> anyhow::Result<()> {
     for warning in &report.warnings {
         writeln!(out, "  warning: {warning}")?;
     }
-    super::emit(&out)
+    emit(&out)
 }
 
 pub fn noise(args: NoiseArgs) -> anyhow::Result<()> {
@@ -274,8 +213,8 @@ pub fn noise(args: NoiseArgs) -> anyhow::Result<()> {
         "--sigma must be a finite number >= 0, got {}",
         args.sigma
     );
-    if super::is_stdio(&args.output) {
-        super::stdio_format(args.stdio.format, "writing to standard output")?;
+    if is_stdio(&args.output) {
+        stdio_format(args.stdio.format, "writing to standard output")?;
     }
     let mut loaded = load_input(&args.input, true, args.stdio.format)?;
     let mode = match args.mode {
@@ -290,7 +229,7 @@ pub fn noise(args: NoiseArgs) -> anyhow::Result<()> {
             .with_seed(args.seed)
             .with_mode(mode),
     );
-    super::save_kept(
+    save_kept(
         &args.output,
         &loaded.mesh,
         &loaded.source,
@@ -298,7 +237,7 @@ pub fn noise(args: NoiseArgs) -> anyhow::Result<()> {
     )?;
     eprintln!(
         "wrote {} (sigma {:.4e} model units, {:?}, seed {})",
-        super::display_output(&args.output),
+        display_output(&args.output),
         absolute,
         mode,
         args.seed
@@ -307,14 +246,14 @@ pub fn noise(args: NoiseArgs) -> anyhow::Result<()> {
 }
 
 pub fn convert(args: ConvertArgs) -> anyhow::Result<()> {
-    if super::is_stdio(&args.output) {
-        super::stdio_format(args.stdio.format, "writing to standard output")?;
+    if is_stdio(&args.output) {
+        stdio_format(args.stdio.format, "writing to standard output")?;
     }
     let mut loaded = load_input(&args.input, !args.no_weld, args.stdio.format)?;
     for _ in 0..args.subdivide {
         loaded.mesh = fairmesh::mesh::subdivide_loop(&loaded.mesh);
     }
-    super::save_kept(
+    save_kept(
         &args.output,
         &loaded.mesh,
         &loaded.source,
@@ -322,7 +261,7 @@ pub fn convert(args: ConvertArgs) -> anyhow::Result<()> {
     )?;
     eprintln!(
         "wrote {} ({} vertices, {} faces)",
-        super::display_output(&args.output),
+        display_output(&args.output),
         loaded.mesh.vertex_count(),
         loaded.mesh.face_count()
     );
@@ -355,7 +294,7 @@ pub fn compare(args: CompareArgs) -> anyhow::Result<()> {
         map.insert("sharpened_edges".into(), json!(count));
     }
     if args.json {
-        return super::emit(&format!("{}\n", serde_json::to_string_pretty(&object)?));
+        return emit(&format!("{}\n", serde_json::to_string_pretty(&object)?));
     }
     let mut out = String::new();
     writeln!(
@@ -397,5 +336,5 @@ pub fn compare(args: CompareArgs) -> anyhow::Result<()> {
         }
         None => writeln!(out, "  (different connectivity: no per-vertex measures)")?,
     }
-    super::emit(&out)
+    emit(&out)
 }

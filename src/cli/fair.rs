@@ -8,6 +8,11 @@ use fairmesh::fairing::{
 use std::path::PathBuf;
 use std::time::Instant;
 
+use super::args::{BoundaryArg, StdioFormat};
+use super::common::{
+    display_output, emit, is_stdio, load_input, median_ms, save_kept, stdio_format,
+};
+
 #[derive(Clone, Copy, Debug, ValueEnum)]
 pub enum MethodArg {
     /// Constrained fairing (the paper's method): smooths without shrinking.
@@ -18,14 +23,6 @@ pub enum MethodArg {
     Taubin,
     /// HC Laplacian of Vollmer et al. (for comparison).
     Hc,
-}
-
-#[derive(Clone, Copy, Debug, ValueEnum)]
-pub enum BoundaryArg {
-    /// Smooth each boundary loop as a curve (paper section 3.3).
-    Curve,
-    /// Keep boundary vertices where they are.
-    Fixed,
 }
 
 #[derive(Clone, Copy, Debug, ValueEnum, PartialEq, Eq)]
@@ -115,17 +112,14 @@ pub struct FairArgs {
     #[arg(long)]
     pub measure: bool,
     #[command(flatten)]
-    pub stdio: super::StdioFormat,
+    pub stdio: StdioFormat,
     #[command(flatten)]
     pub mask: super::mask::MaskArgs,
 }
 
 impl FairArgs {
     fn method_options(&self, mean_edge_length: f64) -> MethodOptions {
-        let boundary = match self.boundary {
-            BoundaryArg::Curve => BoundaryMode::Curve,
-            BoundaryArg::Fixed => BoundaryMode::Fixed,
-        };
+        let boundary = BoundaryMode::from(self.boundary);
         match self.method {
             MethodArg::Constrained => {
                 // `--variant paper` is the paper's method (`FairOptions::paper`): one round, no
@@ -194,13 +188,13 @@ const TEXTURE_SLIDE_WARNING: f64 = 0.02;
 
 pub fn run(args: FairArgs) -> anyhow::Result<()> {
     anyhow::ensure!(
-        !(args.json && super::is_stdio(&args.output)),
+        !(args.json && is_stdio(&args.output)),
         "--json and `-o -` would both write to standard output: write the mesh to a file"
     );
-    if super::is_stdio(&args.output) {
-        super::stdio_format(args.stdio.format, "writing to standard output")?;
+    if is_stdio(&args.output) {
+        stdio_format(args.stdio.format, "writing to standard output")?;
     }
-    let loaded = super::basic::load_input(&args.input, true, args.stdio.format)?;
+    let loaded = load_input(&args.input, true, args.stdio.format)?;
     let (mut mesh, topology, source) = (loaded.mesh, loaded.topology, loaded.source);
     let edge = fairmesh::metrics::mean_edge_length(&mesh);
     let mut options = args.method_options(edge);
@@ -237,7 +231,7 @@ pub fn run(args: FairArgs) -> anyhow::Result<()> {
     let volume_change_percent = (volume_before != 0.0)
         .then(|| 100.0 * (volume_after - volume_before) / volume_before.abs())
         .filter(|change| change.is_finite());
-    let saved = super::save_kept(&args.output, &mesh, &source, args.stdio.format)?;
+    let saved = save_kept(&args.output, &mesh, &source, args.stdio.format)?;
     // In mean edge lengths of the input; none when no round ran.
     let texture_slide = textured_input
         .filter(|_| report.rounds_run > 0)
@@ -314,7 +308,7 @@ pub fn run(args: FairArgs) -> anyhow::Result<()> {
                 map.insert("normal_error_deg".into(), c.normal_error_deg.into());
             }
         }
-        return super::emit(&format!("{json}\n"));
+        return emit(&format!("{json}\n"));
     }
     let volume = match volume_change_percent {
         Some(change) if topology.is_closed() => format!("{change:+.4}%"),
@@ -361,28 +355,15 @@ pub fn run(args: FairArgs) -> anyhow::Result<()> {
         time_ms,
         report.max_move,
         measured,
-        super::display_output(&args.output)
+        display_output(&args.output)
     );
-    if super::is_stdio(&args.output) {
+    if is_stdio(&args.output) {
         // Standard output holds the mesh.
         eprint!("{sentence}");
         Ok(())
     } else {
-        super::emit(&sentence)
+        emit(&sentence)
     }
-}
-
-/// Median time in milliseconds of `runs` calls of `work`.
-fn median_ms(runs: usize, mut work: impl FnMut()) -> f64 {
-    let mut times: Vec<f64> = (0..runs.max(1))
-        .map(|_| {
-            let start = Instant::now();
-            work();
-            start.elapsed().as_secs_f64() * 1e3
-        })
-        .collect();
-    times.sort_by(f64::total_cmp);
-    times[times.len() / 2]
 }
 
 /// Rows for `fairmesh bench`: (operation, milliseconds), medians of several runs.

@@ -4,7 +4,6 @@
 use anyhow::Context;
 use clap::{Args, ValueEnum};
 use fairmesh::fairing::creases::CreaseOptions;
-use fairmesh::fairing::BoundaryMode;
 use fairmesh::hierarchy::{
     build_hierarchy, build_hierarchy_with_topology, Hierarchy, HierarchyOptions,
 };
@@ -15,6 +14,12 @@ use serde_json::json;
 use std::fmt::Write as _;
 use std::path::PathBuf;
 use std::time::Instant;
+
+use super::args::{BoundaryArg, StdioFormat};
+use super::common::{
+    emit, is_stdio, load, load_input, load_shown, median_ms, print_load_warnings, save_kept,
+    stdio_format,
+};
 
 #[derive(Args, Debug, Clone)]
 pub struct BuildArgs {
@@ -89,12 +94,6 @@ pub struct HierarchyArgs {
 }
 
 #[derive(Clone, Copy, Debug, ValueEnum, PartialEq, Eq)]
-pub enum BoundaryArg {
-    Curve,
-    Fixed,
-}
-
-#[derive(Clone, Copy, Debug, ValueEnum, PartialEq, Eq)]
 pub enum VariantArg {
     /// The paper's placement of split vertices (1-ring mean plus one Kobbelt step).
     Paper,
@@ -120,7 +119,7 @@ pub struct MultiresArgs {
     /// Fairing rounds per level (each re-imposes the constraints).
     #[arg(long, default_value_t = 1)]
     pub rounds: usize,
-    #[arg(long, value_enum, default_value_t = BoundaryArg::Curve)]
+    #[arg(long, default_value = "curve", value_parser = BoundaryArg::names_only_parser())]
     pub boundary: BoundaryArg,
     /// Also fair M0 after the last refinement.
     #[arg(long)]
@@ -146,7 +145,7 @@ pub struct MultiresArgs {
     #[arg(long)]
     pub json: bool,
     #[command(flatten)]
-    pub stdio: super::StdioFormat,
+    pub stdio: StdioFormat,
     #[command(flatten)]
     pub build: BuildArgs,
     #[command(flatten)]
@@ -182,9 +181,9 @@ pub fn run_hierarchy(args: HierarchyArgs) -> anyhow::Result<()> {
     // (Its --format is the levels' format: it reads files only.)
     let mut loaded =
         super::progress::Step::run(format!("loading {}", args.input.display()), || {
-            super::basic::load(&args.input, true)
+            load(&args.input, true)
         })?;
-    super::basic::print_load_warnings(&args.input, &loaded);
+    print_load_warnings(&args.input, &loaded);
     // The file's own sharp edges, like the connectivity below, serve the crease detection only.
     let keep_creases = args.subdivide == 0 && args.build.options().creases.is_some();
     let file_edges = if keep_creases {
@@ -258,7 +257,7 @@ pub fn run_hierarchy(args: HierarchyArgs) -> anyhow::Result<()> {
             "record_bytes_per_vertex":
                 hierarchy.record_bytes() as f64 / loaded.mesh.vertex_count().max(1) as f64,
         });
-        return super::emit(&format!("{}\n", serde_json::to_string_pretty(&object)?));
+        return emit(&format!("{}\n", serde_json::to_string_pretty(&object)?));
     }
     let creases = match hierarchy.crease_edge_count() {
         0 => String::new(),
@@ -283,7 +282,7 @@ pub fn run_hierarchy(args: HierarchyArgs) -> anyhow::Result<()> {
             hierarchy.level_build_ms(level)
         )?;
     }
-    super::emit(&out)
+    emit(&out)
 }
 
 /// What the build did with a mesh that is not an oriented 2-manifold, on stderr.
@@ -307,16 +306,16 @@ fn print_notes(hierarchy: &Hierarchy, input: &std::path::Path) {
 }
 
 pub fn run_multires(args: MultiresArgs) -> anyhow::Result<()> {
-    let to_stdout = args.output.as_deref().is_some_and(super::is_stdio);
+    let to_stdout = args.output.as_deref().is_some_and(is_stdio);
     anyhow::ensure!(
         !(args.json && to_stdout),
         "--json and `-o -` would both write to standard output: write the mesh to a file"
     );
     if to_stdout {
-        super::stdio_format(args.stdio.format, "writing to standard output")?;
+        stdio_format(args.stdio.format, "writing to standard output")?;
     }
     let measure = args.measure || args.reference.is_some();
-    let loaded = super::basic::load_input(&args.input, true, args.stdio.format)?;
+    let loaded = load_input(&args.input, true, args.stdio.format)?;
     let source = loaded.source;
     let mask = super::mask::load_for(&args.mask, &source, &loaded.mesh, Some(&loaded.topology))?;
     // The connectivity serves the crease detection only; otherwise it goes before the build.
@@ -333,7 +332,7 @@ pub fn run_multires(args: MultiresArgs) -> anyhow::Result<()> {
     };
     let mut input = loaded.mesh;
     let reference_file = match &args.reference {
-        Some(path) => Some(super::basic::load_shown(path, true, None)?.mesh),
+        Some(path) => Some(load_shown(path, true, None)?.mesh),
         None => None,
     };
     // Results are measured against the input before any noise: keep a copy only when the noise
@@ -396,10 +395,7 @@ pub fn run_multires(args: MultiresArgs) -> anyhow::Result<()> {
                 .with_start_level(level)
                 .with_iterations(args.iterations)
                 .with_rounds(args.rounds)
-                .with_boundary(match args.boundary {
-                    BoundaryArg::Curve => BoundaryMode::Curve,
-                    BoundaryArg::Fixed => BoundaryMode::Fixed,
-                })
+                .with_boundary(args.boundary.into())
                 .with_fair_finest(args.fair_finest)
                 .with_mask(mask.clone())
                 .with_variant(match variant {
@@ -455,7 +451,7 @@ pub fn run_multires(args: MultiresArgs) -> anyhow::Result<()> {
         }
     }
     if let (Some(path), Some(result)) = (&args.output, &last) {
-        super::save_kept(path, result, &source, args.stdio.format)?;
+        save_kept(path, result, &source, args.stdio.format)?;
     }
     if args.json {
         let value = if results.len() == 1 {
@@ -463,7 +459,7 @@ pub fn run_multires(args: MultiresArgs) -> anyhow::Result<()> {
         } else {
             serde_json::Value::Array(results)
         };
-        return super::emit(&format!("{}\n", serde_json::to_string_pretty(&value)?));
+        return emit(&format!("{}\n", serde_json::to_string_pretty(&value)?));
     }
     let mut out = format!(
         "{}: hierarchy of {} level{} in {:.1} ms{}\nlevel  vertices  variant   time ms   volume %{}\n",
@@ -512,7 +508,7 @@ pub fn run_multires(args: MultiresArgs) -> anyhow::Result<()> {
         eprint!("{out}");
         Ok(())
     } else {
-        super::emit(&out)
+        emit(&out)
     }
 }
 
@@ -521,7 +517,7 @@ pub fn bench_rows(mesh: &TriMesh, topology: &Topology) -> Vec<(String, f64)> {
     let runs = 5;
     let options = HierarchyOptions::default();
     let mut hierarchy = None;
-    let build_ms = super::bench::median_ms(runs, || {
+    let build_ms = median_ms(runs, || {
         hierarchy = build_hierarchy(mesh, &options, &mut NoProgress).ok();
     });
     let mut rows = vec![("hierarchy build".to_string(), build_ms)];
@@ -531,7 +527,7 @@ pub fn bench_rows(mesh: &TriMesh, topology: &Topology) -> Vec<(String, f64)> {
         HierarchyOptions::default().with_creases(Some(fairmesh::fairing::CreaseOptions::default()));
     rows.push((
         "hierarchy build keeping creases".to_string(),
-        super::bench::median_ms(runs, || {
+        median_ms(runs, || {
             std::hint::black_box(
                 build_hierarchy_with_topology(mesh, topology, &with_creases, &mut NoProgress).ok(),
             );
@@ -544,7 +540,7 @@ pub fn bench_rows(mesh: &TriMesh, topology: &Topology) -> Vec<(String, f64)> {
     // What `fairmesh multires` pays once: its one run also sets up every level's fairing
     // (connectivity, valences, per-triangle matrices), level by level.
     let options = MultiresOptions::default().with_start_level(coarsest / 2);
-    let first_ms = super::bench::median_ms(runs, || {
+    let first_ms = median_ms(runs, || {
         std::hint::black_box(fair_multires(
             &hierarchy,
             &options,
@@ -561,7 +557,7 @@ pub fn bench_rows(mesh: &TriMesh, topology: &Topology) -> Vec<(String, f64)> {
         let options = MultiresOptions::default().with_start_level(level);
         // Warm the workspace (per-level connectivity) once, then time.
         let _ = fair_multires(&hierarchy, &options, &mut workspace, &mut NoProgress);
-        let ms = super::bench::median_ms(runs, || {
+        let ms = median_ms(runs, || {
             std::hint::black_box(fair_multires(
                 &hierarchy,
                 &options,
