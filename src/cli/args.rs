@@ -63,7 +63,9 @@ impl BoundaryArg {
     /// does (`multires --boundary`; `fair --boundary` lists both).
     pub fn names_only_parser() -> impl TypedValueParser<Value = BoundaryArg> {
         PossibleValuesParser::new(Self::value_variants().iter().filter_map(|value| {
-            value.to_possible_value().map(|possible| possible.help(None))
+            value
+                .to_possible_value()
+                .map(|possible| possible.help(None))
         }))
         .map(|name| {
             Self::from_str(&name, false).expect("the parser accepts only BoundaryArg's names")

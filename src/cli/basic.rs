@@ -2,15 +2,16 @@
 
 use anyhow::Context;
 use clap::{Args, ValueEnum};
+use fairmesh::io::Loaded;
 use fairmesh::metrics;
 use fairmesh::noise::{self, NoiseMode, NoiseOptions};
 use serde_json::json;
 use std::fmt::Write as _;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 use super::args::StdioFormat;
 use super::common::{
-    display_output, emit, is_stdio, load, load_input, load_shown, save_kept, stdio_format,
+    check_output_format, display_output, emit, load, load_input, load_shown, save_kept,
 };
 
 #[derive(Args, Debug)]
@@ -88,18 +89,53 @@ pub struct CompareArgs {
 
 pub fn info(args: InfoArgs) -> anyhow::Result<()> {
     let loaded = load_shown(&args.file, !args.no_weld, args.stdio.format)?;
+    let facts = Facts::of(&loaded);
+    if args.json {
+        let summary = info_json(&args.file, &loaded, &facts);
+        return emit(&format!("{}\n", serde_json::to_string_pretty(&summary)?));
+    }
+    let mut out = String::new();
+    writeln!(out, "{}", args.file.display())?;
+    write_counts(&mut out, &loaded)?;
+    write_topology(&mut out, &loaded, &facts)?;
+    write_measures(&mut out, &loaded, &facts)?;
+    write_load_report(&mut out, &loaded, &facts)?;
+    emit(&out)
+}
+
+/// What `info` derives from a loaded mesh, for both its JSON and its text.
+struct Facts {
+    closed: bool,
+    /// The enclosed volume, of a closed mesh only.
+    volume: Option<f64>,
+    bbox: Option<(fairmesh::glam::DVec3, fairmesh::glam::DVec3)>,
+    /// What the default `fair` leaves out (`mesh::without_loose_triangles`).
+    loose_triangles: usize,
+    /// What the file holds beyond the mesh: kept when saving to the same format.
+    contents: Vec<String>,
+}
+
+impl Facts {
+    fn of(loaded: &Loaded) -> Self {
+        let (mesh, topology) = (&loaded.mesh, &loaded.topology);
+        let closed = topology.is_closed();
+        Facts {
+            closed,
+            volume: closed.then(|| metrics::signed_volume(mesh)),
+            bbox: metrics::bounding_box(mesh),
+            loose_triangles: fairmesh::mesh::without_loose_triangles(mesh, topology)
+                .map_or(0, |(loose, ..)| loose.len()),
+            contents: loaded.source.contents(),
+        }
+    }
+}
+
+/// `info --json`: one object.
+fn info_json(file: &Path, loaded: &Loaded, facts: &Facts) -> serde_json::Value {
     let (mesh, topology, report) = (&loaded.mesh, &loaded.topology, &loaded.report);
-    let closed = topology.is_closed();
-    let volume = closed.then(|| metrics::signed_volume(mesh));
-    let bbox = metrics::bounding_box(mesh);
     let genus: Vec<Option<i64>> = topology.components.iter().map(|c| c.genus).collect();
-    // What the default `fair` leaves out (`mesh::without_loose_triangles`).
-    let loose_triangles = fairmesh::mesh::without_loose_triangles(mesh, topology)
-        .map_or(0, |(loose, ..)| loose.len());
-    // What the file holds beyond the mesh: kept when saving to the same format.
-    let contents = loaded.source.contents();
-    let summary = json!({
-        "file": args.file.display().to_string(),
+    json!({
+        "file": file.display().to_string(),
         "vertices": mesh.vertex_count(),
         "faces": mesh.face_count(),
         "edges": topology.edge_count(),
@@ -108,29 +144,29 @@ pub fn info(args: InfoArgs) -> anyhow::Result<()> {
         "components": topology.components.len(),
         "genus": genus,
         "euler_characteristic": topology.euler_characteristic(),
-        "closed": closed,
+        "closed": facts.closed,
         "manifold": topology.is_manifold(),
         "oriented": topology.inconsistent_edges == 0,
         "non_manifold_edges": topology.non_manifold_edges.len(),
         "non_manifold_vertices": topology.non_manifold_vertices.len(),
-        "loose_triangles": loose_triangles,
+        "loose_triangles": facts.loose_triangles,
         "inconsistently_oriented_edges": topology.inconsistent_edges,
-        "volume": volume,
+        "volume": facts.volume,
         "area": metrics::area(mesh),
         "mean_edge_length": metrics::mean_edge_length(mesh),
-        "bounding_box": bbox.map(|(lo, hi)| json!({"min": lo.to_array(), "max": hi.to_array()})),
+        "bounding_box": facts.bbox.map(|(lo, hi)| json!({"min": lo.to_array(), "max": hi.to_array()})),
         "welded_vertices": report.welded_vertices,
         "removed_degenerate_faces": report.removed_degenerate_faces,
         "removed_repeated_faces": report.removed_repeated_faces,
         "removed_unreferenced_vertices": report.removed_unreferenced_vertices,
         "warnings": report.warnings,
-        "file_contents": contents,
-    });
-    if args.json {
-        return emit(&format!("{}\n", serde_json::to_string_pretty(&summary)?));
-    }
-    let mut out = String::new();
-    writeln!(out, "{}", args.file.display())?;
+        "file_contents": facts.contents,
+    })
+}
+
+/// The counts, and the first ten components.
+fn write_counts(out: &mut String, loaded: &Loaded) -> std::fmt::Result {
+    let (mesh, topology) = (&loaded.mesh, &loaded.topology);
     writeln!(out, "  vertices            {}", mesh.vertex_count())?;
     writeln!(out, "  faces               {}", mesh.face_count())?;
     writeln!(out, "  edges               {}", topology.edge_count())?;
@@ -145,12 +181,18 @@ pub fn info(args: InfoArgs) -> anyhow::Result<()> {
             c.vertices, c.faces, c.boundary_loops
         )?;
     }
+    Ok(())
+}
+
+/// Boundary loops, whether the mesh is closed and a manifold, and its loose triangles.
+fn write_topology(out: &mut String, loaded: &Loaded, facts: &Facts) -> std::fmt::Result {
+    let topology = &loaded.topology;
     writeln!(
         out,
         "  boundary loops      {}",
         topology.boundary_loops.len()
     )?;
-    writeln!(out, "  closed              {closed}")?;
+    writeln!(out, "  closed              {}", facts.closed)?;
     writeln!(
         out,
         "  manifold            {} ({} non-manifold edges, {} non-manifold vertices, {} inconsistently oriented edges)",
@@ -159,14 +201,21 @@ pub fn info(args: InfoArgs) -> anyhow::Result<()> {
         topology.non_manifold_vertices.len(),
         topology.inconsistent_edges
     )?;
-    if loose_triangles > 0 {
+    if facts.loose_triangles > 0 {
         writeln!(
             out,
-            "  loose triangles     {loose_triangles} (over other triangles, or fins hanging from an \
-             edge: the default fair smooths the surface without them)"
+            "  loose triangles     {} (over other triangles, or fins hanging from an \
+             edge: the default fair smooths the surface without them)",
+            facts.loose_triangles
         )?;
     }
-    match volume {
+    Ok(())
+}
+
+/// Volume, area, mean edge length and bounding box.
+fn write_measures(out: &mut String, loaded: &Loaded, facts: &Facts) -> std::fmt::Result {
+    let mesh = &loaded.mesh;
+    match facts.volume {
         Some(v) => writeln!(out, "  volume              {v:.6e}")?,
         None => writeln!(out, "  volume              n/a (open mesh)")?,
     }
@@ -176,13 +225,19 @@ pub fn info(args: InfoArgs) -> anyhow::Result<()> {
         "  mean edge length    {:.6e}",
         metrics::mean_edge_length(mesh)
     )?;
-    if let Some((lo, hi)) = bbox {
+    if let Some((lo, hi)) = facts.bbox {
         writeln!(
             out,
             "  bounding box        [{:.4}, {:.4}, {:.4}] .. [{:.4}, {:.4}, {:.4}]",
             lo.x, lo.y, lo.z, hi.x, hi.y, hi.z
         )?;
     }
+    Ok(())
+}
+
+/// What loading repaired, what else the file holds, and the loader's warnings.
+fn write_load_report(out: &mut String, loaded: &Loaded, facts: &Facts) -> std::fmt::Result {
+    let report = &loaded.report;
     writeln!(out, "  welded vertices     {}", report.welded_vertices)?;
     writeln!(
         out,
@@ -191,20 +246,20 @@ pub fn info(args: InfoArgs) -> anyhow::Result<()> {
         report.removed_repeated_faces,
         report.removed_unreferenced_vertices
     )?;
-    if !contents.is_empty() {
+    if !facts.contents.is_empty() {
         writeln!(
             out,
             "  also in the file    (kept when saving as {}):",
             loaded.source.format()
         )?;
-        for item in &contents {
+        for item in &facts.contents {
             writeln!(out, "    {item}")?;
         }
     }
     for warning in &report.warnings {
         writeln!(out, "  warning: {warning}")?;
     }
-    emit(&out)
+    Ok(())
 }
 
 pub fn noise(args: NoiseArgs) -> anyhow::Result<()> {
@@ -213,9 +268,7 @@ pub fn noise(args: NoiseArgs) -> anyhow::Result<()> {
         "--sigma must be a finite number >= 0, got {}",
         args.sigma
     );
-    if is_stdio(&args.output) {
-        stdio_format(args.stdio.format, "writing to standard output")?;
-    }
+    check_output_format(&args.output, args.stdio.format)?;
     let mut loaded = load_input(&args.input, true, args.stdio.format)?;
     let mode = match args.mode {
         ModeArg::Direction => NoiseMode::Direction,
@@ -246,9 +299,7 @@ pub fn noise(args: NoiseArgs) -> anyhow::Result<()> {
 }
 
 pub fn convert(args: ConvertArgs) -> anyhow::Result<()> {
-    if is_stdio(&args.output) {
-        stdio_format(args.stdio.format, "writing to standard output")?;
-    }
+    check_output_format(&args.output, args.stdio.format)?;
     let mut loaded = load_input(&args.input, !args.no_weld, args.stdio.format)?;
     for _ in 0..args.subdivide {
         loaded.mesh = fairmesh::mesh::subdivide_loop(&loaded.mesh);

@@ -24,6 +24,14 @@ pub(crate) fn stdio_format(format: Option<FormatArg>, what: &str) -> anyhow::Res
     })
 }
 
+/// Refuses `output` `-` without `--format`, before any work is done.
+pub(crate) fn check_output_format(output: &Path, format: Option<FormatArg>) -> anyhow::Result<()> {
+    if is_stdio(output) {
+        stdio_format(format, "writing to standard output")?;
+    }
+    Ok(())
+}
+
 /// An input path as messages show it: `-` is "standard input".
 pub(crate) fn display_input(path: &Path) -> String {
     if is_stdio(path) {

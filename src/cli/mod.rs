@@ -1,6 +1,6 @@
 //! The command-line tool: subcommands on top of the library. `basic.rs` holds `info`, `noise`,
-//! `convert` and `compare`; `fair.rs` `fair`; `hierarchy.rs` `hierarchy` and `multires`;
-//! `bench.rs` `bench`. Beside them: `args.rs`, the argument types several commands share;
+//! `convert` and `compare`; `fair.rs` `fair`; `hierarchy.rs` `hierarchy`; `multires.rs`
+//! `multires`; `bench.rs` `bench`. Beside them: `args.rs`, the argument types several commands share;
 //! `common.rs`, loading the input, saving the result and writing the report; `mask.rs`, `--mask`;
 //! `progress.rs`, the progress line of long steps.
 
@@ -11,6 +11,7 @@ mod common;
 mod fair;
 mod hierarchy;
 mod mask;
+mod multires;
 mod progress;
 
 use clap::{Parser, Subcommand};
@@ -66,7 +67,7 @@ pub enum Command {
     /// Build the decimation hierarchy and print its levels.
     Hierarchy(hierarchy::HierarchyArgs),
     /// Multiresolution fairing from a chosen start level.
-    Multires(hierarchy::MultiresArgs),
+    Multires(multires::MultiresArgs),
     /// Time the operations that matter on a mesh.
     Bench(bench::BenchArgs),
 }
@@ -80,8 +81,8 @@ pub fn run(command: Command) -> anyhow::Result<()> {
         Command::Convert(args) => basic::convert(args),
         Command::Compare(args) => basic::compare(args),
         Command::Fair(args) => fair::run(args),
-        Command::Hierarchy(args) => hierarchy::run_hierarchy(args),
-        Command::Multires(args) => hierarchy::run_multires(args),
+        Command::Hierarchy(args) => hierarchy::run(args),
+        Command::Multires(args) => multires::run(args),
         Command::Bench(args) => bench::run(args),
     }
 }
