@@ -4,8 +4,8 @@
 //! loading, the hierarchy, the fairing and the measuring. Reads the app's state, writes nothing.
 
 use super::panel_view::PanelView;
-use super::panels::seconds;
 use super::state::{HierarchyState, Measures, MethodChoice};
+use super::widgets::seconds;
 
 /// What a greyed number in the Numbers panel means.
 const PENDING_TIP: &str =

@@ -5,8 +5,8 @@
 use super::command::PanelChange;
 use super::paint::BrushView;
 use super::panel_view::{Commands, PanelView, ViewportState, ViewportView};
-use super::panels::tips;
 use super::state::{CompareView, Settings, ViewMode};
+use super::tips;
 use super::Command;
 
 /// The side panel's section: paint mode, brush, mask tint, clear and invert.
