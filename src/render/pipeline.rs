@@ -91,6 +91,16 @@ struct Progress {
     recording: Duration,
 }
 
+/// What [`MeshRenderer::draw_next_part`] did.
+enum PartDrawn {
+    /// Nothing: there is no target to draw into.
+    NoTarget,
+    /// A part; the image needs more.
+    MoreToDraw,
+    /// The last part: the complete image is in the shown target.
+    Complete,
+}
+
 /// Owns the pipelines, the mesh buffers and the offscreen target. Knows nothing of fairing.
 pub struct MeshRenderer {
     pipelines: Pipelines,
@@ -557,12 +567,8 @@ impl MeshRenderer {
         if params.wireframe {
             self.ensure_lines(device);
         }
-        // The pipelines must match the target's sampling (the mesh may have changed since the
-        // target was made: it is made again in the next frame's `ensure_target`).
-        let pipelines = match (&self.target, &self.single_sample) {
-            (Some(target), _) if target.samples == SAMPLE_COUNT => &self.pipelines,
-            (Some(_), Some(single)) => single,
-            _ => return false,
+        let Some(pipelines) = self.pipelines() else {
+            return false;
         };
         queue.write_buffer(&pipelines.uniform_buffer, 0, bytemuck::bytes_of(&uniforms));
         let Some(target) = &self.target else {
@@ -577,48 +583,89 @@ impl MeshRenderer {
             pipelines.draw(encoder, target, mesh, params.wireframe);
             self.last_draw_time = started.elapsed();
         } else {
-            // Part of an image too big for one frame, into the work target.
-            if self
-                .work
-                .as_ref()
-                .is_none_or(|w| w.size != target.size || w.samples != target.samples)
-            {
-                self.work = Some(Target::new(device, target.size, target.samples));
+            match self.draw_next_part(device, encoder, params, (faces, total), started) {
+                PartDrawn::NoTarget => return false,
+                PartDrawn::MoreToDraw => return true,
+                PartDrawn::Complete => {}
             }
-            let Some(work) = &self.work else {
-                return false;
-            };
-            let start = self.progress.as_ref().map_or(0, |p| p.done);
-            let end = (start as usize + self.faces_per_frame).min(total) as u32;
-            let part = Part {
-                faces: start.min(faces)..end.min(faces),
-                edges: start.saturating_sub(faces)..end.saturating_sub(faces),
-                first: start == 0,
-            };
-            let last = end as usize == total;
-            pipelines.draw_part(encoder, work, mesh, params.wireframe, &part, last);
-            let recording = self
-                .progress
-                .as_ref()
-                .map_or(Duration::ZERO, |p| p.recording)
-                + started.elapsed();
-            if !last {
-                self.progress = Some(Progress {
-                    params,
-                    done: end,
-                    recording,
-                });
-                (self.repaint)();
-                return true;
-            }
-            work.copy_image_to(encoder, target);
-            self.progress = None;
-            self.last_draw_time = recording;
         }
         self.target_has_image = true;
         self.drawn = Some(params);
         self.images_drawn += 1;
         true
+    }
+
+    /// The pipelines that match the target's sampling (the mesh may have changed since the
+    /// target was made: it is made again in the next frame's `ensure_target`); `None` without a
+    /// target, or without the single-sample pipelines it needs.
+    fn pipelines(&self) -> Option<&Pipelines> {
+        match (&self.target, &self.single_sample) {
+            (Some(target), _) if target.samples == SAMPLE_COUNT => Some(&self.pipelines),
+            (Some(_), Some(single)) => Some(single),
+            _ => None,
+        }
+    }
+
+    /// Draws the next part of an image too big for one frame (of `faces` faces and `total` faces
+    /// and wireframe edges) into the work target; the part that completes it is copied into the
+    /// shown target. `started` is when this frame's recording began.
+    fn draw_next_part(
+        &mut self,
+        device: &wgpu::Device,
+        encoder: &mut wgpu::CommandEncoder,
+        params: DrawParams,
+        (faces, total): (u32, usize),
+        started: std::time::Instant,
+    ) -> PartDrawn {
+        let Some((size, samples)) = self.target.as_ref().map(|t| (t.size, t.samples)) else {
+            return PartDrawn::NoTarget;
+        };
+        if self
+            .work
+            .as_ref()
+            .is_none_or(|w| w.size != size || w.samples != samples)
+        {
+            self.work = Some(Target::new(device, size, samples));
+        }
+        let (Some(pipelines), Some(target), Some(work)) =
+            (self.pipelines(), &self.target, &self.work)
+        else {
+            return PartDrawn::NoTarget;
+        };
+        let start = self.progress.as_ref().map_or(0, |p| p.done);
+        let end = (start as usize + self.faces_per_frame).min(total) as u32;
+        let part = Part {
+            faces: start.min(faces)..end.min(faces),
+            edges: start.saturating_sub(faces)..end.saturating_sub(faces),
+            first: start == 0,
+        };
+        let last = end as usize == total;
+        pipelines.draw_part(
+            encoder,
+            work,
+            self.mesh.as_ref(),
+            params.wireframe,
+            &part,
+            last,
+        );
+        let recording = self
+            .progress
+            .as_ref()
+            .map_or(Duration::ZERO, |p| p.recording)
+            + started.elapsed();
+        if !last {
+            self.progress = Some(Progress {
+                params,
+                done: end,
+                recording,
+            });
+            (self.repaint)();
+            return PartDrawn::MoreToDraw;
+        }
+        work.copy_image_to(encoder, target);
+        self.progress = None;
+        self.last_draw_time = recording;
+        PartDrawn::Complete
     }
 
     /// Builds the wireframe's edges of the mesh on screen when they are missing and fit: a big
