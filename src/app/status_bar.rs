@@ -21,9 +21,9 @@ pub(super) fn status_bar(ui: &mut egui::Ui, view: &PanelView, commands: &mut Com
             .inner_margin(6.0)
             .corner_radius(4.0)
             .show(ui, |ui| {
-                // The button first and the message wrapped in the width left: a long message
-                // (a path, then what is wrong and what to do) once ran past the window's
-                // edge, taking its end and the button with it.
+                // The button first and the message wrapped in the width left, so that a long
+                // message (a path, then what is wrong and what to do) never runs past the
+                // window's edge, taking its end and the button with it.
                 ui.horizontal(|ui| {
                     if ui
                         .button("Dismiss")

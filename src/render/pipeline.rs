@@ -36,15 +36,15 @@ const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
 const SAMPLE_COUNT: u32 = 4;
 
 /// On a software renderer (lavapipe, llvmpipe: a CPU adapter), meshes with more faces than this
-/// are drawn without multisampling: the 1.2M-face bunny's image took 1.7 s with 4 samples and
-/// 0.6-0.85 s with one under lavapipe on two cores, and the window waits for it.
+/// are drawn without multisampling: on the CPU, four samples cost several times the drawing of
+/// one, and the window waits for the image.
 pub const SOFTWARE_SINGLE_SAMPLE_FACES: usize = 400_000;
 
 /// On a software renderer, a new image draws at most this many faces (or wireframe edges) per
 /// frame: a bigger mesh's image is drawn over several frames into a second target while the
-/// previous image stays on screen, then copied over it. Drawing the 1.2M-face bunny's image
-/// in one frame kept the window from answering input for 0.6-0.85 s under lavapipe on two cores;
-/// in parts of this size each frame stays under ~100 ms.
+/// previous image stays on screen, then copied over it. A big mesh's image drawn in one frame
+/// would keep the window from answering input until it is done; parts of this size keep each
+/// frame short.
 pub const SOFTWARE_FACES_PER_FRAME: usize = 50_000;
 
 /// Everything that decides what one rendered image looks like, apart from the mesh itself.
