@@ -23,7 +23,7 @@ fn main() -> ExitCode {
 
 /// The error and its causes on one line, `: ` between them, leaving out a cause that an earlier
 /// message already says (errors that name their cause in their own message also return it as
-/// their source, and printing both said it twice).
+/// their source: printing both would say it twice).
 fn error_message(error: &anyhow::Error) -> String {
     let mut message = String::new();
     for cause in error.chain() {

@@ -84,32 +84,30 @@ impl Worker {
 
     /// Queues `job` behind the others.
     pub fn submit(&self, job: impl FnOnce() + Send + 'static) {
-        self.lock().jobs.push_back(Queued {
-            slot: None,
-            job: Box::new(job),
-            idle: false,
-        });
-        self.shared.wake.notify_one();
+        self.push(None, job, false);
     }
 
     /// Queues `job` to run when no other job waits (idle jobs run in the order submitted).
     pub fn submit_idle(&self, job: impl FnOnce() + Send + 'static) {
-        self.lock().jobs.push_back(Queued {
-            slot: None,
-            job: Box::new(job),
-            idle: true,
-        });
-        self.shared.wake.notify_one();
+        self.push(None, job, true);
     }
 
     /// Queues `job`, dropping any job of the same `slot` that has not started yet.
     pub fn submit_latest(&self, slot: &'static str, job: impl FnOnce() + Send + 'static) {
+        self.push(Some(slot), job, false);
+    }
+
+    /// Queues `job` (`idle` or not) and wakes the thread; with a `slot`, first drops the jobs of
+    /// that slot that have not started yet.
+    fn push(&self, slot: Option<&'static str>, job: impl FnOnce() + Send + 'static, idle: bool) {
         let mut queue = self.lock();
-        queue.jobs.retain(|queued| queued.slot != Some(slot));
+        if slot.is_some() {
+            queue.jobs.retain(|queued| queued.slot != slot);
+        }
         queue.jobs.push_back(Queued {
-            slot: Some(slot),
+            slot,
             job: Box::new(job),
-            idle: false,
+            idle,
         });
         drop(queue);
         self.shared.wake.notify_one();

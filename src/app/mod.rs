@@ -12,16 +12,17 @@
 //!   fairing, measure, export), each holding its launch and the handling of its result;
 //! - [`jobs`]: worker threads, generation numbers, job results;
 //! - `view_sync.rs`: keeps the viewports' GPU buffers in step with what should be shown;
-//! - [`panels`]: the widgets; each section reads the app's state through a `PanelView`
-//!   (`panel_view.rs`), edits the [`state::Settings`] in place and emits [`Command`]s, applied
-//!   after the frame. Beside it:
-//!   `fairing_panel.rs` (the Fairing section, the sharp-edge controls, every tooltip),
-//!   [`view_panel`] (the View section: compare, heat map, Shading, Studio lighting) and
+//! - [`panels`]: the window's layout, placing the sections; each section reads the app's state
+//!   through a `PanelView` (`panel_view.rs`), edits the [`state::Settings`] in place and emits
+//!   [`Command`]s, applied after the frame. The sections: `toolbar.rs`, `status_bar.rs`,
+//!   [`view_panel`] (the View section: compare, heat map, Shading, Studio lighting),
+//!   `mesh_panel.rs` (Mesh and Noise), `hierarchy_panel.rs` (Hierarchy), `fairing_panel.rs`
+//!   (the Fairing section and the sharp-edge controls), `export_panel.rs` (Export),
+//!   `numbers_panel.rs` (Numbers), `paint_panel.rs`, `performance_panel.rs` (Performance) and
 //!   `viewport_panel.rs` (the 3D view's area: camera input, the brush, the compare views,
 //!   overlays; it reads a `ViewportView` and moves only what it owns, the camera, the brush's
-//!   last dab and the renderers it draws with, through a `ViewportState`),
-//!   `numbers_panel.rs` (the Numbers section), `export_panel.rs` (the Export section) and
-//!   `performance_panel.rs` (the Performance section);
+//!   last dab and the renderers it draws with, through a `ViewportState`); [`tips`], every
+//!   control's tooltip; `widgets.rs`, the small widgets the sections share;
 //! - `input.rs`: shortcuts and dropped files; `frame_stats.rs`: the UI thread's frame times;
 //! - [`camera`]: the orbit camera; [`history`]: undo and redo;
 //! - [`paint`]: the brush that paints where to fair (`tasks/mask.rs` applies its strokes,
@@ -41,10 +42,12 @@ mod confirm_replace;
 mod export_panel;
 mod fairing_panel;
 mod frame_stats;
+mod hierarchy_panel;
 pub mod history;
 mod input;
 pub mod jobs;
 mod launch;
+mod mesh_panel;
 mod numbers_panel;
 pub mod paint;
 mod paint_panel;
@@ -57,10 +60,14 @@ mod results;
 mod sharp_edges;
 pub mod state;
 mod status;
+mod status_bar;
 mod tasks;
+pub mod tips;
+mod toolbar;
 pub mod view_panel;
 mod view_sync;
 mod viewport_panel;
+mod widgets;
 
 pub use command::{Command, PanelChange};
 pub use frame_stats::FrameStats;

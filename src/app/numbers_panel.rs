@@ -4,8 +4,8 @@
 //! loading, the hierarchy, the fairing and the measuring. Reads the app's state, writes nothing.
 
 use super::panel_view::PanelView;
-use super::panels::seconds;
-use super::state::{HierarchyState, Measures, MethodChoice};
+use super::state::{Document, FairedResult, HierarchyState, Measures, MethodChoice};
+use super::widgets::seconds;
 
 /// What a greyed number in the Numbers panel means.
 const PENDING_TIP: &str =
@@ -42,11 +42,7 @@ fn measures(ui: &mut egui::Ui, view: &PanelView) {
         return;
     };
     let faired = document.faired.as_ref();
-    let against_document = faired.and_then(|f| f.against_document.as_ref());
-    let against_clean = faired.and_then(|f| f.against_clean.as_ref());
     let has_clean = document.clean.is_some();
-    let (lo, hi) = document.bounds;
-    let diagonal = ((0..3).map(|k| (hi[k] - lo[k]).powi(2)).sum::<f32>()).sqrt() as f64;
     ui.label(match faired {
         Some(f) => format!("Result: {}", f.method.describe(f.level)),
         None => "Result: none yet".to_owned(),
@@ -63,56 +59,7 @@ fn measures(ui: &mut egui::Ui, view: &PanelView) {
                     .on_hover_text("The clean mesh: the input mesh before noise was added");
             }
             ui.end_row();
-            let percent = |v: f64| format!("{v:+.4} %");
-            let rows = ROWS;
-            // Volume change and RMS displacement against the input come with the result
-            // itself; the other numbers are measured a moment later. Until then they are the
-            // previous result's: greyed, and saying so.
-            let fresh = |name: &str| -> Option<(String, String)> {
-                let f = faired?;
-                match name {
-                    "Volume change" if f.volume_change.is_finite() => {
-                        Some((percent(f.volume_change * 100.0), String::new()))
-                    }
-                    "Volume change" => Some((
-                        "–".into(),
-                        "The input mesh encloses no volume (a flat patch), so there is none to \
-                         change"
-                            .into(),
-                    )),
-                    "RMS displacement" => Some((
-                        format!("{:.3e}", f.rms_displacement),
-                        format!(
-                            "{:.3} % of the bounding box diagonal",
-                            f.rms_displacement / diagonal.max(f64::MIN_POSITIVE) * 100.0
-                        ),
-                    )),
-                    _ => None,
-                }
-            };
-            let pending = faired.is_some_and(|f| f.measures_pending);
-            let value = |ui: &mut egui::Ui, text: String| {
-                let label = ui.add_enabled(!pending, egui::Label::new(text));
-                if pending {
-                    label.on_hover_text(PENDING_TIP);
-                }
-            };
-            for (name, row) in rows {
-                ui.label(name);
-                match fresh(name) {
-                    Some((text, tip)) if tip.is_empty() => {
-                        ui.label(text);
-                    }
-                    Some((text, tip)) => {
-                        ui.label(text).on_hover_text(tip);
-                    }
-                    None => value(ui, against_document.map_or("–".into(), row)),
-                }
-                if has_clean {
-                    value(ui, against_clean.map_or("–".into(), row));
-                }
-                ui.end_row();
-            }
+            measure_rows(ui, document);
             if let Some(noise) = &document.against_clean {
                 ui.label("Noise");
                 ui.label(format!("{:.3e}", noise.mean_distance))
@@ -121,6 +68,65 @@ fn measures(ui: &mut egui::Ui, view: &PanelView) {
             }
         });
     ui.small("Distances in model units.");
+}
+
+/// One grid row per entry of [`ROWS`]: the result against the input and, after noise, against
+/// the clean mesh.
+fn measure_rows(ui: &mut egui::Ui, document: &Document) {
+    let faired = document.faired.as_ref();
+    let against_document = faired.and_then(|f| f.against_document.as_ref());
+    let against_clean = faired.and_then(|f| f.against_clean.as_ref());
+    let has_clean = document.clean.is_some();
+    let (lo, hi) = document.bounds;
+    let diagonal = ((0..3).map(|k| (hi[k] - lo[k]).powi(2)).sum::<f32>()).sqrt() as f64;
+    let pending = faired.is_some_and(|f| f.measures_pending);
+    let value = |ui: &mut egui::Ui, text: String| {
+        let label = ui.add_enabled(!pending, egui::Label::new(text));
+        if pending {
+            label.on_hover_text(PENDING_TIP);
+        }
+    };
+    for (name, row) in ROWS {
+        ui.label(name);
+        match faired.and_then(|f| fresh(name, f, diagonal)) {
+            Some((text, tip)) if tip.is_empty() => {
+                ui.label(text);
+            }
+            Some((text, tip)) => {
+                ui.label(text).on_hover_text(tip);
+            }
+            None => value(ui, against_document.map_or("–".into(), row)),
+        }
+        if has_clean {
+            value(ui, against_clean.map_or("–".into(), row));
+        }
+        ui.end_row();
+    }
+}
+
+/// The numbers of row `name` that come with the result itself (volume change and RMS
+/// displacement against the input), with their tooltip (empty for none); `None` for the other
+/// numbers, measured a moment later: until then they are the previous result's, greyed, and
+/// saying so. `diagonal` is the input's bounding box diagonal.
+fn fresh(name: &str, faired: &FairedResult, diagonal: f64) -> Option<(String, String)> {
+    let percent = |v: f64| format!("{v:+.4} %");
+    match name {
+        "Volume change" if faired.volume_change.is_finite() => {
+            Some((percent(faired.volume_change * 100.0), String::new()))
+        }
+        "Volume change" => Some((
+            "–".into(),
+            "The input mesh encloses no volume (a flat patch), so there is none to change".into(),
+        )),
+        "RMS displacement" => Some((
+            format!("{:.3e}", faired.rms_displacement),
+            format!(
+                "{:.3} % of the bounding box diagonal",
+                faired.rms_displacement / diagonal.max(f64::MIN_POSITIVE) * 100.0
+            ),
+        )),
+        _ => None,
+    }
 }
 
 /// The shown mesh's size and how long each step took.

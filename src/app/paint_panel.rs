@@ -5,8 +5,8 @@
 use super::command::PanelChange;
 use super::paint::BrushView;
 use super::panel_view::{Commands, PanelView, ViewportState, ViewportView};
-use super::panels::tips;
 use super::state::{CompareView, Settings, ViewMode};
+use super::tips;
 use super::Command;
 
 /// The side panel's section: paint mode, brush, mask tint, clear and invert.
@@ -52,20 +52,10 @@ pub(super) fn section(
     let mask = view.document.and_then(|d| d.mask.as_ref());
     ui.horizontal(|ui| {
         let has_mask = mask.is_some();
-        let clear = ui
-            .add_enabled(has_mask, egui::Button::new("Clear mask"))
-            .on_hover_text(tips::CLEAR_MASK)
-            .on_disabled_hover_text(format!("{}\n\nNothing is painted.", tips::CLEAR_MASK));
-        if clear.clicked() {
-            commands.push(Command::ClearMask);
-        }
-        let invert = ui
-            .add_enabled(has_mask, egui::Button::new("Invert mask"))
-            .on_hover_text(tips::INVERT_MASK)
-            .on_disabled_hover_text(format!("{}\n\nNothing is painted.", tips::INVERT_MASK));
-        if invert.clicked() {
-            commands.push(Command::InvertMask);
-        }
+        let clear = ("Clear mask", tips::CLEAR_MASK, Command::ClearMask);
+        mask_button(ui, has_mask, clear, commands);
+        let invert = ("Invert mask", tips::INVERT_MASK, Command::InvertMask);
+        mask_button(ui, has_mask, invert, commands);
     });
     match mask {
         Some(mask) => ui.small(format!(
@@ -75,6 +65,23 @@ pub(super) fn section(
         )),
         None => ui.small("Nothing painted: the whole mesh is smoothed"),
     };
+}
+
+/// A button that changes the mask (`label`, `tip`, the `command` it emits): off, saying so, while
+/// nothing is painted.
+fn mask_button(
+    ui: &mut egui::Ui,
+    has_mask: bool,
+    (label, tip, command): (&str, &str, Command),
+    commands: &mut Commands,
+) {
+    let button = ui
+        .add_enabled(has_mask, egui::Button::new(label))
+        .on_hover_text(tip)
+        .on_disabled_hover_text(format!("{tip}\n\nNothing is painted."));
+    if button.clicked() {
+        commands.push(command);
+    }
 }
 
 /// The brush in the viewport: emits dabs while the left button is down on the view in paint

@@ -16,6 +16,6 @@ pub use document::{
 };
 pub use measures::Measures;
 pub use settings::{
-    CompareView, HeatReference, MethodChoice, Settings, ViewMode, MAX_SHARP_EDGE_ANGLE,
+    CompareView, FairingKey, HeatReference, MethodChoice, Settings, ViewMode, MAX_SHARP_EDGE_ANGLE,
     MIN_SHARP_EDGE_ANGLE,
 };

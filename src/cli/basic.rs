@@ -2,12 +2,17 @@
 
 use anyhow::Context;
 use clap::{Args, ValueEnum};
-use fairmesh::io::{self, LoadOptions, Loaded};
+use fairmesh::io::Loaded;
 use fairmesh::metrics;
 use fairmesh::noise::{self, NoiseMode, NoiseOptions};
 use serde_json::json;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
+
+use super::args::StdioFormat;
+use super::common::{
+    check_output_format, display_output, emit, load, load_input, load_shown, save_kept,
+};
 
 #[derive(Args, Debug)]
 pub struct InfoArgs {
@@ -20,7 +25,7 @@ pub struct InfoArgs {
     #[arg(long)]
     pub no_weld: bool,
     #[command(flatten)]
-    pub stdio: super::StdioFormat,
+    pub stdio: StdioFormat,
 }
 
 #[derive(Clone, Copy, Debug, ValueEnum)]
@@ -50,7 +55,7 @@ pub struct NoiseArgs {
     #[arg(long, value_enum, default_value_t = ModeArg::Normal)]
     pub mode: ModeArg,
     #[command(flatten)]
-    pub stdio: super::StdioFormat,
+    pub stdio: StdioFormat,
 }
 
 #[derive(Args, Debug)]
@@ -68,7 +73,7 @@ pub struct ConvertArgs {
     #[arg(long, default_value_t = 0)]
     pub subdivide: usize,
     #[command(flatten)]
-    pub stdio: super::StdioFormat,
+    pub stdio: StdioFormat,
 }
 
 #[derive(Args, Debug)]
@@ -82,85 +87,55 @@ pub struct CompareArgs {
     pub json: bool,
 }
 
-/// Loads an input mesh; `@bunny` is the bunny compiled into the binary. `-` is refused (the
-/// command has no `--format`); see [`load_from`].
-pub(crate) fn load(path: &Path, weld: bool) -> anyhow::Result<Loaded> {
-    if super::is_stdio(path) {
-        anyhow::bail!("this command reads files only, not standard input (`-`)");
-    }
-    load_from(path, weld, None)
-}
-
-/// [`load_from`] with a progress line on a terminal (see `progress`).
-pub(crate) fn load_shown(
-    path: &Path,
-    weld: bool,
-    format: Option<super::FormatArg>,
-) -> anyhow::Result<Loaded> {
-    super::progress::Step::run(format!("loading {}", super::display_input(path)), || {
-        load_from(path, weld, format)
-    })
-}
-
-/// [`load_shown`], then what the loader skipped or read leniently (faces with fewer than three
-/// corners, point and line primitives, a stray header line, ...) as warnings on standard error,
-/// for the commands that write a mesh: those parts are not in the output, and the user is told.
-/// (`info` lists them in its report instead.)
-pub(crate) fn load_input(
-    path: &Path,
-    weld: bool,
-    format: Option<super::FormatArg>,
-) -> anyhow::Result<Loaded> {
-    let loaded = load_shown(path, weld, format)?;
-    print_load_warnings(path, &loaded);
-    Ok(loaded)
-}
-
-/// Each of the loader's warnings on standard error, with the input's name.
-pub(crate) fn print_load_warnings(path: &Path, loaded: &Loaded) {
-    for warning in &loaded.report.warnings {
-        eprintln!("warning: {}: {warning}", super::display_input(path));
-    }
-}
-
-/// Loads an input mesh: a file, `@bunny` (the bunny compiled into the binary), or `-`, standard
-/// input in the format `format` names.
-pub(crate) fn load_from(
-    path: &Path,
-    weld: bool,
-    format: Option<super::FormatArg>,
-) -> anyhow::Result<Loaded> {
-    let options = LoadOptions { weld };
-    if fairmesh::bundled::is_bunny_pseudo_path(path) {
-        return Ok(fairmesh::bundled::load_bunny(&options)?);
-    }
-    if super::is_stdio(path) {
-        let format = super::stdio_format(format, "reading from standard input")?;
-        let stdin = std::io::stdin().lock();
-        return Ok(io::load_from_reader(
-            stdin,
-            format,
-            "standard input",
-            &options,
-        )?);
-    }
-    Ok(io::load_with(path, &options)?)
-}
-
 pub fn info(args: InfoArgs) -> anyhow::Result<()> {
     let loaded = load_shown(&args.file, !args.no_weld, args.stdio.format)?;
+    let facts = Facts::of(&loaded);
+    if args.json {
+        let summary = info_json(&args.file, &loaded, &facts);
+        return emit(&format!("{}\n", serde_json::to_string_pretty(&summary)?));
+    }
+    let mut out = String::new();
+    writeln!(out, "{}", args.file.display())?;
+    write_counts(&mut out, &loaded)?;
+    write_topology(&mut out, &loaded, &facts)?;
+    write_measures(&mut out, &loaded, &facts)?;
+    write_load_report(&mut out, &loaded, &facts)?;
+    emit(&out)
+}
+
+/// What `info` derives from a loaded mesh, for both its JSON and its text.
+struct Facts {
+    closed: bool,
+    /// The enclosed volume, of a closed mesh only.
+    volume: Option<f64>,
+    bbox: Option<(fairmesh::glam::DVec3, fairmesh::glam::DVec3)>,
+    /// What the default `fair` leaves out (`mesh::without_loose_triangles`).
+    loose_triangles: usize,
+    /// What the file holds beyond the mesh: kept when saving to the same format.
+    contents: Vec<String>,
+}
+
+impl Facts {
+    fn of(loaded: &Loaded) -> Self {
+        let (mesh, topology) = (&loaded.mesh, &loaded.topology);
+        let closed = topology.is_closed();
+        Facts {
+            closed,
+            volume: closed.then(|| metrics::signed_volume(mesh)),
+            bbox: metrics::bounding_box(mesh),
+            loose_triangles: fairmesh::mesh::without_loose_triangles(mesh, topology)
+                .map_or(0, |(loose, ..)| loose.len()),
+            contents: loaded.source.contents(),
+        }
+    }
+}
+
+/// `info --json`: one object.
+fn info_json(file: &Path, loaded: &Loaded, facts: &Facts) -> serde_json::Value {
     let (mesh, topology, report) = (&loaded.mesh, &loaded.topology, &loaded.report);
-    let closed = topology.is_closed();
-    let volume = closed.then(|| metrics::signed_volume(mesh));
-    let bbox = metrics::bounding_box(mesh);
     let genus: Vec<Option<i64>> = topology.components.iter().map(|c| c.genus).collect();
-    // What the default `fair` leaves out (`mesh::without_loose_triangles`).
-    let loose_triangles = fairmesh::mesh::without_loose_triangles(mesh, topology)
-        .map_or(0, |(loose, ..)| loose.len());
-    // What the file holds beyond the mesh: kept when saving to the same format.
-    let contents = loaded.source.contents();
-    let summary = json!({
-        "file": args.file.display().to_string(),
+    json!({
+        "file": file.display().to_string(),
         "vertices": mesh.vertex_count(),
         "faces": mesh.face_count(),
         "edges": topology.edge_count(),
@@ -169,29 +144,29 @@ pub fn info(args: InfoArgs) -> anyhow::Result<()> {
         "components": topology.components.len(),
         "genus": genus,
         "euler_characteristic": topology.euler_characteristic(),
-        "closed": closed,
+        "closed": facts.closed,
         "manifold": topology.is_manifold(),
         "oriented": topology.inconsistent_edges == 0,
         "non_manifold_edges": topology.non_manifold_edges.len(),
         "non_manifold_vertices": topology.non_manifold_vertices.len(),
-        "loose_triangles": loose_triangles,
+        "loose_triangles": facts.loose_triangles,
         "inconsistently_oriented_edges": topology.inconsistent_edges,
-        "volume": volume,
+        "volume": facts.volume,
         "area": metrics::area(mesh),
         "mean_edge_length": metrics::mean_edge_length(mesh),
-        "bounding_box": bbox.map(|(lo, hi)| json!({"min": lo.to_array(), "max": hi.to_array()})),
+        "bounding_box": facts.bbox.map(|(lo, hi)| json!({"min": lo.to_array(), "max": hi.to_array()})),
         "welded_vertices": report.welded_vertices,
         "removed_degenerate_faces": report.removed_degenerate_faces,
         "removed_repeated_faces": report.removed_repeated_faces,
         "removed_unreferenced_vertices": report.removed_unreferenced_vertices,
         "warnings": report.warnings,
-        "file_contents": contents,
-    });
-    if args.json {
-        return super::emit(&format!("{}\n", serde_json::to_string_pretty(&summary)?));
-    }
-    let mut out = String::new();
-    writeln!(out, "{}", args.file.display())?;
+        "file_contents": facts.contents,
+    })
+}
+
+/// The counts, and the first ten components.
+fn write_counts(out: &mut String, loaded: &Loaded) -> std::fmt::Result {
+    let (mesh, topology) = (&loaded.mesh, &loaded.topology);
     writeln!(out, "  vertices            {}", mesh.vertex_count())?;
     writeln!(out, "  faces               {}", mesh.face_count())?;
     writeln!(out, "  edges               {}", topology.edge_count())?;
@@ -206,12 +181,18 @@ pub fn info(args: InfoArgs) -> anyhow::Result<()> {
             c.vertices, c.faces, c.boundary_loops
         )?;
     }
+    Ok(())
+}
+
+/// Boundary loops, whether the mesh is closed and a manifold, and its loose triangles.
+fn write_topology(out: &mut String, loaded: &Loaded, facts: &Facts) -> std::fmt::Result {
+    let topology = &loaded.topology;
     writeln!(
         out,
         "  boundary loops      {}",
         topology.boundary_loops.len()
     )?;
-    writeln!(out, "  closed              {closed}")?;
+    writeln!(out, "  closed              {}", facts.closed)?;
     writeln!(
         out,
         "  manifold            {} ({} non-manifold edges, {} non-manifold vertices, {} inconsistently oriented edges)",
@@ -220,14 +201,21 @@ pub fn info(args: InfoArgs) -> anyhow::Result<()> {
         topology.non_manifold_vertices.len(),
         topology.inconsistent_edges
     )?;
-    if loose_triangles > 0 {
+    if facts.loose_triangles > 0 {
         writeln!(
             out,
-            "  loose triangles     {loose_triangles} (over other triangles, or fins hanging from an \
-             edge: the default fair smooths the surface without them)"
+            "  loose triangles     {} (over other triangles, or fins hanging from an \
+             edge: the default fair smooths the surface without them)",
+            facts.loose_triangles
         )?;
     }
-    match volume {
+    Ok(())
+}
+
+/// Volume, area, mean edge length and bounding box.
+fn write_measures(out: &mut String, loaded: &Loaded, facts: &Facts) -> std::fmt::Result {
+    let mesh = &loaded.mesh;
+    match facts.volume {
         Some(v) => writeln!(out, "  volume              {v:.6e}")?,
         None => writeln!(out, "  volume              n/a (open mesh)")?,
     }
@@ -237,13 +225,19 @@ pub fn info(args: InfoArgs) -> anyhow::Result<()> {
         "  mean edge length    {:.6e}",
         metrics::mean_edge_length(mesh)
     )?;
-    if let Some((lo, hi)) = bbox {
+    if let Some((lo, hi)) = facts.bbox {
         writeln!(
             out,
             "  bounding box        [{:.4}, {:.4}, {:.4}] .. [{:.4}, {:.4}, {:.4}]",
             lo.x, lo.y, lo.z, hi.x, hi.y, hi.z
         )?;
     }
+    Ok(())
+}
+
+/// What loading repaired, what else the file holds, and the loader's warnings.
+fn write_load_report(out: &mut String, loaded: &Loaded, facts: &Facts) -> std::fmt::Result {
+    let report = &loaded.report;
     writeln!(out, "  welded vertices     {}", report.welded_vertices)?;
     writeln!(
         out,
@@ -252,20 +246,20 @@ pub fn info(args: InfoArgs) -> anyhow::Result<()> {
         report.removed_repeated_faces,
         report.removed_unreferenced_vertices
     )?;
-    if !contents.is_empty() {
+    if !facts.contents.is_empty() {
         writeln!(
             out,
             "  also in the file    (kept when saving as {}):",
             loaded.source.format()
         )?;
-        for item in &contents {
+        for item in &facts.contents {
             writeln!(out, "    {item}")?;
         }
     }
     for warning in &report.warnings {
         writeln!(out, "  warning: {warning}")?;
     }
-    super::emit(&out)
+    Ok(())
 }
 
 pub fn noise(args: NoiseArgs) -> anyhow::Result<()> {
@@ -274,9 +268,7 @@ pub fn noise(args: NoiseArgs) -> anyhow::Result<()> {
         "--sigma must be a finite number >= 0, got {}",
         args.sigma
     );
-    if super::is_stdio(&args.output) {
-        super::stdio_format(args.stdio.format, "writing to standard output")?;
-    }
+    check_output_format(&args.output, args.stdio.format)?;
     let mut loaded = load_input(&args.input, true, args.stdio.format)?;
     let mode = match args.mode {
         ModeArg::Direction => NoiseMode::Direction,
@@ -290,7 +282,7 @@ pub fn noise(args: NoiseArgs) -> anyhow::Result<()> {
             .with_seed(args.seed)
             .with_mode(mode),
     );
-    super::save_kept(
+    save_kept(
         &args.output,
         &loaded.mesh,
         &loaded.source,
@@ -298,7 +290,7 @@ pub fn noise(args: NoiseArgs) -> anyhow::Result<()> {
     )?;
     eprintln!(
         "wrote {} (sigma {:.4e} model units, {:?}, seed {})",
-        super::display_output(&args.output),
+        display_output(&args.output),
         absolute,
         mode,
         args.seed
@@ -307,14 +299,12 @@ pub fn noise(args: NoiseArgs) -> anyhow::Result<()> {
 }
 
 pub fn convert(args: ConvertArgs) -> anyhow::Result<()> {
-    if super::is_stdio(&args.output) {
-        super::stdio_format(args.stdio.format, "writing to standard output")?;
-    }
+    check_output_format(&args.output, args.stdio.format)?;
     let mut loaded = load_input(&args.input, !args.no_weld, args.stdio.format)?;
     for _ in 0..args.subdivide {
         loaded.mesh = fairmesh::mesh::subdivide_loop(&loaded.mesh);
     }
-    super::save_kept(
+    save_kept(
         &args.output,
         &loaded.mesh,
         &loaded.source,
@@ -322,7 +312,7 @@ pub fn convert(args: ConvertArgs) -> anyhow::Result<()> {
     )?;
     eprintln!(
         "wrote {} ({} vertices, {} faces)",
-        super::display_output(&args.output),
+        display_output(&args.output),
         loaded.mesh.vertex_count(),
         loaded.mesh.face_count()
     );
@@ -355,7 +345,7 @@ pub fn compare(args: CompareArgs) -> anyhow::Result<()> {
         map.insert("sharpened_edges".into(), json!(count));
     }
     if args.json {
-        return super::emit(&format!("{}\n", serde_json::to_string_pretty(&object)?));
+        return emit(&format!("{}\n", serde_json::to_string_pretty(&object)?));
     }
     let mut out = String::new();
     writeln!(
@@ -397,5 +387,5 @@ pub fn compare(args: CompareArgs) -> anyhow::Result<()> {
         }
         None => writeln!(out, "  (different connectivity: no per-vertex measures)")?,
     }
-    super::emit(&out)
+    emit(&out)
 }

@@ -4,7 +4,8 @@
 use clap::Args;
 use fairmesh::{io, mesh, metrics, Topology, TriMesh};
 use std::path::PathBuf;
-use std::time::Instant;
+
+use super::common::{emit, load, median_ms};
 
 #[derive(Args, Debug)]
 pub struct BenchArgs {
@@ -90,19 +91,6 @@ fn tempfile_dir() -> anyhow::Result<PathBuf> {
     Ok(dir)
 }
 
-/// Median wall time of `runs` calls of `f`, in milliseconds.
-pub fn median_ms(runs: usize, mut f: impl FnMut()) -> f64 {
-    let mut times: Vec<f64> = (0..runs.max(1))
-        .map(|_| {
-            let start = Instant::now();
-            f();
-            start.elapsed().as_secs_f64() * 1e3
-        })
-        .collect();
-    times.sort_by(f64::total_cmp);
-    times[times.len() / 2]
-}
-
 /// The rows timed on the (subdivided) mesh: its topology, weld and measures, fairing, creases
 /// and the hierarchy, as `args` asks.
 fn mesh_rows(args: &BenchArgs, mesh: &TriMesh) -> Vec<(String, f64)> {
@@ -149,11 +137,11 @@ pub fn run(args: BenchArgs) -> anyhow::Result<()> {
     let mut rows: Vec<(String, f64)> = Vec::new();
     if args.wants(BenchGroup::Load) {
         let load_ms = median_ms(args.runs, || {
-            let _ = super::basic::load(&args.input, true);
+            let _ = load(&args.input, true);
         });
         rows.push(("load + weld + clean + topology".into(), load_ms));
     }
-    let mut loaded = super::basic::load(&args.input, true)?;
+    let mut loaded = load(&args.input, true)?;
     if args.subdivide == 0 && args.wants(BenchGroup::Save) {
         rows.extend(save_rows(&args, &loaded)?);
     }
@@ -192,5 +180,5 @@ pub fn run(args: BenchArgs) -> anyhow::Result<()> {
     for (name, ms) in rows {
         out.push_str(&format!("{name:<48} {ms:>12.3}\n"));
     }
-    super::emit(&out)
+    emit(&out)
 }

@@ -3,10 +3,19 @@
 use clap::{Args, ValueEnum};
 use fairmesh::fairing::{
     self, baseline::UmbrellaStencil, BoundaryMode, ConstrainedFairing, CreaseOptions, FairOptions,
-    FairVariant, HcOptions, LaplacianOptions, MethodOptions, Relaxation, Strength, TaubinOptions,
+    FairReport, FairVariant, HcOptions, LaplacianOptions, Mask, MethodOptions, Relaxation,
+    Strength, TaubinOptions,
 };
-use std::path::PathBuf;
+use fairmesh::io::Source;
+use fairmesh::metrics::Comparison;
+use fairmesh::{Topology, TriMesh};
+use std::path::{Path, PathBuf};
 use std::time::Instant;
+
+use super::args::{BoundaryArg, StdioFormat};
+use super::common::{
+    check_output_format, display_output, emit, is_stdio, load_input, median_ms, save_kept,
+};
 
 #[derive(Clone, Copy, Debug, ValueEnum)]
 pub enum MethodArg {
@@ -18,14 +27,6 @@ pub enum MethodArg {
     Taubin,
     /// HC Laplacian of Vollmer et al. (for comparison).
     Hc,
-}
-
-#[derive(Clone, Copy, Debug, ValueEnum)]
-pub enum BoundaryArg {
-    /// Smooth each boundary loop as a curve (paper section 3.3).
-    Curve,
-    /// Keep boundary vertices where they are.
-    Fixed,
 }
 
 #[derive(Clone, Copy, Debug, ValueEnum, PartialEq, Eq)]
@@ -115,17 +116,29 @@ pub struct FairArgs {
     #[arg(long)]
     pub measure: bool,
     #[command(flatten)]
-    pub stdio: super::StdioFormat,
+    pub stdio: StdioFormat,
     #[command(flatten)]
     pub mask: super::mask::MaskArgs,
 }
 
 impl FairArgs {
+    /// The options of the chosen method on `mesh` (loaded from `source`, of mean edge length
+    /// `mean_edge_length`): the file's own sharp edges (split normals, material boundaries) are
+    /// creases too.
+    fn options_for(&self, mesh: &TriMesh, source: &Source, mean_edge_length: f64) -> MethodOptions {
+        let mut options = self.method_options(mean_edge_length);
+        if let MethodOptions::Constrained(FairOptions {
+            creases: Some(creases),
+            ..
+        }) = &mut options
+        {
+            *creases = creases.clone().with_file_edges(source.hard_edges(mesh));
+        }
+        options
+    }
+
     fn method_options(&self, mean_edge_length: f64) -> MethodOptions {
-        let boundary = match self.boundary {
-            BoundaryArg::Curve => BoundaryMode::Curve,
-            BoundaryArg::Fixed => BoundaryMode::Fixed,
-        };
+        let boundary = BoundaryMode::from(self.boundary);
         match self.method {
             MethodArg::Constrained => {
                 // `--variant paper` is the paper's method (`FairOptions::paper`): one round, no
@@ -192,62 +205,119 @@ impl FairArgs {
 /// (root mean square) is worth a warning: the texture moves with them.
 const TEXTURE_SLIDE_WARNING: f64 = 0.02;
 
+/// What one fairing did, for the report: the fairing's own report and what the command measured
+/// around it.
+struct Outcome {
+    report: FairReport,
+    time_ms: f64,
+    /// Whether the mesh is closed (its volume change is then more than indicative).
+    closed: bool,
+    /// None (JSON null, "n/a" in words) when the input encloses no volume to change.
+    volume_change_percent: Option<f64>,
+    texture: Option<TextureSlide>,
+    measures: Option<Comparison>,
+}
+
+/// How far the tangential relaxation slid a textured file's vertices along the surface.
+#[derive(Clone, Copy)]
+struct TextureSlide {
+    /// Root mean square, in mean edge lengths of the input.
+    slide: f64,
+    /// Whether the written file's texture coordinates followed the slide (written back into its
+    /// own format); into another, they stayed with their vertices.
+    follows: bool,
+}
+
 pub fn run(args: FairArgs) -> anyhow::Result<()> {
-    anyhow::ensure!(
-        !(args.json && super::is_stdio(&args.output)),
-        "--json and `-o -` would both write to standard output: write the mesh to a file"
-    );
-    if super::is_stdio(&args.output) {
-        super::stdio_format(args.stdio.format, "writing to standard output")?;
-    }
-    let loaded = super::basic::load_input(&args.input, true, args.stdio.format)?;
+    check_output(&args)?;
+    let loaded = load_input(&args.input, true, args.stdio.format)?;
     let (mut mesh, topology, source) = (loaded.mesh, loaded.topology, loaded.source);
     let edge = fairmesh::metrics::mean_edge_length(&mesh);
-    let mut options = args.method_options(edge);
-    // The file's own sharp edges (split normals, material boundaries) are creases too.
-    if let MethodOptions::Constrained(FairOptions {
-        creases: Some(creases),
-        ..
-    }) = &mut options
-    {
-        *creases = creases.clone().with_file_edges(source.hard_edges(&mesh));
-    }
+    let options = args.options_for(&mesh, &source, edge);
     let mask = super::mask::load_for(&args.mask, &source, &mesh, Some(&topology))?;
     let volume_before = fairmesh::metrics::signed_volume(&mesh);
     // The input is kept only to measure against it.
     let input = args.measure.then(|| mesh.clone());
-    // A file with texture coordinates: its positions are kept to say how far the tangential
-    // relaxation slid the vertices, and the texture with them.
-    let slides = matches!(&options, MethodOptions::Constrained(o) if o.tangential_relaxation > 0.0
-        && o.variant == fairmesh::fairing::FairVariant::NormalProjected);
-    let textured_input =
-        (slides && source.has_texture_coordinates()).then(|| mesh.positions.clone());
-
-    let step = super::progress::Step::start("fairing");
-    let start = Instant::now();
-    let report = match &mask {
-        Some(mask) => fairing::fair_masked(&mut mesh, &topology, &options, mask),
-        None => fairing::fair(&mut mesh, &topology, &options),
-    };
-    let time_ms = start.elapsed().as_secs_f64() * 1e3;
-    drop(step);
-
+    let textured_input = textured_positions(&options, &source, &mesh);
+    let (report, time_ms) = fair_timed(&mut mesh, &topology, &options, mask.as_ref());
     let volume_after = fairmesh::metrics::signed_volume(&mesh);
-    // None (JSON null, "n/a" in words) when the input encloses no volume to change.
     let volume_change_percent = (volume_before != 0.0)
         .then(|| 100.0 * (volume_after - volume_before) / volume_before.abs())
         .filter(|change| change.is_finite());
-    let saved = super::save_kept(&args.output, &mesh, &source, args.stdio.format)?;
-    // In mean edge lengths of the input; none when no round ran.
-    let texture_slide = textured_input
+    let saved = save_kept(&args.output, &mesh, &source, args.stdio.format)?;
+    let texture = textured_input
         .filter(|_| report.rounds_run > 0)
         .map(|before| fairmesh::metrics::tangential_slide(&before, &mesh) / edge)
-        .filter(|slide| slide.is_finite());
-    // Written back into its own format, the file's texture coordinates followed the slide;
-    // into another, they stayed with their vertices.
-    let texture_follows = texture_slide.is_some() && saved.texture_coordinates_follow;
-    if let Some(slide) =
-        texture_slide.filter(|&slide| slide >= TEXTURE_SLIDE_WARNING && !texture_follows)
+        .filter(|slide| slide.is_finite())
+        .map(|slide| TextureSlide {
+            slide,
+            follows: saved.texture_coordinates_follow,
+        });
+    warn_texture_slide(&args.input, texture);
+    note_loose_triangles(&args.input, report.loose_triangles);
+    let measures = input.map(|input| {
+        super::progress::Step::run("measuring against the input", || {
+            fairmesh::metrics::compare(&input, &mesh)
+        })
+    });
+    let outcome = Outcome {
+        report,
+        time_ms,
+        closed: topology.is_closed(),
+        volume_change_percent,
+        texture,
+        measures,
+    };
+    print_outcome(&args, &mesh, &options, mask.as_ref(), &outcome)
+}
+
+/// Refuses `--json` with `-o -` (both would write to standard output), and `-o -` without
+/// `--format`.
+fn check_output(args: &FairArgs) -> anyhow::Result<()> {
+    anyhow::ensure!(
+        !(args.json && is_stdio(&args.output)),
+        "--json and `-o -` would both write to standard output: write the mesh to a file"
+    );
+    check_output_format(&args.output, args.stdio.format)?;
+    Ok(())
+}
+
+/// A textured file's positions before the fairing, kept to say how far the tangential
+/// relaxation slid the vertices, and the texture with them; `None` when nothing slides or the
+/// file has no texture coordinates.
+fn textured_positions(
+    options: &MethodOptions,
+    source: &Source,
+    mesh: &TriMesh,
+) -> Option<Vec<[f32; 3]>> {
+    let slides = matches!(options, MethodOptions::Constrained(o) if o.tangential_relaxation > 0.0
+        && o.variant == FairVariant::NormalProjected);
+    (slides && source.has_texture_coordinates()).then(|| mesh.positions.clone())
+}
+
+/// Fairs `mesh` (within `mask`, if any) under a progress line; the report and the time taken in
+/// milliseconds.
+fn fair_timed(
+    mesh: &mut TriMesh,
+    topology: &Topology,
+    options: &MethodOptions,
+    mask: Option<&Mask>,
+) -> (FairReport, f64) {
+    let step = super::progress::Step::start("fairing");
+    let start = Instant::now();
+    let report = match mask {
+        Some(mask) => fairing::fair_masked(mesh, topology, options, mask),
+        None => fairing::fair(mesh, topology, options),
+    };
+    let time_ms = start.elapsed().as_secs_f64() * 1e3;
+    drop(step);
+    (report, time_ms)
+}
+
+/// Warns, on standard error, when the texture moved with vertices that slid along the surface.
+fn warn_texture_slide(input: &Path, texture: Option<TextureSlide>) {
+    if let Some(TextureSlide { slide, .. }) =
+        texture.filter(|t| t.slide >= TEXTURE_SLIDE_WARNING && !t.follows)
     {
         eprintln!(
             "warning: {}: its texture coordinates stay with their vertices, and the tangential \
@@ -255,73 +325,120 @@ pub fn run(args: FairArgs) -> anyhow::Result<()> {
              (root mean square): the texture moved with them. Written back into its own format, \
              the texture coordinates follow the slide instead; `--tangential 0` keeps every \
              vertex on its normal line (noise that moved vertices along the surface then stays).",
-            args.input.display()
+            input.display()
         );
     }
-    if report.loose_triangles > 0 {
+}
+
+/// Says, on standard error, what became of the triangles that lie loose at non-manifold edges.
+fn note_loose_triangles(input: &Path, loose_triangles: usize) {
+    if loose_triangles > 0 {
         eprintln!(
             "note: {}: {} triangles lie loose at non-manifold edges (over other triangles, or \
              hanging from an edge as fins) and were left out of the smoothing, which would have \
              held their corners with their noise; they are kept in the output, their corners on \
              the surface smoothed with it and a fin's own tip left where it was",
-            args.input.display(),
-            report.loose_triangles
+            input.display(),
+            loose_triangles
         );
     }
-    let measures = input.map(|input| {
-        super::progress::Step::run("measuring against the input", || {
-            fairmesh::metrics::compare(&input, &mesh)
-        })
-    });
+}
 
-    let method = options.method().name();
-    let variant = match &options {
+/// Prints the outcome: one JSON object with `--json`, else a sentence (on standard error when
+/// standard output holds the mesh).
+fn print_outcome(
+    args: &FairArgs,
+    mesh: &TriMesh,
+    options: &MethodOptions,
+    mask: Option<&Mask>,
+    outcome: &Outcome,
+) -> anyhow::Result<()> {
+    if args.json {
+        return emit(&format!(
+            "{}\n",
+            json_report(args, mesh, options, mask, outcome)
+        ));
+    }
+    let sentence = sentence(args, options, mask, outcome);
+    if is_stdio(&args.output) {
+        // Standard output holds the mesh.
+        eprint!("{sentence}");
+        Ok(())
+    } else {
+        emit(&sentence)
+    }
+}
+
+/// The `--json` report.
+fn json_report(
+    args: &FairArgs,
+    mesh: &TriMesh,
+    options: &MethodOptions,
+    mask: Option<&Mask>,
+    outcome: &Outcome,
+) -> serde_json::Value {
+    let report = &outcome.report;
+    let mut json = serde_json::json!({
+        "method": options.method().name(),
+        "variant": variant_name(options),
+        "input": args.input.display().to_string(),
+        "output": args.output.display().to_string(),
+        "vertices": mesh.vertex_count(),
+        "faces": mesh.face_count(),
+        "closed": outcome.closed,
+        "iterations_run": report.iterations_run,
+        "rounds_run": report.rounds_run,
+        "noise_estimate": report.noise_estimate,
+        "tangential_noise": report.tangential_noise,
+        "crease_edges": report.crease_edges,
+        "loose_triangles": report.loose_triangles,
+        "time_ms": outcome.time_ms,
+        "detection_ms": report.detection_ms,
+        "risk_by_round": report.risk_by_round,
+        "volume_change_percent": outcome.volume_change_percent,
+        "max_move": report.max_move,
+        "masked_vertices": mask.map(|m| m.painted_count()),
+        "texture_slide": outcome.texture.map(|t| t.slide),
+        "texture_follows": outcome.texture.map(|t| t.follows),
+    });
+    if let (Some(m), Some(map)) = (&outcome.measures, json.as_object_mut()) {
+        map.insert(
+            "mean_surface_distance".into(),
+            m.mean_surface_distance.into(),
+        );
+        map.insert("hausdorff".into(), m.hausdorff.into());
+        if let Some(c) = &m.same_connectivity {
+            map.insert("rms".into(), c.rms.into());
+            map.insert("normal_error_deg".into(), c.normal_error_deg.into());
+        }
+    }
+    json
+}
+
+/// The constrained variant's name; none for a baseline.
+fn variant_name(options: &MethodOptions) -> Option<&'static str> {
+    match options {
         MethodOptions::Constrained(o) => Some(o.variant.name()),
         _ => None,
-    };
-    if args.json {
-        let mut json = serde_json::json!({
-            "method": method,
-            "variant": variant,
-            "input": args.input.display().to_string(),
-            "output": args.output.display().to_string(),
-            "vertices": mesh.vertex_count(),
-            "faces": mesh.face_count(),
-            "closed": topology.is_closed(),
-            "iterations_run": report.iterations_run,
-            "rounds_run": report.rounds_run,
-            "noise_estimate": report.noise_estimate,
-            "tangential_noise": report.tangential_noise,
-            "crease_edges": report.crease_edges,
-            "loose_triangles": report.loose_triangles,
-            "time_ms": time_ms,
-            "detection_ms": report.detection_ms,
-            "risk_by_round": report.risk_by_round,
-            "volume_change_percent": volume_change_percent,
-            "max_move": report.max_move,
-            "masked_vertices": mask.as_ref().map(|m| m.painted_count()),
-            "texture_slide": texture_slide,
-            "texture_follows": texture_slide.map(|_| texture_follows),
-        });
-        if let (Some(m), Some(map)) = (&measures, json.as_object_mut()) {
-            map.insert(
-                "mean_surface_distance".into(),
-                m.mean_surface_distance.into(),
-            );
-            map.insert("hausdorff".into(), m.hausdorff.into());
-            if let Some(c) = &m.same_connectivity {
-                map.insert("rms".into(), c.rms.into());
-                map.insert("normal_error_deg".into(), c.normal_error_deg.into());
-            }
-        }
-        return super::emit(&format!("{json}\n"));
     }
-    let volume = match volume_change_percent {
-        Some(change) if topology.is_closed() => format!("{change:+.4}%"),
+}
+
+/// The report in words, one line.
+fn sentence(
+    args: &FairArgs,
+    options: &MethodOptions,
+    mask: Option<&Mask>,
+    outcome: &Outcome,
+) -> String {
+    let report = &outcome.report;
+    let volume = match outcome.volume_change_percent {
+        Some(change) if outcome.closed => format!("{change:+.4}%"),
         Some(change) => format!("{change:+.4}% (the mesh is open: volume is only indicative)"),
         None => "n/a (the mesh encloses no volume)".to_string(),
     };
-    let measured = measures
+    let measured = outcome
+        .measures
+        .as_ref()
         .map(|m| {
             format!(
                 ", mean surface distance to the input {:.3e} (Hausdorff {:.3e})",
@@ -329,8 +446,30 @@ pub fn run(args: FairArgs) -> anyhow::Result<()> {
             )
         })
         .unwrap_or_default();
-    // What the automatic strength and the creases decided, in words.
-    let strength = match (report.noise_estimate, &options) {
+    let strength = strength_words(report, options);
+    let creases = match report.crease_edges {
+        0 => String::new(),
+        n => format!("{n} crease edges kept sharp; "),
+    };
+    format!(
+        "{}{}: {}{strength}{creases}{} iterations in {:.1} ms, volume change {volume}, last \
+         largest move {:.3e}{}; wrote {}\n",
+        options.method().name(),
+        variant_name(options)
+            .map(|v| format!(" ({v})"))
+            .unwrap_or_default(),
+        super::mask::describe(mask),
+        report.iterations_run,
+        outcome.time_ms,
+        report.max_move,
+        measured,
+        display_output(&args.output)
+    )
+}
+
+/// What the automatic strength decided, in words (empty when the strength was not automatic).
+fn strength_words(report: &FairReport, options: &MethodOptions) -> String {
+    match (report.noise_estimate, options) {
         (Some(noise), MethodOptions::Constrained(o)) if o.strength == Strength::Auto => {
             if report.rounds_run == 0 {
                 format!(
@@ -346,47 +485,11 @@ pub fn run(args: FairArgs) -> anyhow::Result<()> {
             }
         }
         _ => String::new(),
-    };
-    let creases = match report.crease_edges {
-        0 => String::new(),
-        n => format!("{n} crease edges kept sharp; "),
-    };
-    let sentence = format!(
-        "{}{}: {}{strength}{creases}{} iterations in {:.1} ms, volume change {volume}, last \
-         largest move {:.3e}{}; wrote {}\n",
-        method,
-        variant.map(|v| format!(" ({v})")).unwrap_or_default(),
-        super::mask::describe(mask.as_ref()),
-        report.iterations_run,
-        time_ms,
-        report.max_move,
-        measured,
-        super::display_output(&args.output)
-    );
-    if super::is_stdio(&args.output) {
-        // Standard output holds the mesh.
-        eprint!("{sentence}");
-        Ok(())
-    } else {
-        super::emit(&sentence)
     }
 }
 
-/// Median time in milliseconds of `runs` calls of `work`.
-fn median_ms(runs: usize, mut work: impl FnMut()) -> f64 {
-    let mut times: Vec<f64> = (0..runs.max(1))
-        .map(|_| {
-            let start = Instant::now();
-            work();
-            start.elapsed().as_secs_f64() * 1e3
-        })
-        .collect();
-    times.sort_by(f64::total_cmp);
-    times[times.len() / 2]
-}
-
 /// Rows for `fairmesh bench`: (operation, milliseconds), medians of several runs.
-pub fn bench_rows(mesh: &fairmesh::TriMesh, topology: &fairmesh::Topology) -> Vec<(String, f64)> {
+pub fn bench_rows(mesh: &TriMesh, topology: &Topology) -> Vec<(String, f64)> {
     if mesh.positions.is_empty() {
         return Vec::new();
     }
@@ -430,11 +533,7 @@ pub fn bench_rows(mesh: &fairmesh::TriMesh, topology: &fairmesh::Topology) -> Ve
 }
 
 /// `bench` rows of the crease detection, `runs` runs each.
-pub fn crease_bench_rows(
-    mesh: &fairmesh::TriMesh,
-    topology: &fairmesh::Topology,
-    runs: usize,
-) -> Vec<(String, f64)> {
+pub fn crease_bench_rows(mesh: &TriMesh, topology: &Topology, runs: usize) -> Vec<(String, f64)> {
     let mut rows = Vec::new();
     // Crease detection: on the faces' own normals (a clean mesh), and the guided normal filter
     // a noisy one runs first (one pass and three, so a pass's own cost is their difference / 2).

@@ -1,13 +1,20 @@
-//! The command-line tool: subcommands on top of the library.
+//! The command-line tool: subcommands on top of the library. `basic.rs` holds `info`, `noise`,
+//! `convert` and `compare`; `fair.rs` `fair`; `hierarchy.rs` `hierarchy`; `multires.rs`
+//! `multires`; `bench.rs` `bench`. Beside them: `args.rs`, the argument types several commands share;
+//! `common.rs`, loading the input, saving the result and writing the report; `mask.rs`, `--mask`;
+//! `progress.rs`, the progress line of long steps.
 
+mod args;
 mod basic;
 mod bench;
+mod common;
 mod fair;
 mod hierarchy;
 mod mask;
+mod multires;
 mod progress;
 
-use clap::{Parser, Subcommand, ValueEnum};
+use clap::{Parser, Subcommand};
 use std::path::PathBuf;
 
 #[derive(Parser, Debug)]
@@ -60,7 +67,7 @@ pub enum Command {
     /// Build the decimation hierarchy and print its levels.
     Hierarchy(hierarchy::HierarchyArgs),
     /// Multiresolution fairing from a chosen start level.
-    Multires(hierarchy::MultiresArgs),
+    Multires(multires::MultiresArgs),
     /// Time the operations that matter on a mesh.
     Bench(bench::BenchArgs),
 }
@@ -74,121 +81,8 @@ pub fn run(command: Command) -> anyhow::Result<()> {
         Command::Convert(args) => basic::convert(args),
         Command::Compare(args) => basic::compare(args),
         Command::Fair(args) => fair::run(args),
-        Command::Hierarchy(args) => hierarchy::run_hierarchy(args),
-        Command::Multires(args) => hierarchy::run_multires(args),
+        Command::Hierarchy(args) => hierarchy::run(args),
+        Command::Multires(args) => multires::run(args),
         Command::Bench(args) => bench::run(args),
-    }
-}
-
-/// The format of a mesh read from standard input or written to standard output (`-`).
-#[derive(Clone, Copy, Debug, ValueEnum, PartialEq, Eq)]
-pub enum FormatArg {
-    Obj,
-    Gltf,
-    Glb,
-    Ply,
-    Stl,
-    Off,
-}
-
-impl From<FormatArg> for fairmesh::io::Format {
-    fn from(format: FormatArg) -> Self {
-        use fairmesh::io::Format;
-        match format {
-            FormatArg::Obj => Format::Obj,
-            FormatArg::Gltf => Format::Gltf,
-            FormatArg::Glb => Format::Glb,
-            FormatArg::Ply => Format::Ply,
-            FormatArg::Stl => Format::Stl,
-            FormatArg::Off => Format::Off,
-        }
-    }
-}
-
-/// `--format`, for the commands that read or write one mesh.
-#[derive(clap::Args, Debug, Clone, Copy, Default)]
-pub struct StdioFormat {
-    /// Format of the mesh read from standard input or written to standard output, where the
-    /// input or the output is `-` (files are known by their extension).
-    #[arg(long, value_enum)]
-    pub format: Option<FormatArg>,
-}
-
-/// Whether `path` is `-`: standard input or output.
-pub(crate) fn is_stdio(path: &std::path::Path) -> bool {
-    path.as_os_str() == "-"
-}
-
-/// The format `--format` names for `-`, or an error saying it is needed.
-pub(crate) fn stdio_format(
-    format: Option<FormatArg>,
-    what: &str,
-) -> anyhow::Result<fairmesh::io::Format> {
-    format.map(Into::into).ok_or_else(|| {
-        anyhow::anyhow!(
-            "{what} (`-`) needs --format to name the mesh format (obj, gltf, glb, ply, stl or off)"
-        )
-    })
-}
-
-/// Saves `mesh` into what it was loaded from (see `fairmesh::io::save_with_source`) and prints, on
-/// stderr, what the output could not keep. `-` writes the bare mesh to standard output in the
-/// format `--format` names.
-pub(crate) fn save_kept(
-    path: &std::path::Path,
-    mesh: &fairmesh::TriMesh,
-    source: &fairmesh::io::Source,
-    format: Option<FormatArg>,
-) -> anyhow::Result<fairmesh::io::SaveReport> {
-    let _step = progress::Step::start(format!("saving {}", display_output(path)));
-    if is_stdio(path) {
-        let format = stdio_format(format, "writing to standard output")?;
-        let lost = source.contents();
-        let mut stdout = std::io::BufWriter::with_capacity(1 << 20, std::io::stdout().lock());
-        fairmesh::io::write_to(&mut stdout, mesh, format)?;
-        if !lost.is_empty() {
-            eprintln!(
-                "warning: standard output gets a bare {format} mesh; not kept from the input: {}",
-                lost.join("; ")
-            );
-        }
-        return Ok(Default::default());
-    }
-    let report = fairmesh::io::save_with_source(path, mesh, source)?;
-    for warning in &report.warnings {
-        eprintln!("warning: {}: {warning}", path.display());
-    }
-    Ok(report)
-}
-
-/// An input path as messages show it: `-` is "standard input".
-pub(crate) fn display_input(path: &std::path::Path) -> String {
-    if is_stdio(path) {
-        "standard input (-)".into()
-    } else {
-        path.display().to_string()
-    }
-}
-
-/// An output path as messages show it: `-` is "standard output".
-pub(crate) fn display_output(path: &std::path::Path) -> String {
-    if is_stdio(path) {
-        "standard output (-)".into()
-    } else {
-        path.display().to_string()
-    }
-}
-
-/// Writes command output to stdout. A reader that closes the pipe early (`| head`) ends the output
-/// quietly instead of failing.
-pub fn emit(text: &str) -> anyhow::Result<()> {
-    use std::io::Write;
-    let mut stdout = std::io::stdout().lock();
-    match stdout
-        .write_all(text.as_bytes())
-        .and_then(|()| stdout.flush())
-    {
-        Err(e) if e.kind() != std::io::ErrorKind::BrokenPipe => Err(e.into()),
-        _ => Ok(()),
     }
 }

@@ -36,15 +36,15 @@ const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
 const SAMPLE_COUNT: u32 = 4;
 
 /// On a software renderer (lavapipe, llvmpipe: a CPU adapter), meshes with more faces than this
-/// are drawn without multisampling: the 1.2M-face bunny's image took 1.7 s with 4 samples and
-/// 0.6-0.85 s with one under lavapipe on two cores, and the window waits for it.
+/// are drawn without multisampling: on the CPU, four samples cost several times the drawing of
+/// one, and the window waits for the image.
 pub const SOFTWARE_SINGLE_SAMPLE_FACES: usize = 400_000;
 
 /// On a software renderer, a new image draws at most this many faces (or wireframe edges) per
 /// frame: a bigger mesh's image is drawn over several frames into a second target while the
-/// previous image stays on screen, then copied over it. Drawing the 1.2M-face bunny's image
-/// in one frame kept the window from answering input for 0.6-0.85 s under lavapipe on two cores;
-/// in parts of this size each frame stays under ~100 ms.
+/// previous image stays on screen, then copied over it. A big mesh's image drawn in one frame
+/// would keep the window from answering input until it is done; parts of this size keep each
+/// frame short.
 pub const SOFTWARE_FACES_PER_FRAME: usize = 50_000;
 
 /// Everything that decides what one rendered image looks like, apart from the mesh itself.
@@ -89,6 +89,16 @@ struct Progress {
     done: u32,
     /// CPU time spent recording its parts so far.
     recording: Duration,
+}
+
+/// What [`MeshRenderer::draw_next_part`] did.
+enum PartDrawn {
+    /// Nothing: there is no target to draw into.
+    NoTarget,
+    /// A part; the image needs more.
+    MoreToDraw,
+    /// The last part: the complete image is in the shown target.
+    Complete,
 }
 
 /// Owns the pipelines, the mesh buffers and the offscreen target. Knows nothing of fairing.
@@ -557,12 +567,8 @@ impl MeshRenderer {
         if params.wireframe {
             self.ensure_lines(device);
         }
-        // The pipelines must match the target's sampling (the mesh may have changed since the
-        // target was made: it is made again in the next frame's `ensure_target`).
-        let pipelines = match (&self.target, &self.single_sample) {
-            (Some(target), _) if target.samples == SAMPLE_COUNT => &self.pipelines,
-            (Some(_), Some(single)) => single,
-            _ => return false,
+        let Some(pipelines) = self.pipelines() else {
+            return false;
         };
         queue.write_buffer(&pipelines.uniform_buffer, 0, bytemuck::bytes_of(&uniforms));
         let Some(target) = &self.target else {
@@ -577,48 +583,89 @@ impl MeshRenderer {
             pipelines.draw(encoder, target, mesh, params.wireframe);
             self.last_draw_time = started.elapsed();
         } else {
-            // Part of an image too big for one frame, into the work target.
-            if self
-                .work
-                .as_ref()
-                .is_none_or(|w| w.size != target.size || w.samples != target.samples)
-            {
-                self.work = Some(Target::new(device, target.size, target.samples));
+            match self.draw_next_part(device, encoder, params, (faces, total), started) {
+                PartDrawn::NoTarget => return false,
+                PartDrawn::MoreToDraw => return true,
+                PartDrawn::Complete => {}
             }
-            let Some(work) = &self.work else {
-                return false;
-            };
-            let start = self.progress.as_ref().map_or(0, |p| p.done);
-            let end = (start as usize + self.faces_per_frame).min(total) as u32;
-            let part = Part {
-                faces: start.min(faces)..end.min(faces),
-                edges: start.saturating_sub(faces)..end.saturating_sub(faces),
-                first: start == 0,
-            };
-            let last = end as usize == total;
-            pipelines.draw_part(encoder, work, mesh, params.wireframe, &part, last);
-            let recording = self
-                .progress
-                .as_ref()
-                .map_or(Duration::ZERO, |p| p.recording)
-                + started.elapsed();
-            if !last {
-                self.progress = Some(Progress {
-                    params,
-                    done: end,
-                    recording,
-                });
-                (self.repaint)();
-                return true;
-            }
-            work.copy_image_to(encoder, target);
-            self.progress = None;
-            self.last_draw_time = recording;
         }
         self.target_has_image = true;
         self.drawn = Some(params);
         self.images_drawn += 1;
         true
+    }
+
+    /// The pipelines that match the target's sampling (the mesh may have changed since the
+    /// target was made: it is made again in the next frame's `ensure_target`); `None` without a
+    /// target, or without the single-sample pipelines it needs.
+    fn pipelines(&self) -> Option<&Pipelines> {
+        match (&self.target, &self.single_sample) {
+            (Some(target), _) if target.samples == SAMPLE_COUNT => Some(&self.pipelines),
+            (Some(_), Some(single)) => Some(single),
+            _ => None,
+        }
+    }
+
+    /// Draws the next part of an image too big for one frame (of `faces` faces and `total` faces
+    /// and wireframe edges) into the work target; the part that completes it is copied into the
+    /// shown target. `started` is when this frame's recording began.
+    fn draw_next_part(
+        &mut self,
+        device: &wgpu::Device,
+        encoder: &mut wgpu::CommandEncoder,
+        params: DrawParams,
+        (faces, total): (u32, usize),
+        started: std::time::Instant,
+    ) -> PartDrawn {
+        let Some((size, samples)) = self.target.as_ref().map(|t| (t.size, t.samples)) else {
+            return PartDrawn::NoTarget;
+        };
+        if self
+            .work
+            .as_ref()
+            .is_none_or(|w| w.size != size || w.samples != samples)
+        {
+            self.work = Some(Target::new(device, size, samples));
+        }
+        let (Some(pipelines), Some(target), Some(work)) =
+            (self.pipelines(), &self.target, &self.work)
+        else {
+            return PartDrawn::NoTarget;
+        };
+        let start = self.progress.as_ref().map_or(0, |p| p.done);
+        let end = (start as usize + self.faces_per_frame).min(total) as u32;
+        let part = Part {
+            faces: start.min(faces)..end.min(faces),
+            edges: start.saturating_sub(faces)..end.saturating_sub(faces),
+            first: start == 0,
+        };
+        let last = end as usize == total;
+        pipelines.draw_part(
+            encoder,
+            work,
+            self.mesh.as_ref(),
+            params.wireframe,
+            &part,
+            last,
+        );
+        let recording = self
+            .progress
+            .as_ref()
+            .map_or(Duration::ZERO, |p| p.recording)
+            + started.elapsed();
+        if !last {
+            self.progress = Some(Progress {
+                params,
+                done: end,
+                recording,
+            });
+            (self.repaint)();
+            return PartDrawn::MoreToDraw;
+        }
+        work.copy_image_to(encoder, target);
+        self.progress = None;
+        self.last_draw_time = recording;
+        PartDrawn::Complete
     }
 
     /// Builds the wireframe's edges of the mesh on screen when they are missing and fit: a big

@@ -282,7 +282,7 @@ pub fn default_export_path(input: &Path) -> PathBuf {
 /// Axis-aligned bounds of `positions` (zeros when empty).
 pub fn bounds_of(positions: &[[f32; 3]]) -> ([f32; 3], [f32; 3]) {
     // Branch-free, non-finite coordinates left out one by one: the UI thread runs this for
-    // every document (600k vertices: 2.3 ms with a branch per coordinate).
+    // every document, so it stays cheap on big meshes.
     use glam::Vec3A;
     let (lo, hi) = positions
         .iter()

@@ -176,6 +176,21 @@ impl Default for Settings {
     }
 }
 
+/// The settings that change the fairing result, as [`Settings::fairing_key`] takes them: two
+/// keys differ exactly when the result must be computed again.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct FairingKey {
+    iterations: usize,
+    rounds: usize,
+    boundary: BoundaryMode,
+    fair_finest: bool,
+    variant: MultiresVariant,
+    method: Method,
+    baseline_iterations: usize,
+    /// The baseline's λ as bits, so that the key compares exactly (and NaN equals itself).
+    baseline_lambda_bits: u64,
+}
+
 impl Settings {
     pub const STORAGE_KEY: &'static str = "fairmesh.settings";
     pub const REMEMBERED_FILES: usize = 64;
@@ -219,29 +234,17 @@ impl Settings {
     }
 
     /// The settings that change the fairing result (a change means: run again).
-    #[allow(clippy::type_complexity)]
-    pub fn fairing_key(
-        &self,
-    ) -> (
-        usize,
-        usize,
-        BoundaryMode,
-        bool,
-        MultiresVariant,
-        Method,
-        usize,
-        u64,
-    ) {
-        (
-            self.iterations,
-            self.rounds,
-            self.boundary,
-            self.fair_finest,
-            self.variant,
-            self.method,
-            self.baseline_iterations,
-            self.baseline_lambda.to_bits(),
-        )
+    pub fn fairing_key(&self) -> FairingKey {
+        FairingKey {
+            iterations: self.iterations,
+            rounds: self.rounds,
+            boundary: self.boundary,
+            fair_finest: self.fair_finest,
+            variant: self.variant,
+            method: self.method,
+            baseline_iterations: self.baseline_iterations,
+            baseline_lambda_bits: self.baseline_lambda.to_bits(),
+        }
     }
 
     /// The baseline method's options, or `None` for the paper's method.

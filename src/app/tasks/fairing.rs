@@ -1,15 +1,16 @@
 //! Fairing the document from the start level (or a baseline method), and the level meshes of
 //! the level view, on the compute worker: launch and result.
 
-use std::sync::{Arc, PoisonError};
+use std::sync::{Arc, Mutex, PoisonError};
 use std::time::{Duration, Instant};
 
 use crate::app::jobs::{Faired, JobResult};
 use crate::app::state::{FairedResult, HierarchyState, ViewMode};
 use crate::app::tasks::measure::MeasureRequest;
 use crate::app::App;
-use crate::multires;
-use crate::{hierarchy, metrics, TriMesh};
+use crate::fairing::{Mask, Method, MethodOptions};
+use crate::multires::{self, MultiresOptions, MultiresWorkspace};
+use crate::{hierarchy, metrics, Topology, TriMesh};
 
 /// Rings of vertices over which a painted mask always fades out at its edge.
 const MASK_EDGE_RINGS: usize = 3;
@@ -38,6 +39,8 @@ impl App {
         }
     }
 
+    /// Fairs the document from `level` (or with the baseline method) on the compute worker, the
+    /// result coming back as [`JobResult::Faired`] for `view`.
     pub(in crate::app) fn request_fairing(
         &mut self,
         hierarchy: Arc<hierarchy::Hierarchy>,
@@ -45,19 +48,7 @@ impl App {
         level: usize,
         view: u64,
     ) {
-        let mask = self.document.as_ref().and_then(|d| d.mask.clone());
-        // The document's connectivity, when the hierarchy's M0 has the document's triangles
-        // (otherwise it is built for M0 where needed).
-        let topology = self.document.as_ref().and_then(|d| match &d.hierarchy {
-            HierarchyState::Ready {
-                base_matches_original: true,
-                ..
-            } => Some(d.topology.clone()),
-            _ => None,
-        });
-        let mut options = self.settings.multires_options(level);
-        let baseline = self.settings.baseline_options();
-        let method = self.settings.method;
+        let job = self.fair_job(hierarchy, level);
         let document_generation = self.document_generation.clone();
         let progress_out = self.fair_progress.clone();
         let workspace = self.workspace.clone();
@@ -69,53 +60,13 @@ impl App {
             if !document_generation.is_current(document) {
                 return;
             }
-            let started = Instant::now();
             // A newer slider value does not cancel this run: while dragging, finished runs are
             // what keeps the view moving. Only a new document makes it pointless.
-            let mut progress = |fraction: f32| {
+            let progress = |fraction: f32| {
                 progress_out.set(fraction);
                 document_generation.is_current(document)
             };
-            // Only a mask or a baseline reads M0's connectivity.
-            let topology = (mask.is_some() || baseline.is_some()).then(|| {
-                topology.unwrap_or_else(|| Arc::new(crate::Topology::build(hierarchy.base_mesh())))
-            });
-            // A few rings of fade inside the painted region's edge, whatever the brush left: where
-            // the brush stopped at a silhouette the mask drops from 1 to 0 at once, and the
-            // result would show a step there.
-            let mask = mask
-                .zip(topology.as_deref())
-                .map(|(mask, topology)| mask.with_falloff(topology, MASK_EDGE_RINGS));
-            options.mask = mask.clone();
-            let positions = match (&baseline, topology.as_deref()) {
-                // A baseline smooths the document's mesh itself; the level does not apply.
-                (Some(method), Some(topology)) => {
-                    let mut mesh = hierarchy.base_mesh().clone();
-                    match &mask {
-                        Some(mask) => {
-                            crate::fairing::fair_masked(&mut mesh, topology, method, mask)
-                        }
-                        None => crate::fairing::fair(&mut mesh, topology, method),
-                    };
-                    progress(1.0);
-                    Some(mesh.positions)
-                }
-                _ => {
-                    let mut workspace = workspace.lock().unwrap_or_else(PoisonError::into_inner);
-                    multires::fair_multires(&hierarchy, &options, &mut workspace, &mut progress)
-                }
-            };
-            let result = positions.map(|positions| {
-                let (volume_change, rms_displacement) =
-                    metrics::change_of_positions(hierarchy.base_mesh(), &positions);
-                Faired {
-                    positions,
-                    volume_change,
-                    rms_displacement,
-                    elapsed: started.elapsed(),
-                    method,
-                }
-            });
+            let result = job.run(&workspace, progress);
             let message = JobResult::Faired {
                 document,
                 view,
@@ -124,6 +75,27 @@ impl App {
             };
             Self::send_result(&tx, &ctx, message, ticket);
         });
+    }
+
+    /// What fairing the document from `level` with the current settings needs.
+    fn fair_job(&self, hierarchy: Arc<hierarchy::Hierarchy>, level: usize) -> FairJob {
+        // The document's connectivity, when the hierarchy's M0 has the document's triangles
+        // (otherwise it is built for M0 where needed).
+        let topology = self.document.as_ref().and_then(|d| match &d.hierarchy {
+            HierarchyState::Ready {
+                base_matches_original: true,
+                ..
+            } => Some(d.topology.clone()),
+            _ => None,
+        });
+        FairJob {
+            hierarchy,
+            mask: self.document.as_ref().and_then(|d| d.mask.clone()),
+            topology,
+            options: self.settings.multires_options(level),
+            baseline: self.settings.baseline_options(),
+            method: self.settings.method,
+        }
     }
 
     pub(in crate::app) fn request_level_mesh(
@@ -214,5 +186,76 @@ impl App {
         }
         self.applied_level_view = view;
         current.level_mesh = Some((level, mesh));
+    }
+}
+
+/// One fairing of the document, as the compute worker runs it: taken from the app when it is
+/// asked for, so that the worker reads nothing of the app.
+struct FairJob {
+    hierarchy: Arc<hierarchy::Hierarchy>,
+    /// The painted mask, if any (its edge fades out over [`MASK_EDGE_RINGS`] when the job runs).
+    mask: Option<Mask>,
+    /// The document's connectivity, when the hierarchy's M0 has the document's triangles.
+    topology: Option<Arc<Topology>>,
+    options: MultiresOptions,
+    /// The baseline method's options; `None` for the paper's method.
+    baseline: Option<MethodOptions>,
+    method: Method,
+}
+
+impl FairJob {
+    /// Fairs, reporting to `progress` (which returns false to cancel): the result, or `None`
+    /// when cancelled.
+    fn run(
+        self,
+        workspace: &Mutex<MultiresWorkspace>,
+        mut progress: impl FnMut(f32) -> bool + Send,
+    ) -> Option<Faired> {
+        let started = Instant::now();
+        let FairJob {
+            hierarchy,
+            mask,
+            topology,
+            mut options,
+            baseline,
+            method,
+        } = self;
+        // Only a mask or a baseline reads M0's connectivity.
+        let topology = (mask.is_some() || baseline.is_some())
+            .then(|| topology.unwrap_or_else(|| Arc::new(Topology::build(hierarchy.base_mesh()))));
+        // A few rings of fade inside the painted region's edge, whatever the brush left: where
+        // the brush stopped at a silhouette the mask drops from 1 to 0 at once, and the
+        // result would show a step there.
+        let mask = mask
+            .zip(topology.as_deref())
+            .map(|(mask, topology)| mask.with_falloff(topology, MASK_EDGE_RINGS));
+        options.mask = mask.clone();
+        let positions = match (&baseline, topology.as_deref()) {
+            // A baseline smooths the document's mesh itself; the level does not apply.
+            (Some(method), Some(topology)) => {
+                let mut mesh = hierarchy.base_mesh().clone();
+                match &mask {
+                    Some(mask) => crate::fairing::fair_masked(&mut mesh, topology, method, mask),
+                    None => crate::fairing::fair(&mut mesh, topology, method),
+                };
+                progress(1.0);
+                Some(mesh.positions)
+            }
+            _ => {
+                let mut workspace = workspace.lock().unwrap_or_else(PoisonError::into_inner);
+                multires::fair_multires(&hierarchy, &options, &mut workspace, &mut progress)
+            }
+        };
+        positions.map(|positions| {
+            let (volume_change, rms_displacement) =
+                metrics::change_of_positions(hierarchy.base_mesh(), &positions);
+            Faired {
+                positions,
+                volume_change,
+                rms_displacement,
+                elapsed: started.elapsed(),
+                method,
+            }
+        })
     }
 }

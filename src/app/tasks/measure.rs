@@ -12,9 +12,8 @@ use crate::TriMesh;
 
 /// A faired result is measured once it has been on screen this long with no fairing in flight:
 /// measuring takes a core for 0.1-0.3 s on the bunny (seconds on a 1M-face mesh), and while the
-/// slider is dragged it would compete with the next value's fairing (on a 2-core machine one
-/// slider step in ten then took 8 frames instead of 2-3). The numbers follow when the user
-/// pauses.
+/// slider is dragged it would compete with the next value's fairing for the cores. The numbers
+/// follow when the user pauses.
 pub(in crate::app) const MEASURE_DELAY: Duration = Duration::from_millis(100);
 
 /// A faired result waiting to be measured.

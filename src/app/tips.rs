@@ -1,0 +1,61 @@
+//! The side panel's tooltips: what each control does and when to change it, in plain words (tests
+//! look controls up by them). The View section's are in `view_panel.rs`.
+
+pub const NOISE_SIGMA: &str = "How strong the noise is: how far, on average, each vertex \
+    is pushed, in mean edge lengths. 0.3 looks like a rough scan; 1 and more hides the shape.";
+pub const NOISE_SEED: &str = "Which random pattern the noise uses. The same seed and \
+    strength give the same noise again, to compare smoothers on it; change it for another.";
+pub const NOISE_DIRECTION: &str = "Which way the noise pushes the vertices. Along the \
+    normal: in and out of the surface, like a scanner's depth error. Random direction (the \
+    paper's test) and Isotropic (x, y and z each on their own): also along the surface, \
+    which jitters the triangles too.";
+pub const KEEP_SHARP_EDGES: &str = "Keep the mesh's sharp edges (the edges of a machined \
+    part, a fold, a rim) sharp: the coarse levels keep them and the smoothing runs along them, \
+    not across them. Edges your file marks as hard (where its normals split, or two of its \
+    materials meet) are kept too, however gentle the fold. Turn it off for organic shapes if \
+    smoothing leaves ridges where there should be none.";
+pub const SHARP_EDGE_ANGLE: &str = "How sharply the surface must fold at an edge for the edge \
+    to be kept sharp. Lower: more edges are kept (gentle folds too). Higher: only the sharpest. \
+    The kept edges are drawn over the mesh while you point here.";
+pub const START_LEVEL: &str = "How coarse a version of the mesh the smoothing starts from \
+    (M0 is the mesh itself). Higher: smoother, bigger bumps go. Lower: more of the detail \
+    stays. Raise it until the noise is gone; lower it if wanted features melt away.";
+pub const METHOD: &str = "Constrained fairing (the paper's method) smooths without \
+    shrinking the mesh. The others are classic smoothers to compare with: watch the volume \
+    change under Numbers.";
+pub const ITERATIONS_PER_LEVEL: &str = "Smoothing passes on each level on the way back to \
+    full detail. More: a little smoother and slower. The start level matters far more: \
+    change this last.";
+pub const ROUNDS: &str = "How often each level's smoothing starts over from where it got \
+    to. More: a little smoother and slower; 1 is usually enough.";
+pub const BASELINE_ITERATIONS: &str = "Smoothing passes over the whole mesh. More: \
+    smoother, and (for Laplacian) more shrinkage.";
+pub const LAMBDA: &str = "How far each pass moves a vertex towards its neighbours (0 to \
+    1). Higher: faster smoothing, more shrinkage.";
+pub const BOUNDARY: &str = "What happens to open borders (holes, cut edges). Smooth as \
+    curve: the border line is smoothed too. Fixed: border vertices stay where they are; use \
+    it when the mesh must still meet another part.";
+pub const FAIR_FINEST: &str = "Also smooth the full-detail mesh (M0) at the end. On: the \
+    finest noise goes too. Off: the finest detail stays as it was.";
+pub const VARIANT: &str = "Paper: the method as published. Improved: two corrections that \
+    keep the shape from drifting and shrinking over the levels. Keep Improved unless you \
+    compare with the paper.";
+pub const PAINT: &str = "Paint where to fair (P). On: the left button paints on the mesh \
+    instead of turning the view (middle drag turns it, right drag pans). Only the painted \
+    part is smoothed; the rest keeps its exact shape.";
+pub const BRUSH_ADD: &str = "The brush marks the part to smooth.";
+pub const BRUSH_ERASE: &str = "The brush unmarks what it touches, so it keeps its shape \
+    (on a mesh with no mask yet: protects it while the rest is smoothed). Hold Shift to \
+    erase for a moment.";
+pub const BRUSH_RADIUS: &str = "Size of the brush on screen, in points. Zoom in to paint \
+    finer detail.";
+pub const BRUSH_SOFTNESS: &str = "How much of the brush's edge fades out. Higher: the \
+    smoothing blends gently into the untouched part; 0: a hard edge.";
+pub const SHOW_MASK: &str = "Tint the painted part orange on the mesh (it replaces the \
+    heat map while shown).";
+pub const CLEAR_MASK: &str = "Remove the paint: the whole mesh is smoothed again (undo \
+    with Ctrl+Z).";
+pub const INVERT_MASK: &str = "Smooth what was left alone and keep what was painted \
+    (undo with Ctrl+Z).";
+pub const APPLY: &str = "Make the result the input mesh, to add noise to it, fair it \
+    again or export it as it is (undo with Ctrl+Z).";

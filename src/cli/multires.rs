@@ -1,0 +1,425 @@
+//! `fairmesh multires`: multiresolution fairing (section 4.2 of the paper) from one or more start
+//! levels of the decimation hierarchy (section 4.1, built as `fairmesh hierarchy` builds it), each
+//! result timed and, with `--measure`, measured against the input before any noise.
+
+use std::fmt::Write as _;
+use std::sync::Arc;
+use std::time::Instant;
+
+use anyhow::Context;
+use clap::{Args, ValueEnum};
+use fairmesh::fairing::Mask;
+use fairmesh::hierarchy::Hierarchy;
+use fairmesh::io::Source;
+use fairmesh::multires::{fair_multires, MultiresOptions, MultiresVariant, MultiresWorkspace};
+use fairmesh::noise::{self, NoiseOptions};
+use fairmesh::{metrics, Topology, TriMesh};
+use serde_json::json;
+use std::path::PathBuf;
+
+use super::args::{BoundaryArg, StdioFormat};
+use super::common::{check_output_format, emit, is_stdio, load_input, load_shown, save_kept};
+use super::hierarchy::{build, levels_phrase, print_notes, BuildArgs};
+
+#[derive(Clone, Copy, Debug, ValueEnum, PartialEq, Eq)]
+pub enum VariantArg {
+    /// The paper's placement of split vertices (1-ring mean plus one Kobbelt step).
+    Paper,
+    /// Kobbelt placement plus a low-passed volume restoration (see the multires module docs).
+    Improved,
+}
+
+#[derive(Args, Debug)]
+pub struct MultiresArgs {
+    /// Input mesh.
+    pub input: PathBuf,
+    /// Output mesh (format by extension; `-`: standard output, with --format); optional when
+    /// only timing or measuring.
+    #[arg(short, long)]
+    pub output: Option<PathBuf>,
+    /// Start level(s): 0 is M0 (single-level fairing), larger is coarser and smoother. Several,
+    /// comma separated, run one after another (with --json: one object each, as an array).
+    #[arg(long, value_delimiter = ',', default_value = "1")]
+    pub level: Vec<usize>,
+    /// Fairing iterations per level and round.
+    #[arg(long, default_value_t = 5)]
+    pub iterations: usize,
+    /// Fairing rounds per level (each re-imposes the constraints).
+    #[arg(long, default_value_t = 1)]
+    pub rounds: usize,
+    #[arg(long, default_value = "curve", value_parser = BoundaryArg::names_only_parser())]
+    pub boundary: BoundaryArg,
+    /// Also fair M0 after the last refinement.
+    #[arg(long)]
+    pub fair_finest: bool,
+    /// Placement of split vertices; several, comma separated, run one after another.
+    #[arg(long, value_enum, value_delimiter = ',', default_value = "improved")]
+    pub variant: Vec<VariantArg>,
+    /// Add seeded normal noise of this many mean edge lengths first (the volume change, and with
+    /// --measure the distances, are then taken against the clean input).
+    #[arg(long)]
+    pub noise: Option<f64>,
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
+    /// Measure each result against the input (before any noise): two-way surface distance (mean
+    /// and Hausdorff), vertex RMS and normal error. Costs more than the fairing on large meshes.
+    #[arg(long)]
+    pub measure: bool,
+    /// Measure the result against this mesh instead of the input (implies --measure).
+    #[arg(long)]
+    pub reference: Option<PathBuf>,
+    /// Print JSON instead of text: the time of each run and of the hierarchy build, the volume
+    /// change, and with --measure the distances.
+    #[arg(long)]
+    pub json: bool,
+    #[command(flatten)]
+    pub stdio: StdioFormat,
+    #[command(flatten)]
+    pub build: BuildArgs,
+    #[command(flatten)]
+    pub mask: super::mask::MaskArgs,
+}
+
+impl MultiresArgs {
+    /// The options of the run from `level` with `variant`, fairing within `mask` (if any).
+    fn options(&self, level: usize, variant: VariantArg, mask: Option<Mask>) -> MultiresOptions {
+        MultiresOptions::default()
+            .with_start_level(level)
+            .with_iterations(self.iterations)
+            .with_rounds(self.rounds)
+            .with_boundary(self.boundary.into())
+            .with_fair_finest(self.fair_finest)
+            .with_mask(mask)
+            .with_variant(match variant {
+                VariantArg::Paper => MultiresVariant::Paper,
+                VariantArg::Improved => MultiresVariant::Improved,
+            })
+    }
+}
+
+/// The input of the runs, read and made ready for the hierarchy build.
+struct Prepared {
+    source: Arc<Source>,
+    mask: Option<Mask>,
+    /// The mesh's connectivity, kept only when creases are kept (their detection reads it).
+    topology: Option<Topology>,
+    /// The file's own sharp edges, creases too when creases are kept.
+    file_edges: Vec<[u32; 2]>,
+    /// The input, with the noise `--noise` adds.
+    input: TriMesh,
+    /// The mesh `--reference` names.
+    reference_file: Option<TriMesh>,
+    /// The input before the noise, kept only to measure against it.
+    clean: Option<TriMesh>,
+    /// The volume the results' volume change is taken against: the reference's, else the input's
+    /// before any noise.
+    clean_volume: f64,
+}
+
+pub fn run(args: MultiresArgs) -> anyhow::Result<()> {
+    let to_stdout = check_output(&args)?;
+    let measure = args.measure || args.reference.is_some();
+    let prepared = prepare(&args, measure)?;
+    let started = Instant::now();
+    let hierarchy = build(
+        &prepared.input,
+        prepared.topology.as_ref(),
+        &args.build,
+        prepared.file_edges,
+    )?;
+    drop(prepared.topology);
+    print_notes(&hierarchy, &args.input);
+    // The hierarchy keeps its own copy of the (noisy) input as M0: the input goes, and the
+    // results take their triangles from M0.
+    drop(prepared.input);
+    let base = hierarchy.base_mesh();
+    let reference = measure.then(|| {
+        (prepared.reference_file.as_ref())
+            .or(prepared.clean.as_ref())
+            .unwrap_or(base)
+    });
+    let hierarchy_ms = started.elapsed().as_secs_f64() * 1e3;
+    note_levels_beyond(&args, hierarchy.coarsest_level());
+    let runs = Runs {
+        hierarchy: &hierarchy,
+        mask: prepared.mask,
+        reference,
+        clean_volume: prepared.clean_volume,
+        hierarchy_ms,
+    };
+    let (results, last) = runs.fair_each(&args)?;
+    if let (Some(path), Some(result)) = (&args.output, &last) {
+        save_kept(path, result, &prepared.source, args.stdio.format)?;
+    }
+    print_results(&args, &hierarchy, hierarchy_ms, measure, results, to_stdout)
+}
+
+/// Refuses `--json` with `-o -` (both would write to standard output), and `-o -` without
+/// `--format`; returns whether the mesh goes to standard output.
+fn check_output(args: &MultiresArgs) -> anyhow::Result<bool> {
+    let to_stdout = args.output.as_deref().is_some_and(is_stdio);
+    anyhow::ensure!(
+        !(args.json && to_stdout),
+        "--json and `-o -` would both write to standard output: write the mesh to a file"
+    );
+    if let Some(output) = &args.output {
+        check_output_format(output, args.stdio.format)?;
+    }
+    Ok(to_stdout)
+}
+
+/// Loads the input, its mask and the `--reference`, and adds the noise `--noise` asks for
+/// (keeping the clean input when `measure`d against).
+fn prepare(args: &MultiresArgs, measure: bool) -> anyhow::Result<Prepared> {
+    let loaded = load_input(&args.input, true, args.stdio.format)?;
+    let source = loaded.source;
+    let mask = super::mask::load_for(&args.mask, &source, &loaded.mesh, Some(&loaded.topology))?;
+    // The connectivity serves the crease detection only; otherwise it goes before the build.
+    let topology = args
+        .build
+        .options()
+        .creases
+        .is_some()
+        .then_some(loaded.topology);
+    let file_edges = match topology {
+        Some(_) => source.hard_edges(&loaded.mesh),
+        None => Vec::new(),
+    };
+    let mut input = loaded.mesh;
+    let reference_file = match &args.reference {
+        Some(path) => Some(load_shown(path, true, None)?.mesh),
+        None => None,
+    };
+    // Results are measured against the input before any noise: keep a copy only when the noise
+    // would change it and the distances are asked for.
+    let clean =
+        (measure && reference_file.is_none() && args.noise.is_some()).then(|| input.clone());
+    let clean_volume = match &reference_file {
+        Some(reference) => metrics::signed_volume(reference),
+        None => metrics::signed_volume(&input),
+    };
+    if let Some(sigma) = args.noise {
+        noise::add_noise(
+            &mut input,
+            &NoiseOptions::default()
+                .with_sigma(sigma)
+                .with_seed(args.seed),
+        );
+    }
+    Ok(Prepared {
+        source,
+        mask,
+        topology,
+        file_edges,
+        input,
+        reference_file,
+        clean,
+        clean_volume,
+    })
+}
+
+/// Says, on standard error, which of the asked start levels lie above the coarsest and so
+/// start from it.
+fn note_levels_beyond(args: &MultiresArgs, coarsest: usize) {
+    let mut beyond: Vec<usize> = args
+        .level
+        .iter()
+        .copied()
+        .filter(|&l| l > coarsest)
+        .collect();
+    beyond.sort_unstable();
+    beyond.dedup();
+    if !beyond.is_empty() {
+        let levels: Vec<String> = beyond.iter().map(usize::to_string).collect();
+        eprintln!(
+            "note: {}: the hierarchy has levels 0 to {coarsest}, so {} {} {} from level {coarsest}, \
+             its coarsest",
+            args.input.display(),
+            if beyond.len() == 1 { "level" } else { "levels" },
+            levels.join(", "),
+            if beyond.len() == 1 { "starts" } else { "start" }
+        );
+    }
+}
+
+/// What every run shares: the hierarchy, the mask, what the results are measured against.
+struct Runs<'a> {
+    hierarchy: &'a Hierarchy,
+    mask: Option<Mask>,
+    /// What each result is measured against; `None` without `--measure`.
+    reference: Option<&'a TriMesh>,
+    clean_volume: f64,
+    hierarchy_ms: f64,
+}
+
+impl Runs<'_> {
+    /// Runs every variant from every start level, one after another: each run's JSON row, and the
+    /// last run's result.
+    fn fair_each(
+        &self,
+        args: &MultiresArgs,
+    ) -> anyhow::Result<(Vec<serde_json::Value>, Option<TriMesh>)> {
+        // One run holds only the level it is at; several runs share every level's set-up.
+        let mut workspace = if args.variant.len() * args.level.len() == 1 {
+            MultiresWorkspace::for_one_run()
+        } else {
+            MultiresWorkspace::new()
+        };
+        let mut results = Vec::new();
+        let mut last = None;
+        for &variant in &args.variant {
+            for &level in &args.level {
+                let options = args.options(level, variant, self.mask.clone());
+                let (result, row) = self.fair_one(&options, (level, variant), &mut workspace)?;
+                results.push(row);
+                last = Some(result);
+            }
+        }
+        Ok((results, last))
+    }
+
+    /// One run from `level` with `variant` (both in `options`), timed whole (with the per-level
+    /// set-up a first run on `workspace` does): the result and its JSON row.
+    fn fair_one(
+        &self,
+        options: &MultiresOptions,
+        (level, variant): (usize, VariantArg),
+        workspace: &mut MultiresWorkspace,
+    ) -> anyhow::Result<(TriMesh, serde_json::Value)> {
+        let hierarchy = self.hierarchy;
+        let start = level.min(hierarchy.coarsest_level());
+        let mut step =
+            super::progress::Step::start(format!("multiresolution fairing from level {start}"));
+        let started = Instant::now();
+        let positions = fair_multires(hierarchy, options, workspace, &mut step)
+            .context("multires fairing was cancelled")?;
+        let time_ms = started.elapsed().as_secs_f64() * 1e3;
+        drop(step);
+        let result = TriMesh::new(positions, hierarchy.base_mesh().triangles.clone());
+        let clean_volume = self.clean_volume;
+        let volume_change_percent = (clean_volume != 0.0)
+            .then(|| 100.0 * (metrics::signed_volume(&result) - clean_volume) / clean_volume.abs());
+        let mut row = json!({
+            "level": start,
+            "level_vertices": hierarchy.level_info(start).vertices,
+            "variant": format!("{variant:?}").to_lowercase(),
+            "time_ms": time_ms,
+            "hierarchy_ms": self.hierarchy_ms,
+            "loose_triangles": hierarchy.loose_triangles().len(),
+            "volume_change_percent": volume_change_percent,
+        });
+        if let Some(reference) = self.reference {
+            add_measures(&mut row, reference, &result);
+        }
+        Ok((result, row))
+    }
+}
+
+/// Measures `result` against `reference` into the run's JSON `row`.
+fn add_measures(row: &mut serde_json::Value, reference: &TriMesh, result: &TriMesh) {
+    let Some(map) = row.as_object_mut() else {
+        return;
+    };
+    let comparison = super::progress::Step::run("measuring the result", || {
+        metrics::compare(reference, result)
+    });
+    map.insert(
+        "mean_surface_distance".into(),
+        json!(comparison.mean_surface_distance),
+    );
+    map.insert(
+        "mean_surface_distance_edges".into(),
+        json!(comparison.mean_surface_distance / metrics::mean_edge_length(reference)),
+    );
+    map.insert("hausdorff".into(), json!(comparison.hausdorff));
+    map.insert(
+        "normal_error_deg".into(),
+        json!(comparison.same_connectivity.map(|c| c.normal_error_deg)),
+    );
+    map.insert(
+        "rms".into(),
+        json!(comparison.same_connectivity.map(|c| c.rms)),
+    );
+}
+
+/// Prints the runs: with `--json` one object (several: an array of them), else a table (on
+/// standard error when standard output holds the mesh).
+fn print_results(
+    args: &MultiresArgs,
+    hierarchy: &Hierarchy,
+    hierarchy_ms: f64,
+    measure: bool,
+    mut results: Vec<serde_json::Value>,
+    to_stdout: bool,
+) -> anyhow::Result<()> {
+    if args.json {
+        let value = if results.len() == 1 {
+            results.pop().unwrap_or_default()
+        } else {
+            serde_json::Value::Array(results)
+        };
+        return emit(&format!("{}\n", serde_json::to_string_pretty(&value)?));
+    }
+    let out = results_table(args, hierarchy, hierarchy_ms, measure, &results)?;
+    if to_stdout {
+        // Standard output holds the mesh.
+        eprint!("{out}");
+        Ok(())
+    } else {
+        emit(&out)
+    }
+}
+
+/// The runs as a table: the hierarchy and the noise in a header line, then one row a run.
+fn results_table(
+    args: &MultiresArgs,
+    hierarchy: &Hierarchy,
+    hierarchy_ms: f64,
+    measure: bool,
+    results: &[serde_json::Value],
+) -> anyhow::Result<String> {
+    let mut out = format!(
+        "{}: hierarchy of {} in {:.1} ms{}\nlevel  vertices  variant   time ms   volume %{}\n",
+        args.input.display(),
+        levels_phrase(hierarchy),
+        hierarchy_ms,
+        match args.noise {
+            Some(s) => format!(", noise {s} mean edge lengths (seed {})", args.seed),
+            None => String::new(),
+        },
+        if measure {
+            "   mean dist (edges)  normal err deg"
+        } else {
+            ""
+        }
+    );
+    for r in results {
+        write!(
+            out,
+            "{:>5} {:>9}  {:<8} {:>8.2}",
+            // as numbers: a JSON value ignores the column width
+            r["level"].as_u64().unwrap_or(0),
+            r["level_vertices"].as_u64().unwrap_or(0),
+            r["variant"].as_str().unwrap_or(""),
+            r["time_ms"].as_f64().unwrap_or(0.0),
+        )?;
+        out += &cell(&r["volume_change_percent"], 10, |v| format!("{v:+.4}"));
+        if measure {
+            out += &cell(&r["mean_surface_distance_edges"], 18, |v| format!("{v:.5}"));
+            out += &cell(&r["normal_error_deg"], 15, |v| format!("{v:.3}"));
+        }
+        out.push('\n');
+    }
+    Ok(out)
+}
+
+/// One cell of the table, right-aligned in `width`. A value the row does not have (no volume to
+/// change on a flat or open patch of zero volume, a measure that could not be made) prints as
+/// "-", as in JSON it is null.
+fn cell(value: &serde_json::Value, width: usize, format: fn(f64) -> String) -> String {
+    let text = value
+        .as_f64()
+        .filter(|v| v.is_finite())
+        .map_or_else(|| "-".to_string(), format);
+    format!(" {text:>width$}")
+}
