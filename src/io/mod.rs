@@ -22,7 +22,6 @@ pub(crate) mod atomic;
 mod carry;
 mod error;
 mod gltf;
-mod gltf_writeback;
 mod obj;
 mod off;
 mod ply;
@@ -522,7 +521,7 @@ pub fn save_with_source(
                 })?;
             }
             SourceData::Gltf(gltf) => {
-                gltf_writeback::write(path, format, gltf, source, mesh, &mut report)?
+                gltf::write_back(path, format, gltf, source, mesh, &mut report)?
             }
             SourceData::Plain | SourceData::Unkept(_) | SourceData::Stl(_) => {
                 save_as(path, mesh, format)?

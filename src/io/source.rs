@@ -26,7 +26,7 @@
 
 use super::carry::VertexAttributes;
 use super::scene::Scene;
-use super::{gltf_writeback, Format};
+use super::{gltf, Format};
 use crate::mesh::TriMesh;
 use glam::{DQuat, DVec3};
 use std::path::PathBuf;
@@ -65,7 +65,7 @@ pub(crate) enum SourceData {
     /// The PLY file's bytes.
     Ply(Vec<u8>),
     /// The glTF document, its buffers and which accessor elements became which vertices.
-    Gltf(Box<gltf_writeback::GltfSource>),
+    Gltf(Box<gltf::GltfSource>),
 }
 
 /// What saving did beyond writing the file: what could not be carried through, in plain words.
