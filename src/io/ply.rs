@@ -20,7 +20,8 @@
 //! row without per-face allocation. ASCII rows are one per line (what every writer produces).
 
 use super::carry::{Gather, VertexAttributes};
-use super::source::{dvec, NormalTurns, SmoothGroups, Source};
+use super::normals::{dvec, NormalTurns, SmoothGroups};
+use super::origin::Origin;
 use super::text::{lines, non_finite_kind, parse_f32, parse_f64, parse_i64, quote, tokens};
 use super::{IoError, Parsed};
 use crate::mesh::TriMesh;
@@ -1033,7 +1034,7 @@ fn ascii_value(kind: Scalar, value: f32) -> String {
 pub(crate) fn write_back(
     out: &mut dyn Write,
     bytes: &[u8],
-    source: &Source,
+    origin: &Origin,
     mesh: &TriMesh,
 ) -> std::io::Result<bool> {
     let invalid =
@@ -1050,7 +1051,7 @@ pub(crate) fn write_back(
     // The file's positions, as the reader reads them.
     let before = &vertex_triples(bytes, &header, &rows, element, layout.xyz);
     let after: Vec<[f32; 3]> = (0..before.len())
-        .map(|k| source.welded(k).map_or(before[k], |w| mesh.positions[w]))
+        .map(|k| origin.welded(k).map_or(before[k], |w| mesh.positions[w]))
         .collect();
     let uv_props = uv_properties(element);
     // The faces, only needed to turn normals and move texture coordinates.
@@ -1094,7 +1095,7 @@ pub(crate) fn write_back(
             let slots = (0..before.len())
                 .map(|k| {
                     let normal = values.get(k).copied().unwrap_or_default();
-                    let slot = groups.slot_for(elements.area_before(k), source.welded(k), normal);
+                    let slot = groups.slot_for(elements.area_before(k), origin.welded(k), normal);
                     turns.merge_slot(slot, &elements, k);
                     slot
                 })
@@ -1276,17 +1277,16 @@ pub(crate) fn has_texture_coordinates(bytes: &[u8]) -> bool {
 
 /// The vertex colours (red green blue [alpha]) and UVs (s t, u v or texture_u texture_v) of a
 /// PLY file, per welded vertex, for saving it in another format.
-pub(crate) fn vertex_attributes(bytes: &[u8], source: &Source) -> VertexAttributes {
+pub(crate) fn vertex_attributes(bytes: &[u8], origin: &Origin) -> VertexAttributes {
     let path = Path::new("");
-    let mut out = VertexAttributes::default();
     let Ok(header) = parse_header(bytes, path) else {
-        return out;
+        return VertexAttributes::default();
     };
     let Ok(layout) = find_layout(&header, path) else {
-        return out;
+        return VertexAttributes::default();
     };
     let Some(rows) = vertex_rows(bytes, &header, &layout) else {
-        return out;
+        return VertexAttributes::default();
     };
     let element = &header.elements[layout.vertex_element];
     let find = |name: &[u8]| {
@@ -1304,6 +1304,7 @@ pub(crate) fn vertex_attributes(bytes: &[u8], source: &Source) -> VertexAttribut
         _ => 1.0,
     };
     let rgb = [b"red".as_slice(), b"green", b"blue"].map(find);
+    let mut colours_gathered = None;
     if let [Some(r), Some(g), Some(b)] = rgb {
         let colours = vertex_triples(bytes, &header, &rows, element, [r, g, b]);
         let alphas = find(b"alpha").map(|a| {
@@ -1312,31 +1313,28 @@ pub(crate) fn vertex_attributes(bytes: &[u8], source: &Source) -> VertexAttribut
                 scale(a),
             )
         });
-        let mut gather = Gather::<4>::new(source.welded_vertices, [1.0; 4]);
+        let mut gather = Gather::<4>::new(origin.welded_vertices, [1.0; 4]);
         for (k, c) in colours.iter().enumerate() {
             let alpha = alphas
                 .as_ref()
                 .map_or(1.0, |(values, scale)| values[k][0] * scale);
             let rgba = [c[0] * scale(r), c[1] * scale(g), c[2] * scale(b), alpha];
-            gather.put(source.welded(k), rgba.map(|v| v.clamp(0.0, 1.0)));
+            gather.put(origin.welded(k), rgba.map(|v| v.clamp(0.0, 1.0)));
         }
-        let (values, merged) = gather.finish();
-        out.colours = Some(values);
-        out.colour_splits_merged = merged;
+        colours_gathered = Some(gather);
     }
+    let mut uvs_gathered = None;
     if let Some((u, v)) = uv_properties(element) {
-        let mut gather = Gather::<2>::new(source.welded_vertices, [0.0; 2]);
+        let mut gather = Gather::<2>::new(origin.welded_vertices, [0.0; 2]);
         for (k, uv) in vertex_triples(bytes, &header, &rows, element, [u, v, v])
             .iter()
             .enumerate()
         {
-            gather.put(source.welded(k), [uv[0], uv[1]]);
+            gather.put(origin.welded(k), [uv[0], uv[1]]);
         }
-        let (values, merged) = gather.finish();
-        out.uvs = Some(values);
-        out.uv_splits_merged = merged;
+        uvs_gathered = Some(gather);
     }
-    out
+    VertexAttributes::gathered(uvs_gathered, colours_gathered)
 }
 
 /// What a PLY file holds beyond positions and triangles, in plain words.

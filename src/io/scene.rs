@@ -19,7 +19,7 @@
 //! referred to by its file name; an image stored inside a glTF (buffer view or data: URI) is
 //! written out as a file beside an OBJ's `.mtl` or a `.gltf`. A GLB embeds every image.
 
-use super::source::{dvec, NormalTurns, SmoothGroups};
+use super::normals::{dvec, NormalTurns, SmoothGroups};
 use crate::mesh::TriMesh;
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
@@ -207,7 +207,7 @@ impl Scene {
         if !self.vertices.iter().any(missing) {
             return;
         }
-        let smooth = super::gltf::unit_vertex_normals(mesh);
+        let smooth = super::normals::unit_vertex_normals(mesh);
         for vertex in &mut self.vertices {
             if missing(vertex) {
                 vertex.normal = smooth[vertex.welded as usize];

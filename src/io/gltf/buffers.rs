@@ -200,6 +200,7 @@ pub(super) fn join_buffers(json: &mut Value, buffers: &[Vec<u8>]) -> Joined {
     }
     Joined { bytes: bin, starts }
 }
+
 pub(super) fn set_buffer_length(json: &mut Value, length: usize) {
     if length == 0 {
         return;

@@ -3,8 +3,9 @@
 
 use super::buffers::set_buffer_length;
 use super::uri::{percent_decode, percent_encode};
+use crate::io::origin::Origin;
 use crate::io::scene::image_mime_type;
-use crate::io::source::{SaveReport, Source};
+use crate::io::SaveReport;
 use serde_json::{json, Value};
 use std::path::{Path, PathBuf};
 
@@ -12,7 +13,7 @@ use std::path::{Path, PathBuf};
 /// the input's folder; those that cannot be found are named in the report and left as they are.
 pub(super) fn external_images(
     json: &Value,
-    source: &Source,
+    origin: &Origin,
     report: &mut SaveReport,
 ) -> Vec<(usize, PathBuf)> {
     let mut found = Vec::new();
@@ -24,7 +25,7 @@ pub(super) fn external_images(
         if uri.starts_with("data:") {
             continue;
         }
-        let Some(base) = &source.base_dir else {
+        let Some(base) = &origin.base_dir else {
             report.warnings.push(format!(
                 "image {i} refers to the file {uri:?}, which cannot be found (the input was read from memory): the reference is kept as it was"
             ));
@@ -87,6 +88,7 @@ pub(super) fn embed_images(
     }
     set_buffer_length(json, bin.len());
 }
+
 /// A `.gltf` keeps its images as files beside it: those not already in the output's folder are
 /// copied there (as `<output stem>_<name>` when another file of that name is there) and the
 /// copies to make are returned; those in the same folder are referenced as they were.

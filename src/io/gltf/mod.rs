@@ -40,10 +40,12 @@
 mod accessors;
 mod buffers;
 mod images;
+mod positions;
 mod read;
 mod read_accessors;
 mod source;
 mod source_scene;
+mod texture;
 mod turn_normals;
 mod uri;
 mod validate;
@@ -54,8 +56,7 @@ mod writeback;
 pub(crate) use read::parse;
 pub(crate) use source::GltfSource;
 pub(crate) use write::{
-    unit_vertex_normals, write_glb, write_glb_with, write_gltf, write_gltf_embedded,
-    write_gltf_with,
+    write_glb, write_glb_with, write_gltf, write_gltf_embedded, write_gltf_with,
 };
 pub(crate) use write_scene::write_scene;
 pub(crate) use writeback::write as write_back;

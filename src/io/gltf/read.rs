@@ -6,7 +6,6 @@ use super::read_accessors::{read_indices, read_positions};
 use super::source::{GltfSource, PrimitiveRead};
 use super::uri::{decode_base64, percent_decode};
 use super::validate::{check_glb_header, describe, json_text, older_gltf, validate};
-use crate::io::source::SourceData;
 use crate::io::{IoError, Parsed};
 use crate::mesh::TriMesh;
 use ::gltf::mesh::Mode;
@@ -15,7 +14,11 @@ use glam::{DMat4, DQuat, DVec3};
 use std::borrow::Cow;
 use std::path::Path;
 
-pub(crate) fn parse(bytes: &[u8], path: &Path, base_dir: Option<&Path>) -> Result<Parsed, IoError> {
+pub(crate) fn parse(
+    bytes: &[u8],
+    path: &Path,
+    base_dir: Option<&Path>,
+) -> Result<Parsed<GltfSource>, IoError> {
     check_glb_header(bytes, path)?;
     let document = ::gltf::Gltf::from_slice_without_validation(bytes)
         .map_err(|e| older_gltf(bytes, path).unwrap_or_else(|| describe(e, path)))?;
@@ -51,33 +54,7 @@ pub(crate) fn parse(bytes: &[u8], path: &Path, base_dir: Option<&Path>) -> Resul
             }
         }
     }
-    let skipped = reader.skipped_points + reader.skipped_lines;
-    if reader.mesh.triangles.is_empty() {
-        let detail = if skipped > 0 {
-            format!(
-                ": the scene has only point and line primitives ({} point, {} line)",
-                reader.skipped_points, reader.skipped_lines
-            )
-        } else {
-            String::new()
-        };
-        return Err(IoError::invalid(path, format!("no triangles{detail}")));
-    }
-    if skipped > 0 {
-        // "1 point primitive was skipped", "2 line primitives were skipped", or both.
-        let parts: Vec<String> = [
-            (reader.skipped_points, "point primitive", "point primitives"),
-            (reader.skipped_lines, "line primitive", "line primitives"),
-        ]
-        .into_iter()
-        .filter(|&(n, _, _)| n > 0)
-        .map(|(n, one, many)| crate::io::text::counted(n, one, many))
-        .collect();
-        let verb = if skipped == 1 { "was" } else { "were" };
-        reader
-            .warnings
-            .push(format!("{} {verb} skipped", parts.join(" and ")));
-    }
+    reader.check_skipped()?;
     let SceneReader {
         mesh,
         warnings,
@@ -106,9 +83,11 @@ pub(crate) fn parse(bytes: &[u8], path: &Path, base_dir: Option<&Path>) -> Resul
     Ok(Parsed {
         mesh,
         warnings,
-        data: SourceData::Gltf(Box::new(source)),
+        unkept: Vec::new(),
+        kept: Some(source),
     })
 }
+
 fn load_buffers<'a>(
     document: &'a ::gltf::Gltf,
     path: &Path,
@@ -161,6 +140,7 @@ fn load_buffers<'a>(
     }
     Ok(buffers)
 }
+
 struct SceneReader<'a> {
     path: &'a Path,
     buffers: &'a [Cow<'a, [u8]>],
@@ -235,6 +215,38 @@ impl SceneReader<'_> {
         Ok(())
     }
 
+    /// The point and line primitives skipped, said in a warning; an error when nothing but
+    /// them was read.
+    fn check_skipped(&mut self) -> Result<(), IoError> {
+        let skipped = self.skipped_points + self.skipped_lines;
+        if self.mesh.triangles.is_empty() {
+            let detail = if skipped > 0 {
+                format!(
+                    ": the scene has only point and line primitives ({} point, {} line)",
+                    self.skipped_points, self.skipped_lines
+                )
+            } else {
+                String::new()
+            };
+            return Err(IoError::invalid(self.path, format!("no triangles{detail}")));
+        }
+        if skipped > 0 {
+            // "1 point primitive was skipped", "2 line primitives were skipped", or both.
+            let parts: Vec<String> = [
+                (self.skipped_points, "point primitive", "point primitives"),
+                (self.skipped_lines, "line primitive", "line primitives"),
+            ]
+            .into_iter()
+            .filter(|&(n, _, _)| n > 0)
+            .map(|(n, one, many)| crate::io::text::counted(n, one, many))
+            .collect();
+            let verb = if skipped == 1 { "was" } else { "were" };
+            self.warnings
+                .push(format!("{} {verb} skipped", parts.join(" and ")));
+        }
+        Ok(())
+    }
+
     fn read_mesh(
         &mut self,
         mesh: &::gltf::Mesh,
@@ -267,95 +279,14 @@ impl SceneReader<'_> {
                     .push(format!("{label}: no POSITION attribute, skipped"));
                 continue;
             };
-            let mut positions = read_positions(&position_accessor, self.buffers).map_err(|m| {
-                at(format!(
-                    "POSITION accessor {}: {m}",
-                    position_accessor.index()
-                ))
-            })?;
-            if world != DMat4::IDENTITY {
-                for p in &mut positions {
-                    let q = world.transform_point3(DVec3::from_array(p.map(f64::from)));
-                    *p = q.as_vec3().to_array();
-                }
-            }
-            if let Some((v, _)) = positions
-                .iter()
-                .enumerate()
-                .find(|(_, p)| !p.iter().all(|c| c.is_finite()))
-            {
-                return Err(at(format!(
-                    "vertex {v} has a NaN or infinite coordinate{}",
-                    if world != DMat4::IDENTITY {
-                        " (after the node's transform)"
-                    } else {
-                        ""
-                    }
-                )));
-            }
-            let vertex_count = positions.len();
-            let corners: Vec<u32> = match primitive.indices() {
-                Some(accessor) => {
-                    let indices = read_indices(&accessor, self.buffers)
-                        .map_err(|m| at(format!("index accessor {}: {m}", accessor.index())))?;
-                    if let Some((k, i)) = indices
-                        .iter()
-                        .enumerate()
-                        .find(|(_, &i)| i as usize >= vertex_count)
-                    {
-                        return Err(at(format!(
-                            "index accessor {}, element {k}: index {i} is out of range (the POSITION accessor has {vertex_count} vertices)",
-                            accessor.index()
-                        )));
-                    }
-                    indices
-                }
-                None => {
-                    let n = u32::try_from(vertex_count)
-                        .map_err(|_| at("too many vertices for 32-bit indices".into()))?;
-                    (0..n).collect()
-                }
-            };
+            let positions = self.placed_positions(&position_accessor, world, &at)?;
+            let corners = self.corners(&primitive, positions.len(), &at)?;
             let base = u32::try_from(self.mesh.positions.len())
                 .ok()
-                .filter(|b| (*b as u64) + vertex_count as u64 <= u32::MAX as u64)
+                .filter(|b| (*b as u64) + positions.len() as u64 <= u32::MAX as u64)
                 .ok_or_else(|| at("too many vertices in all for 32-bit indices".into()))?;
-            let flip = world.determinant() < 0.0;
             let before = self.mesh.triangles.len();
-            let mut push = |t: [u32; 3]| {
-                let t = if flip { [t[0], t[2], t[1]] } else { t };
-                self.mesh.triangles.push(t.map(|v| v + base));
-            };
-            match primitive.mode() {
-                Mode::TriangleStrip => {
-                    for (i, w) in corners.windows(3).enumerate() {
-                        push(if i % 2 == 0 {
-                            [w[0], w[1], w[2]]
-                        } else {
-                            [w[0], w[2], w[1]]
-                        });
-                    }
-                }
-                Mode::TriangleFan => {
-                    if let Some((&first, rest)) = corners.split_first() {
-                        for w in rest.windows(2) {
-                            push([w[0], w[1], first]);
-                        }
-                    }
-                }
-                _ => {
-                    for c in corners.chunks_exact(3) {
-                        push([c[0], c[1], c[2]]);
-                    }
-                    if !corners.len().is_multiple_of(3) {
-                        self.warnings.push(format!(
-                            "{label}: {} indices is not a multiple of 3; the last {} were ignored",
-                            corners.len(),
-                            corners.len() % 3
-                        ));
-                    }
-                }
-            }
+            self.push_triangles(primitive.mode(), &corners, base, world, &label);
             if self.mesh.triangles.len() > before {
                 self.reads.push(PrimitiveRead {
                     accessor: position_accessor.index(),
@@ -370,5 +301,113 @@ impl SceneReader<'_> {
             }
         }
         Ok(())
+    }
+
+    /// A primitive's positions placed by `world`, every coordinate finite.
+    fn placed_positions(
+        &self,
+        accessor: &::gltf::Accessor,
+        world: DMat4,
+        at: &impl Fn(String) -> IoError,
+    ) -> Result<Vec<[f32; 3]>, IoError> {
+        let mut positions = read_positions(accessor, self.buffers)
+            .map_err(|m| at(format!("POSITION accessor {}: {m}", accessor.index())))?;
+        if world != DMat4::IDENTITY {
+            for p in &mut positions {
+                let q = world.transform_point3(DVec3::from_array(p.map(f64::from)));
+                *p = q.as_vec3().to_array();
+            }
+        }
+        if let Some((v, _)) = positions
+            .iter()
+            .enumerate()
+            .find(|(_, p)| !p.iter().all(|c| c.is_finite()))
+        {
+            return Err(at(format!(
+                "vertex {v} has a NaN or infinite coordinate{}",
+                if world != DMat4::IDENTITY {
+                    " (after the node's transform)"
+                } else {
+                    ""
+                }
+            )));
+        }
+        Ok(positions)
+    }
+
+    /// A primitive's corners: its indices, each checked against its `vertex_count` vertices, or
+    /// all its vertices in order when it has none.
+    fn corners(
+        &self,
+        primitive: &::gltf::Primitive,
+        vertex_count: usize,
+        at: &impl Fn(String) -> IoError,
+    ) -> Result<Vec<u32>, IoError> {
+        let Some(accessor) = primitive.indices() else {
+            let n = u32::try_from(vertex_count)
+                .map_err(|_| at("too many vertices for 32-bit indices".into()))?;
+            return Ok((0..n).collect());
+        };
+        let indices = read_indices(&accessor, self.buffers)
+            .map_err(|m| at(format!("index accessor {}: {m}", accessor.index())))?;
+        if let Some((k, i)) = indices
+            .iter()
+            .enumerate()
+            .find(|(_, &i)| i as usize >= vertex_count)
+        {
+            return Err(at(format!(
+                "index accessor {}, element {k}: index {i} is out of range (the POSITION accessor has {vertex_count} vertices)",
+                accessor.index()
+            )));
+        }
+        Ok(indices)
+    }
+
+    /// The triangles of `corners` in `mode` (strips and fans unrolled; glTF 2.0 spec, section
+    /// 3.7.2.1), their vertices counted from `base`, their winding flipped back under a
+    /// mirroring `world` transform.
+    fn push_triangles(
+        &mut self,
+        mode: Mode,
+        corners: &[u32],
+        base: u32,
+        world: DMat4,
+        label: &str,
+    ) {
+        let flip = world.determinant() < 0.0;
+        let mut push = |t: [u32; 3]| {
+            let t = if flip { [t[0], t[2], t[1]] } else { t };
+            self.mesh.triangles.push(t.map(|v| v + base));
+        };
+        match mode {
+            Mode::TriangleStrip => {
+                for (i, w) in corners.windows(3).enumerate() {
+                    push(if i % 2 == 0 {
+                        [w[0], w[1], w[2]]
+                    } else {
+                        [w[0], w[2], w[1]]
+                    });
+                }
+            }
+            Mode::TriangleFan => {
+                if let Some((&first, rest)) = corners.split_first() {
+                    for w in rest.windows(2) {
+                        push([w[0], w[1], first]);
+                    }
+                }
+            }
+            _ => {
+                for c in corners.chunks_exact(3) {
+                    push([c[0], c[1], c[2]]);
+                }
+                if !corners.len().is_multiple_of(3) {
+                    self.warnings.push(format!(
+                        "{label}: {} indices is not a multiple of 3; the last {} were ignored",
+                        corners.len(),
+                        corners.len() % 3
+                    ));
+                }
+            }
+        }
     }
 }

@@ -4,7 +4,7 @@
 
 use super::accessors::{decode, Layout, FLOAT};
 use crate::io::carry::{Gather, VertexAttributes};
-use crate::io::source::Source;
+use crate::io::origin::Origin;
 use glam::DMat4;
 use serde_json::Value;
 
@@ -39,7 +39,7 @@ pub(super) fn index(value: &Value, key: &str) -> Option<usize> {
 
 impl GltfSource {
     /// Where the first read of POSITION accessor `accessor` starts among the parser's vertices
-    /// (its elements' welded vertices are `source.welded(start + k)`).
+    /// (its elements' welded vertices are `origin.welded(start + k)`).
     pub(super) fn first_raw_start(&self, accessor: usize) -> Option<usize> {
         self.reads
             .iter()
@@ -264,9 +264,9 @@ impl GltfSource {
 
     /// TEXCOORD_0 and COLOR_0 per welded vertex, for saving in another format: each read
     /// primitive's elements go to the welded vertices its positions became.
-    pub(crate) fn vertex_attributes(&self, source: &Source) -> VertexAttributes {
-        let mut uvs = Gather::<2>::new(source.welded_vertices, [0.0; 2]);
-        let mut colours = Gather::<4>::new(source.welded_vertices, [1.0; 4]);
+    pub(crate) fn vertex_attributes(&self, origin: &Origin) -> VertexAttributes {
+        let mut uvs = Gather::<2>::new(origin.welded_vertices, [0.0; 2]);
+        let mut colours = Gather::<4>::new(origin.welded_vertices, [1.0; 4]);
         let (mut any_uv, mut any_colour) = (false, false);
         for read in &self.reads {
             let layout_of = |name: &str| self.read_attribute(read, name);
@@ -274,7 +274,7 @@ impl GltfSource {
                 any_uv = true;
                 for k in 0..read.count {
                     let uv = [self.read(&layout, k, 0), self.read(&layout, k, 1)];
-                    uvs.put(source.welded(read.raw_start + k), uv);
+                    uvs.put(origin.welded(read.raw_start + k), uv);
                 }
             }
             if let Some(layout) = layout_of("COLOR_0").filter(|l| l.components >= 3) {
@@ -286,22 +286,11 @@ impl GltfSource {
                         1.0
                     };
                     let [r, g, b] = self.read3(&layout, k);
-                    colours.put(source.welded(read.raw_start + k), [r, g, b, alpha]);
+                    colours.put(origin.welded(read.raw_start + k), [r, g, b, alpha]);
                 }
             }
         }
-        let mut out = VertexAttributes::default();
-        if any_uv {
-            let (values, merged) = uvs.finish();
-            out.uvs = Some(values);
-            out.uv_splits_merged = merged;
-        }
-        if any_colour {
-            let (values, merged) = colours.finish();
-            out.colours = Some(values);
-            out.colour_splits_merged = merged;
-        }
-        out
+        VertexAttributes::gathered(any_uv.then_some(uvs), any_colour.then_some(colours))
     }
     /// What the document holds beyond positions and triangles, in plain words.
     pub(crate) fn contents(&self) -> Vec<String> {
@@ -381,6 +370,7 @@ impl GltfSource {
 pub(super) fn name_of<'a>(json: &'a Value, key: &str, index: usize) -> Option<&'a str> {
     json.get(key)?.get(index)?.get("name")?.as_str()
 }
+
 pub(super) fn primitives(json: &Value) -> impl Iterator<Item = &Value> {
     json.get("meshes")
         .and_then(Value::as_array)

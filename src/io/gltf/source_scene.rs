@@ -1,14 +1,16 @@
 //! The kept glTF document as a [`Scene`] (see [`crate::io::scene`]), for saving in another
 //! format: its parts, primitives, file vertices, materials and base colour textures.
 
-use super::source::{attribute, index, name_of, GltfSource};
+use super::accessors::Layout;
+use super::source::{attribute, index, name_of, GltfSource, PrimitiveRead};
 use super::uri::{decode_base64, percent_decode};
 use super::validate::IMAGE_FORMATS;
+use crate::io::normals::dvec;
+use crate::io::origin::Origin;
 use crate::io::scene::{
     image_file_name, image_mime_type, Image, ImageData, Material, Part, Primitive, Scene,
     SceneVertex,
 };
-use crate::io::source::{dvec, Source};
 use crate::mesh::TriMesh;
 use glam::{DMat3, DMat4};
 use serde_json::Value;
@@ -20,12 +22,12 @@ impl GltfSource {
     /// [`crate::io::scene`]): one part per node read (the node's name, and its mesh's name as the
     /// group), one primitive per glTF primitive, vertices and normals in world space, normals
     /// turned with their faces to `mesh`'s positions.
-    pub(crate) fn scene(&self, source: &Source, mesh: &TriMesh) -> Scene {
+    pub(crate) fn scene(&self, origin: &Origin, mesh: &TriMesh) -> Scene {
         let mut scene = Scene {
-            vertices: vec![SceneVertex::new(None, [0.0; 3]); source.raw_vertices],
+            vertices: vec![SceneVertex::new(None, [0.0; 3]); origin.raw_vertices],
             ..Scene::default()
         };
-        scene.materials = self.materials(source, &mut scene.warnings);
+        scene.materials = self.materials(origin, &mut scene.warnings);
         let mut part_of_node: BTreeMap<Option<usize>, usize> = BTreeMap::new();
         let meshes = self.array("meshes");
         for read in &self.reads {
@@ -45,75 +47,10 @@ impl GltfSource {
             {
                 continue;
             }
-            let identity = read.world == DMat4::IDENTITY;
-            let normal_matrix = DMat3::from_mat4(read.world).inverse().transpose();
-            let layout_of = |name: &str| {
-                attribute(primitive, name)
-                    .and_then(|a| self.layout(a).ok())
-                    .filter(|l| l.count == read.count)
-            };
-            let uvs = layout_of("TEXCOORD_0").filter(|l| l.components == 2);
-            let colours = layout_of("COLOR_0").filter(|l| l.components >= 3);
-            let normals = layout_of("NORMAL").filter(|l| l.components == 3);
-            scene.uvs |= uvs.is_some();
-            scene.colours |= colours.is_some();
-            scene.normals |= normals.is_some();
-            let finite = |values: &[f32]| values.iter().all(|c| c.is_finite());
-            for k in 0..read.count {
-                let local = self.read3(&positions, k);
-                let before = if identity {
-                    local
-                } else {
-                    read.world
-                        .transform_point3(dvec(local))
-                        .as_vec3()
-                        .to_array()
-                };
-                let mut vertex = SceneVertex::new(source.welded(read.raw_start + k), before);
-                if let Some(layout) = &uvs {
-                    let uv = [self.read(layout, k, 0), self.read(layout, k, 1)];
-                    vertex.uv = if finite(&uv) { uv } else { [0.0; 2] };
-                }
-                if let Some(layout) = &colours {
-                    let [r, g, b] = self.read3(layout, k);
-                    let a = if layout.components == 4 {
-                        self.read(layout, k, 3)
-                    } else {
-                        1.0
-                    };
-                    let colour = [r, g, b, a];
-                    vertex.colour = if finite(&colour) { colour } else { [1.0; 4] };
-                }
-                if let Some(layout) = &normals {
-                    let n = self.read3(layout, k);
-                    let n = if identity {
-                        n
-                    } else {
-                        (normal_matrix * dvec(n))
-                            .normalize_or_zero()
-                            .as_vec3()
-                            .to_array()
-                    };
-                    vertex.normal = if finite(&n) { n } else { [0.0; 3] };
-                }
-                scene.vertices[read.raw_start + k] = vertex;
-            }
-            let part = *part_of_node.entry(read.node).or_insert_with(|| {
-                let mesh_name = name_of(&self.json, "meshes", read.mesh).map(String::from);
-                let object = match read.node {
-                    Some(n) => Some(
-                        name_of(&self.json, "nodes", n)
-                            .map_or_else(|| format!("node{n}"), String::from),
-                    ),
-                    None => mesh_name.clone(),
-                };
-                scene.parts.push(Part {
-                    object,
-                    group: mesh_name,
-                    primitives: Vec::new(),
-                });
-                scene.parts.len() - 1
-            });
+            self.add_vertices(read, primitive, &positions, origin, &mut scene);
+            let part = *part_of_node
+                .entry(read.node)
+                .or_insert_with(|| self.add_part(read, &mut scene.parts));
             // A mirroring transform: the reader flipped the winding, and so does this.
             let flip = read.world.determinant() < 0.0;
             let triangles = self
@@ -135,9 +72,93 @@ impl GltfSource {
         scene
     }
 
+    /// The file vertices of one primitive read (`positions` its POSITION layout) in world space,
+    /// with their UVs, colours and normals where it has them (a value that is not finite becomes
+    /// zero, or white); the scene notes which it has.
+    fn add_vertices(
+        &self,
+        read: &PrimitiveRead,
+        primitive: &Value,
+        positions: &Layout,
+        origin: &Origin,
+        scene: &mut Scene,
+    ) {
+        let identity = read.world == DMat4::IDENTITY;
+        let normal_matrix = DMat3::from_mat4(read.world).inverse().transpose();
+        let layout_of = |name: &str| {
+            attribute(primitive, name)
+                .and_then(|a| self.layout(a).ok())
+                .filter(|l| l.count == read.count)
+        };
+        let uvs = layout_of("TEXCOORD_0").filter(|l| l.components == 2);
+        let colours = layout_of("COLOR_0").filter(|l| l.components >= 3);
+        let normals = layout_of("NORMAL").filter(|l| l.components == 3);
+        scene.uvs |= uvs.is_some();
+        scene.colours |= colours.is_some();
+        scene.normals |= normals.is_some();
+        let finite = |values: &[f32]| values.iter().all(|c| c.is_finite());
+        for k in 0..read.count {
+            let local = self.read3(positions, k);
+            let before = if identity {
+                local
+            } else {
+                read.world
+                    .transform_point3(dvec(local))
+                    .as_vec3()
+                    .to_array()
+            };
+            let mut vertex = SceneVertex::new(origin.welded(read.raw_start + k), before);
+            if let Some(layout) = &uvs {
+                let uv = [self.read(layout, k, 0), self.read(layout, k, 1)];
+                vertex.uv = if finite(&uv) { uv } else { [0.0; 2] };
+            }
+            if let Some(layout) = &colours {
+                let [r, g, b] = self.read3(layout, k);
+                let a = if layout.components == 4 {
+                    self.read(layout, k, 3)
+                } else {
+                    1.0
+                };
+                let colour = [r, g, b, a];
+                vertex.colour = if finite(&colour) { colour } else { [1.0; 4] };
+            }
+            if let Some(layout) = &normals {
+                let n = self.read3(layout, k);
+                let n = if identity {
+                    n
+                } else {
+                    (normal_matrix * dvec(n))
+                        .normalize_or_zero()
+                        .as_vec3()
+                        .to_array()
+                };
+                vertex.normal = if finite(&n) { n } else { [0.0; 3] };
+            }
+            scene.vertices[read.raw_start + k] = vertex;
+        }
+    }
+
+    /// A new part for the node of `read`: named by the node (or `node<n>`), grouped by its
+    /// mesh's name; returns its index.
+    fn add_part(&self, read: &PrimitiveRead, parts: &mut Vec<Part>) -> usize {
+        let mesh_name = name_of(&self.json, "meshes", read.mesh).map(String::from);
+        let object = match read.node {
+            Some(n) => Some(
+                name_of(&self.json, "nodes", n).map_or_else(|| format!("node{n}"), String::from),
+            ),
+            None => mesh_name.clone(),
+        };
+        parts.push(Part {
+            object,
+            group: mesh_name,
+            primitives: Vec::new(),
+        });
+        parts.len() - 1
+    }
+
     /// Each material's name, base colour, metallic and roughness factors and base colour
     /// texture; what else a material has (other textures, extensions) is named in `warnings`.
-    fn materials(&self, source: &Source, warnings: &mut Vec<String>) -> Vec<Material> {
+    fn materials(&self, origin: &Origin, warnings: &mut Vec<String>) -> Vec<Material> {
         let mut others: Vec<String> = Vec::new();
         let materials = self
             .array("materials")
@@ -177,7 +198,7 @@ impl GltfSource {
                                 .find_map(|e| index(t.get("extensions")?.get(e)?, "source"))
                         })
                     })
-                    .and_then(|image| self.image(image, &name, source, warnings));
+                    .and_then(|image| self.image(image, &name, origin, warnings));
                 let mut unkept: Vec<&str> = [
                     ("normalTexture", "normal map"),
                     ("occlusionTexture", "occlusion map"),
@@ -219,7 +240,7 @@ impl GltfSource {
         &self,
         j: usize,
         material: &str,
-        source: &Source,
+        origin: &Origin,
         warnings: &mut Vec<String>,
     ) -> Option<Image> {
         let image = self.array("images").get(j)?;
@@ -253,7 +274,7 @@ impl GltfSource {
                     data: ImageData::Bytes(bytes),
                 });
             }
-            let Some(base) = &source.base_dir else {
+            let Some(base) = &origin.base_dir else {
                 return lost(format!(
                     "image {j} is the file {uri:?}, which cannot be found: the input was read from memory"
                 ));

@@ -1,14 +1,14 @@
 //! Turning a written-back document's NORMAL and TANGENT elements with their faces (see
-//! [`crate::io::source::NormalTurns`]): per element the area sums of its faces before and after,
+//! [`crate::io::normals::NormalTurns`]): per element the area sums of its faces before and after,
 //! worked out block by block in parallel with the same bits for any number of threads.
 
 use super::accessors::Layout;
 use super::buffers::Joined;
+use super::positions::PositionEdit;
 use super::source::{attribute, primitives, GltfSource};
-use super::writeback::PositionEdit;
-use crate::io::source::{
-    dvec, is_own_normal, NormalTurns, SaveReport, SlotSums, SmoothGroups, Source, Turn,
-};
+use crate::io::normals::{dvec, is_own_normal, NormalTurns, SlotSums, SmoothGroups, Turn};
+use crate::io::origin::Origin;
+use crate::io::SaveReport;
 use glam::DVec3;
 use rayon::prelude::*;
 use std::collections::{BTreeMap, BTreeSet};
@@ -18,18 +18,36 @@ use std::collections::{BTreeMap, BTreeSet};
 /// at a UV seam or between two primitives stays smooth.
 pub(super) fn turn_normals(
     gltf: &GltfSource,
-    source: &Source,
+    origin: &Origin,
     edits: &BTreeMap<usize, PositionEdit>,
     joined: &mut Joined,
     report: &mut SaveReport,
 ) -> BTreeSet<usize> {
+    let normals = normal_uses(gltf, edits, report);
+    let (slotted, shared) = slot_normals(gltf, origin, edits, &normals);
+    let mut changed = BTreeSet::new();
+    for normal in slotted {
+        write_turned(gltf, normal, &shared, joined, &mut changed, report);
+    }
+    changed
+}
+
+/// The triangles of the primitives that use one normal accessor: per primitive, its position
+/// accessor, that accessor's layout and the triangles.
+type Uses = Vec<(usize, Layout, Vec<[u32; 3]>)>;
+
+/// Normal accessor (of a primitive whose positions moved) -> its layout, its [`Uses`], and its
+/// tangent accessors. One that cannot be read or does not match its positions is named in the
+/// report and left out.
+fn normal_uses(
+    gltf: &GltfSource,
+    edits: &BTreeMap<usize, PositionEdit>,
+    report: &mut SaveReport,
+) -> BTreeMap<usize, (Layout, Uses, BTreeSet<usize>)> {
     let touched: BTreeSet<usize> = primitives(&gltf.json)
         .filter(|p| attribute(p, "POSITION").is_some_and(|a| edits.contains_key(&a)))
         .filter_map(|p| attribute(p, "NORMAL"))
         .collect();
-    // Normal accessor -> its layout, its primitives' triangles with their position accessor, and
-    // its tangent accessors.
-    type Uses = Vec<(usize, Layout, Vec<[u32; 3]>)>;
     let mut normals: BTreeMap<usize, (Layout, Uses, BTreeSet<usize>)> = BTreeMap::new();
     for primitive in primitives(&gltf.json) {
         let (Some(p), Some(n)) = (
@@ -61,15 +79,25 @@ pub(super) fn turn_normals(
             tangents.insert(t);
         }
     }
-    // Per element: the area sums of its faces before and after, block by block in parallel
-    // (`block_sums`: each element adds its faces in the order of the triangles, as a serial pass
-    // would). A normal that is its own faces' normal turns with its own sums, worked out in the
-    // same block; the others (`SmoothGroups`) share the sums of their slot, gathered in `shared`
-    // in the order of the elements and turned once every accessor has added to them.
+    normals
+}
+
+/// Per element: the area sums of its faces before and after, block by block in parallel
+/// (`block_sums`: each element adds its faces in the order of the triangles, as a serial pass
+/// would). A normal that is its own faces' normal turns with its own sums, worked out in the
+/// same block; the others (`SmoothGroups`) share the sums of their slot, gathered in the
+/// returned [`NormalTurns`] in the order of the elements and turned once every accessor has
+/// added to them.
+fn slot_normals<'a>(
+    gltf: &GltfSource,
+    origin: &Origin,
+    edits: &BTreeMap<usize, PositionEdit>,
+    normals: &'a BTreeMap<usize, (Layout, Uses, BTreeSet<usize>)>,
+) -> (Vec<Slotted<'a>>, NormalTurns) {
     let mut groups = SmoothGroups::default();
     let mut shared = NormalTurns::new(0);
     let mut slotted: Vec<Slotted> = Vec::new();
-    for (&n, (layout, uses, tangents)) in &normals {
+    for (&n, (layout, uses, tangents)) in normals {
         let faces: Vec<FaceUse> = uses
             .iter()
             .map(|(p, positions, triangles)| match edits.get(p) {
@@ -98,7 +126,7 @@ pub(super) fn turn_normals(
         let start = gltf.first_raw_start(uses[0].0);
         let mut slots = Vec::new();
         for &(k, sums) in blocks.iter().flat_map(|block| &block.shared) {
-            let welded = start.and_then(|s| source.welded(s + k));
+            let welded = start.and_then(|s| origin.welded(s + k));
             let slot = groups.slot(welded, values[k]);
             shared.merge_sums(slot, sums);
             slots.push((k, slot));
@@ -112,53 +140,62 @@ pub(super) fn turn_normals(
             tangents,
         });
     }
-    let mut changed = BTreeSet::new();
-    for normal in slotted {
-        let layout = normal.layout;
-        let shared_turns: Vec<(usize, Option<Turn>)> = normal
-            .slots
-            .iter()
-            .map(|&(k, slot)| (k, shared.turn(slot)))
-            .collect();
-        let mut any = false;
-        let own = normal.blocks.iter().flat_map(|block| &block.normals);
-        for (k, value) in own.enumerate() {
-            if let Some(value) = value {
-                joined.put_direction(layout, k, value);
-                any = true;
-            }
-        }
-        for &(k, turn) in &shared_turns {
-            if let Some(turn) = turn {
-                joined.put_direction(layout, k, &turn.normal(normal.values[k]));
-                any = true;
-            }
-        }
-        if any {
-            changed.insert(normal.accessor);
-        }
-        for &t in normal.tangents {
-            match gltf.layout(t) {
-                Ok(tangent) if tangent.components == 4 && tangent.count == layout.count => {
-                    let own = normal.blocks.iter().flat_map(|block| &block.turns);
-                    let turns = own.copied().enumerate().chain(shared_turns.iter().copied());
-                    for (k, turn) in turns {
-                        if let Some(turn) = turn {
-                            let direction = turn.direction(gltf.read3(&tangent, k));
-                            joined.put_direction(&tangent, k, &direction);
-                        }
-                    }
-                    if any {
-                        changed.insert(t);
-                    }
-                }
-                _ => report.warnings.push(format!(
-                    "tangent accessor {t} does not match its normals: its tangents were not turned"
-                )),
-            }
+    (slotted, shared)
+}
+
+/// Writes one normal accessor's turned normals (its own, and those of the `shared` slots) and
+/// its tangents turned alike; the accessors written go into `changed`.
+fn write_turned(
+    gltf: &GltfSource,
+    normal: Slotted,
+    shared: &NormalTurns,
+    joined: &mut Joined,
+    changed: &mut BTreeSet<usize>,
+    report: &mut SaveReport,
+) {
+    let layout = normal.layout;
+    let shared_turns: Vec<(usize, Option<Turn>)> = normal
+        .slots
+        .iter()
+        .map(|&(k, slot)| (k, shared.turn(slot)))
+        .collect();
+    let mut any = false;
+    let own = normal.blocks.iter().flat_map(|block| &block.normals);
+    for (k, value) in own.enumerate() {
+        if let Some(value) = value {
+            joined.put_direction(layout, k, value);
+            any = true;
         }
     }
-    changed
+    for &(k, turn) in &shared_turns {
+        if let Some(turn) = turn {
+            joined.put_direction(layout, k, &turn.normal(normal.values[k]));
+            any = true;
+        }
+    }
+    if any {
+        changed.insert(normal.accessor);
+    }
+    for &t in normal.tangents {
+        match gltf.layout(t) {
+            Ok(tangent) if tangent.components == 4 && tangent.count == layout.count => {
+                let own = normal.blocks.iter().flat_map(|block| &block.turns);
+                let turns = own.copied().enumerate().chain(shared_turns.iter().copied());
+                for (k, turn) in turns {
+                    if let Some(turn) = turn {
+                        let direction = turn.direction(gltf.read3(&tangent, k));
+                        joined.put_direction(&tangent, k, &direction);
+                    }
+                }
+                if any {
+                    changed.insert(t);
+                }
+            }
+            _ => report.warnings.push(format!(
+                "tangent accessor {t} does not match its normals: its tangents were not turned"
+            )),
+        }
+    }
 }
 
 /// One block of a normal accessor's elements after [`block_sums`]: per element, the turned

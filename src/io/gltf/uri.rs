@@ -67,6 +67,7 @@ pub(crate) fn percent_encode(name: &str) -> String {
     }
     out
 }
+
 /// Standard base64 (RFC 4648) with padding.
 pub(super) fn encode_base64(bytes: &[u8]) -> String {
     const ALPHABET: &[u8; 64] = b"ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";

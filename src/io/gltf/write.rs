@@ -7,42 +7,13 @@
 use super::uri::{encode_base64, percent_encode};
 use crate::io::atomic;
 use crate::io::carry::VertexAttributes;
+use crate::io::normals::unit_vertex_normals;
 use crate::io::IoError;
 use crate::mesh::TriMesh;
-use glam::DVec3;
 use gltf_json as json;
+use json::validation::{Checked::Valid, USize64};
 use std::io::Write;
 use std::path::Path;
-
-/// Area-weighted unit vertex normals in f32; never NaN (see the file's doc comment).
-pub(crate) fn unit_vertex_normals(mesh: &TriMesh) -> Vec<[f32; 3]> {
-    let mut sums = vec![DVec3::ZERO; mesh.positions.len()];
-    let mut fallback = vec![DVec3::ZERO; mesh.positions.len()];
-    for t in 0..mesh.triangles.len() {
-        let n = mesh.face_normal(t);
-        let unit = n.normalize_or_zero();
-        for &v in &mesh.triangles[t] {
-            sums[v as usize] += n;
-            if fallback[v as usize] == DVec3::ZERO {
-                fallback[v as usize] = unit;
-            }
-        }
-    }
-    sums.iter()
-        .zip(&fallback)
-        .map(|(sum, fallback)| {
-            let n = sum.normalize_or_zero();
-            let n = if n != DVec3::ZERO {
-                n
-            } else if *fallback != DVec3::ZERO {
-                *fallback
-            } else {
-                DVec3::Z
-            };
-            n.as_vec3().to_array()
-        })
-        .collect()
-}
 
 /// The glTF document and its binary buffer for `mesh`. `uri` names the buffer file (`.gltf`),
 /// or is `None` for the GLB BIN chunk.
@@ -57,169 +28,21 @@ fn build_with(
     uri: Option<String>,
     extra: &VertexAttributes,
 ) -> std::io::Result<(json::Root, Vec<u8>)> {
-    use json::validation::{Checked::Valid, USize64};
-    let too_big =
-        || std::io::Error::new(std::io::ErrorKind::InvalidInput, "mesh too large for glTF");
     let n = mesh.positions.len();
-    let m = mesh.triangles.len();
-    let normals = unit_vertex_normals(mesh);
-    let positions_len = n.checked_mul(12).ok_or_else(too_big)?;
-    let indices_len = m.checked_mul(12).ok_or_else(too_big)?;
     let uvs = extra.uvs.as_ref().filter(|uvs| uvs.len() == n);
     let colours = extra.colours.as_ref().filter(|colours| colours.len() == n);
-    let uvs_len = if uvs.is_some() { n * 8 } else { 0 };
-    let colours_len = if colours.is_some() { n * 16 } else { 0 };
-    let total = positions_len
-        .checked_mul(2)
-        .and_then(|b| b.checked_add(indices_len))
-        .and_then(|b| b.checked_add(uvs_len + colours_len))
-        .filter(|&t| t <= u32::MAX as usize - 1024)
-        .ok_or_else(too_big)?;
-    let mut bin = Vec::with_capacity(total);
-    for p in &mesh.positions {
-        for c in p {
-            bin.extend_from_slice(&c.to_le_bytes());
-        }
-    }
-    for p in &normals {
-        for c in p {
-            bin.extend_from_slice(&c.to_le_bytes());
-        }
-    }
-    for t in &mesh.triangles {
-        for v in t {
-            bin.extend_from_slice(&v.to_le_bytes());
-        }
-    }
-    for value in uvs.into_iter().flatten().flatten() {
-        bin.extend_from_slice(&value.to_le_bytes());
-    }
-    for value in colours.into_iter().flatten().flatten() {
-        bin.extend_from_slice(&value.to_le_bytes());
-    }
-    let mut min = [f32::INFINITY; 3];
-    let mut max = [f32::NEG_INFINITY; 3];
-    for p in &mesh.positions {
-        for axis in 0..3 {
-            min[axis] = min[axis].min(p[axis]);
-            max[axis] = max[axis].max(p[axis]);
-        }
-    }
-
+    let sizes = Sizes::of(mesh, uvs.is_some(), colours.is_some())?;
+    let bin = buffer(mesh, uvs, colours, sizes.total);
     let mut root = json::Root::default();
     root.asset.generator = Some("fairmesh".into());
     let buffer = root.push(json::Buffer {
-        byte_length: USize64(total as u64),
+        byte_length: USize64(sizes.total as u64),
         name: None,
         uri,
         extensions: Default::default(),
         extras: Default::default(),
     });
-    let view = |offset: usize, length: usize, target: json::buffer::Target| json::buffer::View {
-        buffer,
-        byte_length: USize64(length as u64),
-        byte_offset: Some(USize64(offset as u64)),
-        byte_stride: None,
-        name: None,
-        target: Some(Valid(target)),
-        extensions: Default::default(),
-        extras: Default::default(),
-    };
-    let position_view = view(0, positions_len, json::buffer::Target::ArrayBuffer);
-    let normal_view = view(
-        positions_len,
-        positions_len,
-        json::buffer::Target::ArrayBuffer,
-    );
-    let index_view = view(
-        2 * positions_len,
-        indices_len,
-        json::buffer::Target::ElementArrayBuffer,
-    );
-    let position_view = root.push(position_view);
-    let normal_view = root.push(normal_view);
-    let index_view = root.push(index_view);
-    let accessor = |view, count: usize, component, type_, bounds: Option<([f32; 3], [f32; 3])>| {
-        json::Accessor {
-            buffer_view: Some(view),
-            byte_offset: None,
-            count: USize64(count as u64),
-            component_type: Valid(json::accessor::GenericComponentType(component)),
-            extensions: Default::default(),
-            extras: Default::default(),
-            type_: Valid(type_),
-            min: bounds.map(|(lo, _)| json::Value::from(lo.to_vec())),
-            max: bounds.map(|(_, hi)| json::Value::from(hi.to_vec())),
-            name: None,
-            normalized: false,
-            sparse: None,
-        }
-    };
-    let positions = root.push(accessor(
-        position_view,
-        n,
-        json::accessor::ComponentType::F32,
-        json::accessor::Type::Vec3,
-        Some((min, max)),
-    ));
-    let normals = root.push(accessor(
-        normal_view,
-        n,
-        json::accessor::ComponentType::F32,
-        json::accessor::Type::Vec3,
-        None,
-    ));
-    let indices = root.push(accessor(
-        index_view,
-        3 * m,
-        json::accessor::ComponentType::U32,
-        json::accessor::Type::Scalar,
-        None,
-    ));
-    let mut attributes: std::collections::BTreeMap<_, _> = [
-        (Valid(json::mesh::Semantic::Positions), positions),
-        (Valid(json::mesh::Semantic::Normals), normals),
-    ]
-    .into_iter()
-    .collect();
-    let mut offset = 2 * positions_len + indices_len;
-    for (present, length, semantic, type_) in [
-        (
-            uvs.is_some(),
-            uvs_len,
-            json::mesh::Semantic::TexCoords(0),
-            json::accessor::Type::Vec2,
-        ),
-        (
-            colours.is_some(),
-            colours_len,
-            json::mesh::Semantic::Colors(0),
-            json::accessor::Type::Vec4,
-        ),
-    ] {
-        if !present {
-            continue;
-        }
-        let view = root.push(view(offset, length, json::buffer::Target::ArrayBuffer));
-        offset += length;
-        let values = root.push(accessor(
-            view,
-            n,
-            json::accessor::ComponentType::F32,
-            type_,
-            None,
-        ));
-        attributes.insert(Valid(semantic), values);
-    }
-    let primitive = json::mesh::Primitive {
-        attributes,
-        extensions: Default::default(),
-        extras: Default::default(),
-        indices: Some(indices),
-        material: None,
-        mode: Valid(json::mesh::Mode::Triangles),
-        targets: None,
-    };
+    let primitive = add_primitive(&mut root, buffer, mesh, &sizes);
     let mesh_index = root.push(json::Mesh {
         extensions: Default::default(),
         extras: Default::default(),
@@ -239,6 +62,202 @@ fn build_with(
     });
     root.scene = Some(scene);
     Ok((root, bin))
+}
+
+/// The byte lengths of the parts of a bare mesh's buffer, in their order: positions, normals,
+/// indices, UVs and colours (where it has them).
+struct Sizes {
+    positions: usize,
+    indices: usize,
+    uvs: Option<usize>,
+    colours: Option<usize>,
+    total: usize,
+}
+
+impl Sizes {
+    /// The sizes for `mesh`, or an error when the buffer would not fit a GLB (4 GiB).
+    fn of(mesh: &TriMesh, uvs: bool, colours: bool) -> std::io::Result<Sizes> {
+        let too_big =
+            || std::io::Error::new(std::io::ErrorKind::InvalidInput, "mesh too large for glTF");
+        let n = mesh.positions.len();
+        let positions = n.checked_mul(12).ok_or_else(too_big)?;
+        let indices = mesh.triangles.len().checked_mul(12).ok_or_else(too_big)?;
+        let uvs = uvs.then(|| n * 8);
+        let colours = colours.then(|| n * 16);
+        let total = positions
+            .checked_mul(2)
+            .and_then(|b| b.checked_add(indices))
+            .and_then(|b| b.checked_add(uvs.unwrap_or(0) + colours.unwrap_or(0)))
+            .filter(|&t| t <= u32::MAX as usize - 1024)
+            .ok_or_else(too_big)?;
+        Ok(Sizes {
+            positions,
+            indices,
+            uvs,
+            colours,
+            total,
+        })
+    }
+}
+
+/// The binary buffer of a bare mesh (see [`Sizes`] for its layout).
+fn buffer(
+    mesh: &TriMesh,
+    uvs: Option<&Vec<[f32; 2]>>,
+    colours: Option<&Vec<[f32; 4]>>,
+    total: usize,
+) -> Vec<u8> {
+    let mut bin = Vec::with_capacity(total);
+    for p in &mesh.positions {
+        for c in p {
+            bin.extend_from_slice(&c.to_le_bytes());
+        }
+    }
+    for p in &unit_vertex_normals(mesh) {
+        for c in p {
+            bin.extend_from_slice(&c.to_le_bytes());
+        }
+    }
+    for t in &mesh.triangles {
+        for v in t {
+            bin.extend_from_slice(&v.to_le_bytes());
+        }
+    }
+    for value in uvs.into_iter().flatten().flatten() {
+        bin.extend_from_slice(&value.to_le_bytes());
+    }
+    for value in colours.into_iter().flatten().flatten() {
+        bin.extend_from_slice(&value.to_le_bytes());
+    }
+    bin
+}
+
+/// The per-axis minimum and maximum of `positions`.
+pub(super) fn position_bounds(positions: &[[f32; 3]]) -> ([f32; 3], [f32; 3]) {
+    let mut min = [f32::INFINITY; 3];
+    let mut max = [f32::NEG_INFINITY; 3];
+    for p in positions {
+        for axis in 0..3 {
+            min[axis] = min[axis].min(p[axis]);
+            max[axis] = max[axis].max(p[axis]);
+        }
+    }
+    (min, max)
+}
+
+/// A buffer view of `buffer` with `target`.
+fn view(
+    buffer: json::Index<json::Buffer>,
+    offset: usize,
+    length: usize,
+    target: json::buffer::Target,
+) -> json::buffer::View {
+    json::buffer::View {
+        buffer,
+        byte_length: USize64(length as u64),
+        byte_offset: Some(USize64(offset as u64)),
+        byte_stride: None,
+        name: None,
+        target: Some(Valid(target)),
+        extensions: Default::default(),
+        extras: Default::default(),
+    }
+}
+
+/// An accessor of `count` elements in `view`, with `bounds` as its min and max.
+fn accessor(
+    view: json::Index<json::buffer::View>,
+    count: usize,
+    component: json::accessor::ComponentType,
+    type_: json::accessor::Type,
+    bounds: Option<([f32; 3], [f32; 3])>,
+) -> json::Accessor {
+    json::Accessor {
+        buffer_view: Some(view),
+        byte_offset: None,
+        count: USize64(count as u64),
+        component_type: Valid(json::accessor::GenericComponentType(component)),
+        extensions: Default::default(),
+        extras: Default::default(),
+        type_: Valid(type_),
+        min: bounds.map(|(lo, _)| json::Value::from(lo.to_vec())),
+        max: bounds.map(|(_, hi)| json::Value::from(hi.to_vec())),
+        name: None,
+        normalized: false,
+        sparse: None,
+    }
+}
+
+/// The buffer views and accessors of a bare mesh's buffer (laid out as [`Sizes`] says) and its
+/// one triangle primitive.
+fn add_primitive(
+    root: &mut json::Root,
+    buffer: json::Index<json::Buffer>,
+    mesh: &TriMesh,
+    sizes: &Sizes,
+) -> json::mesh::Primitive {
+    use json::accessor::{ComponentType, Type};
+    use json::buffer::Target;
+    let n = mesh.positions.len();
+    let p = sizes.positions;
+    let position_view = root.push(view(buffer, 0, p, Target::ArrayBuffer));
+    let normal_view = root.push(view(buffer, p, p, Target::ArrayBuffer));
+    let index_view = root.push(view(
+        buffer,
+        2 * p,
+        sizes.indices,
+        Target::ElementArrayBuffer,
+    ));
+    let bounds = position_bounds(&mesh.positions);
+    let positions = root.push(accessor(
+        position_view,
+        n,
+        ComponentType::F32,
+        Type::Vec3,
+        Some(bounds),
+    ));
+    let normals = root.push(accessor(
+        normal_view,
+        n,
+        ComponentType::F32,
+        Type::Vec3,
+        None,
+    ));
+    let indices = root.push(accessor(
+        index_view,
+        3 * mesh.triangles.len(),
+        ComponentType::U32,
+        Type::Scalar,
+        None,
+    ));
+    let mut attributes: std::collections::BTreeMap<_, _> = [
+        (Valid(json::mesh::Semantic::Positions), positions),
+        (Valid(json::mesh::Semantic::Normals), normals),
+    ]
+    .into_iter()
+    .collect();
+    let mut offset = 2 * p + sizes.indices;
+    for (length, semantic, type_) in [
+        (sizes.uvs, json::mesh::Semantic::TexCoords(0), Type::Vec2),
+        (sizes.colours, json::mesh::Semantic::Colors(0), Type::Vec4),
+    ] {
+        let Some(length) = length else {
+            continue;
+        };
+        let view = root.push(view(buffer, offset, length, Target::ArrayBuffer));
+        offset += length;
+        let values = root.push(accessor(view, n, ComponentType::F32, type_, None));
+        attributes.insert(Valid(semantic), values);
+    }
+    json::mesh::Primitive {
+        attributes,
+        extensions: Default::default(),
+        extras: Default::default(),
+        indices: Some(indices),
+        material: None,
+        mode: Valid(json::mesh::Mode::Triangles),
+        targets: None,
+    }
 }
 
 pub(crate) fn write_glb(out: &mut dyn Write, mesh: &TriMesh) -> std::io::Result<()> {
@@ -301,6 +320,7 @@ pub(crate) fn write_gltf_embedded(out: &mut dyn Write, mesh: &TriMesh) -> std::i
     let json_bytes = json::serialize::to_vec_pretty(&root).map_err(std::io::Error::other)?;
     out.write_all(&json_bytes)
 }
+
 /// Write `path` (.gltf) and `<stem>.bin` beside it: both are staged, then renamed into place.
 pub(crate) fn write_gltf(path: &Path, mesh: &TriMesh) -> Result<(), IoError> {
     write_gltf_with(path, mesh, &VertexAttributes::default())
@@ -338,19 +358,6 @@ pub(crate) fn write_gltf_with(
 mod tests {
     use super::super::read::parse;
     use super::*;
-
-    #[test]
-    fn normals_are_unit_and_never_nan() {
-        // A degenerate triangle (all corners equal) and two opposite faces sharing a vertex set.
-        let mesh = TriMesh::new(
-            vec![[0., 0., 0.], [1., 0., 0.], [0., 1., 0.], [5., 5., 5.]],
-            vec![[0, 1, 2], [0, 2, 1], [3, 3, 3]],
-        );
-        for n in unit_vertex_normals(&mesh) {
-            let length = (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt();
-            assert!((length - 1.0).abs() < 1e-6, "{n:?}");
-        }
-    }
 
     #[test]
     fn glb_round_trip_is_bit_exact() {
