@@ -18,6 +18,9 @@ use crate::mesh::TriMesh;
 use std::io::Write;
 use std::path::Path;
 
+/// Parses an OFF file: the header line (OFF, COFF, NOFF, ...), the counts, the vertex lines and
+/// the face lines, each checked and named by its line in errors. A parser's state machine over
+/// the lines, which reads best in one piece.
 pub(crate) fn parse(bytes: &[u8], path: &Path) -> Result<Parsed, IoError> {
     let mut rows = lines(bytes)
         .map(|(n, line)| (n, strip_comment(line)))

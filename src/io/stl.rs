@@ -50,6 +50,8 @@ pub(crate) fn parse(bytes: &[u8], path: &Path) -> Result<Parsed<StlSource>, IoEr
     ))
 }
 
+/// Reads a binary STL: the header, the declared count checked against the file's size, and
+/// each facet's corners. A parser that reads best in one piece.
 fn read_binary(bytes: &[u8], path: &Path) -> Result<Parsed<StlSource>, IoError> {
     let declared = bytes
         .get(80..84)

@@ -51,7 +51,8 @@ pub(crate) struct FollowedUvs {
 
 /// The texture coordinates `uvs` of the triangles `triangles` (over the file's vertices, whose
 /// positions are `before` and `after` the move), moved to follow the vertices' slide along the
-/// surface (see the module docs).
+/// surface (see the module docs). A kernel (the tables it builds and the walks over them,
+/// in parallel), which reads best in one piece.
 pub(crate) fn follow(
     before: &[[f32; 3]],
     after: &[[f32; 3]],

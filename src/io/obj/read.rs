@@ -201,7 +201,8 @@ fn parse_chunk(bytes: &[u8]) -> Result<Chunk, Malformed> {
 
 /// Find the first line that is malformed or gives a bad vertex, and say why. Checks `v` (3
 /// coordinates, optional w or colour), `vt`, `vn`, and `f` indices (1-based, negative = relative,
-/// each within the file's counts).
+/// each within the file's counts). A parser's loop over the lines, which reads best in one
+/// piece.
 fn locate(bytes: &[u8], path: &Path) -> Option<IoError> {
     let (mut total_v, mut total_vt, mut total_vn) = (0i64, 0i64, 0i64);
     for (_, line) in lines(bytes) {

@@ -2,7 +2,7 @@
 
 use crate::io::atomic;
 use crate::io::carry::Gather;
-use crate::io::scene::{ImageData, Scene, SceneVertex};
+use crate::io::scene::{ImageData, PlacedImage, Scene, SceneVertex};
 use crate::io::IoError;
 use crate::mesh::TriMesh;
 use std::collections::HashMap;
@@ -37,26 +37,79 @@ pub(crate) fn write_scene(
         *merged_colours = merged;
         values
     });
-    // Distinct values, numbered in first use.
-    fn numbered<const N: usize>(
-        values: impl Iterator<Item = [f32; N]>,
-    ) -> (Vec<[f32; N]>, HashMap<[u32; N], usize>) {
-        let mut list = Vec::new();
-        let mut index = HashMap::new();
-        for value in values {
-            index.entry(value.map(f32::to_bits)).or_insert_with(|| {
-                list.push(value);
-                list.len() - 1
-            });
-        }
-        (list, index)
-    }
     let (uv_list, uv_index) = numbered(scene.vertices.iter().filter(used).map(|v| v.uv));
     let (normal_list, normal_index) =
         numbered(scene.vertices.iter().filter(used).map(|v| v.normal));
-    let name_token = |name: &str| name.split_whitespace().collect::<Vec<_>>().join("_");
+    let text = ObjText {
+        scene,
+        mesh,
+        mtl_name,
+        colours,
+        uv_list,
+        uv_index,
+        normal_list,
+        normal_index,
+    };
+    let mut staged = Vec::new();
+    for (target, data) in placed.iter().flatten().filter_map(|p| p.write.as_ref()) {
+        let bytes = data.bytes().map_err(|source| IoError::Read {
+            path: match data {
+                ImageData::File(file) => file.clone(),
+                ImageData::Bytes(_) => target.clone(),
+            },
+            source,
+        })?;
+        staged.push(atomic::stage(target, |w| w.write_all(&bytes))?);
+    }
+    if !scene.materials.is_empty() {
+        staged.push(atomic::stage(&mtl_path, |out| {
+            write_mtl(out, scene, &placed)
+        })?);
+    }
+    staged.push(atomic::stage(path, |out| text.write(out))?);
+    for file in staged {
+        file.commit()?;
+    }
+    Ok(())
+}
 
-    let write_obj = |out: &mut dyn Write| -> std::io::Result<()> {
+/// Distinct values, numbered in first use.
+fn numbered<const N: usize>(
+    values: impl Iterator<Item = [f32; N]>,
+) -> (Vec<[f32; N]>, HashMap<[u32; N], usize>) {
+    let mut list = Vec::new();
+    let mut index = HashMap::new();
+    for value in values {
+        index.entry(value.map(f32::to_bits)).or_insert_with(|| {
+            list.push(value);
+            list.len() - 1
+        });
+    }
+    (list, index)
+}
+
+/// A name as one OBJ token (its words joined by `_`).
+fn name_token(name: &str) -> String {
+    name.split_whitespace().collect::<Vec<_>>().join("_")
+}
+
+/// What the OBJ's text is made of: the scene and mesh, the `.mtl`'s name, the colour of each
+/// `v`, and the distinct UVs and normals with their numbers.
+struct ObjText<'a> {
+    scene: &'a Scene,
+    mesh: &'a TriMesh,
+    mtl_name: String,
+    colours: Option<Vec<[f32; 4]>>,
+    uv_list: Vec<[f32; 2]>,
+    uv_index: HashMap<[u32; 2], usize>,
+    normal_list: Vec<[f32; 3]>,
+    normal_index: HashMap<[u32; 3], usize>,
+}
+
+impl ObjText<'_> {
+    /// The OBJ: header, `v`, `vt` and `vn` lines, then the parts.
+    fn write(&self, out: &mut dyn Write) -> std::io::Result<()> {
+        let (scene, mesh) = (self.scene, self.mesh);
         writeln!(out, "# written by fairmesh")?;
         writeln!(
             out,
@@ -65,10 +118,10 @@ pub(crate) fn write_scene(
             scene.triangle_count()
         )?;
         if !scene.materials.is_empty() {
-            writeln!(out, "mtllib {mtl_name}")?;
+            writeln!(out, "mtllib {}", self.mtl_name)?;
         }
         for (v, [x, y, z]) in mesh.positions.iter().enumerate() {
-            match &colours {
+            match &self.colours {
                 Some(colours) => {
                     let [r, g, b, _] = colours[v];
                     writeln!(out, "v {x} {y} {z} {r} {g} {b}")?
@@ -77,15 +130,21 @@ pub(crate) fn write_scene(
             }
         }
         if scene.uvs {
-            for [u, v] in &uv_list {
+            for [u, v] in &self.uv_list {
                 writeln!(out, "vt {u} {v}")?;
             }
         }
         if scene.normals {
-            for [x, y, z] in &normal_list {
+            for [x, y, z] in &self.normal_list {
                 writeln!(out, "vn {x} {y} {z}")?;
             }
         }
+        self.write_parts(out)
+    }
+
+    /// Per part its `o` (when it changes) and `g`, per primitive its `usemtl` and `f` lines.
+    fn write_parts(&self, out: &mut dyn Write) -> std::io::Result<()> {
+        let scene = self.scene;
         let mut last_object: Option<&str> = None;
         for part in &scene.parts {
             if let Some(object) = part.object.as_deref() {
@@ -104,59 +163,53 @@ pub(crate) fn write_scene(
                 for t in &primitive.triangles {
                     out.write_all(b"f")?;
                     for &corner in t {
-                        let vertex = &scene.vertices[corner as usize];
-                        let v = vertex.welded as u64 + 1;
-                        let vt = uv_index
-                            .get(&vertex.uv.map(f32::to_bits))
-                            .map_or(1, |i| i + 1);
-                        let vn = normal_index
-                            .get(&vertex.normal.map(f32::to_bits))
-                            .map_or(1, |i| i + 1);
-                        match (scene.uvs, scene.normals) {
-                            (true, true) => write!(out, " {v}/{vt}/{vn}")?,
-                            (true, false) => write!(out, " {v}/{vt}")?,
-                            (false, true) => write!(out, " {v}//{vn}")?,
-                            (false, false) => write!(out, " {v}")?,
-                        }
+                        self.write_corner(out, &scene.vertices[corner as usize])?;
                     }
                     out.write_all(b"\n")?;
                 }
             }
         }
         Ok(())
-    };
-    let write_mtl = |out: &mut dyn Write| -> std::io::Result<()> {
-        writeln!(out, "# written by fairmesh")?;
-        for (m, material) in scene.materials.iter().enumerate() {
-            let [r, g, b, a] = material.base_colour;
-            writeln!(out, "\nnewmtl {}", name_token(&material.name))?;
-            writeln!(out, "Kd {r} {g} {b}")?;
-            writeln!(out, "d {a}")?;
-            writeln!(out, "Pm {}", material.metallic)?;
-            writeln!(out, "Pr {}", material.roughness)?;
-            if let Some(Some(image)) = placed.get(m) {
-                writeln!(out, "map_Kd {}", image.uri_name)?;
-            }
+    }
+
+    /// One face corner: `v`, `v/vt`, `v//vn` or `v/vt/vn`, 1-based.
+    fn write_corner(&self, out: &mut dyn Write, vertex: &SceneVertex) -> std::io::Result<()> {
+        let v = vertex.welded as u64 + 1;
+        let vt = self
+            .uv_index
+            .get(&vertex.uv.map(f32::to_bits))
+            .map_or(1, |i| i + 1);
+        let vn = self
+            .normal_index
+            .get(&vertex.normal.map(f32::to_bits))
+            .map_or(1, |i| i + 1);
+        match (self.scene.uvs, self.scene.normals) {
+            (true, true) => write!(out, " {v}/{vt}/{vn}"),
+            (true, false) => write!(out, " {v}/{vt}"),
+            (false, true) => write!(out, " {v}//{vn}"),
+            (false, false) => write!(out, " {v}"),
         }
-        Ok(())
-    };
-    let mut staged = Vec::new();
-    for (target, data) in placed.iter().flatten().filter_map(|p| p.write.as_ref()) {
-        let bytes = data.bytes().map_err(|source| IoError::Read {
-            path: match data {
-                ImageData::File(file) => file.clone(),
-                ImageData::Bytes(_) => target.clone(),
-            },
-            source,
-        })?;
-        staged.push(atomic::stage(target, |w| w.write_all(&bytes))?);
     }
-    if !scene.materials.is_empty() {
-        staged.push(atomic::stage(&mtl_path, write_mtl)?);
-    }
-    staged.push(atomic::stage(path, write_obj)?);
-    for file in staged {
-        file.commit()?;
+}
+
+/// The `.mtl`: per material its name, base colour (`Kd`, `d`), metallic (`Pm`), roughness (`Pr`)
+/// and the base colour texture's file as `placed` beside the OBJ.
+fn write_mtl(
+    out: &mut dyn Write,
+    scene: &Scene,
+    placed: &[Option<PlacedImage>],
+) -> std::io::Result<()> {
+    writeln!(out, "# written by fairmesh")?;
+    for (m, material) in scene.materials.iter().enumerate() {
+        let [r, g, b, a] = material.base_colour;
+        writeln!(out, "\nnewmtl {}", name_token(&material.name))?;
+        writeln!(out, "Kd {r} {g} {b}")?;
+        writeln!(out, "d {a}")?;
+        writeln!(out, "Pm {}", material.metallic)?;
+        writeln!(out, "Pr {}", material.roughness)?;
+        if let Some(Some(image)) = placed.get(m) {
+            writeln!(out, "map_Kd {}", image.uri_name)?;
+        }
     }
     Ok(())
 }

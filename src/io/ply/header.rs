@@ -108,6 +108,8 @@ pub(super) struct Header {
     pub(super) stray_lines: Vec<(usize, String)>,
 }
 
+/// Parses the header lines into the format, elements and properties, naming the line of any
+/// error. A parser's state machine over the header lines, which reads best in one piece.
 pub(super) fn parse_header(bytes: &[u8], path: &Path) -> Result<Header, IoError> {
     let mut encoding = None;
     let mut elements: Vec<Element> = Vec::new();

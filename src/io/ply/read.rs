@@ -92,6 +92,9 @@ impl Builder {
     }
 }
 
+/// Reads the ASCII rows of every element (vertices, faces or strips, others skipped), one row a
+/// line, naming the line of any error. A parser's loop over the rows, which reads best in one
+/// piece.
 pub(super) fn read_ascii(
     bytes: &[u8],
     path: &Path,
@@ -319,6 +322,9 @@ pub(super) fn read_int<const BIG: bool>(kind: Scalar, bytes: &[u8]) -> Option<i6
     })
 }
 
+/// Reads the binary rows of every element (vertices, faces or strips, others walked over),
+/// naming the byte offset and element of any error. A parser's loop over the rows, which reads
+/// best in one piece.
 pub(super) fn read_binary<const BIG: bool>(
     bytes: &[u8],
     path: &Path,
