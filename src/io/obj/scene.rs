@@ -11,8 +11,8 @@ use std::collections::HashMap;
 
 /// The OBJ's parts (one per `o`/`g` pair), materials (from its `mtllib` files, read beside it),
 /// and file vertices (one per distinct `v/vt/vn` corner), for saving in another format (see
-/// [`super::scene`]). Normals turn with their faces to `mesh`'s positions, slot by `vn` line as
-/// in [`write_back`].
+/// [`crate::io::scene`]). Normals turn with their faces to `mesh`'s positions, slot by `vn` line as
+/// in [`super::write_back`].
 pub(crate) fn scene(bytes: &[u8], origin: &Origin, mesh: &TriMesh) -> Scene {
     let mut scene = Scene {
         groups_under_objects: true,

@@ -13,9 +13,9 @@ use std::io::Write;
 /// vertices, the `vn` lines of normals whose faces moved and the `vt` lines of texture
 /// coordinates whose vertex slid comes back byte for byte. A moved vertex is written `v x y z`
 /// (shortest round-trip floats; a w is folded in), followed by the line's vertex colour if it had
-/// one. Normals turn with their faces (see [`super::source`]); texture coordinates follow their
+/// one. Normals turn with their faces (see [`crate::io::normals`]); texture coordinates follow their
 /// vertex's slide along the surface, so that the texture stays where it was
-/// ([`super::uv_follow`]), written `vt u v` (f32 shortest round-trip, a w kept as written).
+/// ([`crate::io::uv_follow`]), written `vt u v` (f32 shortest round-trip, a w kept as written).
 /// Returns how many texture coordinates several moved vertices share (those stay).
 pub(crate) fn write_back(
     out: &mut dyn Write,
@@ -24,18 +24,7 @@ pub(crate) fn write_back(
     mesh: &TriMesh,
 ) -> std::io::Result<usize> {
     // The file's own positions (as the reader read them), and each vertex's new position.
-    let mut before: Vec<[f32; 3]> = Vec::with_capacity(origin.raw_vertices);
-    let mut normal_count = 0usize;
-    let mut uvs: Vec<[f64; 2]> = Vec::new();
-    for line in bytes.split(|&b| b == b'\n') {
-        let mut words = tokens(line);
-        match words.next() {
-            Some(b"v") => before.push(vertex_of(words).unwrap_or([f32::NAN; 3])),
-            Some(b"vn") => normal_count += 1,
-            Some(b"vt") => uvs.push(texture_coordinate_of(words).unwrap_or([f64::NAN; 2])),
-            _ => {}
-        }
-    }
+    let (before, normal_count, uvs) = file_values(bytes, origin.raw_vertices);
     let after: Vec<[f32; 3]> = (0..before.len())
         .map(|k| origin.welded(k).map_or(before[k], |w| mesh.positions[w]))
         .collect();
@@ -59,67 +48,140 @@ pub(crate) fn write_back(
     }
     let followed =
         triangles.map(|triangles| crate::io::uv_follow::follow(&before, &after, &triangles, &uvs));
+    let edits = LineEdits {
+        before: &before,
+        after: &after,
+        turns: turns.as_ref(),
+        uvs: &uvs,
+        followed: followed.as_ref().map(|f| f.moved.as_slice()),
+    };
+    edits.write(out, bytes)?;
+    Ok(followed.map_or(0, |f| f.shared))
+}
 
-    let mut vertex = 0usize;
-    let mut normal = 0usize;
-    let mut texture_coordinate = 0usize;
-    for line in bytes.split_inclusive(|&b| b == b'\n') {
-        let (text, ending) = split_ending(line);
-        let mut words = tokens(text);
+/// The file's `v` positions (NaN where a line cannot be read), how many `vn` lines it has, and
+/// its `vt` coordinates (NaN where unreadable).
+fn file_values(bytes: &[u8], vertices: usize) -> (Vec<[f32; 3]>, usize, Vec<[f64; 2]>) {
+    let mut before: Vec<[f32; 3]> = Vec::with_capacity(vertices);
+    let mut normal_count = 0usize;
+    let mut uvs: Vec<[f64; 2]> = Vec::new();
+    for line in bytes.split(|&b| b == b'\n') {
+        let mut words = tokens(line);
         match words.next() {
-            Some(b"v") => {
-                let k = vertex;
-                vertex += 1;
-                if moved(k) {
-                    let [x, y, z] = after[k];
-                    write!(out, "v {x} {y} {z}")?;
-                    let rest: Vec<&[u8]> = words.collect();
-                    if rest.len() == 6 {
-                        // x y z r g b: keep the colour as written.
-                        for colour in &rest[3..] {
-                            out.write_all(b" ")?;
-                            out.write_all(colour)?;
-                        }
-                    }
-                    out.write_all(ending)?;
-                    continue;
-                }
-            }
-            Some(b"vn") => {
-                let k = normal;
-                normal += 1;
-                let turn = turns.as_ref().and_then(|t| t.turn(k));
-                if let (Some(turn), Some(n)) = (turn, vertex_of(words.take(3))) {
-                    let [x, y, z] = turn.normal(n);
-                    write!(out, "vn {x} {y} {z}")?;
-                    out.write_all(ending)?;
-                    continue;
-                }
-            }
-            Some(b"vt") => {
-                let k = texture_coordinate;
-                texture_coordinate += 1;
-                let uv = followed
-                    .as_ref()
-                    .and_then(|f| f.moved.get(k).copied().flatten());
-                // Written as f32 (what the reader reads); unchanged values keep their text.
-                let as_read = uvs[k].map(|c| c as f32);
-                let written = uv.map(|uv| uv.map(|c| c as f32));
-                if let Some([u, v]) = written.filter(|&w| w != as_read) {
-                    write!(out, "vt {u} {v}")?;
-                    for w in words.skip(2) {
-                        out.write_all(b" ")?;
-                        out.write_all(w)?;
-                    }
-                    out.write_all(ending)?;
-                    continue;
-                }
-            }
+            Some(b"v") => before.push(vertex_of(words).unwrap_or([f32::NAN; 3])),
+            Some(b"vn") => normal_count += 1,
+            Some(b"vt") => uvs.push(texture_coordinate_of(words).unwrap_or([f64::NAN; 2])),
             _ => {}
         }
-        out.write_all(line)?;
     }
-    Ok(followed.map_or(0, |f| f.shared))
+    (before, normal_count, uvs)
+}
+
+/// What changes in the lines: the positions before and after, the normals' turns, and the
+/// texture coordinates as read and where they moved.
+struct LineEdits<'a> {
+    before: &'a [[f32; 3]],
+    after: &'a [[f32; 3]],
+    turns: Option<&'a NormalTurns>,
+    uvs: &'a [[f64; 2]],
+    followed: Option<&'a [Option<[f64; 2]>]>,
+}
+
+impl LineEdits<'_> {
+    /// Every line of `bytes` as it was, but the `v`, `vn` and `vt` lines that change.
+    fn write(&self, out: &mut dyn Write, bytes: &[u8]) -> std::io::Result<()> {
+        let (mut vertex, mut normal, mut texture_coordinate) = (0usize, 0usize, 0usize);
+        for line in bytes.split_inclusive(|&b| b == b'\n') {
+            let (text, ending) = split_ending(line);
+            let mut words = tokens(text);
+            let written = match words.next() {
+                Some(b"v") => {
+                    vertex += 1;
+                    self.write_vertex(out, vertex - 1, words, ending)?
+                }
+                Some(b"vn") => {
+                    normal += 1;
+                    self.write_normal(out, normal - 1, words, ending)?
+                }
+                Some(b"vt") => {
+                    texture_coordinate += 1;
+                    self.write_texture_coordinate(out, texture_coordinate - 1, words, ending)?
+                }
+                _ => false,
+            };
+            if !written {
+                out.write_all(line)?;
+            }
+        }
+        Ok(())
+    }
+
+    /// Vertex `k`'s `v` line when it moved (a colour kept as written); whether it wrote one.
+    fn write_vertex<'w>(
+        &self,
+        out: &mut dyn Write,
+        k: usize,
+        words: impl Iterator<Item = &'w [u8]>,
+        ending: &[u8],
+    ) -> std::io::Result<bool> {
+        if !(self.before[k] != self.after[k] && !self.before[k][0].is_nan()) {
+            return Ok(false);
+        }
+        let [x, y, z] = self.after[k];
+        write!(out, "v {x} {y} {z}")?;
+        let rest: Vec<&[u8]> = words.collect();
+        if rest.len() == 6 {
+            // x y z r g b: keep the colour as written.
+            for colour in &rest[3..] {
+                out.write_all(b" ")?;
+                out.write_all(colour)?;
+            }
+        }
+        out.write_all(ending)?;
+        Ok(true)
+    }
+
+    /// Normal `k`'s `vn` line when it turns; whether it wrote one.
+    fn write_normal<'w>(
+        &self,
+        out: &mut dyn Write,
+        k: usize,
+        words: impl Iterator<Item = &'w [u8]>,
+        ending: &[u8],
+    ) -> std::io::Result<bool> {
+        let turn = self.turns.and_then(|t| t.turn(k));
+        let (Some(turn), Some(n)) = (turn, vertex_of(words.take(3))) else {
+            return Ok(false);
+        };
+        let [x, y, z] = turn.normal(n);
+        write!(out, "vn {x} {y} {z}")?;
+        out.write_all(ending)?;
+        Ok(true)
+    }
+
+    /// Texture coordinate `k`'s `vt` line when it followed its vertex to another value (written
+    /// as f32, what the reader reads; a w kept as written); whether it wrote one.
+    fn write_texture_coordinate<'w>(
+        &self,
+        out: &mut dyn Write,
+        k: usize,
+        words: impl Iterator<Item = &'w [u8]>,
+        ending: &[u8],
+    ) -> std::io::Result<bool> {
+        let uv = self.followed.and_then(|f| f.get(k).copied().flatten());
+        let as_read = self.uvs[k].map(|c| c as f32);
+        let written = uv.map(|uv| uv.map(|c| c as f32));
+        let Some([u, v]) = written.filter(|&w| w != as_read) else {
+            return Ok(false);
+        };
+        write!(out, "vt {u} {v}")?;
+        for w in words.skip(2) {
+            out.write_all(b" ")?;
+            out.write_all(w)?;
+        }
+        out.write_all(ending)?;
+        Ok(true)
+    }
 }
 
 /// The (u, v) a `vt` line gives (a missing v reads 0, as the reader reads it); `None` if

@@ -7,7 +7,7 @@ use crate::io::carry::{Gather, VertexAttributes};
 use crate::io::origin::Origin;
 use std::path::Path;
 
-/// Whether the PLY file's vertices have texture coordinates ([`uv_properties`]): what makes
+/// Whether the PLY file's vertices have texture coordinates ([`super::rows::uv_properties`]): what makes
 /// [`vertex_attributes`]' `uvs` `Some`, read from the header alone.
 pub(crate) fn has_texture_coordinates(bytes: &[u8]) -> bool {
     let path = Path::new("");

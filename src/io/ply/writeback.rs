@@ -50,8 +50,8 @@ fn ascii_value(kind: Scalar, value: f32) -> String {
 /// Write the PLY `source` back with `mesh`'s positions, in the file's own encoding: the header,
 /// every other element and every other property come back byte for byte; x, y, z of moved
 /// vertices are written in their declared types, nx, ny, nz (when present) turn with their
-/// faces (see [`super::source`]), and texture coordinates (s t, u v or texture_u texture_v)
-/// follow their vertex's slide along the surface ([`super::uv_follow`]; each vertex row is its
+/// faces (see [`crate::io::normals`]), and texture coordinates (s t, u v or texture_u texture_v)
+/// follow their vertex's slide along the surface ([`crate::io::uv_follow`]; each vertex row is its
 /// own texture coordinate, so a seam's rows follow each in its own chart). Returns whether the
 /// file has texture coordinates per vertex (which then followed).
 pub(crate) fn write_back(
