@@ -78,14 +78,17 @@ pub(super) fn follow_texture(
     changed
 }
 
+/// Texture coordinate accessor -> its position accessor and the triangles of its primitives.
+type TextureUses = BTreeMap<usize, (usize, Vec<[u32; 3]>)>;
+
 /// Per texture coordinate accessor of a primitive whose positions moved: its position accessor
 /// and the triangles of its primitives; and the accessors used with more than one position
 /// accessor (those cannot follow).
 fn texture_uses(
     gltf: &GltfSource,
     edits: &BTreeMap<usize, PositionEdit>,
-) -> (BTreeMap<usize, (usize, Vec<[u32; 3]>)>, BTreeSet<usize>) {
-    let mut uses: BTreeMap<usize, (usize, Vec<[u32; 3]>)> = BTreeMap::new();
+) -> (TextureUses, BTreeSet<usize>) {
+    let mut uses: TextureUses = BTreeMap::new();
     let mut conflicting = BTreeSet::new();
     for primitive in primitives(&gltf.json) {
         let Some(p) = attribute(primitive, "POSITION").filter(|p| edits.contains_key(p)) else {

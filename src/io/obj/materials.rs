@@ -5,7 +5,7 @@ use super::line::rest_of;
 use crate::io::origin::Origin;
 use crate::io::scene::{image_file_name, image_mime_type, Image, ImageData, Material};
 use crate::io::text::tokens;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 /// The materials `names` as the `.mtl` files `libraries` (beside the OBJ) define them: Kd and d
 /// (or Tr) as the base colour, Pm and Pr, and map_Kd (resolved beside the `.mtl`). A material
@@ -34,27 +34,64 @@ pub(super) fn read_materials(
     // The libraries that could not be read, each with why.
     let mut unread: Vec<String> = Vec::new();
     for library in libraries {
-        let Some(base) = &origin.base_dir else {
-            unread.push(format!(
-                "{library} (the input was read from memory, so it cannot be found)"
-            ));
-            continue;
-        };
-        let file = base.join(library);
-        let text = match std::fs::read(&file) {
-            Ok(text) => text,
-            Err(e) => {
-                let why = if e.kind() == std::io::ErrorKind::NotFound {
-                    let obj = origin.path.file_name().unwrap_or_default();
-                    format!("not found beside {}", Path::new(obj).display())
-                } else {
-                    format!("{} cannot be read: {e}", file.display())
-                };
+        let (text, file) = match read_library(library, origin) {
+            Ok(read) => read,
+            Err(why) => {
                 unread.push(format!("{library} ({why})"));
                 continue;
             }
         };
+        let mut read = MtlRead {
+            names,
+            materials: &mut materials,
+            found: &mut found,
+            unkept: &mut unkept,
+            warnings,
+        };
+        read.lines(&text, &file);
+    }
+    warn_about_missing(names, &found, libraries, &unread, warnings);
+    if !unkept.is_empty() {
+        warnings.push(format!(
+            "material maps other than the diffuse map ({})",
+            unkept.join(", ")
+        ));
+    }
+    materials
+}
+
+/// The `.mtl` file `library` beside the OBJ, and its path; or why it cannot be read.
+fn read_library(library: &str, origin: &Origin) -> Result<(Vec<u8>, PathBuf), String> {
+    let Some(base) = &origin.base_dir else {
+        return Err("the input was read from memory, so it cannot be found".into());
+    };
+    let file = base.join(library);
+    match std::fs::read(&file) {
+        Ok(text) => Ok((text, file)),
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => {
+            let obj = origin.path.file_name().unwrap_or_default();
+            Err(format!("not found beside {}", Path::new(obj).display()))
+        }
+        Err(e) => Err(format!("{} cannot be read: {e}", file.display())),
+    }
+}
+
+/// Reading one `.mtl` file into the materials `names`: which were found, the maps not kept,
+/// and the warnings.
+struct MtlRead<'a> {
+    names: &'a [String],
+    materials: &'a mut [Material],
+    found: &'a mut [bool],
+    unkept: &'a mut Vec<String>,
+    warnings: &'a mut Vec<String>,
+}
+
+impl MtlRead<'_> {
+    /// The lines of the `.mtl` `text` at `file`: a parser's loop over the keywords, which reads
+    /// best in one piece.
+    fn lines(&mut self, text: &[u8], file: &Path) {
         let folder = file.parent().map(Path::to_path_buf).unwrap_or_default();
+        let names = self.names;
         let mut current: Option<usize> = None;
         for line in text.split(|&b| b == b'\n') {
             let mut words = tokens(line);
@@ -64,12 +101,12 @@ pub(super) fn read_materials(
             if keyword == b"newmtl" {
                 current = rest_of(words).and_then(|name| names.iter().position(|n| *n == name));
                 if let Some(m) = current {
-                    found[m] = true;
+                    self.found[m] = true;
                 }
                 continue;
             }
             let Some(m) = current else { continue };
-            let material = &mut materials[m];
+            let material = &mut self.materials[m];
             let words: Vec<&[u8]> = words.collect();
             let numbers: Vec<f32> = words
                 .iter()
@@ -105,7 +142,7 @@ pub(super) fn read_materials(
                             data: ImageData::File(image),
                         });
                     } else {
-                        warnings.push(format!(
+                        self.warnings.push(format!(
                             "the texture {name} of material '{}' (not found beside {})",
                             material.name,
                             file.display()
@@ -115,17 +152,28 @@ pub(super) fn read_materials(
                 b"Ka" | b"Ks" | b"Ke" | b"Ns" | b"Ni" | b"illum" | b"Tf" => {}
                 other if other.starts_with(b"map_") || other == b"bump" || other == b"norm" => {
                     let what = format!("'{}' {}", material.name, String::from_utf8_lossy(other));
-                    if !unkept.contains(&what) {
-                        unkept.push(what);
+                    if !self.unkept.contains(&what) {
+                        self.unkept.push(what);
                     }
                 }
                 _ => {}
             }
         }
     }
+}
+
+/// Warnings for the libraries that could not be read (once, with why, when none could) and the
+/// materials no library defines.
+fn warn_about_missing(
+    names: &[String],
+    found: &[bool],
+    libraries: &[String],
+    unread: &[String],
+    warnings: &mut Vec<String>,
+) {
     let missing: Vec<&str> = names
         .iter()
-        .zip(&found)
+        .zip(found)
         .filter(|(_, found)| !**found)
         .map(|(name, _)| name.as_str())
         .collect();
@@ -140,7 +188,7 @@ pub(super) fn read_materials(
             crate::io::text::and_list(&quoted)
         ));
     } else {
-        for library in &unread {
+        for library in unread {
             warnings.push(format!("the material library {library}"));
         }
         if !missing.is_empty() && !libraries.is_empty() {
@@ -151,11 +199,4 @@ pub(super) fn read_materials(
             ));
         }
     }
-    if !unkept.is_empty() {
-        warnings.push(format!(
-            "material maps other than the diffuse map ({})",
-            unkept.join(", ")
-        ));
-    }
-    materials
 }

@@ -124,7 +124,7 @@ impl LineEdits<'_> {
         words: impl Iterator<Item = &'w [u8]>,
         ending: &[u8],
     ) -> std::io::Result<bool> {
-        if !(self.before[k] != self.after[k] && !self.before[k][0].is_nan()) {
+        if self.before[k] == self.after[k] || self.before[k][0].is_nan() {
             return Ok(false);
         }
         let [x, y, z] = self.after[k];

@@ -116,6 +116,9 @@ fn invalid(what: &str) -> std::io::Error {
     std::io::Error::new(std::io::ErrorKind::InvalidData, what.to_string())
 }
 
+/// Each row's texture coordinate as read, and where it moves (`None`: it stays).
+type FollowedUvs = (Vec<[f32; 2]>, Vec<Option<[f64; 2]>>);
+
 /// Each row's texture coordinate as read (`read`, the first two of each triple), and where it
 /// moves.
 fn followed_uvs(
@@ -123,7 +126,7 @@ fn followed_uvs(
     before: &[[f32; 3]],
     after: &[[f32; 3]],
     triangles: &[[u32; 3]],
-) -> (Vec<[f32; 2]>, Vec<Option<[f64; 2]>>) {
+) -> FollowedUvs {
     let read: Vec<[f32; 2]> = read.iter().map(|t| [t[0], t[1]]).collect();
     let uvs: Vec<[f64; 2]> = read.iter().map(|t| t.map(f64::from)).collect();
     let triangles: Vec<crate::io::uv_follow::UvTriangle> =
@@ -172,7 +175,7 @@ struct RowChanges<'a> {
     normal_props: Option<[usize; 3]>,
     slotted: Option<(Vec<usize>, NormalTurns)>,
     uv_props: Option<(usize, usize)>,
-    followed: Option<(Vec<[f32; 2]>, Vec<Option<[f64; 2]>>)>,
+    followed: Option<FollowedUvs>,
 }
 
 impl RowChanges<'_> {
