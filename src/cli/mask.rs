@@ -1,11 +1,11 @@
 //! `--mask FILE` and `--mask-falloff RINGS` of `fair` and `multires`: read a vertex list (0-based
-//! indices in the input file's own vertex order) and turn it into a [`Mask`] on the loaded,
-//! welded mesh ([`fairmesh::fairing::mask`]).
+//! indices in the input file's own vertex order, [`fairmesh::io::read_vertex_list`]) and turn it
+//! into a [`Mask`] on the loaded, welded mesh ([`fairmesh::fairing::mask`]).
 
 use anyhow::Context;
 use clap::Args;
-use fairmesh::fairing::mask::{read_vertex_list, Mask};
-use fairmesh::io::Source;
+use fairmesh::fairing::mask::Mask;
+use fairmesh::io::{loaded_vertices, read_vertex_list, Source};
 use fairmesh::{Topology, TriMesh};
 use std::path::PathBuf;
 
@@ -35,7 +35,8 @@ impl MaskArgs {
             return Ok(None);
         };
         let list = read_vertex_list(path)?;
-        let mask = Mask::from_file_vertices(source, mesh.positions.len(), &list, path)?;
+        let vertices = loaded_vertices(source, &list, path)?;
+        let mask = Mask::from_vertices(mesh.positions.len(), vertices);
         anyhow::ensure!(
             mask.painted_count() > 0,
             "{}: the vertex list names no vertex of the mesh, so nothing would be faired",

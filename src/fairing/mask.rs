@@ -19,15 +19,12 @@
 //! the mesh's vertex count is a caller's mistake the fairing functions cannot report (they return
 //! reports, not results): they then leave the mesh unchanged. [`Mask::check_fits`] says why.
 //!
-//! Vertex lists ([`read_vertex_list`]): a text file of 0-based vertex indices in the input file's
-//! own vertex order, one a line; blank lines and `#` comments are allowed. Loading welds vertices
-//! (an OBJ or glTF splits them at seams), so [`Mask::from_file_vertices`] translates the file's
-//! indices to the loaded mesh's through [`crate::io::Source::loaded_vertex`].
+//! A mask from a file (the CLI's `--mask`) is a vertex list read by
+//! [`crate::io::read_vertex_list`] and mapped onto the loaded vertices by
+//! [`crate::io::loaded_vertices`]; [`Mask::from_vertices`] makes it a mask.
 
-use crate::io::Source;
 use crate::mesh::Topology;
 use std::collections::VecDeque;
-use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
 /// One weight in [0, 1] per vertex: 1 fair, 0 pinned (see the module docs). Cheap to clone.
@@ -36,7 +33,7 @@ pub struct Mask {
     weights: Arc<[f32]>,
 }
 
-/// What is wrong with a mask or a vertex list.
+/// What is wrong with a mask.
 #[derive(Debug, thiserror::Error)]
 #[non_exhaustive]
 pub enum MaskError {
@@ -44,17 +41,6 @@ pub enum MaskError {
     BadWeight { vertex: usize, value: f32 },
     #[error("the mask has {mask} weights but the mesh has {mesh} vertices")]
     WrongLength { mask: usize, mesh: usize },
-    #[error("{}: cannot read the vertex list: {source}", path.display())]
-    Read {
-        path: PathBuf,
-        source: std::io::Error,
-    },
-    #[error("{}, line {line}: {message}", path.display())]
-    Line {
-        path: PathBuf,
-        line: usize,
-        message: String,
-    },
 }
 
 impl std::fmt::Debug for Mask {
@@ -96,34 +82,6 @@ impl Mask {
         Mask {
             weights: weights.into(),
         }
-    }
-
-    /// Weight 1 on the loaded vertices that the file's vertices `file_vertices` (0-based, in
-    /// the file's order, as [`read_vertex_list`] gives them) became. `path` names the list in
-    /// errors: an index beyond the file's vertices is an error naming its line.
-    pub fn from_file_vertices(
-        source: &Source,
-        vertex_count: usize,
-        file_vertices: &[(usize, usize)],
-        path: &Path,
-    ) -> Result<Mask, MaskError> {
-        let file_count = source.file_vertex_count();
-        let mut loaded = Vec::with_capacity(file_vertices.len());
-        for &(line, index) in file_vertices {
-            if index >= file_count {
-                return Err(MaskError::Line {
-                    path: path.to_owned(),
-                    line,
-                    message: format!(
-                        "vertex {index} is out of range: the mesh file has {file_count} vertices \
-                         (indices are 0-based)"
-                    ),
-                });
-            }
-            // A vertex no triangle uses was dropped on loading: nothing to fair there.
-            loaded.extend(source.loaded_vertex(index));
-        }
-        Ok(Mask::from_vertices(vertex_count, loaded))
     }
 
     pub fn len(&self) -> usize {
@@ -231,60 +189,10 @@ impl Mask {
     }
 }
 
-/// Parses a vertex list (see the module docs): (line number, 1-based; vertex index) per entry.
-/// `path` names the list in errors.
-pub fn parse_vertex_list(text: &str, path: &Path) -> Result<Vec<(usize, usize)>, MaskError> {
-    let mut vertices = Vec::new();
-    for (number, line) in text.lines().enumerate() {
-        let content = line.split('#').next().unwrap_or("").trim();
-        if content.is_empty() {
-            continue;
-        }
-        let index = content.parse::<usize>().map_err(|_| MaskError::Line {
-            path: path.to_owned(),
-            line: number + 1,
-            message: format!(
-                "`{content}` is not a vertex index (expected one 0-based whole number a line)"
-            ),
-        })?;
-        vertices.push((number + 1, index));
-    }
-    Ok(vertices)
-}
-
-/// Reads and parses the vertex list at `path` ([`parse_vertex_list`]).
-pub fn read_vertex_list(path: &Path) -> Result<Vec<(usize, usize)>, MaskError> {
-    let bytes = std::fs::read(path).map_err(|source| MaskError::Read {
-        path: path.to_owned(),
-        source,
-    })?;
-    let text = String::from_utf8(bytes).map_err(|e| MaskError::Line {
-        path: path.to_owned(),
-        line: 1 + e.as_bytes()[..e.utf8_error().valid_up_to()]
-            .iter()
-            .filter(|&&b| b == b'\n')
-            .count(),
-        message: "the line is not text (UTF-8)".into(),
-    })?;
-    parse_vertex_list(&text, path)
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::mesh::TriMesh;
-
-    #[test]
-    fn vertex_lists_skip_comments_and_name_the_bad_line() {
-        let path = Path::new("region.txt");
-        let list = parse_vertex_list("# painted\n3\n\n 7  # tip\n0\n", path).unwrap();
-        assert_eq!(list, vec![(2, 3), (4, 7), (5, 0)]);
-        let error = parse_vertex_list("1\n2\nseven\n", path).unwrap_err();
-        let message = error.to_string();
-        assert!(message.starts_with("region.txt, line 3:"), "{message}");
-        assert!(message.contains("`seven`"), "{message}");
-        assert!(parse_vertex_list("-1\n", path).is_err());
-    }
 
     #[test]
     fn weights_outside_zero_to_one_are_refused() {

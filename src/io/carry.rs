@@ -21,6 +21,22 @@ pub(crate) struct VertexAttributes {
 }
 
 impl VertexAttributes {
+    /// The UVs and colours gathered onto the welded vertices, each where the file had them.
+    pub(crate) fn gathered(uvs: Option<Gather<2>>, colours: Option<Gather<4>>) -> Self {
+        let mut out = VertexAttributes::default();
+        if let Some(colours) = colours {
+            let (values, merged) = colours.finish();
+            out.colours = Some(values);
+            out.colour_splits_merged = merged;
+        }
+        if let Some(uvs) = uvs {
+            let (values, merged) = uvs.finish();
+            out.uvs = Some(values);
+            out.uv_splits_merged = merged;
+        }
+        out
+    }
+
     /// What was carried, and what was lost doing so, in plain words.
     pub(crate) fn describe(&self) -> (Vec<&'static str>, Vec<String>) {
         let mut kept = Vec::new();

@@ -19,7 +19,7 @@
 //! referred to by its file name; an image stored inside a glTF (buffer view or data: URI) is
 //! written out as a file beside an OBJ's `.mtl` or a `.gltf`. A GLB embeds every image.
 
-use super::source::{dvec, NormalTurns, SmoothGroups};
+use super::normals::{dvec, NormalTurns, SmoothGroups};
 use crate::mesh::TriMesh;
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
@@ -121,6 +121,17 @@ impl ImageData {
     }
 }
 
+/// Where a scene's triangles and file vertices are, by welded vertex (see
+/// [`Scene::derive`]).
+struct BaseLookup {
+    /// Base triangle (welded corners) -> (part, primitive, file corners).
+    by_triangle: HashMap<[u32; 3], (usize, usize, [u32; 3])>,
+    /// (welded vertex, part, primitive) -> its file vertex there.
+    in_primitive: HashMap<(u32, usize, usize), u32>,
+    /// Welded vertex -> its first file vertex.
+    first_any: Vec<u32>,
+}
+
 /// Where an image goes beside an output: the name the output refers to it by, and the file to
 /// write there (`None` when the input's own file is already in the output's folder).
 pub(crate) struct PlacedImage {
@@ -207,7 +218,7 @@ impl Scene {
         if !self.vertices.iter().any(missing) {
             return;
         }
-        let smooth = super::gltf::unit_vertex_normals(mesh);
+        let smooth = super::normals::unit_vertex_normals(mesh);
         for vertex in &mut self.vertices {
             if missing(vertex) {
                 vertex.normal = smooth[vertex.welded as usize];
@@ -262,64 +273,12 @@ impl Scene {
             let k = (0..3).min_by_key(|&k| t[k]).unwrap_or(0);
             [t[k], t[(k + 1) % 3], t[(k + 2) % 3]]
         };
-        // Base triangle (welded corners) -> (part, primitive, file corners); a triangle the
-        // loader turned over (to orient the mesh consistently) is found reversed.
-        let mut by_triangle: HashMap<[u32; 3], (usize, usize, [u32; 3])> = HashMap::new();
-        let mut in_primitive: HashMap<(u32, usize, usize), u32> = HashMap::new();
-        let mut first_any = vec![u32::MAX; base.positions.len()];
-        for (p, part) in self.parts.iter().enumerate() {
-            for (q, primitive) in part.primitives.iter().enumerate() {
-                for &t in &primitive.triangles {
-                    let welded = t.map(|v| self.vertices[v as usize].welded);
-                    by_triangle.entry(canonical(welded)).or_insert((p, q, t));
-                    by_triangle
-                        .entry(canonical([welded[0], welded[2], welded[1]]))
-                        .or_insert((p, q, t));
-                    for k in 0..3 {
-                        in_primitive.entry((welded[k], p, q)).or_insert(t[k]);
-                        if let Some(first) = first_any.get_mut(welded[k] as usize) {
-                            if *first == u32::MAX {
-                                *first = t[k];
-                            }
-                        }
-                    }
-                }
-            }
-        }
-        let mut derived = Scene {
-            uvs: self.uvs,
-            colours: self.colours,
-            normals: self.normals,
-            groups_under_objects: self.groups_under_objects,
-            parts: self
-                .parts
-                .iter()
-                .map(|part| Part {
-                    object: part.object.clone(),
-                    group: part.group.clone(),
-                    primitives: part
-                        .primitives
-                        .iter()
-                        .map(|p| Primitive {
-                            material: p.material,
-                            triangles: Vec::new(),
-                        })
-                        .collect(),
-                })
-                .collect(),
-            materials: self
-                .materials
-                .iter()
-                .map(|m| Material {
-                    name: m.name.clone(),
-                    base_colour: m.base_colour,
-                    metallic: m.metallic,
-                    roughness: m.roughness,
-                    texture: m.texture.clone(),
-                })
-                .collect(),
-            ..Scene::default()
-        };
+        let BaseLookup {
+            by_triangle,
+            in_primitive,
+            first_any,
+        } = self.base_lookup(base.positions.len(), canonical);
+        let mut derived = self.empty_copy();
         let mut unplaced = Primitive::default();
         let mut index: HashMap<(u32, u32), u32> = HashMap::new();
         let mut vertex_of = |file: u32, level: u32, vertices: &mut Vec<SceneVertex>| {
@@ -373,6 +332,85 @@ impl Scene {
         derived.parts.retain(|p| !p.primitives.is_empty());
         derived.fill_missing_normals(mesh);
         (derived, unplaced_count)
+    }
+
+    /// Where the triangles and file vertices of this scene are, by the welded (base) vertices
+    /// of `base_vertices`: base triangle (welded corners, `canonical` order) -> (part, primitive,
+    /// file corners), found also reversed (a triangle the loader turned over to orient the mesh
+    /// consistently); (welded vertex, part, primitive) -> its file vertex there; welded vertex
+    /// -> its first file vertex.
+    fn base_lookup(
+        &self,
+        base_vertices: usize,
+        canonical: impl Fn([u32; 3]) -> [u32; 3],
+    ) -> BaseLookup {
+        // Base triangle (welded corners) -> (part, primitive, file corners); a triangle the
+        // loader turned over (to orient the mesh consistently) is found reversed.
+        let mut by_triangle: HashMap<[u32; 3], (usize, usize, [u32; 3])> = HashMap::new();
+        let mut in_primitive: HashMap<(u32, usize, usize), u32> = HashMap::new();
+        let mut first_any = vec![u32::MAX; base_vertices];
+        for (p, part) in self.parts.iter().enumerate() {
+            for (q, primitive) in part.primitives.iter().enumerate() {
+                for &t in &primitive.triangles {
+                    let welded = t.map(|v| self.vertices[v as usize].welded);
+                    by_triangle.entry(canonical(welded)).or_insert((p, q, t));
+                    by_triangle
+                        .entry(canonical([welded[0], welded[2], welded[1]]))
+                        .or_insert((p, q, t));
+                    for k in 0..3 {
+                        in_primitive.entry((welded[k], p, q)).or_insert(t[k]);
+                        if let Some(first) = first_any.get_mut(welded[k] as usize) {
+                            if *first == u32::MAX {
+                                *first = t[k];
+                            }
+                        }
+                    }
+                }
+            }
+        }
+        BaseLookup {
+            by_triangle,
+            in_primitive,
+            first_any,
+        }
+    }
+
+    /// This scene's parts, primitives (with no triangles) and materials, with no vertices.
+    fn empty_copy(&self) -> Scene {
+        Scene {
+            uvs: self.uvs,
+            colours: self.colours,
+            normals: self.normals,
+            groups_under_objects: self.groups_under_objects,
+            parts: self
+                .parts
+                .iter()
+                .map(|part| Part {
+                    object: part.object.clone(),
+                    group: part.group.clone(),
+                    primitives: part
+                        .primitives
+                        .iter()
+                        .map(|p| Primitive {
+                            material: p.material,
+                            triangles: Vec::new(),
+                        })
+                        .collect(),
+                })
+                .collect(),
+            materials: self
+                .materials
+                .iter()
+                .map(|m| Material {
+                    name: m.name.clone(),
+                    base_colour: m.base_colour,
+                    metallic: m.metallic,
+                    roughness: m.roughness,
+                    texture: m.texture.clone(),
+                })
+                .collect(),
+            ..Scene::default()
+        }
     }
 
     /// How many triangles in all.

@@ -21,14 +21,15 @@
 //! are recomputed. A vertex that did not move keeps its bytes (or its text) exactly, and so does
 //! a normal whose faces did not move.
 //! Saving to another format writes the mesh with what that format can hold per vertex (UVs and
-//! vertex colours into glTF and OBJ, see [`super::carry`]) and names, in the [`SaveReport`],
+//! vertex colours into glTF and OBJ, see [`super::carry`]) and names, in the [`super::SaveReport`],
 //! everything else it cannot keep.
 
 use super::carry::VertexAttributes;
-use super::scene::Scene;
-use super::{gltf_writeback, Format};
+use super::normals::{dvec, is_own_normal};
+use super::origin::Origin;
+use super::scene::{Scene, SceneVertex};
+use super::{gltf, stl, Format};
 use crate::mesh::TriMesh;
-use glam::{DQuat, DVec3};
 use std::path::PathBuf;
 
 /// What a mesh was read from: kept by [`super::load`] in [`super::Loaded::source`], used by
@@ -36,15 +37,8 @@ use std::path::PathBuf;
 #[derive(Debug)]
 pub struct Source {
     pub(crate) format: Format,
-    /// The path (or the name given to `load_from_bytes`) of the input.
-    pub(crate) path: PathBuf,
-    /// The input's folder, where a glTF's external images live; `None` when loaded from memory.
-    pub(crate) base_dir: Option<PathBuf>,
-    /// Parser vertex -> welded vertex (`u32::MAX` where the vertex was dropped); `None` when the
-    /// welded vertices are the parser's, one for one.
-    pub(crate) raw_to_welded: Option<Vec<u32>>,
-    pub(crate) raw_vertices: usize,
-    pub(crate) welded_vertices: usize,
+    /// The file and the map from its vertices to the welded ones.
+    pub(crate) origin: Origin,
     pub(crate) welded_triangles: usize,
     pub(crate) triangle_fingerprint: u64,
     pub(crate) data: SourceData,
@@ -59,25 +53,13 @@ pub(crate) enum SourceData {
     /// colours): named, in plain words, so that saving says they were not kept.
     Unkept(Vec<String>),
     /// A binary STL's header text (written back into an STL) and what is not kept.
-    Stl(Box<super::stl::StlSource>),
+    Stl(Box<stl::StlSource>),
     /// The OBJ file's bytes.
     Obj(Vec<u8>),
     /// The PLY file's bytes.
     Ply(Vec<u8>),
     /// The glTF document, its buffers and which accessor elements became which vertices.
-    Gltf(Box<gltf_writeback::GltfSource>),
-}
-
-/// What saving did beyond writing the file: what could not be carried through, in plain words.
-#[derive(Clone, Debug, Default)]
-#[non_exhaustive]
-pub struct SaveReport {
-    pub warnings: Vec<String>,
-    /// The file was written back into its own format (OBJ, glTF/GLB, a PLY with per-vertex
-    /// texture coordinates), its texture coordinates following their vertices' slide along the
-    /// surface so that the texture stays where it was; otherwise texture coordinates stay with
-    /// their vertices.
-    pub texture_coordinates_follow: bool,
+    Gltf(Box<gltf::GltfSource>),
 }
 
 impl Source {
@@ -85,11 +67,13 @@ impl Source {
     pub fn plain(mesh: &TriMesh) -> Source {
         Source {
             format: Format::Ply,
-            path: PathBuf::new(),
-            base_dir: None,
-            raw_to_welded: None,
-            raw_vertices: mesh.positions.len(),
-            welded_vertices: mesh.positions.len(),
+            origin: Origin {
+                path: PathBuf::new(),
+                base_dir: None,
+                raw_to_welded: None,
+                raw_vertices: mesh.positions.len(),
+                welded_vertices: mesh.positions.len(),
+            },
             welded_triangles: mesh.triangles.len(),
             triangle_fingerprint: fingerprint(&mesh.triangles),
             data: SourceData::Plain,
@@ -104,7 +88,7 @@ impl Source {
     /// Whether `mesh` has the connectivity of the mesh this source was loaded as (same vertex
     /// count and the same triangles), so that its positions can be written back into the source.
     pub fn matches(&self, mesh: &TriMesh) -> bool {
-        mesh.positions.len() == self.welded_vertices
+        mesh.positions.len() == self.origin.welded_vertices
             && mesh.triangles.len() == self.welded_triangles
             && fingerprint(&mesh.triangles) == self.triangle_fingerprint
     }
@@ -139,9 +123,9 @@ impl Source {
     /// another format.
     pub(crate) fn vertex_attributes(&self) -> VertexAttributes {
         match &self.data {
-            SourceData::Obj(bytes) => super::obj::vertex_attributes(bytes, self),
-            SourceData::Ply(bytes) => super::ply::vertex_attributes(bytes, self),
-            SourceData::Gltf(gltf) => gltf.vertex_attributes(self),
+            SourceData::Obj(bytes) => super::obj::vertex_attributes(bytes, &self.origin),
+            SourceData::Ply(bytes) => super::ply::vertex_attributes(bytes, &self.origin),
+            SourceData::Gltf(gltf) => gltf.vertex_attributes(&self.origin),
             _ => VertexAttributes::default(),
         }
     }
@@ -151,8 +135,8 @@ impl Source {
     /// to carry (PLY, STL, OFF).
     pub(crate) fn scene(&self, mesh: &TriMesh) -> Option<Scene> {
         match &self.data {
-            SourceData::Obj(bytes) => Some(super::obj::scene(bytes, self, mesh)),
-            SourceData::Gltf(gltf) => Some(gltf.scene(self, mesh)),
+            SourceData::Obj(bytes) => Some(super::obj::scene(bytes, &self.origin, mesh)),
+            SourceData::Gltf(gltf) => Some(gltf.scene(&self.origin, mesh)),
             _ => None,
         }
     }
@@ -170,8 +154,8 @@ impl Source {
         if !self.matches(mesh) {
             return Vec::new();
         }
-        // An OBJ with neither normals nor materials marks nothing: no need to read its scene
-        // (a byte search, where reading the scene of a 1.2M-face OBJ takes ~0.6 s).
+        // An OBJ with neither normals nor materials marks nothing: a byte search says so without
+        // reading its scene.
         if let SourceData::Obj(bytes) = &self.data {
             let has = |word: &[u8]| bytes.windows(word.len()).any(|w| w == word);
             if !has(b"vn ") && !has(b"usemtl") {
@@ -314,29 +298,16 @@ impl Source {
 
     /// How many vertices the file holds, in its own order (before welding and clean-up).
     pub fn file_vertex_count(&self) -> usize {
-        self.raw_vertices
+        self.origin.raw_vertices
     }
 
     /// The loaded (welded) vertex that the file's vertex `file_vertex` (0-based, in the file's
     /// order) became; `None` when it is out of range or was dropped (unused by any triangle).
     pub fn loaded_vertex(&self, file_vertex: usize) -> Option<usize> {
-        if file_vertex >= self.raw_vertices {
+        if file_vertex >= self.origin.raw_vertices {
             return None;
         }
-        self.welded(file_vertex)
-    }
-
-    /// The welded vertex that parser vertex `raw` became, if it was kept.
-    #[inline]
-    pub(crate) fn welded(&self, raw: usize) -> Option<usize> {
-        match &self.raw_to_welded {
-            None => Some(raw),
-            Some(map) => map
-                .get(raw)
-                .copied()
-                .filter(|&w| w != u32::MAX)
-                .map(|w| w as usize),
-        }
+        self.origin.welded(file_vertex)
     }
 
     /// Whether writing `format` can carry the source through.
@@ -368,7 +339,7 @@ pub(crate) fn fingerprint(triangles: &[[u32; 3]]) -> u64 {
 fn split_at_vertices<K: PartialEq + Copy>(
     scene: &Scene,
     vertex_count: usize,
-    key: impl Fn(Option<usize>, &super::scene::SceneVertex) -> K,
+    key: impl Fn(Option<usize>, &SceneVertex) -> K,
 ) -> Vec<bool> {
     let mut first: Vec<Option<K>> = vec![None; vertex_count];
     let mut split = vec![false; vertex_count];
@@ -384,242 +355,6 @@ fn split_at_vertices<K: PartialEq + Copy>(
         }
     }
     split
-}
-
-/// How the normals of a file change when its vertices move. Each file normal (an OBJ `vn`, a PLY
-/// vertex's nx ny nz, an element of a glTF NORMAL accessor) belongs to a slot, and each slot
-/// gathers the area vectors of the faces that use it, before and after the move; the normal is
-/// then turned by the shortest rotation between the two sums. Normals whose faces did not move
-/// are left alone. An OBJ's slots are its `vn` lines (the file says which corners share a
-/// normal). A glTF or PLY normal has a slot of its own when it is the normal of its own faces (a
-/// flat-shaded triangle, a vertex nothing else shares), so flat parts stay flat per face; a normal
-/// that is not (it was smoothed over faces of other file vertices: a smooth normal split at a UV
-/// seam or a material boundary) shares its slot with the other normals of the same value on the
-/// same welded vertex ([`SmoothGroups`]), so the copies stay equal, while normals that differ
-/// there (a hard edge) stay apart.
-pub(crate) struct NormalTurns {
-    /// Per slot, side by side so that adding a face touches one place per corner.
-    slots: Vec<SlotSums>,
-}
-
-/// The area sums of one slot's faces, before and after the move, and whether any of them moved.
-#[derive(Clone, Copy, Default)]
-pub(crate) struct SlotSums {
-    before: DVec3,
-    after: DVec3,
-    moved: bool,
-}
-
-impl SlotSums {
-    /// The sum of the area vectors of the faces before the move.
-    pub(crate) fn area_before(&self) -> DVec3 {
-        self.before
-    }
-
-    /// These sums added to those of an empty slot (exactly what [`NormalTurns::merge_slot`]
-    /// gives a slot that has only this one normal).
-    pub(crate) fn alone(self) -> SlotSums {
-        let mut sums = SlotSums::default();
-        sums.merge(self);
-        sums
-    }
-
-    /// The sums of one triangle with corners `before` and `after` the move.
-    #[inline]
-    pub(crate) fn of_triangle(before: [DVec3; 3], after: [DVec3; 3]) -> SlotSums {
-        SlotSums {
-            before: (before[1] - before[0]).cross(before[2] - before[0]),
-            after: (after[1] - after[0]).cross(after[2] - after[0]),
-            moved: before != after,
-        }
-    }
-
-    #[inline]
-    pub(crate) fn merge(&mut self, add: SlotSums) {
-        self.before += add.before;
-        self.after += add.after;
-        self.moved |= add.moved;
-    }
-
-    /// The rotation for the normals of this slot, or `None` when they stay as they are.
-    pub(crate) fn turn(&self) -> Option<Turn> {
-        if !self.moved {
-            return None;
-        }
-        let after = self.after.normalize_or_zero();
-        if after == DVec3::ZERO {
-            return None;
-        }
-        let before = self.before.normalize_or_zero();
-        Some(if before == DVec3::ZERO {
-            Turn::Replace(after)
-        } else {
-            Turn::Rotate(DQuat::from_rotation_arc(before, after))
-        })
-    }
-}
-
-impl NormalTurns {
-    pub(crate) fn new(normals: usize) -> NormalTurns {
-        NormalTurns {
-            slots: vec![SlotSums::default(); normals],
-        }
-    }
-
-    fn slot_mut(&mut self, n: usize) -> &mut SlotSums {
-        if n >= self.slots.len() {
-            self.slots.resize(n + 1, SlotSums::default());
-        }
-        &mut self.slots[n]
-    }
-
-    /// Add a triangle whose corners use the slots `slots`, with its corners' positions before
-    /// and after.
-    #[inline]
-    pub(crate) fn add(&mut self, slots: [usize; 3], before: [DVec3; 3], after: [DVec3; 3]) {
-        let add = SlotSums::of_triangle(before, after);
-        for n in slots {
-            self.slot_mut(n).merge(add);
-        }
-    }
-
-    /// The sum of the area vectors of slot `n`'s faces before the move.
-    pub(crate) fn area_before(&self, n: usize) -> DVec3 {
-        self.slots.get(n).map_or(DVec3::ZERO, |sums| sums.before)
-    }
-
-    /// Add the sums of `from`'s slot `n` to this one's slot `slot`.
-    pub(crate) fn merge_slot(&mut self, slot: usize, from: &NormalTurns, n: usize) {
-        let add = from.slots.get(n).copied().unwrap_or_default();
-        self.merge_sums(slot, add);
-    }
-
-    /// Add `add` to slot `slot`'s sums.
-    pub(crate) fn merge_sums(&mut self, slot: usize, add: SlotSums) {
-        self.slot_mut(slot).merge(add);
-    }
-
-    /// The rotation for normal `n`, or `None` when it stays as it is.
-    pub(crate) fn turn(&self, n: usize) -> Option<Turn> {
-        self.slots.get(n)?.turn()
-    }
-}
-
-/// Slots for normals that turn together: one per (welded vertex, normal value); a normal on no
-/// welded vertex gets a slot of its own.
-#[derive(Default)]
-pub(crate) struct SmoothGroups {
-    /// Per welded vertex, the slot of the first normal value seen there (most vertices have one):
-    /// looked up by index, with no hashing.
-    first: Vec<Option<(usize, [u32; 3])>>,
-    /// The slots of the further values on a vertex (hard edges).
-    others: std::collections::HashMap<
-        (usize, [u32; 3]),
-        usize,
-        std::hash::BuildHasherDefault<crate::mesh::PositionHasher>,
-    >,
-    next: usize,
-}
-
-impl SmoothGroups {
-    /// The slot of a file normal whose own faces (those of its file vertex) add up to the area
-    /// vector `own`, on welded vertex `welded`.
-    pub(crate) fn slot_for(
-        &mut self,
-        own: DVec3,
-        welded: Option<usize>,
-        normal: [f32; 3],
-    ) -> usize {
-        if is_own_normal(own, normal) {
-            return self.fresh();
-        }
-        self.slot(welded, normal)
-    }
-
-    pub(crate) fn slot(&mut self, welded: Option<usize>, normal: [f32; 3]) -> usize {
-        let Some(w) = welded else {
-            return self.fresh();
-        };
-        let bits = normal.map(f32::to_bits);
-        if w >= self.first.len() {
-            self.first.resize(w + 1, None);
-        }
-        match self.first[w] {
-            Some((slot, first_bits)) if first_bits == bits => slot,
-            Some(_) => match self.others.get(&(w, bits)) {
-                Some(&slot) => slot,
-                None => {
-                    let slot = self.fresh();
-                    self.others.insert((w, bits), slot);
-                    slot
-                }
-            },
-            None => {
-                let slot = self.fresh();
-                self.first[w] = Some((slot, bits));
-                slot
-            }
-        }
-    }
-
-    pub(crate) fn fresh(&mut self) -> usize {
-        self.next += 1;
-        self.next - 1
-    }
-}
-
-/// Whether a file normal is the normal of its own faces (whose area vectors add up to `own`):
-/// then it gets a slot of its own ([`SmoothGroups::slot_for`]).
-#[inline]
-pub(crate) fn is_own_normal(own: DVec3, normal: [f32; 3]) -> bool {
-    let own = own.normalize_or_zero();
-    let n = dvec(normal).normalize_or_zero();
-    own != DVec3::ZERO && own.dot(n) > 0.99999
-}
-
-/// What happens to one file normal.
-#[derive(Clone, Copy, Debug)]
-pub(crate) enum Turn {
-    /// Turned by the rotation of its faces.
-    Rotate(DQuat),
-    /// Its faces had no area before: it becomes their normal after.
-    Replace(DVec3),
-}
-
-impl Turn {
-    /// The turned normal (unit length when `normal` was), never NaN.
-    pub(crate) fn normal(self, normal: [f32; 3]) -> [f32; 3] {
-        let turned = match self {
-            Turn::Rotate(q) => q * DVec3::from_array(normal.map(f64::from)),
-            Turn::Replace(n) => n,
-        };
-        if turned.is_finite() {
-            turned.as_vec3().to_array()
-        } else {
-            normal
-        }
-    }
-
-    /// A direction that moves with the surface (a tangent), turned; its length is kept.
-    pub(crate) fn direction(self, direction: [f32; 3]) -> [f32; 3] {
-        match self {
-            Turn::Rotate(q) => {
-                let turned = q * DVec3::from_array(direction.map(f64::from));
-                if turned.is_finite() {
-                    turned.as_vec3().to_array()
-                } else {
-                    direction
-                }
-            }
-            Turn::Replace(_) => direction,
-        }
-    }
-}
-
-/// A point in f64.
-#[inline]
-pub(crate) fn dvec(p: [f32; 3]) -> DVec3 {
-    DVec3::from_array(p.map(f64::from))
 }
 
 #[cfg(test)]
@@ -707,55 +442,5 @@ mod tests {
         assert_ne!(fingerprint(&a), fingerprint(&b));
         assert_ne!(fingerprint(&a), fingerprint(&c));
         assert_eq!(fingerprint(&a), fingerprint(&a.clone()));
-    }
-
-    #[test]
-    fn normals_turn_with_their_faces_and_unmoved_ones_stay() {
-        // Two triangles: one tilts by 90 degrees about the x axis, the other stays.
-        let mut turns = NormalTurns::new(3);
-        let flat = [DVec3::ZERO, DVec3::X, DVec3::Y];
-        let tilted = [DVec3::ZERO, DVec3::X, DVec3::Z];
-        turns.add([0, 0, 0], flat, tilted);
-        turns.add([1, 1, 1], flat, flat);
-        // A custom normal leaning 45 degrees from the face normal keeps its lean.
-        let lean = [0.0, (0.5f32).sqrt(), (0.5f32).sqrt()];
-        let turned = turns.turn(0).unwrap().normal(lean);
-        let expected = [0.0, -(0.5f32).sqrt(), (0.5f32).sqrt()];
-        for axis in 0..3 {
-            assert!((turned[axis] - expected[axis]).abs() < 1e-6, "{turned:?}");
-        }
-        assert!(turns.turn(1).is_none());
-        assert!(turns.turn(2).is_none(), "a normal no face uses stays");
-    }
-
-    #[test]
-    fn smooth_groups_join_equal_normals_on_one_vertex_only() {
-        let mut groups = SmoothGroups::default();
-        let up = [0.0, 0.0, 1.0];
-        let side = [1.0, 0.0, 0.0];
-        let a = groups.slot(Some(4), up);
-        assert_eq!(groups.slot(Some(4), up), a, "a seam copy shares its slot");
-        assert_ne!(groups.slot(Some(4), side), a, "a hard edge does not");
-        assert_ne!(groups.slot(Some(5), up), a, "another vertex does not");
-        let lone = groups.slot(None, up);
-        assert_ne!(groups.slot(None, up), lone);
-        // A normal that is its own faces' normal (flat shading) never shares.
-        let flat = groups.slot_for(DVec3::Z * 2.0, Some(4), up);
-        assert_ne!(flat, a);
-        assert_ne!(groups.slot_for(DVec3::Z, Some(4), up), flat);
-        // One smoothed over other faces does.
-        assert_eq!(groups.slot_for(DVec3::new(1.0, 0.0, 1.0), Some(4), up), a);
-    }
-
-    #[test]
-    fn a_normal_of_collapsed_faces_becomes_the_new_face_normal() {
-        let mut turns = NormalTurns::new(1);
-        let collapsed = [DVec3::ZERO, DVec3::X, DVec3::X * 2.0];
-        let opened = [DVec3::ZERO, DVec3::X, DVec3::Y];
-        turns.add([0, 0, 0], collapsed, opened);
-        assert_eq!(
-            turns.turn(0).unwrap().normal([1.0, 0.0, 0.0]),
-            [0.0, 0.0, 1.0]
-        );
     }
 }

@@ -21,7 +21,7 @@ use std::path::Path;
 const HEADER: usize = 84;
 const RECORD: usize = 50;
 
-pub(crate) fn parse(bytes: &[u8], path: &Path) -> Result<Parsed, IoError> {
+pub(crate) fn parse(bytes: &[u8], path: &Path) -> Result<Parsed<StlSource>, IoError> {
     let declared = bytes
         .get(80..84)
         .and_then(|b| b.try_into().ok())
@@ -50,7 +50,9 @@ pub(crate) fn parse(bytes: &[u8], path: &Path) -> Result<Parsed, IoError> {
     ))
 }
 
-fn read_binary(bytes: &[u8], path: &Path) -> Result<Parsed, IoError> {
+/// Reads a binary STL: the header, the declared count checked against the file's size, and
+/// each facet's corners. A parser that reads best in one piece.
+fn read_binary(bytes: &[u8], path: &Path) -> Result<Parsed<StlSource>, IoError> {
     let declared = bytes
         .get(80..84)
         .and_then(|b| b.try_into().ok())
@@ -134,14 +136,14 @@ fn read_binary(bytes: &[u8], path: &Path) -> Result<Parsed, IoError> {
     }
     let header: [u8; 80] = bytes[..80].try_into().unwrap_or([0; 80]);
     if header_text(&header).is_some() {
-        parsed.data = super::source::SourceData::Stl(Box::new(StlSource { header, unkept }));
-    } else if !unkept.is_empty() {
-        parsed.data = super::source::SourceData::Unkept(unkept);
+        parsed.kept = Some(StlSource { header, unkept });
+    } else {
+        parsed.unkept = unkept;
     }
     Ok(parsed)
 }
 
-fn read_ascii(bytes: &[u8], path: &Path) -> Result<Parsed, IoError> {
+fn read_ascii(bytes: &[u8], path: &Path) -> Result<Parsed<StlSource>, IoError> {
     let mut mesh = TriMesh::default();
     let mut corners: Vec<u32> = Vec::new();
     let mut in_loop = false;
@@ -317,12 +319,9 @@ mod tests {
             bytes.extend_from_slice(&colour);
         }
         let parsed = parse(&bytes, Path::new("c.stl")).unwrap();
-        match parsed.data {
-            super::super::source::SourceData::Unkept(items) => {
-                assert!(items[0].contains("of 1 facets"), "{items:?}")
-            }
-            other => panic!("{other:?}"),
-        }
+        assert!(parsed.kept.is_none());
+        let items = parsed.unkept;
+        assert!(items[0].contains("of 1 facets"), "{items:?}");
     }
 
     #[test]

@@ -91,6 +91,15 @@ pub(crate) fn non_finite_kind(value: f32) -> &'static str {
     }
 }
 
+/// "a", "a and b", "a, b and c".
+pub(crate) fn and_list(items: &[&str]) -> String {
+    match items {
+        [] => String::new(),
+        [one] => one.to_string(),
+        [rest @ .., last] => format!("{} and {last}", rest.join(", ")),
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

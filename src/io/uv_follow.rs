@@ -33,8 +33,8 @@ use rayon::prelude::*;
 const MAX_STEPS: usize = 12;
 
 /// A triangle of a file as the write-backs see it: per corner, the file's vertex and its texture
-/// coordinate ([`NO_UV`]: the corner has none). 24 bytes a triangle: on a 1.2M-face OBJ the
-/// follow's peak is a third lower than with `(usize, Option<usize>)` corners (72 bytes).
+/// coordinate ([`NO_UV`]: the corner has none). 24 bytes a triangle, where
+/// `(usize, Option<usize>)` corners would take 72: the tables of a big file stay small.
 pub(crate) type UvTriangle = [[u32; 2]; 3];
 
 /// A corner without a texture coordinate.
@@ -51,7 +51,8 @@ pub(crate) struct FollowedUvs {
 
 /// The texture coordinates `uvs` of the triangles `triangles` (over the file's vertices, whose
 /// positions are `before` and `after` the move), moved to follow the vertices' slide along the
-/// surface (see the module docs).
+/// surface (see the module docs): the wedges and edges are tabled once, then each texture
+/// coordinate of a moved vertex walks on its own, in parallel.
 pub(crate) fn follow(
     before: &[[f32; 3]],
     after: &[[f32; 3]],
@@ -69,53 +70,122 @@ pub(crate) fn follow(
             shared: 0,
         };
     }
-    let point = |points: &[[f32; 3]], v: u32| DVec3::from(points[v as usize].map(f64::from));
-    let moved = |v: u32| before[v as usize] != after[v as usize];
-    // Every vertex's area normal after the move (summed over all its faces).
-    let mut normals = vec![DVec3::ZERO; before.len()];
-    // The texture coordinate's vertex: NONE not seen yet, SHARED when several vertices use it.
-    const NONE: u32 = u32::MAX;
-    const SHARED: u32 = u32::MAX - 1;
-    let mut owner = vec![NONE; uvs.len()];
-    // How many faces use each texture coordinate at a moved vertex (its wedge; empty where no
-    // vertex using it moved).
-    let mut wedge_sizes = vec![0u32; uvs.len() + 1];
-    for triangle in triangles {
-        let [a, b, c] = triangle.map(|[v, _]| point(after, v));
-        let area = (b - a).cross(c - a);
-        for &[v, t] in triangle {
-            normals[v as usize] += area;
-            if t == NO_UV {
-                continue;
+    let wedges = Wedges::build(before, after, triangles, uvs.len());
+    let edges = sorted_edges(triangles);
+    let surface = Surface {
+        before,
+        after,
+        triangles,
+        uvs,
+        normals: &wedges.normals,
+        edges: &edges,
+    };
+    let moved_uvs: Vec<Option<[f64; 2]>> = (0..uvs.len())
+        .into_par_iter()
+        .with_min_len(1024)
+        .map(|t| {
+            let v = wedges.owner[t];
+            let wedge = wedges.faces(t);
+            if v >= SHARED || wedge.is_empty() {
+                return None;
             }
-            let t = t as usize;
-            owner[t] = match owner[t] {
-                NONE => v,
-                o if o == v => o,
-                _ => SHARED,
-            };
-            wedge_sizes[t + 1] += u32::from(moved(v));
+            surface.follow_one(v, wedge)
+        })
+        .collect();
+    let shared = (0..uvs.len())
+        .filter(|&t| wedges.owner[t] == SHARED && !wedges.faces(t).is_empty())
+        .count();
+    FollowedUvs {
+        moved: moved_uvs,
+        shared,
+    }
+}
+
+/// A texture coordinate's vertex not seen yet.
+const NONE: u32 = u32::MAX;
+/// A texture coordinate several vertices use.
+const SHARED: u32 = u32::MAX - 1;
+
+/// Vertex `v` of `points` in f64.
+fn point(points: &[[f32; 3]], v: u32) -> DVec3 {
+    DVec3::from(points[v as usize].map(f64::from))
+}
+
+/// Per vertex its area normal after the move; per texture coordinate its vertex ([`NONE`],
+/// [`SHARED`]) and its wedge: the faces that use it at a moved vertex.
+struct Wedges {
+    normals: Vec<DVec3>,
+    owner: Vec<u32>,
+    /// `faces[starts[t]..starts[t + 1]]`: texture coordinate `t`'s wedge.
+    starts: Vec<u32>,
+    faces: Vec<u32>,
+}
+
+impl Wedges {
+    fn build(
+        before: &[[f32; 3]],
+        after: &[[f32; 3]],
+        triangles: &[UvTriangle],
+        uv_count: usize,
+    ) -> Wedges {
+        let moved = |v: u32| before[v as usize] != after[v as usize];
+        // Every vertex's area normal after the move (summed over all its faces).
+        let mut normals = vec![DVec3::ZERO; before.len()];
+        let mut owner = vec![NONE; uv_count];
+        // How many faces use each texture coordinate at a moved vertex (its wedge; empty where
+        // no vertex using it moved).
+        let mut wedge_sizes = vec![0u32; uv_count + 1];
+        for triangle in triangles {
+            let [a, b, c] = triangle.map(|[v, _]| point(after, v));
+            let area = (b - a).cross(c - a);
+            for &[v, t] in triangle {
+                normals[v as usize] += area;
+                if t == NO_UV {
+                    continue;
+                }
+                let t = t as usize;
+                owner[t] = match owner[t] {
+                    NONE => v,
+                    o if o == v => o,
+                    _ => SHARED,
+                };
+                wedge_sizes[t + 1] += u32::from(moved(v));
+            }
+        }
+        // The wedges, side by side: faces[wedge_sizes[t]..wedge_sizes[t + 1]] after the sums.
+        for t in 0..uv_count {
+            wedge_sizes[t + 1] += wedge_sizes[t];
+        }
+        let starts = wedge_sizes;
+        let mut fill = starts.clone();
+        let mut faces = vec![0u32; starts[uv_count] as usize];
+        for (f, triangle) in triangles.iter().enumerate() {
+            for &[v, t] in triangle {
+                if t != NO_UV && moved(v) {
+                    faces[fill[t as usize] as usize] = f as u32;
+                    fill[t as usize] += 1;
+                }
+            }
+        }
+        Wedges {
+            normals,
+            owner,
+            starts,
+            faces,
         }
     }
-    // The wedges, side by side: wedge_faces[wedge_sizes[t]..wedge_sizes[t + 1]] after the sums.
-    for t in 0..uvs.len() {
-        wedge_sizes[t + 1] += wedge_sizes[t];
+
+    /// Texture coordinate `t`'s wedge.
+    fn faces(&self, t: usize) -> &[u32] {
+        &self.faces[self.starts[t] as usize..self.starts[t + 1] as usize]
     }
-    let starts = wedge_sizes;
-    let mut fill = starts.clone();
-    let mut wedge_faces = vec![0u32; starts[uvs.len()] as usize];
-    for (f, triangle) in triangles.iter().enumerate() {
-        for &[v, t] in triangle {
-            if t != NO_UV && moved(v) {
-                wedge_faces[fill[t as usize] as usize] = f as u32;
-                fill[t as usize] += 1;
-            }
-        }
-    }
-    // Every edge of every face by its ends (lower vertex first) and the corner it starts from
-    // (3 f + k), sorted: the faces across an edge are those with the same ends, and of those
-    // the ones whose ends carry the same texture coordinates ([`edge_key`]) are in the same
-    // chart; another is a face of another chart (a seam). 12 bytes an edge side.
+}
+
+/// Every edge of every face by its ends (lower vertex first) and the corner it starts from
+/// (3 f + k), sorted: the faces across an edge are those with the same ends, and of those the
+/// ones whose ends carry the same texture coordinates ([`edge_key`]) are in the same chart;
+/// another is a face of another chart (a seam). 12 bytes an edge side.
+fn sorted_edges(triangles: &[UvTriangle]) -> Vec<[u32; 3]> {
     let mut edges: Vec<[u32; 3]> = triangles
         .par_iter()
         .enumerate()
@@ -127,28 +197,45 @@ pub(crate) fn follow(
         })
         .collect();
     edges.par_sort_unstable();
-    let edges = &edges;
-    // The faces on the edge `key` (from `edge_key`): each with its own key of that edge.
-    let faces_on = |key: [u32; 4]| {
+    edges
+}
+
+/// The surface the texture coordinates walk on: the positions before and after, the faces with
+/// their texture coordinates, the vertices' normals after and the sorted edges.
+struct Surface<'a> {
+    before: &'a [[f32; 3]],
+    after: &'a [[f32; 3]],
+    triangles: &'a [UvTriangle],
+    uvs: &'a [[f64; 2]],
+    normals: &'a [DVec3],
+    edges: &'a [[u32; 3]],
+}
+
+impl Surface<'_> {
+    /// The faces on the edge `key` (from `edge_key`): each with its own key of that edge.
+    fn faces_on(&self, key: [u32; 4]) -> impl Iterator<Item = ([u32; 4], u32)> + '_ {
+        let edges = self.edges;
         let first = edges.partition_point(|e| [e[0], e[1]] < [key[0], key[1]]);
         edges[first..]
             .iter()
             .take_while(move |e| [e[0], e[1]] == [key[0], key[1]])
             .map(|e| {
                 let (g, k) = (e[2] / 3, e[2] % 3);
-                (edge_key(&triangles[g as usize], k as usize), g)
+                (edge_key(&self.triangles[g as usize], k as usize), g)
             })
-    };
+    }
 
-    let follow_one = |v: u32, wedge: &[u32]| -> Option<[f64; 2]> {
-        let n = normals[v as usize].try_normalize()?;
+    /// Where the texture coordinate of vertex `v` on the faces `wedge` moves: the slide's end
+    /// located by walking across the faces (see the module docs); `None` where it stays.
+    fn follow_one(&self, v: u32, wedge: &[u32]) -> Option<[f64; 2]> {
+        let n = self.normals[v as usize].try_normalize()?;
         let tangential = |d: DVec3| d - d.dot(n) * n;
-        let x = point(before, v);
-        let target = tangential(point(after, v) - x);
+        let x = point(self.before, v);
+        let target = tangential(point(self.after, v) - x);
         // The barycentric coordinates of the slide's end in face f seen in the plane (`None`
         // for a face seen nearly edge-on there).
         let projected =
-            |f: u32| triangles[f as usize].map(|[u, _]| tangential(point(before, u) - x));
+            |f: u32| self.triangles[f as usize].map(|[u, _]| tangential(point(self.before, u) - x));
         let barycentric = |f: u32| -> Option<[f64; 3]> {
             let p = projected(f);
             let area = |a: DVec3, b: DVec3, c: DVec3| (b - a).cross(c - a).dot(n);
@@ -183,14 +270,16 @@ pub(crate) fn follow(
             let k = (0..3)
                 .min_by(|&i, &j| weights[i].total_cmp(&weights[j]))
                 .unwrap_or(0);
-            let triangle = &triangles[face as usize];
+            let triangle = &self.triangles[face as usize];
             let key = edge_key(triangle, (k + 1) % 3);
             // (An edge with a corner without a coordinate belongs to no chart.)
             let charted = key[2] != NO_UV && key[3] != NO_UV;
-            let across = faces_on(key).find(|&(other, g)| charted && other == key && g != face);
+            let across = self
+                .faces_on(key)
+                .find(|&(other, g)| charted && other == key && g != face);
             let Some((_, next)) = across else {
                 // No face of this chart beyond: a seam if another chart's face is there.
-                extend = faces_on(key).any(|(other, _)| other != key);
+                extend = self.faces_on(key).any(|(other, _)| other != key);
                 break;
             };
             let Some(l) = barycentric(next).filter(|_| next != previous) else {
@@ -208,38 +297,18 @@ pub(crate) fn follow(
         if total.is_nan() || total <= 0.0 {
             return None;
         }
-        let corners = triangles[face as usize];
+        let corners = self.triangles[face as usize];
         let mut uv = [0.0; 2];
         // A face with a corner without a coordinate gives none.
         if corners.iter().any(|&[_, c]| c == NO_UV) {
             return None;
         }
         for (w, [_, c]) in weights.iter().zip(corners) {
-            for i in 0..2 {
-                uv[i] += w / total * uvs[c as usize][i];
+            for (out, value) in uv.iter_mut().zip(self.uvs[c as usize]) {
+                *out += w / total * value;
             }
         }
         uv.iter().all(|c| c.is_finite()).then_some(uv)
-    };
-
-    let moved_uvs: Vec<Option<[f64; 2]>> = (0..uvs.len())
-        .into_par_iter()
-        .with_min_len(1024)
-        .map(|t| {
-            let v = owner[t];
-            let wedge = &wedge_faces[starts[t] as usize..starts[t + 1] as usize];
-            if v >= SHARED || wedge.is_empty() {
-                return None;
-            }
-            follow_one(v, wedge)
-        })
-        .collect();
-    let shared = (0..uvs.len())
-        .filter(|&t| owner[t] == SHARED && starts[t + 1] > starts[t])
-        .count();
-    FollowedUvs {
-        moved: moved_uvs,
-        shared,
     }
 }
 
