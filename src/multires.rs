@@ -56,10 +56,9 @@
 //! umbrella Laplacian once instead of once per adjacent split vertex, and closed fans give the
 //! vertex normals from their fan order (one gather per neighbour instead of three per face).
 
-use crate::fairing::constrained::FanRings;
 use crate::fairing::{BoundaryMode, ConstrainedFairing, Creases, FairOptions, FairVariant, Mask};
 use crate::hierarchy::Hierarchy;
-use crate::mesh::{Topology, TriMesh};
+use crate::mesh::{FanRings, Topology, TriMesh};
 use crate::Progress;
 use glam::Vec3A;
 use rayon::prelude::*;

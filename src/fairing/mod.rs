@@ -59,6 +59,7 @@ pub mod baseline;
 pub mod boundary;
 pub mod constrained;
 pub mod creases;
+mod feature_edges;
 pub mod mask;
 pub mod relaxation;
 pub mod strength;

@@ -41,8 +41,7 @@
 //! 0.5 0.75-0.81, at 0.1 0.24-0.44. It is read on at most [`TANGENTIAL_SAMPLES`] vertices spread
 //! over the numbering, which a median of that many reads to about a percent.
 
-use super::constrained::FanRings;
-use crate::mesh::{Topology, TriMesh};
+use crate::mesh::{FanRings, Topology, TriMesh};
 use glam::Vec3A;
 use rayon::prelude::*;
 

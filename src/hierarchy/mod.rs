@@ -42,12 +42,11 @@
 
 mod decimate;
 
-use crate::fairing::constrained::FanRings;
 use crate::fairing::creases::{
     detect_creases_with_estimate, CreaseOptions, Creases, FaceRingCache, FeatureClass,
     HIERARCHY_ZIGZAG_TURN,
 };
-use crate::mesh::{Topology, TriMesh};
+use crate::mesh::{FanRings, Topology, TriMesh};
 use crate::Progress;
 use decimate::NEVER;
 use rayon::prelude::*;

@@ -1,0 +1,896 @@
+//! The operator's set-up (section 3.2, "How it is computed" in the parent module): every
+//! vertex's averaged local solutions folded into one weight row (umbrella mean, position,
+//! anchor) per one-ring entry, the rows deduplicated (a mesh has few distinct ones) and renumbered
+//! for the locality order ([`Layout`]); the curves the curve operator of section 3.3 moves; and
+//! the update of an operator for other creases ([`ConstrainedFairing::for_other_creases`]).
+
+use super::kernel::{EntryWeightIndex, Workspace};
+use super::operator::{corner_weights, held_corner_weights, triangle_solve};
+use super::ConstrainedFairing;
+use crate::fairing::boundary::BoundaryCurves;
+use crate::fairing::creases::{Creases, FeatureClass};
+use crate::fairing::{BoundaryMode, FairVariant};
+use crate::mesh::{
+    breadth_first_order, inverse_permutation, split_into_vertex_blocks, FanRings, PositionHasher,
+    Topology, TriMesh, VERTEX_BLOCK,
+};
+use rayon::prelude::*;
+use std::collections::HashMap;
+use std::hash::BuildHasherDefault;
+
+/// Valences below this index a dense table of local operators; larger ones are computed on the fly.
+const TABLE_VALENCE: usize = 32;
+/// The locality order is sorted by valence within blocks of this many vertices, so that the
+/// gather loops run the same trip count many times in a row and their exits are predicted (about
+/// 40% less CPU time per iteration on a mesh of mixed valences; blocks of 64 to 512 measured
+/// alike, see `docs/measurements.md`). Neighbours stay within a block of each other.
+const VALENCE_SORTED_BLOCK: usize = 256;
+
+/// What an operator's set-up computes from the connectivity alone: the locality order (internal
+/// vertex i is the mesh's vertex `order[i]`; `internal` is its inverse) and the one-rings in it
+/// (`offsets`, `ring`, relabelled).
+struct Layout {
+    order: Vec<u32>,
+    internal: Vec<u32>,
+    offsets: Vec<u32>,
+    ring: Vec<u32>,
+}
+
+impl Layout {
+    /// From the one-rings in the mesh's numbering (`ring_offsets`, `ring`): a breadth-first
+    /// order, its blocks sorted by valence.
+    fn new(ring_offsets: &[u32], ring: &[u32]) -> Layout {
+        let vertex_count = ring_offsets.len() - 1;
+        let mut order = breadth_first_order(ring_offsets, ring);
+        for block in order.chunks_mut(VALENCE_SORTED_BLOCK) {
+            block.sort_by_key(|&v| ring_offsets[v as usize + 1] - ring_offsets[v as usize]);
+        }
+        let internal = inverse_permutation(&order);
+        let mut offsets = Vec::with_capacity(vertex_count + 1);
+        offsets.push(0u32);
+        for &v in &order {
+            let v = v as usize;
+            let end = offsets[offsets.len() - 1] + ring_offsets[v + 1] - ring_offsets[v];
+            offsets.push(end);
+        }
+        let internal_ring = entries_in_order(&order, &offsets, ring_offsets, ring, |u| {
+            internal[u as usize]
+        });
+        Layout {
+            order,
+            internal,
+            offsets,
+            ring: internal_ring,
+        }
+    }
+}
+
+/// One value per one-ring entry (`values`, laid out by `ring_offsets` in the mesh's numbering)
+/// moved with its vertex into the internal order (`order`, laid out by `offsets`), in parallel
+/// over blocks of vertices, each passed through `map`.
+fn entries_in_order(
+    order: &[u32],
+    offsets: &[u32],
+    ring_offsets: &[u32],
+    values: &[u32],
+    map: impl Fn(u32) -> u32 + Sync,
+) -> Vec<u32> {
+    let mut out = vec![0u32; values.len()];
+    split_into_vertex_blocks(&mut out, offsets)
+        .into_par_iter()
+        .for_each(|(first, block)| {
+            let base = offsets[first] as usize;
+            let last = (first + VERTEX_BLOCK).min(order.len());
+            for (i, &v) in order[first..last].iter().enumerate() {
+                let slots =
+                    offsets[first + i] as usize - base..offsets[first + i + 1] as usize - base;
+                let entries =
+                    ring_offsets[v as usize] as usize..ring_offsets[v as usize + 1] as usize;
+                for (out, &value) in block[slots].iter_mut().zip(&values[entries]) {
+                    *out = map(value);
+                }
+            }
+        });
+    out
+}
+
+impl ConstrainedFairing {
+    /// [`Self::new`] for a caller that already has the mesh's fan-ordered one-rings; `creases`
+    /// kept as in [`Self::with_creases`]; the vertices flagged in `pinned` (empty: none) held
+    /// where they are, like fixed boundary vertices ([`super::mask`]).
+    pub(crate) fn with_fans(
+        mesh: &TriMesh,
+        topology: &Topology,
+        fans: &FanRings,
+        variant: FairVariant,
+        boundary: BoundaryMode,
+        creases: Option<&Creases>,
+        pinned: &[bool],
+    ) -> Self {
+        Self::set_up(
+            mesh, topology, fans, variant, boundary, creases, pinned, None,
+        )
+    }
+
+    /// This operator set up again for other `creases` on the same connectivity (`mesh`,
+    /// `topology` and `fans` those it was built from; the same variant, boundary mode, pinned
+    /// vertices and tangential relaxation): the same operator as [`Self::with_fans`] would give
+    /// (every entry's weights, the own weights, the fans and curves bit for bit; only the
+    /// numbering of the distinct weight rows may differ). Constrained fairing sets its operator
+    /// up again whenever the creases found before a round changed.
+    ///
+    /// Only the vertices whose held status changed (a crease vertex that is one no more, or a
+    /// new one) and their neighbours have other weights: a vertex's weights depend on which of
+    /// its triangles are solved, and that on its triangles' corners. Those are gathered again
+    /// and their rows looked up in (or added to) the distinct rows; the curves are made again.
+    /// When more than an eighth of the vertices changed, the set-up runs whole instead (still
+    /// keeping the locality order and the one-rings renumbered in it).
+    pub(crate) fn for_other_creases(
+        self,
+        mesh: &TriMesh,
+        topology: &Topology,
+        fans: &FanRings,
+        creases: Option<&Creases>,
+        pinned: &[bool],
+    ) -> Self {
+        self.for_other_creases_within(mesh, topology, fans, creases, pinned, 8)
+    }
+
+    /// [`Self::for_other_creases`], updating in place while at most 1/`fraction` of the vertices
+    /// changed (0: never; the tests take both ways).
+    fn for_other_creases_within(
+        mut self,
+        mesh: &TriMesh,
+        topology: &Topology,
+        fans: &FanRings,
+        creases: Option<&Creases>,
+        pinned: &[bool],
+        fraction: usize,
+    ) -> Self {
+        let creases = creases.filter(|c| !c.is_empty());
+        let held = held_flags(topology, creases, pinned);
+        let changed: Vec<u32> = (0..held.len() as u32)
+            .filter(|&v| held[v as usize] != self.held[v as usize])
+            .collect();
+        if fraction == 0 || changed.len() * fraction > held.len() {
+            let (variant, boundary, tangential) = (self.variant, self.boundary, self.tangential);
+            let layout = Layout {
+                order: self.order,
+                internal: self.internal,
+                offsets: self.ring_offsets,
+                ring: self.ring,
+            };
+            let mut fairing = Self::set_up(
+                mesh,
+                topology,
+                fans,
+                variant,
+                boundary,
+                creases,
+                pinned,
+                Some(layout),
+            );
+            fairing.tangential = tangential;
+            return fairing;
+        }
+        let mut affected: Vec<u32> = changed
+            .iter()
+            .flat_map(|&v| std::iter::once(v).chain(topology.neighbors(v).iter().copied()))
+            .collect();
+        affected.sort_unstable();
+        affected.dedup();
+        let (ring_offsets, _) = topology.neighbor_csr();
+        let triangles = &mesh.triangles;
+        // A vertex's rows and whether it is solved, with the triangles solved as `held` says.
+        let gather = |v: usize, held: &[bool], rows: &mut Vec<[f32; 4]>, own: &mut [f32; 3]| {
+            let ring_v = &fans.ring[ring_offsets[v] as usize..ring_offsets[v + 1] as usize];
+            rows.resize(ring_v.len(), [0.0; 4]);
+            let operator = |f: u32| {
+                let t = &triangles[f as usize];
+                let valences = t.map(|c| topology.valence(c));
+                match triangle_solve(t, held, topology, pinned)? {
+                    None => Some(corner_weights(valences)),
+                    // v itself, when it is the held corner, gets no solution from the triangle.
+                    Some(h) => (t[h] as usize != v).then(|| held_corner_weights(valences, h)),
+                }
+            };
+            let mut solved = false;
+            gather_rows(
+                v,
+                ring_v,
+                topology,
+                triangles,
+                operator,
+                rows,
+                own,
+                &mut solved,
+            );
+            solved
+        };
+        let mut row_of: RowMap = self
+            .entry_weights
+            .iter()
+            .enumerate()
+            .map(|(i, row)| (row_key(row), i as u32))
+            .collect();
+        let (mut rows, mut own) = (Vec::new(), [0.0f32; 3]);
+        for &v in &affected {
+            let v = v as usize;
+            let was_solved = gather(v, &self.held, &mut rows, &mut own);
+            let solved = gather(v, &held, &mut rows, &mut own);
+            self.solved_vertices =
+                self.solved_vertices + usize::from(solved) - usize::from(was_solved);
+            let i = self.internal[v] as usize;
+            self.self_weights[i] = own;
+            self.closed_fan[i] = fans.closed_fan[v] && solved;
+            let first = self.ring_offsets[i] as usize;
+            for (k, row) in rows.iter().enumerate() {
+                let index = *row_of.entry(row_key(row)).or_insert_with(|| {
+                    self.entry_weights.push(*row);
+                    (self.entry_weights.len() - 1) as u32
+                });
+                if let EntryWeightIndex::Narrow(narrow) = &self.entry_weight_index {
+                    if index > u32::from(u16::MAX) {
+                        let wide = narrow.iter().map(|&i| u32::from(i)).collect();
+                        self.entry_weight_index = EntryWeightIndex::Wide(wide);
+                    }
+                }
+                match &mut self.entry_weight_index {
+                    EntryWeightIndex::Narrow(narrow) => narrow[first + k] = index as u16,
+                    EntryWeightIndex::Wide(wide) => wide[first + k] = index,
+                }
+            }
+        }
+        self.curves = fairing_curves(topology, self.boundary, creases, &self.internal);
+        self.held = held;
+        self
+    }
+
+    #[allow(clippy::too_many_arguments)]
+    fn set_up(
+        mesh: &TriMesh,
+        topology: &Topology,
+        fans: &FanRings,
+        variant: FairVariant,
+        boundary: BoundaryMode,
+        creases: Option<&Creases>,
+        pinned: &[bool],
+        layout: Option<Layout>,
+    ) -> Self {
+        let vertex_count = mesh.positions.len();
+        let triangles = &mesh.triangles;
+        // Crease vertices and corners, and pinned vertices, bound the surface patches like
+        // boundary vertices do: they get no local solution and their triangles are not solved,
+        // but for those with a single crease corner, solved with it held ([`triangle_solve`]).
+        let creases = creases.filter(|c| !c.is_empty());
+        let held = held_flags(topology, creases, pinned);
+
+        let ring_offsets = topology.neighbor_csr().0.to_vec();
+        let (ring, closed) = (&fans.ring, &fans.closed_fan);
+
+        let valence = |v: u32| topology.valence(v);
+
+        // Local operators of the valence triples that occur, in a dense table, and each triangle's
+        // slot in it (u32::MAX: not solved), found once per triangle rather than once per
+        // corner. Triples with a valence beyond the table get an operator of their own, and so
+        // do the (few) triangles solved with a crease corner held, per triple and held corner.
+        let table_index = |n: [usize; 3]| (n[0] * TABLE_VALENCE + n[1]) * TABLE_VALENCE + n[2];
+        let triangle_valences: Vec<Option<([usize; 3], Option<usize>)>> = triangles
+            .par_iter()
+            .map(|t| triangle_solve(t, &held, topology, pinned).map(|h| (t.map(valence), h)))
+            .collect();
+        let mut table_slot = vec![u32::MAX; TABLE_VALENCE * TABLE_VALENCE * TABLE_VALENCE];
+        let mut held_corner_slot: HashMap<([usize; 3], usize), u32> = HashMap::new();
+        // Per operator, the weights corner r's solution gives corner c's umbrella mean, position
+        // and anchor: G_rc, G_rc/n_c − Σ_c' G_rc'/n_c' and h_r (see "How it is computed"); and
+        // which corner it holds (3: none).
+        let mut operators: Vec<[[[f64; 3]; 3]; 3]> = Vec::new();
+        let mut operator_held: Vec<u8> = Vec::new();
+        let mut operator_slot = |(n, held_at): ([usize; 3], Option<usize>)| -> u32 {
+            if let Some(h) = held_at {
+                return *held_corner_slot.entry((n, h)).or_insert_with(|| {
+                    operators.push(held_corner_weights(n, h));
+                    operator_held.push(h as u8);
+                    (operators.len() - 1) as u32
+                });
+            }
+            let in_table = n.iter().all(|&k| k < TABLE_VALENCE);
+            if in_table && table_slot[table_index(n)] != u32::MAX {
+                return table_slot[table_index(n)];
+            }
+            let slot = operators.len() as u32;
+            operators.push(corner_weights(n));
+            operator_held.push(3);
+            if in_table {
+                table_slot[table_index(n)] = slot;
+            }
+            slot
+        };
+        let triangle_operator: Vec<u32> = triangle_valences
+            .iter()
+            .map(|n| n.map_or(u32::MAX, &mut operator_slot))
+            .collect();
+        drop(triangle_valences);
+
+        // Per vertex, gather the weights of its triangles' solutions (f64, then rounded), one row
+        // (mean, position, anchor, 0) per one-ring entry.
+        let mut self_weights = vec![[0.0f32; 3]; vertex_count];
+        let mut solved = vec![false; vertex_count];
+        let gather = |v: usize,
+                      ring_weights_v: &mut [[f32; 4]],
+                      own_out: &mut [f32; 3],
+                      solved_out: &mut bool| {
+            let ring_v = &ring[ring_offsets[v] as usize..ring_offsets[v + 1] as usize];
+            let operator = |f: u32| {
+                let slot = triangle_operator[f as usize];
+                // v itself, when it is the held corner, gets no solution from the triangle.
+                (slot != u32::MAX
+                    && triangles[f as usize].get(operator_held[slot as usize] as usize)
+                        != Some(&(v as u32)))
+                .then(|| &operators[slot as usize])
+            };
+            gather_rows(
+                v,
+                ring_v,
+                topology,
+                triangles,
+                operator,
+                ring_weights_v,
+                own_out,
+                solved_out,
+            );
+        };
+        // In blocks of vertices, each block's rows deduplicated as soon as they are gathered:
+        // the 16-byte rows of the whole mesh are never held at once (on the 1.2M-face mesh they
+        // were 58 MB at the set-up's peak); only a 4-byte index per entry and the few distinct
+        // rows. The rows are a function of the valences around the vertex, so they repeat.
+        let blocks: Vec<(Vec<u32>, Vec<[f32; 4]>)> = self_weights
+            .par_chunks_mut(VERTEX_BLOCK)
+            .zip(solved.par_chunks_mut(VERTEX_BLOCK))
+            .enumerate()
+            .map(|(b, (own_block, solved_block))| {
+                let first = b * VERTEX_BLOCK;
+                let base = ring_offsets[first] as usize;
+                let end = ring_offsets[first + own_block.len()] as usize;
+                let mut rows = vec![[0.0f32; 4]; end - base];
+                for (i, (own_out, solved_out)) in own_block
+                    .iter_mut()
+                    .zip(solved_block.iter_mut())
+                    .enumerate()
+                {
+                    let v = first + i;
+                    let entries =
+                        ring_offsets[v] as usize - base..ring_offsets[v + 1] as usize - base;
+                    gather(v, &mut rows[entries], own_out, solved_out);
+                }
+                deduplicate_chunk(&rows)
+            })
+            .collect();
+        let (mesh_rows, mesh_index) = join_deduplicated(blocks);
+        let solved_vertices = solved.iter().filter(|&&s| s).count();
+
+        // Renumber for locality: internal vertex i is `order[i]`; every per-vertex array is
+        // permuted and every one-ring entry moved with its vertex (its fan order and weights kept)
+        // and relabelled. (Given a layout, the order and the relabelled rings are those.)
+        let layout = layout.unwrap_or_else(|| Layout::new(&ring_offsets, ring));
+        debug_assert_eq!(layout.order.len(), vertex_count);
+        debug_assert_eq!(layout.ring.len(), ring.len());
+        let Layout {
+            order,
+            internal,
+            offsets: internal_offsets,
+            ring: internal_ring,
+        } = layout;
+        // Only the rows' 4-byte index is permuted (permuting the 16-byte rows and then
+        // deduplicating them held two copies of every entry's row at once). The distinct rows
+        // are then renumbered in order of first use in the internal order, as deduplicating the
+        // permuted rows numbers them, so the operator is the same bit for bit and its table is
+        // read in order.
+        let internal_index =
+            entries_in_order(&order, &internal_offsets, &ring_offsets, &mesh_index, |i| i);
+        drop(mesh_index);
+        let (entry_weights, entry_weight_index) = renumber_by_first_use(&mesh_rows, internal_index);
+        drop(mesh_rows);
+        let self_weights = order.iter().map(|&v| self_weights[v as usize]).collect();
+        // A vertex with no local solution keeps its position: it gets neither the projection nor
+        // the tangential relaxation (corners of creases, vertices whose triangles all touch the
+        // boundary).
+        let closed_fan = order
+            .iter()
+            .map(|&v| closed[v as usize] && solved[v as usize])
+            .collect();
+        let inverse_valence = order
+            .iter()
+            .map(|&v| match topology.valence(v) {
+                0 => 0.0,
+                n => 1.0 / n as f32,
+            })
+            .collect();
+        let curves = fairing_curves(topology, boundary, creases, &internal);
+        ConstrainedFairing {
+            held,
+            variant,
+            boundary,
+            order,
+            internal,
+            ring_offsets: internal_offsets,
+            ring: internal_ring,
+            entry_weight_index,
+            entry_weights,
+            self_weights,
+            inverse_valence,
+            closed_fan,
+            curves,
+            tangential: 0.0,
+            relaxation_share: Vec::new(),
+            solved_vertices,
+            // Allocated by the first load.
+            workspace: Workspace::default(),
+        }
+    }
+}
+
+/// The vertices (mesh numbering) that bound the surface patches like boundary vertices do: the
+/// boundary's, the creases' (their vertices and corners) and the pinned ones.
+pub(super) fn held_flags(
+    topology: &Topology,
+    creases: Option<&Creases>,
+    pinned: &[bool],
+) -> Vec<bool> {
+    let on_boundary = topology.boundary_flags();
+    if creases.is_none() && pinned.is_empty() {
+        return on_boundary.to_vec();
+    }
+    (0..on_boundary.len())
+        .into_par_iter()
+        .with_min_len(VERTEX_BLOCK)
+        .map(|v| {
+            on_boundary[v]
+                || creases.is_some_and(|c| c.is_feature(v as u32))
+                || pinned.get(v).copied().unwrap_or(false)
+        })
+        .collect()
+}
+
+/// Vertex `v`'s weights: the mean of its solved triangles' corner weights (f64, then rounded),
+/// one row (mean, position, anchor, 0) per entry of its one-ring `ring_v` into
+/// `ring_weights_v`, its own into `own_out`; `operator(f)` gives face f's corner weights, `None`
+/// for a face that is not solved. A vertex with no solved face keeps its position (own weights
+/// (0, 1, 0), ring weights 0) and `solved_out` stays false.
+#[allow(clippy::too_many_arguments)]
+fn gather_rows<W>(
+    v: usize,
+    ring_v: &[u32],
+    topology: &Topology,
+    triangles: &[[u32; 3]],
+    operator: impl Fn(u32) -> Option<W>,
+    ring_weights_v: &mut [[f32; 4]],
+    own_out: &mut [f32; 3],
+    solved_out: &mut bool,
+) where
+    W: std::borrow::Borrow<[[[f64; 3]; 3]; 3]>,
+{
+    let mut own = [0.0f64; 3];
+    let mut stack_entries = [[0.0f64; 3]; 64];
+    let mut heap_entries = Vec::new();
+    let entries: &mut [[f64; 3]] = if ring_v.len() <= 64 {
+        &mut stack_entries[..ring_v.len()]
+    } else {
+        heap_entries.resize(ring_v.len(), [0.0f64; 3]);
+        &mut heap_entries
+    };
+    let mut count = 0usize;
+    for &f in topology.faces_of(v as u32) {
+        let Some(weights_of) = operator(f) else {
+            continue;
+        };
+        count += 1;
+        let t = &triangles[f as usize];
+        let r = t
+            .iter()
+            .position(|&c| c as usize == v)
+            .expect("v is a corner");
+        for (c, weights) in weights_of.borrow()[r].iter().enumerate() {
+            let slot = if t[c] as usize == v {
+                &mut own
+            } else {
+                let at = ring_v
+                    .iter()
+                    .position(|&u| u == t[c])
+                    .expect("a triangle's corners are one-ring neighbours");
+                &mut entries[at]
+            };
+            for k in 0..3 {
+                slot[k] += weights[k];
+            }
+        }
+    }
+    *solved_out = false;
+    if count == 0 {
+        // No local solution: the vertex keeps its position (ring weights stay 0).
+        *own_out = [0.0, 1.0, 0.0];
+        ring_weights_v.fill([0.0; 4]);
+        return;
+    }
+    let inv = 1.0 / count as f64;
+    *own_out = own.map(|w| (w * inv) as f32);
+    for (out, e) in ring_weights_v.iter_mut().zip(entries.iter()) {
+        *out = [
+            (e[0] * inv) as f32,
+            (e[1] * inv) as f32,
+            (e[2] * inv) as f32,
+            0.0,
+        ];
+    }
+    *solved_out = true;
+}
+
+/// The curves the curve operator moves (internal numbering): the boundary loops (when they are
+/// faired), cut into open chains at crease corners, and the crease chains.
+fn fairing_curves(
+    topology: &Topology,
+    boundary: BoundaryMode,
+    creases: Option<&Creases>,
+    internal: &[u32],
+) -> BoundaryCurves {
+    let mut closed: Vec<Vec<u32>> = Vec::new();
+    let mut open: Vec<Vec<u32>> = Vec::new();
+    let is_corner = |v: u32| creases.is_some_and(|c| c.class[v as usize] == FeatureClass::Corner);
+    if boundary == BoundaryMode::Curve {
+        for boundary_loop in &topology.boundary_loops {
+            match boundary_loop.iter().position(|&v| is_corner(v)) {
+                None => closed.push(boundary_loop.clone()),
+                Some(first) => {
+                    // Rotate so the loop starts at a corner, then cut at every corner.
+                    let n = boundary_loop.len();
+                    let mut chain = vec![boundary_loop[first]];
+                    for k in 1..=n {
+                        let v = boundary_loop[(first + k) % n];
+                        chain.push(v);
+                        if is_corner(v) {
+                            open.push(std::mem::replace(&mut chain, vec![v]));
+                        }
+                    }
+                }
+            }
+        }
+    }
+    if let Some(creases) = creases {
+        for chain in &creases.chains {
+            if chain.closed {
+                closed.push(chain.vertices.clone());
+            } else {
+                open.push(chain.vertices.clone());
+            }
+        }
+    }
+    let relabel = |curves: Vec<Vec<u32>>| -> Vec<Vec<u32>> {
+        curves
+            .into_iter()
+            .map(|c| c.iter().map(|&v| internal[v as usize]).collect())
+            .collect()
+    };
+    BoundaryCurves::with_open_chains(&relabel(closed), &relabel(open), internal.len())
+}
+
+type RowMap = HashMap<[u32; 3], u32, BuildHasherDefault<PositionHasher>>;
+
+/// A weight row's key: its three weights, bit for bit (the fourth lane is always 0).
+fn row_key(row: &[f32; 4]) -> [u32; 3] {
+    [row[0].to_bits(), row[1].to_bits(), row[2].to_bits()]
+}
+
+/// One chunk of rows deduplicated against a table of its own: each row's index among the
+/// chunk's distinct rows, and those rows in order of first appearance.
+fn deduplicate_chunk(rows: &[[f32; 4]]) -> (Vec<u32>, Vec<[f32; 4]>) {
+    let mut distinct = Vec::new();
+    let mut slot = RowMap::default();
+    let index = rows
+        .iter()
+        .map(|row| {
+            *slot.entry(row_key(row)).or_insert_with(|| {
+                distinct.push(*row);
+                (distinct.len() - 1) as u32
+            })
+        })
+        .collect();
+    (index, distinct)
+}
+
+/// Consecutive chunks deduplicated by [`deduplicate_chunk`], joined: the distinct rows of them
+/// all, numbered in chunk order (which is the order of first appearance over the whole
+/// sequence), and every row's index among them, in order.
+fn join_deduplicated(mut local: Vec<(Vec<u32>, Vec<[f32; 4]>)>) -> (Vec<[f32; 4]>, Vec<u32>) {
+    let mut distinct: Vec<[f32; 4]> = Vec::new();
+    let mut slot = RowMap::default();
+    let global_of_local: Vec<Vec<u32>> = local
+        .iter()
+        .map(|(_, rows)| {
+            rows.iter()
+                .map(|row| {
+                    *slot.entry(row_key(row)).or_insert_with(|| {
+                        distinct.push(*row);
+                        (distinct.len() - 1) as u32
+                    })
+                })
+                .collect()
+        })
+        .collect();
+    local
+        .par_iter_mut()
+        .zip(&global_of_local)
+        .for_each(|((index, _), global)| {
+            for i in index.iter_mut() {
+                *i = global[*i as usize];
+            }
+        });
+    let index = local.into_iter().flat_map(|(index, _)| index).collect();
+    (distinct, index)
+}
+
+/// Two-byte indices where the rows allow.
+fn narrowed(distinct: usize, index: Vec<u32>) -> EntryWeightIndex {
+    if distinct <= 1 << 16 {
+        EntryWeightIndex::Narrow(index.into_par_iter().map(|i| i as u16).collect())
+    } else {
+        EntryWeightIndex::Wide(index)
+    }
+}
+
+/// The distinct rows of `rows` (compared bit for bit) in order of first appearance, and each
+/// row's index among them. Chunks are deduplicated in parallel against small local tables, then
+/// their distinct rows are numbered in chunk order, which is the order of first appearance.
+#[cfg(test)]
+fn deduplicate_rows(rows: &[[f32; 4]]) -> (Vec<[f32; 4]>, EntryWeightIndex) {
+    const ROWS_PER_CHUNK: usize = 1 << 16;
+    let local = rows
+        .par_chunks(ROWS_PER_CHUNK)
+        .map(deduplicate_chunk)
+        .collect();
+    let (distinct, index) = join_deduplicated(local);
+    let index = narrowed(distinct.len(), index);
+    (distinct, index)
+}
+
+/// The rows `rows` (distinct) renumbered in order of their first use in `index`, with `index`
+/// rewritten to the new numbers: what [`deduplicate_rows`] gives for the rows `index` picks, in
+/// that order, without making those rows (2 or 4 bytes per entry instead of 16).
+fn renumber_by_first_use(
+    rows: &[[f32; 4]],
+    mut index: Vec<u32>,
+) -> (Vec<[f32; 4]>, EntryWeightIndex) {
+    let mut new_of_old = vec![u32::MAX; rows.len()];
+    let mut renumbered = Vec::new();
+    for i in index.iter_mut() {
+        let slot = &mut new_of_old[*i as usize];
+        if *slot == u32::MAX {
+            *slot = renumbered.len() as u32;
+            renumbered.push(rows[*i as usize]);
+        }
+        *i = *slot;
+    }
+    let index = narrowed(renumbered.len(), index);
+    (renumbered, index)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::fairing::FairOptions;
+    use crate::mesh::fixtures::Rng;
+
+    #[test]
+    fn a_row_between_two_creases_is_smoothed_with_its_triangles_solved_beside_them() {
+        // A flat grid with noise along z, and two straight creases along the rows y = 4 and
+        // y = 6. Every triangle of row 5 touches one of them: left unsolved (as the boundary's
+        // are) they would leave row 5's noise as it is.
+        let n = 10usize;
+        let at = |x: usize, y: usize| (y * (n + 1) + x) as u32;
+        let mut mesh = crate::mesh::fixtures::grid(n);
+        for (v, p) in mesh.positions.iter_mut().enumerate() {
+            let (x, y) = (v % (n + 1), v / (n + 1));
+            p[2] = (((x * 7 + y * 13) % 11) as f32 - 5.0) * 0.04;
+        }
+        let topology = Topology::build(&mesh);
+        let mut class = vec![FeatureClass::Smooth; mesh.positions.len()];
+        let mut edges = Vec::new();
+        for y in [4, 6] {
+            for x in 0..=n {
+                let end = x == 0 || x == n;
+                class[at(x, y) as usize] = if end {
+                    FeatureClass::Corner
+                } else {
+                    FeatureClass::Crease
+                };
+                if x < n {
+                    edges.push([at(x, y), at(x + 1, y)]);
+                }
+            }
+        }
+        let creases = Creases::from_classified(edges, class);
+        let row_noise = |positions: &[[f32; 3]]| -> f32 {
+            (1..n)
+                .map(|x| positions[at(x, 5) as usize][2].abs())
+                .sum::<f32>()
+                / (n - 1) as f32
+        };
+        let mut positions = mesh.positions.clone();
+        let before = row_noise(&positions);
+        let mut fairing = ConstrainedFairing::with_creases(
+            &mesh,
+            &topology,
+            FairVariant::NormalProjected,
+            BoundaryMode::Fixed,
+            &creases,
+        );
+        let options = FairOptions {
+            iterations: 10,
+            rounds: 5,
+            variant: FairVariant::NormalProjected,
+            ..Default::default()
+        };
+        fairing.run(&mut positions, &options);
+        let after = row_noise(&positions);
+        assert!(before > 0.05, "the row starts noisy: {before}");
+        assert!(after < 0.5 * before, "row 5: mean |z| {before} -> {after}");
+    }
+
+    /// The set-up deduplicates the weight rows in the mesh's order and renumbers them in the
+    /// internal order: that must be exactly what deduplicating the permuted rows gives (the
+    /// same table, in the same order, and the same index), with narrow and wide indices.
+    #[test]
+    fn rows_deduplicated_then_renumbered_are_the_permuted_rows_deduplicated() {
+        let mut rng = Rng(7);
+        for distinct in [37usize, 70_001] {
+            let rows: Vec<[f32; 4]> = (0..150_000)
+                .map(|_| {
+                    let i = (rng.next() * distinct as f64) as usize;
+                    [i as f32, 0.25 * i as f32, -(i as f32), 0.0]
+                })
+                .collect();
+            // A permutation of the entries (the internal order moves whole rings; any
+            // permutation must do).
+            let mut order: Vec<usize> = (0..rows.len()).collect();
+            for i in (1..order.len()).rev() {
+                order.swap(i, (rng.next() * (i + 1) as f64) as usize);
+            }
+            let permuted: Vec<[f32; 4]> = order.iter().map(|&e| rows[e]).collect();
+            let expected = deduplicate_rows(&permuted);
+
+            let (mesh_rows, mesh_index) = deduplicate_rows(&rows);
+            let wide = |index: &EntryWeightIndex| -> Vec<u32> {
+                match index {
+                    EntryWeightIndex::Narrow(i) => i.iter().map(|&k| k as u32).collect(),
+                    EntryWeightIndex::Wide(i) => i.clone(),
+                }
+            };
+            let mesh_index = wide(&mesh_index);
+            let permuted_index = order.iter().map(|&e| mesh_index[e]).collect();
+            let got = renumber_by_first_use(&mesh_rows, permuted_index);
+            // The mesh-order table is in another order (else the renumbering would be moot).
+            assert_ne!(mesh_rows, expected.0);
+            assert_eq!(got.0, expected.0, "{distinct} distinct rows");
+            assert_eq!(got.1, expected.1, "{distinct} distinct rows");
+        }
+    }
+
+    #[test]
+    fn deduplicated_rows_map_back_to_every_row_with_either_index_width() {
+        let row = |i: usize| [i as f32, 0.5 * i as f32, -(i as f32), 0.0];
+        // Few distinct rows, repeated across the parallel chunks: two-byte indices.
+        let rows: Vec<[f32; 4]> = (0..200_000).map(|i| row(i % 37)).collect();
+        let (distinct, index) = deduplicate_rows(&rows);
+        assert_eq!(distinct.len(), 37);
+        // First appearance order.
+        assert!(distinct.iter().enumerate().all(|(i, d)| *d == row(i)));
+        let EntryWeightIndex::Narrow(index) = index else {
+            panic!("37 rows need no wide index");
+        };
+        assert!(rows
+            .iter()
+            .zip(&index)
+            .all(|(r, &i)| distinct[i as usize] == *r));
+        // More than 65536 distinct rows: four-byte indices.
+        let rows: Vec<[f32; 4]> = (0..150_000).map(|i| row((i * 7) % 70_001)).collect();
+        let (distinct, index) = deduplicate_rows(&rows);
+        assert_eq!(distinct.len(), 70_001);
+        let EntryWeightIndex::Wide(index) = index else {
+            panic!("70001 rows need a wide index");
+        };
+        assert!(rows
+            .iter()
+            .zip(&index)
+            .all(|(r, &i)| distinct[i as usize] == *r));
+    }
+
+    #[test]
+    fn an_operator_set_up_again_for_other_creases_is_the_one_set_up_afresh() {
+        use crate::fairing::creases::{detect_creases, CreaseOptions};
+        let mesh = crate::mesh::shapes::cylinder(1.0, 1.0, 0.1);
+        let topology = Topology::build(&mesh);
+        let fans = FanRings::new(&mesh.triangles, &topology);
+        let options = |angle_degrees| CreaseOptions {
+            angle_degrees,
+            ..CreaseOptions::default()
+        };
+        // The rims only, and the rims with the side's facet edges too.
+        let sharp = detect_creases(&mesh, &topology, &options(40.0));
+        let faint = detect_creases(&mesh, &topology, &options(3.0));
+        assert!(!sharp.is_empty() && faint.edges.len() > sharp.edges.len());
+        let noisy: Vec<[f32; 3]> = mesh
+            .positions
+            .iter()
+            .enumerate()
+            .map(|(v, p)| {
+                let bump = ((v * 29) % 13) as f32 * 0.004 - 0.024;
+                [p[0] + bump, p[1] - bump, p[2] + 0.5 * bump]
+            })
+            .collect();
+        for variant in [FairVariant::Paper, FairVariant::NormalProjected] {
+            let run_options = FairOptions {
+                iterations: 3,
+                rounds: 1,
+                variant,
+                ..Default::default()
+            };
+            let set_up = |creases: Option<&Creases>| {
+                let mut fairing = ConstrainedFairing::with_fans(
+                    &mesh,
+                    &topology,
+                    &fans,
+                    variant,
+                    BoundaryMode::Curve,
+                    creases,
+                    &[],
+                );
+                fairing.set_tangential_relaxation(0.3);
+                fairing
+            };
+            // Every entry's weight row, whatever the numbering of the distinct rows.
+            let entry_rows = |fairing: &ConstrainedFairing| -> Vec<[f32; 4]> {
+                let row = |i: usize| fairing.entry_weights[i];
+                match &fairing.entry_weight_index {
+                    EntryWeightIndex::Narrow(index) => {
+                        index.iter().map(|&i| row(i.into())).collect()
+                    }
+                    EntryWeightIndex::Wide(index) => {
+                        index.iter().map(|&i| row(i as usize)).collect()
+                    }
+                }
+            };
+            // Updated in place (fraction 1: whatever changed) and set up whole (0).
+            for fraction in [1, 0] {
+                let mut again = set_up(Some(&sharp));
+                for creases in [Some(&faint), None, Some(&sharp), Some(&faint)] {
+                    let mut afresh = set_up(creases);
+                    again = again.for_other_creases_within(
+                        &mesh,
+                        &topology,
+                        &fans,
+                        creases,
+                        &[],
+                        fraction,
+                    );
+                    assert_eq!(again.held, afresh.held);
+                    assert_eq!(again.order, afresh.order);
+                    assert_eq!(again.ring_offsets, afresh.ring_offsets);
+                    assert_eq!(again.ring, afresh.ring);
+                    assert_eq!(entry_rows(&again), entry_rows(&afresh));
+                    if fraction == 0 {
+                        assert_eq!(again.entry_weight_index, afresh.entry_weight_index);
+                        assert_eq!(again.entry_weights, afresh.entry_weights);
+                    }
+                    assert_eq!(again.self_weights, afresh.self_weights);
+                    assert_eq!(again.closed_fan, afresh.closed_fan);
+                    assert_eq!(again.solved_vertices, afresh.solved_vertices);
+                    assert_eq!(again.curves, afresh.curves);
+                    let (mut a, mut b) = (noisy.clone(), noisy.clone());
+                    again.run(&mut a, &run_options);
+                    afresh.run(&mut b, &run_options);
+                    assert_eq!(a, b);
+                    assert_ne!(a, noisy);
+                }
+            }
+        }
+    }
+}
