@@ -194,7 +194,7 @@ impl MultiresWorkspace {
     /// Frees the buffers a run reuses from level to level (every pass writes them whole before
     /// reading them): a single run does this before each level's set-up, so that a level's
     /// operator is never built beside the buffers the previous level's passes left, sized for
-    /// that level (on the 1.2M-face mesh ~45 MB of the run's peak).
+    /// that level.
     fn free_scratch(&mut self) {
         for buffer in [
             &mut self.laplacians,
@@ -398,6 +398,8 @@ pub fn fair_multires(
     Some(result)
 }
 
+/// [`fair_multires`] on the calling thread: from the start level down, each level faired (and,
+/// Improved, its shrinkage taken back), then refined to the next finer one; M0 last.
 fn fair_multires_on_worker(
     hierarchy: &Hierarchy,
     options: &MultiresOptions,
@@ -408,66 +410,21 @@ fn fair_multires_on_worker(
     let fair_options = level_fair_options(options);
     let operator = (fair_options.variant, fair_options.boundary);
     let release = workspace.release_levels;
-    if release {
-        // A single run builds each level when it gets there; M0's connectivity is needed now
-        // only for a fixed boundary (below), and is freed again once that is read.
-        if options.boundary == BoundaryMode::Fixed {
-            workspace.prepare_levels(hierarchy, 0..=0, |_| None);
-        }
-    } else {
-        // Every level this run touches, with the operators of those it fairs.
-        workspace.prepare_for(hierarchy, options);
-    }
-    let base_vertices = hierarchy.level_info(0).vertices;
-    workspace.positions.clear();
-    workspace
-        .positions
-        .extend_from_slice(hierarchy.level_positions(start));
-
+    let fixed = start_run(hierarchy, options, workspace, start);
     // Progress weights: a level costs about its vertex count.
     let total: f64 = (0..=start)
         .map(|i| hierarchy.level_info(i).vertices as f64)
         .sum::<f64>()
         .max(1.0);
     let mut done = 0.0;
-    let fair_last = start == 0 || options.fair_finest;
-    // Fixed boundary: M0's boundary vertices (internal ids, ascending) are put back at their own
-    // positions after every step that could move them (the shrinkage correction, the split
-    // placement), so that they are fixed at every level, not only on the levels' own boundaries.
-    let fixed: Vec<u32> = match options.boundary {
-        BoundaryMode::Fixed => original_boundary(hierarchy, workspace),
-        _ => Vec::new(),
-    };
-    if release && start > 0 {
-        // Held while the coarser levels are set up, M0's mesh and connectivity were a sixth of
-        // the run's peak (1.2M faces: 51 of 318 MB); it is built again when the run reaches it.
-        if let Some(m0) = workspace.levels.get_mut(0) {
-            *m0 = None;
-        }
-    }
     for level in (1..=start).rev() {
-        if release {
-            workspace.free_scratch();
-            workspace.prepare_levels(hierarchy, level..=level, |_| Some(operator));
-        }
-        let faired = fair_level(workspace, level, &fair_options);
-        if faired && options.variant == MultiresVariant::Improved {
-            remove_low_frequency_shrinkage(workspace, level);
-            restore_fixed(hierarchy, &mut workspace.positions, &fixed);
-        }
-        if release {
-            workspace.levels[level] = None;
-            workspace.free_scratch();
-            workspace.prepare_levels(hierarchy, level - 1..=level - 1, |_| None);
-        }
-        refine_positions(hierarchy, workspace, level - 1, options.variant);
-        restore_fixed(hierarchy, &mut workspace.positions, &fixed);
+        to_finer_level(hierarchy, options, &fair_options, workspace, level, &fixed);
         done += hierarchy.level_info(level).vertices as f64;
         if !progress.report((done / total) as f32) {
             return None;
         }
     }
-    if fair_last {
+    if start == 0 || options.fair_finest {
         if release {
             workspace.free_scratch();
             workspace.prepare_levels(hierarchy, 0..=0, |_| Some(operator));
@@ -480,12 +437,84 @@ fn fair_multires_on_worker(
     if release {
         workspace.levels[0] = None;
     }
+    let base_vertices = hierarchy.level_info(0).vertices;
     debug_assert_eq!(workspace.positions.len(), base_vertices);
     let mut result = vec![[0f32; 3]; base_vertices];
     for (v, p) in workspace.positions.iter().enumerate() {
         result[hierarchy.original_vertex(v as u32) as usize] = *p;
     }
     Some(result)
+}
+
+/// Sets `workspace` up for a run from level `start`: the levels it needs now (all it touches, or
+/// with [`MultiresWorkspace::for_one_run`] only M0 for a fixed boundary), and the start level's
+/// positions. Returns, for a fixed boundary, M0's boundary vertices (internal ids, ascending):
+/// they are put back at their own positions after every step that could move them (the
+/// shrinkage correction, the split placement), so that they are fixed at every level, not only
+/// on the levels' own boundaries.
+fn start_run(
+    hierarchy: &Hierarchy,
+    options: &MultiresOptions,
+    workspace: &mut MultiresWorkspace,
+    start: usize,
+) -> Vec<u32> {
+    let release = workspace.release_levels;
+    if release {
+        // A single run builds each level when it gets there; M0's connectivity is needed now
+        // only for a fixed boundary (below), and is freed again once that is read.
+        if options.boundary == BoundaryMode::Fixed {
+            workspace.prepare_levels(hierarchy, 0..=0, |_| None);
+        }
+    } else {
+        // Every level this run touches, with the operators of those it fairs.
+        workspace.prepare_for(hierarchy, options);
+    }
+    workspace.positions.clear();
+    workspace
+        .positions
+        .extend_from_slice(hierarchy.level_positions(start));
+    let fixed: Vec<u32> = match options.boundary {
+        BoundaryMode::Fixed => original_boundary(hierarchy, workspace),
+        _ => Vec::new(),
+    };
+    if release && start > 0 {
+        // Held while the coarser levels are set up, M0's mesh and connectivity would be a large
+        // share of the run's peak; it is built again when the run reaches it.
+        if let Some(m0) = workspace.levels.get_mut(0) {
+            *m0 = None;
+        }
+    }
+    fixed
+}
+
+/// One step of the run: level `level` faired with `fair_options` (Improved: its shrinkage taken
+/// back), then refined to level `level - 1`; the `fixed` vertices put back after each.
+fn to_finer_level(
+    hierarchy: &Hierarchy,
+    options: &MultiresOptions,
+    fair_options: &FairOptions,
+    workspace: &mut MultiresWorkspace,
+    level: usize,
+    fixed: &[u32],
+) {
+    let release = workspace.release_levels;
+    if release {
+        let operator = (fair_options.variant, fair_options.boundary);
+        workspace.free_scratch();
+        workspace.prepare_levels(hierarchy, level..=level, |_| Some(operator));
+    }
+    let faired = fair_level(workspace, level, fair_options);
+    if faired && options.variant == MultiresVariant::Improved {
+        remove_low_frequency_shrinkage(workspace, level);
+        restore_fixed(hierarchy, &mut workspace.positions, fixed);
+    }
+    if release {
+        workspace.levels[level] = None;
+        workspace.free_scratch();
+        workspace.prepare_levels(hierarchy, level - 1..=level - 1, |_| None);
+    }
+    refine_positions(hierarchy, workspace, level - 1, options.variant);
+    restore_fixed(hierarchy, &mut workspace.positions, fixed);
 }
 
 /// M0's boundary vertices in the hierarchy's internal numbering, ascending.
@@ -626,7 +655,9 @@ fn remove_low_frequency_shrinkage(workspace: &mut MultiresWorkspace, level: usiz
         });
 }
 
-/// Refines the working positions from level `finer + 1` to `finer`: places the split vertices.
+/// Refines the working positions from level `finer + 1` to `finer`: places the split vertices
+/// at their rings' means, moves them by one Kobbelt step and (Improved) gives back the volume
+/// each split added in the original geometry.
 fn refine_positions(
     hierarchy: &Hierarchy,
     workspace: &mut MultiresWorkspace,
@@ -645,36 +676,86 @@ fn refine_positions(
         ..
     } = workspace;
     let data = levels[finer].as_ref().expect("prepared before refining");
-    let topology = &data.topology;
-    let loops = &data.loop_neighbors;
-    let on_loop = |v: usize| !loops.is_empty() && loops[v][0] != NONE;
+    let rings = Rings {
+        topology: &data.topology,
+        loops: &data.loop_neighbors,
+    };
     positions.resize(fine_count, [0.0; 3]);
-    let split = coarse_count..fine_count;
-
-    // Start at the 1-ring mean (loop midpoint on the boundary). Split vertices of one level are
-    // never adjacent, so their neighbours all come before them and have positions.
-    {
-        let (coarse, fine) = positions.split_at_mut(coarse_count);
-        let coarse: &[[f32; 3]] = coarse;
-        let at = |v: u32| Vec3A::from_array(coarse[v as usize]);
-        fine.par_iter_mut()
-            .with_min_len(PARALLEL_GRAIN)
-            .enumerate()
-            .for_each(|(i, p)| {
-                let v = coarse_count + i;
-                let x = if on_loop(v) {
-                    let [a, b] = loops[v];
-                    (at(a) + at(b)) * 0.5
-                } else {
-                    let ring = topology.neighbors(v as u32);
-                    ring.iter().map(|&u| at(u)).sum::<Vec3A>() / ring.len().max(1) as f32
-                };
-                *p = x.to_array();
-            });
+    place_at_ring_means(positions, coarse_count, rings);
+    kobbelt_step(positions, coarse_count, rings, laplacians, displacements);
+    if variant == MultiresVariant::Paper {
+        return;
     }
+    // Improved: restore the volume each split added in the original geometry, low-passed.
+    split_heights(hierarchy, data, positions, coarse_count, heights);
+    for _ in 0..HEIGHT_SMOOTHING_ROUNDS {
+        low_pass_heights(
+            heights,
+            height_sums,
+            rings.topology,
+            coarse_count,
+            fine_count,
+        );
+    }
+    positions[coarse_count..]
+        .par_iter_mut()
+        .zip(heights.par_iter())
+        .for_each(|(p, &(normal, height, _, bound))| {
+            let height = height.clamp(-bound, bound);
+            *p = (Vec3A::from_array(*p) + normal * height as f32).to_array()
+        });
+}
 
-    // One Kobbelt step for all, from the placed positions, applied together: the umbrella
-    // Laplacian of every vertex first (a split vertex needs its neighbours'), then the steps.
+/// A level's one-rings as refining reads them: a vertex on a boundary loop or a crease has its
+/// two loop neighbours for a ring, any other its topology's one-ring.
+#[derive(Clone, Copy)]
+struct Rings<'a> {
+    topology: &'a Topology,
+    /// [`LevelData::loop_neighbors`].
+    loops: &'a [[u32; 2]],
+}
+
+impl Rings<'_> {
+    fn on_loop(&self, v: usize) -> bool {
+        !self.loops.is_empty() && self.loops[v][0] != NONE
+    }
+}
+
+/// Places every split vertex (those from `coarse_count` on) at the 1-ring mean (loop midpoint on
+/// the boundary). Split vertices of one level are never adjacent, so their neighbours all come
+/// before them and have positions.
+fn place_at_ring_means(positions: &mut [[f32; 3]], coarse_count: usize, rings: Rings) {
+    let (coarse, fine) = positions.split_at_mut(coarse_count);
+    let coarse: &[[f32; 3]] = coarse;
+    let at = |v: u32| Vec3A::from_array(coarse[v as usize]);
+    fine.par_iter_mut()
+        .with_min_len(PARALLEL_GRAIN)
+        .enumerate()
+        .for_each(|(i, p)| {
+            let v = coarse_count + i;
+            let x = if rings.on_loop(v) {
+                let [a, b] = rings.loops[v];
+                (at(a) + at(b)) * 0.5
+            } else {
+                let ring = rings.topology.neighbors(v as u32);
+                ring.iter().map(|&u| at(u)).sum::<Vec3A>() / ring.len().max(1) as f32
+            };
+            *p = x.to_array();
+        });
+}
+
+/// One Kobbelt step for all split vertices, from the placed positions, applied together: the
+/// umbrella Laplacian of every vertex first (a split vertex needs its neighbours'), then the
+/// steps.
+fn kobbelt_step(
+    positions: &mut [[f32; 3]],
+    coarse_count: usize,
+    rings: Rings,
+    laplacians: &mut Vec<Vec3A>,
+    displacements: &mut Vec<Vec3A>,
+) {
+    let fine_count = positions.len();
+    let Rings { topology, loops } = rings;
     {
         let placed: &[[f32; 3]] = positions;
         let at = |v: u32| Vec3A::from_array(placed[v as usize]);
@@ -682,7 +763,7 @@ fn refine_positions(
             .into_par_iter()
             .with_min_len(PARALLEL_GRAIN)
             .map(|v| {
-                if on_loop(v) {
+                if rings.on_loop(v) {
                     let [a, b] = loops[v];
                     (at(a) + at(b)) * 0.5 - at(v as u32)
                 } else {
@@ -693,142 +774,142 @@ fn refine_positions(
             })
             .collect_into_vec(laplacians);
     }
-    {
-        let laplacians: &[Vec3A] = laplacians;
-        split
-            .clone()
-            .into_par_iter()
-            .with_min_len(PARALLEL_GRAIN)
-            .map(|v| {
-                let own = laplacians[v];
-                let (sum, inverse_valences, n) = if on_loop(v) {
-                    let [a, b] = loops[v];
-                    (laplacians[a as usize] + laplacians[b as usize], 1.0, 2.0)
-                } else {
-                    let ring = topology.neighbors(v as u32);
-                    let mut sum = Vec3A::ZERO;
-                    let mut inverse_valences = 0.0;
-                    for &u in ring {
-                        sum += laplacians[u as usize];
-                        inverse_valences += 1.0 / topology.valence(u) as f32;
-                    }
-                    (sum, inverse_valences, ring.len() as f32)
-                };
-                let l2 = sum / n - own;
-                let nu = 1.0 + inverse_valences / n;
-                -l2 / nu
-            })
-            .collect_into_vec(displacements);
-    }
+    let laplacians: &[Vec3A] = laplacians;
+    (coarse_count..fine_count)
+        .into_par_iter()
+        .with_min_len(PARALLEL_GRAIN)
+        .map(|v| {
+            let own = laplacians[v];
+            let (sum, inverse_valences, n) = if rings.on_loop(v) {
+                let [a, b] = loops[v];
+                (laplacians[a as usize] + laplacians[b as usize], 1.0, 2.0)
+            } else {
+                let ring = topology.neighbors(v as u32);
+                let mut sum = Vec3A::ZERO;
+                let mut inverse_valences = 0.0;
+                for &u in ring {
+                    sum += laplacians[u as usize];
+                    inverse_valences += 1.0 / topology.valence(u) as f32;
+                }
+                (sum, inverse_valences, ring.len() as f32)
+            };
+            let l2 = sum / n - own;
+            let nu = 1.0 + inverse_valences / n;
+            -l2 / nu
+        })
+        .collect_into_vec(displacements);
     positions[coarse_count..]
         .par_iter_mut()
         .zip(displacements.par_iter())
         .for_each(|(p, d)| *p = (Vec3A::from_array(*p) + *d).to_array());
+}
 
-    if variant == MultiresVariant::Paper {
-        return;
-    }
-
-    // Improved: restore the volume each split added in the original geometry, low-passed.
+/// Improved: per split vertex (from `coarse_count` on), the unit normal of its ring's fan
+/// around its collapse target, the height along it that gives back the volume the split added
+/// in the original geometry, that fan's area (the height's weight) and the most height it may
+/// take.
+fn split_heights(
+    hierarchy: &Hierarchy,
+    data: &LevelData,
+    positions: &[[f32; 3]],
+    coarse_count: usize,
+    heights: &mut Vec<(Vec3A, f64, f64, f64)>,
+) {
     let triangles = &data.mesh.triangles;
-    let (face_offsets, vertex_faces) = topology.face_csr();
+    let (face_offsets, vertex_faces) = data.topology.face_csr();
+    let at = |v: u32| Vec3A::from_array(positions[v as usize]);
+    (coarse_count..positions.len())
+        .into_par_iter()
+        .with_min_len(PARALLEL_GRAIN)
+        .map(|v| {
+            let Some(k) = hierarchy.collapse_target(v as u32) else {
+                return (Vec3A::ZERO, 0.0, 0.0, 0.0);
+            };
+            let (xv, xk) = (at(v as u32), at(k));
+            let mut area = Vec3A::ZERO;
+            // The longest edge at `v` now (every neighbour is some face's `a`, or on an open
+            // fan the last face's `b`).
+            let mut spoke_squared = 0f32;
+            for &f in &vertex_faces[face_offsets[v] as usize..face_offsets[v + 1] as usize] {
+                let t = triangles[f as usize];
+                let (a, b) = if t[0] == v as u32 {
+                    (t[1], t[2])
+                } else if t[1] == v as u32 {
+                    (t[2], t[0])
+                } else {
+                    (t[0], t[1])
+                };
+                let (xa, xb) = (at(a), at(b));
+                spoke_squared = spoke_squared
+                    .max(xa.distance_squared(xv))
+                    .max(xb.distance_squared(xv));
+                if a != k && b != k {
+                    area += (xa - xk).cross(xb - xk);
+                }
+            }
+            let weight = area.length();
+            if weight <= 0.0 || !weight.is_finite() {
+                return (Vec3A::ZERO, 0.0, 0.0, 0.0);
+            }
+            let normal = area / weight;
+            let current = area.dot(xv - xk) as f64;
+            let weight = weight as f64;
+            let height = (hierarchy.six_split_volume(v as u32) as f64 - current) / weight;
+            // The most height a split may take (after the low-pass): twice its longest edge
+            // now. Where the fairing has shrunk its ring to a sliver (a spike's base on a
+            // noisy scan), the volume over that sliver asks for a tower. (A bound by its height
+            // in M0 would need a second position array to read.)
+            let bound = 2.0 * spoke_squared.sqrt() as f64;
+            (normal, height, weight, bound)
+        })
+        .collect_into_vec(heights);
+}
+
+/// One two-ring average of the split heights, weighted by their areas: per vertex of the finer
+/// level (`fine_count`), the weighted heights of its adjacent split vertices (a gather over the
+/// sorted one-ring: the same sums, in the same order, as scattering from the split vertices),
+/// then per split vertex the mean over its ring of those sums.
+fn low_pass_heights(
+    heights: &mut [(Vec3A, f64, f64, f64)],
+    height_sums: &mut Vec<[f64; 2]>,
+    topology: &Topology,
+    coarse_count: usize,
+    fine_count: usize,
+) {
     {
-        let placed: &[[f32; 3]] = positions;
-        let at = |v: u32| Vec3A::from_array(placed[v as usize]);
-        split
-            .clone()
+        let heights: &[(Vec3A, f64, f64, f64)] = heights;
+        (0..fine_count)
             .into_par_iter()
             .with_min_len(PARALLEL_GRAIN)
-            .map(|v| {
-                let Some(k) = hierarchy.collapse_target(v as u32) else {
-                    return (Vec3A::ZERO, 0.0, 0.0, 0.0);
-                };
-                let (xv, xk) = (at(v as u32), at(k));
-                let mut area = Vec3A::ZERO;
-                // The longest edge at `v` now (every neighbour is some face's `a`, or on an open
-                // fan the last face's `b`).
-                let mut spoke_squared = 0f32;
-                for &f in &vertex_faces[face_offsets[v] as usize..face_offsets[v + 1] as usize] {
-                    let t = triangles[f as usize];
-                    let (a, b) = if t[0] == v as u32 {
-                        (t[1], t[2])
-                    } else if t[1] == v as u32 {
-                        (t[2], t[0])
-                    } else {
-                        (t[0], t[1])
-                    };
-                    let (xa, xb) = (at(a), at(b));
-                    spoke_squared = spoke_squared
-                        .max(xa.distance_squared(xv))
-                        .max(xb.distance_squared(xv));
-                    if a != k && b != k {
-                        area += (xa - xk).cross(xb - xk);
-                    }
-                }
-                let weight = area.length();
-                if weight <= 0.0 || !weight.is_finite() {
-                    return (Vec3A::ZERO, 0.0, 0.0, 0.0);
-                }
-                let normal = area / weight;
-                let current = area.dot(xv - xk) as f64;
-                let weight = weight as f64;
-                let height = (hierarchy.six_split_volume(v as u32) as f64 - current) / weight;
-                // The most height a split may take (after the low-pass): twice its longest edge
-                // now. Where the fairing has shrunk its ring to a sliver (a spike's base on a
-                // noisy scan), the volume over that sliver asks for a tower (one vertex of the
-                // noisy Stanford dragon went 83 edge lengths out). Bounding by its height in M0
-                // instead cost a tenth of a multires run (a second position array to read).
-                let bound = 2.0 * spoke_squared.sqrt() as f64;
-                (normal, height, weight, bound)
-            })
-            .collect_into_vec(heights);
-    }
-    for _ in 0..HEIGHT_SMOOTHING_ROUNDS {
-        // Per vertex, the weighted heights of its adjacent split vertices (a gather over the
-        // sorted one-ring: the same sums, in the same order, as scattering from the split
-        // vertices).
-        {
-            let heights: &[(Vec3A, f64, f64, f64)] = heights;
-            (0..fine_count)
-                .into_par_iter()
-                .with_min_len(PARALLEL_GRAIN)
-                .map(|u| {
-                    let mut sum = [0.0; 2];
-                    for &v in topology.neighbors(u as u32) {
-                        if let Some(&(_, height, weight, _)) =
-                            (v as usize).checked_sub(coarse_count).map(|i| &heights[i])
-                        {
-                            sum[0] += height * weight;
-                            sum[1] += weight;
-                        }
-                    }
-                    sum
-                })
-                .collect_into_vec(height_sums);
-        }
-        let sums: &[[f64; 2]] = height_sums;
-        heights
-            .par_iter_mut()
-            .with_min_len(PARALLEL_GRAIN)
-            .enumerate()
-            .for_each(|(i, entry)| {
+            .map(|u| {
                 let mut sum = [0.0; 2];
-                for &u in topology.neighbors((coarse_count + i) as u32) {
-                    let s = sums[u as usize];
-                    sum[0] += s[0];
-                    sum[1] += s[1];
+                for &v in topology.neighbors(u as u32) {
+                    if let Some(&(_, height, weight, _)) =
+                        (v as usize).checked_sub(coarse_count).map(|i| &heights[i])
+                    {
+                        sum[0] += height * weight;
+                        sum[1] += weight;
+                    }
                 }
-                if sum[1] > 0.0 {
-                    entry.1 = sum[0] / sum[1];
-                }
-            });
+                sum
+            })
+            .collect_into_vec(height_sums);
     }
-    positions[coarse_count..]
+    let sums: &[[f64; 2]] = height_sums;
+    heights
         .par_iter_mut()
-        .zip(heights.par_iter())
-        .for_each(|(p, &(normal, height, _, bound))| {
-            let height = height.clamp(-bound, bound);
-            *p = (Vec3A::from_array(*p) + normal * height as f32).to_array()
+        .with_min_len(PARALLEL_GRAIN)
+        .enumerate()
+        .for_each(|(i, entry)| {
+            let mut sum = [0.0; 2];
+            for &u in topology.neighbors((coarse_count + i) as u32) {
+                let s = sums[u as usize];
+                sum[0] += s[0];
+                sum[1] += s[1];
+            }
+            if sum[1] > 0.0 {
+                entry.1 = sum[0] / sum[1];
+            }
         });
 }
 

@@ -82,12 +82,11 @@
 //! cost order. Interior visits of two regions of one round never touch the same state, so the
 //! hierarchy is the same for any number of threads (tested). It is not the one-at-a-time
 //! hierarchy: a vertex near a region's edge is visited after the interiors, whatever its cost
-//! (the first level of the 1.2M-face bunny keeps 434953 vertices instead of 433321, the same
-//! 29 levels; the quality tables in `docs/measurements.md` show multires from every level of
-//! noisy bunny00 as good as before). A region's arrays fit in the last-level cache, which made
-//! the one-thread build a little faster too. If the regions alone would take the level below
+//! (the levels differ by a fraction of a percent in size; the quality tables in
+//! `docs/measurements.md` show multires from every level as good either way). A region's arrays
+//! fit in the last-level cache. If the regions alone would take the level below
 //! `min_vertices`, the pass is visited again one vertex at a time. Smaller levels are visited one
-//! vertex at a time, exactly as before regions.
+//! vertex at a time.
 //!
 //! A level visited in regions also builds its fans and writes the next level in parallel, and M0
 //! is sorted in parallel when it is. The counting sorts with many buckets (M0's faces by first
@@ -264,9 +263,11 @@ fn first_level(mesh: &TriMesh, creases: Option<&Creases>, parallel: bool) -> Lev
         vertex_id.len(),
         parallel,
         |f| [(place[f], f as u32)],
-        &mut offsets,
-        &mut cursor,
-        &mut face_id,
+        SortedBuckets {
+            offsets: &mut offsets,
+            cursor: &mut cursor,
+            sorted: &mut face_id,
+        },
     );
     drop(place);
     let crease = creases.map_or_else(Vec::new, |creases| {
@@ -469,8 +470,8 @@ fn passes(
         );
         // The level just left goes too, rather than wait as the buffers of the one after next:
         // at any time at most two levels and one set of fans are held, never two levels and
-        // fans (1.2M faces: the build's heap peak 132 MB -> below the loader's 120 MB; the
-        // fresh buffers cost no measurable time).
+        // fans (the build's heap peak stays below the loader's; the fresh buffers cost no
+        // measurable time).
         level = std::mem::take(&mut next);
         out.pass_ms.push(started.elapsed().as_secs_f64() * 1e3);
     }
@@ -694,9 +695,8 @@ fn visit_level(
 ///
 /// A least-significant-digit radix sort on the costs' bits (three digits of 11 bits; a digit
 /// every cost shares is skipped), then each run of equal costs sorted by M0 id: runs are short on
-/// scans, and a regular mesh's long ones cost what a comparison sort of them costs. (It replaced
-/// a comparison sort of (cost, id) keys, which took 54 of the 1.2M-face build's 900 ms on one
-/// thread.)
+/// scans, and a regular mesh's long ones cost what a comparison sort of them costs. (A comparison
+/// sort of (cost, id) keys is a measurable part of a big build.)
 fn in_cost_order(
     vertices: impl Iterator<Item = usize>,
     state: &PassState,
@@ -847,10 +847,20 @@ fn build_fans(corners: &[[u32; 3]], vertex_count: usize, parallel: bool, state: 
             let [x, y, z] = corners[f];
             [(x, [y, z]), (y, [z, x]), (z, [x, y])]
         },
-        &mut state.fan_offsets,
-        &mut state.cursor,
-        &mut state.fans,
+        SortedBuckets {
+            offsets: &mut state.fan_offsets,
+            cursor: &mut state.cursor,
+            sorted: &mut state.fans,
+        },
     );
+}
+
+/// Where [`bucket_sort`] writes: the values bucket by bucket, where each bucket starts, and
+/// scratch space.
+struct SortedBuckets<'a, T> {
+    offsets: &'a mut Vec<u32>,
+    cursor: &'a mut Vec<u32>,
+    sorted: &'a mut Vec<T>,
 }
 
 /// A stable counting sort: item `i` of `0..items` brings the `K` entries `entries(i)`, each a
@@ -862,16 +872,18 @@ fn build_fans(corners: &[[u32; 3]], vertex_count: usize, parallel: bool, state: 
 /// counts, then places, only the entries that fall in it, so the result is the same for any
 /// number of blocks. (Reading the items once per block costs little next to the scattered
 /// writes, which are what the blocks share out.)
-#[allow(clippy::too_many_arguments)]
 fn bucket_sort<T: Copy + Default + Send + Sync, const K: usize>(
     items: usize,
     buckets: usize,
     parallel: bool,
     entries: impl Fn(usize) -> [(u32, T); K] + Sync,
-    offsets: &mut Vec<u32>,
-    cursor: &mut Vec<u32>,
-    sorted: &mut Vec<T>,
+    out: SortedBuckets<T>,
 ) {
+    let SortedBuckets {
+        offsets,
+        cursor,
+        sorted,
+    } = out;
     let blocks = if parallel {
         rayon::current_num_threads().clamp(1, MAX_BLOCKS)
     } else {

@@ -505,6 +505,8 @@ pub fn build_hierarchy_with_topology(
     build(mesh, fits.then_some(topology), options, progress)
 }
 
+/// [`build_hierarchy`] with the topology, when one is at hand: checks the mesh, finds the
+/// creases, decimates, then numbers M0 by level.
 fn build(
     mesh: &TriMesh,
     topology: Option<&Topology>,
@@ -512,31 +514,14 @@ fn build(
     progress: &mut dyn Progress,
 ) -> Result<Hierarchy, HierarchyError> {
     let started = std::time::Instant::now();
-    let n = mesh.vertex_count();
-    if n >= u32::MAX as usize / 2 {
-        return Err(HierarchyError::Unsupported(format!(
-            "{n} vertices is more than this hierarchy can number"
-        )));
-    }
-    if let Some(v) = mesh.first_non_finite_vertex() {
-        return Err(HierarchyError::Unsupported(format!(
-            "vertex {v} has a non-finite coordinate"
-        )));
-    }
-    if let Some((f, t)) = mesh.triangles.iter().enumerate().find(|(_, t)| {
-        t.iter().any(|&c| c as usize >= n) || t[0] == t[1] || t[1] == t[2] || t[0] == t[2]
-    }) {
-        return Err(HierarchyError::Unsupported(format!(
-            "face {f} {t:?} repeats a vertex or refers to a missing one"
-        )));
-    }
+    check_supported(mesh)?;
     // A non-manifold scan is decimated without the triangles its reconstruction left lying loose
     // at its non-manifold edges (`crate::mesh::loose_triangles`, as the default fairing leaves
-    // them out): they pinned their corners and neighbours in every level, so the Stanford
-    // dragon's levels stopped at 9997 of its 22982 vertices. They stay in M0; the levels are
-    // those of the mesh without them. With a topology at hand (given, or needed for the creases)
-    // they are looked for at once; otherwise only when the first pass finds a non-manifold
-    // vertex, so a manifold mesh pays nothing.
+    // them out): they would pin their corners and neighbours in every level, and the levels of a
+    // scan such as the Stanford dragon would stop at under half its vertices. They stay in M0;
+    // the levels are those of the mesh without them. With a topology at hand (given, or needed
+    // for the creases) they are looked for at once; otherwise only when the first pass finds a
+    // non-manifold vertex, so a manifold mesh pays nothing.
     let mut topology = topology.map(Cow::Borrowed);
     if options.creases.is_some() && topology.is_none() {
         topology = Some(Cow::Owned(Topology::build(mesh)));
@@ -547,37 +532,16 @@ fn build(
         }
         _ => None,
     };
-    let creases = options
-        .creases
-        .as_ref()
-        .map(|crease_options| {
-            let (levels_mesh, levels_topology) = match &loose_out {
-                Some((_, kept, kept_topology)) => (kept, kept_topology),
-                None => (
-                    mesh,
-                    topology.as_deref().expect("built above for the creases"),
-                ),
-            };
-            let fans = FanRings::new(&levels_mesh.triangles, levels_topology);
-            let crease_options = CreaseOptions {
-                zigzag_turn_degrees: Some(
-                    crease_options
-                        .zigzag_turn_degrees
-                        .unwrap_or(HIERARCHY_ZIGZAG_TURN),
-                ),
-                ..crease_options.clone()
-            };
-            detect_creases_with_estimate(
-                levels_mesh,
-                levels_topology,
-                &fans,
-                &crease_options,
-                &mut FaceRingCache::default(),
-                true,
-            )
-            .1
-        })
-        .filter(|creases| !creases.is_empty());
+    let creases = options.creases.as_ref().and_then(|crease_options| {
+        let (levels_mesh, levels_topology) = match &loose_out {
+            Some((_, kept, kept_topology)) => (kept, kept_topology),
+            None => (
+                mesh,
+                topology.as_deref().expect("built above for the creases"),
+            ),
+        };
+        levels_creases(levels_mesh, levels_topology, crease_options)
+    });
     let setup_ms = started.elapsed().as_secs_f64() * 1e3;
 
     let look_later = options.leave_out_loose_triangles && topology.is_none();
@@ -598,6 +562,79 @@ fn build(
         Some((loose, kept, _)) => (loose, Cow::Owned(kept)),
         None => (Vec::new(), Cow::Borrowed(mesh)),
     };
+    Ok(in_level_order(
+        mesh,
+        &levels_mesh,
+        loose,
+        built,
+        creases,
+        setup_ms,
+    ))
+}
+
+/// An error for a mesh the hierarchy cannot number or decimate: too many vertices, a non-finite
+/// coordinate, or a face that repeats a vertex or refers to a missing one.
+fn check_supported(mesh: &TriMesh) -> Result<(), HierarchyError> {
+    let n = mesh.vertex_count();
+    if n >= u32::MAX as usize / 2 {
+        return Err(HierarchyError::Unsupported(format!(
+            "{n} vertices is more than this hierarchy can number"
+        )));
+    }
+    if let Some(v) = mesh.first_non_finite_vertex() {
+        return Err(HierarchyError::Unsupported(format!(
+            "vertex {v} has a non-finite coordinate"
+        )));
+    }
+    if let Some((f, t)) = mesh.triangles.iter().enumerate().find(|(_, t)| {
+        t.iter().any(|&c| c as usize >= n) || t[0] == t[1] || t[1] == t[2] || t[0] == t[2]
+    }) {
+        return Err(HierarchyError::Unsupported(format!(
+            "face {f} {t:?} repeats a vertex or refers to a missing one"
+        )));
+    }
+    Ok(())
+}
+
+/// The creases the levels keep, found on the mesh that is decimated (`None` when there are
+/// none); groups that wander are kept unless `crease_options` say otherwise
+/// ([`HIERARCHY_ZIGZAG_TURN`]).
+fn levels_creases(
+    levels_mesh: &TriMesh,
+    levels_topology: &Topology,
+    crease_options: &CreaseOptions,
+) -> Option<Creases> {
+    let fans = FanRings::new(&levels_mesh.triangles, levels_topology);
+    let crease_options = CreaseOptions {
+        zigzag_turn_degrees: Some(
+            crease_options
+                .zigzag_turn_degrees
+                .unwrap_or(HIERARCHY_ZIGZAG_TURN),
+        ),
+        ..crease_options.clone()
+    };
+    let (_, creases) = detect_creases_with_estimate(
+        levels_mesh,
+        levels_topology,
+        &fans,
+        &crease_options,
+        &mut FaceRingCache::default(),
+        true,
+    );
+    (!creases.is_empty()).then_some(creases)
+}
+
+/// The hierarchy from the decimation's output: M0 (`mesh`) numbered by level (vertices and
+/// faces by the pass that removed them, latest first), with every per-vertex array in that
+/// order. `levels_mesh` is the mesh that was decimated (`mesh` without its `loose` triangles).
+fn in_level_order(
+    mesh: &TriMesh,
+    levels_mesh: &TriMesh,
+    loose: Vec<u32>,
+    built: decimate::BuildOutput,
+    creases: Option<Creases>,
+    setup_ms: f64,
+) -> Hierarchy {
     let finishing = std::time::Instant::now();
     let passes = built.pass_ms.len();
 
@@ -623,19 +660,7 @@ fn build(
         .with_min_len(4096)
         .map(|&f| levels_mesh.triangles[f as usize].map(|c| rank[c as usize]))
         .collect();
-    // The levels mesh's faces are M0's without the loose ones, in M0's order.
-    let face_order = if loose.is_empty() {
-        face_order
-    } else {
-        let mut is_loose = vec![false; mesh.face_count()];
-        for &f in &loose {
-            is_loose[f as usize] = true;
-        }
-        let kept: Vec<u32> = (0..mesh.face_count() as u32)
-            .filter(|&f| !is_loose[f as usize])
-            .collect();
-        face_order.iter().map(|&f| kept[f as usize]).collect()
-    };
+    let face_order = with_loose_faces(face_order, &loose, mesh.face_count());
     let target = order
         .par_iter()
         .with_min_len(4096)
@@ -667,7 +692,7 @@ fn build(
     let mut level_ms = vec![setup_ms + finishing.elapsed().as_secs_f64() * 1e3];
     level_ms.extend_from_slice(&built.pass_ms);
 
-    Ok(Hierarchy {
+    Hierarchy {
         base: mesh.clone(),
         id: NEXT_HIERARCHY_ID.fetch_add(1, Ordering::Relaxed),
         order,
@@ -684,7 +709,23 @@ fn build(
         crease_edges,
         non_manifold: built.non_manifold,
         loose,
-    })
+    }
+}
+
+/// The levels mesh's faces in level order (`face_order`, ids of the mesh without its `loose`
+/// faces) as ids of M0's `face_count` faces.
+fn with_loose_faces(face_order: Vec<u32>, loose: &[u32], face_count: usize) -> Vec<u32> {
+    if loose.is_empty() {
+        return face_order;
+    }
+    let mut is_loose = vec![false; face_count];
+    for &f in loose {
+        is_loose[f as usize] = true;
+    }
+    let kept: Vec<u32> = (0..face_count as u32)
+        .filter(|&f| !is_loose[f as usize])
+        .collect();
+    face_order.iter().map(|&f| kept[f as usize]).collect()
 }
 
 /// Vertices (or faces) ordered by the pass that removed them, latest first and those never

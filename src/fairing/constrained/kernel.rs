@@ -302,7 +302,6 @@ impl<I: Copy + Into<u32> + Sync> Stencil<'_, I> {
     /// the move x̃_v − x_v along the normal of their fan of umbrella means (centre m_v, ring m_u,
     /// gathered anyway for the update), plus `tangential` (times the vertex's `share` unless that
     /// is empty) of the tangential part of its umbrella vector. Returns the largest squared move.
-    #[allow(clippy::too_many_arguments)]
     fn averaged_solutions<const PROJECT: bool>(
         &self,
         pairs: &[PositionAndMean],

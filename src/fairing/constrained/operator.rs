@@ -80,9 +80,10 @@ pub fn invert3(a: &Matrix3) -> Option<Matrix3> {
     };
     let det = a[0][0] * cofactor(0, 0) + a[0][1] * cofactor(0, 1) + a[0][2] * cofactor(0, 2);
     let scale = a.iter().flatten().fold(0.0f64, |m, x| m.max(x.abs()));
-    // Negated on purpose: a NaN determinant (or scale) must count as singular too.
-    #[allow(clippy::neg_cmp_op_on_partial_ord)]
-    if !(det.abs() > 1e-12 * scale * scale * scale) {
+    // Singular unless |det| is greater than the threshold; a NaN determinant (or scale)
+    // compares as neither, so it counts as singular too.
+    let threshold = 1e-12 * scale * scale * scale;
+    if det.abs().partial_cmp(&threshold) != Some(std::cmp::Ordering::Greater) {
         return None;
     }
     Some(std::array::from_fn(|r| {

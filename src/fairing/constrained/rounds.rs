@@ -14,8 +14,8 @@ use crate::fairing::creases::{
 };
 use crate::fairing::relaxation::{self, read_tangential_noise};
 use crate::fairing::strength::{
-    normal_filtering_for, read_noise, RoundRisk, CLEAN_NOISE, MAX_AUTO_ROUNDS, RISK_MIN_FALL,
-    RISK_PATIENCE,
+    normal_filtering_for, read_noise, NoiseReading, RoundRisk, CLEAN_NOISE, MAX_AUTO_ROUNDS,
+    RISK_MIN_FALL, RISK_PATIENCE,
 };
 use crate::fairing::volume::VolumeKeeper;
 use crate::fairing::{FairOptions, FairReport, FairVariant, Relaxation, Strength};
@@ -92,37 +92,8 @@ pub fn fair_constrained(
             return FairReport::default();
         }
     }
-    // A non-manifold scan is faired as the surface it stands for: without the triangles its
-    // reconstruction left lying loose at its non-manifold edges (overlays on a fan, fins), which
-    // made their corners boundary vertices on chains no boundary curve runs through, and so
-    // held them with their noise (`crate::mesh::loose_triangles`). Same vertices, nothing
-    // renumbered; a corner only loose triangles use (a fin's tip) stays where it is.
-    // On the noisy Stanford dragon (vrip) the vertices at non-manifold edges went from twice
-    // the others' distance to the clean surface to about theirs (`docs/measurements.md`).
-    if options.variant == FairVariant::NormalProjected && !topology.non_manifold_edges.is_empty() {
-        if let Some((loose, mut kept, kept_topology)) =
-            crate::mesh::without_loose_triangles(mesh, topology)
-        {
-            // The volume kept is the file's, loose triangles included: they follow their
-            // corners, and their own (cone) volume changes with them; one more uniform offset
-            // takes that back (about a thousandth of an edge length on the dragon, which moved
-            // the volume by 0.04 % without it).
-            let pinned = options
-                .mask
-                .as_ref()
-                .map(|mask| mask.pinned_flags())
-                .unwrap_or_default();
-            let volume = options
-                .keep_volume
-                .then(|| VolumeKeeper::new(mesh, topology, &pinned));
-            let mut report = fair_constrained(&mut kept, &kept_topology, options);
-            mesh.positions = kept.positions;
-            if let Some(volume) = volume.filter(|_| report.rounds_run > 0) {
-                volume.restore(mesh, topology, |v| pinned.get(v).copied().unwrap_or(false));
-            }
-            report.loose_triangles += loose.len();
-            return report;
-        }
+    if let Some(report) = fair_without_loose_triangles(mesh, topology, options) {
+        return report;
     }
     let original = options.mask.as_ref().map(|_| mesh.positions.clone());
     let pinned = options
@@ -151,6 +122,40 @@ pub fn fair_constrained(
     report
 }
 
+/// A non-manifold scan is faired as the surface it stands for: without the triangles its
+/// reconstruction left lying loose at its non-manifold edges (overlays on a fan, fins), which
+/// would make their corners boundary vertices on chains no boundary curve runs through, and so
+/// hold them with their noise (`crate::mesh::loose_triangles`, `docs/measurements.md`). Same
+/// vertices, nothing renumbered; a corner only loose triangles use (a fin's tip) stays where it
+/// is. `None` when the default variant has no loose triangles to leave out.
+fn fair_without_loose_triangles(
+    mesh: &mut TriMesh,
+    topology: &Topology,
+    options: &FairOptions,
+) -> Option<FairReport> {
+    if options.variant != FairVariant::NormalProjected || topology.non_manifold_edges.is_empty() {
+        return None;
+    }
+    let (loose, mut kept, kept_topology) = crate::mesh::without_loose_triangles(mesh, topology)?;
+    // The volume kept is the file's, loose triangles included: they follow their corners, and
+    // their own (cone) volume changes with them; one more uniform offset takes that back.
+    let pinned = options
+        .mask
+        .as_ref()
+        .map(|mask| mask.pinned_flags())
+        .unwrap_or_default();
+    let volume = options
+        .keep_volume
+        .then(|| VolumeKeeper::new(mesh, topology, &pinned));
+    let mut report = fair_constrained(&mut kept, &kept_topology, options);
+    mesh.positions = kept.positions;
+    if let Some(volume) = volume.filter(|_| report.rounds_run > 0) {
+        volume.restore(mesh, topology, |v| pinned.get(v).copied().unwrap_or(false));
+    }
+    report.loose_triangles += loose.len();
+    Some(report)
+}
+
 /// Rounds from which a run in the locality order pays for making it (see [`in_local_order`]).
 const LOCAL_ORDER_ROUNDS: usize = 3;
 
@@ -159,10 +164,9 @@ const LOCAL_ORDER_ROUNDS: usize = 3;
 /// mesh's numbering. Every per-vertex pass of a round outside the operator (the crease detection
 /// and the noise estimate over the fans, the volume correction's normals, the risk's normals)
 /// gathers its neighbours' data; in a file's own order (a scan's, a subdivided mesh's) those sit
-/// megabytes apart, here a few breadth-first fronts apart. On the noisy 1.2M-face bunny, whose
-/// file order is poor, the whole default `fair` went from 23.3 to 19.9 s for ~0.2 s of
-/// reordering and a second topology (`docs/measurements.md`). The operator renumbers its own vertices the same
-/// way, so its iterations are unchanged. What `options` number by vertex (the file's hard edges)
+/// megabytes apart, here a few breadth-first fronts apart; the reordering and a second topology
+/// cost little next to the rounds (`docs/measurements.md`). The operator renumbers its own
+/// vertices the same way, so its iterations are unchanged. What `options` number by vertex (the file's hard edges)
 /// is renumbered too; `pinned` stands for the mask, which `fair` does not see.
 fn in_local_order(
     mesh: &mut TriMesh,
@@ -243,56 +247,19 @@ fn decide_and_fair(
     // The fan-ordered one-rings the operator is built from serve the noise estimate and the
     // crease detection first (`read_noise`, `detect_creases_with_estimate`).
     let fans = FanRings::new(&mesh.triangles, topology);
-    // The noise estimate decides the strength (automatic) and how much the normals are filtered
-    // before creases are detected (raw normals of a noisy mesh make creases of the noise).
-    // Automatic strength fairs only a noisy mesh, so its creases are always found on filtered
-    // normals; a fixed strength finds the estimate and the faces' own feature edges in one
-    // gather, and skips the filter when the mesh is clean.
     // Without `may_reorder` the mesh is already the locality-ordered copy (`in_local_order`):
-    // the filter keeps its face order (the same normals bit for bit, its lists built in about
-    // half the time).
+    // the filter keeps its face order (the same normals bit for bit, its lists built faster).
     let mut face_rings = if may_reorder {
         FaceRingCache::default()
     } else {
         FaceRingCache::in_mesh_order()
     };
     let started = std::time::Instant::now();
-    // Automatic strength reads, in the same gather, which vertices lie on sharp edges.
-    let (estimate, found, reading) = match (&options.creases, options.strength) {
-        (Some(crease_options), Strength::Fixed) => {
-            let (estimate, creases) = detect_creases_with_estimate(
-                mesh,
-                topology,
-                &fans,
-                crease_options,
-                &mut face_rings,
-                true,
-            );
-            (estimate, Some(creases), None)
-        }
-        (_, Strength::Auto) => {
-            let angle = options
-                .creases
-                .as_ref()
-                .map_or(CreaseOptions::default().angle_degrees, |c| c.angle_degrees);
-            let reading = read_noise(mesh, topology, &fans, angle);
-            (reading.noise(topology), None, Some(reading))
-        }
-        (None, _) => (None, None, None),
-    };
-    // Automatic strength: a clean mesh is left as it is, and so is one that reads noisy only
-    // because of its sharp edges (a coarse CAD part: most of its vertices lie on or beside an
-    // edge, and those make the median read noise; away from the edges it reads clean).
-    let clean_away_from_edges = || {
-        reading
-            .as_ref()
-            .and_then(|reading| reading.away_from_edges(topology))
-            .is_some_and(|away| away <= CLEAN_NOISE)
-    };
+    let (estimate, found, reading) = first_reading(mesh, topology, &fans, options, &mut face_rings);
     let auto_noise = match options.strength {
-        Strength::Auto => match estimate {
-            Some(noise) if noise > CLEAN_NOISE && !clean_away_from_edges() => Some(noise),
-            _ => {
+        Strength::Auto => match noisy(estimate, reading.as_ref(), topology) {
+            Some(noise) => Some(noise),
+            None => {
                 return FairReport {
                     noise_estimate: estimate,
                     detection_ms: milliseconds(started),
@@ -335,6 +302,60 @@ fn decide_and_fair(
     report
 }
 
+/// The first reading of the input: the noise estimate, which decides the strength (automatic)
+/// and how much the normals are filtered before creases are detected (raw normals of a noisy
+/// mesh make creases of the noise). A fixed strength finds the estimate and the creases in one
+/// gather (skipping the filter when the mesh is clean); automatic strength fairs only a noisy
+/// mesh, so its creases are always found later on filtered normals, and it reads in the same
+/// gather which vertices lie on sharp edges ([`read_noise`]).
+fn first_reading(
+    mesh: &TriMesh,
+    topology: &Topology,
+    fans: &FanRings,
+    options: &FairOptions,
+    face_rings: &mut FaceRingCache,
+) -> (Option<f64>, Option<Creases>, Option<NoiseReading>) {
+    match (&options.creases, options.strength) {
+        (Some(crease_options), Strength::Fixed) => {
+            let (estimate, creases) = detect_creases_with_estimate(
+                mesh,
+                topology,
+                fans,
+                crease_options,
+                face_rings,
+                true,
+            );
+            (estimate, Some(creases), None)
+        }
+        (_, Strength::Auto) => {
+            let angle = options
+                .creases
+                .as_ref()
+                .map_or(CreaseOptions::default().angle_degrees, |c| c.angle_degrees);
+            let reading = read_noise(mesh, topology, fans, angle);
+            (reading.noise(topology), None, Some(reading))
+        }
+        (None, _) => (None, None, None),
+    }
+}
+
+/// Automatic strength: the noise to fair, `None` for a mesh left as it is: a clean one, or one
+/// that reads noisy only because of its sharp edges (a coarse CAD part: most of its vertices lie
+/// on or beside an edge, and those make the median read noise; away from the edges it reads
+/// clean).
+fn noisy(
+    estimate: Option<f64>,
+    reading: Option<&NoiseReading>,
+    topology: &Topology,
+) -> Option<f64> {
+    let clean_away_from_edges = || {
+        reading
+            .and_then(|reading| reading.away_from_edges(topology))
+            .is_some_and(|away| away <= CLEAN_NOISE)
+    };
+    estimate.filter(|&noise| noise > CLEAN_NOISE && !clean_away_from_edges())
+}
+
 /// Milliseconds since `start`.
 fn milliseconds(start: std::time::Instant) -> f64 {
     start.elapsed().as_secs_f64() * 1e3
@@ -354,7 +375,10 @@ struct Rounds<'a> {
 
 /// The rounds of [`fair_constrained`], after the decision to fair: `fans` are `mesh`'s,
 /// `found` the creases found with the noise estimate (a fixed strength), if any, with the faces
-/// around each face if that detection filtered the normals.
+/// around each face if that detection filtered the normals. Each round finds the creases again
+/// when they are due ([`Creases`]), sets the relaxation's shares ([`RelaxationPlan`]), runs the
+/// operator, gives the volume back and, with automatic strength, reads the risk ([`RiskJudge`]),
+/// which may stop the rounds and undo the last ones.
 fn fair_rounds(
     mesh: &mut TriMesh,
     topology: &Topology,
@@ -368,226 +392,408 @@ fn fair_rounds(
         auto_noise,
         pinned,
     } = rounds;
-    // Creases are found again before every round (every CREASE_RECHECK_ROUNDS-th once they stop
-    // changing): the noise left after a round makes fewer false creases, and a crease found on
-    // the noisy input may turn out to be noise (`docs/measurements.md`). The normals are filtered
-    // as much as the current noise asks for: the first time as the input's estimate says, later
-    // as the estimate made in the same gather as the faces' own feature edges says
-    // (`detect_creases_with_estimate`; once the noise is gone, that gather is the detection).
     let started = std::time::Instant::now();
-    let mut creases = found.or_else(|| {
-        options.creases.as_ref().map(|crease_options| {
-            let mut crease_options = crease_options.clone();
-            crease_options.normal_filtering = crease_options
-                .normal_filtering
-                .max(estimate.map_or(0, normal_filtering_for));
-            detect_creases_cached(mesh, topology, &crease_options, &mut face_rings)
-        })
-    });
+    let creases =
+        found.or_else(|| first_creases(mesh, topology, options, estimate, &mut face_rings));
     let first_detection_ms = milliseconds(started);
     let max_rounds = match auto_noise {
         Some(_) => MAX_AUTO_ROUNDS,
         None => options.rounds,
     };
     let redetect = options.creases.is_some() && max_rounds > 1;
-    let build = |mesh: &TriMesh, creases: Option<&Creases>, fans: &FanRings| {
-        let mut fairing = ConstrainedFairing::with_fans(
-            mesh,
-            topology,
-            fans,
-            options.variant,
-            options.boundary,
-            creases,
-            pinned,
-        );
-        fairing.set_tangential_relaxation(options.tangential_relaxation as f32);
-        fairing
-    };
-    let mut fairing = build(mesh, creases.as_ref(), &fans);
-    // The relaxation where it is needed: the share every vertex gets, from how much of the
-    // input's noise lies along its surface ([`relaxation`]); the slivers' before every round.
+    let mut fairing = ConstrainedFairing::with_fans(
+        mesh,
+        topology,
+        &fans,
+        options.variant,
+        options.boundary,
+        creases.as_ref(),
+        pinned,
+    );
+    fairing.set_tangential_relaxation(options.tangential_relaxation as f32);
     let started = std::time::Instant::now();
-    let tangential_noise = (options.variant == FairVariant::NormalProjected
-        && options.tangential_relaxation > 0.0
-        && options.relaxation == Relaxation::WhereNeeded)
-        .then(|| read_tangential_noise(mesh, topology, &fans));
-    let mut everywhere =
-        tangential_noise.map(|reading| relaxation::everywhere_share(reading, estimate));
-    // Without creases the surface is taken for a smooth one, whose thin triangles may lie along a
-    // bend: only the folded ones are relaxed ([`relaxation::Slivers`]).
-    let slivers = match options.creases {
-        Some(_) => relaxation::Slivers::All,
-        None => relaxation::Slivers::Folded,
-    };
+    let relaxation = RelaxationPlan::read(mesh, topology, &fans, options, estimate);
     let reading_ms = milliseconds(started);
     // The fans serve the later rounds only to find the creases again (and estimate the noise
     // that sets the filtering for it) and to read the noise along the surface again while the
     // relaxation acts everywhere: otherwise they are freed before the iterations (the peak,
-    // while the operator is set up from them, stays: 277 MB for `fair --rounds 3 --no-creases`
-    // on 1.2M faces either way).
-    let fans = (redetect || everywhere.is_some_and(|share| share > 0.0)).then_some(fans);
+    // while the operator is set up from them, stays).
+    let fans = (redetect || relaxation.everywhere.is_some_and(|share| share > 0.0)).then_some(fans);
     let volume = options
         .keep_volume
         .then(|| VolumeKeeper::new(mesh, topology, pinned));
     let mut report = FairReport {
         detection_ms: first_detection_ms + reading_ms,
-        tangential_noise: tangential_noise.flatten(),
+        tangential_noise: relaxation.tangential_noise,
         ..FairReport::default()
     };
-    // Automatic strength: round by round while the estimated risk of the result falls (see
-    // [`super::strength`]): a copy of the input, moved a little along its normals, goes through
-    // the same rounds, and the mesh goes back to the last round that lowered the risk clearly
-    // (RISK_MIN_FALL).
-    let mut risk = auto_noise.map(|noise| {
-        // σ is read away from the first detection's creases and the boundary.
-        let held = held_flags(topology, creases.as_ref(), &[]);
-        RoundRisk::new(
-            mesh,
-            topology,
-            crate::metrics::mean_edge_length(mesh),
-            noise,
-            &held,
-        )
-    });
-    // The last round kept (see RISK_MIN_FALL): its number, its risk, its positions and crease
-    // count.
-    let mut kept_round: Option<(usize, f64)> = None;
-    let mut kept_positions = Vec::new();
-    let mut kept_creases = 0;
-    let mut first_fall = 0.0;
-    let mut before_restore = Vec::new();
-    let mut copy_report = FairReport::default();
-    // Detections in a row that found the creases already kept (or changed in a few edges in
-    // CREASE_SETTLED): from two on, the creases are found again only every
-    // CREASE_RECHECK_ROUNDS rounds (once the noise is gone they change little: on the noisy
-    // 1.2M-face bunny the later detections change 0-4 of ~75 edges; counting those as settled
-    // took the run from 29 detections to 20, 8.6 % less time, the same mean distance).
-    let mut unchanged = 0usize;
-    // Whether a detection has read the mesh clean (its estimate asked for no filtering): the
-    // rounds only smooth it further, so the later ones find the faces' own feature edges without
-    // estimating again (on the noisy 1.2M-face bunny the estimates fell from 0.047 after the
-    // first round to 0.001; the estimate's share of a detection is ~4 of 15 ms).
-    let mut read_clean = false;
-    let detect_in = |round: usize, unchanged: usize| {
-        redetect && (unchanged < 2 || round.is_multiple_of(CREASE_RECHECK_ROUNDS))
+    let judge = auto_noise.map(|noise| RiskJudge::new(mesh, topology, noise, creases.as_ref()));
+    let mut rounds = RoundLoop {
+        topology,
+        options,
+        pinned,
+        fairing,
+        fans,
+        face_rings,
+        redetect,
+        tracked: TrackedCreases {
+            creases,
+            unchanged: 0,
+            read_clean: false,
+        },
+        relaxation,
+        volume,
+        judge,
     };
     for round in 0..max_rounds {
-        if let (true, Some(fans), Some(crease_options)) = (
-            round > 0 && detect_in(round, unchanged),
-            &fans,
-            &options.creases,
-        ) {
-            let started = std::time::Instant::now();
-            let (noise, found) = detect_creases_with_estimate(
-                mesh,
-                topology,
-                fans,
-                crease_options,
-                &mut face_rings,
-                !read_clean,
-            );
-            report.detection_ms += milliseconds(started);
-            read_clean |= noise.is_some_and(|noise| normal_filtering_for(noise) == 0);
-            let found = Some(found);
-            fn edges(creases: &Option<Creases>) -> &[[u32; 2]] {
-                creases.as_ref().map_or(&[], |c| &c.edges)
-            }
-            let (before, after) = (edges(&creases), edges(&found));
-            if before != after {
-                // A change of a few edges in twenty counts as settled: the crease set is taken
-                // all the same, but the detections thin out.
-                let settled =
-                    CREASE_SETTLED * edges_changed(before, after) <= before.len().max(after.len());
-                creases = found;
-                unchanged = if settled { unchanged + 1 } else { 0 };
-                fairing = fairing.for_other_creases(mesh, topology, fans, creases.as_ref(), pinned);
-            } else {
-                unchanged += 1;
-            }
-        }
-        let held = creases.as_ref().map(|c| c.class.as_slice()).unwrap_or(&[]);
-        let corner = |v: usize| held.get(v) == Some(&FeatureClass::Corner);
-        // Imposes the constraints on the positions this round starts from.
-        fairing.load(&mesh.positions);
-        if let Some(share) = &mut everywhere {
-            // Once the noise along the surface is gone (the mesh reads as even as a relaxed one),
-            // the relaxation keeps to the thin triangles (`relaxation::still_needed_share`).
-            if round > 0 && *share > 0.0 {
-                if let Some(fans) = &fans {
-                    let started = std::time::Instant::now();
-                    let reading = read_tangential_noise(mesh, topology, fans);
-                    *share = share.min(relaxation::still_needed_share(reading));
-                    report.detection_ms += milliseconds(started);
-                }
-            }
-            // From the mesh's state: the risk's copy is faired with the same shares.
-            fairing.relax_where_needed(*share, slivers);
-        }
-        fairing.run_round(options, &mut report);
-        fairing.store(&mut mesh.positions);
-        if let Some(volume) = &volume {
-            if risk.is_some() {
-                before_restore.clone_from(&mesh.positions);
-            }
-            volume.restore(mesh, topology, corner);
-        }
-        if let Some((risk, copy)) = &mut risk {
-            // The copy's round, with the same operator (and creases) as the mesh's.
-            fairing.load(copy);
-            fairing.run_round(options, &mut copy_report);
-            fairing.store(copy);
-            // The volume correction offsets every vertex by one distance per part along its
-            // normal; the copy takes the mesh's offsets (what its own correction would give, but
-            // for a change of the distance that sums a part's volume change, of order 1/N per
-            // vertex against the local response the risk reads).
-            if volume.is_some() {
-                copy.par_chunks_mut(CHUNK)
-                    .zip(mesh.positions.par_chunks(CHUNK))
-                    .zip(before_restore.par_chunks(CHUNK))
-                    .for_each(|((copy, after), before)| {
-                        for ((c, a), b) in copy.iter_mut().zip(after).zip(before) {
-                            for k in 0..3 {
-                                c[k] += a[k] - b[k];
-                            }
-                        }
-                    });
-            }
-            let now = risk.read(mesh, topology, copy);
-            report.risk_by_round.push(now);
-            let edges = creases.as_ref().map_or(0, |c| c.edges.len());
-            // A round is kept when it lowers the risk below the last kept round's by
-            // RISK_MIN_FALL of what the second round lowered it by (the falls after a kept round
-            // add up until they pass that); the rounds stop RISK_PATIENCE rounds after the last
-            // kept one.
-            if round == 1 {
-                if let Some((_, first)) = kept_round {
-                    first_fall = (first - now).max(0.0);
-                }
-            }
-            if kept_round.is_none_or(|(_, kept_risk)| now < kept_risk - RISK_MIN_FALL * first_fall)
-            {
-                kept_round = Some((round, now));
-                kept_positions.clone_from(&mesh.positions);
-                kept_creases = edges;
-            } else if now.is_nan() {
-                break;
-            }
-            if kept_round.is_some_and(|(kept, _)| round - kept >= RISK_PATIENCE) {
-                break;
-            }
+        if rounds.run(mesh, round, &mut report) {
+            break;
         }
     }
-    let mut crease_edges = creases.map_or(0, |c| c.edges.len());
-    if let Some((round, _)) = kept_round {
-        if round + 1 != report.rounds_run {
-            mesh.positions = kept_positions;
-            report.rounds_run = round + 1;
-            crease_edges = kept_creases;
-        }
+    let tracked = rounds.tracked;
+    let judge = rounds.judge;
+    let mut crease_edges = tracked.creases.map_or(0, |c| c.edges.len());
+    if let Some(judge) = judge {
+        judge.roll_back(mesh, &mut report, &mut crease_edges);
     }
     report.noise_estimate = estimate;
     report.crease_edges = crease_edges;
     report
+}
+
+/// What the rounds of [`fair_rounds`] work with, set up before the first.
+struct RoundLoop<'a> {
+    topology: &'a Topology,
+    options: &'a FairOptions,
+    /// Vertices a mask pins (empty: none).
+    pinned: &'a [bool],
+    fairing: ConstrainedFairing,
+    /// The mesh's fans, kept only while later rounds need them (see [`fair_rounds`]).
+    fans: Option<FanRings>,
+    face_rings: FaceRingCache,
+    /// Whether the creases are found again before later rounds.
+    redetect: bool,
+    tracked: TrackedCreases,
+    relaxation: RelaxationPlan,
+    volume: Option<VolumeKeeper>,
+    judge: Option<RiskJudge>,
+}
+
+impl RoundLoop<'_> {
+    /// Round `round` on `mesh`, counted in `report`: the creases found again when they are due
+    /// (the operator set up again for them when they changed), the relaxation's shares, the
+    /// operator's iterations, the volume given back, and, with automatic strength, the risk
+    /// read. Whether the rounds stop.
+    fn run(&mut self, mesh: &mut TriMesh, round: usize, report: &mut FairReport) -> bool {
+        let topology = self.topology;
+        if let (true, Some(fans), Some(crease_options)) = (
+            self.redetect && round > 0 && self.tracked.due(round),
+            &self.fans,
+            &self.options.creases,
+        ) {
+            let detection = (fans, crease_options, &mut self.face_rings);
+            if self.tracked.detect_again(mesh, topology, detection, report) {
+                let creases = self.tracked.creases.as_ref();
+                let fairing = &mut self.fairing;
+                fairing.for_other_creases(mesh, topology, fans, creases, self.pinned);
+            }
+        }
+        // Imposes the constraints on the positions this round starts from.
+        self.fairing.load(&mesh.positions);
+        let fans = self.fans.as_ref();
+        let at = (&*mesh, topology);
+        self.relaxation
+            .before_round(&mut self.fairing, round, at, fans, report);
+        self.fairing.run_round(self.options, report);
+        self.fairing.store(&mut mesh.positions);
+        if let Some(volume) = &self.volume {
+            if let Some(judge) = &mut self.judge {
+                judge.before_restore.clone_from(&mesh.positions);
+            }
+            let class = self.tracked.creases.as_ref().map(|c| c.class.as_slice());
+            let class = class.unwrap_or(&[]);
+            volume.restore(mesh, topology, |v| {
+                class.get(v) == Some(&FeatureClass::Corner)
+            });
+        }
+        let Some(judge) = &mut self.judge else {
+            return false;
+        };
+        let volume_kept = self.volume.is_some();
+        judge.fair_copy(
+            &mut self.fairing,
+            self.options,
+            &mesh.positions,
+            volume_kept,
+        );
+        let edges = self.tracked.creases.as_ref().map_or(0, |c| c.edges.len());
+        judge.stops_after(round, (mesh, topology), edges, report)
+    }
+}
+
+/// The creases the first round fairs with, when the noise estimate's gather did not find them:
+/// the normals filtered as much as the input's estimate asks for.
+fn first_creases(
+    mesh: &TriMesh,
+    topology: &Topology,
+    options: &FairOptions,
+    estimate: Option<f64>,
+    face_rings: &mut FaceRingCache,
+) -> Option<Creases> {
+    options.creases.as_ref().map(|crease_options| {
+        let mut crease_options = crease_options.clone();
+        crease_options.normal_filtering = crease_options
+            .normal_filtering
+            .max(estimate.map_or(0, normal_filtering_for));
+        detect_creases_cached(mesh, topology, &crease_options, face_rings)
+    })
+}
+
+/// The creases the rounds fair with, found again before every round (every
+/// [`CREASE_RECHECK_ROUNDS`]-th once they stop changing): the noise left after a round makes
+/// fewer false creases, and a crease found on the noisy input may turn out to be noise
+/// (`docs/measurements.md`). The normals are filtered as much as the current noise asks for, as
+/// the estimate made in the same gather as the faces' own feature edges says
+/// ([`detect_creases_with_estimate`]; once the noise is gone, that gather is the detection).
+struct TrackedCreases {
+    creases: Option<Creases>,
+    /// Detections in a row that found the creases already kept (or changed in a few edges in
+    /// [`CREASE_SETTLED`]): from two on, the creases are found again only every
+    /// [`CREASE_RECHECK_ROUNDS`] rounds (once the noise is gone they change little).
+    unchanged: usize,
+    /// Whether a detection has read the mesh clean (its estimate asked for no filtering): the
+    /// rounds only smooth it further, so the later ones find the faces' own feature edges without
+    /// estimating again.
+    read_clean: bool,
+}
+
+impl TrackedCreases {
+    /// Whether the creases are found again before round `round` (not the first).
+    fn due(&self, round: usize) -> bool {
+        self.unchanged < 2 || round.is_multiple_of(CREASE_RECHECK_ROUNDS)
+    }
+
+    /// Finds the creases again (with `fans`, the crease options and the faces around each face
+    /// the detection keeps), counting the time in `report`; whether they changed.
+    fn detect_again(
+        &mut self,
+        mesh: &TriMesh,
+        topology: &Topology,
+        (fans, crease_options, face_rings): (&FanRings, &CreaseOptions, &mut FaceRingCache),
+        report: &mut FairReport,
+    ) -> bool {
+        let started = std::time::Instant::now();
+        let (noise, found) = detect_creases_with_estimate(
+            mesh,
+            topology,
+            fans,
+            crease_options,
+            face_rings,
+            !self.read_clean,
+        );
+        report.detection_ms += milliseconds(started);
+        self.read_clean |= noise.is_some_and(|noise| normal_filtering_for(noise) == 0);
+        let found = Some(found);
+        fn edges(creases: &Option<Creases>) -> &[[u32; 2]] {
+            creases.as_ref().map_or(&[], |c| &c.edges)
+        }
+        let (before, after) = (edges(&self.creases), edges(&found));
+        if before == after {
+            self.unchanged += 1;
+            return false;
+        }
+        // A change of a few edges in twenty counts as settled: the crease set is taken all the
+        // same, but the detections thin out.
+        let settled =
+            CREASE_SETTLED * edges_changed(before, after) <= before.len().max(after.len());
+        self.creases = found;
+        self.unchanged = if settled { self.unchanged + 1 } else { 0 };
+        true
+    }
+}
+
+/// The tangential relaxation where it is needed ([`relaxation`]): the share every vertex gets,
+/// from how much of the input's noise lies along its surface; the slivers' before every round.
+struct RelaxationPlan {
+    /// The share every vertex gets (`None`: the relaxation acts everywhere in full, or not at
+    /// all).
+    everywhere: Option<f32>,
+    /// Which thin triangles get the whole relaxation: without creases the surface is taken for a
+    /// smooth one, whose thin triangles may lie along a bend, so only the folded ones.
+    slivers: relaxation::Slivers,
+    /// The input's noise along the surface, when it was read (reported).
+    tangential_noise: Option<f64>,
+}
+
+impl RelaxationPlan {
+    /// The plan for `options` on the input `mesh` (its noise along the surface read from `fans`
+    /// where the relaxation is only where needed; `estimate` the noise across it).
+    fn read(
+        mesh: &TriMesh,
+        topology: &Topology,
+        fans: &FanRings,
+        options: &FairOptions,
+        estimate: Option<f64>,
+    ) -> RelaxationPlan {
+        let tangential_noise = (options.variant == FairVariant::NormalProjected
+            && options.tangential_relaxation > 0.0
+            && options.relaxation == Relaxation::WhereNeeded)
+            .then(|| read_tangential_noise(mesh, topology, fans));
+        let everywhere =
+            tangential_noise.map(|reading| relaxation::everywhere_share(reading, estimate));
+        let slivers = match options.creases {
+            Some(_) => relaxation::Slivers::All,
+            None => relaxation::Slivers::Folded,
+        };
+        RelaxationPlan {
+            everywhere,
+            slivers,
+            tangential_noise: tangential_noise.flatten(),
+        }
+    }
+
+    /// Gives `fairing` (loaded with the positions round `round` starts from) its shares. Once
+    /// the noise along the surface is gone (the mesh reads as even as a relaxed one), the
+    /// relaxation keeps to the thin triangles ([`relaxation::still_needed_share`]), read with
+    /// `fans` (the time counted in `report`).
+    fn before_round(
+        &mut self,
+        fairing: &mut ConstrainedFairing,
+        round: usize,
+        (mesh, topology): (&TriMesh, &Topology),
+        fans: Option<&FanRings>,
+        report: &mut FairReport,
+    ) {
+        let Some(share) = &mut self.everywhere else {
+            return;
+        };
+        if round > 0 && *share > 0.0 {
+            if let Some(fans) = fans {
+                let started = std::time::Instant::now();
+                let reading = read_tangential_noise(mesh, topology, fans);
+                *share = share.min(relaxation::still_needed_share(reading));
+                report.detection_ms += milliseconds(started);
+            }
+        }
+        // From the mesh's state: the risk's copy is faired with the same shares.
+        fairing.relax_where_needed(*share, self.slivers);
+    }
+}
+
+/// Automatic strength: round by round while the estimated risk of the result falls (see
+/// [`crate::fairing::strength`]): a copy of the input, moved a little along its normals, goes
+/// through the same rounds, and the mesh goes back to the last round that lowered the risk
+/// clearly ([`RISK_MIN_FALL`]).
+struct RiskJudge {
+    risk: RoundRisk,
+    /// The risk's copy of the mesh, faired round by round beside it.
+    copy: Vec<[f32; 3]>,
+    copy_report: FairReport,
+    /// The mesh's positions before this round's volume correction.
+    before_restore: Vec<[f32; 3]>,
+    /// The last round kept: its number and risk, its positions and crease count.
+    kept_round: Option<(usize, f64)>,
+    kept_positions: Vec<[f32; 3]>,
+    kept_creases: usize,
+    /// What the second round lowered the risk by.
+    first_fall: f64,
+}
+
+impl RiskJudge {
+    /// The judge for the input `mesh` with noise `noise` (mean edge lengths); σ is read away
+    /// from the first detection's `creases` and the boundary.
+    fn new(mesh: &TriMesh, topology: &Topology, noise: f64, creases: Option<&Creases>) -> Self {
+        let held = held_flags(topology, creases, &[]);
+        let edge = crate::metrics::mean_edge_length(mesh);
+        let (risk, copy) = RoundRisk::new(mesh, topology, edge, noise, &held);
+        RiskJudge {
+            risk,
+            copy,
+            copy_report: FairReport::default(),
+            before_restore: Vec::new(),
+            kept_round: None,
+            kept_positions: Vec::new(),
+            kept_creases: 0,
+            first_fall: 0.0,
+        }
+    }
+
+    /// The copy's round, with the same operator (and creases) as the mesh's. The volume
+    /// correction (when `volume_kept`) offsets every vertex by one distance per part along its
+    /// normal; the copy takes the mesh's offsets (`after` less the positions before the
+    /// correction): what its own correction would give, but for a change of the distance that
+    /// sums a part's volume change, of order 1/N per vertex against the local response the risk
+    /// reads.
+    fn fair_copy(
+        &mut self,
+        fairing: &mut ConstrainedFairing,
+        options: &FairOptions,
+        after: &[[f32; 3]],
+        volume_kept: bool,
+    ) {
+        fairing.load(&self.copy);
+        fairing.run_round(options, &mut self.copy_report);
+        fairing.store(&mut self.copy);
+        if volume_kept {
+            self.copy
+                .par_chunks_mut(CHUNK)
+                .zip(after.par_chunks(CHUNK))
+                .zip(self.before_restore.par_chunks(CHUNK))
+                .for_each(|((copy, after), before)| {
+                    for ((c, a), b) in copy.iter_mut().zip(after).zip(before) {
+                        for k in 0..3 {
+                            c[k] += a[k] - b[k];
+                        }
+                    }
+                });
+        }
+    }
+
+    /// Reads the risk after round `round` (the mesh with `crease_edges` crease edges) into
+    /// `report` and keeps the round when it lowers the risk below the last kept round's by
+    /// [`RISK_MIN_FALL`] of what the second round lowered it by (the falls after a kept round
+    /// add up until they pass that); whether the rounds stop ([`RISK_PATIENCE`] rounds after the
+    /// last kept one, or on a risk that is no number).
+    fn stops_after(
+        &mut self,
+        round: usize,
+        (mesh, topology): (&TriMesh, &Topology),
+        crease_edges: usize,
+        report: &mut FairReport,
+    ) -> bool {
+        let now = self.risk.read(mesh, topology, &self.copy);
+        report.risk_by_round.push(now);
+        if round == 1 {
+            if let Some((_, first)) = self.kept_round {
+                self.first_fall = (first - now).max(0.0);
+            }
+        }
+        let fall = RISK_MIN_FALL * self.first_fall;
+        if self
+            .kept_round
+            .is_none_or(|(_, kept_risk)| now < kept_risk - fall)
+        {
+            self.kept_round = Some((round, now));
+            self.kept_positions.clone_from(&mesh.positions);
+            self.kept_creases = crease_edges;
+        } else if now.is_nan() {
+            return true;
+        }
+        self.kept_round
+            .is_some_and(|(kept, _)| round - kept >= RISK_PATIENCE)
+    }
+
+    /// Puts `mesh` back to the last kept round (its positions, its round count in `report` and
+    /// its `crease_edges`), when later rounds ran.
+    fn roll_back(self, mesh: &mut TriMesh, report: &mut FairReport, crease_edges: &mut usize) {
+        if let Some((round, _)) = self.kept_round {
+            if round + 1 != report.rounds_run {
+                mesh.positions = self.kept_positions;
+                report.rounds_run = round + 1;
+                *crease_edges = self.kept_creases;
+            }
+        }
+    }
 }
 
 #[cfg(test)]

@@ -97,7 +97,7 @@ fn entries_in_order(
 impl ConstrainedFairing {
     /// [`Self::new`] for a caller that already has the mesh's fan-ordered one-rings; `creases`
     /// kept as in [`Self::with_creases`]; the vertices flagged in `pinned` (empty: none) held
-    /// where they are, like fixed boundary vertices ([`super::mask`]).
+    /// where they are, like fixed boundary vertices ([`crate::fairing::mask`]).
     pub(crate) fn with_fans(
         mesh: &TriMesh,
         topology: &Topology,
@@ -107,12 +107,19 @@ impl ConstrainedFairing {
         creases: Option<&Creases>,
         pinned: &[bool],
     ) -> Self {
-        Self::set_up(
-            mesh, topology, fans, variant, boundary, creases, pinned, None,
-        )
+        let spec = Spec {
+            mesh,
+            topology,
+            fans,
+            variant,
+            boundary,
+            creases,
+            pinned,
+        };
+        Self::set_up(&spec, None)
     }
 
-    /// This operator set up again for other `creases` on the same connectivity (`mesh`,
+    /// Sets this operator up again for other `creases` on the same connectivity (`mesh`,
     /// `topology` and `fans` those it was built from; the same variant, boundary mode, pinned
     /// vertices and tangential relaxation): the same operator as [`Self::with_fans`] would give
     /// (every entry's weights, the own weights, the fans and curves bit for bit; only the
@@ -126,53 +133,72 @@ impl ConstrainedFairing {
     /// When more than an eighth of the vertices changed, the set-up runs whole instead (still
     /// keeping the locality order and the one-rings renumbered in it).
     pub(crate) fn for_other_creases(
-        self,
+        &mut self,
         mesh: &TriMesh,
         topology: &Topology,
         fans: &FanRings,
         creases: Option<&Creases>,
         pinned: &[bool],
-    ) -> Self {
-        self.for_other_creases_within(mesh, topology, fans, creases, pinned, 8)
+    ) {
+        self.for_other_creases_within(mesh, topology, fans, creases, pinned, 8);
     }
 
     /// [`Self::for_other_creases`], updating in place while at most 1/`fraction` of the vertices
     /// changed (0: never; the tests take both ways).
     fn for_other_creases_within(
-        mut self,
+        &mut self,
         mesh: &TriMesh,
         topology: &Topology,
         fans: &FanRings,
         creases: Option<&Creases>,
         pinned: &[bool],
         fraction: usize,
-    ) -> Self {
-        let creases = creases.filter(|c| !c.is_empty());
-        let held = held_flags(topology, creases, pinned);
+    ) {
+        let spec = Spec {
+            mesh,
+            topology,
+            fans,
+            variant: self.variant,
+            boundary: self.boundary,
+            creases: creases.filter(|c| !c.is_empty()),
+            pinned,
+        };
+        let held = held_flags(topology, spec.creases, pinned);
         let changed: Vec<u32> = (0..held.len() as u32)
             .filter(|&v| held[v as usize] != self.held[v as usize])
             .collect();
         if fraction == 0 || changed.len() * fraction > held.len() {
-            let (variant, boundary, tangential) = (self.variant, self.boundary, self.tangential);
-            let layout = Layout {
-                order: self.order,
-                internal: self.internal,
-                offsets: self.ring_offsets,
-                ring: self.ring,
-            };
-            let mut fairing = Self::set_up(
-                mesh,
-                topology,
-                fans,
-                variant,
-                boundary,
-                creases,
-                pinned,
-                Some(layout),
-            );
-            fairing.tangential = tangential;
-            return fairing;
+            self.set_up_again(&spec);
+        } else {
+            self.update_rows(&spec, held, &changed);
         }
+    }
+
+    /// The whole set-up for `spec`, keeping this operator's locality order, one-rings and
+    /// tangential relaxation.
+    fn set_up_again(&mut self, spec: &Spec) {
+        let tangential = self.tangential;
+        let layout = Layout {
+            order: std::mem::take(&mut self.order),
+            internal: std::mem::take(&mut self.internal),
+            offsets: std::mem::take(&mut self.ring_offsets),
+            ring: std::mem::take(&mut self.ring),
+        };
+        *self = Self::set_up(spec, Some(layout));
+        self.tangential = tangential;
+    }
+
+    /// This operator with `held` (the vertices `spec` holds) in place of its own held vertices:
+    /// the rows of the vertices in `changed` and of their neighbours gathered again, their
+    /// solved flags and fans updated, the curves made again.
+    fn update_rows(&mut self, spec: &Spec, held: Vec<bool>, changed: &[u32]) {
+        let Spec {
+            mesh,
+            topology,
+            fans,
+            pinned,
+            ..
+        } = *spec;
         let mut affected: Vec<u32> = changed
             .iter()
             .flat_map(|&v| std::iter::once(v).chain(topology.neighbors(v).iter().copied()))
@@ -182,7 +208,7 @@ impl ConstrainedFairing {
         let (ring_offsets, _) = topology.neighbor_csr();
         let triangles = &mesh.triangles;
         // A vertex's rows and whether it is solved, with the triangles solved as `held` says.
-        let gather = |v: usize, held: &[bool], rows: &mut Vec<[f32; 4]>, own: &mut [f32; 3]| {
+        let gather = |v: usize, held: &[bool], rows: &mut Vec<[f32; 4]>| {
             let ring_v = &fans.ring[ring_offsets[v] as usize..ring_offsets[v + 1] as usize];
             rows.resize(ring_v.len(), [0.0; 4]);
             let operator = |f: u32| {
@@ -194,18 +220,7 @@ impl ConstrainedFairing {
                     Some(h) => (t[h] as usize != v).then(|| held_corner_weights(valences, h)),
                 }
             };
-            let mut solved = false;
-            gather_rows(
-                v,
-                ring_v,
-                topology,
-                triangles,
-                operator,
-                rows,
-                own,
-                &mut solved,
-            );
-            solved
+            gather_rows(v, ring_v, topology, triangles, operator, rows)
         };
         let mut row_of: RowMap = self
             .entry_weights
@@ -213,11 +228,11 @@ impl ConstrainedFairing {
             .enumerate()
             .map(|(i, row)| (row_key(row), i as u32))
             .collect();
-        let (mut rows, mut own) = (Vec::new(), [0.0f32; 3]);
+        let mut rows = Vec::new();
         for &v in &affected {
             let v = v as usize;
-            let was_solved = gather(v, &self.held, &mut rows, &mut own);
-            let solved = gather(v, &held, &mut rows, &mut own);
+            let (_, was_solved) = gather(v, &self.held, &mut rows);
+            let (own, solved) = gather(v, &held, &mut rows);
             self.solved_vertices =
                 self.solved_vertices + usize::from(solved) - usize::from(was_solved);
             let i = self.internal[v] as usize;
@@ -225,148 +240,60 @@ impl ConstrainedFairing {
             self.closed_fan[i] = fans.closed_fan[v] && solved;
             let first = self.ring_offsets[i] as usize;
             for (k, row) in rows.iter().enumerate() {
-                let index = *row_of.entry(row_key(row)).or_insert_with(|| {
-                    self.entry_weights.push(*row);
-                    (self.entry_weights.len() - 1) as u32
-                });
-                if let EntryWeightIndex::Narrow(narrow) = &self.entry_weight_index {
-                    if index > u32::from(u16::MAX) {
-                        let wide = narrow.iter().map(|&i| u32::from(i)).collect();
-                        self.entry_weight_index = EntryWeightIndex::Wide(wide);
-                    }
-                }
-                match &mut self.entry_weight_index {
-                    EntryWeightIndex::Narrow(narrow) => narrow[first + k] = index as u16,
-                    EntryWeightIndex::Wide(wide) => wide[first + k] = index,
-                }
+                self.set_entry_row(first + k, row, &mut row_of);
             }
         }
-        self.curves = fairing_curves(topology, self.boundary, creases, &self.internal);
+        self.curves = fairing_curves(topology, self.boundary, spec.creases, &self.internal);
         self.held = held;
-        self
     }
 
-    #[allow(clippy::too_many_arguments)]
-    fn set_up(
-        mesh: &TriMesh,
-        topology: &Topology,
-        fans: &FanRings,
-        variant: FairVariant,
-        boundary: BoundaryMode,
-        creases: Option<&Creases>,
-        pinned: &[bool],
-        layout: Option<Layout>,
-    ) -> Self {
+    /// Gives one-ring entry `entry` the weight row `row`: its index among the distinct rows
+    /// (`row_of`), added to them if it is new (the index widened past 65536 rows).
+    fn set_entry_row(&mut self, entry: usize, row: &[f32; 4], row_of: &mut RowMap) {
+        let index = *row_of.entry(row_key(row)).or_insert_with(|| {
+            self.entry_weights.push(*row);
+            (self.entry_weights.len() - 1) as u32
+        });
+        if let EntryWeightIndex::Narrow(narrow) = &self.entry_weight_index {
+            if index > u32::from(u16::MAX) {
+                let wide = narrow.iter().map(|&i| u32::from(i)).collect();
+                self.entry_weight_index = EntryWeightIndex::Wide(wide);
+            }
+        }
+        match &mut self.entry_weight_index {
+            EntryWeightIndex::Narrow(narrow) => narrow[entry] = index as u16,
+            EntryWeightIndex::Wide(wide) => wide[entry] = index,
+        }
+    }
+
+    /// The operator `spec` asks for: every vertex's rows gathered ([`gather_all_rows`]), then
+    /// moved into the locality order (`layout`, or a new one).
+    fn set_up(spec: &Spec, layout: Option<Layout>) -> Self {
+        let Spec {
+            mesh,
+            topology,
+            fans,
+            variant,
+            boundary,
+            pinned,
+            ..
+        } = *spec;
         let vertex_count = mesh.positions.len();
-        let triangles = &mesh.triangles;
         // Crease vertices and corners, and pinned vertices, bound the surface patches like
         // boundary vertices do: they get no local solution and their triangles are not solved,
         // but for those with a single crease corner, solved with it held ([`triangle_solve`]).
-        let creases = creases.filter(|c| !c.is_empty());
+        let creases = spec.creases.filter(|c| !c.is_empty());
         let held = held_flags(topology, creases, pinned);
-
         let ring_offsets = topology.neighbor_csr().0.to_vec();
         let (ring, closed) = (&fans.ring, &fans.closed_fan);
-
-        let valence = |v: u32| topology.valence(v);
-
-        // Local operators of the valence triples that occur, in a dense table, and each triangle's
-        // slot in it (u32::MAX: not solved), found once per triangle rather than once per
-        // corner. Triples with a valence beyond the table get an operator of their own, and so
-        // do the (few) triangles solved with a crease corner held, per triple and held corner.
-        let table_index = |n: [usize; 3]| (n[0] * TABLE_VALENCE + n[1]) * TABLE_VALENCE + n[2];
-        let triangle_valences: Vec<Option<([usize; 3], Option<usize>)>> = triangles
-            .par_iter()
-            .map(|t| triangle_solve(t, &held, topology, pinned).map(|h| (t.map(valence), h)))
-            .collect();
-        let mut table_slot = vec![u32::MAX; TABLE_VALENCE * TABLE_VALENCE * TABLE_VALENCE];
-        let mut held_corner_slot: HashMap<([usize; 3], usize), u32> = HashMap::new();
-        // Per operator, the weights corner r's solution gives corner c's umbrella mean, position
-        // and anchor: G_rc, G_rc/n_c − Σ_c' G_rc'/n_c' and h_r (see "How it is computed"); and
-        // which corner it holds (3: none).
-        let mut operators: Vec<[[[f64; 3]; 3]; 3]> = Vec::new();
-        let mut operator_held: Vec<u8> = Vec::new();
-        let mut operator_slot = |(n, held_at): ([usize; 3], Option<usize>)| -> u32 {
-            if let Some(h) = held_at {
-                return *held_corner_slot.entry((n, h)).or_insert_with(|| {
-                    operators.push(held_corner_weights(n, h));
-                    operator_held.push(h as u8);
-                    (operators.len() - 1) as u32
-                });
-            }
-            let in_table = n.iter().all(|&k| k < TABLE_VALENCE);
-            if in_table && table_slot[table_index(n)] != u32::MAX {
-                return table_slot[table_index(n)];
-            }
-            let slot = operators.len() as u32;
-            operators.push(corner_weights(n));
-            operator_held.push(3);
-            if in_table {
-                table_slot[table_index(n)] = slot;
-            }
-            slot
-        };
-        let triangle_operator: Vec<u32> = triangle_valences
-            .iter()
-            .map(|n| n.map_or(u32::MAX, &mut operator_slot))
-            .collect();
-        drop(triangle_valences);
-
-        // Per vertex, gather the weights of its triangles' solutions (f64, then rounded), one row
-        // (mean, position, anchor, 0) per one-ring entry.
-        let mut self_weights = vec![[0.0f32; 3]; vertex_count];
-        let mut solved = vec![false; vertex_count];
-        let gather = |v: usize,
-                      ring_weights_v: &mut [[f32; 4]],
-                      own_out: &mut [f32; 3],
-                      solved_out: &mut bool| {
-            let ring_v = &ring[ring_offsets[v] as usize..ring_offsets[v + 1] as usize];
-            let operator = |f: u32| {
-                let slot = triangle_operator[f as usize];
-                // v itself, when it is the held corner, gets no solution from the triangle.
-                (slot != u32::MAX
-                    && triangles[f as usize].get(operator_held[slot as usize] as usize)
-                        != Some(&(v as u32)))
-                .then(|| &operators[slot as usize])
-            };
-            gather_rows(
-                v,
-                ring_v,
-                topology,
-                triangles,
-                operator,
-                ring_weights_v,
-                own_out,
-                solved_out,
-            );
-        };
-        // In blocks of vertices, each block's rows deduplicated as soon as they are gathered:
-        // the 16-byte rows of the whole mesh are never held at once (on the 1.2M-face mesh they
-        // were 58 MB at the set-up's peak); only a 4-byte index per entry and the few distinct
-        // rows. The rows are a function of the valences around the vertex, so they repeat.
-        let blocks: Vec<(Vec<u32>, Vec<[f32; 4]>)> = self_weights
-            .par_chunks_mut(VERTEX_BLOCK)
-            .zip(solved.par_chunks_mut(VERTEX_BLOCK))
-            .enumerate()
-            .map(|(b, (own_block, solved_block))| {
-                let first = b * VERTEX_BLOCK;
-                let base = ring_offsets[first] as usize;
-                let end = ring_offsets[first + own_block.len()] as usize;
-                let mut rows = vec![[0.0f32; 4]; end - base];
-                for (i, (own_out, solved_out)) in own_block
-                    .iter_mut()
-                    .zip(solved_block.iter_mut())
-                    .enumerate()
-                {
-                    let v = first + i;
-                    let entries =
-                        ring_offsets[v] as usize - base..ring_offsets[v + 1] as usize - base;
-                    gather(v, &mut rows[entries], own_out, solved_out);
-                }
-                deduplicate_chunk(&rows)
-            })
-            .collect();
-        let (mesh_rows, mesh_index) = join_deduplicated(blocks);
+        let table = OperatorTable::new(&mesh.triangles, &held, topology, pinned);
+        let GatheredRows {
+            rows: mesh_rows,
+            index: mesh_index,
+            self_weights,
+            solved,
+        } = gather_all_rows(&table, &mesh.triangles, topology, &ring_offsets, ring);
+        drop(table);
         let solved_vertices = solved.iter().filter(|&&s| s).count();
 
         // Renumber for locality: internal vertex i is `order[i]`; every per-vertex array is
@@ -381,11 +308,10 @@ impl ConstrainedFairing {
             offsets: internal_offsets,
             ring: internal_ring,
         } = layout;
-        // Only the rows' 4-byte index is permuted (permuting the 16-byte rows and then
-        // deduplicating them held two copies of every entry's row at once). The distinct rows
-        // are then renumbered in order of first use in the internal order, as deduplicating the
-        // permuted rows numbers them, so the operator is the same bit for bit and its table is
-        // read in order.
+        // Only the rows' 4-byte index is permuted, never the 16-byte rows themselves. The
+        // distinct rows are then renumbered in order of first use in the internal order, as
+        // deduplicating the permuted rows numbers them, so the operator is the same bit for bit
+        // and its table is read in order.
         let internal_index =
             entries_in_order(&order, &internal_offsets, &ring_offsets, &mesh_index, |i| i);
         drop(mesh_index);
@@ -430,6 +356,156 @@ impl ConstrainedFairing {
     }
 }
 
+/// What an operator is set up for: the mesh's connectivity (`topology` built from `mesh`,
+/// `fans` its fan-ordered one-rings), the variant and boundary mode, the creases kept (`None`:
+/// none) and the vertices pinned (empty: none).
+#[derive(Clone, Copy)]
+struct Spec<'a> {
+    mesh: &'a TriMesh,
+    topology: &'a Topology,
+    fans: &'a FanRings,
+    variant: FairVariant,
+    boundary: BoundaryMode,
+    creases: Option<&'a Creases>,
+    pinned: &'a [bool],
+}
+
+/// The local operators of the valence triples that occur, and each triangle's slot among them
+/// (`u32::MAX`: not solved), found once per triangle rather than once per corner. Triples below
+/// [`TABLE_VALENCE`] are looked up in a dense table, larger ones get an operator of their own, and
+/// so do the (few) triangles solved with a crease corner held, per triple and held corner.
+struct OperatorTable {
+    /// Per operator, the weights corner r's solution gives corner c's umbrella mean, position
+    /// and anchor: G_rc, G_rc/n_c − Σ_c' G_rc'/n_c' and h_r (see "How it is computed" in the
+    /// parent module).
+    operators: Vec<[[[f64; 3]; 3]; 3]>,
+    /// Per operator, the corner it holds (3: none).
+    operator_held: Vec<u8>,
+    /// Per triangle, its operator (`u32::MAX`: not solved).
+    triangle_operator: Vec<u32>,
+}
+
+impl OperatorTable {
+    /// The operators of `triangles` with the vertices flagged in `held` held (see
+    /// [`triangle_solve`]).
+    fn new(
+        triangles: &[[u32; 3]],
+        held: &[bool],
+        topology: &Topology,
+        pinned: &[bool],
+    ) -> OperatorTable {
+        let valence = |v: u32| topology.valence(v);
+        let table_index = |n: [usize; 3]| (n[0] * TABLE_VALENCE + n[1]) * TABLE_VALENCE + n[2];
+        let triangle_valences: Vec<Option<([usize; 3], Option<usize>)>> = triangles
+            .par_iter()
+            .map(|t| triangle_solve(t, held, topology, pinned).map(|h| (t.map(valence), h)))
+            .collect();
+        let mut table_slot = vec![u32::MAX; TABLE_VALENCE * TABLE_VALENCE * TABLE_VALENCE];
+        let mut held_corner_slot: HashMap<([usize; 3], usize), u32> = HashMap::new();
+        let mut operators: Vec<[[[f64; 3]; 3]; 3]> = Vec::new();
+        let mut operator_held: Vec<u8> = Vec::new();
+        let mut operator_slot = |(n, held_at): ([usize; 3], Option<usize>)| -> u32 {
+            if let Some(h) = held_at {
+                return *held_corner_slot.entry((n, h)).or_insert_with(|| {
+                    operators.push(held_corner_weights(n, h));
+                    operator_held.push(h as u8);
+                    (operators.len() - 1) as u32
+                });
+            }
+            let in_table = n.iter().all(|&k| k < TABLE_VALENCE);
+            if in_table && table_slot[table_index(n)] != u32::MAX {
+                return table_slot[table_index(n)];
+            }
+            let slot = operators.len() as u32;
+            operators.push(corner_weights(n));
+            operator_held.push(3);
+            if in_table {
+                table_slot[table_index(n)] = slot;
+            }
+            slot
+        };
+        let triangle_operator: Vec<u32> = triangle_valences
+            .iter()
+            .map(|n| n.map_or(u32::MAX, &mut operator_slot))
+            .collect();
+        OperatorTable {
+            operators,
+            operator_held,
+            triangle_operator,
+        }
+    }
+
+    /// Face `f`'s corner weights for its corner `v`, `None` when the face is not solved or `v`
+    /// is its held corner (which gets no solution from it).
+    fn for_corner(&self, triangles: &[[u32; 3]], f: u32, v: usize) -> Option<&[[[f64; 3]; 3]; 3]> {
+        let slot = self.triangle_operator[f as usize];
+        (slot != u32::MAX
+            && triangles[f as usize].get(self.operator_held[slot as usize] as usize)
+                != Some(&(v as u32)))
+        .then(|| &self.operators[slot as usize])
+    }
+}
+
+/// Every vertex's weight rows (mesh numbering), deduplicated: see [`gather_all_rows`].
+struct GatheredRows {
+    /// The distinct rows, in order of first appearance.
+    rows: Vec<[f32; 4]>,
+    /// Per one-ring entry (laid out by the topology's one-ring offsets), its row's index.
+    index: Vec<u32>,
+    /// Per vertex: the weights of its own umbrella mean, position and anchor.
+    self_weights: Vec<[f32; 3]>,
+    /// Per vertex: whether it gets at least one local solution.
+    solved: Vec<bool>,
+}
+
+/// Per vertex, the weights of its triangles' solutions (f64, then rounded; [`gather_rows`]), one
+/// row (mean, position, anchor, 0) per one-ring entry (`ring`, laid out by `ring_offsets`). In
+/// blocks of vertices, each block's rows deduplicated as soon as they are gathered: the 16-byte
+/// rows of the whole mesh are never held at once, only a 4-byte index per entry and the few
+/// distinct rows (the rows are a function of the valences around the vertex, so they repeat).
+fn gather_all_rows(
+    table: &OperatorTable,
+    triangles: &[[u32; 3]],
+    topology: &Topology,
+    ring_offsets: &[u32],
+    ring: &[u32],
+) -> GatheredRows {
+    let vertex_count = ring_offsets.len() - 1;
+    let mut self_weights = vec![[0.0f32; 3]; vertex_count];
+    let mut solved = vec![false; vertex_count];
+    let blocks: Vec<(Vec<u32>, Vec<[f32; 4]>)> = self_weights
+        .par_chunks_mut(VERTEX_BLOCK)
+        .zip(solved.par_chunks_mut(VERTEX_BLOCK))
+        .enumerate()
+        .map(|(b, (own_block, solved_block))| {
+            let first = b * VERTEX_BLOCK;
+            let base = ring_offsets[first] as usize;
+            let end = ring_offsets[first + own_block.len()] as usize;
+            let mut rows = vec![[0.0f32; 4]; end - base];
+            for (i, (own_out, solved_out)) in own_block
+                .iter_mut()
+                .zip(solved_block.iter_mut())
+                .enumerate()
+            {
+                let v = first + i;
+                let ring_v = &ring[ring_offsets[v] as usize..ring_offsets[v + 1] as usize];
+                let entries = ring_offsets[v] as usize - base..ring_offsets[v + 1] as usize - base;
+                let operator = |f: u32| table.for_corner(triangles, f, v);
+                (*own_out, *solved_out) =
+                    gather_rows(v, ring_v, topology, triangles, operator, &mut rows[entries]);
+            }
+            deduplicate_chunk(&rows)
+        })
+        .collect();
+    let (rows, index) = join_deduplicated(blocks);
+    GatheredRows {
+        rows,
+        index,
+        self_weights,
+        solved,
+    }
+}
+
 /// The vertices (mesh numbering) that bound the surface patches like boundary vertices do: the
 /// boundary's, the creases' (their vertices and corners) and the pinned ones.
 pub(super) fn held_flags(
@@ -454,10 +530,9 @@ pub(super) fn held_flags(
 
 /// Vertex `v`'s weights: the mean of its solved triangles' corner weights (f64, then rounded),
 /// one row (mean, position, anchor, 0) per entry of its one-ring `ring_v` into
-/// `ring_weights_v`, its own into `own_out`; `operator(f)` gives face f's corner weights, `None`
-/// for a face that is not solved. A vertex with no solved face keeps its position (own weights
-/// (0, 1, 0), ring weights 0) and `solved_out` stays false.
-#[allow(clippy::too_many_arguments)]
+/// `ring_weights_v`; returns its own weights and whether it is solved. `operator(f)` gives face
+/// f's corner weights, `None` for a face that is not solved. A vertex with no solved face keeps
+/// its position (own weights (0, 1, 0), ring weights 0) and is not solved.
 fn gather_rows<W>(
     v: usize,
     ring_v: &[u32],
@@ -465,9 +540,8 @@ fn gather_rows<W>(
     triangles: &[[u32; 3]],
     operator: impl Fn(u32) -> Option<W>,
     ring_weights_v: &mut [[f32; 4]],
-    own_out: &mut [f32; 3],
-    solved_out: &mut bool,
-) where
+) -> ([f32; 3], bool)
+where
     W: std::borrow::Borrow<[[[f64; 3]; 3]; 3]>,
 {
     let mut own = [0.0f64; 3];
@@ -505,15 +579,12 @@ fn gather_rows<W>(
             }
         }
     }
-    *solved_out = false;
     if count == 0 {
         // No local solution: the vertex keeps its position (ring weights stay 0).
-        *own_out = [0.0, 1.0, 0.0];
         ring_weights_v.fill([0.0; 4]);
-        return;
+        return ([0.0, 1.0, 0.0], false);
     }
     let inv = 1.0 / count as f64;
-    *own_out = own.map(|w| (w * inv) as f32);
     for (out, e) in ring_weights_v.iter_mut().zip(entries.iter()) {
         *out = [
             (e[0] * inv) as f32,
@@ -522,7 +593,7 @@ fn gather_rows<W>(
             0.0,
         ];
     }
-    *solved_out = true;
+    (own.map(|w| (w * inv) as f32), true)
 }
 
 /// The curves the curve operator moves (internal numbering): the boundary loops (when they are
@@ -863,14 +934,7 @@ mod tests {
                 let mut again = set_up(Some(&sharp));
                 for creases in [Some(&faint), None, Some(&sharp), Some(&faint)] {
                     let mut afresh = set_up(creases);
-                    again = again.for_other_creases_within(
-                        &mesh,
-                        &topology,
-                        &fans,
-                        creases,
-                        &[],
-                        fraction,
-                    );
+                    again.for_other_creases_within(&mesh, &topology, &fans, creases, &[], fraction);
                     assert_eq!(again.held, afresh.held);
                     assert_eq!(again.order, afresh.order);
                     assert_eq!(again.ring_offsets, afresh.ring_offsets);

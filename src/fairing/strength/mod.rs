@@ -66,7 +66,7 @@ mod risk;
 mod scan;
 
 pub use noise::estimate_noise;
-pub(crate) use noise::read_noise;
+pub(crate) use noise::{read_noise, NoiseReading};
 pub(crate) use risk::RoundRisk;
 pub use risk::{RISK_DRAW_AVERAGING, RISK_MIN_FALL, RISK_PATIENCE, RISK_STEP};
 pub(crate) use scan::scan_fans;

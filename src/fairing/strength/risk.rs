@@ -34,11 +34,9 @@ pub const RISK_PATIENCE: usize = 2;
 /// (the elephant with isotropic noise reads rounds 4 and 5 within 0.04 % of each other; round
 /// 4 is the closer).
 ///
-/// Measured on the 32-row peer table over three noise seeds, against the rule it replaced (the
-/// least always kept; only a round's own fall of this fraction counting towards
-/// [`RISK_PATIENCE`]): closer on every seed's geometric mean, the noisy 1.2M-face bunny 43 → 59
-/// rounds and 0.0433 → 0.0402 edge lengths for about a fifth more time (`docs/measurements.md`,
-/// "The stop: small falls add up, a draw of ±1").
+/// Measured on the 32-row peer table over three noise seeds (`docs/measurements.md`, "The stop:
+/// small falls add up, a draw of ±1"): letting the falls add up comes closer to the clean
+/// surfaces than keeping the least and counting only a round's own fall.
 pub const RISK_MIN_FALL: f64 = 0.005;
 
 /// How far the risk's copy of the input is moved along the normals, in mean edge lengths (small
@@ -189,8 +187,7 @@ fn averaged_over_rings(topology: &Topology, directions: &[Vec3A]) -> Vec<Vec3A> 
 /// variance r_v would have for unit noise; over the vertices with no `held` vertex within two
 /// rings (over all where fewer than a tenth are such; `held` empty: none). `None` where no vertex
 /// can be read. On big meshes g_v is averaged over every [`GAIN_STRIDE`]-th vertex read (its
-/// row's listing is most of the cost: 150 ms of the 1.2M-face mesh on two threads, taken for
-/// every vertex).
+/// row's listing is most of the cost).
 ///
 /// Measured on the 16 meshes of the peer table with noise of 0.15, 0.3 and 0.5 edge lengths along
 /// the normals and per coordinate (`docs/measurements.md`): the reading over the truth has a mean
