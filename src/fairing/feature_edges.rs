@@ -10,10 +10,10 @@ use glam::Vec3A;
 /// A feature edge `[v, u]` (v < u) with its crease direction (unit, either sign).
 pub(crate) type FeatureEdge = ([u32; 2], Vec3A);
 
-/// Appends the feature edges `[v, u]` with u > v, ascending by u, with `normal(f)` a normal of
-/// face f (of any length): the edges with exactly two faces whose normals' angle has its cosine
-/// below `threshold` (the cosine of the crease angle). The faces of an edge v–u are among v's own, so
-/// no other vertex's list is searched, and v's triangles are read once.
+/// Appends the feature edges `[v, u]` with u > v, ascending by u, with `normal(f)` a normal of face
+/// f (of any length): the edges with exactly two faces whose normals' angle has its cosine below
+/// `threshold` (the cosine of the crease angle). The faces of an edge v–u are among v's own, so no
+/// other vertex's list is searched, and v's triangles are read once.
 pub(crate) fn vertex_feature_edges(
     mesh: &TriMesh,
     topology: &Topology,

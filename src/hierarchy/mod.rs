@@ -19,23 +19,23 @@
 //!   from M0's corners. Both are exact: coarsening to the top and refining back gives M0's faces,
 //!   in M0's order once mapped back through [`Hierarchy::original_vertex`].
 //!
-//! Creases ([`HierarchyOptions::creases`], off by default for now; not in the paper): M0's creases are
-//! found as [`crate::fairing::detect_creases`] finds them (normals filtered as much as the noise
-//! estimate asks; groups that wander are dropped only where their edges turn by more than
-//! [`HIERARCHY_ZIGZAG_TURN`] unless the options say otherwise, since a coarse level keeps its
-//! shape by those bends), corners never collapse and crease vertices collapse only along their
-//! crease (see `decimate.rs`), so every level's creases are M0's feature edges with their ends followed
-//! along `target` ([`Hierarchy::level_creases`]); multiresolution fairing fairs them as curves.
-//! The detection costs a topology, the fan-ordered one-rings and one gather over them that gives
-//! the noise estimate and the feature edges together (the guided normal filter only on a noisy
-//! mesh); figures in `docs/measurements.md`.
+//! Creases ([`HierarchyOptions::creases`], off by default for now; not in the paper): M0's creases
+//! are found as [`crate::fairing::detect_creases`] finds them (normals filtered as much as the
+//! noise estimate asks; groups that wander are dropped only where their edges turn by more than
+//! [`HIERARCHY_ZIGZAG_TURN`] unless the options say otherwise, since a coarse level keeps its shape
+//! by those bends), corners never collapse and crease vertices collapse only along their crease
+//! (see `decimate.rs`), so every level's creases are M0's feature edges with their ends followed
+//! along `target` ([`Hierarchy::level_creases`]); multiresolution fairing fairs them as curves. The
+//! detection costs a topology, the fan-ordered one-rings and one gather over them that gives the
+//! noise estimate and the feature edges together (the guided normal filter only on a noisy mesh);
+//! figures in `docs/measurements.md`.
 //!
 //! Loose triangles (not in the paper): on a mesh with non-manifold edges, the triangles a scan's
 //! reconstruction left lying over a fan or hanging as fins ([`crate::mesh::loose_triangles`])
 //! are left out of the levels ([`HierarchyOptions::leave_out_loose_triangles`]): level 0 is M0
 //! without them, M0 itself stays whole, and `face_order` maps into M0's faces. Kept in, their
-//! corners were non-manifold and pinned with their neighbours in every level (the Stanford
-//! dragon's levels stopped at 9997 of its 22982 vertices; without them they reach 627).
+//! corners would be non-manifold and pinned with their neighbours in every level (a scan such as
+//! the Stanford dragon would keep under half its vertices in its coarsest level).
 //!
 //! Storage per M0 vertex: target 4 bytes, cone volume 4, the vertex order both ways 8, and the
 //! face order (about two faces per vertex) 8: 24 bytes, besides M0 itself in internal order.

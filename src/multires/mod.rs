@@ -44,17 +44,17 @@
 //!
 //! Speed: a [`MultiresWorkspace`] keeps, per level used so far, its connectivity (`TriMesh`
 //! triangles and `Topology`), loop neighbours, fan-ordered one-rings and fairing operator, built
-//! (levels in parallel) by the first run that needs them or by
-//! [`MultiresWorkspace::prepare_for`]; a run then only moves positions, and allocates nothing but its result.
+//! (levels in parallel) by the first run that needs them or by [`MultiresWorkspace::prepare_for`];
+//! a run then only moves positions, and allocates nothing but its result.
 //! [`MultiresWorkspace::for_one_run`] keeps instead only the level a run is at (built when the run
-//! reaches it, freed when it leaves it): about a third of the memory for a single run (the
-//! command line), at the cost of building levels one after another. The whole run
-//! executes on a worker of the rayon pool (a run makes a dozen parallel calls per level, and each
-//! call issued from outside the pool is a cross-thread hand-off); passes over the coarse levels
-//! are not split below `PARALLEL_GRAIN` vertices. The per-level passes (Kobbelt step, vertex
-//! normals, low-pass filters) work in f32 SIMD points; the Kobbelt step takes every vertex's
-//! umbrella Laplacian once instead of once per adjacent split vertex, and closed fans give the
-//! vertex normals from their fan order (one gather per neighbour instead of three per face).
+//! reaches it, freed when it leaves it): about a third of the memory for a single run (the command
+//! line), at the cost of building levels one after another. The whole run executes on a worker of
+//! the rayon pool (a run makes a dozen parallel calls per level, and each call issued from outside
+//! the pool is a cross-thread hand-off); passes over the coarse levels are not split below
+//! `PARALLEL_GRAIN` vertices. The per-level passes (Kobbelt step, vertex normals, low-pass filters)
+//! work in f32 SIMD points; the Kobbelt step takes every vertex's umbrella Laplacian once instead
+//! of once per adjacent split vertex, and closed fans give the vertex normals from their fan order
+//! (one gather per neighbour instead of three per face).
 //!
 //! # Files
 //! - `refine`: the steps between two levels (the shrinkage taken back, the split vertices

@@ -11,7 +11,7 @@ use crate::fairing::FairVariant;
 use glam::{Vec3A, Vec3Swizzles};
 use rayon::prelude::*;
 
-/// Vertices per parallel work item: 256 and 512 were the fastest on meshes of 75k and 1.2M faces
+/// Vertices per parallel work item: 256 and 512 are the fastest on meshes of 75k and 1.2M faces
 /// (`docs/measurements.md`).
 pub(super) const CHUNK: usize = 512;
 /// Evaluates `$body` with `$stencil` bound to `$fairing`'s one-ring stencil, whichever width its
@@ -297,11 +297,12 @@ impl<I: Copy + Into<u32> + Sync> Stencil<'_, I> {
     }
 
     /// Pass 2 of an iteration: x̃_v = anchor term + own terms + Σ (α·m_u + β·x_u) over the
-    /// one-ring, into `next` (the iterate itself: pass 2 reads the previous positions from
-    /// `pairs`, so no second position buffer is needed). With `PROJECT`, vertices with a closed fan keep only the part of
-    /// the move x̃_v − x_v along the normal of their fan of umbrella means (centre m_v, ring m_u,
-    /// gathered anyway for the update), plus `tangential` (times the vertex's `share` unless that
-    /// is empty) of the tangential part of its umbrella vector. Returns the largest squared move.
+    /// one-ring, into `next` (the iterate itself: pass 2 reads the previous positions from `pairs`,
+    /// so no second position buffer is needed). With `PROJECT`, vertices with a closed fan keep
+    /// only the part of the move x̃_v − x_v along the normal of their fan of umbrella means (centre
+    /// m_v, ring m_u, gathered anyway for the update), plus `tangential` (times the vertex's
+    /// `share` unless that is empty) of the tangential part of its umbrella vector. Returns the
+    /// largest squared move.
     fn averaged_solutions<const PROJECT: bool>(
         &self,
         pairs: &[PositionAndMean],

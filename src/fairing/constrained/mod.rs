@@ -228,7 +228,7 @@ impl ConstrainedFairing {
     /// Frees the buffers a run works in (80 bytes per vertex: the current state, the anchors and
     /// their terms, the positions with their umbrella means); the next [`Self::load`] allocates
     /// them again. For a caller that keeps many operators and runs one at a time (the editor
-    /// keeps one per level of the hierarchy, and these buffers were over half of their memory).
+    /// keeps one per level of the hierarchy, and these buffers are over half of their memory).
     pub fn release_buffers(&mut self) {
         self.workspace = Workspace::default();
     }

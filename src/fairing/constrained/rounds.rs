@@ -159,15 +159,15 @@ fn fair_without_loose_triangles(
 /// Rounds from which a run in the locality order pays for making it (see [`in_local_order`]).
 const LOCAL_ORDER_ROUNDS: usize = 3;
 
-/// Runs `fair` on a copy of `mesh` whose vertices are numbered breadth-first over the one-rings
-/// and whose faces are sorted by their lowest corner, then puts the faired positions back in the
-/// mesh's numbering. Every per-vertex pass of a round outside the operator (the crease detection
-/// and the noise estimate over the fans, the volume correction's normals, the risk's normals)
-/// gathers its neighbours' data; in a file's own order (a scan's, a subdivided mesh's) those sit
-/// megabytes apart, here a few breadth-first fronts apart; the reordering and a second topology
-/// cost little next to the rounds (`docs/measurements.md`). The operator renumbers its own
-/// vertices the same way, so its iterations are unchanged. What `options` number by vertex (the file's hard edges)
-/// is renumbered too; `pinned` stands for the mask, which `fair` does not see.
+/// Runs `fair` on a copy of `mesh` whose vertices are numbered breadth-first over the one-rings and
+/// whose faces are sorted by their lowest corner, then puts the faired positions back in the mesh's
+/// numbering. Every per-vertex pass of a round outside the operator (the crease detection and the
+/// noise estimate over the fans, the volume correction's normals, the risk's normals) gathers its
+/// neighbours' data; in a file's own order (a scan's, a subdivided mesh's) those sit megabytes
+/// apart, here a few breadth-first fronts apart; the reordering and a second topology cost little
+/// next to the rounds (`docs/measurements.md`). The operator renumbers its own vertices the same
+/// way, so its iterations are unchanged. What `options` number by vertex (the file's hard edges) is
+/// renumbered too; `pinned` stands for the mask, which `fair` does not see.
 fn in_local_order(
     mesh: &mut TriMesh,
     topology: &Topology,

@@ -325,13 +325,7 @@ impl ConstrainedFairing {
             .iter()
             .map(|&v| closed[v as usize] && solved[v as usize])
             .collect();
-        let inverse_valence = order
-            .iter()
-            .map(|&v| match topology.valence(v) {
-                0 => 0.0,
-                n => 1.0 / n as f32,
-            })
-            .collect();
+        let inverse_valence = inverse_valences(&order, topology);
         let curves = fairing_curves(topology, boundary, creases, &internal);
         ConstrainedFairing {
             held,
@@ -354,6 +348,17 @@ impl ConstrainedFairing {
             workspace: Workspace::default(),
         }
     }
+}
+
+/// 1/n_v of every vertex `order` lists, in that order (0 for unreferenced vertices).
+fn inverse_valences(order: &[u32], topology: &Topology) -> Vec<f32> {
+    order
+        .iter()
+        .map(|&v| match topology.valence(v) {
+            0 => 0.0,
+            n => 1.0 / n as f32,
+        })
+        .collect()
 }
 
 /// What an operator is set up for: the mesh's connectivity (`topology` built from `mesh`,

@@ -84,9 +84,9 @@ impl Creases {
                 chains.extend(walk(v, first, &mut used));
             }
         }
-        // A closed crease of a few vertices is no curve the section 3.3 constraints can fair (in
-        // multires from coarse levels its vertices were seen to run together, leaving faces with
-        // no area): it is held in place, as corners are, and its edges become chains between them.
+        // A closed crease of a few vertices is no curve the section 3.3 constraints can fair (its
+        // vertices run together, leaving faces with no area, in multires from coarse levels): it
+        // is held in place, as corners are, and its edges become chains between them.
         if chains
             .iter()
             .any(|c| c.closed && c.vertices.len() < MIN_FAIRED_LOOP)

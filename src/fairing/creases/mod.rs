@@ -36,16 +36,16 @@
 //!   their angle, and are never dropped as a small or zigzagging group: the file's author said so.
 //! - A crease vertex has exactly two feature edges whose crease directions (the cross product of
 //!   each edge's two filtered face normals: on a noisy crease the vertices zigzag, the faces on
-//!   either side do not) turn by less than [`CreaseOptions::corner_turn_degrees`]; any other vertex with feature edges is a corner (the
-//!   end of a crease, three or more creases meeting, a sharp turn, or a crease meeting the
-//!   boundary) and is held fixed.
+//!   either side do not) turn by less than [`CreaseOptions::corner_turn_degrees`]; any other vertex
+//!   with feature edges is a corner (the end of a crease, three or more creases meeting, a sharp
+//!   turn, or a crease meeting the boundary) and is held fixed.
 //!
-//! Speed: detection runs before every round of constrained fairing, so it must cost little next
-//! to a round. Constrained fairing and the hierarchy detect through
-//! `detect_creases_with_estimate`, whose one gather over the fan-ordered one-rings gives the noise
-//! estimate and the feature edges of the faces' own normals at once, so a clean mesh reads no face and never runs the filter. The
-//! filter (noisy meshes) works in f32 on a face-around-face list built once for all passes.
-//! Every vertex and face is computed by the same operations whatever the thread count.
+//! Speed: detection runs before every round of constrained fairing, so it must cost little next to
+//! a round. Constrained fairing and the hierarchy detect through `detect_creases_with_estimate`,
+//! whose one gather over the fan-ordered one-rings gives the noise estimate and the feature edges
+//! of the faces' own normals at once, so a clean mesh reads no face and never runs the filter. The
+//! filter (noisy meshes) works in f32 on a face-around-face list built once for all passes. Every
+//! vertex and face is computed by the same operations whatever the thread count.
 //!
 //! # Files
 //! - `normal_filter`: the guided normal filter ([`filtered_face_normals`]).

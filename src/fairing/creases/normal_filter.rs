@@ -54,14 +54,15 @@ impl FaceRingCache {
 ///
 /// How it is computed: in f32 (normals are directions; a pass averages a dozen of them), with the
 /// faces around each face (those sharing a vertex with it, each with the number of vertices it
-/// shares) listed once, before the passes, in blocks of faces ([`FaceRings`]). A pass is then
-/// three parallel gathers over the faces: every patch's mean and spread (once per face), every
-/// face's guidance (the least spread among the patches around it), the filtered normal. The first
-/// and the last take the faces around four at a time (their x, y, z and area in four lanes, the
-/// weights' exponentials by [`exp_of_negative`]). Each face is computed by the same operations whatever the thread count. No pass (a clean
-/// mesh) builds nothing: the normals are the faces' own. Three arrays of the faces' size are
-/// written (the normals, the patches and then the filtered normals over them, the guidance): a
-/// detection's first touch of their pages is a measurable part of its time on a big mesh.
+/// shares) listed once, before the passes, in blocks of faces ([`FaceRings`]). A pass is then three
+/// parallel gathers over the faces: every patch's mean and spread (once per face), every face's
+/// guidance (the least spread among the patches around it), the filtered normal. The first and the
+/// last take the faces around four at a time (their x, y, z and area in four lanes, the weights'
+/// exponentials by [`exp_of_negative`]). Each face is computed by the same operations whatever the
+/// thread count. No pass (a clean mesh) builds nothing: the normals are the faces' own. Three
+/// arrays of the faces' size are written (the normals, the patches and then the filtered normals
+/// over them, the guidance): a detection's first touch of their pages is a measurable part of its
+/// time on a big mesh.
 pub(super) fn filter_face_normals(
     mesh: &TriMesh,
     topology: &Topology,

@@ -34,26 +34,27 @@
 //!
 //! and the last sum (the smoother's divergence along the normals) is estimated by fairing, next to
 //! the input, a copy of it moved by ε b_v along the input's normals (b_v a fixed draw of ±1,
-//! `risk::sign_draw`; the normals averaged over the one-rings [`RISK_DRAW_AVERAGING`] times, so that
-//! they stand for the clean surface's): Σ b_v n_v · (f_v(y + ε b n) − f_v(y)) / ε. That is
-//! Hutchinson's estimate of a trace, bᵀ J b for E[bᵀ J b] = tr J; with b_v = ±1 (Rademacher)
-//! its variance is 2 Σ_{u≠v} J_uv², the least of any draw of independent b_v, where a Gaussian
-//! draw adds 2 Σ J_vv² from b_v² ≠ 1 (`docs/measurements.md`, "The stop: small falls add up, a
-//! draw of ±1"). The copy goes through
-//! the same operator, round for round, so every round costs its iterations twice. σ itself is
-//! read from the input by second differences (`risk::second_difference_variance`): with L the umbrella
-//! operator (the mean of the neighbours), r_v = n_v · ((I − L)² y)_v is, on a smooth surface,
-//! the change of the curvature term across two rings (small) plus the noise filtered by a row of
-//! (I − L)², whose squared norm g_v is known; so σ² = Σ r_v² / Σ g_v over the vertices whose two
-//! rings hold no crease and no boundary vertex (there the surface is not smooth). A reading from
-//! the first round's residual, E Σ (n · (f − y))² = bias + σ² (N − 2 div + Σ |n · ∂f n|²) taken
-//! with the bias as zero, would read high (the shape the round removes counts as noise) and stop
-//! the coarse scans a round late (`docs/measurements.md`, "σ by second differences"). A round is kept when it lowers the risk below the last kept round's by
-//! at least [`RISK_MIN_FALL`] of what the second round lowered it by (so small falls add up until
-//! they count, and a round that is lower by less than that is not worth its extra smoothing);
-//! the rounds stop [`RISK_PATIENCE`] rounds after the last kept one (the risk is not always
-//! convex in the rounds: a CAD part's creases found again after a few rounds lower it again), or
-//! after [`MAX_AUTO_ROUNDS`], and the mesh goes back to the last kept round.
+//! `risk::sign_draw`; the normals averaged over the one-rings [`RISK_DRAW_AVERAGING`] times, so
+//! that they stand for the clean surface's): Σ b_v n_v · (f_v(y + ε b n) − f_v(y)) / ε. That is
+//! Hutchinson's estimate of a trace, bᵀ J b for E[bᵀ J b] = tr J; with b_v = ±1 (Rademacher) its
+//! variance is 2 Σ_{u≠v} J_uv², the least of any draw of independent b_v, where a Gaussian draw
+//! adds 2 Σ J_vv² from b_v² ≠ 1 (`docs/measurements.md`, "The stop: small falls add up, a draw of
+//! ±1"). The copy goes through the same operator, round for round, so every round costs its
+//! iterations twice. σ itself is read from the input by second differences
+//! (`risk::second_difference_variance`): with L the umbrella operator (the mean of the neighbours),
+//! r_v = n_v · ((I − L)² y)_v is, on a smooth surface, the change of the curvature term across two
+//! rings (small) plus the noise filtered by a row of (I − L)², whose squared norm g_v is known; so
+//! σ² = Σ r_v² / Σ g_v over the vertices whose two rings hold no crease and no boundary vertex
+//! (there the surface is not smooth). A reading from the first round's residual, E Σ (n · (f − y))²
+//! = bias + σ² (N − 2 div + Σ |n · ∂f n|²) taken with the bias as zero, would read high (the shape
+//! the round removes counts as noise) and stop the coarse scans a round late
+//! (`docs/measurements.md`, "σ by second differences"). A round is kept when it lowers the risk
+//! below the last kept round's by at least [`RISK_MIN_FALL`] of what the second round lowered it by
+//! (so small falls add up until they count, and a round that is lower by less than that is not
+//! worth its extra smoothing); the rounds stop [`RISK_PATIENCE`] rounds after the last kept one
+//! (the risk is not always convex in the rounds: a CAD part's creases found again after a few
+//! rounds lower it again), or after [`MAX_AUTO_ROUNDS`], and the mesh goes back to the last kept
+//! round.
 //!
 //! # Files
 //! - `scan`: the fused gather over the fan-ordered one-rings: h_v, the mean edge length and the

@@ -239,12 +239,13 @@ impl Heights {
     }
 }
 
-/// The value of rank `rank` (from 0) of `values`, all of them positive or zero or positive NaNs,
-/// in `f32::total_cmp`'s order (`None` when there are no more than `rank` values). For such values that order is the order
-/// of their bits as unsigned integers, so the rank is found by counting the values' top 12 bits
-/// (sign, exponent and 3 bits of the mantissa) in parallel, then selecting among the few values
-/// that share the top bits of the one sought. The same value as `select_nth_unstable_by` with
-/// `total_cmp`, in about a quarter of its time on 600k residuals (2 threads).
+/// The value of rank `rank` (from 0) of `values`, all of them positive or zero or positive NaNs, in
+/// `f32::total_cmp`'s order (`None` when there are no more than `rank` values). For such values
+/// that order is the order of their bits as unsigned integers, so the rank is found by counting the
+/// values' top 12 bits (sign, exponent and 3 bits of the mantissa) in parallel, then selecting
+/// among the few values that share the top bits of the one sought. The same value as
+/// `select_nth_unstable_by` with `total_cmp`, in about a quarter of its time on 600k residuals (2
+/// threads).
 fn select_non_negative(values: &[f32], rank: usize) -> Option<f32> {
     const SHIFT: u32 = 20;
     const BINS: usize = 1 << (32 - SHIFT);
