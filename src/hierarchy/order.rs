@@ -46,18 +46,7 @@ pub(super) fn in_level_order(
         .map(|&f| levels_mesh.triangles[f as usize].map(|c| rank[c as usize]))
         .collect();
     let face_order = with_loose_faces(face_order, &loose, mesh.face_count());
-    let target = order
-        .par_iter()
-        .with_min_len(4096)
-        .map(|&v| {
-            let k = built.target[v as usize];
-            if k == NEVER {
-                NEVER
-            } else {
-                rank[k as usize]
-            }
-        })
-        .collect();
+    let target = targets_in_order(&order, &rank, &built.target);
     let six_split_volume = order
         .par_iter()
         .with_min_len(4096)
@@ -95,6 +84,23 @@ pub(super) fn in_level_order(
         non_manifold: built.non_manifold,
         loose,
     }
+}
+
+/// Every vertex's collapse target (`target`, M0's numbering; `NEVER` for none) in the internal
+/// order (`order`, with `rank` its inverse), as an internal id.
+fn targets_in_order(order: &[u32], rank: &[u32], target: &[u32]) -> Vec<u32> {
+    order
+        .par_iter()
+        .with_min_len(4096)
+        .map(|&v| {
+            let k = target[v as usize];
+            if k == NEVER {
+                NEVER
+            } else {
+                rank[k as usize]
+            }
+        })
+        .collect()
 }
 
 /// The levels mesh's faces in level order (`face_order`, ids of the mesh without its `loose`

@@ -29,6 +29,38 @@ pub(super) fn remove_low_frequency_shrinkage(workspace: &mut MultiresWorkspace, 
     } = workspace;
     let data = levels[level].as_ref().expect("prepared before fairing");
     let n = data.mesh.positions.len();
+    normal_displacements(data, positions, before_fairing, normals, normal_moves);
+    for _ in 0..SHRINKAGE_SMOOTHING_ROUNDS {
+        low_pass_displacements(&data.topology, normal_moves, smoothed_moves);
+        std::mem::swap(normal_moves, smoothed_moves);
+    }
+    let (moves, normals): (&[[f32; 2]], &[Vec3A]) = (normal_moves, normals);
+    // Crease vertices and corners take the correction too: holding them loses volume from coarse
+    // levels (CAD shapes, the elephant), and so does holding only the corners.
+    positions[..n]
+        .par_iter_mut()
+        .with_min_len(PARALLEL_GRAIN)
+        .enumerate()
+        .for_each(|(v, p)| {
+            let [weighted, area] = moves[v];
+            if area > 0.0 {
+                *p = (Vec3A::from_array(*p) - normals[v] * (weighted / area)).to_array();
+            }
+        });
+}
+
+/// Per vertex of the level (`data`), its unit area-weighted normal into `normals` and, into
+/// `normal_moves`, its normal displacement from `before` to `positions` weighted by its area,
+/// with that area (twice the area: Σ over the fan of (a − x) × (b − x), from the fan order
+/// where the fan is closed, from the faces otherwise).
+fn normal_displacements(
+    data: &LevelData,
+    positions: &[[f32; 3]],
+    before: &[[f32; 3]],
+    normals: &mut Vec<Vec3A>,
+    normal_moves: &mut Vec<[f32; 2]>,
+) {
+    let n = data.mesh.positions.len();
     let topology = &data.topology;
     let triangles = &data.mesh.triangles;
     let (offsets, _) = topology.neighbor_csr();
@@ -36,12 +68,7 @@ pub(super) fn remove_low_frequency_shrinkage(workspace: &mut MultiresWorkspace, 
         .fans
         .as_ref()
         .expect("a faired level has its fan-ordered rings");
-    let positions_now: &[[f32; 3]] = positions;
-    let before: &[[f32; 3]] = before_fairing;
-    let at = |v: u32| Vec3A::from_array(positions_now[v as usize]);
-    // Area-weighted vertex normals (twice the area: Σ over the fan of (a − x) × (b − x), from the
-    // fan order where the fan is closed, from the faces otherwise), unit normals, and the normal
-    // displacement weighted by the area.
+    let at = |v: u32| Vec3A::from_array(positions[v as usize]);
     (0..n)
         .into_par_iter()
         .with_min_len(PARALLEL_GRAIN)
@@ -72,37 +99,25 @@ pub(super) fn remove_low_frequency_shrinkage(workspace: &mut MultiresWorkspace, 
             (unit, [moved.dot(unit) * area, area])
         })
         .unzip_into_vecs(normals, normal_moves);
-    for _ in 0..SHRINKAGE_SMOOTHING_ROUNDS {
-        let moves: &[[f32; 2]] = normal_moves;
-        (0..n)
-            .into_par_iter()
-            .with_min_len(PARALLEL_GRAIN)
-            .map(|v| {
-                let mut sum = moves[v];
-                for &u in topology.neighbors(v as u32) {
-                    let m = moves[u as usize];
-                    sum[0] += m[0];
-                    sum[1] += m[1];
-                }
-                let mean = if sum[1] > 0.0 { sum[0] / sum[1] } else { 0.0 };
-                [mean * moves[v][1], moves[v][1]]
-            })
-            .collect_into_vec(smoothed_moves);
-        std::mem::swap(normal_moves, smoothed_moves);
-    }
-    let (moves, normals): (&[[f32; 2]], &[Vec3A]) = (normal_moves, normals);
-    // Crease vertices and corners take the correction too: holding them lost up to 8% of the
-    // volume from coarse levels (CAD shapes, the elephant), holding only the corners 7%.
-    positions[..n]
-        .par_iter_mut()
+}
+
+/// One area-weighted 1-ring average of the weighted normal displacements `moves` (each with
+/// its area) into `smoothed`.
+fn low_pass_displacements(topology: &Topology, moves: &[[f32; 2]], smoothed: &mut Vec<[f32; 2]>) {
+    (0..moves.len())
+        .into_par_iter()
         .with_min_len(PARALLEL_GRAIN)
-        .enumerate()
-        .for_each(|(v, p)| {
-            let [weighted, area] = moves[v];
-            if area > 0.0 {
-                *p = (Vec3A::from_array(*p) - normals[v] * (weighted / area)).to_array();
+        .map(|v| {
+            let mut sum = moves[v];
+            for &u in topology.neighbors(v as u32) {
+                let m = moves[u as usize];
+                sum[0] += m[0];
+                sum[1] += m[1];
             }
-        });
+            let mean = if sum[1] > 0.0 { sum[0] / sum[1] } else { 0.0 };
+            [mean * moves[v][1], moves[v][1]]
+        })
+        .collect_into_vec(smoothed);
 }
 
 /// Refines the working positions from level `finer + 1` to `finer`: places the split vertices
