@@ -71,12 +71,16 @@
 //! # Files
 //! - `operator`: the local operator, eq (7) in closed form, and the corner weights it gives.
 //! - `kernel`: one Jacobi iteration (two gather passes) and the workspace it runs in.
+//! - `rows`: the deduplicated table of weight rows and its renumbering.
 //! - `weights`: the set-up, folding the averaged local solutions into deduplicated weight rows.
+//! - `round_steps`: one round and the state the rounds carry (creases, relaxation, risk).
 //! - `rounds`: [`fair_constrained`], the driver: strength, creases, rounds, volume, risk.
 
 mod kernel;
 mod operator;
+mod round_steps;
 mod rounds;
+mod rows;
 mod weights;
 
 pub use operator::{invert3, umbrella_local_matrix, LocalOperator, Matrix3};
