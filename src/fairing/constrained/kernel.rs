@@ -83,11 +83,11 @@ impl Workspace {
 }
 impl ConstrainedFairing {
     /// Gives the tangential relaxation ([`Self::set_tangential_relaxation`]) only where it is
-    /// needed ([`super::relaxation`]): `everywhere` (0 to 1) of its weight at every vertex, and all
-    /// of it at the vertices with a thin triangle among theirs (every one, or only the folded ones:
-    /// `slivers`) in the current state (the positions of the last [`Self::load`];
-    /// [`super::relaxation::fan_sliver_share`] of its fan). Holds until called again;
-    /// `everywhere` 1 (or no state loaded yet) gives every vertex the whole weight again.
+    /// needed ([`crate::fairing::relaxation`]): `everywhere` (0 to 1) of its weight at every
+    /// vertex, and all of it at the vertices with a thin triangle among theirs (every one, or only
+    /// the folded ones: `slivers`) in the current state (the positions of the last [`Self::load`];
+    /// `relaxation::fan_sliver_share` of its fan). Holds until called again; `everywhere` 1 (or no
+    /// state loaded yet) gives every vertex the whole weight again.
     pub fn relax_where_needed(&mut self, everywhere: f32, slivers: relaxation::Slivers) {
         let everywhere = if everywhere.is_nan() {
             1.0

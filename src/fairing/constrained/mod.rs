@@ -16,7 +16,7 @@
 //!   other corners minimise the same energy ‖AP − Q‖² with their own midpoint kept
 //!   (P_a + P_b = P⁰_a + P⁰_b), while the crease corner moves along its curve. Writing P_a = s and
 //!   P_b = K − s with K = P⁰_a + P⁰_b, the residual is d·s + e with d = A_a − A_b (columns of A)
-//!   and e = A_b·K + A_h·x_h − Q, so s = −dᵀe / dᵀd ([`operator::held_corner_weights`]). Left
+//!   and e = A_b·K + A_h·x_h − Q, so s = −dᵀe / dᵀd (`operator::held_corner_weights`). Left
 //!   unsolved, as the paper leaves the boundary's triangles, they would leave every vertex beside
 //!   a crease fewer solutions to average, and on coarse scans (where crease vertices are many)
 //!   some with none, so the noise would stay there (`docs/measurements.md`, "Triangles beside a

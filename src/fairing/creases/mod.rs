@@ -50,7 +50,7 @@
 //! # Files
 //! - `normal_filter`: the guided normal filter ([`filtered_face_normals`]).
 //! - `feature_graph`: the feature edges' groups, the vertices' classes and the chains.
-//! - [`super::feature_edges`] (beside this module, shared with the noise estimate's scan): which
+//! - `super::feature_edges` (beside this module, shared with the noise estimate's scan): which
 //!   edges are feature edges.
 
 mod feature_graph;

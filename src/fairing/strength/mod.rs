@@ -58,7 +58,7 @@
 //!
 //! # Files
 //! - `scan`: the fused gather over the fan-ordered one-rings: h_v, the mean edge length and the
-//!   faces' own feature edges at once ([`scan_fans`], which crease detection uses too).
+//!   faces' own feature edges at once (`scan_fans`, which crease detection uses too).
 //! - `noise`: the noise estimate from it ([`estimate_noise`]).
 //! - `risk`: Stein's unbiased risk estimate that stops the automatic rounds.
 
