@@ -15,75 +15,8 @@ impl Creases {
     /// two feature edges (one with another number is taken as a corner).
     pub fn from_classified(edges: Vec<[u32; 2]>, mut class: Vec<FeatureClass>) -> Creases {
         let graph = FeatureGraph::new(&edges, class.len());
-        let feature_neighbors = |v: u32| graph.neighbors(v);
-        // A vertex with no feature edge is smooth; one with two may be a crease vertex; any
-        // other is a corner.
-        for (v, c) in class.iter_mut().enumerate() {
-            if *c != FeatureClass::Smooth && graph.index(v as u32).is_none() {
-                *c = FeatureClass::Smooth;
-            }
-        }
-        for (i, &v) in graph.vertices.list.iter().enumerate() {
-            let c = &mut class[v as usize];
-            *c = match (*c, graph.neighbors_at(i).len()) {
-                (FeatureClass::Crease, 2) => FeatureClass::Crease,
-                _ => FeatureClass::Corner,
-            };
-        }
-        let mut used = vec![false; graph.adjacent.len()];
-        let slot = |from: u32, to: u32| -> usize {
-            let i = graph.index(from).expect("a feature edge's end is listed");
-            graph.offsets[i] as usize
-                + graph
-                    .neighbors_at(i)
-                    .iter()
-                    .position(|&u| u == to)
-                    .expect("a feature edge is listed at both ends")
-        };
-        let walk = |start: u32, first: u32, used: &mut Vec<bool>| -> Option<Chain> {
-            if used[slot(start, first)] {
-                return None;
-            }
-            let mut vertices = vec![start];
-            let (mut previous, mut current) = (start, first);
-            loop {
-                used[slot(previous, current)] = true;
-                used[slot(current, previous)] = true;
-                if current == start {
-                    return Some(Chain {
-                        vertices,
-                        closed: true,
-                    });
-                }
-                vertices.push(current);
-                if class[current as usize] != FeatureClass::Crease {
-                    return Some(Chain {
-                        vertices,
-                        closed: false,
-                    });
-                }
-                let next = feature_neighbors(current)
-                    .iter()
-                    .copied()
-                    .find(|&u| u != previous)
-                    .expect("a crease vertex has two feature edges");
-                (previous, current) = (current, next);
-            }
-        };
-        let mut chains = Vec::new();
-        for (i, &v) in graph.vertices.list.iter().enumerate() {
-            if class[v as usize] == FeatureClass::Corner {
-                for &u in graph.neighbors_at(i) {
-                    chains.extend(walk(v, u, &mut used));
-                }
-            }
-        }
-        for (i, &v) in graph.vertices.list.iter().enumerate() {
-            if class[v as usize] == FeatureClass::Crease {
-                let first = graph.neighbors_at(i)[0];
-                chains.extend(walk(v, first, &mut used));
-            }
-        }
+        settle_classes(&graph, &mut class);
+        let chains = walk_chains(&graph, &class);
         // A closed crease of a few vertices is no curve the section 3.3 constraints can fair (its
         // vertices run together, leaving faces with no area, in multires from coarse levels): it
         // is held in place, as corners are, and its edges become chains between them.
@@ -107,6 +40,85 @@ impl Creases {
             chains,
         }
     }
+}
+
+/// The classes `graph` allows: a vertex with no feature edge is smooth; one classed `Crease`
+/// with two stays a crease vertex; any other with feature edges is a corner.
+fn settle_classes(graph: &FeatureGraph, class: &mut [FeatureClass]) {
+    for (v, c) in class.iter_mut().enumerate() {
+        if *c != FeatureClass::Smooth && graph.index(v as u32).is_none() {
+            *c = FeatureClass::Smooth;
+        }
+    }
+    for (i, &v) in graph.vertices.list.iter().enumerate() {
+        let c = &mut class[v as usize];
+        *c = match (*c, graph.neighbors_at(i).len()) {
+            (FeatureClass::Crease, 2) => FeatureClass::Crease,
+            _ => FeatureClass::Corner,
+        };
+    }
+}
+
+/// The chains of `graph`'s feature edges: walked from every corner along each of its feature
+/// edges to the next corner (open), then around the loops of crease vertices that remain
+/// (closed); every edge in one chain.
+fn walk_chains(graph: &FeatureGraph, class: &[FeatureClass]) -> Vec<Chain> {
+    let mut used = vec![false; graph.adjacent.len()];
+    let slot = |from: u32, to: u32| -> usize {
+        let i = graph.index(from).expect("a feature edge's end is listed");
+        graph.offsets[i] as usize
+            + graph
+                .neighbors_at(i)
+                .iter()
+                .position(|&u| u == to)
+                .expect("a feature edge is listed at both ends")
+    };
+    let walk = |start: u32, first: u32, used: &mut Vec<bool>| -> Option<Chain> {
+        if used[slot(start, first)] {
+            return None;
+        }
+        let mut vertices = vec![start];
+        let (mut previous, mut current) = (start, first);
+        loop {
+            used[slot(previous, current)] = true;
+            used[slot(current, previous)] = true;
+            if current == start {
+                return Some(Chain {
+                    vertices,
+                    closed: true,
+                });
+            }
+            vertices.push(current);
+            if class[current as usize] != FeatureClass::Crease {
+                return Some(Chain {
+                    vertices,
+                    closed: false,
+                });
+            }
+            let next = graph
+                .neighbors(current)
+                .iter()
+                .copied()
+                .find(|&u| u != previous)
+                .expect("a crease vertex has two feature edges");
+            (previous, current) = (current, next);
+        }
+    };
+    let mut chains = Vec::new();
+    for (i, &v) in graph.vertices.list.iter().enumerate() {
+        if class[v as usize] == FeatureClass::Corner {
+            for &u in graph.neighbors_at(i) {
+                chains.extend(walk(v, u, &mut used));
+            }
+        }
+    }
+    for (i, &v) in graph.vertices.list.iter().enumerate() {
+        if class[v as usize] == FeatureClass::Crease {
+            let first = graph.neighbors_at(i)[0];
+            chains.extend(walk(v, first, &mut used));
+        }
+    }
+    chains
 }
 
 /// Closed creases with fewer vertices than this are held in place.
