@@ -73,6 +73,8 @@ struct VertexScan {
 }
 
 impl Topology {
+    /// The connectivity of `mesh` (see the module docs for how it is computed). A kernel: its
+    /// passes share one scratch space, so they stay in one function.
     pub fn build(mesh: &TriMesh) -> Topology {
         let vertex_count = mesh.positions.len();
         let triangles = &mesh.triangles;
