@@ -2,8 +2,8 @@
 //! baselines it is compared against (Laplacian, Taubin, HC Laplacian).
 //!
 //! - [`fair_constrained`] ([`constrained`]): every interior triangle solves the local problem (6)
-//!   in closed form (eq 7) with its barycentre held at its anchor; each vertex takes the mean of its
-//!   triangles' solutions (Jacobi). Boundary loops are faired as closed curves ([`boundary`]).
+//!   in closed form (eq 7) with its barycentre held at its anchor; each vertex takes the mean of
+//!   its triangles' solutions (Jacobi). Boundary loops are faired as closed curves ([`boundary`]).
 //! - [`fair_laplacian`], [`fair_taubin`], [`fair_hc`] ([`baseline`]): the classic umbrella
 //!   smoothers, with the same boundary options, for comparison.
 //! - [`Method`] and [`MethodOptions`] name one of the four for the CLI and the editor;
@@ -59,6 +59,7 @@ pub mod baseline;
 pub mod boundary;
 pub mod constrained;
 pub mod creases;
+mod feature_edges;
 pub mod mask;
 pub mod relaxation;
 pub mod strength;

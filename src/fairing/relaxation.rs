@@ -25,7 +25,7 @@
 //! [`everywhere_share`] of the weight, reads it again before every later round until the mesh is
 //! as even as a relaxed one ([`still_needed_share`]: relaxing on from there only evens the
 //! sampling out, as above), and before every round also relaxes fully the vertices with a sliver
-//! among their triangles ([`fan_sliver_share`]: [`sliver_share`] of its quality; without creases
+//! among their triangles (`fan_sliver_share`: [`sliver_share`] of its quality; without creases
 //! times [`fold_share`] of its turn from the fan).
 //!
 //! # The tangential noise reading
@@ -41,8 +41,7 @@
 //! 0.5 0.75-0.81, at 0.1 0.24-0.44. It is read on at most [`TANGENTIAL_SAMPLES`] vertices spread
 //! over the numbering, which a median of that many reads to about a percent.
 
-use super::constrained::FanRings;
-use crate::mesh::{Topology, TriMesh};
+use crate::mesh::{FanRings, Topology, TriMesh};
 use glam::Vec3A;
 use rayon::prelude::*;
 
@@ -158,7 +157,7 @@ pub fn fold_share(cos_angle: f32) -> f32 {
     ) as f32
 }
 
-/// Which thin triangles the relaxation acts on ([`fan_sliver_share`]).
+/// Which thin triangles the relaxation acts on (`fan_sliver_share`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Slivers {
     /// Every one: on the flat faces of a CAD part every degree a thin triangle tilts is an error

@@ -11,8 +11,8 @@
 //! volume's derivative under a uniform normal offset being about the area; exactly, the root of
 //! the part's volume as a cubic in δ, see [`VolumeKeeper::restore`]).
 //! Being a single number per part, it carries no detail of the noise back, unlike a correction
-//! that varies over the surface (a low-passed per-vertex correction was tried and kept too much
-//! noise: `docs/measurements.md`).
+//! that varies over the surface (a low-passed per-vertex correction keeps too much noise:
+//! `docs/measurements.md`).
 //!
 //! An open part has no inside; its "volume" here is that of the cone from its centroid (taken
 //! before fairing) to its surface, which a uniform inward drift of the surface lowers just the

@@ -1,6 +1,6 @@
 //! Volume-preserving decimation hierarchy (paper section 4.1) and moving between its levels.
 //!
-//! [`build_hierarchy`] runs the passes of `decimate.rs` (one pass per level, see that module for
+//! [`build_hierarchy`] runs the passes of `decimate` (one pass per level, see that module for
 //! the cost, the independent set, the cone volume and the validity rules) and then stores the
 //! result in a form where every level is cheap to reach:
 //!
@@ -19,40 +19,44 @@
 //!   from M0's corners. Both are exact: coarsening to the top and refining back gives M0's faces,
 //!   in M0's order once mapped back through [`Hierarchy::original_vertex`].
 //!
-//! Creases ([`HierarchyOptions::creases`], off by default for now; not in the paper): M0's creases are
-//! found as [`crate::fairing::detect_creases`] finds them (normals filtered as much as the noise
-//! estimate asks; groups that wander are dropped only where their edges turn by more than
-//! [`HIERARCHY_ZIGZAG_TURN`] unless the options say otherwise, since a coarse level keeps its
-//! shape by those bends), corners never collapse and crease vertices collapse only along their
-//! crease (see `decimate.rs`), so every level's creases are M0's feature edges with their ends followed
-//! along `target` ([`Hierarchy::level_creases`]); multiresolution fairing fairs them as curves.
-//! The detection costs a topology, the fan-ordered one-rings and one gather over them that gives
-//! the noise estimate and the feature edges together (the guided normal filter only on a noisy
-//! mesh); figures in `docs/measurements.md`.
+//! Creases ([`HierarchyOptions::creases`], off by default for now; not in the paper): M0's creases
+//! are found as [`crate::fairing::detect_creases`] finds them (normals filtered as much as the
+//! noise estimate asks; groups that wander are dropped only where their edges turn by more than
+//! [`HIERARCHY_ZIGZAG_TURN`] unless the options say otherwise, since a coarse level keeps its shape
+//! by those bends), corners never collapse and crease vertices collapse only along their crease
+//! (see `decimate.rs`), so every level's creases are M0's feature edges with their ends followed
+//! along `target` ([`Hierarchy::level_creases`]); multiresolution fairing fairs them as curves. The
+//! detection costs a topology, the fan-ordered one-rings and one gather over them that gives the
+//! noise estimate and the feature edges together (the guided normal filter only on a noisy mesh);
+//! figures in `docs/measurements.md`.
 //!
 //! Loose triangles (not in the paper): on a mesh with non-manifold edges, the triangles a scan's
 //! reconstruction left lying over a fan or hanging as fins ([`crate::mesh::loose_triangles`])
 //! are left out of the levels ([`HierarchyOptions::leave_out_loose_triangles`]): level 0 is M0
 //! without them, M0 itself stays whole, and `face_order` maps into M0's faces. Kept in, their
-//! corners were non-manifold and pinned with their neighbours in every level (the Stanford
-//! dragon's levels stopped at 9997 of its 22982 vertices; without them they reach 627).
+//! corners would be non-manifold and pinned with their neighbours in every level (a scan such as
+//! the Stanford dragon would keep under half its vertices in its coarsest level).
 //!
 //! Storage per M0 vertex: target 4 bytes, cone volume 4, the vertex order both ways 8, and the
 //! face order (about two faces per vertex) 8: 24 bytes, besides M0 itself in internal order.
+//!
+//! # Files
+//! - `decimate`: the passes that remove the vertices, level by level.
+//! - `order`: M0 numbered by level from the passes' output.
 
 mod decimate;
+mod order;
 
-use crate::fairing::constrained::FanRings;
 use crate::fairing::creases::{
     detect_creases_with_estimate, CreaseOptions, Creases, FaceRingCache, FeatureClass,
     HIERARCHY_ZIGZAG_TURN,
 };
-use crate::mesh::{Topology, TriMesh};
+use crate::mesh::{FanRings, Topology, TriMesh};
 use crate::Progress;
 use decimate::NEVER;
-use rayon::prelude::*;
+use order::in_level_order;
 use std::borrow::Cow;
-use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::atomic::AtomicU64;
 
 /// Options of [`build_hierarchy`]; build them with `HierarchyOptions::default()` and the
 /// `with_*` setters.
@@ -506,6 +510,8 @@ pub fn build_hierarchy_with_topology(
     build(mesh, fits.then_some(topology), options, progress)
 }
 
+/// [`build_hierarchy`] with the topology, when one is at hand: checks the mesh, finds the
+/// creases, decimates, then numbers M0 by level.
 fn build(
     mesh: &TriMesh,
     topology: Option<&Topology>,
@@ -513,31 +519,14 @@ fn build(
     progress: &mut dyn Progress,
 ) -> Result<Hierarchy, HierarchyError> {
     let started = std::time::Instant::now();
-    let n = mesh.vertex_count();
-    if n >= u32::MAX as usize / 2 {
-        return Err(HierarchyError::Unsupported(format!(
-            "{n} vertices is more than this hierarchy can number"
-        )));
-    }
-    if let Some(v) = mesh.first_non_finite_vertex() {
-        return Err(HierarchyError::Unsupported(format!(
-            "vertex {v} has a non-finite coordinate"
-        )));
-    }
-    if let Some((f, t)) = mesh.triangles.iter().enumerate().find(|(_, t)| {
-        t.iter().any(|&c| c as usize >= n) || t[0] == t[1] || t[1] == t[2] || t[0] == t[2]
-    }) {
-        return Err(HierarchyError::Unsupported(format!(
-            "face {f} {t:?} repeats a vertex or refers to a missing one"
-        )));
-    }
+    check_supported(mesh)?;
     // A non-manifold scan is decimated without the triangles its reconstruction left lying loose
     // at its non-manifold edges (`crate::mesh::loose_triangles`, as the default fairing leaves
-    // them out): they pinned their corners and neighbours in every level, so the Stanford
-    // dragon's levels stopped at 9997 of its 22982 vertices. They stay in M0; the levels are
-    // those of the mesh without them. With a topology at hand (given, or needed for the creases)
-    // they are looked for at once; otherwise only when the first pass finds a non-manifold
-    // vertex, so a manifold mesh pays nothing.
+    // them out): they would pin their corners and neighbours in every level, and the levels of a
+    // scan such as the Stanford dragon would stop at under half its vertices. They stay in M0;
+    // the levels are those of the mesh without them. With a topology at hand (given, or needed
+    // for the creases) they are looked for at once; otherwise only when the first pass finds a
+    // non-manifold vertex, so a manifold mesh pays nothing.
     let mut topology = topology.map(Cow::Borrowed);
     if options.creases.is_some() && topology.is_none() {
         topology = Some(Cow::Owned(Topology::build(mesh)));
@@ -548,37 +537,16 @@ fn build(
         }
         _ => None,
     };
-    let creases = options
-        .creases
-        .as_ref()
-        .map(|crease_options| {
-            let (levels_mesh, levels_topology) = match &loose_out {
-                Some((_, kept, kept_topology)) => (kept, kept_topology),
-                None => (
-                    mesh,
-                    topology.as_deref().expect("built above for the creases"),
-                ),
-            };
-            let fans = FanRings::new(&levels_mesh.triangles, levels_topology);
-            let crease_options = CreaseOptions {
-                zigzag_turn_degrees: Some(
-                    crease_options
-                        .zigzag_turn_degrees
-                        .unwrap_or(HIERARCHY_ZIGZAG_TURN),
-                ),
-                ..crease_options.clone()
-            };
-            detect_creases_with_estimate(
-                levels_mesh,
-                levels_topology,
-                &fans,
-                &crease_options,
-                &mut FaceRingCache::default(),
-                true,
-            )
-            .1
-        })
-        .filter(|creases| !creases.is_empty());
+    let creases = options.creases.as_ref().and_then(|crease_options| {
+        let (levels_mesh, levels_topology) = match &loose_out {
+            Some((_, kept, kept_topology)) => (kept, kept_topology),
+            None => (
+                mesh,
+                topology.as_deref().expect("built above for the creases"),
+            ),
+        };
+        levels_creases(levels_mesh, levels_topology, crease_options)
+    });
     let setup_ms = started.elapsed().as_secs_f64() * 1e3;
 
     let look_later = options.leave_out_loose_triangles && topology.is_none();
@@ -599,184 +567,66 @@ fn build(
         Some((loose, kept, _)) => (loose, Cow::Owned(kept)),
         None => (Vec::new(), Cow::Borrowed(mesh)),
     };
-    let finishing = std::time::Instant::now();
-    let passes = built.pass_ms.len();
-
-    // Internal order: by pass of removal, latest (or never) first; ties by id.
-    let ByPass {
-        order,
-        rank,
-        level_sizes: level_vertices,
-    } = by_pass(&built.removed_in_pass, passes, true);
-    let ByPass {
-        order: face_order,
-        level_sizes: level_faces,
-        ..
-    } = by_pass(&built.face_removed_in_pass, passes, false);
-    // Gathers in M0's order (parallel, as they mostly wait on memory).
-    let positions = order
-        .par_iter()
-        .with_min_len(4096)
-        .map(|&v| mesh.positions[v as usize])
-        .collect();
-    let triangles = face_order
-        .par_iter()
-        .with_min_len(4096)
-        .map(|&f| levels_mesh.triangles[f as usize].map(|c| rank[c as usize]))
-        .collect();
-    // The levels mesh's faces are M0's without the loose ones, in M0's order.
-    let face_order = if loose.is_empty() {
-        face_order
-    } else {
-        let mut is_loose = vec![false; mesh.face_count()];
-        for &f in &loose {
-            is_loose[f as usize] = true;
-        }
-        let kept: Vec<u32> = (0..mesh.face_count() as u32)
-            .filter(|&f| !is_loose[f as usize])
-            .collect();
-        face_order.iter().map(|&f| kept[f as usize]).collect()
-    };
-    let target = order
-        .par_iter()
-        .with_min_len(4096)
-        .map(|&v| {
-            let k = built.target[v as usize];
-            if k == NEVER {
-                NEVER
-            } else {
-                rank[k as usize]
-            }
-        })
-        .collect();
-    let six_split_volume = order
-        .par_iter()
-        .with_min_len(4096)
-        .map(|&v| built.six_split_volume[v as usize])
-        .collect();
-    let (feature_class, crease_edges) = match creases {
-        Some(creases) => (
-            order.iter().map(|&v| creases.class[v as usize]).collect(),
-            creases
-                .edges
-                .iter()
-                .map(|e| e.map(|c| rank[c as usize]))
-                .collect(),
-        ),
-        None => (Vec::new(), Vec::new()),
-    };
-    let mut level_ms = vec![setup_ms + finishing.elapsed().as_secs_f64() * 1e3];
-    level_ms.extend_from_slice(&built.pass_ms);
-
-    Ok(Hierarchy {
-        base: mesh.clone(),
-        id: NEXT_HIERARCHY_ID.fetch_add(1, Ordering::Relaxed),
-        order,
-        rank,
-        positions,
-        triangles,
-        face_order,
-        target,
-        six_split_volume,
-        level_vertices,
-        level_faces,
-        level_ms,
-        feature_class,
-        crease_edges,
-        non_manifold: built.non_manifold,
+    Ok(in_level_order(
+        mesh,
+        &levels_mesh,
         loose,
-    })
+        built,
+        creases,
+        setup_ms,
+    ))
 }
 
-/// Vertices (or faces) ordered by the pass that removed them, latest first and those never
-/// removed before all; ties by id.
-struct ByPass {
-    /// Ids in that order.
-    order: Vec<u32>,
-    /// Place of each id in `order` (empty unless asked for).
-    rank: Vec<u32>,
-    /// `level_sizes[i]`: how many were not removed in passes `0..i`, for `i` in `0..=passes`.
-    level_sizes: Vec<u32>,
+/// An error for a mesh the hierarchy cannot number or decimate: too many vertices, a non-finite
+/// coordinate, or a face that repeats a vertex or refers to a missing one.
+fn check_supported(mesh: &TriMesh) -> Result<(), HierarchyError> {
+    let n = mesh.vertex_count();
+    if n >= u32::MAX as usize / 2 {
+        return Err(HierarchyError::Unsupported(format!(
+            "{n} vertices is more than this hierarchy can number"
+        )));
+    }
+    if let Some(v) = mesh.first_non_finite_vertex() {
+        return Err(HierarchyError::Unsupported(format!(
+            "vertex {v} has a non-finite coordinate"
+        )));
+    }
+    if let Some((f, t)) = mesh.triangles.iter().enumerate().find(|(_, t)| {
+        t.iter().any(|&c| c as usize >= n) || t[0] == t[1] || t[1] == t[2] || t[0] == t[2]
+    }) {
+        return Err(HierarchyError::Unsupported(format!(
+            "face {f} {t:?} repeats a vertex or refers to a missing one"
+        )));
+    }
+    Ok(())
 }
 
-/// A stable counting sort of the ids by `removed_in_pass` (`NEVER`, or a pass below `passes`),
-/// in parallel over chunks of ids: each chunk counts its ids per pass, the counts give each chunk
-/// its places, and each chunk places its ids (and writes their ranks, which are its own), so the
-/// order is the same for any number of threads.
-fn by_pass(removed_in_pass: &[u32], passes: usize, with_rank: bool) -> ByPass {
-    const CHUNK: usize = 1 << 15;
-    // Bucket 0 for survivors, `passes - p` for ids removed in pass p.
-    let bucket = |p: u32| if p == NEVER { 0 } else { passes - p as usize };
-    let counts: Vec<Vec<u32>> = removed_in_pass
-        .par_chunks(CHUNK)
-        .map(|chunk| {
-            let mut count = vec![0u32; passes + 1];
-            for &p in chunk {
-                count[bucket(p)] += 1;
-            }
-            count
-        })
-        .collect();
-    // Each chunk's first place in each bucket.
-    let mut next = vec![0u32; passes + 1];
-    for count in &counts {
-        for (n, c) in next.iter_mut().zip(count) {
-            *n += c;
-        }
-    }
-    let totals = next.clone();
-    let mut sum = 0;
-    for n in &mut next {
-        (*n, sum) = (sum, sum + *n);
-    }
-    let starts: Vec<Vec<u32>> = counts
-        .iter()
-        .map(|count| {
-            let start = next.clone();
-            for (n, c) in next.iter_mut().zip(count) {
-                *n += c;
-            }
-            start
-        })
-        .collect();
-    let order = decimate::atomics(removed_in_pass.len(), 0);
-    let mut rank = if with_rank {
-        vec![0u32; removed_in_pass.len()]
-    } else {
-        Vec::new()
+/// The creases the levels keep, found on the mesh that is decimated (`None` when there are
+/// none); groups that wander are kept unless `crease_options` say otherwise
+/// ([`HIERARCHY_ZIGZAG_TURN`]).
+fn levels_creases(
+    levels_mesh: &TriMesh,
+    levels_topology: &Topology,
+    crease_options: &CreaseOptions,
+) -> Option<Creases> {
+    let fans = FanRings::new(&levels_mesh.triangles, levels_topology);
+    let crease_options = CreaseOptions {
+        zigzag_turn_degrees: Some(
+            crease_options
+                .zigzag_turn_degrees
+                .unwrap_or(HIERARCHY_ZIGZAG_TURN),
+        ),
+        ..crease_options.clone()
     };
-    let rank_chunks: Vec<Option<&mut [u32]>> = if with_rank {
-        rank.chunks_mut(CHUNK).map(Some).collect()
-    } else {
-        (0..starts.len()).map(|_| None).collect()
-    };
-    removed_in_pass
-        .par_chunks(CHUNK)
-        .zip(starts)
-        .zip(rank_chunks)
-        .enumerate()
-        .for_each(|(c, ((chunk, mut slot), mut rank))| {
-            for (i, &p) in chunk.iter().enumerate() {
-                let slot = &mut slot[bucket(p)];
-                order[*slot as usize].store((c * CHUNK + i) as u32, Ordering::Relaxed);
-                if let Some(rank) = rank.as_mut() {
-                    rank[i] = *slot;
-                }
-                *slot += 1;
-            }
-        });
-    // Level i keeps the survivors and the ids removed in passes i and later: buckets
-    // `0..=passes - i`.
-    let level_sizes = (0..=passes)
-        .map(|i| totals[..=passes - i].iter().sum())
-        .collect();
-    ByPass {
-        // (Atomics only so that the chunks can place their ids at once; the same layout, so
-        // this reuses the memory.)
-        order: decimate::into_inner(order),
-        rank,
-        level_sizes,
-    }
+    let (_, creases) = detect_creases_with_estimate(
+        levels_mesh,
+        levels_topology,
+        &fans,
+        &crease_options,
+        &mut FaceRingCache::default(),
+        true,
+    );
+    (!creases.is_empty()).then_some(creases)
 }
 
 #[cfg(test)]

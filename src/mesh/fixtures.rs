@@ -79,3 +79,45 @@ pub(crate) fn bipyramid_with(extra: &[[u32; 3]]) -> TriMesh {
     triangles.extend_from_slice(extra);
     TriMesh::new(positions, triangles)
 }
+
+/// Small deterministic generator (xorshift) so the tests need no seeds from outside.
+pub(crate) struct Rng(pub(crate) u64);
+impl Rng {
+    pub(crate) fn next(&mut self) -> f64 {
+        self.0 ^= self.0 << 13;
+        self.0 ^= self.0 >> 7;
+        self.0 ^= self.0 << 17;
+        (self.0 >> 11) as f64 / (1u64 << 53) as f64
+    }
+    pub(crate) fn range(&mut self, lo: f64, hi: f64) -> f64 {
+        lo + (hi - lo) * self.next()
+    }
+}
+
+/// A small irregular closed mesh: an octahedron subdivided irregularly, with bumps.
+pub(crate) fn irregular_sphere() -> TriMesh {
+    let TriMesh {
+        mut positions,
+        mut triangles,
+    } = crate::mesh::fixtures::octahedron(1.0);
+    // Split some faces at their centre (1-to-3) to make valences irregular.
+    let mut rng = Rng(12345);
+    for round in 0..3 {
+        let count = triangles.len();
+        for f in (0..count).filter(|f| (f + round) % 2 == 0) {
+            let [a, b, c] = triangles[f];
+            let centre: [f32; 3] = std::array::from_fn(|k| {
+                (positions[a as usize][k] + positions[b as usize][k] + positions[c as usize][k])
+                    / 3.0
+            });
+            let length = centre.iter().map(|x| x * x).sum::<f32>().sqrt();
+            let bump = 1.0 + 0.1 * rng.range(-1.0, 1.0) as f32;
+            positions.push(centre.map(|x| x / length * bump));
+            let m = positions.len() as u32 - 1;
+            triangles[f] = [a, b, m];
+            triangles.push([b, c, m]);
+            triangles.push([c, a, m]);
+        }
+    }
+    TriMesh::new(positions, triangles)
+}

@@ -8,12 +8,16 @@
 //!   output files keep the input's vertex order.
 //! - [`loose_triangles`]: triangles lying over a fan or hanging from a non-manifold edge, which
 //!   the default fairing leaves out.
+//! - `FanRings`: one-rings in fan order, and the face and vertex normals the gathers take
+//!   from them and from the faces (`area_normal`).
 //! - [`breadth_first_order`]: a locality order for the gather kernels, which keep their own
 //!   internal numbering and map back on output.
 
 mod clean;
+mod fans;
 #[cfg(test)]
 pub(crate) mod fixtures;
+mod normals;
 mod orient;
 mod overlay;
 mod reorder;
@@ -25,6 +29,8 @@ pub use clean::{clean, weld, CleanReport, WeldReport};
 pub(crate) use clean::{
     clean_with_map_but_repeats, remove_triangles, repeats_among, weld_with_map, PositionHasher,
 };
+pub(crate) use fans::{split_into_vertex_blocks, FanRings, VERTEX_BLOCK};
+pub(crate) use normals::{area_normal, unit_vertex_normals};
 pub use orient::{orient_consistently, OrientReport};
 pub use overlay::{loose_triangles, without_loose_triangles};
 pub(crate) use reorder::morton_code;

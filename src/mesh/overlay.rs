@@ -20,10 +20,9 @@
 //! triangles or fewer, the overlays go, not the piece.
 //!
 //! A corner that only loose triangles use (a fin's tip) has nothing left to smooth it and stays
-//! where it is. Moving it with its base (by the mean of the base's moves) was tried and measured
-//! worse: on the noisy dragon and bust the tips that followed ended farther from the clean
-//! surface (the base's move takes out the base's noise, not the tip's), Hausdorff distance up
-//! by a tenth to a fifth.
+//! where it is. Moving it with its base (by the mean of the base's moves) would take it farther
+//! from the clean surface (the base's move takes out the base's noise, not the tip's;
+//! `docs/measurements.md`).
 
 use super::{Topology, TriMesh};
 use std::collections::HashMap;

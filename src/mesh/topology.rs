@@ -73,6 +73,8 @@ struct VertexScan {
 }
 
 impl Topology {
+    /// The connectivity of `mesh` (see the module docs for how it is computed). A kernel: its
+    /// passes share one scratch space, so they stay in one function.
     pub fn build(mesh: &TriMesh) -> Topology {
         let vertex_count = mesh.positions.len();
         let triangles = &mesh.triangles;
@@ -121,10 +123,11 @@ impl Topology {
             })
             .collect();
 
-        // Compact the neighbour lists (entries are sorted; neighbours are entries >> 1, deduplicated
-        // in place by scan_vertex into the slot's prefix) within the scratch space itself: a vertex
-        // has at most two neighbours per face, so every list moves down or stays, and no second
-        // array of all the neighbours is held beside the scratch space (the peak of a load).
+        // Compact the neighbour lists (entries are sorted; neighbours are entries >> 1,
+        // deduplicated in place by scan_vertex into the slot's prefix) within the scratch space
+        // itself: a vertex has at most two neighbours per face, so every list moves down or stays,
+        // and no second array of all the neighbours is held beside the scratch space (the peak of a
+        // load).
         let mut neighbor_offsets = vec![0u32; vertex_count + 1];
         for v in 0..vertex_count {
             neighbor_offsets[v + 1] = neighbor_offsets[v] + scans[v].neighbor_count;

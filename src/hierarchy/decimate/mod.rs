@@ -82,12 +82,11 @@
 //! cost order. Interior visits of two regions of one round never touch the same state, so the
 //! hierarchy is the same for any number of threads (tested). It is not the one-at-a-time
 //! hierarchy: a vertex near a region's edge is visited after the interiors, whatever its cost
-//! (the first level of the 1.2M-face bunny keeps 434953 vertices instead of 433321, the same
-//! 29 levels; the quality tables in `docs/measurements.md` show multires from every level of
-//! noisy bunny00 as good as before). A region's arrays fit in the last-level cache, which made
-//! the one-thread build a little faster too. If the regions alone would take the level below
+//! (the levels differ by a fraction of a percent in size; the quality tables in
+//! `docs/measurements.md` show multires from every level as good either way). A region's arrays
+//! fit in the last-level cache. If the regions alone would take the level below
 //! `min_vertices`, the pass is visited again one vertex at a time. Smaller levels are visited one
-//! vertex at a time, exactly as before regions.
+//! vertex at a time.
 //!
 //! A level visited in regions also builds its fans and writes the next level in parallel, and M0
 //! is sorted in parallel when it is. The counting sorts with many buckets (M0's faces by first
@@ -98,16 +97,30 @@
 //! half their branches); the next level is written in chunks of a region's least size (each
 //! chunk counts what it keeps, the running sums place it); the per-pass arrays are filled and
 //! the removals recorded in parallel too. All give the same arrays for any number of threads.
-//! (Sorting each chunk of faces by block first, ordered parallel filters that gather the labels
-//! twice, and giving each block of the fans' sort only the range of faces that reach it (faces
-//! across the jumps of the Morton order span nearly every range) were tried and were slower.)
+//!
+//! # Files
+//! - `levels`: M0 as the first level, and the level after a pass's collapses.
+//! - `collapse`: one visit, choosing and checking a vertex's collapse.
+//! - `sort`: the parallel counting and radix sorts the passes and levels use.
+//! - This file: the passes (costs, regions, visits, fans) and the build's output. Its pass
+//!   driver (`passes`) and the level and collapse kernels stay long where one loop reads as one
+//!   step over the level's arrays.
+
+mod collapse;
+mod levels;
+mod sort;
 
 use super::{HierarchyError, HierarchyOptions};
 use crate::fairing::creases::{Creases, FeatureClass};
 use crate::mesh::TriMesh;
 use crate::Progress;
+use collapse::{visit, PassView, Scratch};
 use glam::DVec3;
+use levels::{first_level, next_level};
 use rayon::prelude::*;
+use sort::{
+    bucket_sort, digit_sort, running_starts, sort_by_first, split_by_lengths, SortedBuckets,
+};
 use std::sync::atomic::{AtomicU32, AtomicU64, Ordering::Relaxed};
 use std::time::Instant;
 
@@ -188,122 +201,6 @@ struct Level {
 const NO_CREASE: [u32; 2] = [NEVER; 2];
 /// `Level::crease` of a corner, which never collapses.
 const CORNER: [u32; 2] = [NEVER - 1; 2];
-
-/// M0 as the first level: the vertices that some face uses (isolated ones are never removed) in
-/// Morton order of their positions (quantized to 10 bits per axis in M0's bounding box; ties by
-/// id), the faces in order of their first corner's place in that order (ties by id); with the
-/// creases' classes and crease neighbours in the same order. `parallel`: sort in chunks and
-/// blocks (the same order).
-fn first_level(mesh: &TriMesh, creases: Option<&Creases>, parallel: bool) -> Level {
-    let n = mesh.vertex_count();
-    let (lo, hi) = crate::metrics::bounding_box(mesh).unwrap_or_default();
-    let scale = (hi - lo).max_element().max(f64::MIN_POSITIVE);
-    // Every vertex's key (isolated ones are taken out after the sort, which leaves the others'
-    // order as it is: a filtered parallel collect cost more than the codes).
-    let keys: Vec<u64> = (0..n)
-        .into_par_iter()
-        .with_min_len(4096)
-        .map(|v| {
-            let p = mesh.positions[v].map(f64::from);
-            crate::mesh::morton_code(p.into(), lo, scale) << 32 | v as u64
-        })
-        .collect();
-    // Sorted by code (30 bits), ties by id (the keys come in id order and each pass is stable):
-    // the low 15 bits of the code, then the high 15; the second pass writes each vertex's
-    // place too.
-    let digit = |k: u64, shift: u32| (k >> (32 + shift)) as usize & 0x7fff;
-    let by_low: Vec<AtomicU64> = (0..n).into_par_iter().map(|_| AtomicU64::new(0)).collect();
-    digit_sort(
-        &keys,
-        |&k| digit(k, 0),
-        parallel,
-        |slot, &k| {
-            by_low[slot].store(k, Relaxed);
-        },
-    );
-    drop(keys);
-    let by_low: Vec<u64> = by_low.into_iter().map(AtomicU64::into_inner).collect();
-    let (vertex_id, place_of) = (atomics(n, 0), atomics(n, 0));
-    digit_sort(
-        &by_low,
-        |&k| digit(k, 15),
-        parallel,
-        |slot, &k| {
-            vertex_id[slot].store(k as u32, Relaxed);
-            place_of[k as u32 as usize].store(slot as u32, Relaxed);
-        },
-    );
-    drop(by_low);
-    let mut vertex_id = into_inner(vertex_id);
-    let mut level_of = into_inner(place_of);
-    let mut used = vec![false; n];
-    for t in &mesh.triangles {
-        for &c in t {
-            used[c as usize] = true;
-        }
-    }
-    if used.contains(&false) {
-        vertex_id.retain(|&v| used[v as usize]);
-        level_of.fill(NEVER);
-        for (i, &v) in vertex_id.iter().enumerate() {
-            level_of[v as usize] = i as u32;
-        }
-    }
-    drop(used);
-    let (mut offsets, mut cursor) = (Vec::new(), Vec::new());
-    // Faces by a counting sort on their first corner's place (stable, so ties stay by id).
-    let place: Vec<u32> = mesh
-        .triangles
-        .par_iter()
-        .with_min_len(4096)
-        .map(|t| level_of[t[0] as usize])
-        .collect();
-    let mut face_id = Vec::new();
-    bucket_sort(
-        place.len(),
-        vertex_id.len(),
-        parallel,
-        |f| [(place[f], f as u32)],
-        &mut offsets,
-        &mut cursor,
-        &mut face_id,
-    );
-    drop(place);
-    let crease = creases.map_or_else(Vec::new, |creases| {
-        let mut crease: Vec<[u32; 2]> = vertex_id
-            .iter()
-            .map(|&v| match creases.class[v as usize] {
-                FeatureClass::Smooth => NO_CREASE,
-                FeatureClass::Corner => CORNER,
-                FeatureClass::Crease => [NEVER; 2],
-            })
-            .collect();
-        for &[a, b] in &creases.edges {
-            let (a, b) = (level_of[a as usize], level_of[b as usize]);
-            for (x, y) in [(a, b), (b, a)] {
-                let slots = &mut crease[x as usize];
-                if *slots != CORNER {
-                    let free = if slots[0] == NEVER { 0 } else { 1 };
-                    slots[free] = y;
-                }
-            }
-        }
-        crease
-    });
-    Level {
-        crease,
-        points: vertex_id
-            .par_iter()
-            .map(|&v| mesh.positions[v as usize])
-            .collect(),
-        corners: face_id
-            .par_iter()
-            .map(|&f| mesh.triangles[f as usize].map(|c| level_of[c as usize]))
-            .collect(),
-        vertex_id,
-        face_id,
-    }
-}
 
 /// `mark` of a vertex that is neither removed nor locked in the current pass.
 const FREE: u32 = u32::MAX;
@@ -469,8 +366,8 @@ fn passes(
         );
         // The level just left goes too, rather than wait as the buffers of the one after next:
         // at any time at most two levels and one set of fans are held, never two levels and
-        // fans (1.2M faces: the build's heap peak 132 MB -> below the loader's 120 MB; the
-        // fresh buffers cost no measurable time).
+        // fans (the build's heap peak stays below the loader's; the fresh buffers cost no
+        // measurable time).
         level = std::mem::take(&mut next);
         out.pass_ms.push(started.elapsed().as_secs_f64() * 1e3);
     }
@@ -512,53 +409,6 @@ fn refill(cells: &mut Vec<AtomicU32>, n: usize, value: u32) {
 /// The values of `cells` (the same layout, so the memory is reused).
 pub(super) fn into_inner(cells: Vec<AtomicU32>) -> Vec<u32> {
     cells.into_iter().map(AtomicU32::into_inner).collect()
-}
-
-/// A stable counting sort of `items` by a 15-bit `digit`: `place(slot, item)` is called once per
-/// item with its place in the sorted order. In parallel (when `parallel`) over one chunk of
-/// consecutive items per thread: each chunk counts its digits, the counts give each chunk its
-/// first place per digit (digits in order, chunks in order within a digit), and each chunk
-/// places its items, so the order is the same for any number of chunks. (Unlike `bucket_sort`,
-/// whose blocks each read every item: on random keys half of a block's branches mispredict.)
-fn digit_sort<T: Sync>(
-    items: &[T],
-    digit: impl Fn(&T) -> usize + Sync,
-    parallel: bool,
-    place: impl Fn(usize, &T) + Sync,
-) {
-    const DIGITS: usize = 1 << 15;
-    let chunks = if parallel {
-        rayon::current_num_threads().clamp(1, MAX_BLOCKS)
-    } else {
-        1
-    };
-    let chunk_len = items.len().div_ceil(chunks).max(1);
-    let mut next: Vec<Vec<u32>> = items
-        .par_chunks(chunk_len)
-        .map(|chunk| {
-            let mut count = vec![0u32; DIGITS];
-            for item in chunk {
-                count[digit(item)] += 1;
-            }
-            count
-        })
-        .collect();
-    let mut sum = 0;
-    for d in 0..DIGITS {
-        for count in &mut next {
-            (count[d], sum) = (sum, sum + count[d]);
-        }
-    }
-    items
-        .par_chunks(chunk_len)
-        .zip(next)
-        .for_each(|(chunk, mut next)| {
-            for item in chunk {
-                let slot = &mut next[digit(item)];
-                place(*slot as usize, item);
-                *slot += 1;
-            }
-        });
 }
 
 /// How a level is cut into regions that are visited at the same time: consecutive ranges of its
@@ -694,9 +544,8 @@ fn visit_level(
 ///
 /// A least-significant-digit radix sort on the costs' bits (three digits of 11 bits; a digit
 /// every cost shares is skipped), then each run of equal costs sorted by M0 id: runs are short on
-/// scans, and a regular mesh's long ones cost what a comparison sort of them costs. (It replaced
-/// a comparison sort of (cost, id) keys, which took 54 of the 1.2M-face build's 900 ms on one
-/// thread.)
+/// scans, and a regular mesh's long ones cost what a comparison sort of them costs. (A comparison
+/// sort of (cost, id) keys is a measurable part of a big build.)
 fn in_cost_order(
     vertices: impl Iterator<Item = usize>,
     state: &PassState,
@@ -713,37 +562,6 @@ fn in_cost_order(
     }
     order.clear();
     order.extend(keyed.iter().map(|&[_, v]| v));
-}
-
-/// `items` sorted by their first value, stably (a least-significant-digit radix sort, three
-/// digits of 11 bits); `spare` is scratch space.
-fn sort_by_first(items: &mut Vec<[u32; 2]>, spare: &mut Vec<[u32; 2]>) {
-    const BITS: u32 = 11;
-    const BUCKETS: usize = 1 << BITS;
-    let digit = |key: u32, d: u32| (key >> (d * BITS)) as usize & (BUCKETS - 1);
-    let mut counts = [[0u32; BUCKETS]; 3];
-    for &[key, _] in items.iter() {
-        for (d, count) in counts.iter_mut().enumerate() {
-            count[digit(key, d as u32)] += 1;
-        }
-    }
-    spare.clear();
-    spare.resize(items.len(), [0; 2]);
-    for (d, count) in counts.iter_mut().enumerate() {
-        if count.iter().any(|&c| c as usize == items.len()) {
-            continue;
-        }
-        let mut sum = 0;
-        for c in count.iter_mut() {
-            (*c, sum) = (sum, sum + *c);
-        }
-        for &item in items.iter() {
-            let slot = &mut count[digit(item[0], d as u32)];
-            spare[*slot as usize] = item;
-            *slot += 1;
-        }
-        std::mem::swap(items, spare);
-    }
 }
 
 /// Each vertex's least and greatest two-ring vertex (into `state.reach`), from the one-rings'.
@@ -776,66 +594,6 @@ fn reset_pass(level: &Level, state: &mut PassState) {
         .extend(level.crease.iter().map(|c| c.map(AtomicU32::new)));
 }
 
-/// Visits `v`: if it is free and may go, performs its first valid collapse and returns the target
-/// and the six split volume.
-fn visit(v: u32, view: &PassView, scratch: &mut Scratch) -> Option<(u32, f32)> {
-    if view.mark[v as usize].load(Relaxed) != FREE {
-        return None;
-    }
-    let open = view.open[v as usize];
-    if open && view.keep_boundary
-        || view
-            .pinned
-            .get(view.vertex_id[v as usize] as usize)
-            .is_some_and(|&p| p)
-    {
-        return None;
-    }
-    // A crease vertex collapses only along its crease; a corner never. Nor when its crease
-    // neighbours are joined by an edge already: a loop of three would close on itself, and where a
-    // face holds the three (a noisy crease zigzags), the split would put the vertex back between
-    // the other two, on their line, and leave that face with no area.
-    let crease_of = |u: u32| view.crease[u as usize].each_ref().map(|c| c.load(Relaxed));
-    let along = if view.crease.is_empty() {
-        NO_CREASE
-    } else {
-        crease_of(v)
-    };
-    if along == CORNER
-        || along != NO_CREASE
-            && (crease_of(along[0]).contains(&along[1])
-                || view
-                    .fan(v)
-                    .iter()
-                    .any(|&[a, b]| along == [a, b] || along == [b, a]))
-    {
-        return None;
-    }
-    let along = (along != NO_CREASE).then_some(along);
-    let (k, six_volume) = choose_collapse(v, open, along, view, scratch)?;
-    if let Some([a, b]) = along {
-        // The crease now runs w - k.
-        let w = if k == a { b } else { a };
-        for (x, from, to) in [(k, v, w), (w, v, k)] {
-            for slot in &view.crease[x as usize] {
-                if slot.load(Relaxed) == from {
-                    slot.store(to, Relaxed);
-                }
-            }
-        }
-    }
-    // Perform v -> k: faces are relabelled when the next level is built (a pass's collapses touch
-    // disjoint face sets, so they compose as one simultaneous relabelling).
-    view.mark[v as usize].store(k, Relaxed);
-    for &x in &scratch.neighbors {
-        view.mark[x as usize].store(LOCKED, Relaxed);
-    }
-    let head = view.absorbed_head[k as usize].load(Relaxed);
-    view.absorbed_next[v as usize].store(head, Relaxed);
-    view.absorbed_head[k as usize].store(v, Relaxed);
-    Some((k, six_volume as f32))
-}
-
 /// The fans of a level with `vertex_count` vertices in CSR form, by a counting sort of the
 /// faces' corners (a vertex's pairs come in face order).
 fn build_fans(corners: &[[u32; 3]], vertex_count: usize, parallel: bool, state: &mut PassState) {
@@ -847,94 +605,13 @@ fn build_fans(corners: &[[u32; 3]], vertex_count: usize, parallel: bool, state: 
             let [x, y, z] = corners[f];
             [(x, [y, z]), (y, [z, x]), (z, [x, y])]
         },
-        &mut state.fan_offsets,
-        &mut state.cursor,
-        &mut state.fans,
+        SortedBuckets {
+            offsets: &mut state.fan_offsets,
+            cursor: &mut state.cursor,
+            sorted: &mut state.fans,
+        },
     );
 }
-
-/// A stable counting sort: item `i` of `0..items` brings the `K` entries `entries(i)`, each a
-/// bucket in `0..buckets` and a value; `sorted` gets the values bucket by bucket, in item order
-/// within a bucket, and `offsets` (`buckets + 1` of them) where each bucket starts. `cursor` is
-/// scratch space.
-///
-/// In parallel: one block of consecutive buckets per thread. Each block reads every item and
-/// counts, then places, only the entries that fall in it, so the result is the same for any
-/// number of blocks. (Reading the items once per block costs little next to the scattered
-/// writes, which are what the blocks share out.)
-#[allow(clippy::too_many_arguments)]
-fn bucket_sort<T: Copy + Default + Send + Sync, const K: usize>(
-    items: usize,
-    buckets: usize,
-    parallel: bool,
-    entries: impl Fn(usize) -> [(u32, T); K] + Sync,
-    offsets: &mut Vec<u32>,
-    cursor: &mut Vec<u32>,
-    sorted: &mut Vec<T>,
-) {
-    let blocks = if parallel {
-        rayon::current_num_threads().clamp(1, MAX_BLOCKS)
-    } else {
-        1
-    };
-    let block_len = buckets.div_ceil(blocks).max(1);
-    offsets.clear();
-    offsets.resize(buckets + 1, 0);
-    // Each block's counts, then their running sums within the block.
-    offsets[1..]
-        .par_chunks_mut(block_len)
-        .enumerate()
-        .for_each(|(b, ends)| {
-            let (first, len) = ((b * block_len) as u32, ends.len() as u32);
-            for i in 0..items {
-                for (bucket, _) in entries(i) {
-                    let j = bucket.wrapping_sub(first);
-                    if j < len {
-                        ends[j as usize] += 1;
-                    }
-                }
-            }
-            for j in 1..ends.len() {
-                ends[j] += ends[j - 1];
-            }
-        });
-    // Then each block's start added to its entries.
-    let block_entries: Vec<u32> = offsets[1..]
-        .chunks(block_len)
-        .map(|ends| ends.last().copied().unwrap_or(0))
-        .collect();
-    let block_start = running_starts(&block_entries);
-    offsets[1..]
-        .par_chunks_mut(block_len)
-        .zip(&block_start)
-        .for_each(|(ends, &start)| ends.iter_mut().for_each(|e| *e += start));
-    // Fresh zeroed pages from the allocator: the blocks' writes fault them in, in parallel.
-    *sorted = vec![T::default(); K * items];
-    cursor.clear();
-    cursor.extend_from_slice(&offsets[..buckets]);
-    let sorted_of_block = split_by_lengths(sorted, &block_entries);
-    cursor
-        .par_chunks_mut(block_len)
-        .zip(sorted_of_block)
-        .enumerate()
-        .for_each(|(b, (cursor, sorted))| {
-            let (first, len) = ((b * block_len) as u32, cursor.len() as u32);
-            let base = block_start[b];
-            for i in 0..items {
-                for (bucket, value) in entries(i) {
-                    let j = bucket.wrapping_sub(first);
-                    if j < len {
-                        let slot = &mut cursor[j as usize];
-                        sorted[(*slot - base) as usize] = value;
-                        *slot += 1;
-                    }
-                }
-            }
-        });
-}
-
-/// At most this many blocks of [`bucket_sort`] (each reads every item).
-const MAX_BLOCKS: usize = 16;
 
 /// Every vertex's cost (as the bits of a non-negative f32, which order like the value) into
 /// `state.cost`, whether it is on a boundary into `state.open`, and its one-ring's least and
@@ -991,150 +668,6 @@ fn vertex_costs(level: &Level, options: &HierarchyOptions, state: &mut PassState
             };
             *key = bits;
         });
-}
-
-/// The level after the pass's collapses: survivors keep their relative order, faces of removed
-/// vertices are relabelled to the targets, and those that degenerate disappear (recorded in
-/// `face_removed_in_pass`). `level.corners` is relabelled in place on the way.
-///
-/// In parallel over consecutive chunks of `chunk` vertices and of `chunk` faces (one chunk of
-/// each when `None`): each chunk first counts what it keeps, the running sums of the counts give
-/// each chunk its place in the next level, and each chunk then writes its part there, so the
-/// next level is the same for any number of threads.
-fn next_level(
-    level: &mut Level,
-    state: &mut PassState,
-    pass: u32,
-    removed: usize,
-    face_removed_in_pass: &[AtomicU32],
-    chunk: Option<usize>,
-    next: &mut Level,
-) {
-    let n = level.points.len();
-    let vertices = n - removed;
-    let chunk_len = |len: usize| chunk.unwrap_or(len).max(1);
-    let chunk = chunk_len(n);
-    let (mark, label) = (&state.mark, &mut state.label);
-    let survives = |m: &AtomicU32| m.load(Relaxed) >= LOCKED;
-    // Survivors, chunk by chunk: their labels, points and M0 ids.
-    let kept: Vec<u32> = mark
-        .par_chunks(chunk)
-        .map(|marks| marks.iter().filter(|m| survives(m)).count() as u32)
-        .collect();
-    // (Every entry is written below: survivors get theirs, removed vertices their target's.)
-    refill(label, n, NEVER);
-    next.points = vec![[0.0; 3]; vertices];
-    next.vertex_id = vec![0; vertices];
-    let starts = running_starts(&kept);
-    mark.par_chunks(chunk)
-        .zip(label.par_chunks(chunk))
-        .zip(split_by_lengths(&mut next.points, &kept))
-        .zip(split_by_lengths(&mut next.vertex_id, &kept))
-        .enumerate()
-        .for_each(|(c, (((marks, labels), points), ids))| {
-            let first = c * chunk;
-            let mut slot = 0;
-            for (i, (m, l)) in marks.iter().zip(labels).enumerate() {
-                if survives(m) {
-                    l.store(starts[c] + slot as u32, Relaxed);
-                    points[slot] = level.points[first + i];
-                    ids[slot] = level.vertex_id[first + i];
-                    slot += 1;
-                }
-            }
-        });
-    // A removed vertex takes its target's label (a target survives the pass).
-    let label_of = |v: u32| label[v as usize].load(Relaxed);
-    mark.par_chunks(chunk)
-        .zip(label.par_chunks(chunk))
-        .for_each(|(marks, labels)| {
-            for (m, l) in marks.iter().zip(labels) {
-                let m = m.load(Relaxed);
-                if m < LOCKED {
-                    l.store(label_of(m), Relaxed);
-                }
-            }
-        });
-    // Crease neighbours were moved to survivors as the collapses happened.
-    next.crease = Vec::new();
-    if !level.crease.is_empty() {
-        next.crease = vec![NO_CREASE; vertices];
-        level
-            .crease
-            .par_chunks(chunk)
-            .zip(mark.par_chunks(chunk))
-            .zip(split_by_lengths(&mut next.crease, &kept))
-            .for_each(|((creases, marks), out)| {
-                let kept = creases.iter().zip(marks).filter(|(_, m)| survives(m));
-                for ((&c, _), slot) in kept.zip(out) {
-                    *slot = if c == NO_CREASE || c == CORNER {
-                        c
-                    } else {
-                        c.map(label_of)
-                    };
-                }
-            });
-    }
-    // Faces, relabelled in place; those that degenerate are the removed ones.
-    let chunk = chunk_len(level.corners.len());
-    let degenerate = |t: &[u32; 3]| t[0] == t[1] || t[1] == t[2] || t[0] == t[2];
-    let kept: Vec<u32> = level
-        .corners
-        .par_chunks_mut(chunk)
-        .zip(level.face_id.par_chunks(chunk))
-        .map(|(corners, ids)| {
-            let mut kept = 0;
-            for (t, &f) in corners.iter_mut().zip(ids) {
-                *t = t.map(label_of);
-                if degenerate(t) {
-                    face_removed_in_pass[f as usize].store(pass, Relaxed);
-                } else {
-                    kept += 1;
-                }
-            }
-            kept
-        })
-        .collect();
-    let faces = kept.iter().map(|&k| k as usize).sum();
-    next.corners = vec![[0; 3]; faces];
-    next.face_id = vec![0; faces];
-    level
-        .corners
-        .par_chunks(chunk)
-        .zip(level.face_id.par_chunks(chunk))
-        .zip(split_by_lengths(&mut next.corners, &kept))
-        .zip(split_by_lengths(&mut next.face_id, &kept))
-        .for_each(|(((corners, ids), out_corners), out_ids)| {
-            let kept = corners.iter().zip(ids).filter(|(t, _)| !degenerate(t));
-            for (((t, &f), slot), id) in kept.zip(out_corners).zip(out_ids) {
-                *slot = *t;
-                *id = f;
-            }
-        });
-}
-
-/// Where each chunk's items start, for chunks of `lengths` items.
-fn running_starts(lengths: &[u32]) -> Vec<u32> {
-    lengths
-        .iter()
-        .scan(0u32, |sum, &len| {
-            let start = *sum;
-            *sum += len;
-            Some(start)
-        })
-        .collect()
-}
-
-/// `items` cut into consecutive pieces of `lengths` items (which add up to at most its length).
-fn split_by_lengths<'a, T>(mut items: &'a mut [T], lengths: &[u32]) -> Vec<&'a mut [T]> {
-    lengths
-        .iter()
-        .map(|&len| {
-            let (piece, rest) = std::mem::take(&mut items).split_at_mut(len as usize);
-            items = rest;
-            piece
-        })
-        .collect()
 }
 
 #[inline]
@@ -1203,346 +736,5 @@ fn is_one_fan(fan: &[[u32; 2]], next: &mut Vec<usize>) -> bool {
 /// No face (in `is_one_fan`).
 const NONE: usize = usize::MAX;
 
-/// The level and the pass state as visits see them.
-struct PassView<'a> {
-    points: &'a [[f32; 3]],
-    vertex_id: &'a [u32],
-    fan_offsets: &'a [u32],
-    fans: &'a [[u32; 2]],
-    open: &'a [bool],
-    /// Per M0 id, empty when nothing is pinned.
-    pinned: &'a [bool],
-    keep_boundary: bool,
-    mark: &'a [AtomicU32],
-    absorbed_head: &'a [AtomicU32],
-    absorbed_next: &'a [AtomicU32],
-    crease: &'a [[AtomicU32; 2]],
-}
-
-impl<'a> PassView<'a> {
-    fn new(
-        level: &'a Level,
-        state: &'a PassState,
-        pinned: &'a [bool],
-        keep_boundary: bool,
-    ) -> Self {
-        PassView {
-            points: &level.points,
-            vertex_id: &level.vertex_id,
-            fan_offsets: &state.fan_offsets,
-            fans: &state.fans,
-            open: &state.open,
-            pinned,
-            keep_boundary,
-            mark: &state.mark,
-            absorbed_head: &state.absorbed_head,
-            absorbed_next: &state.absorbed_next,
-            crease: &state.crease,
-        }
-    }
-}
-
-impl PassView<'_> {
-    #[inline]
-    fn fan(&self, v: u32) -> &[[u32; 2]] {
-        &self.fans[self.fan_offsets[v as usize] as usize..self.fan_offsets[v as usize + 1] as usize]
-    }
-
-    /// The current label of a vertex of the level: its target if removed in this pass.
-    #[inline]
-    fn current(&self, c: u32) -> u32 {
-        let m = self.mark[c as usize].load(Relaxed);
-        if m < LOCKED {
-            m
-        } else {
-            c
-        }
-    }
-
-    /// Calls `visit` with the two other corners of every live face of `k`: its faces at the start
-    /// of the pass, relabelled by this pass's collapses (a face that degenerates is gone), and
-    /// those of the vertices collapsed into it during this pass.
-    #[inline]
-    fn for_each_face_of(&self, k: u32, mut visit: impl FnMut(u32, u32)) {
-        for &[a, b] in self.fan(k) {
-            let (a, b) = (self.current(a), self.current(b));
-            if a != b && a != k && b != k {
-                visit(a, b);
-            }
-        }
-        let mut absorbed = self.absorbed_head[k as usize].load(Relaxed);
-        while absorbed != NEVER {
-            for &[a, b] in self.fan(absorbed) {
-                // The absorbed vertex's neighbours were locked when it went: they are unchanged.
-                if a != k && b != k {
-                    visit(a, b);
-                }
-            }
-            absorbed = self.absorbed_next[absorbed as usize].load(Relaxed);
-        }
-    }
-}
-
-#[derive(Default)]
-struct Scratch {
-    neighbors: Vec<u32>,
-    /// Positions of `a` and `b` relative to `v` for each face `(v, a, b)` of the vertex being
-    /// tried.
-    positions: Vec<[DVec3; 2]>,
-    /// The normal (x_a - x_v) x (x_b - x_v) of each of those faces.
-    normals: Vec<DVec3>,
-    /// `(|cone|, k, signed cone)`.
-    candidates: Vec<(f64, u32, f64)>,
-    /// Scratch space of [`in_cost_order`].
-    keys: Vec<[u32; 2]>,
-}
-
-/// The first valid collapse target of `v` (on a boundary if `on_boundary`; one of `along` when
-/// it is on a crease) in increasing cone volume, with its signed cone volume.
-fn choose_collapse(
-    v: u32,
-    on_boundary: bool,
-    along: Option<[u32; 2]>,
-    view: &PassView,
-    scratch: &mut Scratch,
-) -> Option<(u32, f64)> {
-    let m0_id = view.vertex_id;
-    let fan = view.fan(v);
-    if fan.is_empty() {
-        return None;
-    }
-    let p = |c: u32| point(view.points, c);
-    // An open fan starts with an edge v-a (a first in its face) that no face has as v-b and ends
-    // with one v-b that no face has as v-a.
-    let mut fan_start = NEVER;
-    let mut fan_end = NEVER;
-    if on_boundary {
-        for &[a, _] in fan {
-            if !fan.iter().any(|&[_, b]| b == a) {
-                fan_start = a;
-            }
-        }
-        for &[_, b] in fan {
-            if !fan.iter().any(|&[a, _]| a == b) {
-                fan_end = b;
-            }
-        }
-    }
-    // Positions relative to `x_v` (exact: differences of f32 values are f64 values), and the
-    // fan's area vector N = sum over v's faces of (x_a - x_v) x (x_b - x_v), each term kept as
-    // the face's normal before the collapse.
-    let xv = p(v);
-    scratch.neighbors.clear();
-    scratch.positions.clear();
-    scratch.normals.clear();
-    let mut area = DVec3::ZERO;
-    for &[a, b] in fan {
-        scratch.neighbors.push(a);
-        let (xa, xb) = (p(a) - xv, p(b) - xv);
-        let normal = xa.cross(xb);
-        area += normal;
-        scratch.positions.push([xa, xb]);
-        scratch.normals.push(normal);
-    }
-    if on_boundary {
-        scratch.neighbors.push(fan_end);
-    }
-
-    // Cone volumes. With x_v at the origin a face's term is ((a - k) x (b - k)) . (-k), and
-    // (a - k) x (b - k) = a x b - a x k - k x b, whose last two parts are orthogonal to k; so
-    // the cone is -N . (x_k - x_v) for every candidate (faces containing `k` add zero, as they
-    // should), one dot product each instead of a sum over the fan.
-    scratch.candidates.clear();
-    for &k in &scratch.neighbors {
-        if on_boundary && k != fan_start && k != fan_end {
-            continue;
-        }
-        if along.is_some_and(|along| !along.contains(&k)) {
-            continue;
-        }
-        let cone = -area.dot(p(k) - xv);
-        scratch.candidates.push((cone.abs(), k, cone));
-    }
-
-    // Candidates in increasing (|cone|, M0 id): the first is nearly always valid, so take the
-    // least one at a time instead of sorting them.
-    let valence = scratch.neighbors.len();
-    'candidate: while let Some(best) = (0..scratch.candidates.len()).min_by(|&x, &y| {
-        let (x, y) = (&scratch.candidates[x], &scratch.candidates[y]);
-        x.0.total_cmp(&y.0)
-            .then_with(|| m0_id[x.1 as usize].cmp(&m0_id[y.1 as usize]))
-    }) {
-        let (_, k, cone) = scratch.candidates.swap_remove(best);
-        let xk = p(k) - xv;
-        // No surviving face may flip or degenerate.
-        let mut opposite = [NEVER; 2];
-        for ((&[a, b], &[xa, xb]), &old) in fan.iter().zip(&scratch.positions).zip(&scratch.normals)
-        {
-            if a == k {
-                opposite[0] = b;
-                continue;
-            }
-            if b == k {
-                opposite[1] = a;
-                continue;
-            }
-            let new = (xa - xk).cross(xb - xk);
-            if old.dot(new) <= 0.0 {
-                continue 'candidate;
-            }
-        }
-        // Link condition: apart from the opposite vertices, no neighbour of v may be one of k.
-        let neighbors = &scratch.neighbors;
-        // (Without early exits: this runs for every face of `k`, and exits would be unpredictable.)
-        let shared = |x: u32| {
-            let found = neighbors.iter().fold(false, |found, &y| found | (y == x));
-            found & (x != opposite[0]) & (x != opposite[1])
-        };
-        let mut link_ok = true;
-        let tetrahedron_check = !on_boundary && valence == 3;
-        let single_triangle = on_boundary && valence == 2;
-        let third = if opposite[0] != NEVER {
-            opposite[0]
-        } else {
-            opposite[1]
-        };
-        let mut faces_on_third_edge = 0;
-        view.for_each_face_of(k, |a, b| {
-            link_ok &= !(shared(a) | shared(b));
-            // The tetrahedron case: k's other faces already hold both opposite vertices.
-            if tetrahedron_check
-                && (a == opposite[0] && b == opposite[1] || a == opposite[1] && b == opposite[0])
-            {
-                link_ok = false;
-            }
-            if single_triangle && (a == third || b == third) {
-                faces_on_third_edge += 1;
-            }
-        });
-        if !link_ok || (single_triangle && faces_on_third_edge < 2) {
-            continue;
-        }
-        return Some((k, cone));
-    }
-    None
-}
-
 #[cfg(test)]
-mod tests {
-    use super::*;
-
-    /// Pseudo-random draws below a bound, from `seed` (a linear congruential generator).
-    fn draws(seed: u64) -> impl FnMut(u64) -> u64 {
-        let mut state = seed;
-        move |below| {
-            state = state
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            (state >> 33) % below
-        }
-    }
-
-    /// The radix sort and its tie-breaking give (cost, M0 id) order: costs with many ties, with
-    /// digits all share (skipped) and with every digit in use, including infinity.
-    #[test]
-    fn cost_order_is_by_cost_then_m0_id() {
-        let mut next = draws(99);
-        let n = 5000;
-        let costs: [Vec<u32>; 3] = [
-            // Few values: long runs of ties.
-            (0..n).map(|_| (next(7) as f32 * 0.5).to_bits()).collect(),
-            // Only the low digit varies.
-            (0..n).map(|_| 0x3f80_0000 | next(1 << 11) as u32).collect(),
-            // Anything, now and then infinity.
-            (0..n)
-                .map(|_| match next(50) {
-                    0 => f32::INFINITY.to_bits(),
-                    _ => (next(1 << 20) as f32 * 1e-3).to_bits(),
-                })
-                .collect(),
-        ];
-        for cost in costs {
-            let mut vertex_id: Vec<u32> = (0..n as u32).map(|i| i * 7 % n as u32).collect();
-            vertex_id.reverse();
-            let level = Level {
-                vertex_id,
-                ..Level::default()
-            };
-            let pass = PassState {
-                cost,
-                ..PassState::default()
-            };
-            // Every third vertex, as a region's interior would be a part of the level.
-            let chosen = (0..n).filter(|v| v % 3 != 1);
-            let mut expected: Vec<u32> = chosen.clone().map(|v| v as u32).collect();
-            expected.sort_by_key(|&v| (pass.cost[v as usize], level.vertex_id[v as usize]));
-            let mut order = Vec::new();
-            in_cost_order(chosen, &pass, &level, &mut order, &mut Vec::new());
-            assert_eq!(order, expected);
-        }
-    }
-
-    /// M0's order: the vertices some face uses by Morton code, ties by id, isolated ones left
-    /// out; the faces by their first corner's place, ties by id; the same whether sorted in
-    /// chunks on several threads or on one.
-    #[test]
-    fn first_level_orders_used_vertices_by_code_then_id_on_any_thread_count() {
-        // Positions from a few values, so many vertices share a code; every seventh vertex is
-        // isolated (some share their code with used ones). The faces need no shape here.
-        let mut next = draws(12345);
-        let n = 6000u32;
-        let positions: Vec<[f32; 3]> = (0..n)
-            .map(|_| [0; 3].map(|_| next(5) as f32 * 0.25))
-            .collect();
-        let used: Vec<u32> = (0..n).filter(|v| v % 7 != 3).collect();
-        let triangles: Vec<[u32; 3]> = (0..9000)
-            .map(|_| loop {
-                let t = [0; 3].map(|_| used[next(used.len() as u64) as usize]);
-                if t[0] != t[1] && t[1] != t[2] && t[0] != t[2] {
-                    break t;
-                }
-            })
-            .collect();
-        let mesh = TriMesh::new(positions, triangles);
-        let (lo, hi) = crate::metrics::bounding_box(&mesh).unwrap();
-        let scale = (hi - lo).max_element();
-        let code = |v: u32| {
-            let p = mesh.positions[v as usize].map(f64::from);
-            crate::mesh::morton_code(p.into(), lo, scale)
-        };
-        // (A few of `used` may have been drawn by no face.)
-        let mut in_faces = vec![false; n as usize];
-        for &c in mesh.triangles.iter().flatten() {
-            in_faces[c as usize] = true;
-        }
-        let mut expected: Vec<u32> = (0..n).filter(|&v| in_faces[v as usize]).collect();
-        expected.sort_by_key(|&v| (code(v), v));
-        let mut place = vec![NEVER; n as usize];
-        for (i, &v) in expected.iter().enumerate() {
-            place[v as usize] = i as u32;
-        }
-        let mut faces: Vec<u32> = (0..mesh.face_count() as u32).collect();
-        faces.sort_by_key(|&f| (place[mesh.triangles[f as usize][0] as usize], f));
-
-        let serial = first_level(&mesh, None, false);
-        assert_eq!(serial.vertex_id, expected);
-        assert_eq!(serial.face_id, faces);
-        for (corners, &f) in serial.corners.iter().zip(&faces) {
-            assert_eq!(
-                *corners,
-                mesh.triangles[f as usize].map(|c| place[c as usize])
-            );
-        }
-        for threads in [1, 2, 3, 5] {
-            let level = rayon::ThreadPoolBuilder::new()
-                .num_threads(threads)
-                .build()
-                .unwrap()
-                .install(|| first_level(&mesh, None, true));
-            assert_eq!(level.vertex_id, serial.vertex_id, "{threads} threads");
-            assert_eq!(level.face_id, serial.face_id, "{threads} threads");
-            assert_eq!(level.corners, serial.corners, "{threads} threads");
-            assert_eq!(level.points, serial.points, "{threads} threads");
-        }
-    }
-}
+mod tests;

@@ -44,25 +44,31 @@
 //!
 //! Speed: a [`MultiresWorkspace`] keeps, per level used so far, its connectivity (`TriMesh`
 //! triangles and `Topology`), loop neighbours, fan-ordered one-rings and fairing operator, built
-//! (levels in parallel) by the first run that needs them or by
-//! [`MultiresWorkspace::prepare_for`]; a run then only moves positions, and allocates nothing but its result.
+//! (levels in parallel) by the first run that needs them or by [`MultiresWorkspace::prepare_for`];
+//! a run then only moves positions, and allocates nothing but its result.
 //! [`MultiresWorkspace::for_one_run`] keeps instead only the level a run is at (built when the run
-//! reaches it, freed when it leaves it): about a third of the memory for a single run (the
-//! command line), at the cost of building levels one after another. The whole run
-//! executes on a worker of the rayon pool (a run makes a dozen parallel calls per level, and each
-//! call issued from outside the pool is a cross-thread hand-off); passes over the coarse levels
-//! are not split below `PARALLEL_GRAIN` vertices. The per-level passes (Kobbelt step, vertex
-//! normals, low-pass filters) work in f32 SIMD points; the Kobbelt step takes every vertex's
-//! umbrella Laplacian once instead of once per adjacent split vertex, and closed fans give the
-//! vertex normals from their fan order (one gather per neighbour instead of three per face).
+//! reaches it, freed when it leaves it): about a third of the memory for a single run (the command
+//! line), at the cost of building levels one after another. The whole run executes on a worker of
+//! the rayon pool (a run makes a dozen parallel calls per level, and each call issued from outside
+//! the pool is a cross-thread hand-off); passes over the coarse levels are not split below
+//! `PARALLEL_GRAIN` vertices. The per-level passes (Kobbelt step, vertex normals, low-pass filters)
+//! work in f32 SIMD points; the Kobbelt step takes every vertex's umbrella Laplacian once instead
+//! of once per adjacent split vertex, and closed fans give the vertex normals from their fan order
+//! (one gather per neighbour instead of three per face).
+//!
+//! # Files
+//! - `refine`: the steps between two levels (the shrinkage taken back, the split vertices
+//!   placed).
 
-use crate::fairing::constrained::FanRings;
+mod refine;
+
 use crate::fairing::{BoundaryMode, ConstrainedFairing, Creases, FairOptions, FairVariant, Mask};
 use crate::hierarchy::Hierarchy;
-use crate::mesh::{Topology, TriMesh};
+use crate::mesh::{FanRings, Topology, TriMesh};
 use crate::Progress;
 use glam::Vec3A;
 use rayon::prelude::*;
+use refine::{refine_positions, remove_low_frequency_shrinkage};
 
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 #[non_exhaustive]
@@ -195,7 +201,7 @@ impl MultiresWorkspace {
     /// Frees the buffers a run reuses from level to level (every pass writes them whole before
     /// reading them): a single run does this before each level's set-up, so that a level's
     /// operator is never built beside the buffers the previous level's passes left, sized for
-    /// that level (on the 1.2M-face mesh ~45 MB of the run's peak).
+    /// that level.
     fn free_scratch(&mut self) {
         for buffer in [
             &mut self.laplacians,
@@ -399,6 +405,8 @@ pub fn fair_multires(
     Some(result)
 }
 
+/// [`fair_multires`] on the calling thread: from the start level down, each level faired (and,
+/// Improved, its shrinkage taken back), then refined to the next finer one; M0 last.
 fn fair_multires_on_worker(
     hierarchy: &Hierarchy,
     options: &MultiresOptions,
@@ -409,66 +417,21 @@ fn fair_multires_on_worker(
     let fair_options = level_fair_options(options);
     let operator = (fair_options.variant, fair_options.boundary);
     let release = workspace.release_levels;
-    if release {
-        // A single run builds each level when it gets there; M0's connectivity is needed now
-        // only for a fixed boundary (below), and is freed again once that is read.
-        if options.boundary == BoundaryMode::Fixed {
-            workspace.prepare_levels(hierarchy, 0..=0, |_| None);
-        }
-    } else {
-        // Every level this run touches, with the operators of those it fairs.
-        workspace.prepare_for(hierarchy, options);
-    }
-    let base_vertices = hierarchy.level_info(0).vertices;
-    workspace.positions.clear();
-    workspace
-        .positions
-        .extend_from_slice(hierarchy.level_positions(start));
-
+    let fixed = start_run(hierarchy, options, workspace, start);
     // Progress weights: a level costs about its vertex count.
     let total: f64 = (0..=start)
         .map(|i| hierarchy.level_info(i).vertices as f64)
         .sum::<f64>()
         .max(1.0);
     let mut done = 0.0;
-    let fair_last = start == 0 || options.fair_finest;
-    // Fixed boundary: M0's boundary vertices (internal ids, ascending) are put back at their own
-    // positions after every step that could move them (the shrinkage correction, the split
-    // placement), so that they are fixed at every level, not only on the levels' own boundaries.
-    let fixed: Vec<u32> = match options.boundary {
-        BoundaryMode::Fixed => original_boundary(hierarchy, workspace),
-        _ => Vec::new(),
-    };
-    if release && start > 0 {
-        // Held while the coarser levels are set up, M0's mesh and connectivity were a sixth of
-        // the run's peak (1.2M faces: 51 of 318 MB); it is built again when the run reaches it.
-        if let Some(m0) = workspace.levels.get_mut(0) {
-            *m0 = None;
-        }
-    }
     for level in (1..=start).rev() {
-        if release {
-            workspace.free_scratch();
-            workspace.prepare_levels(hierarchy, level..=level, |_| Some(operator));
-        }
-        let faired = fair_level(workspace, level, &fair_options);
-        if faired && options.variant == MultiresVariant::Improved {
-            remove_low_frequency_shrinkage(workspace, level);
-            restore_fixed(hierarchy, &mut workspace.positions, &fixed);
-        }
-        if release {
-            workspace.levels[level] = None;
-            workspace.free_scratch();
-            workspace.prepare_levels(hierarchy, level - 1..=level - 1, |_| None);
-        }
-        refine_positions(hierarchy, workspace, level - 1, options.variant);
-        restore_fixed(hierarchy, &mut workspace.positions, &fixed);
+        to_finer_level(hierarchy, options, &fair_options, workspace, level, &fixed);
         done += hierarchy.level_info(level).vertices as f64;
         if !progress.report((done / total) as f32) {
             return None;
         }
     }
-    if fair_last {
+    if start == 0 || options.fair_finest {
         if release {
             workspace.free_scratch();
             workspace.prepare_levels(hierarchy, 0..=0, |_| Some(operator));
@@ -481,12 +444,84 @@ fn fair_multires_on_worker(
     if release {
         workspace.levels[0] = None;
     }
+    let base_vertices = hierarchy.level_info(0).vertices;
     debug_assert_eq!(workspace.positions.len(), base_vertices);
     let mut result = vec![[0f32; 3]; base_vertices];
     for (v, p) in workspace.positions.iter().enumerate() {
         result[hierarchy.original_vertex(v as u32) as usize] = *p;
     }
     Some(result)
+}
+
+/// Sets `workspace` up for a run from level `start`: the levels it needs now (all it touches, or
+/// with [`MultiresWorkspace::for_one_run`] only M0 for a fixed boundary), and the start level's
+/// positions. Returns, for a fixed boundary, M0's boundary vertices (internal ids, ascending):
+/// they are put back at their own positions after every step that could move them (the
+/// shrinkage correction, the split placement), so that they are fixed at every level, not only
+/// on the levels' own boundaries.
+fn start_run(
+    hierarchy: &Hierarchy,
+    options: &MultiresOptions,
+    workspace: &mut MultiresWorkspace,
+    start: usize,
+) -> Vec<u32> {
+    let release = workspace.release_levels;
+    if release {
+        // A single run builds each level when it gets there; M0's connectivity is needed now
+        // only for a fixed boundary (below), and is freed again once that is read.
+        if options.boundary == BoundaryMode::Fixed {
+            workspace.prepare_levels(hierarchy, 0..=0, |_| None);
+        }
+    } else {
+        // Every level this run touches, with the operators of those it fairs.
+        workspace.prepare_for(hierarchy, options);
+    }
+    workspace.positions.clear();
+    workspace
+        .positions
+        .extend_from_slice(hierarchy.level_positions(start));
+    let fixed: Vec<u32> = match options.boundary {
+        BoundaryMode::Fixed => original_boundary(hierarchy, workspace),
+        _ => Vec::new(),
+    };
+    if release && start > 0 {
+        // Held while the coarser levels are set up, M0's mesh and connectivity would be a large
+        // share of the run's peak; it is built again when the run reaches it.
+        if let Some(m0) = workspace.levels.get_mut(0) {
+            *m0 = None;
+        }
+    }
+    fixed
+}
+
+/// One step of the run: level `level` faired with `fair_options` (Improved: its shrinkage taken
+/// back), then refined to level `level - 1`; the `fixed` vertices put back after each.
+fn to_finer_level(
+    hierarchy: &Hierarchy,
+    options: &MultiresOptions,
+    fair_options: &FairOptions,
+    workspace: &mut MultiresWorkspace,
+    level: usize,
+    fixed: &[u32],
+) {
+    let release = workspace.release_levels;
+    if release {
+        let operator = (fair_options.variant, fair_options.boundary);
+        workspace.free_scratch();
+        workspace.prepare_levels(hierarchy, level..=level, |_| Some(operator));
+    }
+    let faired = fair_level(workspace, level, fair_options);
+    if faired && options.variant == MultiresVariant::Improved {
+        remove_low_frequency_shrinkage(workspace, level);
+        restore_fixed(hierarchy, &mut workspace.positions, fixed);
+    }
+    if release {
+        workspace.levels[level] = None;
+        workspace.free_scratch();
+        workspace.prepare_levels(hierarchy, level - 1..=level - 1, |_| None);
+    }
+    refine_positions(hierarchy, workspace, level - 1, options.variant);
+    restore_fixed(hierarchy, &mut workspace.positions, fixed);
 }
 
 /// M0's boundary vertices in the hierarchy's internal numbering, ascending.
@@ -533,304 +568,6 @@ fn fair_level(workspace: &mut MultiresWorkspace, level: usize, options: &FairOpt
     // keeps every level's) hold no working buffers between runs.
     fairing.release_buffers();
     true
-}
-
-/// Improved: removes the smooth part of the normal displacement the level's fairing made.
-/// Noise removal is a high-frequency normal motion; shrinkage of curved and thin parts is a
-/// coherent (low-frequency) one. The normal displacement `h_v = (x_v - x_v^before) . n_v` is
-/// low-passed by two area-weighted 1-ring averages, and that part is taken back.
-fn remove_low_frequency_shrinkage(workspace: &mut MultiresWorkspace, level: usize) {
-    let MultiresWorkspace {
-        levels,
-        positions,
-        before_fairing,
-        normals,
-        normal_moves,
-        smoothed_moves,
-        ..
-    } = workspace;
-    let data = levels[level].as_ref().expect("prepared before fairing");
-    let n = data.mesh.positions.len();
-    let topology = &data.topology;
-    let triangles = &data.mesh.triangles;
-    let (offsets, _) = topology.neighbor_csr();
-    let fans = data
-        .fans
-        .as_ref()
-        .expect("a faired level has its fan-ordered rings");
-    let positions_now: &[[f32; 3]] = positions;
-    let before: &[[f32; 3]] = before_fairing;
-    let at = |v: u32| Vec3A::from_array(positions_now[v as usize]);
-    // Area-weighted vertex normals (twice the area: Σ over the fan of (a − x) × (b − x), from the
-    // fan order where the fan is closed, from the faces otherwise), unit normals, and the normal
-    // displacement weighted by the area.
-    (0..n)
-        .into_par_iter()
-        .with_min_len(PARALLEL_GRAIN)
-        .map(|v| {
-            let centre = at(v as u32);
-            let mut normal = Vec3A::ZERO;
-            if fans.closed_fan[v] {
-                let fan = &fans.ring[offsets[v] as usize..offsets[v + 1] as usize];
-                let mut previous = at(fan[fan.len() - 1]) - centre;
-                for &u in fan {
-                    let current = at(u) - centre;
-                    normal += previous.cross(current);
-                    previous = current;
-                }
-            } else {
-                for &f in topology.faces_of(v as u32) {
-                    let [a, b, c] = triangles[f as usize].map(at);
-                    normal += (b - a).cross(c - a);
-                }
-            }
-            let area = normal.length();
-            let unit = if area > 0.0 && area.is_finite() {
-                normal / area
-            } else {
-                Vec3A::ZERO
-            };
-            let moved = centre - Vec3A::from_array(before[v]);
-            (unit, [moved.dot(unit) * area, area])
-        })
-        .unzip_into_vecs(normals, normal_moves);
-    for _ in 0..SHRINKAGE_SMOOTHING_ROUNDS {
-        let moves: &[[f32; 2]] = normal_moves;
-        (0..n)
-            .into_par_iter()
-            .with_min_len(PARALLEL_GRAIN)
-            .map(|v| {
-                let mut sum = moves[v];
-                for &u in topology.neighbors(v as u32) {
-                    let m = moves[u as usize];
-                    sum[0] += m[0];
-                    sum[1] += m[1];
-                }
-                let mean = if sum[1] > 0.0 { sum[0] / sum[1] } else { 0.0 };
-                [mean * moves[v][1], moves[v][1]]
-            })
-            .collect_into_vec(smoothed_moves);
-        std::mem::swap(normal_moves, smoothed_moves);
-    }
-    let (moves, normals): (&[[f32; 2]], &[Vec3A]) = (normal_moves, normals);
-    // Crease vertices and corners take the correction too: holding them lost up to 8% of the
-    // volume from coarse levels (CAD shapes, the elephant), holding only the corners 7%.
-    positions[..n]
-        .par_iter_mut()
-        .with_min_len(PARALLEL_GRAIN)
-        .enumerate()
-        .for_each(|(v, p)| {
-            let [weighted, area] = moves[v];
-            if area > 0.0 {
-                *p = (Vec3A::from_array(*p) - normals[v] * (weighted / area)).to_array();
-            }
-        });
-}
-
-/// Refines the working positions from level `finer + 1` to `finer`: places the split vertices.
-fn refine_positions(
-    hierarchy: &Hierarchy,
-    workspace: &mut MultiresWorkspace,
-    finer: usize,
-    variant: MultiresVariant,
-) {
-    let coarse_count = hierarchy.level_info(finer + 1).vertices;
-    let fine_count = hierarchy.level_info(finer).vertices;
-    let MultiresWorkspace {
-        levels,
-        positions,
-        laplacians,
-        displacements,
-        heights,
-        height_sums,
-        ..
-    } = workspace;
-    let data = levels[finer].as_ref().expect("prepared before refining");
-    let topology = &data.topology;
-    let loops = &data.loop_neighbors;
-    let on_loop = |v: usize| !loops.is_empty() && loops[v][0] != NONE;
-    positions.resize(fine_count, [0.0; 3]);
-    let split = coarse_count..fine_count;
-
-    // Start at the 1-ring mean (loop midpoint on the boundary). Split vertices of one level are
-    // never adjacent, so their neighbours all come before them and have positions.
-    {
-        let (coarse, fine) = positions.split_at_mut(coarse_count);
-        let coarse: &[[f32; 3]] = coarse;
-        let at = |v: u32| Vec3A::from_array(coarse[v as usize]);
-        fine.par_iter_mut()
-            .with_min_len(PARALLEL_GRAIN)
-            .enumerate()
-            .for_each(|(i, p)| {
-                let v = coarse_count + i;
-                let x = if on_loop(v) {
-                    let [a, b] = loops[v];
-                    (at(a) + at(b)) * 0.5
-                } else {
-                    let ring = topology.neighbors(v as u32);
-                    ring.iter().map(|&u| at(u)).sum::<Vec3A>() / ring.len().max(1) as f32
-                };
-                *p = x.to_array();
-            });
-    }
-
-    // One Kobbelt step for all, from the placed positions, applied together: the umbrella
-    // Laplacian of every vertex first (a split vertex needs its neighbours'), then the steps.
-    {
-        let placed: &[[f32; 3]] = positions;
-        let at = |v: u32| Vec3A::from_array(placed[v as usize]);
-        (0..fine_count)
-            .into_par_iter()
-            .with_min_len(PARALLEL_GRAIN)
-            .map(|v| {
-                if on_loop(v) {
-                    let [a, b] = loops[v];
-                    (at(a) + at(b)) * 0.5 - at(v as u32)
-                } else {
-                    let ring = topology.neighbors(v as u32);
-                    let sum: Vec3A = ring.iter().map(|&u| at(u)).sum();
-                    sum / ring.len().max(1) as f32 - at(v as u32)
-                }
-            })
-            .collect_into_vec(laplacians);
-    }
-    {
-        let laplacians: &[Vec3A] = laplacians;
-        split
-            .clone()
-            .into_par_iter()
-            .with_min_len(PARALLEL_GRAIN)
-            .map(|v| {
-                let own = laplacians[v];
-                let (sum, inverse_valences, n) = if on_loop(v) {
-                    let [a, b] = loops[v];
-                    (laplacians[a as usize] + laplacians[b as usize], 1.0, 2.0)
-                } else {
-                    let ring = topology.neighbors(v as u32);
-                    let mut sum = Vec3A::ZERO;
-                    let mut inverse_valences = 0.0;
-                    for &u in ring {
-                        sum += laplacians[u as usize];
-                        inverse_valences += 1.0 / topology.valence(u) as f32;
-                    }
-                    (sum, inverse_valences, ring.len() as f32)
-                };
-                let l2 = sum / n - own;
-                let nu = 1.0 + inverse_valences / n;
-                -l2 / nu
-            })
-            .collect_into_vec(displacements);
-    }
-    positions[coarse_count..]
-        .par_iter_mut()
-        .zip(displacements.par_iter())
-        .for_each(|(p, d)| *p = (Vec3A::from_array(*p) + *d).to_array());
-
-    if variant == MultiresVariant::Paper {
-        return;
-    }
-
-    // Improved: restore the volume each split added in the original geometry, low-passed.
-    let triangles = &data.mesh.triangles;
-    let (face_offsets, vertex_faces) = topology.face_csr();
-    {
-        let placed: &[[f32; 3]] = positions;
-        let at = |v: u32| Vec3A::from_array(placed[v as usize]);
-        split
-            .clone()
-            .into_par_iter()
-            .with_min_len(PARALLEL_GRAIN)
-            .map(|v| {
-                let Some(k) = hierarchy.collapse_target(v as u32) else {
-                    return (Vec3A::ZERO, 0.0, 0.0, 0.0);
-                };
-                let (xv, xk) = (at(v as u32), at(k));
-                let mut area = Vec3A::ZERO;
-                // The longest edge at `v` now (every neighbour is some face's `a`, or on an open
-                // fan the last face's `b`).
-                let mut spoke_squared = 0f32;
-                for &f in &vertex_faces[face_offsets[v] as usize..face_offsets[v + 1] as usize] {
-                    let t = triangles[f as usize];
-                    let (a, b) = if t[0] == v as u32 {
-                        (t[1], t[2])
-                    } else if t[1] == v as u32 {
-                        (t[2], t[0])
-                    } else {
-                        (t[0], t[1])
-                    };
-                    let (xa, xb) = (at(a), at(b));
-                    spoke_squared = spoke_squared
-                        .max(xa.distance_squared(xv))
-                        .max(xb.distance_squared(xv));
-                    if a != k && b != k {
-                        area += (xa - xk).cross(xb - xk);
-                    }
-                }
-                let weight = area.length();
-                if weight <= 0.0 || !weight.is_finite() {
-                    return (Vec3A::ZERO, 0.0, 0.0, 0.0);
-                }
-                let normal = area / weight;
-                let current = area.dot(xv - xk) as f64;
-                let weight = weight as f64;
-                let height = (hierarchy.six_split_volume(v as u32) as f64 - current) / weight;
-                // The most height a split may take (after the low-pass): twice its longest edge
-                // now. Where the fairing has shrunk its ring to a sliver (a spike's base on a
-                // noisy scan), the volume over that sliver asks for a tower (one vertex of the
-                // noisy Stanford dragon went 83 edge lengths out). Bounding by its height in M0
-                // instead cost a tenth of a multires run (a second position array to read).
-                let bound = 2.0 * spoke_squared.sqrt() as f64;
-                (normal, height, weight, bound)
-            })
-            .collect_into_vec(heights);
-    }
-    for _ in 0..HEIGHT_SMOOTHING_ROUNDS {
-        // Per vertex, the weighted heights of its adjacent split vertices (a gather over the
-        // sorted one-ring: the same sums, in the same order, as scattering from the split
-        // vertices).
-        {
-            let heights: &[(Vec3A, f64, f64, f64)] = heights;
-            (0..fine_count)
-                .into_par_iter()
-                .with_min_len(PARALLEL_GRAIN)
-                .map(|u| {
-                    let mut sum = [0.0; 2];
-                    for &v in topology.neighbors(u as u32) {
-                        if let Some(&(_, height, weight, _)) =
-                            (v as usize).checked_sub(coarse_count).map(|i| &heights[i])
-                        {
-                            sum[0] += height * weight;
-                            sum[1] += weight;
-                        }
-                    }
-                    sum
-                })
-                .collect_into_vec(height_sums);
-        }
-        let sums: &[[f64; 2]] = height_sums;
-        heights
-            .par_iter_mut()
-            .with_min_len(PARALLEL_GRAIN)
-            .enumerate()
-            .for_each(|(i, entry)| {
-                let mut sum = [0.0; 2];
-                for &u in topology.neighbors((coarse_count + i) as u32) {
-                    let s = sums[u as usize];
-                    sum[0] += s[0];
-                    sum[1] += s[1];
-                }
-                if sum[1] > 0.0 {
-                    entry.1 = sum[0] / sum[1];
-                }
-            });
-    }
-    positions[coarse_count..]
-        .par_iter_mut()
-        .zip(heights.par_iter())
-        .for_each(|(p, &(normal, height, _, bound))| {
-            let height = height.clamp(-bound, bound);
-            *p = (Vec3A::from_array(*p) + normal * height as f32).to_array()
-        });
 }
 
 #[cfg(test)]

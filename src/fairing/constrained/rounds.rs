@@ -1,0 +1,584 @@
+//! The driver of constrained fairing: [`fair_constrained`] decides whether and how much to fair
+//! (the noise estimate, [`crate::fairing::strength`]), finds the creases
+//! ([`crate::fairing::creases`]) and runs the rounds of section 3.2 ("imposing and relaxing the
+//! centre constraints by turns"), with the creases found again, the tangential relaxation where
+//! it is needed, the volume given back and, with automatic strength, the risk read after every
+//! round and the rounds after the best one undone.
+
+use super::round_steps::{milliseconds, RelaxationPlan, RiskJudge, RoundLoop, TrackedCreases};
+use super::ConstrainedFairing;
+use crate::fairing::creases::{
+    detect_creases_cached, detect_creases_with_estimate, CreaseOptions, Creases, FaceRingCache,
+};
+use crate::fairing::strength::{
+    normal_filtering_for, read_noise, NoiseReading, CLEAN_NOISE, MAX_AUTO_ROUNDS,
+};
+use crate::fairing::volume::VolumeKeeper;
+use crate::fairing::{FairOptions, FairReport, FairVariant, Strength};
+use crate::mesh::{breadth_first_order, inverse_permutation, FanRings, Topology, TriMesh};
+use rayon::prelude::*;
+
+/// Constrained fairing of `mesh` in place (sections 3.2 and 3.3); `topology` must be built from
+/// `mesh`. Precomputes the operator (see [`ConstrainedFairing`] to reuse it) and runs
+/// `options.rounds` rounds of up to `options.iterations` iterations each.
+///
+/// ```
+/// use fairmesh::fairing::{fair_constrained, FairOptions};
+/// use fairmesh::metrics::signed_volume;
+/// use fairmesh::noise::{add_noise, NoiseOptions};
+///
+/// let loaded = fairmesh::bundled::load_bunny(&Default::default())?;
+/// let (mut mesh, topology) = (loaded.mesh, loaded.topology);
+/// add_noise(&mut mesh, &NoiseOptions::default());
+/// let noisy = mesh.clone();
+///
+/// let options = FairOptions::default().with_rounds(3);
+/// let report = fair_constrained(&mut mesh, &topology, &options);
+/// assert!(report.iterations_run > 0);
+/// // Smoother: the vertices moved, by less than the noise's size.
+/// let moved = mesh.positions.iter().zip(&noisy.positions).filter(|(a, b)| a != b).count();
+/// assert!(moved > mesh.vertex_count() / 2);
+/// // And without shrinkage: the volume stays within 0.1%.
+/// let change = signed_volume(&mesh) / signed_volume(&noisy) - 1.0;
+/// assert!(change.abs() < 1e-3, "{change}");
+/// # Ok::<(), fairmesh::io::IoError>(())
+/// ```
+pub fn fair_constrained(
+    mesh: &mut TriMesh,
+    topology: &Topology,
+    options: &FairOptions,
+) -> FairReport {
+    if options.iterations == 0 || mesh.positions.is_empty() {
+        return FairReport::default();
+    }
+    if options.strength == Strength::Fixed && options.rounds == 0 {
+        return FairReport::default();
+    }
+    // A mask that does not fit, or pins everything: nothing may move.
+    if let Some(mask) = &options.mask {
+        if mask.check_fits(mesh.positions.len()).is_err() || mask.painted_count() == 0 {
+            return FairReport::default();
+        }
+    }
+    if let Some(report) = fair_without_loose_triangles(mesh, topology, options) {
+        return report;
+    }
+    let original = options.mask.as_ref().map(|_| mesh.positions.clone());
+    let pinned = options
+        .mask
+        .as_ref()
+        .map(|mask| mask.pinned_flags())
+        .unwrap_or_default();
+    let report = if options.strength == Strength::Fixed && options.rounds >= LOCAL_ORDER_ROUNDS {
+        in_local_order(
+            mesh,
+            topology,
+            options,
+            &pinned,
+            |mesh, topology, options, pinned| {
+                decide_and_fair(mesh, topology, options, pinned, false)
+            },
+        )
+    } else {
+        decide_and_fair(mesh, topology, options, &pinned, true)
+    };
+    // The operator held the pinned vertices; the blend fades the rest by their weights (and
+    // puts back pinned boundary vertices, which the boundary curves may have moved).
+    if let (Some(mask), Some(original)) = (&options.mask, &original) {
+        mask.blend(original, &mut mesh.positions);
+    }
+    report
+}
+
+/// A non-manifold scan is faired as the surface it stands for: without the triangles its
+/// reconstruction left lying loose at its non-manifold edges (overlays on a fan, fins), which
+/// would make their corners boundary vertices on chains no boundary curve runs through, and so
+/// hold them with their noise (`crate::mesh::loose_triangles`, `docs/measurements.md`). Same
+/// vertices, nothing renumbered; a corner only loose triangles use (a fin's tip) stays where it
+/// is. `None` when the default variant has no loose triangles to leave out.
+fn fair_without_loose_triangles(
+    mesh: &mut TriMesh,
+    topology: &Topology,
+    options: &FairOptions,
+) -> Option<FairReport> {
+    if options.variant != FairVariant::NormalProjected || topology.non_manifold_edges.is_empty() {
+        return None;
+    }
+    let (loose, mut kept, kept_topology) = crate::mesh::without_loose_triangles(mesh, topology)?;
+    // The volume kept is the file's, loose triangles included: they follow their corners, and
+    // their own (cone) volume changes with them; one more uniform offset takes that back.
+    let pinned = options
+        .mask
+        .as_ref()
+        .map(|mask| mask.pinned_flags())
+        .unwrap_or_default();
+    let volume = options
+        .keep_volume
+        .then(|| VolumeKeeper::new(mesh, topology, &pinned));
+    let mut report = fair_constrained(&mut kept, &kept_topology, options);
+    mesh.positions = kept.positions;
+    if let Some(volume) = volume.filter(|_| report.rounds_run > 0) {
+        volume.restore(mesh, topology, |v| pinned.get(v).copied().unwrap_or(false));
+    }
+    report.loose_triangles += loose.len();
+    Some(report)
+}
+
+/// Rounds from which a run in the locality order pays for making it (see [`in_local_order`]).
+const LOCAL_ORDER_ROUNDS: usize = 3;
+
+/// Runs `fair` on a copy of `mesh` whose vertices are numbered breadth-first over the one-rings and
+/// whose faces are sorted by their lowest corner, then puts the faired positions back in the mesh's
+/// numbering. Every per-vertex pass of a round outside the operator (the crease detection and the
+/// noise estimate over the fans, the volume correction's normals, the risk's normals) gathers its
+/// neighbours' data; in a file's own order (a scan's, a subdivided mesh's) those sit megabytes
+/// apart, here a few breadth-first fronts apart; the reordering and a second topology cost little
+/// next to the rounds (`docs/measurements.md`). The operator renumbers its own vertices the same
+/// way, so its iterations are unchanged. What `options` number by vertex (the file's hard edges) is
+/// renumbered too; `pinned` stands for the mask, which `fair` does not see.
+fn in_local_order(
+    mesh: &mut TriMesh,
+    topology: &Topology,
+    options: &FairOptions,
+    pinned: &[bool],
+    fair: impl FnOnce(&mut TriMesh, &Topology, &FairOptions, &[bool]) -> FairReport,
+) -> FairReport {
+    let (offsets, neighbors) = topology.neighbor_csr();
+    let order = breadth_first_order(offsets, neighbors);
+    let position = inverse_permutation(&order);
+    let positions: Vec<[f32; 3]> = order
+        .par_iter()
+        .map(|&v| mesh.positions[v as usize])
+        .collect();
+    // Faces relabelled (corners in their own order, so the winding stays), then placed by their
+    // lowest corner with a stable counting sort.
+    let relabelled: Vec<[u32; 3]> = mesh
+        .triangles
+        .par_iter()
+        .map(|t| t.map(|v| position[v as usize]))
+        .collect();
+    let lowest = |t: &[u32; 3]| t[0].min(t[1]).min(t[2]) as usize;
+    let mut start = vec![0u32; positions.len() + 1];
+    for t in &relabelled {
+        start[lowest(t) + 1] += 1;
+    }
+    for v in 0..positions.len() {
+        start[v + 1] += start[v];
+    }
+    let mut triangles = vec![[0u32; 3]; relabelled.len()];
+    for t in relabelled {
+        let slot = &mut start[lowest(&t)];
+        triangles[*slot as usize] = t;
+        *slot += 1;
+    }
+    let mut local = TriMesh::new(positions, triangles);
+    let local_topology = Topology::build(&local);
+    let local_pinned: Vec<bool> = if pinned.is_empty() {
+        Vec::new()
+    } else {
+        order.iter().map(|&v| pinned[v as usize]).collect()
+    };
+    let mut local_options = options.clone();
+    local_options.mask = None;
+    if let Some(creases) = &mut local_options.creases {
+        let edges: Vec<[u32; 2]> = creases
+            .file_edges
+            .iter()
+            .map(
+                |&[a, b]| match (position.get(a as usize), position.get(b as usize)) {
+                    (Some(&pa), Some(&pb)) if a < b => [pa.min(pb), pa.max(pb)],
+                    // Edges the detection leaves out (a reversed pair, a vertex out of range) are
+                    // passed on as they are, to be left out there too.
+                    _ => [a, b],
+                },
+            )
+            .collect();
+        creases.file_edges = edges.into();
+    }
+    let report = fair(&mut local, &local_topology, &local_options, &local_pinned);
+    for (&v, p) in order.iter().zip(&local.positions) {
+        mesh.positions[v as usize] = *p;
+    }
+    report
+}
+
+/// The noise estimate, the decision to fair at all (automatic strength leaves a clean mesh as it
+/// is), the first creases, then the rounds. With `may_reorder`, automatic strength on a noisy
+/// mesh runs its rounds in the locality order ([`in_local_order`]).
+fn decide_and_fair(
+    mesh: &mut TriMesh,
+    topology: &Topology,
+    options: &FairOptions,
+    pinned: &[bool],
+    may_reorder: bool,
+) -> FairReport {
+    // The fan-ordered one-rings the operator is built from serve the noise estimate and the
+    // crease detection first (`read_noise`, `detect_creases_with_estimate`).
+    let fans = FanRings::new(&mesh.triangles, topology);
+    // Without `may_reorder` the mesh is already the locality-ordered copy (`in_local_order`):
+    // the filter keeps its face order (the same normals bit for bit, its lists built faster).
+    let mut face_rings = if may_reorder {
+        FaceRingCache::default()
+    } else {
+        FaceRingCache::in_mesh_order()
+    };
+    let started = std::time::Instant::now();
+    let (estimate, found, reading) = first_reading(mesh, topology, &fans, options, &mut face_rings);
+    let auto_noise = match options.strength {
+        Strength::Auto => match noisy(estimate, reading.as_ref(), topology) {
+            Some(noise) => Some(noise),
+            None => {
+                return FairReport {
+                    noise_estimate: estimate,
+                    detection_ms: milliseconds(started),
+                    ..FairReport::default()
+                }
+            }
+        },
+        _ => None,
+    };
+    drop(reading);
+    let decided_ms = milliseconds(started);
+    let rounds = Rounds {
+        estimate,
+        auto_noise,
+        pinned,
+    };
+    let mut report = if may_reorder && auto_noise.is_some() {
+        drop(fans);
+        in_local_order(
+            mesh,
+            topology,
+            options,
+            pinned,
+            |mesh, topology, options, pinned| {
+                let fans = FanRings::new(&mesh.triangles, topology);
+                fair_rounds(
+                    mesh,
+                    topology,
+                    fans,
+                    (None, FaceRingCache::in_mesh_order()),
+                    options,
+                    Rounds { pinned, ..rounds },
+                )
+            },
+        )
+    } else {
+        fair_rounds(mesh, topology, fans, (found, face_rings), options, rounds)
+    };
+    report.detection_ms += decided_ms;
+    report
+}
+
+/// The first reading of the input: the noise estimate, which decides the strength (automatic)
+/// and how much the normals are filtered before creases are detected (raw normals of a noisy
+/// mesh make creases of the noise). A fixed strength finds the estimate and the creases in one
+/// gather (skipping the filter when the mesh is clean); automatic strength fairs only a noisy
+/// mesh, so its creases are always found later on filtered normals, and it reads in the same
+/// gather which vertices lie on sharp edges ([`read_noise`]).
+fn first_reading(
+    mesh: &TriMesh,
+    topology: &Topology,
+    fans: &FanRings,
+    options: &FairOptions,
+    face_rings: &mut FaceRingCache,
+) -> (Option<f64>, Option<Creases>, Option<NoiseReading>) {
+    match (&options.creases, options.strength) {
+        (Some(crease_options), Strength::Fixed) => {
+            let (estimate, creases) = detect_creases_with_estimate(
+                mesh,
+                topology,
+                fans,
+                crease_options,
+                face_rings,
+                true,
+            );
+            (estimate, Some(creases), None)
+        }
+        (_, Strength::Auto) => {
+            let angle = options
+                .creases
+                .as_ref()
+                .map_or(CreaseOptions::default().angle_degrees, |c| c.angle_degrees);
+            let reading = read_noise(mesh, topology, fans, angle);
+            (reading.noise(topology), None, Some(reading))
+        }
+        (None, _) => (None, None, None),
+    }
+}
+
+/// Automatic strength: the noise to fair, `None` for a mesh left as it is: a clean one, or one
+/// that reads noisy only because of its sharp edges (a coarse CAD part: most of its vertices lie
+/// on or beside an edge, and those make the median read noise; away from the edges it reads
+/// clean).
+fn noisy(
+    estimate: Option<f64>,
+    reading: Option<&NoiseReading>,
+    topology: &Topology,
+) -> Option<f64> {
+    let clean_away_from_edges = || {
+        reading
+            .and_then(|reading| reading.away_from_edges(topology))
+            .is_some_and(|away| away <= CLEAN_NOISE)
+    };
+    estimate.filter(|&noise| noise > CLEAN_NOISE && !clean_away_from_edges())
+}
+
+/// What [`fair_rounds`] takes from the decision to fair.
+#[derive(Clone, Copy)]
+struct Rounds<'a> {
+    /// The input's noise estimate (reported, and setting the first detection's filtering).
+    estimate: Option<f64>,
+    /// Automatic strength: the noise estimate of the input that is faired; `None` for a fixed
+    /// strength.
+    auto_noise: Option<f64>,
+    /// Vertices a mask pins (empty: none).
+    pinned: &'a [bool],
+}
+
+/// The rounds of [`fair_constrained`], after the decision to fair: `fans` are `mesh`'s,
+/// `found` the creases found with the noise estimate (a fixed strength), if any, with the faces
+/// around each face if that detection filtered the normals. Each round finds the creases again
+/// when they are due ([`Creases`]), sets the relaxation's shares ([`RelaxationPlan`]), runs the
+/// operator, gives the volume back and, with automatic strength, reads the risk ([`RiskJudge`]),
+/// which may stop the rounds and undo the last ones.
+fn fair_rounds(
+    mesh: &mut TriMesh,
+    topology: &Topology,
+    fans: FanRings,
+    (found, mut face_rings): (Option<Creases>, FaceRingCache),
+    options: &FairOptions,
+    rounds: Rounds,
+) -> FairReport {
+    let Rounds {
+        estimate,
+        auto_noise,
+        pinned,
+    } = rounds;
+    let started = std::time::Instant::now();
+    let creases =
+        found.or_else(|| first_creases(mesh, topology, options, estimate, &mut face_rings));
+    let first_detection_ms = milliseconds(started);
+    let max_rounds = match auto_noise {
+        Some(_) => MAX_AUTO_ROUNDS,
+        None => options.rounds,
+    };
+    let redetect = options.creases.is_some() && max_rounds > 1;
+    let mut fairing = ConstrainedFairing::with_fans(
+        mesh,
+        topology,
+        &fans,
+        options.variant,
+        options.boundary,
+        creases.as_ref(),
+        pinned,
+    );
+    fairing.set_tangential_relaxation(options.tangential_relaxation as f32);
+    let started = std::time::Instant::now();
+    let relaxation = RelaxationPlan::read(mesh, topology, &fans, options, estimate);
+    let reading_ms = milliseconds(started);
+    // The fans serve the later rounds only to find the creases again (and estimate the noise
+    // that sets the filtering for it) and to read the noise along the surface again while the
+    // relaxation acts everywhere: otherwise they are freed before the iterations (the peak,
+    // while the operator is set up from them, stays).
+    let fans = (redetect || relaxation.everywhere.is_some_and(|share| share > 0.0)).then_some(fans);
+    let volume = options
+        .keep_volume
+        .then(|| VolumeKeeper::new(mesh, topology, pinned));
+    let mut report = FairReport {
+        detection_ms: first_detection_ms + reading_ms,
+        tangential_noise: relaxation.tangential_noise,
+        ..FairReport::default()
+    };
+    let judge = auto_noise.map(|noise| RiskJudge::new(mesh, topology, noise, creases.as_ref()));
+    let mut rounds = RoundLoop {
+        topology,
+        options,
+        pinned,
+        fairing,
+        fans,
+        face_rings,
+        redetect,
+        tracked: TrackedCreases {
+            creases,
+            unchanged: 0,
+            read_clean: false,
+        },
+        relaxation,
+        volume,
+        judge,
+    };
+    for round in 0..max_rounds {
+        if rounds.run(mesh, round, &mut report) {
+            break;
+        }
+    }
+    let tracked = rounds.tracked;
+    let judge = rounds.judge;
+    let mut crease_edges = tracked.creases.map_or(0, |c| c.edges.len());
+    if let Some(judge) = judge {
+        judge.roll_back(mesh, &mut report, &mut crease_edges);
+    }
+    report.noise_estimate = estimate;
+    report.crease_edges = crease_edges;
+    report
+}
+
+/// The creases the first round fairs with, when the noise estimate's gather did not find them:
+/// the normals filtered as much as the input's estimate asks for.
+fn first_creases(
+    mesh: &TriMesh,
+    topology: &Topology,
+    options: &FairOptions,
+    estimate: Option<f64>,
+    face_rings: &mut FaceRingCache,
+) -> Option<Creases> {
+    options.creases.as_ref().map(|crease_options| {
+        let mut crease_options = crease_options.clone();
+        crease_options.normal_filtering = crease_options
+            .normal_filtering
+            .max(estimate.map_or(0, normal_filtering_for));
+        detect_creases_cached(mesh, topology, &crease_options, face_rings)
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::fairing::BoundaryMode;
+    use crate::mesh::fixtures::irregular_sphere;
+
+    #[test]
+    fn a_vertex_with_no_interior_triangle_keeps_its_position() {
+        // A fan of 6 triangles around a centre: every triangle touches the boundary, so the centre
+        // has no local solution and must stay (the pseudocode would move it to the origin).
+        let mut positions = vec![[0.3f32, 0.2, 0.5]];
+        for i in 0..6 {
+            let a = i as f32 / 6.0 * std::f32::consts::TAU;
+            positions.push([a.cos(), a.sin(), 0.0]);
+        }
+        let triangles = (0..6u32).map(|i| [0, 1 + i, 1 + (i + 1) % 6]).collect();
+        let mut mesh = TriMesh::new(positions, triangles);
+        let topology = Topology::build(&mesh);
+        for variant in [FairVariant::Paper, FairVariant::NormalProjected] {
+            let before = mesh.positions.clone();
+            fair_constrained(
+                &mut mesh,
+                &topology,
+                &FairOptions {
+                    boundary: BoundaryMode::Fixed,
+                    variant,
+                    ..Default::default()
+                },
+            );
+            assert_eq!(mesh.positions, before);
+        }
+    }
+
+    #[test]
+    fn a_run_in_the_locality_order_sees_the_mesh_renumbered_and_gives_back_its_positions() {
+        // The irregular sphere with its vertices shuffled, so the locality order is not the
+        // input's.
+        let sphere = irregular_sphere();
+        let n = sphere.positions.len();
+        let shuffle: Vec<u32> = (0..n as u32).map(|i| (i * 37 + 11) % n as u32).collect();
+        let mut sorted = shuffle.clone();
+        sorted.sort_unstable();
+        assert!(
+            sorted.iter().enumerate().all(|(i, &v)| v == i as u32),
+            "37 divides {n}"
+        );
+        let mut positions = vec![[0.0f32; 3]; n];
+        for (old, &new) in shuffle.iter().enumerate() {
+            positions[new as usize] = sphere.positions[old];
+        }
+        let triangles = sphere
+            .triangles
+            .iter()
+            .map(|t| t.map(|v| shuffle[v as usize]))
+            .collect();
+        let mesh = TriMesh::new(positions, triangles);
+        let topology = Topology::build(&mesh);
+        // Vertices are told apart by their positions (all distinct on this sphere).
+        let key = |p: [f32; 3]| p.map(f32::to_bits);
+        let pinned: Vec<bool> = (0..n).map(|v| v % 7 == 0).collect();
+        let file_edges: Vec<[u32; 2]> = (0..n as u32)
+            .step_by(5)
+            .flat_map(|a| topology.neighbors(a).iter().map(move |&b| [a, b]))
+            .filter(|[a, b]| a < b)
+            .collect();
+        let edge_keys = |mesh: &TriMesh, edges: &[[u32; 2]]| {
+            let mut keys: Vec<_> = edges
+                .iter()
+                .map(|e| {
+                    let [a, b] = e.map(|v| key(mesh.positions[v as usize]));
+                    [a.min(b), a.max(b)]
+                })
+                .collect();
+            keys.sort_unstable();
+            keys
+        };
+        let triangle_keys = |mesh: &TriMesh| {
+            let mut keys: Vec<_> = mesh
+                .triangles
+                .iter()
+                .map(|t| {
+                    // Rotated to start at the least corner: the winding is kept.
+                    let k = t.map(|v| key(mesh.positions[v as usize]));
+                    let first = (0..3).min_by_key(|&i| k[i]).unwrap();
+                    [k[first], k[(first + 1) % 3], k[(first + 2) % 3]]
+                })
+                .collect();
+            keys.sort_unstable();
+            keys
+        };
+        let options = FairOptions::default().with_creases(Some(
+            CreaseOptions::default().with_file_edges(file_edges.clone()),
+        ));
+        let moved = |p: [f32; 3]| [p[0] * 2.0, p[1] + 1.0, -p[2]];
+        let mut faired = mesh.clone();
+        let report = in_local_order(
+            &mut faired,
+            &topology,
+            &options,
+            &pinned,
+            |local, local_topology, local_options, local_pinned| {
+                assert_ne!(local.positions, mesh.positions, "the order changed nothing");
+                assert_eq!(triangle_keys(local), triangle_keys(&mesh));
+                let from = |p: [f32; 3]| mesh.positions.iter().position(|&q| key(q) == key(p));
+                for (v, &p) in local.positions.iter().enumerate() {
+                    assert_eq!(
+                        local_pinned[v],
+                        pinned[from(p).unwrap()],
+                        "pinned flag of {v}"
+                    );
+                }
+                let local_edges = &local_options.creases.as_ref().unwrap().file_edges;
+                assert!(local_edges.iter().all(|[a, b]| a < b));
+                assert_eq!(edge_keys(local, local_edges), edge_keys(&mesh, &file_edges));
+                assert_eq!(
+                    local_topology.neighbor_csr(),
+                    Topology::build(local).neighbor_csr()
+                );
+                // Faces in order of their lowest corner.
+                let lowest = |t: &[u32; 3]| t[0].min(t[1]).min(t[2]);
+                assert!(local
+                    .triangles
+                    .windows(2)
+                    .all(|w| lowest(&w[0]) <= lowest(&w[1])));
+                for p in &mut local.positions {
+                    *p = moved(*p);
+                }
+                FairReport {
+                    rounds_run: 7,
+                    ..FairReport::default()
+                }
+            },
+        );
+        assert_eq!(report.rounds_run, 7);
+        for (after, &before) in faired.positions.iter().zip(&mesh.positions) {
+            assert_eq!(*after, moved(before));
+        }
+        assert_eq!(faired.triangles, mesh.triangles);
+    }
+}
