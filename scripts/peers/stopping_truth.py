@@ -7,7 +7,7 @@ default `fair` with `--json` (its rounds and `risk_by_round`), then `fair --roun
 K up to --rounds, each measured against the clean mesh two ways:
 - the true risk: the mean squared distance along the result's vertex normals (area-weighted) to
   the clean vertices, plus sigma squared, which is what the risk `fair` reads estimates (Stein's
-  unbiased risk estimate without its constant; `src/fairing/strength.rs`);
+  unbiased risk estimate without its constant; `src/fairing/strength/risk.rs`);
 - the mean surface distance both ways (`fairmesh compare`), the yardstick of the peer tables.
 Both in mean edge lengths of the clean mesh (the risk squared). `--rounds K` gives the same
 rounds as the default's first K (the same operator, creases and schedule), so the default's

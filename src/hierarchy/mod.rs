@@ -24,7 +24,7 @@
 //! noise estimate asks; groups that wander are dropped only where their edges turn by more than
 //! [`HIERARCHY_ZIGZAG_TURN`] unless the options say otherwise, since a coarse level keeps its shape
 //! by those bends), corners never collapse and crease vertices collapse only along their crease
-//! (see `decimate.rs`), so every level's creases are M0's feature edges with their ends followed
+//! (see `decimate/`), so every level's creases are M0's feature edges with their ends followed
 //! along `target` ([`Hierarchy::level_creases`]); multiresolution fairing fairs them as curves. The
 //! detection costs a topology, the fan-ordered one-rings and one gather over them that gives the
 //! noise estimate and the feature edges together (the guided normal filter only on a noisy mesh);
