@@ -494,6 +494,67 @@ fn obj_keeps_every_line_but_the_moved_vertices_their_normals_and_texture_coordin
     assert!(normals.iter().all(|n| (n.length() - 1.0).abs() < 1e-5));
 }
 
+/// An OBJ written back into another folder takes its material library and the images it names
+/// along (its `mtllib` line stays as it was; without them a viewer shows it untextured). A
+/// different file of that name already there is never replaced, and what cannot be copied is
+/// named in a warning.
+#[test]
+fn obj_written_elsewhere_takes_its_material_library_and_images_along() {
+    let read = |path: PathBuf| std::fs::read(&path).unwrap_or_else(|e| panic!("{path:?}: {e}"));
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("faired.obj");
+    let (loaded, mesh, report) = fair_and_save("textured.obj", &out);
+    assert!(report.warnings.is_empty(), "{:?}", report.warnings);
+    for name in ["textured.mtl", "textured.png"] {
+        assert_eq!(read(dir.path().join(name)), read(data(name)), "{name}");
+    }
+    // Saved there again: the files beside it are the same, so there is nothing to say.
+    let report = io::save_with_source(&out, &mesh, &loaded.source).unwrap();
+    assert!(report.warnings.is_empty(), "{:?}", report.warnings);
+
+    // A folder that already holds another textured.mtl: it stays, and a warning says so.
+    let other = tempfile::tempdir().unwrap();
+    std::fs::write(other.path().join("textured.mtl"), "newmtl mine\n").unwrap();
+    let report =
+        io::save_with_source(other.path().join("faired.obj"), &mesh, &loaded.source).unwrap();
+    assert_eq!(read(other.path().join("textured.mtl")), b"newmtl mine\n");
+    assert!(
+        report
+            .warnings
+            .iter()
+            .any(|w| w.contains("textured.mtl") && w.contains("a different file of that name")),
+        "{:?}",
+        report.warnings
+    );
+    assert_eq!(
+        read(other.path().join("textured.png")),
+        read(data("textured.png"))
+    );
+
+    // An input whose image is missing: its library is copied, the image named in a warning.
+    let input = tempfile::tempdir().unwrap();
+    for name in ["textured.obj", "textured.mtl"] {
+        std::fs::copy(data(name), input.path().join(name)).unwrap();
+    }
+    let lonely = io::load(input.path().join("textured.obj")).unwrap();
+    let third = tempfile::tempdir().unwrap();
+    let report =
+        io::save_with_source(third.path().join("t.obj"), &lonely.mesh, &lonely.source).unwrap();
+    assert_eq!(
+        read(third.path().join("textured.mtl")),
+        read(data("textured.mtl"))
+    );
+    assert!(!third.path().join("textured.png").exists());
+    assert!(
+        report
+            .warnings
+            .iter()
+            .any(|w| w.contains("image textured.png") && w.contains("not beside the input")),
+        "{:?}",
+        report.warnings
+    );
+}
+
 /// The vertex property types of a PLY header, in order.
 fn ply_vertex_properties(header: &str) -> Vec<(String, String)> {
     let mut in_vertex = false;
@@ -959,6 +1020,24 @@ fn a_gltf_scene_saved_as_obj_keeps_names_materials_uvs_colours_and_split_normals
     assert_eq!(
         std::fs::read(dir.path().join(texture)).unwrap(),
         std::fs::read(data("checker.png")).unwrap()
+    );
+    // Saved again into that folder: the image there has the same bytes, so it is used, not
+    // written again under another name; a different image of that name is never replaced.
+    io::save_with_source(dir.path().join("again.obj"), &mesh, &loaded.source).unwrap();
+    let again = read_mtl(&dir.path().join("again.mtl"));
+    assert_eq!(mtl_value(&again["checker"], "map_Kd"), Some(texture));
+    assert!(!dir.path().join(format!("again_{texture}")).exists());
+    std::fs::write(dir.path().join(texture), b"another image").unwrap();
+    io::save_with_source(dir.path().join("third.obj"), &mesh, &loaded.source).unwrap();
+    assert_eq!(
+        std::fs::read(dir.path().join(texture)).unwrap(),
+        b"another image"
+    );
+    let third = read_mtl(&dir.path().join("third.mtl"));
+    let renamed = format!("third_{texture}");
+    assert_eq!(
+        mtl_value(&third["checker"], "map_Kd"),
+        Some(renamed.as_str())
     );
 
     // UVs and colours: each corner has the input's UV at its place; seams stay split.

@@ -96,6 +96,15 @@ fn explain_create_error(error: std::io::Error, path: &Path) -> std::io::Error {
     std::io::Error::new(error.kind(), message)
 }
 
+/// Stage a copy of the file `from` at `to`.
+pub(crate) fn stage_copy(from: &Path, to: &Path) -> Result<Staged, IoError> {
+    let bytes = std::fs::read(from).map_err(|source| IoError::Read {
+        path: from.to_owned(),
+        source,
+    })?;
+    stage(to, |w| w.write_all(&bytes))
+}
+
 /// Write `path` atomically with `fill`, which writes the whole content.
 pub(crate) fn write(
     path: &Path,

@@ -78,11 +78,19 @@ fn write_back(
     let origin = &source.origin;
     match &source.data {
         SourceData::Obj(bytes) => {
+            // Its material libraries and their images go beside it; every file is staged and
+            // renamed into place only when all are complete.
+            let copies = obj::companion_copies(bytes, origin, path, &mut report.warnings);
+            let staged_copies = obj::stage_copies(&copies, path)?;
             let mut shared = 0;
-            atomic::write(path, |w| {
+            let staged_obj = atomic::stage(path, |w| {
                 shared = obj::write_back(w, bytes, origin, mesh)?;
                 Ok(())
             })?;
+            for staged in staged_copies {
+                staged.commit()?;
+            }
+            staged_obj.commit()?;
             report.texture_coordinates_follow = true;
             if shared > 0 {
                 report.warnings.push(format!(

@@ -464,8 +464,14 @@ impl Scene {
                     });
                 }
                 let mut name = image.name.clone();
+                // A file of that name already beside the output is a clash unless it holds the
+                // same bytes (an earlier export, or the write-back's copy of the image).
                 let clash = |name: &str, taken: &[(String, String)]| {
-                    taken.iter().any(|(n, _)| n == name) || out_dir.join(name).exists()
+                    let target = out_dir.join(name);
+                    taken.iter().any(|(n, _)| n == name)
+                        || (target.exists()
+                            && std::fs::read(&target).ok().as_deref()
+                                != image.data.bytes().ok().as_deref())
                 };
                 if clash(&name, &taken) {
                     name = format!("{stem}_{}", image.name);

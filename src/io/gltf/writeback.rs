@@ -189,11 +189,7 @@ fn write_gltf_files(
         .transpose()?;
     let mut staged_images = Vec::new();
     for (from, to) in &copies {
-        let bytes = std::fs::read(from).map_err(|source| IoError::Read {
-            path: from.clone(),
-            source,
-        })?;
-        staged_images.push(atomic::stage(to, |w| w.write_all(&bytes))?);
+        staged_images.push(atomic::stage_copy(from, to)?);
     }
     let staged_json = atomic::stage(path, |w| w.write_all(&text))?;
     for staged in staged_images {

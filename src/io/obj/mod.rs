@@ -22,9 +22,11 @@
 //! of a kept file share: a line's words, a vertex, a corner's indices), `write.rs` (a bare mesh),
 //! `attributes.rs` (what the file holds, per welded vertex and in plain words), `scene.rs` and
 //! `materials.rs` (the file as a [`crate::io::scene::Scene`]), `write_scene.rs` and
-//! `writeback.rs` (the file with new positions).
+//! `writeback.rs` (the file with new positions), `companions.rs` (its material libraries and
+//! their images, copied beside a file written back into another folder).
 
 mod attributes;
+mod companions;
 mod line;
 mod materials;
 mod read;
@@ -34,6 +36,7 @@ mod write_scene;
 mod writeback;
 
 pub(crate) use attributes::{contents, has_texture_coordinates, vertex_attributes};
+pub(crate) use companions::{companion_copies, stage_copies};
 pub(crate) use read::parse;
 pub(crate) use scene::scene;
 pub(crate) use write::{write, write_with};
