@@ -254,40 +254,38 @@ pub(super) fn fan(corners: &[u32], builder: &mut Builder) {
     }
 }
 
+/// One `$t` from the first `$n` bytes of `$bytes`, big endian when `$big`; returns `None` from
+/// the calling function when there are fewer bytes.
+macro_rules! scalar_at {
+    ($bytes:expr, $big:expr, $t:ty, $n:literal) => {{
+        let raw: [u8; $n] = $bytes.get(..$n)?.try_into().ok()?;
+        if $big {
+            <$t>::from_be_bytes(raw)
+        } else {
+            <$t>::from_le_bytes(raw)
+        }
+    }};
+}
+
 /// Read one scalar from the start of `bytes` (which has at least `kind.size()` bytes).
 #[inline]
 pub(super) fn read_f64<const BIG: bool>(kind: Scalar, bytes: &[u8]) -> Option<f64> {
-    macro_rules! get {
-        ($t:ty, $n:literal) => {{
-            let raw: [u8; $n] = bytes.get(..$n)?.try_into().ok()?;
-            if BIG {
-                <$t>::from_be_bytes(raw)
-            } else {
-                <$t>::from_le_bytes(raw)
-            }
-        }};
-    }
     Some(match kind {
-        Scalar::I8 => get!(i8, 1) as f64,
-        Scalar::U8 => get!(u8, 1) as f64,
-        Scalar::I16 => get!(i16, 2) as f64,
-        Scalar::U16 => get!(u16, 2) as f64,
-        Scalar::I32 => get!(i32, 4) as f64,
-        Scalar::U32 => get!(u32, 4) as f64,
-        Scalar::F32 => get!(f32, 4) as f64,
-        Scalar::F64 => get!(f64, 8),
+        Scalar::I8 => scalar_at!(bytes, BIG, i8, 1) as f64,
+        Scalar::U8 => scalar_at!(bytes, BIG, u8, 1) as f64,
+        Scalar::I16 => scalar_at!(bytes, BIG, i16, 2) as f64,
+        Scalar::U16 => scalar_at!(bytes, BIG, u16, 2) as f64,
+        Scalar::I32 => scalar_at!(bytes, BIG, i32, 4) as f64,
+        Scalar::U32 => scalar_at!(bytes, BIG, u32, 4) as f64,
+        Scalar::F32 => scalar_at!(bytes, BIG, f32, 4) as f64,
+        Scalar::F64 => scalar_at!(bytes, BIG, f64, 8),
     })
 }
 
 #[inline]
 pub(super) fn read_f32<const BIG: bool>(kind: Scalar, bytes: &[u8]) -> Option<f32> {
     if kind == Scalar::F32 {
-        let raw: [u8; 4] = bytes.get(..4)?.try_into().ok()?;
-        return Some(if BIG {
-            f32::from_be_bytes(raw)
-        } else {
-            f32::from_le_bytes(raw)
-        });
+        return Some(scalar_at!(bytes, BIG, f32, 4));
     }
     read_f64::<BIG>(kind, bytes).map(|v| v as f32)
 }
@@ -295,23 +293,13 @@ pub(super) fn read_f32<const BIG: bool>(kind: Scalar, bytes: &[u8]) -> Option<f3
 /// An integer property; float types are accepted when they hold a whole number.
 #[inline]
 pub(super) fn read_int<const BIG: bool>(kind: Scalar, bytes: &[u8]) -> Option<i64> {
-    macro_rules! get {
-        ($t:ty, $n:literal) => {{
-            let raw: [u8; $n] = bytes.get(..$n)?.try_into().ok()?;
-            if BIG {
-                <$t>::from_be_bytes(raw)
-            } else {
-                <$t>::from_le_bytes(raw)
-            }
-        }};
-    }
     Some(match kind {
-        Scalar::I8 => get!(i8, 1) as i64,
-        Scalar::U8 => get!(u8, 1) as i64,
-        Scalar::I16 => get!(i16, 2) as i64,
-        Scalar::U16 => get!(u16, 2) as i64,
-        Scalar::I32 => get!(i32, 4) as i64,
-        Scalar::U32 => get!(u32, 4) as i64,
+        Scalar::I8 => scalar_at!(bytes, BIG, i8, 1) as i64,
+        Scalar::U8 => scalar_at!(bytes, BIG, u8, 1) as i64,
+        Scalar::I16 => scalar_at!(bytes, BIG, i16, 2) as i64,
+        Scalar::U16 => scalar_at!(bytes, BIG, u16, 2) as i64,
+        Scalar::I32 => scalar_at!(bytes, BIG, i32, 4) as i64,
+        Scalar::U32 => scalar_at!(bytes, BIG, u32, 4) as i64,
         Scalar::F32 | Scalar::F64 => {
             let v = read_f64::<BIG>(kind, bytes)?;
             if v.fract() != 0.0 || !(-9.0e15..=9.0e15).contains(&v) {
