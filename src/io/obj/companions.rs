@@ -25,11 +25,16 @@ pub(crate) fn companion_copies(
     output: &Path,
     warnings: &mut Vec<String>,
 ) -> Vec<(PathBuf, PathBuf)> {
+    let (out_dir, _) = crate::io::folder_and_stem(output);
+    if let Some(base) = &origin.base_dir {
+        if same_folder(base, &out_dir) {
+            return Vec::new();
+        }
+    }
     let libraries = libraries_named(bytes);
     if libraries.is_empty() {
         return Vec::new();
     }
-    let (out_dir, _) = crate::io::folder_and_stem(output);
     let Some(base) = &origin.base_dir else {
         warnings.push(format!(
             "the material libraries {} are not copied beside {}: the input was read from memory, so they cannot be found",
@@ -38,9 +43,6 @@ pub(crate) fn companion_copies(
         ));
         return Vec::new();
     };
-    if same_folder(base, &out_dir) {
-        return Vec::new();
-    }
     let mut copies = Copies {
         out_dir: &out_dir,
         output,
@@ -89,6 +91,10 @@ pub(crate) fn stage_copies(
 fn libraries_named(bytes: &[u8]) -> Vec<String> {
     let mut names: Vec<String> = Vec::new();
     for line in bytes.split(|&b| b == b'\n') {
+        // Only `mtllib` lines are split into words: the `v` and `f` lines are most of the file.
+        if !line.trim_ascii_start().starts_with(b"mtllib") {
+            continue;
+        }
         let mut words = tokens(line);
         if words.next() == Some(b"mtllib") {
             if let Some(name) = rest_of(words) {
