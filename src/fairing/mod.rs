@@ -70,7 +70,7 @@ use crate::mesh::{Topology, TriMesh};
 pub use baseline::{
     fair_hc, fair_laplacian, fair_taubin, HcOptions, LaplacianOptions, TaubinOptions,
 };
-pub use constrained::{fair_constrained, ConstrainedFairing};
+pub use constrained::{fair_constrained, fair_constrained_with_progress, ConstrainedFairing};
 pub use creases::{detect_creases, CreaseOptions, Creases, FeatureClass};
 pub use mask::{Mask, MaskError};
 pub use strength::estimate_noise;
@@ -356,6 +356,35 @@ pub fn fair(mesh: &mut TriMesh, topology: &Topology, options: &MethodOptions) ->
         MethodOptions::Taubin(o) => fair_taubin(mesh, topology, o),
         MethodOptions::Hc(o) => fair_hc(mesh, topology, o),
     }
+}
+
+/// [`fair`], or [`fair_masked`] with a `mask`, reporting to `progress` and stopping when it
+/// returns false (`None` then, with `mesh` left part-way: the caller drops it). Constrained
+/// fairing reports after every round ([`fair_constrained_with_progress`]); a baseline, whose
+/// iterations take a fraction of that, reports when it is done. Not cancelled, the result is
+/// the same as [`fair`]'s or [`fair_masked`]'s, bit for bit.
+pub fn fair_with_progress(
+    mesh: &mut TriMesh,
+    topology: &Topology,
+    options: &MethodOptions,
+    mask: Option<&Mask>,
+    progress: &mut dyn crate::Progress,
+) -> Option<FairReport> {
+    if let (MethodOptions::Constrained(o), Some(mask)) = (options, mask) {
+        if mask.check_fits(mesh.positions.len()).is_err() {
+            return progress.report(1.0).then(FairReport::default);
+        }
+        let masked = o.clone().with_mask(Some(mask.clone()));
+        return fair_constrained_with_progress(mesh, topology, &masked, progress);
+    }
+    if let MethodOptions::Constrained(o) = options {
+        return fair_constrained_with_progress(mesh, topology, o, progress);
+    }
+    let report = match mask {
+        Some(mask) => fair_masked(mesh, topology, options, mask),
+        None => fair(mesh, topology, options),
+    };
+    progress.report(1.0).then_some(report)
 }
 
 /// [`fair`] changing the mesh only where `mask` allows ([`mask`]): constrained fairing holds the

@@ -16,6 +16,7 @@ use crate::fairing::strength::{
 use crate::fairing::volume::VolumeKeeper;
 use crate::fairing::{FairOptions, FairReport, FairVariant, Strength};
 use crate::mesh::{breadth_first_order, inverse_permutation, FanRings, Topology, TriMesh};
+use crate::Progress;
 use rayon::prelude::*;
 
 /// Constrained fairing of `mesh` in place (sections 3.2 and 3.3); `topology` must be built from
@@ -48,19 +49,34 @@ pub fn fair_constrained(
     topology: &Topology,
     options: &FairOptions,
 ) -> FairReport {
+    fair_constrained_with_progress(mesh, topology, options, &mut crate::NoProgress)
+        .unwrap_or_default()
+}
+
+/// [`fair_constrained`] reporting to `progress` after every round (a fraction of the rounds
+/// asked for; with automatic strength, whose number of rounds is not known beforehand, a
+/// fraction that rises with every round and nears 1 as the rounds run out), and stopping when it
+/// returns false: `None` then, with `mesh` left part-way (the caller drops it). The result of a
+/// run that is not cancelled is the same as [`fair_constrained`]'s, bit for bit.
+pub fn fair_constrained_with_progress(
+    mesh: &mut TriMesh,
+    topology: &Topology,
+    options: &FairOptions,
+    progress: &mut dyn Progress,
+) -> Option<FairReport> {
     if options.iterations == 0 || mesh.positions.is_empty() {
-        return FairReport::default();
+        return progress.report(1.0).then(FairReport::default);
     }
     if options.strength == Strength::Fixed && options.rounds == 0 {
-        return FairReport::default();
+        return progress.report(1.0).then(FairReport::default);
     }
     // A mask that does not fit, or pins everything: nothing may move.
     if let Some(mask) = &options.mask {
         if mask.check_fits(mesh.positions.len()).is_err() || mask.painted_count() == 0 {
-            return FairReport::default();
+            return progress.report(1.0).then(FairReport::default);
         }
     }
-    if let Some(report) = fair_without_loose_triangles(mesh, topology, options) {
+    if let Some(report) = fair_without_loose_triangles(mesh, topology, options, progress) {
         return report;
     }
     let original = options.mask.as_ref().map(|_| mesh.positions.clone());
@@ -76,18 +92,18 @@ pub fn fair_constrained(
             options,
             &pinned,
             |mesh, topology, options, pinned| {
-                decide_and_fair(mesh, topology, options, pinned, false)
+                decide_and_fair(mesh, topology, options, pinned, false, progress)
             },
         )
     } else {
-        decide_and_fair(mesh, topology, options, &pinned, true)
-    };
+        decide_and_fair(mesh, topology, options, &pinned, true, progress)
+    }?;
     // The operator held the pinned vertices; the blend fades the rest by their weights (and
     // puts back pinned boundary vertices, which the boundary curves may have moved).
     if let (Some(mask), Some(original)) = (&options.mask, &original) {
         mask.blend(original, &mut mesh.positions);
     }
-    report
+    progress.report(1.0).then_some(report)
 }
 
 /// A non-manifold scan is faired as the surface it stands for: without the triangles its
@@ -96,11 +112,14 @@ pub fn fair_constrained(
 /// hold them with their noise (`crate::mesh::loose_triangles`, `docs/measurements.md`). Same
 /// vertices, nothing renumbered; a corner only loose triangles use (a fin's tip) stays where it
 /// is. `None` when the default variant has no loose triangles to leave out.
+/// The outer `Option` says whether there were loose triangles to leave out, the inner one
+/// whether the run went to its end (`None`: cancelled through `progress`).
 fn fair_without_loose_triangles(
     mesh: &mut TriMesh,
     topology: &Topology,
     options: &FairOptions,
-) -> Option<FairReport> {
+    progress: &mut dyn Progress,
+) -> Option<Option<FairReport>> {
     if options.variant != FairVariant::NormalProjected || topology.non_manifold_edges.is_empty() {
         return None;
     }
@@ -115,13 +134,17 @@ fn fair_without_loose_triangles(
     let volume = options
         .keep_volume
         .then(|| VolumeKeeper::new(mesh, topology, &pinned));
-    let mut report = fair_constrained(&mut kept, &kept_topology, options);
+    let Some(mut report) =
+        fair_constrained_with_progress(&mut kept, &kept_topology, options, progress)
+    else {
+        return Some(None);
+    };
     mesh.positions = kept.positions;
     if let Some(volume) = volume.filter(|_| report.rounds_run > 0) {
         volume.restore(mesh, topology, |v| pinned.get(v).copied().unwrap_or(false));
     }
     report.loose_triangles += loose.len();
-    Some(report)
+    Some(Some(report))
 }
 
 /// Rounds from which a run in the locality order pays for making it (see [`in_local_order`]).
@@ -141,8 +164,8 @@ fn in_local_order(
     topology: &Topology,
     options: &FairOptions,
     pinned: &[bool],
-    fair: impl FnOnce(&mut TriMesh, &Topology, &FairOptions, &[bool]) -> FairReport,
-) -> FairReport {
+    fair: impl FnOnce(&mut TriMesh, &Topology, &FairOptions, &[bool]) -> Option<FairReport>,
+) -> Option<FairReport> {
     let (offsets, neighbors) = topology.neighbor_csr();
     let order = breadth_first_order(offsets, neighbors);
     let position = inverse_permutation(&order);
@@ -195,11 +218,11 @@ fn in_local_order(
             .collect();
         creases.file_edges = edges.into();
     }
-    let report = fair(&mut local, &local_topology, &local_options, &local_pinned);
+    let report = fair(&mut local, &local_topology, &local_options, &local_pinned)?;
     for (&v, p) in order.iter().zip(&local.positions) {
         mesh.positions[v as usize] = *p;
     }
-    report
+    Some(report)
 }
 
 /// The noise estimate, the decision to fair at all (automatic strength leaves a clean mesh as it
@@ -211,7 +234,8 @@ fn decide_and_fair(
     options: &FairOptions,
     pinned: &[bool],
     may_reorder: bool,
-) -> FairReport {
+    progress: &mut dyn Progress,
+) -> Option<FairReport> {
     // The fan-ordered one-rings the operator is built from serve the noise estimate and the
     // crease detection first (`read_noise`, `detect_creases_with_estimate`).
     let fans = FanRings::new(&mesh.triangles, topology);
@@ -228,11 +252,11 @@ fn decide_and_fair(
         Strength::Auto => match noisy(estimate, reading.as_ref(), topology) {
             Some(noise) => Some(noise),
             None => {
-                return FairReport {
+                return Some(FairReport {
                     noise_estimate: estimate,
                     detection_ms: milliseconds(started),
                     ..FairReport::default()
-                }
+                })
             }
         },
         _ => None,
@@ -260,14 +284,23 @@ fn decide_and_fair(
                     (None, FaceRingCache::in_mesh_order()),
                     options,
                     Rounds { pinned, ..rounds },
+                    progress,
                 )
             },
         )
     } else {
-        fair_rounds(mesh, topology, fans, (found, face_rings), options, rounds)
-    };
+        fair_rounds(
+            mesh,
+            topology,
+            fans,
+            (found, face_rings),
+            options,
+            rounds,
+            progress,
+        )
+    }?;
     report.detection_ms += decided_ms;
-    report
+    Some(report)
 }
 
 /// The first reading of the input: the noise estimate, which decides the strength (automatic)
@@ -349,7 +382,8 @@ fn fair_rounds(
     (found, mut face_rings): (Option<Creases>, FaceRingCache),
     options: &FairOptions,
     rounds: Rounds,
-) -> FairReport {
+    progress: &mut dyn Progress,
+) -> Option<FairReport> {
     let Rounds {
         estimate,
         auto_noise,
@@ -409,7 +443,11 @@ fn fair_rounds(
         judge,
     };
     for round in 0..max_rounds {
-        if rounds.run(mesh, round, &mut report) {
+        let stop = rounds.run(mesh, round, &mut report);
+        if !progress.report(round_fraction(round + 1, max_rounds, auto_noise.is_some())) {
+            return None;
+        }
+        if stop {
             break;
         }
     }
@@ -421,7 +459,20 @@ fn fair_rounds(
     }
     report.noise_estimate = estimate;
     report.crease_edges = crease_edges;
-    report
+    Some(report)
+}
+
+/// The progress after `done` rounds of at most `max_rounds`: their share, or with automatic
+/// strength (which stops long before its cap on most meshes) a share that rises by a little less
+/// with every round, `done / (done + AUTO_ROUNDS_HALF_WAY)`, so a bar keeps moving.
+fn round_fraction(done: usize, max_rounds: usize, automatic: bool) -> f32 {
+    /// Rounds at which an automatic run reads half done (the default stops after 10 to 60).
+    const AUTO_ROUNDS_HALF_WAY: f32 = 15.0;
+    if automatic {
+        done as f32 / (done as f32 + AUTO_ROUNDS_HALF_WAY)
+    } else {
+        done as f32 / max_rounds.max(1) as f32
+    }
 }
 
 /// The creases the first round fairs with, when the noise estimate's gather did not find them:
@@ -569,16 +620,67 @@ mod tests {
                 for p in &mut local.positions {
                     *p = moved(*p);
                 }
-                FairReport {
+                Some(FairReport {
                     rounds_run: 7,
                     ..FairReport::default()
-                }
+                })
             },
-        );
+        )
+        .expect("the closure finished");
         assert_eq!(report.rounds_run, 7);
         for (after, &before) in faired.positions.iter().zip(&mesh.positions) {
             assert_eq!(*after, moved(before));
         }
         assert_eq!(faired.triangles, mesh.triangles);
+    }
+
+    #[test]
+    fn progress_rises_round_by_round_and_a_refusal_cancels_the_run() {
+        let mut noisy = irregular_sphere();
+        crate::noise::add_noise(&mut noisy, &crate::noise::NoiseOptions::default());
+        let topology = Topology::build(&noisy);
+        for options in [
+            FairOptions::default(),
+            FairOptions::default().with_rounds(4),
+        ] {
+            let mut plain = noisy.clone();
+            let expected = fair_constrained(&mut plain, &topology, &options);
+            assert!(expected.rounds_run > 0, "the noisy sphere is faired");
+            let mut reported = Vec::new();
+            let mut watched = noisy.clone();
+            let report = fair_constrained_with_progress(
+                &mut watched,
+                &topology,
+                &options,
+                &mut |fraction: f32| {
+                    reported.push(fraction);
+                    true
+                },
+            );
+            // Watching changes nothing (but the time taken).
+            let untimed = |report: FairReport| FairReport {
+                detection_ms: 0.0,
+                ..report
+            };
+            assert_eq!(report.map(untimed), Some(untimed(expected)));
+            assert_eq!(watched.positions, plain.positions);
+            assert!(reported.len() >= 2, "{reported:?}");
+            assert!(reported.windows(2).all(|w| w[0] <= w[1]), "{reported:?}");
+            assert!(reported.iter().all(|f| (0.0..=1.0).contains(f)));
+            assert_eq!(reported.last(), Some(&1.0));
+            // Refusing after the first round stops the run there.
+            let mut calls = 0;
+            let cancelled = fair_constrained_with_progress(
+                &mut noisy.clone(),
+                &topology,
+                &options,
+                &mut |_: f32| {
+                    calls += 1;
+                    false
+                },
+            );
+            assert_eq!(cancelled, None);
+            assert_eq!(calls, 1, "no round runs after the refusal");
+        }
     }
 }
