@@ -1365,3 +1365,96 @@ fn texture_coordinates_follow_across_a_uv_seam_in_obj_and_glb() {
     }
     assert!(checked > (N - 2) * (N - 2), "{checked} inner elements");
 }
+
+#[test]
+fn multires_from_level_0_is_the_default_fair_byte_for_byte_and_coarser_levels_start_from_it() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = |name: &str| dir.path().join(name).to_string_lossy().into_owned();
+    let noisy = path("noisy.ply");
+    let out = fairmesh(&[
+        "noise",
+        &data("elephant.obj"),
+        "-o",
+        &noisy,
+        "--sigma",
+        "0.3",
+        "--seed",
+        "2",
+    ]);
+    assert!(out.status.success(), "{out:?}");
+    let fair = json_of(&["fair", &noisy, "-o", &path("fair.ply"), "--json"]);
+    assert!(fair["rounds_run"].as_u64().unwrap() > 0, "{fair}");
+    let rows = json_of(&[
+        "multires",
+        &noisy,
+        "-o",
+        &path("multires.ply"),
+        "--level",
+        "4,0",
+        "--json",
+    ]);
+    let rows = rows.as_array().expect("one row per level");
+    for row in rows {
+        // Both levels start from the same denoise, the run `fair` makes.
+        assert_eq!(row["denoise"]["rounds_run"], fair["rounds_run"], "{row}");
+        assert_eq!(
+            row["denoise"]["crease_edges"], fair["crease_edges"],
+            "{row}"
+        );
+    }
+    // The last level asked for (0) is written: the same file as `fair`'s.
+    let bytes = |name: &str| std::fs::read(dir.path().join(name)).unwrap();
+    assert!(bytes("multires.ply") == bytes("fair.ply"));
+    // Without the denoise, level 0 is the paper's single-level fairing: another surface.
+    let paper = fairmesh(&[
+        "multires",
+        &noisy,
+        "-o",
+        &path("paper.ply"),
+        "--level",
+        "0",
+        "--denoise",
+        "off",
+    ]);
+    assert!(paper.status.success(), "{paper:?}");
+    assert!(bytes("paper.ply") != bytes("fair.ply"));
+    let bad = fairmesh(&["multires", &noisy, "--denoise", "lots"]);
+    assert_eq!(bad.status.code(), Some(2), "{bad:?}");
+    assert!(String::from_utf8_lossy(&bad.stderr).contains("auto, off or a number of rounds"));
+}
+
+#[test]
+fn multires_with_a_mask_moves_only_the_masked_vertices_of_the_input() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = |name: &str| dir.path().join(name).to_string_lossy().into_owned();
+    let noisy = path("noisy.ply");
+    let out = fairmesh(&["noise", &data("elephant.obj"), "-o", &noisy]);
+    assert!(out.status.success(), "{out:?}");
+    let painted: Vec<usize> = (0..1500).step_by(3).collect();
+    let list: String = painted.iter().map(|v| format!("{v}\n")).collect();
+    std::fs::write(dir.path().join("mask.txt"), list).unwrap();
+    let out = fairmesh(&[
+        "multires",
+        &noisy,
+        "-o",
+        &path("masked.ply"),
+        "--level",
+        "2",
+        "--mask",
+        &path("mask.txt"),
+    ]);
+    assert!(out.status.success(), "{out:?}");
+    let before = fairmesh::io::load(Path::new(&noisy)).unwrap().mesh;
+    let after = fairmesh::io::load(&dir.path().join("masked.ply"))
+        .unwrap()
+        .mesh;
+    let moved: Vec<usize> = (0..before.vertex_count())
+        .filter(|&v| before.positions[v] != after.positions[v])
+        .collect();
+    assert!(!moved.is_empty());
+    // Unpainted vertices keep the input's positions exactly (not the denoised ones).
+    assert!(
+        moved.iter().all(|v| painted.binary_search(v).is_ok()),
+        "{moved:?}"
+    );
+}

@@ -38,8 +38,8 @@ pub struct BuildArgs {
     pub keep_boundary: bool,
     /// Keep sharp edges (CAD parts, machined edges): every level keeps the edges where the
     /// surface folds by more than --crease-angle (a vertex on one collapses only along it, the
-    /// corners never), and multires fairs them as curves. Off by default: on noisy organic scans
-    /// the detector finds a few false creases, which then stay as ridges.
+    /// corners never), and multires fairs them as curves. `hierarchy` leaves them out unless
+    /// asked; `multires` keeps them unless --no-creases, as `fair` does.
     #[arg(long)]
     pub keep_creases: bool,
     /// How many degrees the surface must fold at an edge to keep it sharp (implies
@@ -99,14 +99,31 @@ pub(super) fn build(
     args: &BuildArgs,
     file_edges: Vec<[u32; 2]>,
 ) -> anyhow::Result<Hierarchy> {
+    build_with(mesh, topology, args, args.options(), file_edges)
+}
+
+/// Refuses a --crease-angle outside (0, 180) degrees.
+pub(super) fn check_crease_angle(args: &BuildArgs) -> anyhow::Result<()> {
     if let Some(angle) = args.crease_angle {
         anyhow::ensure!(
             angle > 0.0 && angle < 180.0,
             "--crease-angle must be between 0 and 180 degrees (got {angle})"
         );
     }
+    Ok(())
+}
+
+/// [`build`] with `options` (made from `args`, perhaps changed), the file's own hard edges
+/// added to its creases.
+pub(super) fn build_with(
+    mesh: &TriMesh,
+    topology: Option<&Topology>,
+    args: &BuildArgs,
+    mut options: HierarchyOptions,
+    file_edges: Vec<[u32; 2]>,
+) -> anyhow::Result<Hierarchy> {
+    check_crease_angle(args)?;
     let mut step = super::progress::Step::start("building the hierarchy");
-    let mut options = args.options();
     if let Some(creases) = &mut options.creases {
         *creases = creases.clone().with_file_edges(file_edges);
     }

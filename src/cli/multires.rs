@@ -8,10 +8,15 @@ use std::time::Instant;
 
 use anyhow::Context;
 use clap::{Args, ValueEnum};
+use fairmesh::fairing::creases::{CreaseOptions, DEFAULT_CREASE_ANGLE};
 use fairmesh::fairing::Mask;
 use fairmesh::hierarchy::Hierarchy;
+use fairmesh::hierarchy::HierarchyOptions;
 use fairmesh::io::Source;
-use fairmesh::multires::{fair_multires, MultiresOptions, MultiresVariant, MultiresWorkspace};
+use fairmesh::multires::{
+    fair_multires, Denoise, DenoiseOptions, Denoised, MultiresOptions, MultiresVariant,
+    MultiresWorkspace,
+};
 use fairmesh::noise::{self, NoiseOptions};
 use fairmesh::{metrics, Topology, TriMesh};
 use serde_json::json;
@@ -19,7 +24,7 @@ use std::path::PathBuf;
 
 use super::args::{BoundaryArg, StdioFormat};
 use super::common::{check_output_format, emit, is_stdio, load_input, load_shown, save_kept};
-use super::hierarchy::{build, levels_phrase, print_notes, BuildArgs};
+use super::hierarchy::{build_with, check_crease_angle, levels_phrase, print_notes, BuildArgs};
 
 #[derive(Clone, Copy, Debug, ValueEnum, PartialEq, Eq)]
 pub enum VariantArg {
@@ -55,6 +60,17 @@ pub struct MultiresArgs {
     /// Placement of split vertices; several, comma separated, run one after another.
     #[arg(long, value_enum, value_delimiter = ',', default_value = "improved")]
     pub variant: Vec<VariantArg>,
+    /// Denoise the mesh first, once, as `fairmesh fair` does by default, and build the hierarchy
+    /// on the result: level 0 is then exactly `fair`'s result and a coarser level removes detail
+    /// on top of it (as the editor does). `auto`: the automatic strength (a clean mesh is left
+    /// as it is); a number: that many rounds; `off`: the paper's multires alone (level 0 then
+    /// fairs M0 with --iterations and --rounds).
+    #[arg(long, default_value = "auto", value_parser = parse_denoise)]
+    pub denoise: Denoise,
+    /// Fair across sharp edges too, in the denoise and on every level (by default they are kept,
+    /// as `fair` keeps them: found at --crease-angle, plus the file's own hard edges).
+    #[arg(long, conflicts_with_all = ["keep_creases", "crease_angle"])]
+    pub no_creases: bool,
     /// Add seeded normal noise of this many mean edge lengths first (the volume change, and with
     /// --measure the distances, are then taken against the clean input).
     #[arg(long)]
@@ -80,7 +96,31 @@ pub struct MultiresArgs {
     pub mask: super::mask::MaskArgs,
 }
 
+/// `--denoise`: `auto`, `off` or a number of rounds.
+fn parse_denoise(text: &str) -> Result<Denoise, String> {
+    match text {
+        "auto" => Ok(Denoise::Automatic),
+        "off" => Ok(Denoise::Off),
+        rounds => rounds
+            .parse()
+            .map(Denoise::Rounds)
+            .map_err(|_| format!("expected auto, off or a number of rounds, not `{text}`")),
+    }
+}
+
 impl MultiresArgs {
+    /// The hierarchy's options: those of `fairmesh hierarchy`, with sharp edges kept unless
+    /// --no-creases.
+    fn hierarchy_options(&self) -> HierarchyOptions {
+        let options = self.build.options();
+        if self.no_creases || options.creases.is_some() {
+            return options;
+        }
+        options.with_creases(Some(
+            CreaseOptions::default().with_angle_degrees(DEFAULT_CREASE_ANGLE),
+        ))
+    }
+
     /// The options of the run from `level` with `variant`, fairing within `mask` (if any).
     fn options(&self, level: usize, variant: VariantArg, mask: Option<Mask>) -> MultiresOptions {
         MultiresOptions::default()
@@ -101,7 +141,8 @@ impl MultiresArgs {
 struct Prepared {
     source: Arc<Source>,
     mask: Option<Mask>,
-    /// The mesh's connectivity, kept only when creases are kept (their detection reads it).
+    /// The mesh's connectivity, kept only when creases are kept or the mesh is denoised first
+    /// (both read it).
     topology: Option<Topology>,
     /// The file's own sharp edges, creases too when creases are kept.
     file_edges: Vec<[u32; 2]>,
@@ -118,16 +159,31 @@ struct Prepared {
 
 pub fn run(args: MultiresArgs) -> anyhow::Result<()> {
     let to_stdout = check_output(&args)?;
+    check_crease_angle(&args.build)?;
     let measure = args.measure || args.reference.is_some();
-    let prepared = prepare(&args, measure)?;
+    let mut prepared = prepare(&args, measure)?;
     let started = Instant::now();
-    let hierarchy = build(
-        &prepared.input,
+    let denoised = denoise_first(&args, &prepared)?;
+    // A mask fades the results into the input itself, not into the denoised mesh.
+    let unmasked = prepared
+        .mask
+        .is_some()
+        .then(|| prepared.input.positions.clone());
+    let denoise_ms = started.elapsed().as_secs_f64() * 1e3;
+    let (built_on, denoise_report) = match denoised {
+        Some(Denoised { mesh, report }) => (mesh, Some(report)),
+        None => (std::mem::take(&mut prepared.input), None),
+    };
+    let started = Instant::now();
+    let hierarchy = build_with(
+        &built_on,
         prepared.topology.as_ref(),
         &args.build,
+        args.hierarchy_options(),
         prepared.file_edges,
     )?;
     drop(prepared.topology);
+    drop(built_on);
     print_notes(&hierarchy, &args.input);
     // The hierarchy keeps its own copy of the (noisy) input as M0: the input goes, and the
     // results take their triangles from M0.
@@ -143,6 +199,8 @@ pub fn run(args: MultiresArgs) -> anyhow::Result<()> {
     let runs = Runs {
         hierarchy: &hierarchy,
         mask: prepared.mask,
+        unmasked,
+        denoise: denoise_report.map(|report| (report, denoise_ms)),
         reference,
         clean_volume: prepared.clean_volume,
         hierarchy_ms,
@@ -151,7 +209,36 @@ pub fn run(args: MultiresArgs) -> anyhow::Result<()> {
     if let (Some(path), Some(result)) = (&args.output, &last) {
         save_kept(path, result, &prepared.source, args.stdio.format)?;
     }
-    print_results(&args, &hierarchy, hierarchy_ms, measure, results, to_stdout)
+    let header = Header {
+        hierarchy: &hierarchy,
+        hierarchy_ms,
+        denoise: runs.denoise.as_ref(),
+    };
+    print_results(&args, &header, measure, results, to_stdout)
+}
+
+/// The first stage (`--denoise`): the input faired as `fairmesh fair` fairs it, with the file's
+/// own hard edges kept as `fair` keeps them; `None` with `--denoise off` or 0 rounds.
+fn denoise_first(args: &MultiresArgs, prepared: &Prepared) -> anyhow::Result<Option<Denoised>> {
+    let options = DenoiseOptions {
+        denoise: args.denoise,
+        creases: args
+            .hierarchy_options()
+            .creases
+            .map(|creases| creases.with_file_edges(prepared.file_edges.clone())),
+        boundary: args.boundary.into(),
+    };
+    if options.fair_options().is_none() {
+        return Ok(None);
+    }
+    let Some(topology) = prepared.topology.as_ref() else {
+        anyhow::bail!("the denoise needs the mesh's connectivity");
+    };
+    let mut step = super::progress::Step::start("denoising (the automatic default of fair)");
+    let denoised = fairmesh::multires::denoise(&prepared.input, topology, &options, &mut step)
+        .context("the denoise was cancelled")?;
+    drop(step);
+    Ok(denoised)
 }
 
 /// Refuses `--json` with `-o -` (both would write to standard output), and `-o -` without
@@ -174,16 +261,15 @@ fn prepare(args: &MultiresArgs, measure: bool) -> anyhow::Result<Prepared> {
     let loaded = load_input(&args.input, true, args.stdio.format)?;
     let source = loaded.source;
     let mask = super::mask::load_for(&args.mask, &source, &loaded.mesh, Some(&loaded.topology))?;
-    // The connectivity serves the crease detection only; otherwise it goes before the build.
-    let topology = args
-        .build
-        .options()
-        .creases
-        .is_some()
-        .then_some(loaded.topology);
-    let file_edges = match topology {
-        Some(_) => source.hard_edges(&loaded.mesh),
-        None => Vec::new(),
+    // The connectivity serves the crease detection and the denoise only; otherwise it goes
+    // before the build.
+    let creases = args.hierarchy_options().creases.is_some();
+    let denoise = args.denoise != Denoise::Off && args.denoise != Denoise::Rounds(0);
+    let topology = (creases || denoise).then_some(loaded.topology);
+    let file_edges = if creases {
+        source.hard_edges(&loaded.mesh)
+    } else {
+        Vec::new()
     };
     let mut input = loaded.mesh;
     let reference_file = match &args.reference {
@@ -246,6 +332,10 @@ fn note_levels_beyond(args: &MultiresArgs, coarsest: usize) {
 struct Runs<'a> {
     hierarchy: &'a Hierarchy,
     mask: Option<Mask>,
+    /// With a mask: the input's positions (before the denoise), which it fades the results into.
+    unmasked: Option<Vec<[f32; 3]>>,
+    /// The denoise's report and milliseconds, when the mesh was denoised first.
+    denoise: Option<(fairmesh::fairing::FairReport, f64)>,
     /// What each result is measured against; `None` without `--measure`.
     reference: Option<&'a TriMesh>,
     clean_volume: f64,
@@ -269,7 +359,9 @@ impl Runs<'_> {
         let mut last = None;
         for &variant in &args.variant {
             for &level in &args.level {
-                let options = args.options(level, variant, self.mask.clone());
+                // After a denoise the mask is applied here, against the input (`fair_one`).
+                let mask = self.mask.clone().filter(|_| self.denoise.is_none());
+                let options = args.options(level, variant, mask);
                 let (result, row) = self.fair_one(&options, (level, variant), &mut workspace)?;
                 results.push(row);
                 last = Some(result);
@@ -291,8 +383,18 @@ impl Runs<'_> {
         let mut step =
             super::progress::Step::start(format!("multiresolution fairing from level {start}"));
         let started = Instant::now();
-        let positions = fair_multires(hierarchy, options, workspace, &mut step)
-            .context("multires fairing was cancelled")?;
+        let mut positions = if self.denoise.is_some() && start == 0 {
+            // Level 0 is the denoised mesh itself (M0 keeps the input's numbering).
+            hierarchy.base_mesh().positions.clone()
+        } else {
+            fair_multires(hierarchy, options, workspace, &mut step)
+                .context("multires fairing was cancelled")?
+        };
+        if let (Some(mask), Some(unmasked), Some(_)) = (&self.mask, &self.unmasked, &self.denoise) {
+            if mask.check_fits(unmasked.len()).is_ok() {
+                mask.blend(unmasked, &mut positions);
+            }
+        }
         let time_ms = started.elapsed().as_secs_f64() * 1e3;
         drop(step);
         let result = TriMesh::new(positions, hierarchy.base_mesh().triangles.clone());
@@ -307,6 +409,12 @@ impl Runs<'_> {
             "hierarchy_ms": self.hierarchy_ms,
             "loose_triangles": hierarchy.loose_triangles().len(),
             "volume_change_percent": volume_change_percent,
+            "denoise": self.denoise.as_ref().map(|(report, time_ms)| json!({
+                "rounds_run": report.rounds_run,
+                "noise_estimate": report.noise_estimate,
+                "crease_edges": report.crease_edges,
+                "time_ms": time_ms,
+            })),
         });
         if let Some(reference) = self.reference {
             add_measures(&mut row, reference, &result);
@@ -342,12 +450,18 @@ fn add_measures(row: &mut serde_json::Value, reference: &TriMesh, result: &TriMe
     );
 }
 
+/// What the table's header says: the hierarchy, its build time and the denoise.
+struct Header<'a> {
+    hierarchy: &'a Hierarchy,
+    hierarchy_ms: f64,
+    denoise: Option<&'a (fairmesh::fairing::FairReport, f64)>,
+}
+
 /// Prints the runs: with `--json` one object (several: an array of them), else a table (on
 /// standard error when standard output holds the mesh).
 fn print_results(
     args: &MultiresArgs,
-    hierarchy: &Hierarchy,
-    hierarchy_ms: f64,
+    header: &Header,
     measure: bool,
     mut results: Vec<serde_json::Value>,
     to_stdout: bool,
@@ -360,7 +474,7 @@ fn print_results(
         };
         return emit(&format!("{}\n", serde_json::to_string_pretty(&value)?));
     }
-    let out = results_table(args, hierarchy, hierarchy_ms, measure, &results)?;
+    let out = results_table(args, header, measure, &results)?;
     if to_stdout {
         // Standard output holds the mesh.
         eprint!("{out}");
@@ -373,16 +487,19 @@ fn print_results(
 /// The runs as a table: the hierarchy and the noise in a header line, then one row a run.
 fn results_table(
     args: &MultiresArgs,
-    hierarchy: &Hierarchy,
-    hierarchy_ms: f64,
+    header: &Header,
     measure: bool,
     results: &[serde_json::Value],
 ) -> anyhow::Result<String> {
     let mut out = format!(
-        "{}: hierarchy of {} in {:.1} ms{}\nlevel  vertices  variant   time ms   volume %{}\n",
+        "{}: {}hierarchy of {} in {:.1} ms{}\nlevel  vertices  variant   time ms   volume %{}\n",
         args.input.display(),
-        levels_phrase(hierarchy),
-        hierarchy_ms,
+        match header.denoise {
+            Some((report, ms)) => format!("{}, ", denoise_phrase(report, *ms)),
+            None => String::new(),
+        },
+        levels_phrase(header.hierarchy),
+        header.hierarchy_ms,
         match args.noise {
             Some(s) => format!(", noise {s} mean edge lengths (seed {})", args.seed),
             None => String::new(),
@@ -411,6 +528,22 @@ fn results_table(
         out.push('\n');
     }
     Ok(out)
+}
+
+/// The denoise in words: "denoised in 35 ms (noise about 0.27 mean edge lengths: 12 rounds, 49
+/// sharp edges kept)", or that it found the mesh clean.
+fn denoise_phrase(report: &fairmesh::fairing::FairReport, ms: f64) -> String {
+    if report.rounds_run == 0 {
+        return format!("no noise to remove found in {ms:.1} ms");
+    }
+    let noise = report
+        .noise_estimate
+        .map(|noise| format!("noise about {noise:.2} mean edge lengths: "))
+        .unwrap_or_default();
+    format!(
+        "denoised in {ms:.1} ms ({noise}{} rounds, {} sharp edges kept)",
+        report.rounds_run, report.crease_edges
+    )
 }
 
 /// One cell of the table, right-aligned in `width`. A value the row does not have (no volume to

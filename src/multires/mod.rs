@@ -57,10 +57,15 @@
 //! (one gather per neighbour instead of three per face).
 //!
 //! # Files
+//! - `denoise`: the stage before the levels as the editor and `fairmesh multires` run them (the
+//!   automatic default of constrained fairing, once; the hierarchy is built on its result).
 //! - `refine`: the steps between two levels (the shrinkage taken back, the split vertices
 //!   placed).
 
+pub mod denoise;
 mod refine;
+
+pub use denoise::{denoise, Denoise, DenoiseOptions, Denoised};
 
 use crate::fairing::{BoundaryMode, ConstrainedFairing, Creases, FairOptions, FairVariant, Mask};
 use crate::hierarchy::Hierarchy;
