@@ -1445,7 +1445,7 @@ fn multires_with_a_mask_moves_only_the_masked_vertices_of_the_input() {
     ]);
     assert!(out.status.success(), "{out:?}");
     let before = fairmesh::io::load(Path::new(&noisy)).unwrap().mesh;
-    let after = fairmesh::io::load(&dir.path().join("masked.ply"))
+    let after = fairmesh::io::load(dir.path().join("masked.ply"))
         .unwrap()
         .mesh;
     let moved: Vec<usize> = (0..before.vertex_count())

@@ -946,22 +946,10 @@ fn keep_sharp_edges_keeps_a_boxs_edges_in_the_hierarchy_and_draws_them_while_poi
     settle(&mut harness);
     let status = harness.state().status();
     assert!(status.hierarchy_ready);
-    assert_eq!(status.sharp_edges_kept, 0, "off by default");
-    let levels_without = status.level_count;
-
-    harness
-        .get_by_role_and_label(Role::CheckBox, "Keep sharp edges")
-        .click();
-    settle(&mut harness);
-    let status = harness.state().status();
-    assert!(status.hierarchy_ready, "the hierarchy was built again");
-    // The box's two outlines (60 edges each) and four upright edges (5 each).
-    assert_eq!(status.sharp_edges_kept, 140);
-    assert!(status.faired_serial.is_some(), "and the view fairs with it");
-    assert!(
-        status.level_count >= levels_without,
-        "kept edges never make the hierarchy shorter"
-    );
+    // On by default (as in `fairmesh fair`): the box's two outlines (60 edges each) and four
+    // upright edges (5 each).
+    assert_eq!(status.sharp_edges_kept, 140, "on by default");
+    let levels_with = status.level_count;
 
     // Pointing at the control draws the kept edges the camera sees (a box shows at most three
     // faces, so some edges are behind it).
@@ -977,8 +965,15 @@ fn keep_sharp_edges_keeps_a_boxs_edges_in_the_hierarchy_and_draws_them_while_poi
         .get_by_role_and_label(Role::CheckBox, "Keep sharp edges")
         .click();
     settle(&mut harness);
-    assert_eq!(harness.state().status().sharp_edges_kept, 0);
+    let status = harness.state().status();
+    assert!(status.hierarchy_ready, "the hierarchy was built again");
+    assert_eq!(status.sharp_edges_kept, 0);
     assert!(!harness.state().settings().keep_sharp_edges);
+    assert!(status.faired_serial.is_some(), "and the view fairs with it");
+    assert!(
+        levels_with >= status.level_count,
+        "kept edges never make the hierarchy shorter"
+    );
 }
 
 /// The noise controls explain themselves too (sigma, seed, direction and the button).
@@ -1002,4 +997,110 @@ fn noise_controls_explain_themselves() {
         slider.accesskit_node().description().as_deref(),
         Some(tips::NOISE_SIGMA)
     );
+}
+
+/// Edges whose two faces fold by more than 90° (their normals point more than a right angle
+/// apart), counted over the interior edges of `positions` on `triangles`.
+fn edges_folded_beyond_90_degrees(positions: &[[f32; 3]], triangles: &[[u32; 3]]) -> usize {
+    let normal = |t: &[u32; 3]| {
+        let [a, b, c] = t.map(|v| glam::Vec3::from(positions[v as usize]));
+        (b - a).cross(c - a)
+    };
+    let mut faces_of_edge = std::collections::HashMap::<(u32, u32), Vec<usize>>::new();
+    for (f, t) in triangles.iter().enumerate() {
+        for k in 0..3 {
+            let (a, b) = (t[k], t[(k + 1) % 3]);
+            faces_of_edge
+                .entry((a.min(b), a.max(b)))
+                .or_default()
+                .push(f);
+        }
+    }
+    faces_of_edge
+        .values()
+        .filter(|faces| faces.len() == 2)
+        .filter(|faces| normal(&triangles[faces[0]]).dot(normal(&triangles[faces[1]])) < 0.0)
+        .count()
+}
+
+/// Runs the command-line tool, which must succeed.
+fn cli(args: &[&str]) {
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_fairmesh"))
+        .args(args)
+        .output()
+        .expect("the fairmesh binary runs");
+    assert!(out.status.success(), "fairmesh {args:?}: {out:?}");
+}
+
+#[test]
+fn with_no_control_touched_the_editor_fairs_as_fair_does_and_coarser_levels_start_from_it() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = |name: &str| dir.path().join(name).to_string_lossy().into_owned();
+    let noisy = path("noisy.ply");
+    let bunny = bunny();
+    cli(&[
+        "noise",
+        bunny.to_str().unwrap(),
+        "-o",
+        &noisy,
+        "--sigma",
+        "0.3",
+    ]);
+    cli(&["fair", &noisy, "-o", &path("fair.ply")]);
+    let by_fair = fairmesh::io::load(path("fair.ply")).unwrap().mesh;
+
+    let mut harness = harness_for(noisy.clone().into());
+    settle(&mut harness);
+    let opening_level = harness.state().status().level;
+    assert!(opening_level > 0, "a file opens at a middle level");
+    let mesh = harness.state().document_mesh().unwrap();
+    let opening = harness.state().faired_positions().unwrap();
+    // The panel says what the denoise found.
+    harness.get_by_label_contains("Noise about");
+    harness
+        .state_mut()
+        .push_command(fairmesh::app::Command::SetLevel(0));
+    settle(&mut harness);
+    let at_m0 = harness.state().faired_positions().unwrap();
+    // Byte for byte the command line's result (the file keeps every bit of an f32).
+    assert!(at_m0.as_slice() == by_fair.positions.as_slice());
+    // The opening level removes detail on top of it, and leaves very few of the edges the
+    // noise folded (the paper's multires alone left a fifth of them on this mesh).
+    assert!(opening.as_slice() != at_m0.as_slice());
+    let folded =
+        |positions: &[[f32; 3]]| edges_folded_beyond_90_degrees(positions, &mesh.triangles);
+    let noisy_folds = folded(&mesh.positions);
+    assert!(
+        noisy_folds > 1000,
+        "the noise folds many edges: {noisy_folds}"
+    );
+    assert!(
+        folded(&opening) * 100 < noisy_folds,
+        "{} folded edges at the opening level, {} after fair, {noisy_folds} in the noisy mesh",
+        folded(&opening),
+        folded(&by_fair.positions)
+    );
+}
+
+#[test]
+fn a_box_keeps_its_corners_at_the_opening_level() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("box.obj");
+    let cuboid = fairmesh::mesh::shapes::cuboid([2.0, 1.0, 0.5], 0.05);
+    fairmesh::io::save(&path, &cuboid).unwrap();
+    let mut harness = harness_for(path);
+    settle(&mut harness);
+    assert!(harness.state().status().level > 0, "a middle level");
+    let faired = harness.state().faired_positions().unwrap();
+    let diagonal = (2.0f32 * 2.0 + 1.0 + 0.25).sqrt();
+    let (low, high) = fairmesh::app::state::bounds_of(&cuboid.positions);
+    let at_side = |p: [f32; 3], k: usize| p[k] == low[k] || p[k] == high[k];
+    let corners: Vec<usize> = (0..cuboid.positions.len())
+        .filter(|&v| (0..3).all(|k| at_side(cuboid.positions[v], k)))
+        .collect();
+    assert_eq!(corners.len(), 8);
+    for v in corners {
+        let moved = glam::Vec3::from(faired[v]).distance(glam::Vec3::from(cuboid.positions[v]));
+        assert!(moved <= 0.01 * diagonal, "corner {v} moved {moved}");
+    }
 }

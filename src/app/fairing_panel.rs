@@ -8,13 +8,13 @@ use super::camera::OrbitCamera;
 use super::command::PanelChange;
 use super::panel_view::{Commands, PanelView, ViewportView};
 use super::state::{
-    CompareView, HierarchyState, MethodChoice, Settings, ViewMode, MAX_SHARP_EDGE_ANGLE,
-    MIN_SHARP_EDGE_ANGLE,
+    CompareView, HierarchyState, MethodChoice, Settings, ViewMode, MAX_DENOISE_ROUNDS,
+    MAX_SHARP_EDGE_ANGLE, MIN_SHARP_EDGE_ANGLE,
 };
 use super::tips;
 use super::Command;
 use crate::fairing::{BoundaryMode, Method};
-use crate::multires::MultiresVariant;
+use crate::multires::{Denoise, MultiresVariant};
 
 /// The fairing section: start level, method and its options, Apply. Every control says in its
 /// tooltip what it does and when to change it; the ones the chosen method does not use are
@@ -42,6 +42,7 @@ pub(super) fn fairing_controls(
         )
     });
     let not_for_baseline = not_for_baseline.as_deref();
+    denoise_controls(ui, document, settings, not_for_baseline);
     start_level_slider(commands, ui, (level, top_level), ready, not_for_baseline);
     let before = settings.clone();
     method_controls(settings, ui, method);
@@ -50,6 +51,90 @@ pub(super) fn fairing_controls(
         commands.push(Command::Refair);
     }
     progress_and_apply(ui, view, commands, applied);
+}
+
+/// "Remove noise first": Automatic, a number of rounds, or Off, and what the denoise found
+/// (a change builds the hierarchy again: [`sharp_edge_controls`] sees the hierarchy's settings
+/// change).
+fn denoise_controls(
+    ui: &mut egui::Ui,
+    document: &super::state::Document,
+    settings: &mut Settings,
+    not_for_baseline: Option<&str>,
+) {
+    let enabled = not_for_baseline.is_none();
+    let label = |denoise: Denoise| match denoise {
+        Denoise::Automatic => "Automatic",
+        Denoise::Rounds(_) => "Rounds",
+        Denoise::Off => "Off",
+    };
+    ui.horizontal(|ui| {
+        let combo = ui.add_enabled_ui(enabled, |ui| {
+            egui::ComboBox::from_label("Remove noise first")
+                .selected_text(label(settings.denoise))
+                .show_ui(ui, |ui| {
+                    let rounds = match settings.denoise {
+                        Denoise::Rounds(rounds) => rounds,
+                        _ => denoised_rounds(document).unwrap_or(10),
+                    };
+                    for (choice, tip) in [
+                        (Denoise::Automatic, tips::DENOISE_AUTOMATIC),
+                        (Denoise::Rounds(rounds), tips::DENOISE_ROUNDS),
+                        (Denoise::Off, tips::DENOISE_OFF),
+                    ] {
+                        let chosen = std::mem::discriminant(&settings.denoise)
+                            == std::mem::discriminant(&choice);
+                        if ui
+                            .selectable_label(chosen, label(choice))
+                            .on_hover_text(tip)
+                            .clicked()
+                            && !chosen
+                        {
+                            settings.denoise = choice;
+                        }
+                    }
+                })
+                .response
+        });
+        explain(combo.inner, tips::REMOVE_NOISE, not_for_baseline);
+        if let Denoise::Rounds(count) = &mut settings.denoise {
+            let value = ui.add_enabled(
+                enabled,
+                egui::DragValue::new(count).range(1..=MAX_DENOISE_ROUNDS),
+            );
+            explain(value, tips::DENOISE_ROUNDS, not_for_baseline);
+        }
+    });
+    if !enabled {
+        return;
+    }
+    match &document.hierarchy {
+        HierarchyState::Ready {
+            denoise: Some(found),
+            ..
+        } => {
+            ui.small(found.describe())
+                .on_hover_text(format!("Took {:.2} s", found.time.as_secs_f64()));
+        }
+        HierarchyState::Ready { denoise: None, .. } => {
+            ui.small("The levels are built on the mesh as it is");
+        }
+        HierarchyState::Building if settings.denoise != Denoise::Off => {
+            ui.small("Measuring the noise…");
+        }
+        _ => {}
+    }
+}
+
+/// The rounds the last automatic denoise kept, to start the manual setting from.
+fn denoised_rounds(document: &super::state::Document) -> Option<usize> {
+    match &document.hierarchy {
+        HierarchyState::Ready {
+            denoise: Some(found),
+            ..
+        } => Some(found.report.rounds_run.max(1)),
+        _ => None,
+    }
 }
 
 /// The start level slider (`level` of `0..=top`), off for a baseline and until the hierarchy
@@ -232,8 +317,12 @@ pub(super) fn sharp_edge_controls(
     // The hierarchy is built again when the angle is let go (not at every step of a drag).
     let settled = !angle.dragged();
     // (`start_hierarchy` records the settings it builds with, before the next frame.)
-    let rebuild = settled && settings.hierarchy_key() != view.hierarchy_built_with;
-    if pointed_at || rebuild {
+    let rebuild = settled && Some(settings.hierarchy_key()) != view.hierarchy_built_with;
+    // The edges are shown when their own settings change (not the denoise's).
+    let edges_changed = view
+        .hierarchy_built_with
+        .is_some_and(|built| !built.same_sharp_edges(&settings.hierarchy_key()));
+    if pointed_at || (rebuild && edges_changed) {
         commands.push(Command::Panel(PanelChange::ShowSharpEdgesUntil(
             now + SHARP_EDGES_LINGER,
         )));

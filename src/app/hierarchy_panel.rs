@@ -19,6 +19,12 @@ pub(super) fn hierarchy_section(
     let mut top_level = 0;
     match &document.hierarchy {
         HierarchyState::Building => {
+            ui.label(if view.hierarchy_denoising {
+                "Removing noise first…"
+            } else {
+                "Building the levels…"
+            })
+            .on_hover_text(super::tips::HIERARCHY_BUILDING);
             ui.horizontal(|ui| {
                 ui.add(
                     egui::ProgressBar::new(view.hierarchy_progress)
@@ -26,7 +32,11 @@ pub(super) fn hierarchy_section(
                         // Narrow enough that the toolbar stays one row at 1200 points.
                         .desired_width(180.0),
                 );
-                if ui.button("Cancel").clicked() {
+                if ui
+                    .button("Cancel")
+                    .on_hover_text(super::tips::CANCEL_HIERARCHY)
+                    .clicked()
+                {
                     commands.push(Command::CancelHierarchy);
                 }
             });

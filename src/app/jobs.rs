@@ -18,12 +18,11 @@ use std::sync::atomic::{AtomicU32, AtomicU64, AtomicUsize, Ordering};
 use std::sync::{Arc, Condvar, Mutex, PoisonError};
 use std::time::Duration;
 
-use crate::hierarchy::{Hierarchy, HierarchyError};
+use crate::hierarchy::HierarchyError;
 use crate::io::LoadReport;
 use crate::TriMesh;
 
-use super::sharp_edges::SharpEdgeLines;
-use super::state::Measures;
+use super::state::{KeptHierarchy, Measures};
 
 type Job = Box<dyn FnOnce() + Send + 'static>;
 
@@ -243,9 +242,9 @@ pub enum JobResult {
     Hierarchy {
         document: u64,
         hierarchy: u64,
-        /// The hierarchy, and whether its M0 has the loaded mesh's triangles.
-        result: Result<(Arc<Hierarchy>, bool, Arc<SharpEdgeLines>), HierarchyError>,
-        elapsed: Duration,
+        /// The hierarchy (built on the denoised mesh when there was a denoise), whether its M0
+        /// has the loaded mesh's triangles, and the time the denoise and the build took.
+        result: Result<KeptHierarchy, HierarchyError>,
     },
     Faired {
         document: u64,

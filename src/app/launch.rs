@@ -121,6 +121,7 @@ impl App {
         let settings = if options.persistence {
             cc.storage
                 .and_then(|storage| eframe::get_value::<Settings>(storage, Settings::STORAGE_KEY))
+                .map(Settings::upgraded)
                 .unwrap_or_default()
         } else {
             Settings::default()
@@ -161,6 +162,7 @@ impl App {
             applied_view: 0,
             applied_level_view: 0,
             hierarchy_progress: SharedProgress::default(),
+            hierarchy_denoising: Default::default(),
             fair_progress: SharedProgress::default(),
             fair_in_flight: false,
             fair_view: 0,
@@ -199,7 +201,7 @@ impl App {
             stroke: None,
             last_dab: None,
             mask_revision: 0,
-            hierarchy_built_with: (false, 0),
+            hierarchy_built_with: None,
             sharp_edges_shown_until: None,
             sharp_edges_drawn: 0,
             confirm_replace: None,

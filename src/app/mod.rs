@@ -106,6 +106,8 @@ pub struct App {
     applied_view: u64,
     applied_level_view: u64,
     hierarchy_progress: SharedProgress,
+    /// The hierarchy's job is still denoising (its progress is the denoise's).
+    hierarchy_denoising: Arc<std::sync::atomic::AtomicBool>,
     fair_progress: SharedProgress,
     fair_in_flight: bool,
     /// View generation of the newest fairing asked for.
@@ -165,7 +167,7 @@ pub struct App {
     mask_revision: u64,
     /// The sharp-edge settings the current hierarchy was asked for (see
     /// [`Settings::hierarchy_key`]): a change builds it again.
-    hierarchy_built_with: (bool, u64),
+    hierarchy_built_with: Option<state::HierarchyKey>,
     /// Draw the kept sharp edges over the mesh until then (their controls are hovered or were
     /// just changed).
     sharp_edges_shown_until: Option<std::time::Instant>,

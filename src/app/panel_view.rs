@@ -29,10 +29,12 @@ pub struct PanelView<'a> {
     pub open_path: &'a str,
     pub history: &'a History<DocumentSnapshot>,
     pub hierarchy_progress: f32,
+    /// The hierarchy's job is denoising the mesh before building on it.
+    pub hierarchy_denoising: bool,
     pub fair_in_flight: bool,
     pub fair_progress: f32,
     /// The sharp-edge settings the current hierarchy was built with.
-    pub hierarchy_built_with: (bool, u64),
+    pub hierarchy_built_with: Option<super::state::HierarchyKey>,
     /// The single view shows "before" instead of "after".
     pub show_before: bool,
     /// The left button paints the mask instead of orbiting.
@@ -65,6 +67,9 @@ impl App {
             open_path: &self.open_path,
             history: &self.history,
             hierarchy_progress: self.hierarchy_progress.get(),
+            hierarchy_denoising: self
+                .hierarchy_denoising
+                .load(std::sync::atomic::Ordering::Relaxed),
             fair_in_flight: self.fair_in_flight,
             fair_progress: self.fair_progress.get(),
             hierarchy_built_with: self.hierarchy_built_with,

@@ -41,8 +41,7 @@ impl App {
                 document,
                 hierarchy,
                 result,
-                elapsed,
-            } => self.on_hierarchy(document, hierarchy, result, elapsed),
+            } => self.on_hierarchy(document, hierarchy, result),
             JobResult::Faired {
                 document,
                 view,

@@ -12,10 +12,11 @@ mod measures;
 mod settings;
 
 pub use document::{
-    bounds_of, default_export_path, Document, DocumentSnapshot, FairedResult, HierarchyState,
+    bounds_of, default_export_path, DenoiseSummary, Document, DocumentSnapshot, FairedResult,
+    HierarchyState, KeptHierarchy,
 };
 pub use measures::Measures;
 pub use settings::{
-    CompareView, FairingKey, HeatReference, MethodChoice, Settings, ViewMode, MAX_SHARP_EDGE_ANGLE,
-    MIN_SHARP_EDGE_ANGLE,
+    CompareView, FairingKey, HeatReference, HierarchyKey, MethodChoice, Settings, ViewMode,
+    MAX_DENOISE_ROUNDS, MAX_SHARP_EDGE_ANGLE, MIN_SHARP_EDGE_ANGLE, SETTINGS_VERSION,
 };

@@ -17,9 +17,27 @@ pub const KEEP_SHARP_EDGES: &str = "Keep the mesh's sharp edges (the edges of a 
 pub const SHARP_EDGE_ANGLE: &str = "How sharply the surface must fold at an edge for the edge \
     to be kept sharp. Lower: more edges are kept (gentle folds too). Higher: only the sharpest. \
     The kept edges are drawn over the mesh while you point here.";
-pub const START_LEVEL: &str = "How coarse a version of the mesh the smoothing starts from \
-    (M0 is the mesh itself). Higher: smoother, bigger bumps go. Lower: more of the detail \
-    stays. Raise it until the noise is gone; lower it if wanted features melt away.";
+pub const START_LEVEL: &str = "How coarse a version of the mesh the smoothing starts from. \
+    M0: the mesh with its noise removed (the same result as the command line's `fair`). \
+    Higher: smoother, bigger bumps and fine detail go too. Lower: more of the detail stays. \
+    Raise it until the surface is as plain as you want; lower it if wanted features melt \
+    away.";
+pub const REMOVE_NOISE: &str = "Remove the mesh's noise before anything else, once: the \
+    smoother measures how noisy the mesh is and smooths until the result stops getting \
+    better (a clean mesh is left as it is). The levels are built on the result, so the \
+    start level only takes away detail on top of it. Automatic is right for nearly every \
+    mesh.";
+pub const DENOISE_AUTOMATIC: &str = "Measure the noise and smooth as much as it needs: \
+    the same result as the command line's `fair` with no options.";
+pub const DENOISE_ROUNDS: &str = "Smooth exactly this many rounds instead of measuring the \
+    noise: more rounds remove more (and round off more of the fine detail).";
+pub const DENOISE_OFF: &str = "Do not remove noise first: the smoothing starts at the start \
+    level alone, as in the paper (M0 then gets a few light passes).";
+pub const HIERARCHY_BUILDING: &str = "First the noise is removed (see Remove noise first), \
+    then the mesh is simplified level by level for the start level slider. Both happen once \
+    per mesh, in the background.";
+pub const CANCEL_HIERARCHY: &str = "Stop removing the noise and building the levels. \
+    Build hierarchy starts them again.";
 pub const METHOD: &str = "Constrained fairing (the paper's method) smooths without \
     shrinking the mesh. The others are classic smoothers to compare with: watch the volume \
     change under Numbers.";
@@ -35,8 +53,9 @@ pub const LAMBDA: &str = "How far each pass moves a vertex towards its neighbour
 pub const BOUNDARY: &str = "What happens to open borders (holes, cut edges). Smooth as \
     curve: the border line is smoothed too. Fixed: border vertices stay where they are; use \
     it when the mesh must still meet another part.";
-pub const FAIR_FINEST: &str = "Also smooth the full-detail mesh (M0) at the end. On: the \
-    finest noise goes too. Off: the finest detail stays as it was.";
+pub const FAIR_FINEST: &str = "Also smooth the full-detail mesh (M0) at the end, lightly. \
+    On: the vertices put back from the coarse levels are evened out (a few edges would stay \
+    folded otherwise). Off: they stay where they were put back.";
 pub const VARIANT: &str = "Paper: the method as published. Improved: two corrections that \
     keep the shape from drifting and shrinking over the levels. Keep Improved unless you \
     compare with the paper.";

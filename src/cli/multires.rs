@@ -54,8 +54,10 @@ pub struct MultiresArgs {
     pub rounds: usize,
     #[arg(long, default_value = "curve", value_parser = BoundaryArg::names_only_parser())]
     pub boundary: BoundaryArg,
-    /// Also fair M0 after the last refinement.
-    #[arg(long)]
+    /// Also fair M0 after the last refinement (`--fair-finest false`: not): a light pass that
+    /// unfolds the few edges the vertex splits leave folded.
+    #[arg(long, default_value_t = true, num_args = 0..=1, default_missing_value = "true",
+          action = clap::ArgAction::Set, value_name = "BOOL")]
     pub fair_finest: bool,
     /// Placement of split vertices; several, comma separated, run one after another.
     #[arg(long, value_enum, value_delimiter = ',', default_value = "improved")]

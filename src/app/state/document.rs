@@ -9,15 +9,66 @@ use std::time::Duration;
 
 use crate::app::history::SizeInBytes;
 use crate::app::sharp_edges::SharpEdgeLines;
-use crate::fairing::{Mask, Method};
+use crate::fairing::{FairReport, Mask, Method};
 use crate::hierarchy::{Hierarchy, LevelInfo};
 use crate::io::LoadReport;
 use crate::TriMesh;
 
 use super::Measures;
 
+/// What the denoise before the hierarchy found ([`crate::multires::denoise`]); the denoised
+/// positions are the hierarchy's M0.
+#[derive(Clone, Debug)]
+pub struct DenoiseSummary {
+    /// The fairing's report: the noise estimate, the rounds kept, the sharp edges.
+    pub report: FairReport,
+    pub time: Duration,
+}
+
+impl DenoiseSummary {
+    /// What the denoise found, in a few words for the panel: "Noise about 0.23 edge lengths:
+    /// 31 rounds; 49 sharp edges kept", or that it found none.
+    pub fn describe(&self) -> String {
+        let report = &self.report;
+        if report.rounds_run == 0 {
+            return match report.noise_estimate {
+                Some(noise) => format!(
+                    "No noise to remove (about {noise:.2} edge lengths, which reads as clean): \
+                     the mesh is used as it is"
+                ),
+                None => "No noise to remove: the mesh is used as it is".to_owned(),
+            };
+        }
+        let noise = report
+            .noise_estimate
+            .map(|noise| format!("Noise about {noise:.2} edge lengths: "))
+            .unwrap_or_default();
+        let rounds = match report.rounds_run {
+            1 => "1 round".to_owned(),
+            n => format!("{n} rounds"),
+        };
+        let edges = match report.crease_edges {
+            0 => String::new(),
+            1 => "; 1 sharp edge kept".to_owned(),
+            n => format!("; {n} sharp edges kept"),
+        };
+        format!("{noise}{rounds}{edges}")
+    }
+}
+
+/// A built hierarchy as undo keeps it (see [`HierarchyState::Ready`]).
+#[derive(Clone)]
+pub struct KeptHierarchy {
+    pub hierarchy: Arc<Hierarchy>,
+    pub build_time: Duration,
+    pub base_matches_original: bool,
+    pub sharp_edges: Arc<SharpEdgeLines>,
+    pub denoise: Option<DenoiseSummary>,
+}
+
 /// Where the hierarchy of the current document stands.
 pub enum HierarchyState {
+    /// Being built, after the denoise before it.
     Building,
     Ready {
         hierarchy: Arc<Hierarchy>,
@@ -28,6 +79,9 @@ pub enum HierarchyState {
         base_matches_original: bool,
         /// The sharp edges the hierarchy keeps, to draw over the mesh.
         sharp_edges: Arc<SharpEdgeLines>,
+        /// What the denoise found, when the hierarchy was built on the denoised mesh (its M0);
+        /// `None` when on the document's mesh itself ("Remove noise first" off).
+        denoise: Option<DenoiseSummary>,
     },
     Failed(String),
 }
@@ -160,7 +214,7 @@ pub struct DocumentSnapshot {
     pub export_path: String,
     pub source: Arc<crate::io::Source>,
     /// The hierarchy, its build time, and whether its M0 has the mesh's triangles.
-    pub hierarchy: Option<(Arc<Hierarchy>, Duration, bool, Arc<SharpEdgeLines>)>,
+    pub hierarchy: Option<KeptHierarchy>,
     /// See [`Document::applied`].
     pub applied: bool,
     /// The view of this document when it was left (set by the app, which owns the camera), so
@@ -180,8 +234,8 @@ impl SizeInBytes for DocumentSnapshot {
         // Shared meshes are counted once per snapshot: an over-estimate, on the safe side.
         mesh_bytes(&self.mesh)
             + self.clean.as_deref().map_or(0, mesh_bytes)
-            + self.hierarchy.as_ref().map_or(0, |(h, _, _, _)| {
-                h.record_bytes() + mesh_bytes(h.base_mesh())
+            + self.hierarchy.as_ref().map_or(0, |kept| {
+                kept.hierarchy.record_bytes() + mesh_bytes(kept.hierarchy.base_mesh())
             })
             + self
                 .against_clean
@@ -211,13 +265,15 @@ impl Document {
                     build_time,
                     base_matches_original,
                     sharp_edges,
+                    denoise,
                     ..
-                } => Some((
-                    hierarchy.clone(),
-                    *build_time,
-                    *base_matches_original,
-                    sharp_edges.clone(),
-                )),
+                } => Some(KeptHierarchy {
+                    hierarchy: hierarchy.clone(),
+                    build_time: *build_time,
+                    base_matches_original: *base_matches_original,
+                    sharp_edges: sharp_edges.clone(),
+                    denoise: denoise.clone(),
+                }),
                 _ => None,
             },
             applied: self.applied,
@@ -231,17 +287,16 @@ impl Document {
     pub fn from_snapshot(snapshot: DocumentSnapshot, generation: u64) -> Self {
         let bounds = bounds_of(&snapshot.mesh.positions);
         let hierarchy = match snapshot.hierarchy {
-            Some((hierarchy, build_time, base_matches_original, sharp_edges)) => {
-                HierarchyState::Ready {
-                    levels: (0..hierarchy.level_count())
-                        .map(|l| hierarchy.level_info(l))
-                        .collect(),
-                    base_matches_original,
-                    hierarchy,
-                    build_time,
-                    sharp_edges,
-                }
-            }
+            Some(kept) => HierarchyState::Ready {
+                levels: (0..kept.hierarchy.level_count())
+                    .map(|l| kept.hierarchy.level_info(l))
+                    .collect(),
+                base_matches_original: kept.base_matches_original,
+                hierarchy: kept.hierarchy,
+                build_time: kept.build_time,
+                sharp_edges: kept.sharp_edges,
+                denoise: kept.denoise,
+            },
             None => HierarchyState::Building,
         };
         Self {

@@ -11,7 +11,7 @@ use crate::fairing::{
     BoundaryMode, HcOptions, LaplacianOptions, Method, MethodOptions, TaubinOptions,
 };
 use crate::hierarchy::HierarchyOptions;
-use crate::multires::{MultiresOptions, MultiresVariant};
+use crate::multires::{Denoise, DenoiseOptions, MultiresOptions, MultiresVariant};
 use crate::noise::{NoiseMode, NoiseOptions};
 use crate::render::{Lighting, Shading};
 
@@ -85,6 +85,9 @@ pub enum CompareView {
     SideBySide,
 }
 
+/// The most rounds of denoise the editor offers.
+pub const MAX_DENOISE_ROUNDS: usize = 100;
+
 /// The range of the sharp-edge angle the editor offers, in degrees.
 pub const MIN_SHARP_EDGE_ANGLE: f64 = 10.0;
 pub const MAX_SHARP_EDGE_ANGLE: f64 = 90.0;
@@ -137,6 +140,40 @@ pub struct Settings {
     pub shading: Shading,
     /// Lighting: Simple or Studio (key, fill and rim lights).
     pub lighting: Lighting,
+    /// "Remove noise first": how much the mesh is denoised before the hierarchy is built on it
+    /// ([`crate::multires::denoise`]): automatically (the default of `fairmesh fair`), a fixed
+    /// number of rounds, or not at all (the paper's multires alone).
+    pub denoise: Denoise,
+    /// Which defaults the settings were saved under (missing in files saved before there was
+    /// one: 0). [`Settings::upgraded`] brings older files to today's defaults.
+    #[serde(default = "unversioned")]
+    pub version: u32,
+}
+
+impl HierarchyKey {
+    /// Whether `other` keeps the same sharp edges (whatever the denoise).
+    pub fn same_sharp_edges(&self, other: &HierarchyKey) -> bool {
+        (self.keep_sharp_edges, self.sharp_edge_angle_bits)
+            == (other.keep_sharp_edges, other.sharp_edge_angle_bits)
+    }
+}
+
+/// The version of a settings file saved before [`Settings::version`] existed.
+fn unversioned() -> u32 {
+    0
+}
+
+/// The defaults' version [`Settings::version`] records; see [`Settings::upgraded`].
+pub const SETTINGS_VERSION: u32 = 1;
+
+/// Sharp edges and the denoise as the stored fields of a [`HierarchyKey`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct HierarchyKey {
+    keep_sharp_edges: bool,
+    sharp_edge_angle_bits: u64,
+    denoise: Denoise,
+    /// The denoise moves boundaries as the fairing does.
+    boundary: BoundaryMode,
 }
 
 impl Default for Settings {
@@ -146,7 +183,9 @@ impl Default for Settings {
             iterations: defaults.iterations,
             rounds: defaults.rounds,
             boundary: BoundaryMode::Curve,
-            fair_finest: defaults.fair_finest,
+            // The levels' vertex splits leave a few edges folded, which a light pass over M0
+            // unfolds (docs/measurements.md, "Multiresolution fairing").
+            fair_finest: true,
             variant: MultiresVariant::Improved,
             wireframe: false,
             view_mode: ViewMode::Faired,
@@ -167,11 +206,14 @@ impl Default for Settings {
             levels_to: usize::MAX,
             start_levels: Vec::new(),
             paint: Default::default(),
-            keep_sharp_edges: HierarchyOptions::default().creases.is_some(),
+            // As `fairmesh fair` keeps them (the hierarchy's own default leaves them out).
+            keep_sharp_edges: true,
             sharp_edge_angle: DEFAULT_CREASE_ANGLE,
             recent_files: Vec::new(),
             shading: Shading::default(),
             lighting: Lighting::default(),
+            denoise: Denoise::Automatic,
+            version: SETTINGS_VERSION,
         }
     }
 }
@@ -291,9 +333,41 @@ impl Settings {
         }
     }
 
-    /// The settings that change the hierarchy (a change means: build it again).
-    pub fn hierarchy_key(&self) -> (bool, u64) {
-        (self.keep_sharp_edges, self.sharp_edge_angle.to_bits())
+    /// Settings saved under older defaults, brought to today's: before version 1 every file
+    /// stored "Keep sharp edges" and "Fair M0 too" off, which were the defaults then and not a
+    /// choice, and there was no denoise (its field comes in as [`Denoise::Automatic`]); sharp edges are kept now, as
+    /// `fairmesh fair` keeps them.
+    pub fn upgraded(mut self) -> Self {
+        if self.version < 1 {
+            self.keep_sharp_edges = true;
+            self.fair_finest = true;
+        }
+        self.version = SETTINGS_VERSION;
+        self
+    }
+
+    /// The settings that change the hierarchy, the denoise before it included (a change means:
+    /// build it again).
+    pub fn hierarchy_key(&self) -> HierarchyKey {
+        HierarchyKey {
+            keep_sharp_edges: self.keep_sharp_edges,
+            sharp_edge_angle_bits: self.sharp_edge_angle.to_bits(),
+            denoise: self.denoise,
+            boundary: self.boundary,
+        }
+    }
+
+    /// The denoise these settings ask for (sharp edges as the hierarchy keeps them; the caller
+    /// adds the file's own hard edges, as `fairmesh fair` does).
+    pub fn denoise_options(&self) -> DenoiseOptions {
+        DenoiseOptions {
+            denoise: match self.denoise {
+                Denoise::Rounds(rounds) => Denoise::Rounds(rounds.min(MAX_DENOISE_ROUNDS)),
+                other => other,
+            },
+            creases: self.hierarchy_options().creases,
+            boundary: self.boundary,
+        }
     }
 
     /// The hierarchy these settings ask for (the angle clamped to a sane range).
@@ -410,6 +484,40 @@ mod tests {
             (&written["boundary"], &written["variant"]),
             (&serde_json::json!("Curve"), &serde_json::json!("Improved"))
         );
+    }
+
+    #[test]
+    fn settings_saved_before_the_denoise_get_sharp_edges_and_the_automatic_denoise() {
+        // What every settings file stored before version 1 (sharp edges off was the default).
+        let old: Settings =
+            serde_json::from_str(r#"{"keep_sharp_edges": false, "iterations": 4}"#).unwrap();
+        assert_eq!(old.version, 0);
+        let upgraded = old.upgraded();
+        assert!(upgraded.keep_sharp_edges && upgraded.fair_finest);
+        assert_eq!(upgraded.denoise, Denoise::Automatic);
+        assert_eq!(upgraded.iterations, 4, "the rest is kept");
+        assert_eq!(upgraded.version, SETTINGS_VERSION);
+        // Unticked under today's defaults, it is the user's choice and stays.
+        let chosen = Settings {
+            keep_sharp_edges: false,
+            denoise: Denoise::Rounds(3),
+            ..Settings::default()
+        };
+        let json = serde_json::to_string(&chosen).unwrap();
+        let back = serde_json::from_str::<Settings>(&json).unwrap().upgraded();
+        assert_eq!(back, chosen);
+        // The denoise is the default fair's unless changed, and a change rebuilds.
+        let defaults = Settings::default();
+        let options = defaults.denoise_options();
+        assert_eq!(options.denoise, Denoise::Automatic);
+        assert!(options.creases.is_some());
+        assert_ne!(defaults.hierarchy_key(), chosen.hierarchy_key());
+        let off = Settings {
+            denoise: Denoise::Off,
+            ..Settings::default()
+        };
+        assert_ne!(defaults.hierarchy_key(), off.hierarchy_key());
+        assert!(off.denoise_options().fair_options().is_none());
     }
 
     #[test]

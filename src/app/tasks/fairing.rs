@@ -48,7 +48,9 @@ impl App {
         level: usize,
         view: u64,
     ) {
-        let job = self.fair_job(hierarchy, level);
+        let Some(job) = self.fair_job(hierarchy, level) else {
+            return;
+        };
         let document_generation = self.document_generation.clone();
         let progress_out = self.fair_progress.clone();
         let workspace = self.workspace.clone();
@@ -78,24 +80,25 @@ impl App {
     }
 
     /// What fairing the document from `level` with the current settings needs.
-    fn fair_job(&self, hierarchy: Arc<hierarchy::Hierarchy>, level: usize) -> FairJob {
-        // The document's connectivity, when the hierarchy's M0 has the document's triangles
-        // (otherwise it is built for M0 where needed).
-        let topology = self.document.as_ref().and_then(|d| match &d.hierarchy {
+    fn fair_job(&self, hierarchy: Arc<hierarchy::Hierarchy>, level: usize) -> Option<FairJob> {
+        let document = self.document.as_ref()?;
+        let denoised = matches!(
+            document.hierarchy,
             HierarchyState::Ready {
-                base_matches_original: true,
+                denoise: Some(_),
                 ..
-            } => Some(d.topology.clone()),
-            _ => None,
-        });
-        FairJob {
+            }
+        );
+        Some(FairJob {
             hierarchy,
-            mask: self.document.as_ref().and_then(|d| d.mask.clone()),
-            topology,
+            original: document.original.clone(),
+            denoised,
+            mask: document.mask.clone(),
+            topology: document.topology.clone(),
             options: self.settings.multires_options(level),
             baseline: self.settings.baseline_options(),
             method: self.settings.method,
-        }
+        })
     }
 
     pub(in crate::app) fn request_level_mesh(
@@ -192,11 +195,18 @@ impl App {
 /// One fairing of the document, as the compute worker runs it: taken from the app when it is
 /// asked for, so that the worker reads nothing of the app.
 struct FairJob {
+    /// Built on the denoised mesh when `denoised`, else on the document's mesh.
     hierarchy: Arc<hierarchy::Hierarchy>,
+    /// The document's mesh: what a baseline smooths, what a mask fades the result into, what
+    /// the result is measured against.
+    original: Arc<TriMesh>,
+    /// The hierarchy's M0 is the denoised mesh ("Remove noise first"): start level 0 is that
+    /// mesh as it is.
+    denoised: bool,
     /// The painted mask, if any (its edge fades out over [`MASK_EDGE_RINGS`] when the job runs).
     mask: Option<Mask>,
-    /// The document's connectivity, when the hierarchy's M0 has the document's triangles.
-    topology: Option<Arc<Topology>>,
+    /// The document's connectivity.
+    topology: Arc<Topology>,
     options: MultiresOptions,
     /// The baseline method's options; `None` for the paper's method.
     baseline: Option<MethodOptions>,
@@ -214,48 +224,46 @@ impl FairJob {
         let started = Instant::now();
         let FairJob {
             hierarchy,
+            original,
+            denoised,
             mask,
             topology,
-            mut options,
+            options,
             baseline,
             method,
         } = self;
-        // Only a mask or a baseline reads M0's connectivity.
-        let topology = (mask.is_some() || baseline.is_some())
-            .then(|| topology.unwrap_or_else(|| Arc::new(Topology::build(hierarchy.base_mesh()))));
         // A few rings of fade inside the painted region's edge, whatever the brush left: where
         // the brush stopped at a silhouette the mask drops from 1 to 0 at once, and the
         // result would show a step there.
-        let mask = mask
-            .zip(topology.as_deref())
-            .map(|(mask, topology)| mask.with_falloff(topology, MASK_EDGE_RINGS));
-        options.mask = mask.clone();
-        let positions = match (&baseline, topology.as_deref()) {
+        let mask = mask.map(|mask| mask.with_falloff(&topology, MASK_EDGE_RINGS));
+        let mut positions = match &baseline {
             // A baseline smooths the document's mesh itself; the level does not apply.
-            (Some(method), Some(topology)) => {
-                let mut mesh = hierarchy.base_mesh().clone();
-                match &mask {
-                    Some(mask) => crate::fairing::fair_masked(&mut mesh, topology, method, mask),
-                    None => crate::fairing::fair(&mut mesh, topology, method),
-                };
-                progress(1.0);
-                Some(mesh.positions)
+            Some(method) => {
+                let mut mesh = original.as_ref().clone();
+                crate::fairing::fair(&mut mesh, &topology, method);
+                progress(1.0).then_some(mesh.positions)?
             }
-            _ => {
+            // Start level 0 of a hierarchy built on the denoised mesh: that mesh.
+            None if denoised && options.start_level == 0 => {
+                progress(1.0).then(|| hierarchy.base_mesh().positions.clone())?
+            }
+            None => {
                 let mut workspace = workspace.lock().unwrap_or_else(PoisonError::into_inner);
-                multires::fair_multires(&hierarchy, &options, &mut workspace, &mut progress)
+                multires::fair_multires(&hierarchy, &options, &mut workspace, &mut progress)?
             }
         };
-        positions.map(|positions| {
-            let (volume_change, rms_displacement) =
-                metrics::change_of_positions(hierarchy.base_mesh(), &positions);
-            Faired {
-                positions,
-                volume_change,
-                rms_displacement,
-                elapsed: started.elapsed(),
-                method,
-            }
+        // The mask fades the result into the document's mesh (not into the denoised one the
+        // levels start from): unpainted vertices keep their positions exactly.
+        if let Some(mask) = mask.filter(|mask| mask.check_fits(positions.len()).is_ok()) {
+            mask.blend(&original.positions, &mut positions);
+        }
+        let (volume_change, rms_displacement) = metrics::change_of_positions(&original, &positions);
+        Some(Faired {
+            positions,
+            volume_change,
+            rms_displacement,
+            elapsed: started.elapsed(),
+            method,
         })
     }
 }

@@ -1,18 +1,46 @@
 //! Building the decimation hierarchy (on the compute worker) and setting up its levels: launch
 //! and result.
 
+use std::sync::atomic::Ordering;
 use std::sync::{Arc, PoisonError};
-use std::time::{Duration, Instant};
+use std::time::Instant;
 
 use crate::app::jobs::JobResult;
 use crate::app::sharp_edges::SharpEdgeLines;
-use crate::app::state::HierarchyState;
+use crate::app::state::{DenoiseSummary, HierarchyState, KeptHierarchy};
 use crate::app::App;
-use crate::hierarchy::{self, HierarchyError};
+use crate::hierarchy::{self, HierarchyError, HierarchyOptions};
+use crate::multires::denoise;
+use crate::{Topology, TriMesh};
+
+/// Builds the hierarchy on `built_on` (the denoised mesh, or the document's own `mesh`), whose
+/// triangles and `topology` are `mesh`'s: the hierarchy, whether its M0 has `mesh`'s triangles,
+/// and its sharp edges as lines to draw.
+fn build_on(
+    built_on: &TriMesh,
+    mesh: &TriMesh,
+    topology: &Topology,
+    options: &HierarchyOptions,
+    progress: &mut dyn crate::Progress,
+) -> Result<(Arc<hierarchy::Hierarchy>, bool, Arc<SharpEdgeLines>), HierarchyError> {
+    let built = hierarchy::build_hierarchy_with_topology(built_on, topology, options, progress)?;
+    // Compared here, not on the UI thread (millions of triangles).
+    let matches = built.base_mesh().triangles == mesh.triangles;
+    let sharp_edges = if matches {
+        SharpEdgeLines::new(mesh, built.crease_edges())
+    } else {
+        SharpEdgeLines::default()
+    };
+    Ok((Arc::new(built), matches, Arc::new(sharp_edges)))
+}
 
 impl App {
+    /// Denoises the document's mesh ([`crate::multires::denoise`], as the settings ask) and
+    /// builds the hierarchy on the result, on the compute worker; both report to the
+    /// hierarchy's progress (the denoise first, flagged in `hierarchy_denoising`) and are
+    /// cancelled together.
     pub(in crate::app) fn start_hierarchy(&mut self) {
-        self.hierarchy_built_with = self.settings.hierarchy_key();
+        self.hierarchy_built_with = Some(self.settings.hierarchy_key());
         let Some(document) = &mut self.document else {
             return;
         };
@@ -22,10 +50,13 @@ impl App {
         let mesh = document.original.clone();
         let topology = document.topology.clone();
         let mut options = self.settings.hierarchy_options();
+        let mut denoise_options = self.settings.denoise_options();
         let source = document.source.clone();
         let document_generation = document.generation;
         let hierarchy_generation = self.hierarchy_generation.clone();
         let progress_out = self.hierarchy_progress.clone();
+        let denoising = self.hierarchy_denoising.clone();
+        denoising.store(denoise_options.fair_options().is_some(), Ordering::Relaxed);
         let (tx, ctx, ticket) = (self.results_tx.clone(), self.ctx.clone(), self.jobs.start());
         self.compute.submit(move || {
             if !hierarchy_generation.is_current(generation) {
@@ -37,27 +68,43 @@ impl App {
                 hierarchy_generation.is_current(generation)
             };
             // The file's own sharp edges (split normals, material boundaries) are kept
-            // too when sharp edges are.
+            // too when sharp edges are, as `fairmesh fair` keeps them.
+            let file_edges = if options.creases.is_some() {
+                source.hard_edges(&mesh)
+            } else {
+                Vec::new()
+            };
             if let Some(creases) = &mut options.creases {
-                *creases = creases.clone().with_file_edges(source.hard_edges(&mesh));
+                *creases = creases.clone().with_file_edges(file_edges.clone());
             }
-            let built =
-                hierarchy::build_hierarchy_with_topology(&mesh, &topology, &options, &mut progress);
-            let result = built.map(|built| {
-                // Compared here, not on the UI thread (millions of triangles).
-                let matches = built.base_mesh().triangles == mesh.triangles;
-                let sharp_edges = if matches {
-                    SharpEdgeLines::new(&mesh, built.crease_edges())
-                } else {
-                    SharpEdgeLines::default()
-                };
-                (Arc::new(built), matches, Arc::new(sharp_edges))
-            });
+            if let Some(creases) = &mut denoise_options.creases {
+                *creases = creases.clone().with_file_edges(file_edges);
+            }
+            let result = match denoise(&mesh, &topology, &denoise_options, &mut progress) {
+                None => Err(HierarchyError::Cancelled),
+                Some(denoised) => {
+                    let denoise = denoised.as_ref().map(|d| DenoiseSummary {
+                        report: d.report.clone(),
+                        time: started.elapsed(),
+                    });
+                    denoising.store(false, Ordering::Relaxed);
+                    progress_out.set(0.0);
+                    let built_on = denoised.as_ref().map_or(mesh.as_ref(), |d| &d.mesh);
+                    build_on(built_on, &mesh, &topology, &options, &mut progress).map(
+                        |(hierarchy, base_matches_original, sharp_edges)| KeptHierarchy {
+                            hierarchy,
+                            build_time: started.elapsed(),
+                            base_matches_original,
+                            sharp_edges,
+                            denoise,
+                        },
+                    )
+                }
+            };
             let message = JobResult::Hierarchy {
                 document: document_generation,
                 hierarchy: generation,
                 result,
-                elapsed: started.elapsed(),
             };
             Self::send_result(&tx, &ctx, message, ticket);
         });
@@ -97,8 +144,7 @@ impl App {
         &mut self,
         document: u64,
         hierarchy: u64,
-        result: Result<(Arc<hierarchy::Hierarchy>, bool, Arc<SharpEdgeLines>), HierarchyError>,
-        elapsed: Duration,
+        result: Result<KeptHierarchy, HierarchyError>,
     ) {
         if !self.hierarchy_generation.is_current(hierarchy) {
             return;
@@ -107,9 +153,9 @@ impl App {
             return;
         };
         match result {
-            Ok((hierarchy, base_matches_original, sharp_edges)) => {
-                let levels = (0..hierarchy.level_count())
-                    .map(|l| hierarchy.level_info(l))
+            Ok(kept) => {
+                let levels = (0..kept.hierarchy.level_count())
+                    .map(|l| kept.hierarchy.level_info(l))
                     .collect::<Vec<_>>();
                 current.level = if current.pick_start_level {
                     current.pick_start_level = false;
@@ -117,13 +163,14 @@ impl App {
                 } else {
                     current.level.min(levels.len().saturating_sub(1))
                 };
-                let warm = hierarchy.clone();
+                let warm = kept.hierarchy.clone();
                 current.hierarchy = HierarchyState::Ready {
-                    base_matches_original,
-                    sharp_edges,
-                    hierarchy,
+                    base_matches_original: kept.base_matches_original,
+                    sharp_edges: kept.sharp_edges,
+                    hierarchy: kept.hierarchy,
                     levels,
-                    build_time: elapsed,
+                    build_time: kept.build_time,
+                    denoise: kept.denoise,
                 };
                 self.refresh_view();
                 self.prepare_levels(warm, document);

@@ -56,10 +56,12 @@ impl App {
         let Some(current) = self.document.as_ref().filter(|d| d.generation == document) else {
             return;
         };
-        let HierarchyState::Ready { hierarchy, .. } = &current.hierarchy else {
+        if !matches!(current.hierarchy, HierarchyState::Ready { .. }) {
             return;
-        };
-        let hierarchy = hierarchy.clone();
+        }
+        // Measured against the document's mesh (the hierarchy's M0 may be its denoised copy),
+        // with its triangles.
+        let base = current.original.clone();
         let clean = current.clean.clone();
         let pool = self.measure_pool.clone();
         let document_generation = self.document_generation.clone();
@@ -74,7 +76,7 @@ impl App {
                 return;
             }
             let started = Instant::now();
-            let base = hierarchy.base_mesh();
+            let base = base.as_ref();
             let faired = TriMesh {
                 positions: positions.as_ref().clone(),
                 triangles: base.triangles.clone(),
