@@ -24,7 +24,7 @@ pub(super) fn show(
     let label = ui.label("Export path:");
     ui.add(egui::TextEdit::singleline(&mut export_path).desired_width(f32::INFINITY))
         .labelled_by(label.id);
-    ui.small("GLB, glTF, OBJ or PLY, by extension");
+    ui.small(super::tips::EXPORT_FORMATS);
     ui.horizontal(|ui| {
         if ui
             .button("Export")

@@ -66,9 +66,11 @@ fn start_level_slider(
         (None, false) => Some("Waiting for the hierarchy to be built.".to_owned()),
         (None, true) => None,
     };
+    // Until the hierarchy is built the range reaches the level, which is shown, not 0.
+    let top = top_level.max(level);
     let slider = ui.add_enabled(
         level_off.is_none(),
-        egui::Slider::new(&mut level, 0..=top_level).text("Start level"),
+        egui::Slider::new(&mut level, 0..=top).text("Start level"),
     );
     if explain(slider, tips::START_LEVEL, level_off.as_deref()).changed() {
         commands.push(Command::SetLevel(level));

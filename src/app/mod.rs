@@ -74,6 +74,7 @@ pub use frame_stats::FrameStats;
 pub use launch::{run, AppOptions};
 pub use status::AppStatus;
 pub use view_sync::Slot;
+pub use viewport_panel::COMPUTING;
 
 use std::path::PathBuf;
 use std::sync::mpsc::{Receiver, Sender};

@@ -65,7 +65,8 @@ pub struct DrawParams {
     pub wireframe: bool,
     /// Scalars mapped to the heat map's two ends; `None` draws the plain base colour.
     pub scalar_range: Option<[f32; 2]>,
-    /// Without a heat map: the scalars are a mask (0 to 1), tinted over the base colour.
+    /// Show the mask weights ([`MeshRenderer::set_mask`]): tinted over the base colour, or,
+    /// over a heat map (whose colours must read as its legend says), as an outline.
     pub mask_tint: bool,
     /// Target size in physical pixels.
     pub size: [u32; 2],
@@ -141,6 +142,10 @@ pub struct MeshRenderer {
     /// The newest positions whose normals the upload thread is computing (the mesh on screen
     /// keeps its positions until they land, so positions and normals always match).
     pending_move: Option<u64>,
+    /// Scalars and mask weights set while those positions are on their way: they belong to
+    /// the new positions (a heat map of the new result), so they are written with them.
+    move_scalars: Option<Vec<f32>>,
+    move_mask: Option<Vec<f32>>,
     /// Whether the last image had the wireframe (a big upload then builds its edges too).
     wireframe: bool,
     /// Meshes of at least this many bytes (positions + triangles) upload on the upload thread.
@@ -182,6 +187,8 @@ impl MeshRenderer {
             lines_requested: None,
             move_serial: 0,
             pending_move: None,
+            move_scalars: None,
+            move_mask: None,
             wireframe: false,
             async_upload_bytes: DEFAULT_ASYNC_UPLOAD_BYTES,
             problem: None,
@@ -246,6 +253,8 @@ impl MeshRenderer {
         self.generation += 1;
         self.pending = None;
         self.pending_move = None;
+        self.move_scalars = None;
+        self.move_mask = None;
         self.lines_requested = None;
         self.lines_failed = false;
         let (vertex_count, face_count) = (source.positions().len(), source.triangles().len());
@@ -272,6 +281,7 @@ impl MeshRenderer {
                             generation,
                             vertex_count,
                             scalars: None,
+                            mask: None,
                         });
                         return;
                     }
@@ -306,8 +316,17 @@ impl MeshRenderer {
                         .as_ref()
                         .is_some_and(|p| p.generation == buffers.generation)
                     {
-                        if let Some(scalars) = self.pending.take().and_then(|p| p.scalars) {
-                            queue.write_buffer(&buffers.scalars, 0, bytemuck::cast_slice(&scalars));
+                        if let Some(pending) = self.pending.take() {
+                            if let Some(scalars) = pending.scalars {
+                                queue.write_buffer(
+                                    &buffers.scalars,
+                                    0,
+                                    bytemuck::cast_slice(&scalars),
+                                );
+                            }
+                            if let Some(mask) = pending.mask {
+                                queue.write_buffer(&buffers.mask, 0, bytemuck::cast_slice(&mask));
+                            }
                         }
                         self.mesh = Some(buffers);
                         self.redraw();
@@ -336,6 +355,7 @@ impl MeshRenderer {
                     {
                         // A move's normals failed: the mesh keeps its last positions.
                         self.pending_move = None;
+                        self.write_move_tints(queue);
                     }
                 }
                 Uploaded::Moved {
@@ -352,6 +372,7 @@ impl MeshRenderer {
                         mesh.write_positions(queue, source, &normals);
                         self.redraw();
                     }
+                    self.write_move_tints(queue);
                 }
                 Uploaded::Lines { generation, lines } => {
                     if self.lines_requested == Some(generation) {
@@ -408,7 +429,22 @@ impl MeshRenderer {
         let normals = vertex_normals(source.positions(), source.triangles());
         mesh.write_positions(queue, source, &normals);
         self.redraw();
+        self.write_move_tints(queue);
         true
+    }
+
+    /// Writes the scalars and mask weights that waited for a move's positions.
+    fn write_move_tints(&mut self, queue: &wgpu::Queue) {
+        let (scalars, mask) = (self.move_scalars.take(), self.move_mask.take());
+        if let Some(mesh) = &self.mesh {
+            if let Some(scalars) = scalars.filter(|s| s.len() == mesh.vertex_count) {
+                queue.write_buffer(&mesh.scalars, 0, bytemuck::cast_slice(&scalars));
+            }
+            if let Some(mask) = mask.filter(|m| m.len() == mesh.vertex_count) {
+                queue.write_buffer(&mesh.mask, 0, bytemuck::cast_slice(&mask));
+            }
+            self.redraw();
+        }
     }
 
     /// Reads back the vertex normals in the GPU buffer of the mesh on screen (tests: what
@@ -442,24 +478,48 @@ impl MeshRenderer {
     }
 
     /// Replaces the per-vertex scalars (one per vertex) of the mesh on screen or, while one
-    /// uploads, of that one; `false` when the count does not match.
+    /// uploads, of that one; `false` when the count does not match. While new positions are on
+    /// their way (a big mesh's normals on the upload thread) they are written with them, so a
+    /// heat map never colours the positions it was not measured on.
     pub fn set_scalars(&mut self, queue: &wgpu::Queue, scalars: &[f32]) -> bool {
+        self.set_per_vertex(queue, scalars, false)
+    }
+
+    /// Replaces the painted mask's weights (0 to 1, one per vertex), like [`Self::set_scalars`].
+    pub fn set_mask(&mut self, queue: &wgpu::Queue, weights: &[f32]) -> bool {
+        self.set_per_vertex(queue, weights, true)
+    }
+
+    fn set_per_vertex(&mut self, queue: &wgpu::Queue, values: &[f32], mask: bool) -> bool {
         self.poll_uploads(queue);
         if let Some(pending) = &mut self.pending {
-            if pending.vertex_count != scalars.len() {
+            if pending.vertex_count != values.len() {
                 return false;
             }
-            pending.scalars = Some(scalars.to_vec());
+            match mask {
+                true => pending.mask = Some(values.to_vec()),
+                false => pending.scalars = Some(values.to_vec()),
+            }
             return true;
         }
-        match &self.mesh {
-            Some(mesh) if mesh.vertex_count == scalars.len() => {
-                queue.write_buffer(&mesh.scalars, 0, bytemuck::cast_slice(scalars));
-                self.redraw();
-                true
+        let Some(mesh) = self
+            .mesh
+            .as_ref()
+            .filter(|m| m.vertex_count == values.len())
+        else {
+            return false;
+        };
+        if self.pending_move.is_some() {
+            match mask {
+                true => self.move_mask = Some(values.to_vec()),
+                false => self.move_scalars = Some(values.to_vec()),
             }
-            _ => false,
+            return true;
         }
+        let buffer = if mask { &mesh.mask } else { &mesh.scalars };
+        queue.write_buffer(buffer, 0, bytemuck::cast_slice(values));
+        self.redraw();
+        true
     }
 
     pub fn has_mesh(&self) -> bool {

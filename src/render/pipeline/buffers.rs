@@ -1,5 +1,6 @@
-//! The GPU copies of one mesh ([`MeshBuffers`]: positions, vertex normals, scalars, triangles
-//! and, once the wireframe is wanted, its edges) and how they are filled.
+//! The GPU copies of one mesh ([`MeshBuffers`]: positions, vertex normals, heat-map scalars,
+//! painted-mask weights, triangles and, once the wireframe is wanted, its edges) and how they
+//! are filled.
 
 use std::sync::Arc;
 
@@ -13,7 +14,10 @@ pub(super) struct MeshBuffers {
     pub(super) positions: wgpu::Buffer,
     /// Area-weighted unit vertex normals of the positions now in `positions`.
     pub(super) normals: wgpu::Buffer,
+    /// The heat map's per-vertex values.
     pub(super) scalars: wgpu::Buffer,
+    /// The painted mask's per-vertex weights (0 to 1), tinted over the surface.
+    pub(super) mask: wgpu::Buffer,
     pub(super) triangles: wgpu::Buffer,
     pub(super) vertex_count: usize,
     pub(super) index_count: u32,
@@ -62,14 +66,18 @@ impl MeshBuffers {
                 | wgpu::BufferUsages::COPY_DST
                 | wgpu::BufferUsages::COPY_SRC,
         });
-        // Scalars come later through `set_scalars`; wgpu zero-fills a buffer that is not mapped
-        // at creation.
-        let scalars_buffer = device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("fairmesh scalars"),
-            size: (positions.len() * 4) as u64,
-            usage: wgpu::BufferUsages::VERTEX | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
+        // Scalars and mask weights come later through `set_scalars` and `set_mask`; wgpu
+        // zero-fills a buffer that is not mapped at creation.
+        let per_vertex = |label| {
+            device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some(label),
+                size: (positions.len() * 4) as u64,
+                usage: wgpu::BufferUsages::VERTEX | wgpu::BufferUsages::COPY_DST,
+                mapped_at_creation: false,
+            })
+        };
+        let scalars_buffer = per_vertex("fairmesh scalars");
+        let mask_buffer = per_vertex("fairmesh mask");
         let triangles_buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("fairmesh triangles"),
             contents: bytemuck::cast_slice(triangles),
@@ -80,6 +88,7 @@ impl MeshBuffers {
             positions: positions_buffer,
             normals: normals_buffer,
             scalars: scalars_buffer,
+            mask: mask_buffer,
             triangles: triangles_buffer,
             vertex_count: positions.len(),
             index_count: (triangles.len() * 3) as u32,

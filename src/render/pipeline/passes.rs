@@ -46,10 +46,10 @@ impl Uniforms {
             up: [params.up[0], params.up[1], params.up[2], 0.0],
             base_color: [0.62, 0.56, 0.48, 1.0],
             wire_color: [0.02, 0.03, 0.05, 1.0],
-            scalar_range: match (params.scalar_range, params.mask_tint) {
-                (Some([lo, hi]), _) => [lo, hi, 1.0, 0.0],
-                (None, true) => [0.0, 1.0, 2.0, 0.0],
-                (None, false) => [0.0, 1.0, 0.0, 0.0],
+            scalar_range: {
+                let [lo, hi] = params.scalar_range.unwrap_or([0.0, 1.0]);
+                let heat = f32::from(u8::from(params.scalar_range.is_some()));
+                [lo, hi, heat, f32::from(u8::from(params.mask_tint))]
             },
             look: [
                 f32::from(u8::from(params.shading == Shading::Smooth)),
@@ -354,6 +354,7 @@ impl Pipelines {
             pass.set_vertex_buffer(0, mesh.positions.slice(..));
             pass.set_vertex_buffer(1, mesh.scalars.slice(..));
             pass.set_vertex_buffer(2, mesh.normals.slice(..));
+            pass.set_vertex_buffer(3, mesh.mask.slice(..));
             pass.set_index_buffer(mesh.triangles.slice(..), wgpu::IndexFormat::Uint32);
             let face_count = mesh.index_count / 3;
             let faces = part.faces.start.min(face_count)..part.faces.end.min(face_count);
@@ -375,8 +376,9 @@ impl Pipelines {
     }
 }
 
-/// The vertex buffers' layouts: positions (location 0), scalars (1), normals (2).
-fn vertex_layouts() -> [wgpu::VertexBufferLayout<'static>; 3] {
+/// The vertex buffers' layouts: positions (location 0), scalars (1), normals (2), mask
+/// weights (3).
+fn vertex_layouts() -> [wgpu::VertexBufferLayout<'static>; 4] {
     let position_layout = wgpu::VertexBufferLayout {
         array_stride: 12,
         step_mode: wgpu::VertexStepMode::Vertex,
@@ -404,7 +406,16 @@ fn vertex_layouts() -> [wgpu::VertexBufferLayout<'static>; 3] {
             shader_location: 2,
         }],
     };
-    [position_layout, scalar_layout, normal_layout]
+    let mask_layout = wgpu::VertexBufferLayout {
+        array_stride: 4,
+        step_mode: wgpu::VertexStepMode::Vertex,
+        attributes: &[wgpu::VertexAttribute {
+            format: wgpu::VertexFormat::Float32,
+            offset: 0,
+            shader_location: 3,
+        }],
+    };
+    [position_layout, scalar_layout, normal_layout, mask_layout]
 }
 
 /// The colour target both pipelines draw into.
@@ -431,7 +442,7 @@ fn fill_pipeline(
     shader: &wgpu::ShaderModule,
     samples: u32,
 ) -> wgpu::RenderPipeline {
-    let [position_layout, scalar_layout, normal_layout] = vertex_layouts();
+    let [position_layout, scalar_layout, normal_layout, mask_layout] = vertex_layouts();
     let targets = color_targets();
     device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
         label: Some("fairmesh triangles"),
@@ -444,6 +455,7 @@ fn fill_pipeline(
                 Some(position_layout),
                 Some(scalar_layout),
                 Some(normal_layout),
+                Some(mask_layout),
             ],
         },
         primitive: wgpu::PrimitiveState {
@@ -482,7 +494,7 @@ fn line_pipeline(
     shader: &wgpu::ShaderModule,
     samples: u32,
 ) -> wgpu::RenderPipeline {
-    let [position_layout, _, _] = vertex_layouts();
+    let [position_layout, _, _, _] = vertex_layouts();
     let targets = color_targets();
     device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
         label: Some("fairmesh wireframe"),

@@ -159,4 +159,6 @@ pub(super) struct PendingMesh {
     pub(super) vertex_count: usize,
     /// Scalars set while the upload was in flight, written once it lands.
     pub(super) scalars: Option<Vec<f32>>,
+    /// Mask weights set while the upload was in flight, written once it lands.
+    pub(super) mask: Option<Vec<f32>>,
 }
