@@ -18,8 +18,6 @@ pub(super) fn show(
     let Some(document) = view.document else {
         return;
     };
-    ui.separator();
-    ui.heading("Export");
     let mut export_path = document.export_path.clone();
     let label = ui.label("Export path:");
     ui.add(egui::TextEdit::singleline(&mut export_path).desired_width(f32::INFINITY))
