@@ -85,10 +85,8 @@ pub const PAINT_SECTION: &str = "Paint where to fair";
 /// One section of the side panel under its heading (open at first; a click folds it): what
 /// `body` returned, `None` while folded.
 fn section<R>(ui: &mut egui::Ui, title: &str, body: impl FnOnce(&mut egui::Ui) -> R) -> Option<R> {
-    // A line between sections, none above the first.
-    if ui.min_rect().height() > 0.0 {
-        ui.separator();
-    }
+    // The headings stand out enough between sections without a line, and the lines' room
+    // keeps Export on an 800-point-high screen.
     egui::CollapsingHeader::new(egui::RichText::new(title).heading())
         .id_salt(("fairmesh-section", title))
         .default_open(true)

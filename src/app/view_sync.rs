@@ -10,6 +10,7 @@ use crate::app::state::{
 };
 use crate::app::App;
 use crate::hierarchy;
+use crate::render::appearance::Appearance;
 use crate::render::{DrawParams, MeshSource, Viewport3d};
 use crate::TriMesh;
 
@@ -54,6 +55,7 @@ impl SlotLook {
             wireframe: settings.wireframe,
             scalar_range: self.scalar_range,
             mask_tint: self.mask_tint,
+            clay: settings.clay,
             size: [0, 0],
         }
     }
@@ -111,21 +113,25 @@ fn view_mesh(
     document: &Document,
     what: ShownMesh,
     base: Option<(Arc<hierarchy::Hierarchy>, bool)>,
+    appearance: Option<Arc<Appearance>>,
 ) -> Option<ViewMesh> {
     Some(match what {
         ShownMesh::Original => ViewMesh {
             connectivity: SharedMesh::Mesh(document.original.clone()),
             positions: None,
+            appearance,
         },
         ShownMesh::Faired { .. } => {
             let faired = document.faired.as_ref()?;
-            let connectivity = match base {
-                Some((hierarchy, false)) => SharedMesh::Base(hierarchy),
-                _ => SharedMesh::Mesh(document.original.clone()),
+            // The file's colours need its triangles: M0 without its loose triangles has others.
+            let (connectivity, appearance) = match base {
+                Some((hierarchy, false)) => (SharedMesh::Base(hierarchy), None),
+                _ => (SharedMesh::Mesh(document.original.clone()), appearance),
             };
             ViewMesh {
                 connectivity,
                 positions: Some(faired.positions.clone()),
+                appearance,
             }
         }
         ShownMesh::Level { .. } => {
@@ -133,6 +139,7 @@ fn view_mesh(
             ViewMesh {
                 connectivity: SharedMesh::Mesh(mesh.clone()),
                 positions: None,
+                appearance: None,
             }
         }
     })
@@ -160,6 +167,8 @@ impl SharedMesh {
 pub(in crate::app) struct ViewMesh {
     pub(in crate::app) connectivity: SharedMesh,
     pub(in crate::app) positions: Option<Arc<Vec<[f32; 3]>>>,
+    /// The file's colours over these triangles (the document's), when it has any.
+    pub(in crate::app) appearance: Option<Arc<Appearance>>,
 }
 
 impl MeshSource for ViewMesh {
@@ -171,6 +180,9 @@ impl MeshSource for ViewMesh {
     }
     fn triangles(&self) -> &[[u32; 3]] {
         &self.connectivity.mesh().triangles
+    }
+    fn appearance(&self) -> Option<Arc<Appearance>> {
+        self.appearance.clone()
     }
 }
 
@@ -338,6 +350,7 @@ impl App {
             shown.is_none_or(|s| (s.document, s.what) != (wanted.document, wanted.what));
         let mut counts = None;
         if mesh_changed {
+            self.make_appearance();
             let Some(uploaded) = self.upload_mesh(slot, shown, wanted) else {
                 return;
             };
@@ -364,6 +377,18 @@ impl App {
             }
             Slot::Before => self.shown_before = Some(uploaded),
         }
+    }
+
+    /// Makes the document's file's colours for the viewport, once per loaded file.
+    fn make_appearance(&mut self) {
+        let Some(document) = &self.document else {
+            return;
+        };
+        if (self.appearance.as_ref()).is_some_and(|(s, _)| Arc::ptr_eq(s, &document.source)) {
+            return;
+        }
+        let appearance = super::appearance::appearance_of(&document.source, &document.original);
+        self.appearance = Some((document.source.clone(), appearance.map(Arc::new)));
     }
 
     /// The slot's renderer handle, when there is a wgpu renderer.
@@ -397,7 +422,8 @@ impl App {
             shown.document == wanted.document
                 && shown.what.connectivity(matches) == wanted.what.connectivity(matches)
         });
-        let source = view_mesh(document, wanted.what, base)?;
+        let appearance = self.appearance.as_ref().and_then(|(_, a)| a.clone());
+        let source = view_mesh(document, wanted.what, base, appearance)?;
         let counts = (source.positions().len(), source.triangles().len());
         if let Some(viewport) = self.slot_viewport(slot) {
             let source: Arc<dyn MeshSource> = Arc::new(source);

@@ -9,6 +9,7 @@
 //! heat-map scalars and (through `set_mask`) the painted mask's weights, and knows nothing of
 //! fairing. It computes the vertex normals smooth shading needs itself ([`normals`]); [`shading`] names the shading and lighting choices.
 
+pub mod appearance;
 pub mod colormap;
 pub mod normals;
 pub mod pipeline;

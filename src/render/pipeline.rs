@@ -23,10 +23,12 @@ mod upload;
 use std::sync::Arc;
 use std::time::Duration;
 
+use super::appearance::Appearance;
 use super::normals::vertex_normals;
 use super::shading::{Lighting, Shading};
-use buffers::{line_buffer, MeshBuffers};
-use passes::{Part, Pipelines, Target, Uniforms};
+use buffers::MaterialGroup;
+use buffers::{draw_triangles, line_buffer, MeshBuffers};
+use passes::{MaterialKit, Part, Pipelines, Target, Uniforms};
 use upload::{PendingMesh, UploadJob, Uploaded, Uploader};
 
 /// Format of the image the mesh is drawn into (and that egui then samples).
@@ -68,6 +70,9 @@ pub struct DrawParams {
     /// Show the mask weights ([`MeshRenderer::set_mask`]): tinted over the base colour, or,
     /// over a heat map (whose colours must read as its legend says), as an outline.
     pub mask_tint: bool,
+    /// Every surface in the clay colour, the file's materials, textures and vertex colours left
+    /// out (to judge the shape alone).
+    pub clay: bool,
     /// Target size in physical pixels.
     pub size: [u32; 2],
 }
@@ -76,6 +81,10 @@ pub struct DrawParams {
 pub trait MeshSource: Send + Sync + 'static {
     fn positions(&self) -> &[[f32; 3]];
     fn triangles(&self) -> &[[u32; 3]];
+    /// The file's materials, texture coordinates and colours over these triangles, if shown.
+    fn appearance(&self) -> Option<Arc<Appearance>> {
+        None
+    }
 }
 
 /// Meshes whose positions and triangles take fewer bytes than this are uploaded in the calling
@@ -104,6 +113,9 @@ enum PartDrawn {
 
 /// Owns the pipelines, the mesh buffers and the offscreen target. Knows nothing of fairing.
 pub struct MeshRenderer {
+    /// The materials' bind group layout (shared by both samplings' pipelines) and the group of
+    /// "no material".
+    materials: MaterialKit,
     pipelines: Pipelines,
     /// The same pipelines for a target without multisampling (made when first needed).
     single_sample: Option<Pipelines>,
@@ -165,8 +177,10 @@ impl MeshRenderer {
     /// Pipelines on `device`, and an upload thread for big meshes that calls `on_upload_done`
     /// (from that thread) whenever an upload lands, so the UI can repaint.
     pub fn new(device: &wgpu::Device, on_upload_done: Arc<dyn Fn() + Send + Sync>) -> Self {
+        let materials = MaterialKit::new(device);
         Self {
-            pipelines: Pipelines::new(device, SAMPLE_COUNT),
+            pipelines: Pipelines::new(device, SAMPLE_COUNT, &materials),
+            materials,
             single_sample: None,
             software: false,
             newest_faces: 0,
@@ -318,14 +332,10 @@ impl MeshRenderer {
                     {
                         if let Some(pending) = self.pending.take() {
                             if let Some(scalars) = pending.scalars {
-                                queue.write_buffer(
-                                    &buffers.scalars,
-                                    0,
-                                    bytemuck::cast_slice(&scalars),
-                                );
+                                buffers.write_per_vertex(queue, &buffers.scalars, &scalars);
                             }
                             if let Some(mask) = pending.mask {
-                                queue.write_buffer(&buffers.mask, 0, bytemuck::cast_slice(&mask));
+                                buffers.write_per_vertex(queue, &buffers.mask, &mask);
                             }
                         }
                         self.mesh = Some(buffers);
@@ -438,10 +448,10 @@ impl MeshRenderer {
         let (scalars, mask) = (self.move_scalars.take(), self.move_mask.take());
         if let Some(mesh) = &self.mesh {
             if let Some(scalars) = scalars.filter(|s| s.len() == mesh.vertex_count) {
-                queue.write_buffer(&mesh.scalars, 0, bytemuck::cast_slice(&scalars));
+                mesh.write_per_vertex(queue, &mesh.scalars, &scalars);
             }
             if let Some(mask) = mask.filter(|m| m.len() == mesh.vertex_count) {
-                queue.write_buffer(&mesh.mask, 0, bytemuck::cast_slice(&mask));
+                mesh.write_per_vertex(queue, &mesh.mask, &mask);
             }
             self.redraw();
         }
@@ -456,7 +466,7 @@ impl MeshRenderer {
     ) -> Option<Vec<[f32; 3]>> {
         self.poll_uploads(queue);
         let mesh = self.mesh.as_ref()?;
-        let size = (mesh.vertex_count * 12) as u64;
+        let size = (mesh.draw_count * 12) as u64;
         let staging = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("fairmesh normals read-back"),
             size,
@@ -517,7 +527,7 @@ impl MeshRenderer {
             return true;
         }
         let buffer = if mask { &mesh.mask } else { &mesh.scalars };
-        queue.write_buffer(buffer, 0, bytemuck::cast_slice(values));
+        mesh.write_per_vertex(queue, buffer, values);
         self.redraw();
         true
     }
@@ -583,7 +593,7 @@ impl MeshRenderer {
             return false;
         }
         if samples != SAMPLE_COUNT && self.single_sample.is_none() {
-            self.single_sample = Some(Pipelines::new(device, samples));
+            self.single_sample = Some(Pipelines::new(device, samples, &self.materials));
         }
         self.target = Some(Target::new(device, size, samples));
         self.target_has_image = false;
@@ -623,7 +633,16 @@ impl MeshRenderer {
         };
         self.wireframe = params.wireframe;
         let started = std::time::Instant::now();
-        let uniforms = Uniforms::of(&params);
+        self.ensure_materials(device, queue);
+        let (materials, colours, uvs) = self.mesh.as_ref().map_or((false, false, false), |m| {
+            let look = m.appearance.as_deref();
+            (
+                !params.clay && look.is_some_and(|l| !l.is_plain()),
+                look.is_some_and(|l| l.colours.is_some()),
+                look.is_some_and(|l| l.uvs.is_some()),
+            )
+        });
+        let uniforms = Uniforms::of(&params, materials, colours, uvs);
         if params.wireframe {
             self.ensure_lines(device);
         }
@@ -640,7 +659,8 @@ impl MeshRenderer {
         let total = faces as usize + edges as usize;
         let at_once = total <= self.faces_per_frame || !self.target_has_image;
         if at_once {
-            pipelines.draw(encoder, target, mesh, params.wireframe);
+            let plain = self.materials.plain.as_ref();
+            pipelines.draw(encoder, target, (mesh, plain), params.wireframe);
             self.last_draw_time = started.elapsed();
         } else {
             match self.draw_next_part(device, encoder, params, (faces, total), started) {
@@ -703,7 +723,7 @@ impl MeshRenderer {
         pipelines.draw_part(
             encoder,
             work,
-            self.mesh.as_ref(),
+            (self.mesh.as_ref(), self.materials.plain.as_ref()),
             params.wireframe,
             &part,
             last,
@@ -726,6 +746,30 @@ impl MeshRenderer {
         self.progress = None;
         self.last_draw_time = recording;
         PartDrawn::Complete
+    }
+
+    /// Uploads the textures and uniforms of the mesh's materials, and the "no material" group,
+    /// when they are not on the GPU yet.
+    fn ensure_materials(&mut self, device: &wgpu::Device, queue: &wgpu::Queue) {
+        if self.materials.plain.is_none() {
+            self.materials.plain = Some(self.materials.group(device, queue, None));
+        }
+        if let Some(mesh) = &mut self.mesh {
+            if mesh.materials.is_none() {
+                let looks = mesh
+                    .appearance
+                    .as_ref()
+                    .map_or(&[][..], |a| &a.materials[..]);
+                mesh.materials = Some(
+                    looks
+                        .iter()
+                        .map(|look| MaterialGroup {
+                            bind_group: self.materials.group(device, queue, Some(look)),
+                        })
+                        .collect(),
+                );
+            }
+        }
     }
 
     /// Builds the wireframe's edges of the mesh on screen when they are missing and fit: a big
@@ -756,7 +800,7 @@ impl MeshRenderer {
                 if sent {
                     self.lines_requested = Some(mesh.generation);
                 } else {
-                    mesh.lines = Some(line_buffer(device, mesh.source.triangles()));
+                    mesh.lines = Some(line_buffer(device, &draw_triangles(mesh.source.as_ref())));
                 }
             }
         }

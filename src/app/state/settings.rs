@@ -137,6 +137,9 @@ pub struct Settings {
     pub shading: Shading,
     /// Lighting: Simple or Studio (key, fill and rim lights).
     pub lighting: Lighting,
+    /// Clay: every surface in one clay colour, the file's materials, textures and vertex
+    /// colours left out.
+    pub clay: bool,
 }
 
 impl Default for Settings {
@@ -172,6 +175,7 @@ impl Default for Settings {
             recent_files: Vec::new(),
             shading: Shading::default(),
             lighting: Lighting::default(),
+            clay: false,
         }
     }
 }

@@ -5,7 +5,7 @@
 use std::sync::mpsc::{self, Receiver, Sender};
 use std::sync::{Arc, Mutex};
 
-use super::buffers::{line_buffer, MeshBuffers};
+use super::buffers::{draw_triangles, line_buffer, MeshBuffers};
 use super::MeshSource;
 use crate::render::normals::vertex_normals;
 
@@ -46,7 +46,7 @@ impl UploadJob {
             } => Uploaded::Mesh(MeshBuffers::create(device, source, with_lines, generation)),
             UploadJob::Lines { generation, source } => Uploaded::Lines {
                 generation,
-                lines: line_buffer(device, source.triangles()),
+                lines: line_buffer(device, &draw_triangles(source.as_ref())),
             },
             UploadJob::Move {
                 generation,
