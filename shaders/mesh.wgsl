@@ -1,8 +1,11 @@
 // fairmesh viewport shader: triangles lit flat (one normal per triangle, from the screen-space
 // derivatives of the world position, so positions are uploaded once and shared by all corners) or
 // smooth (the area-weighted vertex normals the renderer computes, blended across each triangle),
-// under simple or studio lighting; an optional per-vertex heat map (viridis) or mask tint; and a
-// wireframe drawn as lines over the filled mesh.
+// under simple or studio lighting; the surface's colour from the file's material (base colour
+// factor times its base colour texture at the vertex's texture coordinates) times its vertex
+// colour, or the clay colour; an optional per-vertex heat map (viridis) and painted-mask
+// tint (an orange tint, or its outline over a heat map); and a wireframe drawn as lines over the
+// filled mesh.
 
 struct Uniforms {
     view_proj: mat4x4<f32>,
@@ -16,20 +19,35 @@ struct Uniforms {
     up: vec4<f32>,
     base_color: vec4<f32>,
     wire_color: vec4<f32>,
-    // x: scalar mapped to blue, y: scalar mapped to red, z: 1 when scalars are a heat map, 2
-    // when they are a mask (0 to 1) tinted over the base colour.
+    // x: scalar mapped to the map's low end, y: to its high end, z: 1 when the scalars are
+    // shown as a heat map, w: 1 when the mask weights (0 to 1) are shown.
     scalar_range: vec4<f32>,
-    // x: 1 for smooth shading (vertex normals), y: 1 for the studio lighting.
+    // x: 1 for smooth shading (vertex normals), y: 1 for the studio lighting, z: 1 to draw the
+    // materials' colours (0: clay), w: vertex colours (+1) and texture coordinates (+2) there.
     look: vec4<f32>,
 };
 
 @group(0) @binding(0) var<uniform> u: Uniforms;
+
+struct Material {
+    // Linear RGBA.
+    base_colour: vec4<f32>,
+    // x: 1 when the material has a base colour texture.
+    flags: vec4<f32>,
+};
+
+@group(1) @binding(0) var<uniform> material: Material;
+@group(1) @binding(1) var base_texture: texture_2d<f32>;
+@group(1) @binding(2) var base_sampler: sampler;
 
 struct MeshOut {
     @builtin(position) clip: vec4<f32>,
     @location(0) world: vec3<f32>,
     @location(1) scalar: f32,
     @location(2) normal: vec3<f32>,
+    @location(3) mask: f32,
+    @location(4) uv: vec2<f32>,
+    @location(5) colour: vec4<f32>,
 };
 
 @vertex
@@ -37,8 +55,14 @@ fn vs_mesh(
     @location(0) position: vec3<f32>,
     @location(1) scalar: f32,
     @location(2) normal: vec3<f32>,
+    @location(3) mask: f32,
+    @location(4) uv: vec2<f32>,
+    @location(5) colour: vec4<f32>,
 ) -> MeshOut {
     var out: MeshOut;
+    out.mask = mask;
+    out.uv = uv;
+    out.colour = colour;
     out.clip = u.view_proj * vec4<f32>(position, 1.0);
     out.world = position;
     out.scalar = scalar;
@@ -147,14 +171,38 @@ fn simple(albedo: vec3<f32>, n: vec3<f32>, to_eye: vec3<f32>, heat: bool) -> vec
 fn fs_mesh(in: MeshOut, @builtin(front_facing) front: bool) -> @location(0) vec4<f32> {
     let to_eye = normalize(u.eye.xyz - in.world);
     let normal = surface_normal(in, front, to_eye);
+    // Sampled before any branch (implicit derivatives need every pixel of the quad); a mesh
+    // with no material samples a white texel.
+    let texel = textureSample(base_texture, base_sampler, in.uv);
     var albedo = u.base_color.rgb;
-    let heat = u.scalar_range.z > 0.5 && u.scalar_range.z < 1.5;
-    if (u.scalar_range.z > 1.5) {
-        // The painted region in a warm orange, as strong as its weight.
-        albedo = mix(albedo, vec3<f32>(0.95, 0.28, 0.06), 0.5 * clamp(in.scalar, 0.0, 1.0));
-    } else if (heat) {
+    if (u.look.z > 0.5) {
+        albedo = material.base_colour.rgb;
+        let extras = u32(u.look.w + 0.5);
+        if (material.flags.x > 0.5 && (extras & 2u) != 0u) {
+            albedo = albedo * texel.rgb;
+        }
+        if ((extras & 1u) != 0u) {
+            albedo = albedo * in.colour.rgb;
+        }
+    }
+    let heat = u.scalar_range.z > 0.5;
+    let mask = u.scalar_range.w > 0.5;
+    // Derivatives before any branch (they need every pixel of the quad).
+    let mask_step = fwidth(in.mask);
+    if (heat) {
         let span = max(u.scalar_range.y - u.scalar_range.x, 1e-20);
         albedo = viridis((in.scalar - u.scalar_range.x) / span);
+        if (mask) {
+            // Over a heat map the painted region's edge (weight one half) is outlined in
+            // orange, so the map's colours still read as its legend says.
+            let across = abs(in.mask - 0.5) / max(mask_step, 1e-6);
+            if (across < 1.0 && mask_step > 0.0) {
+                albedo = vec3<f32>(0.95, 0.28, 0.06);
+            }
+        }
+    } else if (mask) {
+        // The painted region in a warm orange, as strong as its weight.
+        albedo = mix(albedo, vec3<f32>(0.95, 0.28, 0.06), 0.5 * clamp(in.mask, 0.0, 1.0));
     }
     if (!front) {
         // Back faces (holes, inverted patches) in a cooler, darker tone.

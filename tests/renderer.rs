@@ -210,6 +210,7 @@ fn params(size: [u32; 2], zoom: f32, wireframe: bool) -> fairmesh::render::DrawP
         wireframe,
         scalar_range: None,
         mask_tint: false,
+        clay: false,
         size,
     }
 }

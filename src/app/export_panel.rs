@@ -18,13 +18,11 @@ pub(super) fn show(
     let Some(document) = view.document else {
         return;
     };
-    ui.separator();
-    ui.heading("Export");
     let mut export_path = document.export_path.clone();
     let label = ui.label("Export path:");
     ui.add(egui::TextEdit::singleline(&mut export_path).desired_width(f32::INFINITY))
         .labelled_by(label.id);
-    ui.small("GLB, glTF, OBJ or PLY, by extension");
+    ui.small(super::tips::EXPORT_FORMATS);
     ui.horizontal(|ui| {
         if ui
             .button("Export")

@@ -151,10 +151,10 @@ fn start_level_slider(
         (None, false) => Some("Waiting for the hierarchy to be built.".to_owned()),
         (None, true) => None,
     };
-    let slider = ui.add_enabled(
-        level_off.is_none(),
-        egui::Slider::new(&mut level, 0..=top_level).text("Start level"),
-    );
+    // Until the hierarchy is built the range reaches the level, which is shown, not 0.
+    let top = top_level.max(level);
+    let slider =
+        super::widgets::slider(ui, level_off.is_none(), &mut level, 0..=top, "Start level");
     if explain(slider, tips::START_LEVEL, level_off.as_deref()).changed() {
         commands.push(Command::SetLevel(level));
     }

@@ -14,8 +14,6 @@ pub(super) fn hierarchy_section(
     let Some(document) = view.document else {
         return 0;
     };
-    ui.separator();
-    ui.heading("Hierarchy");
     let mut top_level = 0;
     match &document.hierarchy {
         HierarchyState::Building => {

@@ -65,10 +65,10 @@ impl App {
     }
 
     /// The keys without modifiers: F fit view, W wireframe, B before/after, H heat map,
-    /// P paint, S shading (Flat / Smooth).
+    /// P paint, S shading (Flat / Smooth), C clay.
     fn plain_key_toggles(&mut self, ctx: &egui::Context) {
         let plain = |i: &egui::InputState, key| i.key_pressed(key) && i.modifiers.is_none();
-        let (fit, wire, before, heat, paint, shading) = ctx.input(|i| {
+        let (fit, wire, before, heat, paint, shading, clay) = ctx.input(|i| {
             (
                 plain(i, egui::Key::F),
                 plain(i, egui::Key::W),
@@ -76,8 +76,12 @@ impl App {
                 plain(i, egui::Key::H),
                 plain(i, egui::Key::P),
                 plain(i, egui::Key::S),
+                plain(i, egui::Key::C),
             )
         });
+        if clay {
+            self.settings.clay = !self.settings.clay;
+        }
         if paint {
             self.paint_mode = !self.paint_mode;
             if !self.paint_mode {

@@ -12,8 +12,6 @@ pub(super) fn mesh_section(ui: &mut egui::Ui, view: &PanelView) {
     let Some(document) = view.document else {
         return;
     };
-    ui.separator();
-    ui.heading("Mesh");
     let name = document
         .path
         .file_name()
@@ -59,9 +57,8 @@ pub(super) fn mesh_section(ui: &mut egui::Ui, view: &PanelView) {
 
 /// Sigma, seed and direction of the noise, and the button that adds it.
 pub(super) fn noise_section(ui: &mut egui::Ui, settings: &mut Settings, commands: &mut Commands) {
-    ui.separator();
-    ui.heading("Noise");
-    ui.add(egui::Slider::new(&mut settings.noise_sigma, 0.0..=2.0).text("Sigma (× mean edge)"))
+    let sigma = &mut settings.noise_sigma;
+    super::widgets::slider(ui, true, sigma, 0.0..=2.0, "Sigma (× mean edge)")
         .on_hover_text(tips::NOISE_SIGMA);
     ui.horizontal(|ui| {
         let label = ui.label("Seed").on_hover_text(tips::NOISE_SEED);

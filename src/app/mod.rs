@@ -12,6 +12,8 @@
 //!   fairing, measure, export), each holding its launch and the handling of its result;
 //! - [`jobs`]: worker threads, generation numbers, job results;
 //! - `view_sync.rs`: keeps the viewports' GPU buffers in step with what should be shown;
+//!   `appearance.rs`: the loaded file's materials, textures and colours as the viewport draws
+//!   them;
 //! - [`panels`]: the window's layout, placing the sections; each section reads the app's state
 //!   through a `PanelView` (`panel_view.rs`), edits the [`state::Settings`] in place and emits
 //!   [`Command`]s, applied after the frame. The sections: `toolbar.rs`, `status_bar.rs`,
@@ -36,6 +38,7 @@
 //! `fairmesh-upload` thread for big meshes. Loading another file cancels the hierarchy build and
 //! fairing of the previous one through their generation numbers.
 
+mod appearance;
 pub mod camera;
 mod command;
 mod confirm_replace;
@@ -74,6 +77,7 @@ pub use frame_stats::FrameStats;
 pub use launch::{run, AppOptions};
 pub use status::AppStatus;
 pub use view_sync::Slot;
+pub use viewport_panel::COMPUTING;
 
 use std::path::PathBuf;
 use std::sync::mpsc::{Receiver, Sender};
@@ -141,6 +145,13 @@ pub struct App {
     shown_before: Option<Shown>,
     /// Largest heat-map scalar uploaded per slot (the legend's and the colour map's top).
     heat_max: [Option<f32>; 2],
+    /// The file's colours as the viewport draws them, made once per loaded file (keyed by its
+    /// [`crate::io::Source`], held so that it is never mistaken for another); `None` inside when
+    /// the file has none.
+    appearance: Option<(
+        Arc<crate::io::Source>,
+        Option<Arc<crate::render::appearance::Appearance>>,
+    )>,
     /// The single view shows "before" instead of "after" (toggled with B).
     show_before: bool,
     shown_counts: (usize, usize),

@@ -5,6 +5,7 @@
 
 use super::panel_view::PanelView;
 use super::state::{Document, FairedResult, HierarchyState, Measures, MethodChoice};
+use super::tips::{FARTHER_THAN_NOISE, NOISE_ROW, ROW_TIPS};
 use super::widgets::seconds;
 
 /// What a greyed number in the Numbers panel means.
@@ -61,13 +62,33 @@ fn measures(ui: &mut egui::Ui, view: &PanelView) {
             ui.end_row();
             measure_rows(ui, document);
             if let Some(noise) = &document.against_clean {
-                ui.label("Noise");
+                ui.label("Noise").on_hover_text(NOISE_ROW);
                 ui.label(format!("{:.3e}", noise.mean_distance))
-                    .on_hover_text("Mean distance of the input mesh from the clean mesh");
+                    .on_hover_text(NOISE_ROW);
                 ui.end_row();
             }
         });
     ui.small("Distances in model units.");
+    if farther_than_noise(document) {
+        ui.label(
+            egui::RichText::new("Farther from clean than the noise was (point here for why)")
+                .small()
+                .color(ui.visuals().warn_fg_color),
+        )
+        .on_hover_text(FARTHER_THAN_NOISE);
+    }
+}
+
+/// Whether the result, measured, is farther from the clean mesh than the input mesh is.
+fn farther_than_noise(document: &Document) -> bool {
+    let faired = document.faired.as_ref().filter(|f| !f.measures_pending);
+    match (
+        faired.and_then(|f| f.against_clean.as_ref()),
+        &document.against_clean,
+    ) {
+        (Some(result), Some(noise)) => result.mean_distance > noise.mean_distance,
+        _ => false,
+    }
 }
 
 /// One grid row per entry of [`ROWS`]: the result against the input and, after noise, against
@@ -86,8 +107,8 @@ fn measure_rows(ui: &mut egui::Ui, document: &Document) {
             label.on_hover_text(PENDING_TIP);
         }
     };
-    for (name, row) in ROWS {
-        ui.label(name);
+    for ((name, row), (_, tip)) in ROWS.into_iter().zip(ROW_TIPS) {
+        ui.label(name).on_hover_text(tip);
         match faired.and_then(|f| fresh(name, f, diagonal)) {
             Some((text, tip)) if tip.is_empty() => {
                 ui.label(text);

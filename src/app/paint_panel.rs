@@ -16,8 +16,6 @@ pub(super) fn section(
     settings: &mut Settings,
     commands: &mut Commands,
 ) {
-    ui.separator();
-    ui.heading("Paint where to fair");
     let level_view = settings.view_mode == ViewMode::Level;
     let mut paint_mode = view.paint_mode;
     let paint = ui
@@ -43,9 +41,15 @@ pub(super) fn section(
         ui.selectable_value(&mut brush.erase, true, "Erase")
             .on_hover_text(tips::BRUSH_ERASE);
     });
-    ui.add(egui::Slider::new(&mut brush.radius, 4.0..=200.0).text("Brush radius (pt)"))
-        .on_hover_text(tips::BRUSH_RADIUS);
-    ui.add(egui::Slider::new(&mut brush.softness, 0.0..=1.0).text("Soft edge"))
+    super::widgets::slider(
+        ui,
+        true,
+        &mut brush.radius,
+        4.0..=200.0,
+        "Brush radius (pt)",
+    )
+    .on_hover_text(tips::BRUSH_RADIUS);
+    super::widgets::slider(ui, true, &mut brush.softness, 0.0..=1.0, "Soft edge")
         .on_hover_text(tips::BRUSH_SOFTNESS);
     ui.checkbox(&mut brush.show_mask, "Show mask")
         .on_hover_text(tips::SHOW_MASK);

@@ -100,6 +100,8 @@ pub struct ViewportView<'a> {
     pub heat_legend: Option<(f32, HeatReference)>,
     /// How each slot's image is coloured (indexed by [`Slot`]).
     pub looks: [SlotLook; 2],
+    /// The main view shows an older picture than the one being computed.
+    pub main_behind: bool,
     /// Draw the kept sharp edges over the mesh until then.
     pub sharp_edges_shown_until: Option<Instant>,
 }
@@ -154,6 +156,7 @@ impl App {
             capturing_view: self.capturing_view,
             heat_legend,
             looks,
+            main_behind: self.main_view_behind(),
             sharp_edges_shown_until: self.sharp_edges_shown_until,
         };
         let mut state = ViewportState {

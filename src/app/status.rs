@@ -37,6 +37,16 @@ pub struct AppStatus {
     /// A viewport is drawing a new image over several frames (a big mesh on a software
     /// renderer); the view shows the one before it.
     pub drawing: bool,
+    /// The faired result whose shape the main view shows (its serial), if it shows one.
+    pub shown_serial: Option<u64>,
+    /// The main view colours its mesh with a heat map: that mesh's own distances.
+    pub heat_shown: bool,
+    /// The main view tints the painted mask over its mesh.
+    pub mask_shown: bool,
+    /// The main view's picture is older than the one being computed ("computing…").
+    pub view_behind: bool,
+    /// The main view's caption (in the single view, unless it shows "Before").
+    pub caption: String,
     /// Sharp edges the current hierarchy keeps (0 without "Keep sharp edges").
     pub sharp_edges_kept: usize,
     /// Sharp edges drawn over the mesh in the last frame (while their controls are pointed at).
@@ -136,6 +146,18 @@ impl App {
             message: self.message.clone(),
             images_drawn: self.viewport.as_ref().map_or(0, Viewport3d::images_drawn),
             drawing: self.drawing(),
+            shown_serial: self.shown.and_then(|s| match s.what {
+                super::view_sync::ShownMesh::Faired { serial } => Some(serial),
+                _ => None,
+            }),
+            heat_shown: self.shown.is_some_and(|s| s.heat.is_some())
+                && self.slot_look(super::Slot::Main).scalar_range.is_some(),
+            mask_shown: self.shown.is_some_and(|s| s.mask.is_some()),
+            view_behind: self.main_view_behind(),
+            caption: super::viewport_panel::main_caption(
+                self.settings.view_mode,
+                self.main_view_behind(),
+            ),
             sharp_edges_kept: document.map_or(0, |d| match &d.hierarchy {
                 HierarchyState::Ready { hierarchy, .. } => hierarchy.crease_edge_count(),
                 _ => 0,

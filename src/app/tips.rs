@@ -70,11 +70,56 @@ pub const BRUSH_RADIUS: &str = "Size of the brush on screen, in points. Zoom in 
     finer detail.";
 pub const BRUSH_SOFTNESS: &str = "How much of the brush's edge fades out. Higher: the \
     smoothing blends gently into the untouched part; 0: a hard edge.";
-pub const SHOW_MASK: &str = "Tint the painted part orange on the mesh (it replaces the \
-    heat map while shown).";
+pub const SHOW_MASK: &str = "Tint the painted part orange on the mesh (over the heat map, \
+    only its edge is drawn, so the map's colours stay true).";
 pub const CLEAR_MASK: &str = "Remove the paint: the whole mesh is smoothed again (undo \
     with Ctrl+Z).";
 pub const INVERT_MASK: &str = "Smooth what was left alone and keep what was painted \
     (undo with Ctrl+Z).";
 pub const APPLY: &str = "Make the result the input mesh, to add noise to it, fair it \
     again or export it as it is (undo with Ctrl+Z).";
+
+// The Numbers section.
+
+/// What each row of the measures grid means (its name's tooltip), in the rows' order.
+pub const ROW_TIPS: [(&str, &str); 5] = [
+    (
+        "Volume change",
+        "How much the volume the surface encloses changed, in percent. Smoothers that shrink \
+         the mesh show it here; constrained fairing keeps it near 0.",
+    ),
+    (
+        "Mean distance",
+        "How far the result's surface lies from the other mesh's surface, on average over \
+         the area, measured both ways. In model units.",
+    ),
+    (
+        "Max distance",
+        "The farthest any point of one surface lies from the other (the Hausdorff \
+         distance): where the result changed most. In model units.",
+    ),
+    (
+        "RMS displacement",
+        "How far the vertices moved, as a root mean square over all vertices. In model units.",
+    ),
+    (
+        "Barycenter drift",
+        "How far the mesh's centre (the mean of its vertices) moved. Near 0 when the \
+         smoothing does not push the mesh one way. In model units.",
+    ),
+];
+
+/// Said when the result is farther from the clean mesh than the input mesh (the noise) was.
+pub const FARTHER_THAN_NOISE: &str = "The result is farther from the clean mesh than the \
+    noisy input is. The clean mesh is the input as it was before noise was added: if that \
+    file was noisy or detailed already, the fairing smooths its own bumps too, and those \
+    count as distance. Lower the start level to keep more detail.";
+
+/// What the Noise row says.
+pub const NOISE_ROW: &str = "Mean distance of the input mesh from the clean mesh: how far the \
+    noise moved the surface. A good result comes back closer to clean than this.";
+
+// The Export section.
+
+/// The formats Export writes, as the README lists them.
+pub const EXPORT_FORMATS: &str = "GLB, glTF, OBJ, PLY, STL or OFF, by extension";

@@ -20,6 +20,10 @@ pub mod tips {
     pub const STUDIO: &str = "On: a warm key light, a cool fill light and a rim light along \
         the outline, with a soft highlight: uneven spots show as kinks in the highlight. Off: \
         one plain light from above left of you";
+    pub const CLAY: &str = "On: every surface in one plain clay colour, to judge the shape \
+        alone. Off: the file's own colours (its materials' colours and textures, its vertex \
+        colours), so you see what the smoothing does to them: a texture moves with the \
+        surface. C switches it";
     pub const HEAT_INPUT: &str = "Colour by distance from the input mesh: how far the result \
         moved";
     pub const HEAT_CLEAN: &str = "Colour by distance from the clean mesh (before noise was \
@@ -69,6 +73,9 @@ fn heat_rows(
         .then(|| commands.push(Command::Panel(PanelChange::ToggleBefore)));
         ui.checkbox(&mut settings.heat_map, "Heat map (H)")
             .on_hover_text("Colour each vertex by its distance from the reference mesh (H)");
+        // On the heat map's row (it colours the surface too), so the panel keeps its width.
+        ui.checkbox(&mut settings.clay, CLAY)
+            .on_hover_text(tips::CLAY);
     });
     // The reference only while the heat map is on: the panel below stays a row higher, so
     // Export fits an 800-point-high window.
@@ -124,6 +131,9 @@ fn look_rows(ui: &mut egui::Ui, settings: &mut Settings) {
         }
     });
 }
+
+/// The control that leaves the file's colours out.
+pub const CLAY: &str = "Clay (C)";
 
 /// The lighting control's label.
 pub const STUDIO_LIGHTING: &str = "Studio lighting";

@@ -10,22 +10,25 @@ use crate::app::state::{
 };
 use crate::app::App;
 use crate::hierarchy;
+use crate::render::appearance::Appearance;
 use crate::render::{DrawParams, MeshSource, Viewport3d};
 use crate::TriMesh;
 
-/// What the viewport has uploaded, to know when to upload again.
+/// What a viewport has uploaded, to know when to upload again: one record per viewport, so
+/// that its shape, its heat map and its mask tint are always of one result.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub(in crate::app) struct Shown {
     pub(in crate::app) document: u64,
     pub(in crate::app) what: ShownMesh,
-    /// The heat map's reference, when the heat map is on.
+    /// The heat map's reference, when the scalars on the GPU are `what`'s own distances from
+    /// it (never another result's).
     pub(in crate::app) heat: Option<HeatReference>,
-    /// The painted mask's revision, when it is tinted over the mesh (instead of a heat map).
+    /// The painted mask's revision, when its weights are tinted over the mesh.
     pub(in crate::app) mask: Option<u64>,
 }
 
 /// How one viewport's image is coloured, apart from the camera and the settings: the heat map's
-/// range or the painted mask's tint (see [`App::slot_look`]).
+/// range and the painted mask's tint (see [`App::slot_look`]).
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub(in crate::app) struct SlotLook {
     pub(in crate::app) scalar_range: Option<[f32; 2]>,
@@ -52,6 +55,7 @@ impl SlotLook {
             wireframe: settings.wireframe,
             scalar_range: self.scalar_range,
             mask_tint: self.mask_tint,
+            clay: settings.clay,
             size: [0, 0],
         }
     }
@@ -84,13 +88,15 @@ impl ShownMesh {
     }
 }
 
-/// The heat map's top: the 99th percentile of the distances, so a few outliers do not turn the
-/// rest of the mesh into the map's darkest colour (larger values take the top colour).
+/// The heat map's top: the 99th percentile of the distances above zero, so a few outliers do
+/// not turn the rest of the mesh into the map's darkest colour (larger values take the top
+/// colour), and a result faired under a small painted mask (the rest did not move) gets a
+/// range from the part that moved.
 pub(in crate::app) fn heat_map_top(distances: &[f32]) -> f32 {
     let mut finite: Vec<f32> = distances
         .iter()
         .copied()
-        .filter(|d| d.is_finite())
+        .filter(|d| d.is_finite() && *d > 0.0)
         .collect();
     if finite.is_empty() {
         return 0.0;
@@ -107,21 +113,25 @@ fn view_mesh(
     document: &Document,
     what: ShownMesh,
     base: Option<(Arc<hierarchy::Hierarchy>, bool)>,
+    appearance: Option<Arc<Appearance>>,
 ) -> Option<ViewMesh> {
     Some(match what {
         ShownMesh::Original => ViewMesh {
             connectivity: SharedMesh::Mesh(document.original.clone()),
             positions: None,
+            appearance,
         },
         ShownMesh::Faired { .. } => {
             let faired = document.faired.as_ref()?;
-            let connectivity = match base {
-                Some((hierarchy, false)) => SharedMesh::Base(hierarchy),
-                _ => SharedMesh::Mesh(document.original.clone()),
+            // The file's colours need its triangles: M0 without its loose triangles has others.
+            let (connectivity, appearance) = match base {
+                Some((hierarchy, false)) => (SharedMesh::Base(hierarchy), None),
+                _ => (SharedMesh::Mesh(document.original.clone()), appearance),
             };
             ViewMesh {
                 connectivity,
                 positions: Some(faired.positions.clone()),
+                appearance,
             }
         }
         ShownMesh::Level { .. } => {
@@ -129,6 +139,7 @@ fn view_mesh(
             ViewMesh {
                 connectivity: SharedMesh::Mesh(mesh.clone()),
                 positions: None,
+                appearance: None,
             }
         }
     })
@@ -156,6 +167,8 @@ impl SharedMesh {
 pub(in crate::app) struct ViewMesh {
     pub(in crate::app) connectivity: SharedMesh,
     pub(in crate::app) positions: Option<Arc<Vec<[f32; 3]>>>,
+    /// The file's colours over these triangles (the document's), when it has any.
+    pub(in crate::app) appearance: Option<Arc<Appearance>>,
 }
 
 impl MeshSource for ViewMesh {
@@ -167,6 +180,9 @@ impl MeshSource for ViewMesh {
     }
     fn triangles(&self) -> &[[u32; 3]] {
         &self.connectivity.mesh().triangles
+    }
+    fn appearance(&self) -> Option<Arc<Appearance>> {
+        self.appearance.clone()
     }
 }
 
@@ -190,12 +206,13 @@ impl App {
 
     /// What a viewport should show now: for the main one the view mode's mesh when it exists,
     /// otherwise the last good mesh of this document, otherwise the loaded mesh; for the before
-    /// one the document's mesh.
+    /// one the document's mesh. With the heat map on, a result whose distances are still being
+    /// measured waits: the view keeps the picture before it, shape and colours together (see
+    /// [`Self::main_view_behind`]).
     pub(super) fn wanted_mesh(&self, slot: Slot) -> Option<Shown> {
         let document = self.document.as_ref()?;
         let mask = self.mask_tint();
-        // The tint and the heat map share the mesh's scalars: the mask wins while it is shown.
-        let heat = self.heat_reference().filter(|_| mask.is_none());
+        let heat = self.heat_reference();
         if slot == Slot::Before {
             return Some(Shown {
                 document: document.generation,
@@ -204,11 +221,34 @@ impl App {
                 mask,
             });
         }
-        let previous = self
-            .shown
-            .filter(|s| s.document == document.generation)
-            .map(|s| s.what);
-        let what = match self.settings.view_mode {
+        let previous = self.shown.filter(|s| s.document == document.generation);
+        let what = self.newest_mesh(document, previous.map(|s| s.what));
+        // A level mesh has other vertices than the mask's.
+        let mask = mask.filter(|_| !matches!(what, ShownMesh::Level { .. }));
+        let mut wanted = Shown {
+            document: document.generation,
+            what,
+            heat,
+            mask,
+        };
+        if let Some(reference) = heat {
+            if !matches!(what, ShownMesh::Level { .. })
+                && self.heat_scalars(what, reference).is_none()
+            {
+                match previous {
+                    // The picture on screen with its own colours, until these are measured.
+                    Some(kept) if kept.heat == heat => wanted.what = kept.what,
+                    _ => wanted.heat = None,
+                }
+            }
+        }
+        Some(wanted)
+    }
+
+    /// The mesh the main view's mode asks for, as far as it is computed: the newest result, the
+    /// level mesh (or `previous` until one exists), the input mesh.
+    fn newest_mesh(&self, document: &Document, previous: Option<ShownMesh>) -> ShownMesh {
+        match self.settings.view_mode {
             ViewMode::Original => ShownMesh::Original,
             ViewMode::Faired => match &document.faired {
                 Some(faired) => ShownMesh::Faired {
@@ -220,18 +260,41 @@ impl App {
                 Some((level, _)) => ShownMesh::Level { level: *level },
                 None => previous.unwrap_or(ShownMesh::Original),
             },
+        }
+    }
+
+    /// Whether the main view shows an older picture than the one being computed (the input
+    /// while the first result is computed, the previous result while the next one is faired or
+    /// measured for the heat map, the previous level): its caption says "computing…".
+    pub(super) fn main_view_behind(&self) -> bool {
+        let Some(document) = &self.document else {
+            return false;
         };
-        let mask = mask.filter(|_| !matches!(what, ShownMesh::Level { .. }));
-        Some(Shown {
-            document: document.generation,
-            what,
-            heat,
-            mask,
-        })
+        let shown = self.shown.filter(|s| s.document == document.generation);
+        match self.settings.view_mode {
+            ViewMode::Original => shown.is_none_or(|s| s.what != ShownMesh::Original),
+            ViewMode::Level => {
+                matches!(document.hierarchy, HierarchyState::Building)
+                    || document.level_mesh.as_ref().is_none_or(|(level, _)| {
+                        *level != document.level
+                            || shown.is_none_or(|s| s.what != ShownMesh::Level { level: *level })
+                    })
+            }
+            ViewMode::Faired => {
+                let newest = self.newest_mesh(document, None);
+                let heat_waits = self.heat_reference().is_some()
+                    && shown.is_some_and(|s| s.heat != self.heat_reference());
+                self.fair_in_flight
+                    || matches!(document.hierarchy, HierarchyState::Building)
+                    || shown.is_none_or(|s| s.what != newest)
+                    || heat_waits
+            }
+        }
     }
 
     /// Distance of each vertex of `what` from the heat map's reference (`None`: no heat map for
-    /// that mesh, as for level meshes, or not computed yet).
+    /// that mesh, as for level meshes, or not measured yet: a result's distances are its own or
+    /// none, never the previous result's).
     pub(super) fn heat_scalars(
         &self,
         what: ShownMesh,
@@ -239,8 +302,11 @@ impl App {
     ) -> Option<Arc<Vec<f32>>> {
         let document = self.document.as_ref()?;
         match what {
-            ShownMesh::Faired { .. } => {
-                let faired = document.faired.as_ref()?;
+            ShownMesh::Faired { serial } => {
+                let faired = document
+                    .faired
+                    .as_ref()
+                    .filter(|f| f.serial == serial && !f.measures_pending)?;
                 let measures = match reference {
                     HeatReference::Clean => faired.against_clean.as_ref(),
                     HeatReference::Document => faired.against_document.as_ref(),
@@ -284,21 +350,45 @@ impl App {
             shown.is_none_or(|s| (s.document, s.what) != (wanted.document, wanted.what));
         let mut counts = None;
         if mesh_changed {
+            self.make_appearance();
             let Some(uploaded) = self.upload_mesh(slot, shown, wanted) else {
                 return;
             };
             counts = Some(uploaded);
         }
-        self.heat_max[slot as usize] = self.upload_tint(slot, wanted);
+        // New buffers start with zero scalars and weights: both are written again.
+        let mut uploaded = wanted;
+        if mesh_changed || shown.is_none_or(|s| s.heat != wanted.heat) {
+            self.heat_max[slot as usize] = self.upload_heat(slot, wanted);
+            // Scalars that are not there yet are asked for again next frame.
+            if self.heat_max[slot as usize].is_none() {
+                uploaded.heat = None;
+            }
+        }
+        if mesh_changed || shown.is_none_or(|s| s.mask != wanted.mask) {
+            self.upload_mask(slot, wanted);
+        }
         match slot {
             Slot::Main => {
                 if let Some(counts) = counts {
                     self.shown_counts = counts;
                 }
-                self.shown = Some(wanted);
+                self.shown = Some(uploaded);
             }
-            Slot::Before => self.shown_before = Some(wanted),
+            Slot::Before => self.shown_before = Some(uploaded),
         }
+    }
+
+    /// Makes the document's file's colours for the viewport, once per loaded file.
+    fn make_appearance(&mut self) {
+        let Some(document) = &self.document else {
+            return;
+        };
+        if (self.appearance.as_ref()).is_some_and(|(s, _)| Arc::ptr_eq(s, &document.source)) {
+            return;
+        }
+        let appearance = super::appearance::appearance_of(&document.source, &document.original);
+        self.appearance = Some((document.source.clone(), appearance.map(Arc::new)));
     }
 
     /// The slot's renderer handle, when there is a wgpu renderer.
@@ -332,7 +422,8 @@ impl App {
             shown.document == wanted.document
                 && shown.what.connectivity(matches) == wanted.what.connectivity(matches)
         });
-        let source = view_mesh(document, wanted.what, base)?;
+        let appearance = self.appearance.as_ref().and_then(|(_, a)| a.clone());
+        let source = view_mesh(document, wanted.what, base, appearance)?;
         let counts = (source.positions().len(), source.triangles().len());
         if let Some(viewport) = self.slot_viewport(slot) {
             let source: Arc<dyn MeshSource> = Arc::new(source);
@@ -343,25 +434,25 @@ impl App {
         Some(counts)
     }
 
-    /// Uploads what the wanted view tints the mesh with: the heat map's scalars or the painted
-    /// mask's weights. The heat map's top when its scalars went up.
-    fn upload_tint(&self, slot: Slot, wanted: Shown) -> Option<f32> {
+    /// Uploads the wanted view's heat-map scalars (the shown mesh's own distances); the heat
+    /// map's top, or `None` when there is no heat map or its scalars are not there yet.
+    fn upload_heat(&self, slot: Slot, wanted: Shown) -> Option<f32> {
         let viewport = self.slot_viewport(slot);
-        let mut heat_max = None;
-        if let Some(reference) = wanted.heat {
-            if let Some(scalars) = self.heat_scalars(wanted.what, reference) {
-                if viewport.is_none_or(|v| v.set_scalars(&scalars)) {
-                    heat_max = Some(heat_map_top(&scalars));
-                }
-            }
+        let scalars = self.heat_scalars(wanted.what, wanted.heat?)?;
+        viewport
+            .is_none_or(|v| v.set_scalars(&scalars))
+            .then(|| heat_map_top(&scalars))
+    }
+
+    /// Uploads the painted mask's weights when the wanted view tints them.
+    fn upload_mask(&self, slot: Slot, wanted: Shown) {
+        if wanted.mask.is_none() {
+            return;
         }
-        if wanted.mask.is_some() {
-            let mask = self.document.as_ref().and_then(|d| d.mask.as_ref());
-            if let (Some(mask), Some(viewport)) = (mask, viewport) {
-                viewport.set_scalars(mask.weights());
-            }
+        let mask = self.document.as_ref().and_then(|d| d.mask.as_ref());
+        if let (Some(mask), Some(viewport)) = (mask, self.slot_viewport(slot)) {
+            viewport.set_mask(mask.weights());
         }
-        heat_max
     }
 
     /// The heat map's top value for the slots on screen (shared, so the colours compare).
@@ -399,7 +490,8 @@ impl App {
             .draw_params(&self.camera, &self.settings, rect)
     }
 
-    /// How a viewport's image is coloured now (the heat map's range, or the mask's tint).
+    /// How a viewport's image is coloured now (the heat map's range, the mask's tint): from
+    /// what the viewport has uploaded, so the colours are always those of the shape shown.
     pub(super) fn slot_look(&self, slot: Slot) -> SlotLook {
         let top = self.heat_top();
         let scalar_range = self.heat_max[slot as usize].and(top).map(|top| [0.0, top]);
@@ -407,7 +499,7 @@ impl App {
             Slot::Main => self.shown,
             Slot::Before => self.shown_before,
         };
-        let mask_tint = scalar_range.is_none() && shown.is_some_and(|s| s.mask.is_some());
+        let mask_tint = shown.is_some_and(|s| s.mask.is_some());
         SlotLook {
             scalar_range,
             mask_tint,

@@ -105,6 +105,23 @@ fn camera_input(
     }
 }
 
+/// What a view's caption adds while its picture is the previous one.
+pub const COMPUTING: &str = "computing…";
+
+/// The main view's caption in `mode`; `behind`: its picture is the previous one until the new
+/// one is computed (and measured, for the heat map), and the caption says so.
+pub fn main_caption(mode: ViewMode, behind: bool) -> String {
+    let name = match mode {
+        ViewMode::Faired => "After (faired)",
+        ViewMode::Level => "Level mesh",
+        ViewMode::Original => "Input mesh",
+    };
+    match behind {
+        true => format!("{name}: {COMPUTING}"),
+        false => name.to_owned(),
+    }
+}
+
 fn caption(painter: &egui::Painter, at: egui::Pos2, align: egui::Align2, text: &str) {
     painter.text(
         at,
@@ -124,11 +141,7 @@ fn draw_views(
     rect: egui::Rect,
     divider_x: f32,
 ) {
-    let after_name = match settings.view_mode {
-        ViewMode::Faired => "After (faired)",
-        ViewMode::Level => "Level mesh",
-        ViewMode::Original => "Input mesh",
-    };
+    let after_name = &main_caption(settings.view_mode, view.main_behind);
     let top_left = |r: egui::Rect| r.left_top() + egui::vec2(10.0, 8.0);
     let params = |state: &ViewportState, rect: egui::Rect, slot: Slot| {
         view.looks[slot as usize].draw_params(state.camera, settings, rect)

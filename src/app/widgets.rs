@@ -1,5 +1,5 @@
 //! Small widgets and formats the editor's panels share: the activity spinner beside work in
-//! progress and durations in seconds. Imports no panel, so that every panel can use it.
+//! progress, durations in seconds and a slider that takes taps and keyboard focus. Imports no panel, so that every panel can use it.
 
 /// A turning arc beside work in progress, like egui's spinner but without asking for a frame
 /// of its own: it moves when the app repaints for the work's progress (every 50 ms, or 250 ms on
@@ -29,4 +29,57 @@ pub(super) fn activity_spinner(ui: &mut egui::Ui) {
 /// A duration as the Numbers and the panels show it: seconds, three decimals.
 pub(super) fn seconds(duration: std::time::Duration) -> String {
     format!("{:.3} s", duration.as_secs_f64())
+}
+
+/// A slider over `value` in `range` that also takes a quick tap: a press and release within one
+/// frame (a touchpad tap) sets the value under the pointer, which egui's slider alone ignores
+/// (it moves only while the button is seen down). A press on it gives it keyboard focus, so the
+/// arrow keys step it next.
+pub(super) fn slider<N: egui::emath::Numeric>(
+    ui: &mut egui::Ui,
+    enabled: bool,
+    value: &mut N,
+    range: std::ops::RangeInclusive<N>,
+    text: &str,
+) -> egui::Response {
+    let (low, high) = (range.start().to_f64(), range.end().to_f64());
+    let mut response = ui.add_enabled(enabled, egui::Slider::new(value, range).text(text));
+    if !enabled {
+        return response;
+    }
+    // The rail is the left part of the response (the number field follows it), as tall as a
+    // row; the handle's centre stays a handle's radius inside its ends.
+    let thickness = ui
+        .text_style_height(&egui::TextStyle::Body)
+        .max(ui.spacing().interact_size.y);
+    let rail = egui::Rect::from_min_size(
+        response.rect.min,
+        egui::vec2(ui.spacing().slider_width, thickness),
+    );
+    let tap = ui.input(|i| {
+        i.pointer.primary_clicked()
+            && i.pointer
+                .interact_pos()
+                .filter(|p| rail.contains(*p))
+                .is_some()
+    });
+    if tap && response.hovered() {
+        if let Some(pointer) = ui.input(|i| i.pointer.interact_pos()) {
+            let ends = rail.x_range().shrink(thickness / 2.5);
+            let fraction = ((pointer.x - ends.min) / ends.span().max(1.0)).clamp(0.0, 1.0);
+            let mut picked = low + f64::from(fraction) * (high - low);
+            if N::INTEGRAL {
+                picked = picked.round();
+            }
+            let picked = N::from_f64(picked);
+            if picked != *value {
+                *value = picked;
+                response.mark_changed();
+            }
+        }
+    }
+    if tap && response.hovered() || response.drag_started() {
+        response.request_focus();
+    }
+    response
 }

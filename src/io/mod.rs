@@ -33,7 +33,7 @@ mod ply;
 mod report;
 mod save;
 mod save_source;
-mod scene;
+pub(crate) mod scene;
 mod source;
 mod stl;
 mod text;

@@ -95,6 +95,56 @@ pub(crate) struct Material {
     pub metallic: f32,
     pub roughness: f32,
     pub texture: Option<Image>,
+    /// How the base colour texture is sampled (a glTF texture's sampler; defaults otherwise).
+    pub sampler: TextureSampler,
+}
+
+/// How a texture is sampled, as a glTF sampler says (an MTL says nothing: the defaults).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct TextureSampler {
+    /// Magnified texels blend (LINEAR) or stay sharp squares (NEAREST).
+    pub mag_linear: bool,
+    /// Minified texels blend (LINEAR, or a *_MIPMAP_* filter's own choice between texels).
+    pub min_linear: bool,
+    /// How texture coordinates outside 0..1 wrap, along u (wrapS) and v (wrapT).
+    pub wrap: [TextureWrap; 2],
+}
+
+impl Default for TextureSampler {
+    /// glTF's defaults where a sampler leaves a field out: linear filters, repeat.
+    fn default() -> Self {
+        TextureSampler {
+            mag_linear: true,
+            min_linear: true,
+            wrap: [TextureWrap::Repeat; 2],
+        }
+    }
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum TextureWrap {
+    Repeat,
+    MirroredRepeat,
+    ClampToEdge,
+}
+
+impl TextureSampler {
+    /// A glTF `samplers[]` entry (its GL enum values).
+    pub(crate) fn from_gltf(sampler: &serde_json::Value) -> TextureSampler {
+        let number = |key: &str| sampler.get(key).and_then(serde_json::Value::as_u64);
+        let wrap = |key: &str| match number(key) {
+            Some(33071) => TextureWrap::ClampToEdge,
+            Some(33648) => TextureWrap::MirroredRepeat,
+            _ => TextureWrap::Repeat,
+        };
+        TextureSampler {
+            // 9728 NEAREST; 9984 NEAREST_MIPMAP_NEAREST and 9986 NEAREST_MIPMAP_LINEAR pick
+            // the nearest texel within a level.
+            mag_linear: number("magFilter") != Some(9728),
+            min_linear: !matches!(number("minFilter"), Some(9728 | 9984 | 9986)),
+            wrap: [wrap("wrapS"), wrap("wrapT")],
+        }
+    }
 }
 
 #[derive(Debug, Clone)]
@@ -407,6 +457,7 @@ impl Scene {
                     metallic: m.metallic,
                     roughness: m.roughness,
                     texture: m.texture.clone(),
+                    sampler: m.sampler,
                 })
                 .collect(),
             ..Scene::default()
@@ -582,5 +633,24 @@ mod tests {
         scene.drop_degenerate();
         assert_eq!(scene.parts[0].primitives.len(), 1);
         assert_eq!(scene.parts[0].primitives[0].triangles, vec![[0, 1, 4]]);
+    }
+
+    #[test]
+    fn a_gltf_samplers_filters_and_wrapping_are_read() {
+        let sampler = |json: &str| TextureSampler::from_gltf(&serde_json::from_str(json).unwrap());
+        assert_eq!(sampler("{}"), TextureSampler::default());
+        let pixel_art =
+            sampler(r#"{"magFilter": 9728, "minFilter": 9984, "wrapS": 33071, "wrapT": 33648}"#);
+        assert_eq!(
+            pixel_art,
+            TextureSampler {
+                mag_linear: false,
+                min_linear: false,
+                wrap: [TextureWrap::ClampToEdge, TextureWrap::MirroredRepeat],
+            }
+        );
+        let smooth = sampler(r#"{"magFilter": 9729, "minFilter": 9987, "wrapS": 10497}"#);
+        assert!(smooth.mag_linear && smooth.min_linear);
+        assert_eq!(smooth.wrap, [TextureWrap::Repeat; 2]);
     }
 }

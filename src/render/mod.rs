@@ -5,10 +5,11 @@
 //! the callback's `prepare` step, and that texture is shown as an ordinary egui image. So the
 //! mesh gets a depth buffer whatever egui's own render pass has (eframe without `depth_buffer`,
 //! or egui_kittest's single-sample pass with none), and the same code runs in the window and in
-//! headless tests. The renderer takes positions, triangles and (through `set_scalars`)
-//! per-vertex scalars, and knows nothing of fairing. It computes the vertex normals smooth
-//! shading needs itself ([`normals`]); [`shading`] names the shading and lighting choices.
+//! headless tests. The renderer takes positions, triangles, (through `set_scalars`) per-vertex
+//! heat-map scalars and (through `set_mask`) the painted mask's weights, and knows nothing of
+//! fairing. It computes the vertex normals smooth shading needs itself ([`normals`]); [`shading`] names the shading and lighting choices.
 
+pub mod appearance;
 pub mod colormap;
 pub mod normals;
 pub mod pipeline;
@@ -126,6 +127,13 @@ impl Viewport3d {
     pub fn set_scalars(&self, scalars: &[f32]) -> bool {
         let queue = &self.state.queue;
         self.with_renderer(|r| r.set_scalars(queue, scalars))
+            .unwrap_or(false)
+    }
+
+    /// Replaces the painted mask's weights; `false` when the count differs.
+    pub fn set_mask(&self, weights: &[f32]) -> bool {
+        let queue = &self.state.queue;
+        self.with_renderer(|r| r.set_mask(queue, weights))
             .unwrap_or(false)
     }
 

@@ -23,10 +23,12 @@ mod upload;
 use std::sync::Arc;
 use std::time::Duration;
 
+use super::appearance::Appearance;
 use super::normals::vertex_normals;
 use super::shading::{Lighting, Shading};
-use buffers::{line_buffer, MeshBuffers};
-use passes::{Part, Pipelines, Target, Uniforms};
+use buffers::MaterialGroup;
+use buffers::{draw_triangles, line_buffer, MeshBuffers};
+use passes::{MaterialKit, Part, Pipelines, Target, Uniforms};
 use upload::{PendingMesh, UploadJob, Uploaded, Uploader};
 
 /// Format of the image the mesh is drawn into (and that egui then samples).
@@ -65,8 +67,12 @@ pub struct DrawParams {
     pub wireframe: bool,
     /// Scalars mapped to the heat map's two ends; `None` draws the plain base colour.
     pub scalar_range: Option<[f32; 2]>,
-    /// Without a heat map: the scalars are a mask (0 to 1), tinted over the base colour.
+    /// Show the mask weights ([`MeshRenderer::set_mask`]): tinted over the base colour, or,
+    /// over a heat map (whose colours must read as its legend says), as an outline.
     pub mask_tint: bool,
+    /// Every surface in the clay colour, the file's materials, textures and vertex colours left
+    /// out (to judge the shape alone).
+    pub clay: bool,
     /// Target size in physical pixels.
     pub size: [u32; 2],
 }
@@ -75,6 +81,10 @@ pub struct DrawParams {
 pub trait MeshSource: Send + Sync + 'static {
     fn positions(&self) -> &[[f32; 3]];
     fn triangles(&self) -> &[[u32; 3]];
+    /// The file's materials, texture coordinates and colours over these triangles, if shown.
+    fn appearance(&self) -> Option<Arc<Appearance>> {
+        None
+    }
 }
 
 /// Meshes whose positions and triangles take fewer bytes than this are uploaded in the calling
@@ -103,6 +113,9 @@ enum PartDrawn {
 
 /// Owns the pipelines, the mesh buffers and the offscreen target. Knows nothing of fairing.
 pub struct MeshRenderer {
+    /// The materials' bind group layout (shared by both samplings' pipelines) and the group of
+    /// "no material".
+    materials: MaterialKit,
     pipelines: Pipelines,
     /// The same pipelines for a target without multisampling (made when first needed).
     single_sample: Option<Pipelines>,
@@ -141,6 +154,10 @@ pub struct MeshRenderer {
     /// The newest positions whose normals the upload thread is computing (the mesh on screen
     /// keeps its positions until they land, so positions and normals always match).
     pending_move: Option<u64>,
+    /// Scalars and mask weights set while those positions are on their way: they belong to
+    /// the new positions (a heat map of the new result), so they are written with them.
+    move_scalars: Option<Vec<f32>>,
+    move_mask: Option<Vec<f32>>,
     /// Whether the last image had the wireframe (a big upload then builds its edges too).
     wireframe: bool,
     /// Meshes of at least this many bytes (positions + triangles) upload on the upload thread.
@@ -160,8 +177,10 @@ impl MeshRenderer {
     /// Pipelines on `device`, and an upload thread for big meshes that calls `on_upload_done`
     /// (from that thread) whenever an upload lands, so the UI can repaint.
     pub fn new(device: &wgpu::Device, on_upload_done: Arc<dyn Fn() + Send + Sync>) -> Self {
+        let materials = MaterialKit::new(device);
         Self {
-            pipelines: Pipelines::new(device, SAMPLE_COUNT),
+            pipelines: Pipelines::new(device, SAMPLE_COUNT, &materials),
+            materials,
             single_sample: None,
             software: false,
             newest_faces: 0,
@@ -182,6 +201,8 @@ impl MeshRenderer {
             lines_requested: None,
             move_serial: 0,
             pending_move: None,
+            move_scalars: None,
+            move_mask: None,
             wireframe: false,
             async_upload_bytes: DEFAULT_ASYNC_UPLOAD_BYTES,
             problem: None,
@@ -246,6 +267,8 @@ impl MeshRenderer {
         self.generation += 1;
         self.pending = None;
         self.pending_move = None;
+        self.move_scalars = None;
+        self.move_mask = None;
         self.lines_requested = None;
         self.lines_failed = false;
         let (vertex_count, face_count) = (source.positions().len(), source.triangles().len());
@@ -272,6 +295,7 @@ impl MeshRenderer {
                             generation,
                             vertex_count,
                             scalars: None,
+                            mask: None,
                         });
                         return;
                     }
@@ -306,8 +330,13 @@ impl MeshRenderer {
                         .as_ref()
                         .is_some_and(|p| p.generation == buffers.generation)
                     {
-                        if let Some(scalars) = self.pending.take().and_then(|p| p.scalars) {
-                            queue.write_buffer(&buffers.scalars, 0, bytemuck::cast_slice(&scalars));
+                        if let Some(pending) = self.pending.take() {
+                            if let Some(scalars) = pending.scalars {
+                                buffers.write_per_vertex(queue, &buffers.scalars, &scalars);
+                            }
+                            if let Some(mask) = pending.mask {
+                                buffers.write_per_vertex(queue, &buffers.mask, &mask);
+                            }
                         }
                         self.mesh = Some(buffers);
                         self.redraw();
@@ -336,6 +365,7 @@ impl MeshRenderer {
                     {
                         // A move's normals failed: the mesh keeps its last positions.
                         self.pending_move = None;
+                        self.write_move_tints(queue);
                     }
                 }
                 Uploaded::Moved {
@@ -352,6 +382,7 @@ impl MeshRenderer {
                         mesh.write_positions(queue, source, &normals);
                         self.redraw();
                     }
+                    self.write_move_tints(queue);
                 }
                 Uploaded::Lines { generation, lines } => {
                     if self.lines_requested == Some(generation) {
@@ -408,7 +439,22 @@ impl MeshRenderer {
         let normals = vertex_normals(source.positions(), source.triangles());
         mesh.write_positions(queue, source, &normals);
         self.redraw();
+        self.write_move_tints(queue);
         true
+    }
+
+    /// Writes the scalars and mask weights that waited for a move's positions.
+    fn write_move_tints(&mut self, queue: &wgpu::Queue) {
+        let (scalars, mask) = (self.move_scalars.take(), self.move_mask.take());
+        if let Some(mesh) = &self.mesh {
+            if let Some(scalars) = scalars.filter(|s| s.len() == mesh.vertex_count) {
+                mesh.write_per_vertex(queue, &mesh.scalars, &scalars);
+            }
+            if let Some(mask) = mask.filter(|m| m.len() == mesh.vertex_count) {
+                mesh.write_per_vertex(queue, &mesh.mask, &mask);
+            }
+            self.redraw();
+        }
     }
 
     /// Reads back the vertex normals in the GPU buffer of the mesh on screen (tests: what
@@ -420,7 +466,7 @@ impl MeshRenderer {
     ) -> Option<Vec<[f32; 3]>> {
         self.poll_uploads(queue);
         let mesh = self.mesh.as_ref()?;
-        let size = (mesh.vertex_count * 12) as u64;
+        let size = (mesh.draw_count * 12) as u64;
         let staging = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("fairmesh normals read-back"),
             size,
@@ -442,24 +488,48 @@ impl MeshRenderer {
     }
 
     /// Replaces the per-vertex scalars (one per vertex) of the mesh on screen or, while one
-    /// uploads, of that one; `false` when the count does not match.
+    /// uploads, of that one; `false` when the count does not match. While new positions are on
+    /// their way (a big mesh's normals on the upload thread) they are written with them, so a
+    /// heat map never colours the positions it was not measured on.
     pub fn set_scalars(&mut self, queue: &wgpu::Queue, scalars: &[f32]) -> bool {
+        self.set_per_vertex(queue, scalars, false)
+    }
+
+    /// Replaces the painted mask's weights (0 to 1, one per vertex), like [`Self::set_scalars`].
+    pub fn set_mask(&mut self, queue: &wgpu::Queue, weights: &[f32]) -> bool {
+        self.set_per_vertex(queue, weights, true)
+    }
+
+    fn set_per_vertex(&mut self, queue: &wgpu::Queue, values: &[f32], mask: bool) -> bool {
         self.poll_uploads(queue);
         if let Some(pending) = &mut self.pending {
-            if pending.vertex_count != scalars.len() {
+            if pending.vertex_count != values.len() {
                 return false;
             }
-            pending.scalars = Some(scalars.to_vec());
+            match mask {
+                true => pending.mask = Some(values.to_vec()),
+                false => pending.scalars = Some(values.to_vec()),
+            }
             return true;
         }
-        match &self.mesh {
-            Some(mesh) if mesh.vertex_count == scalars.len() => {
-                queue.write_buffer(&mesh.scalars, 0, bytemuck::cast_slice(scalars));
-                self.redraw();
-                true
+        let Some(mesh) = self
+            .mesh
+            .as_ref()
+            .filter(|m| m.vertex_count == values.len())
+        else {
+            return false;
+        };
+        if self.pending_move.is_some() {
+            match mask {
+                true => self.move_mask = Some(values.to_vec()),
+                false => self.move_scalars = Some(values.to_vec()),
             }
-            _ => false,
+            return true;
         }
+        let buffer = if mask { &mesh.mask } else { &mesh.scalars };
+        mesh.write_per_vertex(queue, buffer, values);
+        self.redraw();
+        true
     }
 
     pub fn has_mesh(&self) -> bool {
@@ -523,7 +593,7 @@ impl MeshRenderer {
             return false;
         }
         if samples != SAMPLE_COUNT && self.single_sample.is_none() {
-            self.single_sample = Some(Pipelines::new(device, samples));
+            self.single_sample = Some(Pipelines::new(device, samples, &self.materials));
         }
         self.target = Some(Target::new(device, size, samples));
         self.target_has_image = false;
@@ -563,7 +633,16 @@ impl MeshRenderer {
         };
         self.wireframe = params.wireframe;
         let started = std::time::Instant::now();
-        let uniforms = Uniforms::of(&params);
+        self.ensure_materials(device, queue);
+        let (materials, colours, uvs) = self.mesh.as_ref().map_or((false, false, false), |m| {
+            let look = m.appearance.as_deref();
+            (
+                !params.clay && look.is_some_and(|l| !l.is_plain()),
+                look.is_some_and(|l| l.colours.is_some()),
+                look.is_some_and(|l| l.uvs.is_some()),
+            )
+        });
+        let uniforms = Uniforms::of(&params, materials, colours, uvs);
         if params.wireframe {
             self.ensure_lines(device);
         }
@@ -580,7 +659,8 @@ impl MeshRenderer {
         let total = faces as usize + edges as usize;
         let at_once = total <= self.faces_per_frame || !self.target_has_image;
         if at_once {
-            pipelines.draw(encoder, target, mesh, params.wireframe);
+            let plain = self.materials.plain.as_ref();
+            pipelines.draw(encoder, target, (mesh, plain), params.wireframe);
             self.last_draw_time = started.elapsed();
         } else {
             match self.draw_next_part(device, encoder, params, (faces, total), started) {
@@ -643,7 +723,7 @@ impl MeshRenderer {
         pipelines.draw_part(
             encoder,
             work,
-            self.mesh.as_ref(),
+            (self.mesh.as_ref(), self.materials.plain.as_ref()),
             params.wireframe,
             &part,
             last,
@@ -666,6 +746,30 @@ impl MeshRenderer {
         self.progress = None;
         self.last_draw_time = recording;
         PartDrawn::Complete
+    }
+
+    /// Uploads the textures and uniforms of the mesh's materials, and the "no material" group,
+    /// when they are not on the GPU yet.
+    fn ensure_materials(&mut self, device: &wgpu::Device, queue: &wgpu::Queue) {
+        if self.materials.plain.is_none() {
+            self.materials.plain = Some(self.materials.group(device, queue, None));
+        }
+        if let Some(mesh) = &mut self.mesh {
+            if mesh.materials.is_none() {
+                let looks = mesh
+                    .appearance
+                    .as_ref()
+                    .map_or(&[][..], |a| &a.materials[..]);
+                mesh.materials = Some(
+                    looks
+                        .iter()
+                        .map(|look| MaterialGroup {
+                            bind_group: self.materials.group(device, queue, Some(look)),
+                        })
+                        .collect(),
+                );
+            }
+        }
     }
 
     /// Builds the wireframe's edges of the mesh on screen when they are missing and fit: a big
@@ -696,7 +800,7 @@ impl MeshRenderer {
                 if sent {
                     self.lines_requested = Some(mesh.generation);
                 } else {
-                    mesh.lines = Some(line_buffer(device, mesh.source.triangles()));
+                    mesh.lines = Some(line_buffer(device, &draw_triangles(mesh.source.as_ref())));
                 }
             }
         }

@@ -140,6 +140,9 @@ pub struct Settings {
     pub shading: Shading,
     /// Lighting: Simple or Studio (key, fill and rim lights).
     pub lighting: Lighting,
+    /// Clay: every surface in one clay colour, the file's materials, textures and vertex
+    /// colours left out.
+    pub clay: bool,
     /// "Remove noise first": how much the mesh is denoised before the hierarchy is built on it
     /// ([`crate::multires::denoise`]): automatically (the default of `fairmesh fair`), a fixed
     /// number of rounds, or not at all (the paper's multires alone).
@@ -212,6 +215,7 @@ impl Default for Settings {
             recent_files: Vec::new(),
             shading: Shading::default(),
             lighting: Lighting::default(),
+            clay: false,
             denoise: Denoise::Automatic,
             version: SETTINGS_VERSION,
         }

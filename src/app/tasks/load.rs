@@ -157,6 +157,8 @@ impl App {
                     document.pick_start_level = true;
                 }
                 self.error = None;
+                // What the status bar said was about the previous file.
+                self.message = None;
                 self.fit_view();
             }
             Err(error) => {

@@ -9,7 +9,7 @@ use crate::io::normals::dvec;
 use crate::io::origin::Origin;
 use crate::io::scene::{
     image_file_name, image_mime_type, Image, ImageData, Material, Part, Primitive, Scene,
-    SceneVertex,
+    SceneVertex, TextureSampler,
 };
 use crate::mesh::TriMesh;
 use glam::{DMat3, DMat4};
@@ -186,10 +186,15 @@ impl GltfSource {
                         }
                     }
                 }
-                let texture = pbr
+                let texture_entry = pbr
                     .and_then(|p| p.get("baseColorTexture"))
                     .and_then(|t| index(t, "index"))
-                    .and_then(|t| self.array("textures").get(t))
+                    .and_then(|t| self.array("textures").get(t));
+                let sampler = texture_entry
+                    .and_then(|t| index(t, "sampler"))
+                    .and_then(|s| self.array("samplers").get(s))
+                    .map_or_else(TextureSampler::default, TextureSampler::from_gltf);
+                let texture = texture_entry
                     .and_then(|t| {
                         // Its own image (a PNG or JPEG) where it has one, which other tools read
                         // more widely; otherwise the one in another format (KTX2, WebP, ...).
@@ -222,6 +227,7 @@ impl GltfSource {
                     metallic: factor("metallicFactor"),
                     roughness: factor("roughnessFactor"),
                     texture,
+                    sampler,
                 }
             })
             .collect();

@@ -24,6 +24,7 @@ pub(super) fn read_materials(
             metallic: 0.0,
             roughness: 1.0,
             texture: None,
+            sampler: Default::default(),
         })
         .collect();
     if names.is_empty() {

@@ -1,42 +1,107 @@
-//! The GPU copies of one mesh ([`MeshBuffers`]: positions, vertex normals, scalars, triangles
-//! and, once the wireframe is wanted, its edges) and how they are filled.
+//! The GPU copies of one mesh ([`MeshBuffers`]: positions, vertex normals, heat-map scalars,
+//! painted-mask weights, texture coordinates and colours, triangles and, once the wireframe is
+//! wanted, its edges) and how they are filled.
 
 use std::sync::Arc;
 
 use wgpu::util::DeviceExt;
 
 use super::MeshSource;
+use crate::render::appearance::Appearance;
 use crate::render::normals::vertex_normals;
 
-/// GPU copies of one mesh.
+/// GPU copies of one mesh, over its draw vertices (the file's own vertices when it has an
+/// [`Appearance`], otherwise the mesh's).
 pub(super) struct MeshBuffers {
     pub(super) positions: wgpu::Buffer,
-    /// Area-weighted unit vertex normals of the positions now in `positions`.
+    /// Area-weighted unit vertex normals of the positions now in `positions` (computed on the
+    /// mesh's vertices, so they are smooth across the file's seams).
     pub(super) normals: wgpu::Buffer,
+    /// The heat map's per-vertex values.
     pub(super) scalars: wgpu::Buffer,
+    /// The painted mask's per-vertex weights (0 to 1), tinted over the surface.
+    pub(super) mask: wgpu::Buffer,
+    /// Texture coordinates and linear RGBA colours per draw vertex (zeros when the file has
+    /// none: the shader is told).
+    pub(super) uvs: wgpu::Buffer,
+    pub(super) colours: wgpu::Buffer,
     pub(super) triangles: wgpu::Buffer,
+    /// The mesh's vertices (what scalars, weights and positions are given for).
     pub(super) vertex_count: usize,
+    /// The draw vertices (the buffers' length).
+    pub(super) draw_count: usize,
     pub(super) index_count: u32,
     /// Edge list for the wireframe, built when first needed (on the upload thread for a big
-    /// mesh) from `source`'s triangles.
+    /// mesh) from the draw triangles.
     pub(super) lines: Option<(wgpu::Buffer, u32)>,
     /// The mesh on screen: its triangles, and the positions last written.
     pub(super) source: Arc<dyn MeshSource>,
+    /// The file's materials, texture coordinates and colours, when it has any to show.
+    pub(super) appearance: Option<Arc<Appearance>>,
+    /// The materials' textures and uniforms on the GPU, made on the render thread when first
+    /// drawn (they need the queue).
+    pub(super) materials: Option<Vec<MaterialGroup>>,
     /// Which `MeshRenderer::set_mesh` call this mesh answers.
     pub(super) generation: u64,
 }
 
+/// One material's bind group (its uniform, texture and sampler).
+pub(super) struct MaterialGroup {
+    pub(super) bind_group: wgpu::BindGroup,
+}
+
+/// The triangles the renderer draws for `source`: its appearance's (over the draw vertices) or
+/// its own.
+pub(super) fn draw_triangles(source: &dyn MeshSource) -> std::borrow::Cow<'_, [[u32; 3]]> {
+    match source.appearance() {
+        Some(appearance) => match &appearance.triangles {
+            Some(triangles) => std::borrow::Cow::Owned(triangles.clone()),
+            None => std::borrow::Cow::Borrowed(source.triangles()),
+        },
+        None => std::borrow::Cow::Borrowed(source.triangles()),
+    }
+}
+
 impl MeshBuffers {
-    /// Writes new positions of the same connectivity and their normals.
+    /// Writes new positions of the same connectivity and their normals (per mesh vertex).
     pub(super) fn write_positions(
         &mut self,
         queue: &wgpu::Queue,
         source: Arc<dyn MeshSource>,
         normals: &[[f32; 3]],
     ) {
-        queue.write_buffer(&self.positions, 0, bytemuck::cast_slice(source.positions()));
-        queue.write_buffer(&self.normals, 0, bytemuck::cast_slice(normals));
+        match &self.appearance {
+            Some(look) if look.vertex_of.is_some() => {
+                let positions = look.gather(source.positions());
+                queue.write_buffer(&self.positions, 0, bytemuck::cast_slice(&positions));
+                queue.write_buffer(
+                    &self.normals,
+                    0,
+                    bytemuck::cast_slice(&look.gather(normals)),
+                );
+            }
+            _ => {
+                queue.write_buffer(&self.positions, 0, bytemuck::cast_slice(source.positions()));
+                queue.write_buffer(&self.normals, 0, bytemuck::cast_slice(normals));
+            }
+        }
         self.source = source;
+    }
+
+    /// Writes per-mesh-vertex `values` (scalars or mask weights) into `buffer`, taken onto the
+    /// draw vertices.
+    pub(super) fn write_per_vertex(
+        &self,
+        queue: &wgpu::Queue,
+        buffer: &wgpu::Buffer,
+        values: &[f32],
+    ) {
+        match &self.appearance {
+            Some(look) if look.vertex_of.is_some() => {
+                queue.write_buffer(buffer, 0, bytemuck::cast_slice(&look.gather(values)));
+            }
+            _ => queue.write_buffer(buffer, 0, bytemuck::cast_slice(values)),
+        }
     }
 
     /// Buffers for `source` (and its wireframe edges when `with_lines`), answering the
@@ -48,42 +113,83 @@ impl MeshBuffers {
         generation: u64,
     ) -> Self {
         let positions = source.positions();
-        let triangles = source.triangles();
+        let mesh_triangles = source.triangles();
+        let appearance = source.appearance();
+        let normals = vertex_normals(positions, mesh_triangles);
+        let (draw_positions, draw_normals) = match &appearance {
+            Some(look) if look.vertex_of.is_some() => {
+                (Some(look.gather(positions)), Some(look.gather(&normals)))
+            }
+            _ => (None, None),
+        };
+        let draw_count = draw_positions.as_ref().map_or(positions.len(), Vec::len);
+        let triangles = draw_triangles(source.as_ref());
         let positions_buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("fairmesh positions"),
-            contents: bytemuck::cast_slice(positions),
+            contents: bytemuck::cast_slice(draw_positions.as_deref().unwrap_or(positions)),
             usage: wgpu::BufferUsages::VERTEX | wgpu::BufferUsages::COPY_DST,
         });
         let normals_buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("fairmesh normals"),
-            contents: bytemuck::cast_slice(&vertex_normals(positions, triangles)),
+            contents: bytemuck::cast_slice(draw_normals.as_deref().unwrap_or(&normals)),
             // COPY_SRC: tests read back what was uploaded.
             usage: wgpu::BufferUsages::VERTEX
                 | wgpu::BufferUsages::COPY_DST
                 | wgpu::BufferUsages::COPY_SRC,
         });
-        // Scalars come later through `set_scalars`; wgpu zero-fills a buffer that is not mapped
-        // at creation.
-        let scalars_buffer = device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("fairmesh scalars"),
-            size: (positions.len() * 4) as u64,
-            usage: wgpu::BufferUsages::VERTEX | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
+        // Scalars and mask weights come later through `set_scalars` and `set_mask`; wgpu
+        // zero-fills a buffer that is not mapped at creation.
+        let per_vertex = |label, bytes: usize| {
+            device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some(label),
+                size: (draw_count * bytes) as u64,
+                usage: wgpu::BufferUsages::VERTEX | wgpu::BufferUsages::COPY_DST,
+                mapped_at_creation: false,
+            })
+        };
+        let scalars_buffer = per_vertex("fairmesh scalars", 4);
+        let mask_buffer = per_vertex("fairmesh mask", 4);
+        let filled = |label, contents: &[u8], bytes: usize| match contents.is_empty() {
+            true => per_vertex(label, bytes),
+            false => device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some(label),
+                contents,
+                usage: wgpu::BufferUsages::VERTEX,
+            }),
+        };
+        let look = appearance.as_deref();
+        let uvs = look
+            .and_then(|l| l.uvs.as_deref())
+            .filter(|u| u.len() == draw_count);
+        let colours = look
+            .and_then(|l| l.colours.as_deref())
+            .filter(|c| c.len() == draw_count);
+        let uvs_buffer = filled("fairmesh uvs", bytemuck::cast_slice(uvs.unwrap_or(&[])), 8);
+        let colours_buffer = filled(
+            "fairmesh colours",
+            bytemuck::cast_slice(colours.unwrap_or(&[])),
+            16,
+        );
         let triangles_buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("fairmesh triangles"),
-            contents: bytemuck::cast_slice(triangles),
+            contents: bytemuck::cast_slice(&triangles),
             usage: wgpu::BufferUsages::INDEX,
         });
-        let lines = with_lines.then(|| line_buffer(device, triangles));
+        let lines = with_lines.then(|| line_buffer(device, &triangles));
         Self {
             positions: positions_buffer,
             normals: normals_buffer,
             scalars: scalars_buffer,
+            mask: mask_buffer,
+            uvs: uvs_buffer,
+            colours: colours_buffer,
             triangles: triangles_buffer,
             vertex_count: positions.len(),
+            draw_count,
             index_count: (triangles.len() * 3) as u32,
             lines,
+            appearance,
+            materials: None,
             source,
             generation,
         }

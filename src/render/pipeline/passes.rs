@@ -8,6 +8,7 @@ use std::ops::Range;
 
 use super::buffers::MeshBuffers;
 use super::{DrawParams, COLOR_FORMAT, DEPTH_FORMAT};
+use crate::render::appearance::{Batch, MaterialLook, Sampling, TextureImage, Wrap};
 use crate::render::shading::{Lighting, Shading};
 
 #[repr(C)]
@@ -21,13 +22,16 @@ pub(super) struct Uniforms {
     base_color: [f32; 4],
     wire_color: [f32; 4],
     scalar_range: [f32; 4],
-    /// x: 1 for smooth shading, y: 1 for the studio lighting.
+    /// x: 1 for smooth shading, y: 1 for the studio lighting, z: 1 to draw the materials'
+    /// colours (not clay), w: 1 when the vertex colours are there, 2 with texture coordinates
+    /// too, 3 with texture coordinates alone.
     look: [f32; 4],
 }
 
 impl Uniforms {
-    /// What the shader is told for `params`.
-    pub(super) fn of(params: &DrawParams) -> Self {
+    /// What the shader is told for `params`, for a mesh that shows its materials' colours or
+    /// not (`materials`), with or without vertex colours and texture coordinates.
+    pub(super) fn of(params: &DrawParams, materials: bool, colours: bool, uvs: bool) -> Self {
         Uniforms {
             view_proj: params.view_proj,
             eye: [params.eye[0], params.eye[1], params.eye[2], 1.0],
@@ -46,16 +50,16 @@ impl Uniforms {
             up: [params.up[0], params.up[1], params.up[2], 0.0],
             base_color: [0.62, 0.56, 0.48, 1.0],
             wire_color: [0.02, 0.03, 0.05, 1.0],
-            scalar_range: match (params.scalar_range, params.mask_tint) {
-                (Some([lo, hi]), _) => [lo, hi, 1.0, 0.0],
-                (None, true) => [0.0, 1.0, 2.0, 0.0],
-                (None, false) => [0.0, 1.0, 0.0, 0.0],
+            scalar_range: {
+                let [lo, hi] = params.scalar_range.unwrap_or([0.0, 1.0]);
+                let heat = f32::from(u8::from(params.scalar_range.is_some()));
+                [lo, hi, heat, f32::from(u8::from(params.mask_tint))]
             },
             look: [
                 f32::from(u8::from(params.shading == Shading::Smooth)),
                 f32::from(u8::from(params.lighting == Lighting::Studio)),
-                0.0,
-                0.0,
+                f32::from(u8::from(materials)),
+                f32::from(u8::from(colours)) + 2.0 * f32::from(u8::from(uvs)),
             ],
         }
     }
@@ -221,6 +225,145 @@ impl Part {
     }
 }
 
+/// What every material's bind group is made with (group 1 of the filled triangles): its layout,
+/// and the group of "no material" (white, untextured), made when first drawn.
+pub(super) struct MaterialKit {
+    pub(super) layout: wgpu::BindGroupLayout,
+    pub(super) plain: Option<wgpu::BindGroup>,
+}
+
+/// A material's uniform: its base colour factor and whether it has a texture (x of `flags`).
+#[repr(C)]
+#[derive(Clone, Copy, Pod, Zeroable)]
+struct MaterialUniform {
+    base_colour: [f32; 4],
+    flags: [f32; 4],
+}
+
+impl MaterialKit {
+    pub(super) fn new(device: &wgpu::Device) -> Self {
+        let entry = |binding, ty| wgpu::BindGroupLayoutEntry {
+            binding,
+            visibility: wgpu::ShaderStages::FRAGMENT,
+            ty,
+            count: None,
+        };
+        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("fairmesh material"),
+            entries: &[
+                entry(
+                    0,
+                    wgpu::BindingType::Buffer {
+                        ty: wgpu::BufferBindingType::Uniform,
+                        has_dynamic_offset: false,
+                        min_binding_size: None,
+                    },
+                ),
+                entry(
+                    1,
+                    wgpu::BindingType::Texture {
+                        sample_type: wgpu::TextureSampleType::Float { filterable: true },
+                        view_dimension: wgpu::TextureViewDimension::D2,
+                        multisampled: false,
+                    },
+                ),
+                entry(
+                    2,
+                    wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering),
+                ),
+            ],
+        });
+        Self {
+            layout,
+            plain: None,
+        }
+    }
+
+    /// The bind group of `material` (`None`: no material, white): its base colour factor, its
+    /// texture uploaded (sRGB) with its sampler's filters and wrapping, or a white texel.
+    pub(super) fn group(
+        &self,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        material: Option<&MaterialLook>,
+    ) -> wgpu::BindGroup {
+        use wgpu::util::DeviceExt;
+        let white = TextureImage {
+            width: 1,
+            height: 1,
+            rgba: vec![255; 4],
+            sampling: Sampling::default(),
+        };
+        let texture = material.and_then(|m| m.texture.as_ref());
+        let image = texture.unwrap_or(&white);
+        let uniform = MaterialUniform {
+            base_colour: material.map_or([1.0; 4], |m| m.base_colour),
+            flags: [f32::from(u8::from(texture.is_some())), 0.0, 0.0, 0.0],
+        };
+        let buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("fairmesh material"),
+            contents: bytemuck::bytes_of(&uniform),
+            usage: wgpu::BufferUsages::UNIFORM,
+        });
+        let texture = device.create_texture_with_data(
+            queue,
+            &wgpu::TextureDescriptor {
+                label: Some("fairmesh base colour"),
+                size: wgpu::Extent3d {
+                    width: image.width,
+                    height: image.height,
+                    depth_or_array_layers: 1,
+                },
+                mip_level_count: 1,
+                sample_count: 1,
+                dimension: wgpu::TextureDimension::D2,
+                format: wgpu::TextureFormat::Rgba8UnormSrgb,
+                usage: wgpu::TextureUsages::TEXTURE_BINDING,
+                view_formats: &[],
+            },
+            wgpu::util::TextureDataOrder::LayerMajor,
+            &image.rgba,
+        );
+        let filter = |linear| match linear {
+            true => wgpu::FilterMode::Linear,
+            false => wgpu::FilterMode::Nearest,
+        };
+        let address = |wrap| match wrap {
+            Wrap::Repeat => wgpu::AddressMode::Repeat,
+            Wrap::MirroredRepeat => wgpu::AddressMode::MirrorRepeat,
+            Wrap::ClampToEdge => wgpu::AddressMode::ClampToEdge,
+        };
+        let sampling = image.sampling;
+        let sampler = device.create_sampler(&wgpu::SamplerDescriptor {
+            label: Some("fairmesh base colour"),
+            address_mode_u: address(sampling.wrap[0]),
+            address_mode_v: address(sampling.wrap[1]),
+            mag_filter: filter(sampling.mag_linear),
+            min_filter: filter(sampling.min_linear),
+            ..Default::default()
+        });
+        let view = texture.create_view(&Default::default());
+        device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("fairmesh material"),
+            layout: &self.layout,
+            entries: &[
+                wgpu::BindGroupEntry {
+                    binding: 0,
+                    resource: buffer.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 1,
+                    resource: wgpu::BindingResource::TextureView(&view),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 2,
+                    resource: wgpu::BindingResource::Sampler(&sampler),
+                },
+            ],
+        })
+    }
+}
+
 /// The pipelines and their uniforms, made once per renderer.
 pub(super) struct Pipelines {
     fill: wgpu::RenderPipeline,
@@ -231,7 +374,7 @@ pub(super) struct Pipelines {
 
 impl Pipelines {
     /// Pipelines drawing into targets with `samples` per pixel.
-    pub(super) fn new(device: &wgpu::Device, samples: u32) -> Self {
+    pub(super) fn new(device: &wgpu::Device, samples: u32, materials: &MaterialKit) -> Self {
         let shader = device.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some("fairmesh mesh shader"),
             source: wgpu::ShaderSource::Wgsl(include_str!("../../../shaders/mesh.wgsl").into()),
@@ -251,6 +394,11 @@ impl Pipelines {
         });
         let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
             label: Some("fairmesh pipeline layout"),
+            bind_group_layouts: &[Some(&bind_group_layout), Some(&materials.layout)],
+            immediate_size: 0,
+        });
+        let line_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("fairmesh wireframe layout"),
             bind_group_layouts: &[Some(&bind_group_layout)],
             immediate_size: 0,
         });
@@ -271,7 +419,7 @@ impl Pipelines {
 
         Self {
             fill: fill_pipeline(device, &layout, &shader, samples),
-            line: line_pipeline(device, &layout, &shader, samples),
+            line: line_pipeline(device, &line_layout, &shader, samples),
             uniform_buffer,
             bind_group,
         }
@@ -283,11 +431,11 @@ impl Pipelines {
         &self,
         encoder: &mut wgpu::CommandEncoder,
         target: &Target,
-        mesh: Option<&MeshBuffers>,
+        (mesh, plain): (Option<&MeshBuffers>, Option<&wgpu::BindGroup>),
         wireframe: bool,
     ) {
         let whole = Part::whole(mesh, wireframe);
-        self.draw_part(encoder, target, mesh, wireframe, &whole, true);
+        self.draw_part(encoder, target, (mesh, plain), wireframe, &whole, true);
     }
 
     /// Records the pass that draws `part` of the image into `target`: the first part clears
@@ -297,7 +445,7 @@ impl Pipelines {
         &self,
         encoder: &mut wgpu::CommandEncoder,
         target: &Target,
-        mesh: Option<&MeshBuffers>,
+        (mesh, plain): (Option<&MeshBuffers>, Option<&wgpu::BindGroup>),
         wireframe: bool,
         part: &Part,
         last: bool,
@@ -354,11 +502,36 @@ impl Pipelines {
             pass.set_vertex_buffer(0, mesh.positions.slice(..));
             pass.set_vertex_buffer(1, mesh.scalars.slice(..));
             pass.set_vertex_buffer(2, mesh.normals.slice(..));
+            pass.set_vertex_buffer(3, mesh.mask.slice(..));
+            pass.set_vertex_buffer(4, mesh.uvs.slice(..));
+            pass.set_vertex_buffer(5, mesh.colours.slice(..));
             pass.set_index_buffer(mesh.triangles.slice(..), wgpu::IndexFormat::Uint32);
             let face_count = mesh.index_count / 3;
             let faces = part.faces.start.min(face_count)..part.faces.end.min(face_count);
-            if !faces.is_empty() {
-                pass.draw_indexed(faces.start * 3..faces.end * 3, 0, 0..1);
+            // Each material's run of triangles with its own group; without materials, one run.
+            let whole = [Batch {
+                material: None,
+                first: 0,
+                end: face_count,
+            }];
+            let batches = match (&mesh.appearance, &mesh.materials) {
+                (Some(look), Some(_)) if !look.batches.is_empty() => look.batches.as_slice(),
+                _ => &whole,
+            };
+            for batch in batches {
+                let run = faces.start.max(batch.first)..faces.end.min(batch.end);
+                if run.is_empty() {
+                    continue;
+                }
+                let group = match (batch.material, &mesh.materials) {
+                    (Some(m), Some(groups)) => groups.get(m).map(|g| &g.bind_group),
+                    _ => None,
+                };
+                let Some(group) = group.or(plain) else {
+                    continue;
+                };
+                pass.set_bind_group(1, group, &[]);
+                pass.draw_indexed(run.start * 3..run.end * 3, 0, 0..1);
             }
             if wireframe {
                 if let Some((lines, count)) = &mesh.lines {
@@ -375,8 +548,9 @@ impl Pipelines {
     }
 }
 
-/// The vertex buffers' layouts: positions (location 0), scalars (1), normals (2).
-fn vertex_layouts() -> [wgpu::VertexBufferLayout<'static>; 3] {
+/// The vertex buffers' layouts: positions (location 0), scalars (1), normals (2), mask
+/// weights (3), texture coordinates (4), colours (5).
+fn vertex_layouts() -> [wgpu::VertexBufferLayout<'static>; 6] {
     let position_layout = wgpu::VertexBufferLayout {
         array_stride: 12,
         step_mode: wgpu::VertexStepMode::Vertex,
@@ -404,7 +578,41 @@ fn vertex_layouts() -> [wgpu::VertexBufferLayout<'static>; 3] {
             shader_location: 2,
         }],
     };
-    [position_layout, scalar_layout, normal_layout]
+    let mask_layout = wgpu::VertexBufferLayout {
+        array_stride: 4,
+        step_mode: wgpu::VertexStepMode::Vertex,
+        attributes: &[wgpu::VertexAttribute {
+            format: wgpu::VertexFormat::Float32,
+            offset: 0,
+            shader_location: 3,
+        }],
+    };
+    let uv_layout = wgpu::VertexBufferLayout {
+        array_stride: 8,
+        step_mode: wgpu::VertexStepMode::Vertex,
+        attributes: &[wgpu::VertexAttribute {
+            format: wgpu::VertexFormat::Float32x2,
+            offset: 0,
+            shader_location: 4,
+        }],
+    };
+    let colour_layout = wgpu::VertexBufferLayout {
+        array_stride: 16,
+        step_mode: wgpu::VertexStepMode::Vertex,
+        attributes: &[wgpu::VertexAttribute {
+            format: wgpu::VertexFormat::Float32x4,
+            offset: 0,
+            shader_location: 5,
+        }],
+    };
+    [
+        position_layout,
+        scalar_layout,
+        normal_layout,
+        mask_layout,
+        uv_layout,
+        colour_layout,
+    ]
 }
 
 /// The colour target both pipelines draw into.
@@ -431,7 +639,8 @@ fn fill_pipeline(
     shader: &wgpu::ShaderModule,
     samples: u32,
 ) -> wgpu::RenderPipeline {
-    let [position_layout, scalar_layout, normal_layout] = vertex_layouts();
+    let [position_layout, scalar_layout, normal_layout, mask_layout, uv_layout, colour_layout] =
+        vertex_layouts();
     let targets = color_targets();
     device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
         label: Some("fairmesh triangles"),
@@ -444,6 +653,9 @@ fn fill_pipeline(
                 Some(position_layout),
                 Some(scalar_layout),
                 Some(normal_layout),
+                Some(mask_layout),
+                Some(uv_layout),
+                Some(colour_layout),
             ],
         },
         primitive: wgpu::PrimitiveState {
@@ -482,7 +694,7 @@ fn line_pipeline(
     shader: &wgpu::ShaderModule,
     samples: u32,
 ) -> wgpu::RenderPipeline {
-    let [position_layout, _, _] = vertex_layouts();
+    let [position_layout, ..] = vertex_layouts();
     let targets = color_targets();
     device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
         label: Some("fairmesh wireframe"),

@@ -5,7 +5,7 @@
 use std::sync::mpsc::{self, Receiver, Sender};
 use std::sync::{Arc, Mutex};
 
-use super::buffers::{line_buffer, MeshBuffers};
+use super::buffers::{draw_triangles, line_buffer, MeshBuffers};
 use super::MeshSource;
 use crate::render::normals::vertex_normals;
 
@@ -46,7 +46,7 @@ impl UploadJob {
             } => Uploaded::Mesh(MeshBuffers::create(device, source, with_lines, generation)),
             UploadJob::Lines { generation, source } => Uploaded::Lines {
                 generation,
-                lines: line_buffer(device, source.triangles()),
+                lines: line_buffer(device, &draw_triangles(source.as_ref())),
             },
             UploadJob::Move {
                 generation,
@@ -159,4 +159,6 @@ pub(super) struct PendingMesh {
     pub(super) vertex_count: usize,
     /// Scalars set while the upload was in flight, written once it lands.
     pub(super) scalars: Option<Vec<f32>>,
+    /// Mask weights set while the upload was in flight, written once it lands.
+    pub(super) mask: Option<Vec<f32>>,
 }

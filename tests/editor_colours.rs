@@ -1,0 +1,130 @@
+//! Headless tests of the viewport's colours: a glTF scene's textured ball (base colour texture
+//! through its texture coordinates) and painted box (base colour factor), a PLY's vertex
+//! colours and an OBJ's material library are drawn in their own colours; "Clay" (C) draws them
+//! all in the clay colour again, and back.
+#![cfg(feature = "gui")]
+
+use egui_kittest::kittest::{NodeT, Queryable};
+
+mod editor_common;
+use editor_common::{harness_for, settle, viewport_image};
+use fairmesh::app::view_panel::{tips, CLAY};
+use fairmesh::app::App;
+
+type Harness = egui_kittest::Harness<'static, App>;
+
+fn asset(name: &str) -> std::path::PathBuf {
+    std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("tests/data/roundtrip")
+        .join(name)
+}
+
+/// Pixels where blue clearly leads (the checker's blue squares; clay and its lights never).
+fn blue_pixels(image: &image::RgbaImage) -> usize {
+    image
+        .pixels()
+        .filter(|p| p[2] as i32 > p[0] as i32 + 40 && p[2] as i32 > p[1] as i32 + 20)
+        .count()
+}
+
+/// Pixels where red clearly leads (the painted box: base colour factor ≈ 0.9, 0.31, 0.2).
+fn red_pixels(image: &image::RgbaImage) -> usize {
+    image
+        .pixels()
+        .filter(|p| p[0] as i32 > p[1] as i32 + 60 && p[0] as i32 > p[2] as i32 + 60)
+        .count()
+}
+
+fn snapshot(image: &image::RgbaImage, name: &str) {
+    egui_kittest::image_snapshot_options(
+        image,
+        name,
+        &egui_kittest::SnapshotOptions::new()
+            .threshold(2.0)
+            .max_failed_pixels(2500),
+    );
+}
+
+fn loaded(name: &str) -> Harness {
+    let mut harness = harness_for(asset(name));
+    settle(&mut harness);
+    harness
+}
+
+#[test]
+fn a_scene_shows_its_texture_and_base_colours_and_clay_hides_them() {
+    let mut harness = loaded("scene.glb");
+    let node = harness.get_by_label(CLAY);
+    assert_eq!(
+        node.accesskit_node().description().as_deref(),
+        Some(tips::CLAY)
+    );
+    assert!(!harness.state().settings().clay);
+    let coloured = viewport_image(&mut harness);
+    let (blue, red) = (blue_pixels(&coloured), red_pixels(&coloured));
+    assert!(blue > 1500, "the checker texture on the ball: {blue} px");
+    assert!(red > 1500, "the painted box: {red} px");
+    snapshot(&coloured, "viewport_scene_textured");
+
+    harness.key_press(egui::Key::C);
+    harness.step();
+    settle(&mut harness);
+    assert!(harness.state().settings().clay);
+    assert!(harness.state().main_draw_params().unwrap().clay);
+    let clay = viewport_image(&mut harness);
+    assert_eq!(blue_pixels(&clay), 0, "clay: no texture");
+    assert_eq!(red_pixels(&clay), 0, "clay: no base colours");
+    snapshot(&clay, "viewport_scene_clay");
+
+    harness.get_by_label(CLAY).click();
+    settle(&mut harness);
+    assert!(!harness.state().settings().clay);
+    let again = viewport_image(&mut harness);
+    assert!(blue_pixels(&again) > 1500);
+}
+
+#[test]
+fn a_plys_vertex_colours_are_drawn() {
+    let mut harness = loaded("colored.ply");
+    let coloured = viewport_image(&mut harness);
+    harness.key_press(egui::Key::C);
+    harness.step();
+    settle(&mut harness);
+    let clay = viewport_image(&mut harness);
+    // The clay is one warm hue; the vertex colours add others: count the distinct coarse hues.
+    let hues = |image: &image::RgbaImage| {
+        let mut seen = std::collections::BTreeSet::new();
+        for p in image.pixels().filter(|p| p[0].max(p[1]).max(p[2]) > 40) {
+            let (r, g, b) = (p[0] as i32, p[1] as i32, p[2] as i32);
+            seen.insert(((r - g).signum(), (g - b).signum(), (r - b).signum()));
+        }
+        seen.len()
+    };
+    assert!(
+        hues(&coloured) > hues(&clay),
+        "the vertex colours add hues: {} against clay's {}",
+        hues(&coloured),
+        hues(&clay)
+    );
+    snapshot(&coloured, "viewport_colored_ply");
+}
+
+#[test]
+fn an_obj_with_a_textured_material_shows_its_texture() {
+    let mut harness = loaded("textured.obj");
+    let coloured = viewport_image(&mut harness);
+    harness.key_press(egui::Key::C);
+    harness.step();
+    settle(&mut harness);
+    let clay = viewport_image(&mut harness);
+    let differing = coloured
+        .pixels()
+        .zip(clay.pixels())
+        .filter(|(a, b)| a != b)
+        .count();
+    assert!(
+        differing > 5000,
+        "the texture changes the picture: {differing} px"
+    );
+    snapshot(&coloured, "viewport_textured_obj");
+}
