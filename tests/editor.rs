@@ -161,7 +161,8 @@ fn measuring_stops_when_the_view_moves_on_and_is_redone() {
 #[test]
 fn exports_and_reloads_the_result() {
     let dir = tempfile::tempdir().unwrap();
-    let mut harness = harness_for(bunny());
+    // Tall enough that the Export section sits in the side panel's view.
+    let mut harness = harness_sized(bunny(), egui::vec2(1200.0, 1400.0));
     settle(&mut harness);
     let loaded = harness.state().status();
 

@@ -8,7 +8,7 @@ use egui::accesskit::Role;
 use egui_kittest::kittest::Queryable;
 
 mod editor_common;
-use editor_common::{bunny, harness_for, retype, settle, viewport_image};
+use editor_common::{bunny, harness_for, harness_sized, retype, settle, viewport_image};
 
 /// The bundled bunny copied into `dir` (what the editor writes beside it stays there).
 fn bunny_in(dir: &Path) -> PathBuf {
@@ -23,7 +23,8 @@ fn export_asks_before_replacing_a_file_and_cancel_writes_nothing() {
     let input = bunny_in(dir.path());
     let target = dir.path().join("bunny00_faired.obj");
     std::fs::write(&target, "precious").unwrap();
-    let mut harness = harness_for(input);
+    // Tall enough that the Export section sits in the side panel's view.
+    let mut harness = harness_sized(input, egui::vec2(1200.0, 1400.0));
     settle(&mut harness);
 
     // Ctrl+E to the existing default path asks first, and Cancel leaves the file alone.
