@@ -86,9 +86,10 @@ pub struct FairArgs {
     #[arg(long)]
     pub no_volume_correction: bool,
     /// Constrained only: stop a round early once no vertex moves more than this many mean edge
-    /// lengths in one iteration (0: always run all iterations).
-    #[arg(long, default_value_t = 0.0)]
-    pub tolerance: f64,
+    /// lengths in one iteration [default: 0.001, the round has settled; 0: always run all
+    /// iterations].
+    #[arg(long)]
+    pub tolerance: Option<f64>,
     /// How boundary vertices of open meshes move.
     #[arg(long, value_enum, default_value_t = BoundaryArg::Curve)]
     pub boundary: BoundaryArg,
@@ -164,8 +165,12 @@ impl FairArgs {
                 };
                 let mut options = base
                     .with_iterations(self.iterations)
-                    .with_tolerance(self.tolerance * mean_edge_length)
                     .with_boundary(boundary);
+                if let Some(tolerance) = self.tolerance {
+                    options = options
+                        .with_tolerance(tolerance * mean_edge_length)
+                        .with_settled(tolerance);
+                }
                 if let Some(rounds) = self.rounds {
                     options = options.with_rounds(rounds);
                 }
@@ -394,6 +399,7 @@ fn json_report(
         "loose_triangles": report.loose_triangles,
         "time_ms": outcome.time_ms,
         "detection_ms": report.detection_ms,
+        "phases_ms": report.phases,
         "risk_by_round": report.risk_by_round,
         "volume_change_percent": outcome.volume_change_percent,
         "max_move": report.max_move,
