@@ -270,7 +270,10 @@ fn a_round_ends_once_it_has_settled_and_ends_where_all_its_iterations_would() {
         .zip(&full.positions)
         .map(|(a, b)| (glam::Vec3::from(*a) - glam::Vec3::from(*b)).length() as f64)
         .fold(0.0, f64::max);
-    assert!(farthest < 10.0 * ROUND_SETTLED * edge, "{farthest} against {edge}");
+    assert!(
+        farthest < 10.0 * ROUND_SETTLED * edge,
+        "{farthest} against {edge}"
+    );
 }
 
 #[test]

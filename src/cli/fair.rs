@@ -53,8 +53,9 @@ pub struct FairArgs {
     /// Smoothing method.
     #[arg(long, value_enum, default_value_t = MethodArg::Constrained)]
     pub method: MethodArg,
-    /// Iterations (per round for constrained fairing). Constrained fairing settles after 5 to
-    /// 10 iterations; use --rounds to smooth more.
+    /// Iterations (per round for constrained fairing, at most: a round ends once it has settled,
+    /// see --tolerance). Constrained fairing settles after 5 to 10 iterations; use --rounds to
+    /// smooth more.
     #[arg(long, default_value_t = 10)]
     pub iterations: usize,
     /// Constrained only: rounds; each round re-anchors the triangle centres at the current

@@ -111,7 +111,12 @@ impl VolumeKeeper {
     /// na·(b×c) + a·(nb×c + b×nc), na·(nb×c + b×nc) + a·(nb×nc), na·(nb×nc); in double precision
     /// and as eight separate triple products this pass took as long as four iterations of the
     /// operator (`docs/measurements.md`, "The volume correction").
-    fn volume_cubics(&self, mesh: &TriMesh, normals: Option<&[Vec3A]>) -> Vec<[f64; 4]> {
+    /// `normals` come with which vertices move (the others' normals count as zero).
+    fn volume_cubics(
+        &self,
+        mesh: &TriMesh,
+        normals: Option<(&[Vec3A], &(dyn Fn(usize) -> bool + Sync))>,
+    ) -> Vec<[f64; 4]> {
         let parts = self.parts();
         let apexes: Vec<Vec3A> = self.apex.iter().map(|a| a.as_vec3a()).collect();
         let point = |v: u32| Vec3A::from_array(mesh.positions[v as usize]);
@@ -127,10 +132,17 @@ impl VolumeKeeper {
                     let bc = b.cross(c);
                     let sum = &mut sums[part as usize];
                     sum[0] += f64::from(a.dot(bc));
-                    let Some(normals) = normals else {
+                    let Some((normals, moves)) = normals else {
                         continue;
                     };
-                    let [na, nb, nc] = t.map(|v| normals[v as usize]);
+                    let [na, nb, nc] = t.map(|v| {
+                        let v = v as usize;
+                        if moves(v) {
+                            normals[v]
+                        } else {
+                            Vec3A::ZERO
+                        }
+                    });
                     let mixed = nb.cross(c) + b.cross(nc);
                     let nbc = nb.cross(nc);
                     sum[1] += f64::from(na.dot(bc) + a.dot(mixed));
@@ -208,14 +220,8 @@ impl VolumeKeeper {
                 }
             })
             .collect();
-        let offset_normals: Vec<Vec3A> = normals
-            .par_iter()
-            .enumerate()
-            .with_min_len(BLOCK)
-            .map(|(v, &n)| if moves(v) { n } else { Vec3A::ZERO })
-            .collect();
         // Per part, the coefficients of V(δ) = c0 + c1 δ + c2 δ² + c3 δ³.
-        let cubic = self.volume_cubics(mesh, Some(&offset_normals));
+        let cubic = self.volume_cubics(mesh, Some((&normals, &moves)));
         let offsets: Vec<f64> = cubic
             .iter()
             .zip(&self.target)
@@ -223,12 +229,13 @@ impl VolumeKeeper {
             .collect();
         mesh.positions
             .par_iter_mut()
-            .zip(&offset_normals)
+            .zip(&normals)
             .zip(&self.vertex_part)
+            .enumerate()
             .with_min_len(BLOCK)
-            .for_each(|((position, normal), &part)| {
+            .for_each(|(v, ((position, normal), &part))| {
                 let offset = offsets[part as usize];
-                if *normal != Vec3A::ZERO && offset != 0.0 {
+                if *normal != Vec3A::ZERO && offset != 0.0 && moves(v) {
                     let moved = DVec3::from(position.map(f64::from)) + normal.as_dvec3() * offset;
                     *position = moved.as_vec3().to_array();
                 }

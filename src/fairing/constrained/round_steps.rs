@@ -128,12 +128,7 @@ impl RoundLoop<'_> {
         };
         let started = std::time::Instant::now();
         let volume_kept = self.volume.is_some();
-        judge.fair_copy(
-            &mut self.fairing,
-            iterations,
-            &mesh.positions,
-            volume_kept,
-        );
+        judge.fair_copy(&mut self.fairing, iterations, &mesh.positions, volume_kept);
         let edges = self.tracked.creases.as_ref().map_or(0, |c| c.edges.len());
         let stop = judge.stops_after(round, (mesh, topology), edges, report);
         report.phases.risk += milliseconds(started);
@@ -366,7 +361,9 @@ impl RiskJudge {
         report: &mut FairReport,
     ) -> bool {
         let normals = self.normals.take();
-        let now = self.risk.read(mesh, topology, &self.copy, normals.as_deref());
+        let now = self
+            .risk
+            .read(mesh, topology, &self.copy, normals.as_deref());
         report.risk_by_round.push(now);
         if round == 1 {
             if let Some((_, first)) = self.kept_round {

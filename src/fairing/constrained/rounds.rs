@@ -408,7 +408,9 @@ fn fair_rounds(
         None if options.settled > 0.0 => crate::metrics::mean_edge_length(mesh),
         None => 0.0,
     } * options.settled;
-    let options = &options.clone().with_tolerance(options.tolerance.max(settled));
+    let options = &options
+        .clone()
+        .with_tolerance(options.tolerance.max(settled));
     let mut rounds = RoundLoop {
         topology,
         options,
