@@ -31,6 +31,9 @@ const BLOCK: usize = 4096;
 /// round's offset is a small fraction of an edge length, where two or three steps settle).
 const NEWTON_STEPS: usize = 8;
 
+/// Whether a vertex is offset (see [`VolumeKeeper::restore`]).
+type MovesFlag<'a> = dyn Fn(usize) -> bool + Sync + 'a;
+
 /// The volume of each connected part of a mesh before fairing, and which vertices may be offset.
 #[derive(Clone, Debug)]
 pub struct VolumeKeeper {
@@ -115,7 +118,7 @@ impl VolumeKeeper {
     fn volume_cubics(
         &self,
         mesh: &TriMesh,
-        normals: Option<(&[Vec3A], &(dyn Fn(usize) -> bool + Sync))>,
+        normals: Option<(&[Vec3A], &MovesFlag<'_>)>,
     ) -> Vec<[f64; 4]> {
         let parts = self.parts();
         let apexes: Vec<Vec3A> = self.apex.iter().map(|a| a.as_vec3a()).collect();
