@@ -5,7 +5,7 @@
 //!
 //! Run: `cargo run --release --no-default-features --example fairing_default [-- --trace]`
 //! (`--only gear,cube` runs just those meshes; `--files a.obj,b.ply` adds meshes from files, named
-//! by their stem; `--sigma 0.15` changes the noise; `--default-only` prints the default's row
+//! by their stem; `--sigma 0.15` changes the noise, `--seed 2` its draw (1 unless told); `--default-only` prints the default's row
 //! alone; `--save DIR` writes the clean meshes as PLY files and stops; `--tangential 0.1` gives the
 //! default that tangential relaxation weight at every vertex, as `fair --tangential` does;
 //! `--trace` also prints, per round, the noise estimate and the distance to the clean surface). `docs/measurements.md` holds what it printed and says which meshes the rules were
@@ -99,6 +99,7 @@ fn main() {
     let only = list("--only");
     let files = list("--files").unwrap_or_default();
     let sigma: f64 = value("--sigma").map_or(0.3, |s| s.parse().expect("--sigma: a number"));
+    let seed: u64 = value("--seed").map_or(1, |s| s.parse().expect("--seed: a whole number"));
     let default_only = args.iter().any(|a| a == "--default-only");
     // `--tangential W`: the default with that tangential relaxation weight at every vertex.
     let default_options = match value("--tangential") {
@@ -133,7 +134,10 @@ fn main() {
             if let Some(mode) = mode {
                 add_noise(
                     &mut input,
-                    &NoiseOptions::default().with_sigma(sigma).with_mode(mode),
+                    &NoiseOptions::default()
+                        .with_sigma(sigma)
+                        .with_mode(mode)
+                        .with_seed(seed),
                 );
             }
             let mut faired = input.clone();

@@ -4,7 +4,7 @@
 
 use fairmesh::fairing::{
     fair, fair_constrained, fair_hc, fair_laplacian, fair_taubin, BoundaryMode, FairOptions,
-    FairVariant, HcOptions, LaplacianOptions, MethodOptions, TaubinOptions,
+    FairVariant, HcOptions, LaplacianOptions, MethodOptions, TaubinOptions, ROUND_SETTLED,
 };
 use fairmesh::metrics::{mean_edge_length, signed_volume};
 use fairmesh::noise::{add_noise, NoiseMode, NoiseOptions};
@@ -239,11 +239,41 @@ fn tolerance_stops_early() {
                 .with_rounds(1)
                 .with_tangential_relaxation(0.0)
                 .with_tolerance(tolerance)
+                .with_settled(0.0)
                 .with_variant(variant),
         );
         assert!(report.iterations_run < 30, "{variant:?}: {report:?}");
         assert!(report.max_move < tolerance);
     }
+}
+
+#[test]
+fn a_round_ends_once_it_has_settled_and_ends_where_all_its_iterations_would() {
+    let mesh = noisy(icosphere(4), 0.3, 1);
+    let topology = Topology::build(&mesh);
+    let edge = mean_edge_length(&mesh);
+    let options = FairOptions::default().with_rounds(3);
+    let mut settled = mesh.clone();
+    let report = fair_constrained(&mut settled, &topology, &options);
+    assert_eq!(report.rounds_run, 3);
+    // The last iteration of the last round moved no vertex by more than the default settle
+    // distance, and the rounds stopped before their ten iterations.
+    assert!(report.max_move < ROUND_SETTLED * edge, "{report:?}");
+    assert!(report.iterations_run < 30, "{report:?}");
+    // Every iteration run: the surface ends within a few settle distances.
+    let mut full = mesh.clone();
+    let full_report = fair_constrained(&mut full, &topology, &options.with_settled(0.0));
+    assert_eq!(full_report.iterations_run, 30);
+    let farthest = settled
+        .positions
+        .iter()
+        .zip(&full.positions)
+        .map(|(a, b)| (glam::Vec3::from(*a) - glam::Vec3::from(*b)).length() as f64)
+        .fold(0.0, f64::max);
+    assert!(
+        farthest < 10.0 * ROUND_SETTLED * edge,
+        "{farthest} against {edge}"
+    );
 }
 
 #[test]
@@ -265,8 +295,10 @@ fn rounds_smooth_further_and_still_keep_the_volume() {
     let mut five = mesh.clone();
     let report_five =
         fair_constrained(&mut five, &topology, &FairOptions::default().with_rounds(5));
-    assert_eq!(report_one.iterations_run, 10);
-    assert_eq!(report_five.iterations_run, 50);
+    // Each round ends once it has settled, within its 10 iterations.
+    assert_eq!((report_one.rounds_run, report_five.rounds_run), (1, 5));
+    assert!(report_one.iterations_run <= 10);
+    assert!(report_five.iterations_run <= 50);
     assert!(roughness(&five) < roughness(&one));
     assert!(relative_volume_change(&mesh, &five) < 1e-3);
 }

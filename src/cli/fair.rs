@@ -53,8 +53,9 @@ pub struct FairArgs {
     /// Smoothing method.
     #[arg(long, value_enum, default_value_t = MethodArg::Constrained)]
     pub method: MethodArg,
-    /// Iterations (per round for constrained fairing). Constrained fairing settles after 5 to
-    /// 10 iterations; use --rounds to smooth more.
+    /// Iterations (per round for constrained fairing, at most: a round ends once it has settled,
+    /// see --tolerance). Constrained fairing settles after 5 to 10 iterations; use --rounds to
+    /// smooth more.
     #[arg(long, default_value_t = 10)]
     pub iterations: usize,
     /// Constrained only: rounds; each round re-anchors the triangle centres at the current
@@ -86,9 +87,10 @@ pub struct FairArgs {
     #[arg(long)]
     pub no_volume_correction: bool,
     /// Constrained only: stop a round early once no vertex moves more than this many mean edge
-    /// lengths in one iteration (0: always run all iterations).
-    #[arg(long, default_value_t = 0.0)]
-    pub tolerance: f64,
+    /// lengths in one iteration [default: 0.001, the round has settled; 0: always run all
+    /// iterations].
+    #[arg(long)]
+    pub tolerance: Option<f64>,
     /// How boundary vertices of open meshes move.
     #[arg(long, value_enum, default_value_t = BoundaryArg::Curve)]
     pub boundary: BoundaryArg,
@@ -164,8 +166,12 @@ impl FairArgs {
                 };
                 let mut options = base
                     .with_iterations(self.iterations)
-                    .with_tolerance(self.tolerance * mean_edge_length)
                     .with_boundary(boundary);
+                if let Some(tolerance) = self.tolerance {
+                    options = options
+                        .with_tolerance(tolerance * mean_edge_length)
+                        .with_settled(tolerance);
+                }
                 if let Some(rounds) = self.rounds {
                     options = options.with_rounds(rounds);
                 }
@@ -394,6 +400,7 @@ fn json_report(
         "loose_triangles": report.loose_triangles,
         "time_ms": outcome.time_ms,
         "detection_ms": report.detection_ms,
+        "phases_ms": report.phases,
         "risk_by_round": report.risk_by_round,
         "volume_change_percent": outcome.volume_change_percent,
         "max_move": report.max_move,

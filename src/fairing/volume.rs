@@ -31,6 +31,9 @@ const BLOCK: usize = 4096;
 /// round's offset is a small fraction of an edge length, where two or three steps settle).
 const NEWTON_STEPS: usize = 8;
 
+/// Whether a vertex is offset (see [`VolumeKeeper::restore`]).
+type MovesFlag<'a> = dyn Fn(usize) -> bool + Sync + 'a;
+
 /// The volume of each connected part of a mesh before fairing, and which vertices may be offset.
 #[derive(Clone, Debug)]
 pub struct VolumeKeeper {
@@ -102,10 +105,24 @@ impl VolumeKeeper {
     /// `normals` entry (each face's triple product expanded in δ): c0 is the volume now. `None`:
     /// no normals, only c0 (the other three are zero). One sum for both uses, so that a part that
     /// did not change reads its target exactly and is not offset at all.
-    fn volume_cubics(&self, mesh: &TriMesh, normals: Option<&[Vec3A]>) -> Vec<[f64; 4]> {
+    ///
+    /// Each face's four coefficients are products of single precision points (relative to the
+    /// apex, so the products are of the part's size, not of its distance from the origin) summed
+    /// in double precision: a face's rounding, ~1e-7 of its own cone volume, averages out over the
+    /// faces (the sum's, not the faces', error counts against the volume change of a round, of
+    /// order 1e-5 of the volume). The expansion shares its cross products: a·(b×c),
+    /// na·(b×c) + a·(nb×c + b×nc), na·(nb×c + b×nc) + a·(nb×nc), na·(nb×nc); in double precision
+    /// and as eight separate triple products this pass took as long as four iterations of the
+    /// operator (`docs/measurements.md`, "The volume correction").
+    /// `normals` come with which vertices move (the others' normals count as zero).
+    fn volume_cubics(
+        &self,
+        mesh: &TriMesh,
+        normals: Option<(&[Vec3A], &MovesFlag<'_>)>,
+    ) -> Vec<[f64; 4]> {
         let parts = self.parts();
-        let normal = |v: u32| normals.map_or(DVec3::ZERO, |n| n[v as usize].as_dvec3());
-        let triple = |x: DVec3, y: DVec3, z: DVec3| x.dot(y.cross(z));
+        let apexes: Vec<Vec3A> = self.apex.iter().map(|a| a.as_vec3a()).collect();
+        let point = |v: u32| Vec3A::from_array(mesh.positions[v as usize]);
         let blocks: Vec<Vec<[f64; 4]>> = mesh
             .triangles
             .par_chunks(BLOCK)
@@ -113,14 +130,27 @@ impl VolumeKeeper {
             .map(|(faces, owners)| {
                 let mut sums = vec![[0.0; 4]; parts];
                 for (t, &part) in faces.iter().zip(owners) {
-                    let apex = self.apex[part as usize];
-                    let [a, b, c] = t.map(|v| mesh.point(v) - apex);
-                    let [na, nb, nc] = t.map(normal);
+                    let apex = apexes[part as usize];
+                    let [a, b, c] = t.map(|v| point(v) - apex);
+                    let bc = b.cross(c);
                     let sum = &mut sums[part as usize];
-                    sum[0] += triple(a, b, c) / 6.0;
-                    sum[1] += (triple(na, b, c) + triple(a, nb, c) + triple(a, b, nc)) / 6.0;
-                    sum[2] += (triple(na, nb, c) + triple(na, b, nc) + triple(a, nb, nc)) / 6.0;
-                    sum[3] += triple(na, nb, nc) / 6.0;
+                    sum[0] += f64::from(a.dot(bc));
+                    let Some((normals, moves)) = normals else {
+                        continue;
+                    };
+                    let [na, nb, nc] = t.map(|v| {
+                        let v = v as usize;
+                        if moves(v) {
+                            normals[v]
+                        } else {
+                            Vec3A::ZERO
+                        }
+                    });
+                    let mixed = nb.cross(c) + b.cross(nc);
+                    let nbc = nb.cross(nc);
+                    sum[1] += f64::from(na.dot(bc) + a.dot(mixed));
+                    sum[2] += f64::from(na.dot(mixed) + a.dot(nbc));
+                    sum[3] += f64::from(na.dot(nbc));
                 }
                 sums
             })
@@ -129,7 +159,7 @@ impl VolumeKeeper {
         for block in blocks {
             for (total, sum) in cubic.iter_mut().zip(block) {
                 for k in 0..4 {
-                    total[k] += sum[k];
+                    total[k] += sum[k] / 6.0;
                 }
             }
         }
@@ -153,18 +183,30 @@ impl VolumeKeeper {
         topology: &Topology,
         held: impl Fn(usize) -> bool + Sync,
     ) -> f64 {
+        self.restore_with_normals(mesh, topology, held).0
+    }
+
+    /// [`Self::restore`], also giving back every vertex's unit normal (area-weighted; zero where
+    /// the faces' normals sum to zero, and for a vertex with no face) before the offsets: the
+    /// offsets move the surface by a small fraction of an edge length, uniformly, so these are
+    /// the restored mesh's normals but for that fraction times its curvature (the risk estimate
+    /// reads them instead of another pass over the faces).
+    pub fn restore_with_normals(
+        &self,
+        mesh: &mut TriMesh,
+        topology: &Topology,
+        held: impl Fn(usize) -> bool + Sync,
+    ) -> (f64, Vec<Vec3A>) {
         let moves = |v: usize| self.movable[v] && !held(v);
         let positions = &mesh.positions;
         let point = |v: u32| Vec3A::from_array(positions[v as usize]);
-        // Each movable vertex's unit normal: the sum of its faces' area normals N_f (computed
-        // here from its own corner, (a − v) × (b − v)), zero for the vertices that stay.
+        // Each vertex's unit normal: the sum of its faces' area normals N_f (computed here from
+        // its own corner, (a − v) × (b − v)); the offsets take them for the movable vertices and
+        // zero for the vertices that stay.
         let normals: Vec<Vec3A> = (0..positions.len())
             .into_par_iter()
             .with_min_len(BLOCK)
             .map(|v| {
-                if !moves(v) {
-                    return Vec3A::ZERO;
-                }
                 let p = point(v as u32);
                 let mut sum = Vec3A::ZERO;
                 for &f in topology.faces_of(v as u32) {
@@ -182,7 +224,7 @@ impl VolumeKeeper {
             })
             .collect();
         // Per part, the coefficients of V(δ) = c0 + c1 δ + c2 δ² + c3 δ³.
-        let cubic = self.volume_cubics(mesh, Some(&normals));
+        let cubic = self.volume_cubics(mesh, Some((&normals, &moves)));
         let offsets: Vec<f64> = cubic
             .iter()
             .zip(&self.target)
@@ -192,15 +234,16 @@ impl VolumeKeeper {
             .par_iter_mut()
             .zip(&normals)
             .zip(&self.vertex_part)
+            .enumerate()
             .with_min_len(BLOCK)
-            .for_each(|((position, normal), &part)| {
+            .for_each(|(v, ((position, normal), &part))| {
                 let offset = offsets[part as usize];
-                if *normal != Vec3A::ZERO && offset != 0.0 {
+                if *normal != Vec3A::ZERO && offset != 0.0 && moves(v) {
                     let moved = DVec3::from(position.map(f64::from)) + normal.as_dvec3() * offset;
                     *position = moved.as_vec3().to_array();
                 }
             });
-        offsets.iter().fold(0.0, |m, d| m.max(d.abs()))
+        (offsets.iter().fold(0.0, |m, d| m.max(d.abs())), normals)
     }
 }
 

@@ -356,6 +356,8 @@ fn level_fair_options(options: &MultiresOptions) -> FairOptions {
         relaxation: crate::fairing::Relaxation::Everywhere,
         boundary: options.boundary,
         tolerance: 0.0,
+        // Every level runs all its iterations, as it always has.
+        settled: 0.0,
         mask: None,
         // Multires corrects the shrinkage per level itself.
         keep_volume: false,

@@ -217,15 +217,28 @@ impl ConstrainedFairing {
     }
 
     /// Up to `options.iterations` iterations from the current anchors (one round), counted in
-    /// `report`.
-    pub fn run_round(&mut self, options: &FairOptions, report: &mut FairReport) {
+    /// `report`; how many ran.
+    pub fn run_round(&mut self, options: &FairOptions, report: &mut FairReport) -> usize {
+        let mut run = 0;
         for _ in 0..options.iterations {
             report.max_move = self.step();
-            report.iterations_run += 1;
+            run += 1;
             if report.max_move < options.tolerance {
                 break;
             }
         }
+        report.iterations_run += run;
+        report.rounds_run += 1;
+        run
+    }
+
+    /// Exactly `iterations` iterations from the current anchors (one round), counted in
+    /// `report`.
+    pub fn run_iterations(&mut self, iterations: usize, report: &mut FairReport) {
+        for _ in 0..iterations {
+            report.max_move = self.step();
+        }
+        report.iterations_run += iterations;
         report.rounds_run += 1;
     }
 

@@ -15,6 +15,7 @@ use crate::fairing::strength::{normal_filtering_for, RoundRisk, RISK_MIN_FALL, R
 use crate::fairing::volume::VolumeKeeper;
 use crate::fairing::{FairOptions, FairReport, FairVariant, Relaxation};
 use crate::mesh::{FanRings, Topology, TriMesh};
+use glam::Vec3A;
 use rayon::prelude::*;
 
 /// Once two detections in a row found the creases unchanged (or settled, see
@@ -87,41 +88,51 @@ impl RoundLoop<'_> {
         ) {
             let detection = (fans, crease_options, &mut self.face_rings);
             if self.tracked.detect_again(mesh, topology, detection, report) {
+                let started = std::time::Instant::now();
                 let creases = self.tracked.creases.as_ref();
                 let fairing = &mut self.fairing;
                 fairing.for_other_creases(mesh, topology, fans, creases, self.pinned);
+                report.phases.set_up += milliseconds(started);
             }
         }
         // Imposes the constraints on the positions this round starts from.
+        let started = std::time::Instant::now();
         self.fairing.load(&mesh.positions);
+        let mut iterations_ms = milliseconds(started);
         let fans = self.fans.as_ref();
         let at = (&*mesh, topology);
         self.relaxation
             .before_round(&mut self.fairing, round, at, fans, report);
-        self.fairing.run_round(self.options, report);
+        let started = std::time::Instant::now();
+        let iterations = self.fairing.run_round(self.options, report);
         self.fairing.store(&mut mesh.positions);
+        iterations_ms += milliseconds(started);
+        report.phases.iterations += iterations_ms;
+        let started = std::time::Instant::now();
         if let Some(volume) = &self.volume {
             if let Some(judge) = &mut self.judge {
                 judge.before_restore.clone_from(&mesh.positions);
             }
             let class = self.tracked.creases.as_ref().map(|c| c.class.as_slice());
             let class = class.unwrap_or(&[]);
-            volume.restore(mesh, topology, |v| {
+            let (_, normals) = volume.restore_with_normals(mesh, topology, |v| {
                 class.get(v) == Some(&FeatureClass::Corner)
             });
+            if let Some(judge) = &mut self.judge {
+                judge.normals = Some(normals);
+            }
         }
+        report.phases.volume += milliseconds(started);
         let Some(judge) = &mut self.judge else {
             return false;
         };
+        let started = std::time::Instant::now();
         let volume_kept = self.volume.is_some();
-        judge.fair_copy(
-            &mut self.fairing,
-            self.options,
-            &mesh.positions,
-            volume_kept,
-        );
+        judge.fair_copy(&mut self.fairing, iterations, &mesh.positions, volume_kept);
         let edges = self.tracked.creases.as_ref().map_or(0, |c| c.edges.len());
-        judge.stops_after(round, (mesh, topology), edges, report)
+        let stop = judge.stops_after(round, (mesh, topology), edges, report);
+        report.phases.risk += milliseconds(started);
+        stop
     }
 }
 
@@ -261,12 +272,16 @@ impl RelaxationPlan {
 /// through the same rounds, and the mesh goes back to the last round that lowered the risk
 /// clearly ([`RISK_MIN_FALL`]).
 pub(super) struct RiskJudge {
+    /// The input's mean edge length.
+    pub(super) edge: f64,
     pub(super) risk: RoundRisk,
     /// The risk's copy of the mesh, faired round by round beside it.
     pub(super) copy: Vec<[f32; 3]>,
     pub(super) copy_report: FairReport,
     /// The mesh's positions before this round's volume correction.
     pub(super) before_restore: Vec<[f32; 3]>,
+    /// The mesh's unit vertex normals from this round's volume correction, if it ran.
+    pub(super) normals: Option<Vec<Vec3A>>,
     /// The last round kept: its number and risk, its positions and crease count.
     pub(super) kept_round: Option<(usize, f64)>,
     pub(super) kept_positions: Vec<[f32; 3]>,
@@ -288,10 +303,12 @@ impl RiskJudge {
         let edge = crate::metrics::mean_edge_length(mesh);
         let (risk, copy) = RoundRisk::new(mesh, topology, edge, noise, &held);
         RiskJudge {
+            edge,
             risk,
             copy,
             copy_report: FairReport::default(),
             before_restore: Vec::new(),
+            normals: None,
             kept_round: None,
             kept_positions: Vec::new(),
             kept_creases: 0,
@@ -299,7 +316,8 @@ impl RiskJudge {
         }
     }
 
-    /// The copy's round, with the same operator (and creases) as the mesh's. The volume
+    /// The copy's round, with the same operator (and creases) as the mesh's and its `iterations`
+    /// (the mesh's round settled after that many: the copy goes through the same map). The volume
     /// correction (when `volume_kept`) offsets every vertex by one distance per part along its
     /// normal; the copy takes the mesh's offsets (`after` less the positions before the
     /// correction): what its own correction would give, but for a change of the distance that
@@ -308,12 +326,12 @@ impl RiskJudge {
     pub(super) fn fair_copy(
         &mut self,
         fairing: &mut ConstrainedFairing,
-        options: &FairOptions,
+        iterations: usize,
         after: &[[f32; 3]],
         volume_kept: bool,
     ) {
         fairing.load(&self.copy);
-        fairing.run_round(options, &mut self.copy_report);
+        fairing.run_iterations(iterations, &mut self.copy_report);
         fairing.store(&mut self.copy);
         if volume_kept {
             self.copy
@@ -342,7 +360,10 @@ impl RiskJudge {
         crease_edges: usize,
         report: &mut FairReport,
     ) -> bool {
-        let now = self.risk.read(mesh, topology, &self.copy);
+        let normals = self.normals.take();
+        let now = self
+            .risk
+            .read(mesh, topology, &self.copy, normals.as_deref());
         report.risk_by_round.push(now);
         if round == 1 {
             if let Some((_, first)) = self.kept_round {

@@ -166,6 +166,7 @@ fn in_local_order(
     pinned: &[bool],
     fair: impl FnOnce(&mut TriMesh, &Topology, &FairOptions, &[bool]) -> Option<FairReport>,
 ) -> Option<FairReport> {
+    let started = std::time::Instant::now();
     let (offsets, neighbors) = topology.neighbor_csr();
     let order = breadth_first_order(offsets, neighbors);
     let position = inverse_permutation(&order);
@@ -196,6 +197,7 @@ fn in_local_order(
     }
     let mut local = TriMesh::new(positions, triangles);
     let local_topology = Topology::build(&local);
+    let set_up_ms = milliseconds(started);
     let local_pinned: Vec<bool> = if pinned.is_empty() {
         Vec::new()
     } else {
@@ -218,10 +220,12 @@ fn in_local_order(
             .collect();
         creases.file_edges = edges.into();
     }
-    let report = fair(&mut local, &local_topology, &local_options, &local_pinned)?;
+    let mut report = fair(&mut local, &local_topology, &local_options, &local_pinned)?;
+    let started = std::time::Instant::now();
     for (&v, p) in order.iter().zip(&local.positions) {
         mesh.positions[v as usize] = *p;
     }
+    report.phases.set_up += set_up_ms + milliseconds(started);
     Some(report)
 }
 
@@ -398,6 +402,7 @@ fn fair_rounds(
         None => options.rounds,
     };
     let redetect = options.creases.is_some() && max_rounds > 1;
+    let started = std::time::Instant::now();
     let mut fairing = ConstrainedFairing::with_fans(
         mesh,
         topology,
@@ -408,6 +413,7 @@ fn fair_rounds(
         pinned,
     );
     fairing.set_tangential_relaxation(options.tangential_relaxation as f32);
+    let set_up_ms = milliseconds(started);
     let started = std::time::Instant::now();
     let relaxation = RelaxationPlan::read(mesh, topology, &fans, options, estimate);
     let reading_ms = milliseconds(started);
@@ -416,6 +422,7 @@ fn fair_rounds(
     // relaxation acts everywhere: otherwise they are freed before the iterations (the peak,
     // while the operator is set up from them, stays).
     let fans = (redetect || relaxation.everywhere.is_some_and(|share| share > 0.0)).then_some(fans);
+    let started = std::time::Instant::now();
     let volume = options
         .keep_volume
         .then(|| VolumeKeeper::new(mesh, topology, pinned));
@@ -424,7 +431,20 @@ fn fair_rounds(
         tangential_noise: relaxation.tangential_noise,
         ..FairReport::default()
     };
+    report.phases.volume = milliseconds(started);
+    report.phases.set_up = set_up_ms;
+    let started = std::time::Instant::now();
     let judge = auto_noise.map(|noise| RiskJudge::new(mesh, topology, noise, creases.as_ref()));
+    report.phases.risk = milliseconds(started);
+    // A round ends once it has settled (`FairOptions::settled`) or at `options.tolerance`.
+    let settled = match judge.as_ref() {
+        Some(judge) => judge.edge,
+        None if options.settled > 0.0 => crate::metrics::mean_edge_length(mesh),
+        None => 0.0,
+    } * options.settled;
+    let options = &options
+        .clone()
+        .with_tolerance(options.tolerance.max(settled));
     let mut rounds = RoundLoop {
         topology,
         options,

@@ -115,9 +115,23 @@ impl RoundRisk {
     }
 
     /// The estimated risk (per vertex, squared length) of `mesh` as the rounds' result, the
-    /// input's copy having gone through the same rounds to `copy`.
-    pub(crate) fn read(&self, mesh: &TriMesh, topology: &Topology, copy: &[[f32; 3]]) -> f64 {
-        let normals = unit_vertex_normals(mesh, topology);
+    /// input's copy having gone through the same rounds to `copy`; `normals` are `mesh`'s unit
+    /// vertex normals when the caller has them (the volume correction's), else they are computed.
+    pub(crate) fn read(
+        &self,
+        mesh: &TriMesh,
+        topology: &Topology,
+        copy: &[[f32; 3]],
+        normals: Option<&[Vec3A]>,
+    ) -> f64 {
+        let computed;
+        let normals = match normals {
+            Some(normals) => normals,
+            None => {
+                computed = unit_vertex_normals(mesh, topology);
+                &computed
+            }
+        };
         let step = self.step;
         let sums = mesh
             .positions
@@ -362,7 +376,7 @@ mod tests {
         let copy_mesh = TriMesh::new(copy, input.triangles.clone());
         let read = |a: f32| {
             let (result, moved) = (smooth(&input, a), smooth(&copy_mesh, a));
-            risk.read(&result, &topology, &moved.positions)
+            risk.read(&result, &topology, &moved.positions, None)
         };
         // Sigma as read from the input by second differences: the noise itself.
         let (oracle, half, none) = (read(0.0), read(0.5), read(1.0));
