@@ -70,7 +70,7 @@ use crate::mesh::{Topology, TriMesh};
 pub use baseline::{
     fair_hc, fair_laplacian, fair_taubin, HcOptions, LaplacianOptions, TaubinOptions,
 };
-pub use constrained::{fair_constrained, ConstrainedFairing};
+pub use constrained::{fair_constrained, fair_constrained_with_progress, ConstrainedFairing};
 pub use creases::{detect_creases, CreaseOptions, Creases, FeatureClass};
 pub use mask::{Mask, MaskError};
 pub use strength::estimate_noise;
@@ -379,4 +379,39 @@ pub fn fair_masked(
     let report = fair(mesh, topology, options);
     mask.blend(&original, &mut mesh.positions);
     report
+}
+
+/// [`fair`], or [`fair_masked`] with a `mask`, reporting to `progress`: constrained fairing
+/// before every round ([`fair_constrained_with_progress`]), a baseline before and after its
+/// iterations. `None` when `progress` cancelled the run (`mesh` may then be half faired).
+/// Otherwise the same result, bit for bit, as without the hook.
+pub fn fair_with_progress(
+    mesh: &mut TriMesh,
+    topology: &Topology,
+    options: &MethodOptions,
+    mask: Option<&Mask>,
+    progress: &mut dyn crate::Progress,
+) -> Option<FairReport> {
+    let MethodOptions::Constrained(o) = options else {
+        if !progress.report(0.0) {
+            return None;
+        }
+        let report = match mask {
+            Some(mask) => fair_masked(mesh, topology, options, mask),
+            None => fair(mesh, topology, options),
+        };
+        progress.report(1.0);
+        return Some(report);
+    };
+    match mask {
+        Some(mask) if mask.check_fits(mesh.positions.len()).is_err() => {
+            progress.report(1.0);
+            Some(FairReport::default())
+        }
+        Some(mask) => {
+            let masked = o.clone().with_mask(Some(mask.clone()));
+            fair_constrained_with_progress(mesh, topology, &masked, progress)
+        }
+        None => fair_constrained_with_progress(mesh, topology, o, progress),
+    }
 }

@@ -84,7 +84,7 @@ mod rows;
 mod weights;
 
 pub use operator::{invert3, umbrella_local_matrix, LocalOperator, Matrix3};
-pub use rounds::fair_constrained;
+pub use rounds::{fair_constrained, fair_constrained_with_progress};
 
 use super::boundary::BoundaryCurves;
 use super::creases::Creases;

@@ -16,6 +16,7 @@ use crate::fairing::strength::{
 use crate::fairing::volume::VolumeKeeper;
 use crate::fairing::{FairOptions, FairReport, FairVariant, Strength};
 use crate::mesh::{breadth_first_order, inverse_permutation, FanRings, Topology, TriMesh};
+use crate::{NoProgress, Progress};
 use rayon::prelude::*;
 
 /// Constrained fairing of `mesh` in place (sections 3.2 and 3.3); `topology` must be built from
@@ -48,19 +49,43 @@ pub fn fair_constrained(
     topology: &Topology,
     options: &FairOptions,
 ) -> FairReport {
+    fair_constrained_with_progress(mesh, topology, options, &mut NoProgress).unwrap_or_default()
+}
+
+/// [`fair_constrained`] reporting to `progress` before every round (the fraction is the share of
+/// the most rounds the run may take: automatic strength usually stops well before them). `None`
+/// when `progress` cancelled the run; `mesh` may then hold the positions of a round half way.
+pub fn fair_constrained_with_progress(
+    mesh: &mut TriMesh,
+    topology: &Topology,
+    options: &FairOptions,
+    progress: &mut dyn Progress,
+) -> Option<FairReport> {
+    let report = fair_constrained_reported(mesh, topology, options, progress)?;
+    // Done: the answer no longer matters.
+    progress.report(1.0);
+    Some(report)
+}
+
+fn fair_constrained_reported(
+    mesh: &mut TriMesh,
+    topology: &Topology,
+    options: &FairOptions,
+    progress: &mut dyn Progress,
+) -> Option<FairReport> {
     if options.iterations == 0 || mesh.positions.is_empty() {
-        return FairReport::default();
+        return Some(FairReport::default());
     }
     if options.strength == Strength::Fixed && options.rounds == 0 {
-        return FairReport::default();
+        return Some(FairReport::default());
     }
     // A mask that does not fit, or pins everything: nothing may move.
     if let Some(mask) = &options.mask {
         if mask.check_fits(mesh.positions.len()).is_err() || mask.painted_count() == 0 {
-            return FairReport::default();
+            return Some(FairReport::default());
         }
     }
-    if let Some(report) = fair_without_loose_triangles(mesh, topology, options) {
+    if let Some(report) = fair_without_loose_triangles(mesh, topology, options, progress) {
         return report;
     }
     let original = options.mask.as_ref().map(|_| mesh.positions.clone());
@@ -76,18 +101,18 @@ pub fn fair_constrained(
             options,
             &pinned,
             |mesh, topology, options, pinned| {
-                decide_and_fair(mesh, topology, options, pinned, false)
+                decide_and_fair(mesh, topology, options, pinned, false, progress)
             },
-        )
+        )?
     } else {
-        decide_and_fair(mesh, topology, options, &pinned, true)
+        decide_and_fair(mesh, topology, options, &pinned, true, progress)?
     };
     // The operator held the pinned vertices; the blend fades the rest by their weights (and
     // puts back pinned boundary vertices, which the boundary curves may have moved).
     if let (Some(mask), Some(original)) = (&options.mask, &original) {
         mask.blend(original, &mut mesh.positions);
     }
-    report
+    Some(report)
 }
 
 /// A non-manifold scan is faired as the surface it stands for: without the triangles its
@@ -95,12 +120,14 @@ pub fn fair_constrained(
 /// would make their corners boundary vertices on chains no boundary curve runs through, and so
 /// hold them with their noise (`crate::mesh::loose_triangles`, `docs/measurements.md`). Same
 /// vertices, nothing renumbered; a corner only loose triangles use (a fin's tip) stays where it
-/// is. `None` when the default variant has no loose triangles to leave out.
+/// is. `None` when the default variant has no loose triangles to leave out; `Some(None)` when
+/// `progress` cancelled the run.
 fn fair_without_loose_triangles(
     mesh: &mut TriMesh,
     topology: &Topology,
     options: &FairOptions,
-) -> Option<FairReport> {
+    progress: &mut dyn Progress,
+) -> Option<Option<FairReport>> {
     if options.variant != FairVariant::NormalProjected || topology.non_manifold_edges.is_empty() {
         return None;
     }
@@ -115,13 +142,16 @@ fn fair_without_loose_triangles(
     let volume = options
         .keep_volume
         .then(|| VolumeKeeper::new(mesh, topology, &pinned));
-    let mut report = fair_constrained(&mut kept, &kept_topology, options);
+    let Some(mut report) = fair_constrained_reported(&mut kept, &kept_topology, options, progress)
+    else {
+        return Some(None);
+    };
     mesh.positions = kept.positions;
     if let Some(volume) = volume.filter(|_| report.rounds_run > 0) {
         volume.restore(mesh, topology, |v| pinned.get(v).copied().unwrap_or(false));
     }
     report.loose_triangles += loose.len();
-    Some(report)
+    Some(Some(report))
 }
 
 /// Rounds from which a run in the locality order pays for making it (see [`in_local_order`]).
@@ -141,8 +171,8 @@ fn in_local_order(
     topology: &Topology,
     options: &FairOptions,
     pinned: &[bool],
-    fair: impl FnOnce(&mut TriMesh, &Topology, &FairOptions, &[bool]) -> FairReport,
-) -> FairReport {
+    fair: impl FnOnce(&mut TriMesh, &Topology, &FairOptions, &[bool]) -> Option<FairReport>,
+) -> Option<FairReport> {
     let (offsets, neighbors) = topology.neighbor_csr();
     let order = breadth_first_order(offsets, neighbors);
     let position = inverse_permutation(&order);
@@ -195,23 +225,25 @@ fn in_local_order(
             .collect();
         creases.file_edges = edges.into();
     }
-    let report = fair(&mut local, &local_topology, &local_options, &local_pinned);
+    let report = fair(&mut local, &local_topology, &local_options, &local_pinned)?;
     for (&v, p) in order.iter().zip(&local.positions) {
         mesh.positions[v as usize] = *p;
     }
-    report
+    Some(report)
 }
 
 /// The noise estimate, the decision to fair at all (automatic strength leaves a clean mesh as it
 /// is), the first creases, then the rounds. With `may_reorder`, automatic strength on a noisy
-/// mesh runs its rounds in the locality order ([`in_local_order`]).
+/// mesh runs its rounds in the locality order ([`in_local_order`]). `None` when `progress`
+/// cancelled the run.
 fn decide_and_fair(
     mesh: &mut TriMesh,
     topology: &Topology,
     options: &FairOptions,
     pinned: &[bool],
     may_reorder: bool,
-) -> FairReport {
+    progress: &mut dyn Progress,
+) -> Option<FairReport> {
     // The fan-ordered one-rings the operator is built from serve the noise estimate and the
     // crease detection first (`read_noise`, `detect_creases_with_estimate`).
     let fans = FanRings::new(&mesh.triangles, topology);
@@ -228,11 +260,11 @@ fn decide_and_fair(
         Strength::Auto => match noisy(estimate, reading.as_ref(), topology) {
             Some(noise) => Some(noise),
             None => {
-                return FairReport {
+                return Some(FairReport {
                     noise_estimate: estimate,
                     detection_ms: milliseconds(started),
                     ..FairReport::default()
-                }
+                })
             }
         },
         _ => None,
@@ -260,14 +292,23 @@ fn decide_and_fair(
                     (None, FaceRingCache::in_mesh_order()),
                     options,
                     Rounds { pinned, ..rounds },
+                    progress,
                 )
             },
-        )
+        )?
     } else {
-        fair_rounds(mesh, topology, fans, (found, face_rings), options, rounds)
+        fair_rounds(
+            mesh,
+            topology,
+            fans,
+            (found, face_rings),
+            options,
+            rounds,
+            progress,
+        )?
     };
     report.detection_ms += decided_ms;
-    report
+    Some(report)
 }
 
 /// The first reading of the input: the noise estimate, which decides the strength (automatic)
@@ -341,7 +382,8 @@ struct Rounds<'a> {
 /// around each face if that detection filtered the normals. Each round finds the creases again
 /// when they are due ([`Creases`]), sets the relaxation's shares ([`RelaxationPlan`]), runs the
 /// operator, gives the volume back and, with automatic strength, reads the risk ([`RiskJudge`]),
-/// which may stop the rounds and undo the last ones.
+/// which may stop the rounds and undo the last ones. `progress` hears before every round;
+/// `None` when it cancelled the run.
 fn fair_rounds(
     mesh: &mut TriMesh,
     topology: &Topology,
@@ -349,7 +391,8 @@ fn fair_rounds(
     (found, mut face_rings): (Option<Creases>, FaceRingCache),
     options: &FairOptions,
     rounds: Rounds,
-) -> FairReport {
+    progress: &mut dyn Progress,
+) -> Option<FairReport> {
     let Rounds {
         estimate,
         auto_noise,
@@ -409,6 +452,9 @@ fn fair_rounds(
         judge,
     };
     for round in 0..max_rounds {
+        if !progress.report(round as f32 / max_rounds as f32) {
+            return None;
+        }
         if rounds.run(mesh, round, &mut report) {
             break;
         }
@@ -421,7 +467,7 @@ fn fair_rounds(
     }
     report.noise_estimate = estimate;
     report.crease_edges = crease_edges;
-    report
+    Some(report)
 }
 
 /// The creases the first round fairs with, when the noise estimate's gather did not find them:
@@ -569,16 +615,49 @@ mod tests {
                 for p in &mut local.positions {
                     *p = moved(*p);
                 }
-                FairReport {
+                Some(FairReport {
                     rounds_run: 7,
                     ..FairReport::default()
-                }
+                })
             },
-        );
+        )
+        .expect("the closure fairs");
         assert_eq!(report.rounds_run, 7);
         for (after, &before) in faired.positions.iter().zip(&mesh.positions) {
             assert_eq!(*after, moved(before));
         }
         assert_eq!(faired.triangles, mesh.triangles);
+    }
+
+    #[test]
+    fn a_progress_hook_hears_every_round_and_can_stop_the_run() {
+        let mut noisy = irregular_sphere();
+        crate::noise::add_noise(&mut noisy, &crate::noise::NoiseOptions::default());
+        let topology = Topology::build(&noisy);
+        let options = FairOptions::default().with_rounds(4);
+        let mut plain = noisy.clone();
+        let expected = fair_constrained(&mut plain, &topology, &options);
+        let mut heard = Vec::new();
+        let mut hooked = noisy.clone();
+        let report = fair_constrained_with_progress(&mut hooked, &topology, &options, &mut |f| {
+            heard.push(f);
+            true
+        });
+        // The same report but for the time taken.
+        let same_time = |r: FairReport| FairReport {
+            detection_ms: 0.0,
+            ..r
+        };
+        assert_eq!(report.map(same_time), Some(same_time(expected)));
+        assert_eq!(hooked.positions, plain.positions);
+        assert_eq!(heard, [0.0, 0.25, 0.5, 0.75, 1.0]);
+        let mut stopped = noisy.clone();
+        let mut calls = 0;
+        let report = fair_constrained_with_progress(&mut stopped, &topology, &options, &mut |_| {
+            calls += 1;
+            calls < 3
+        });
+        assert_eq!(report, None);
+        assert_eq!(calls, 3, "stopped before the third round");
     }
 }
