@@ -232,12 +232,15 @@ pub fn hierarchy(
     if let Some(creases) = &mut options.creases {
         *creases = creases.clone().with_file_edges(file_edges);
     }
-    let built = run_detached(py, progress, threads, |hook| {
-        match build_hierarchy_with_topology(&mesh, &topology, &options, hook) {
+    let built = run_detached(
+        py,
+        progress,
+        threads,
+        |hook| match build_hierarchy_with_topology(&mesh, &topology, &options, hook) {
             Err(HierarchyError::Cancelled) => None,
             other => Some(other),
-        }
-    })?
+        },
+    )?
     .map_err(|e| PyValueError::new_err(e.to_string()))?;
     Ok(Hierarchy {
         hierarchy: built,

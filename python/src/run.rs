@@ -155,7 +155,7 @@ impl Drop for FinishedSignal<'_> {
 /// Calls `callback(fraction)`: anything but False (None included) goes on.
 fn keep_going(callback: &Bound<'_, PyAny>, fraction: f32) -> PyResult<bool> {
     let answer = callback.call1((fraction,))?;
-    Ok(!(answer.is_instance_of::<pyo3::types::PyBool>() && !answer.is_truthy()?))
+    Ok(!answer.is_instance_of::<pyo3::types::PyBool>() || answer.is_truthy()?)
 }
 
 /// A panic in the library, as an exception (it is a bug: the message asks for a report).
