@@ -35,7 +35,12 @@ class Cancelled(Exception):
 
 class Mesh:
     """A mesh loaded from a file by ``load``: arrays, and the file kept so that ``save`` writes it
-    back with only the positions changed (as ``fairmesh fair IN -o OUT`` does)."""
+    back with only the positions changed (as ``fairmesh fair IN -o OUT`` does).
+
+    ``fair(mesh)`` works on the loaded mesh itself (no array made, nothing copied but the
+    result), so one ``Mesh`` serves one such call at a time: another thread's call on the same
+    object meanwhile raises ``RuntimeError`` (``fair(mesh.vertices, mesh.faces)`` has no such
+    limit)."""
 
     @property
     def vertices(self) -> npt.NDArray[np.float64]:

@@ -12,6 +12,7 @@ use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::IntoPyDict;
 use std::path::PathBuf;
+use std::sync::OnceLock;
 
 pyo3::create_exception!(
     fairmesh,
@@ -75,8 +76,9 @@ pub fn from_arrays(
 pub struct Mesh {
     pub loaded: Loaded,
     path: PathBuf,
-    vertices: Py<PyAny>,
-    faces: Py<PyAny>,
+    /// The arrays, made on first use: `fair(mesh)` and `save` need neither.
+    vertices: OnceLock<Py<PyAny>>,
+    faces: OnceLock<Py<PyAny>>,
 }
 
 impl Mesh {
@@ -96,14 +98,23 @@ impl Mesh {
 impl Mesh {
     /// The welded vertices, (n, 3) float64, read-only (a result is a new array).
     #[getter]
-    fn vertices(&self, py: Python<'_>) -> Py<PyAny> {
-        self.vertices.clone_ref(py)
+    fn vertices(&self, py: Python<'_>) -> PyResult<Py<PyAny>> {
+        if let Some(array) = self.vertices.get() {
+            return Ok(array.clone_ref(py));
+        }
+        let positions = self.loaded.mesh.positions.clone();
+        let array = read_only(arrays::positions_array(py, positions, Precision::F64))?;
+        Ok(self.vertices.get_or_init(|| array).clone_ref(py))
     }
 
     /// The triangles, (m, 3) int64 indices into `vertices`, read-only.
     #[getter]
-    fn faces(&self, py: Python<'_>) -> Py<PyAny> {
-        self.faces.clone_ref(py)
+    fn faces(&self, py: Python<'_>) -> PyResult<Py<PyAny>> {
+        if let Some(array) = self.faces.get() {
+            return Ok(array.clone_ref(py));
+        }
+        let array = read_only(arrays::triangles_array(py, &self.loaded.mesh.triangles))?;
+        Ok(self.faces.get_or_init(|| array).clone_ref(py))
     }
 
     /// The file's sharp edges ((k, 2) int64 vertex pairs): split normals and material
@@ -247,17 +258,11 @@ pub fn load(
     for warning in &loaded.report.warnings {
         warn(py, &format!("{}: {warning}", path.display()))?;
     }
-    let vertices = read_only(arrays::positions_array(
-        py,
-        loaded.mesh.positions.clone(),
-        Precision::F64,
-    ))?;
-    let faces = read_only(arrays::triangles_array(py, &loaded.mesh.triangles))?;
     Ok(Mesh {
         loaded,
         path,
-        vertices,
-        faces,
+        vertices: OnceLock::new(),
+        faces: OnceLock::new(),
     })
 }
 

@@ -138,3 +138,19 @@ def test_hierarchy_levels_and_repeated_multires(bunny):
     moved8 = fairmesh.compare(noisy, bunny.faces, first)["rms"]
     moved12 = fairmesh.compare(noisy, bunny.faces, smoother)["rms"]
     assert 0 < moved8 < moved12
+
+
+def test_vertices_no_face_uses_stay_where_they_are(bunny):
+    noisy = fairmesh.noise(bunny.vertices, bunny.faces)
+    loose = np.vstack([noisy, [[5.0, 5.0, 5.0]]])
+    smooth, report = fairmesh.fair(loose, bunny.faces, rounds=2)
+    expected, _ = fairmesh.fair(noisy, bunny.faces, rounds=2)
+    np.testing.assert_array_equal(smooth[-1], [5.0, 5.0, 5.0])
+    np.testing.assert_array_equal(smooth[:-1], expected)
+    assert report["vertices"] == len(loose)
+
+
+def test_a_loaded_mesh_saves_back_its_own_positions(tmp_path, bunny):
+    out = tmp_path / "same.obj"
+    bunny.save(out)
+    np.testing.assert_array_equal(fairmesh.load(out).vertices, bunny.vertices)

@@ -124,6 +124,21 @@ def test_progress_is_reported_and_can_cancel(bunny, noisy):
     np.testing.assert_array_equal(first, levels.multires(10))
 
 
+def test_fair_reports_every_round_and_stops_when_told(bunny, noisy):
+    fractions = []
+    fairmesh.fair(noisy, bunny.faces, rounds=60, progress=fractions.append)
+    assert fractions[-1] == 1.0 and fractions == sorted(fractions) and len(fractions) > 2
+    heard = []
+
+    def stop_soon(fraction):
+        heard.append(fraction)
+        return fraction < 0.05
+
+    with pytest.raises(fairmesh.Cancelled):
+        fairmesh.fair(noisy, bunny.faces, rounds=2000, progress=stop_soon)
+    assert heard[-1] >= 0.05 and heard[-1] < 0.5
+
+
 def test_ctrl_c_stops_a_long_fair(bunny, noisy):
     quick = time.perf_counter()
     fairmesh.fair(noisy, bunny.faces, rounds=20)
