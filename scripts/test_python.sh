@@ -2,7 +2,7 @@
 # The Python package's tests (python/): makes a virtual environment (python/.venv), installs
 # maturin, numpy, pytest and trimesh (for fairmesh.trimesh) into it, builds the wheel (release,
 # abi3), installs it and runs pytest, which compares results with the command-line tool built by
-# the Rust tests (target/debug/fairmesh, built here when missing). Run by .ci/run after them.
+# the Rust tests (target/debug/fairmesh, built here when missing; or $FAIRMESH_CLI). Run by .ci/run after them.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 python=${PYTHON:-python3}
@@ -18,10 +18,15 @@ venv=python/.venv
 [ -x "$venv/bin/python" ] || "$python" -m venv "$venv"
 "$venv/bin/python" -m pip install --quiet --upgrade "maturin>=1.9.4,<2" numpy pytest trimesh
 target=${CARGO_TARGET_DIR:-target}
-cargo build --quiet --bin fairmesh
+# The command line the tests compare with: $FAIRMESH_CLI, else the test build's binary.
+if [ -z "${FAIRMESH_CLI:-}" ]; then
+  cargo build --quiet --bin fairmesh
+  FAIRMESH_CLI="$(realpath "$target/debug/fairmesh")"
+fi
+FAIRMESH_CLI="$(realpath "$FAIRMESH_CLI")"
 rm -rf python/dist
 (cd python && ../"$venv"/bin/maturin build --release --locked --out dist)
 "$venv/bin/python" -m pip install --quiet --force-reinstall --no-deps python/dist/fairmesh-*.whl
 # From the tests' folder, so that `import fairmesh` finds the installed wheel, not python/fairmesh.
 cd python/tests
-FAIRMESH_CLI="$(cd ../.. && realpath "$target/debug/fairmesh")" "../../$venv/bin/python" -m pytest -q
+FAIRMESH_CLI="$FAIRMESH_CLI" "../../$venv/bin/python" -m pytest -q
