@@ -1,14 +1,16 @@
 #!/usr/bin/env bash
 # The checks that keep the code as it is meant to be, run by CI after the tests (it reuses the
-# test build): clippy with no warning, with and without the editor (the lints of Cargo.toml's
-# `[lints]` table); no import cycle between the files of a module (scripts/import_cycles.py);
-# every file the `fairmesh` binary writes on the repository's meshes byte-identical to
+# test build): clippy with no warning, with and without the editor, and on the Python package
+# (the lints of Cargo.toml's `[lints]` table); no import cycle between the files of a module
+# (scripts/import_cycles.py); every file the `fairmesh` binary writes on the repository's meshes byte-identical to
 # scripts/output_sums.txt (scripts/check_outputs.sh).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 if cargo clippy --version >/dev/null 2>&1; then
   cargo clippy --all-targets -- -D warnings
   cargo clippy --no-default-features --features cli --all-targets -- -D warnings
+  # The Python package (python/, a member of the workspace that the commands above leave out).
+  cargo clippy -p fairmesh-python --all-targets -- -D warnings
 else
   echo "check_code: cargo clippy is not installed (rustup component add clippy); lints not checked" >&2
 fi

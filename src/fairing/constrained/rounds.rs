@@ -231,7 +231,8 @@ fn in_local_order(
 
 /// The noise estimate, the decision to fair at all (automatic strength leaves a clean mesh as it
 /// is), the first creases, then the rounds. With `may_reorder`, automatic strength on a noisy
-/// mesh runs its rounds in the locality order ([`in_local_order`]).
+/// mesh runs its rounds in the locality order ([`in_local_order`]). `None` when `progress`
+/// cancelled the run.
 fn decide_and_fair(
     mesh: &mut TriMesh,
     topology: &Topology,
@@ -378,7 +379,8 @@ struct Rounds<'a> {
 /// around each face if that detection filtered the normals. Each round finds the creases again
 /// when they are due ([`Creases`]), sets the relaxation's shares ([`RelaxationPlan`]), runs the
 /// operator, gives the volume back and, with automatic strength, reads the risk ([`RiskJudge`]),
-/// which may stop the rounds and undo the last ones.
+/// which may stop the rounds and undo the last ones. `progress` hears after every round;
+/// `None` when it cancelled the run.
 fn fair_rounds(
     mesh: &mut TriMesh,
     topology: &Topology,

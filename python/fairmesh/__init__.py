@@ -1,0 +1,55 @@
+"""fairmesh: take noise and unwanted detail out of triangle meshes without shrinking them.
+
+Constrained fairing (Liu, Bao, Heng, Wong, Peng, "Constrained Fairing for Meshes") on numpy
+arrays: ``vertices`` is an (n, 3) float array (float32 or float64), ``faces`` an (m, 3) integer
+array of vertex indices; results are new numpy arrays and the inputs are never changed.
+
+    import fairmesh
+    mesh = fairmesh.load("scan.ply")                # or any (vertices, faces) arrays
+    smooth, report = fairmesh.fair(mesh.vertices, mesh.faces)
+    print(report["rounds_run"], report["volume_change_percent"])
+    mesh.save("scan_faired.ply", smooth)            # the file comes back with new positions
+
+- ``fair``: the command line's ``fair``, options as keyword arguments with its names and
+  defaults; the report has the fields of ``fairmesh fair --json``.
+- ``noise``, ``compare``: seeded noise; distances and volume change between two meshes.
+- ``hierarchy``: the decimation hierarchy, whose ``multires(start_level)`` fairs from a coarse
+  level and can be run again and again without building anything again.
+- ``load`` / ``Mesh.save``: files kept as the command line keeps them (written back into
+  their own format with only the positions changed); ``save`` writes a bare mesh.
+- ``fairmesh.trimesh`` and ``fairmesh.open3d``: the same on trimesh and Open3D meshes.
+
+Long calls release the GIL (other Python threads run meanwhile), take ``progress=callable``
+(called with the fraction done; returning False stops the call with ``Cancelled``) and stop on
+Ctrl+C with ``KeyboardInterrupt``.
+"""
+
+from ._fairmesh import (
+    Cancelled,
+    Hierarchy,
+    Mesh,
+    MeshFileError,
+    MeshWarning,
+    __version__,
+    compare,
+    fair,
+    hierarchy,
+    load,
+    noise,
+    save,
+)
+
+__all__ = [
+    "Cancelled",
+    "Hierarchy",
+    "Mesh",
+    "MeshFileError",
+    "MeshWarning",
+    "__version__",
+    "compare",
+    "fair",
+    "hierarchy",
+    "load",
+    "noise",
+    "save",
+]

@@ -1,0 +1,402 @@
+//! `fairmesh.fair`: the command line's `fair` on arrays (or on a loaded [`Mesh`]), with its
+//! options as keyword arguments under the same names and defaults, and its `--json` report as a
+//! dict with the same fields.
+
+use crate::arrays::{self, Precision, VertexSelection};
+use crate::mesh::{from_arrays, Mesh};
+use crate::options;
+use crate::run::run_detached;
+use fairmesh::fairing::{
+    self, creases::DEFAULT_CREASE_ANGLE, CreaseOptions, FairOptions, FairReport, FairVariant,
+    HcOptions, LaplacianOptions, Mask, Method, MethodOptions, Relaxation, TaubinOptions,
+};
+use fairmesh::{metrics, Topology, TriMesh};
+use pyo3::exceptions::{PyTypeError, PyValueError};
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+use std::time::Instant;
+
+/// The keyword arguments of `fair`, as the command line's `fair` names them.
+pub struct FairArgs {
+    pub method: Method,
+    pub iterations: usize,
+    pub rounds: Option<usize>,
+    pub crease_angle: f64,
+    pub no_creases: bool,
+    pub tangential: Option<f64>,
+    pub no_volume_correction: bool,
+    pub tolerance: f64,
+    pub boundary: fairing::BoundaryMode,
+    pub paper_variant: bool,
+    pub lambda: Option<f64>,
+    pub mu: Option<f64>,
+    pub alpha: Option<f64>,
+    pub beta: Option<f64>,
+}
+
+impl FairArgs {
+    /// The options of the chosen method, as `fairmesh fair` builds them (`src/cli/fair.rs`),
+    /// with `hard_edges` (the file's sharp edges) as creases too.
+    fn method_options(&self, mean_edge_length: f64, hard_edges: Vec<[u32; 2]>) -> MethodOptions {
+        let boundary = self.boundary;
+        match self.method {
+            Method::Laplacian => {
+                let defaults = LaplacianOptions::default();
+                MethodOptions::Laplacian(LaplacianOptions {
+                    iterations: self.iterations,
+                    lambda: self.lambda.unwrap_or(defaults.lambda),
+                    boundary,
+                })
+            }
+            Method::Taubin => {
+                let defaults = TaubinOptions::default();
+                MethodOptions::Taubin(TaubinOptions {
+                    iterations: self.iterations,
+                    lambda: self.lambda.unwrap_or(defaults.lambda),
+                    mu: self.mu.unwrap_or(defaults.mu),
+                    boundary,
+                })
+            }
+            Method::Hc => {
+                let defaults = HcOptions::default();
+                MethodOptions::Hc(HcOptions {
+                    iterations: self.iterations,
+                    alpha: self.alpha.unwrap_or(defaults.alpha),
+                    beta: self.beta.unwrap_or(defaults.beta),
+                    boundary,
+                })
+            }
+            _ => {
+                let base = if self.paper_variant {
+                    FairOptions::paper()
+                } else {
+                    let options = FairOptions::default()
+                        .with_keep_volume(!self.no_volume_correction)
+                        .with_creases((!self.no_creases).then(|| {
+                            CreaseOptions::default()
+                                .with_angle_degrees(self.crease_angle)
+                                .with_file_edges(hard_edges)
+                        }));
+                    match self.tangential {
+                        Some(weight) => options
+                            .with_tangential_relaxation(weight)
+                            .with_relaxation(Relaxation::Everywhere),
+                        None => options,
+                    }
+                };
+                let mut options = base
+                    .with_iterations(self.iterations)
+                    .with_tolerance(self.tolerance * mean_edge_length)
+                    .with_boundary(boundary);
+                if let Some(rounds) = self.rounds {
+                    options = options.with_rounds(rounds);
+                }
+                MethodOptions::Constrained(options)
+            }
+        }
+    }
+}
+
+/// What one fairing did, for the report.
+struct Outcome {
+    report: FairReport,
+    time_ms: f64,
+    volume_change_percent: Option<f64>,
+    texture_slide: Option<f64>,
+    measures: Option<metrics::Comparison>,
+}
+
+/// Fairs `mesh` (within `mask`) as `fairmesh fair` does, timing the fairing alone.
+fn fair_mesh(
+    mesh: &mut TriMesh,
+    topology: &Topology,
+    options: &MethodOptions,
+    mask: Option<&Mask>,
+    textured: bool,
+    measure: bool,
+    progress: &mut dyn fairmesh::Progress,
+) -> Option<Outcome> {
+    let edge = metrics::mean_edge_length(mesh);
+    let volume_before = metrics::signed_volume(mesh);
+    let input = measure.then(|| mesh.clone());
+    let slides = matches!(options, MethodOptions::Constrained(o) if o.tangential_relaxation > 0.0
+        && o.variant == FairVariant::NormalProjected);
+    let textured_input = (slides && textured).then(|| mesh.positions.clone());
+    let start = Instant::now();
+    let report = fairing::fair_with_progress(mesh, topology, options, mask, progress)?;
+    let time_ms = start.elapsed().as_secs_f64() * 1e3;
+    let volume_after = metrics::signed_volume(mesh);
+    let volume_change_percent = (volume_before != 0.0)
+        .then(|| 100.0 * (volume_after - volume_before) / volume_before.abs())
+        .filter(|change| change.is_finite());
+    let texture_slide = textured_input
+        .filter(|_| report.rounds_run > 0)
+        .map(|before| metrics::tangential_slide(&before, mesh) / edge)
+        .filter(|slide| slide.is_finite());
+    let measures = input.map(|input| metrics::compare(&input, mesh));
+    Some(Outcome {
+        report,
+        time_ms,
+        volume_change_percent,
+        texture_slide,
+        measures,
+    })
+}
+
+/// The mask of `mask` (weights or vertex indices) on `mesh`, faded over `falloff` rings.
+fn read_mask(
+    mask: Option<&Bound<'_, PyAny>>,
+    falloff: usize,
+    mesh: &TriMesh,
+    topology: &Topology,
+) -> PyResult<Option<Mask>> {
+    let Some(mask) = mask.filter(|m| !m.is_none()) else {
+        if falloff > 0 {
+            return Err(PyValueError::new_err("mask_falloff needs a mask"));
+        }
+        return Ok(None);
+    };
+    let n = mesh.vertex_count();
+    let mask = match arrays::read_selection("mask", mask, n)? {
+        VertexSelection::Weights(weights) => {
+            Mask::new(weights).map_err(|e| PyValueError::new_err(format!("mask: {e}")))?
+        }
+        VertexSelection::Indices(vertices) => Mask::from_vertices(n, vertices),
+    };
+    if mask.painted_count() == 0 {
+        return Err(PyValueError::new_err(
+            "mask lets no vertex move, so nothing would be faired",
+        ));
+    }
+    Ok(Some(if falloff > 0 {
+        mask.with_falloff(topology, falloff)
+    } else {
+        mask
+    }))
+}
+
+/// The report, with the fields of `fairmesh fair --json` (`input`/`output`: the loaded file's
+/// path and None; `texture_follows`: None, as it depends on where the result is saved).
+fn report_dict<'py>(
+    py: Python<'py>,
+    input: Option<String>,
+    mesh: &TriMesh,
+    topology: &Topology,
+    options: &MethodOptions,
+    mask: Option<&Mask>,
+    outcome: &Outcome,
+) -> PyResult<Bound<'py, PyDict>> {
+    let report = &outcome.report;
+    let variant = match options {
+        MethodOptions::Constrained(o) => Some(o.variant.name()),
+        _ => None,
+    };
+    let dict = PyDict::new(py);
+    dict.set_item("method", options.method().name())?;
+    dict.set_item("variant", variant)?;
+    dict.set_item("input", input)?;
+    dict.set_item("output", py.None())?;
+    dict.set_item("vertices", mesh.vertex_count())?;
+    dict.set_item("faces", mesh.face_count())?;
+    dict.set_item("closed", topology.is_closed())?;
+    dict.set_item("iterations_run", report.iterations_run)?;
+    dict.set_item("rounds_run", report.rounds_run)?;
+    dict.set_item("noise_estimate", report.noise_estimate)?;
+    dict.set_item("tangential_noise", report.tangential_noise)?;
+    dict.set_item("crease_edges", report.crease_edges)?;
+    dict.set_item("loose_triangles", report.loose_triangles)?;
+    dict.set_item("time_ms", outcome.time_ms)?;
+    dict.set_item("detection_ms", report.detection_ms)?;
+    dict.set_item("risk_by_round", report.risk_by_round.clone())?;
+    dict.set_item("volume_change_percent", outcome.volume_change_percent)?;
+    dict.set_item("max_move", report.max_move)?;
+    dict.set_item("masked_vertices", mask.map(|m| m.painted_count()))?;
+    dict.set_item("texture_slide", outcome.texture_slide)?;
+    dict.set_item("texture_follows", py.None())?;
+    if let Some(m) = &outcome.measures {
+        dict.set_item("mean_surface_distance", m.mean_surface_distance)?;
+        dict.set_item("hausdorff", m.hausdorff)?;
+        if let Some(c) = &m.same_connectivity {
+            dict.set_item("rms", c.rms)?;
+            dict.set_item("normal_error_deg", c.normal_error_deg)?;
+        }
+    }
+    Ok(dict)
+}
+
+/// `fairmesh.fair(vertices, faces, **options)`; `vertices` may be a loaded `Mesh` instead,
+/// with `faces` left out: its file's sharp edges are then kept, as the command line keeps them.
+#[pyfunction]
+#[pyo3(signature = (
+    vertices, faces=None, *, method="constrained", iterations=10, rounds=None,
+    crease_angle=DEFAULT_CREASE_ANGLE, no_creases=false, tangential=None,
+    no_volume_correction=false, tolerance=0.0, boundary="curve", variant="normal-projected",
+    lambda_=None, mu=None, alpha=None, beta=None, mask=None, mask_falloff=0, hard_edges=None,
+    measure=false, progress=None, threads=None
+))]
+#[allow(clippy::too_many_arguments)]
+pub fn fair<'py>(
+    py: Python<'py>,
+    vertices: &Bound<'py, PyAny>,
+    faces: Option<&Bound<'py, PyAny>>,
+    method: &str,
+    iterations: i64,
+    rounds: Option<i64>,
+    crease_angle: f64,
+    no_creases: bool,
+    tangential: Option<f64>,
+    no_volume_correction: bool,
+    tolerance: f64,
+    boundary: &str,
+    variant: &str,
+    lambda_: Option<f64>,
+    mu: Option<f64>,
+    alpha: Option<f64>,
+    beta: Option<f64>,
+    mask: Option<&Bound<'py, PyAny>>,
+    mask_falloff: i64,
+    hard_edges: Option<&Bound<'py, PyAny>>,
+    measure: bool,
+    progress: Option<&Bound<'py, PyAny>>,
+    threads: Option<i64>,
+) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyDict>)> {
+    let threads = options::threads(threads)?;
+    let method = match options::choice(
+        "method",
+        method,
+        &["constrained", "laplacian", "taubin", "hc"],
+    )? {
+        0 => Method::Constrained,
+        1 => Method::Laplacian,
+        2 => Method::Taubin,
+        _ => Method::Hc,
+    };
+    let args = FairArgs {
+        method,
+        iterations: options::count("iterations", iterations)?,
+        rounds: rounds.map(|r| options::count("rounds", r)).transpose()?,
+        crease_angle: options::number_in("crease_angle", crease_angle, 0.0, 180.0)?,
+        no_creases,
+        tangential: tangential
+            .map(|t| options::number_in("tangential", t, 0.0, 1.0))
+            .transpose()?,
+        no_volume_correction,
+        tolerance: options::number_in("tolerance", tolerance, 0.0, f64::MAX)?,
+        boundary: options::boundary(boundary)?,
+        paper_variant: options::choice("variant", variant, &["normal-projected", "paper"])? == 1,
+        lambda: lambda_.map(|v| options::finite("lambda_", v)).transpose()?,
+        mu: mu.map(|v| options::finite("mu", v)).transpose()?,
+        alpha: alpha
+            .map(|v| options::number_in("alpha", v, 0.0, 1.0))
+            .transpose()?,
+        beta: beta
+            .map(|v| options::number_in("beta", v, 0.0, 1.0))
+            .transpose()?,
+    };
+    let mask_falloff = options::count("mask_falloff", mask_falloff)?;
+    if let Ok(loaded) = vertices.cast::<Mesh>() {
+        if faces.is_some_and(|f| !f.is_none()) {
+            return Err(PyTypeError::new_err(
+                "faces must be left out when vertices is a fairmesh.Mesh (its faces are used)",
+            ));
+        }
+        let mut loaded = loaded.borrow_mut();
+        let file_edges = match hard_edges {
+            Some(edges) if !edges.is_none() => {
+                read_edges(edges, loaded.loaded.mesh.vertex_count())?
+            }
+            _ => loaded.file_hard_edges(),
+        };
+        let input = Some(loaded.path().display().to_string());
+        let textured = loaded.loaded.source.has_texture_coordinates();
+        let state = &mut loaded.loaded;
+        let mask = read_mask(mask, mask_falloff, &state.mesh, &state.topology)?;
+        let edge = metrics::mean_edge_length(&state.mesh);
+        let options = args.method_options(edge, file_edges);
+        // The loaded mesh is faired in place on a copy of its positions, which are put back.
+        let mut positions = state.mesh.positions.clone();
+        let (mesh, topology) = (&mut state.mesh, &state.topology);
+        let outcome = run_detached(py, progress, threads, |hook| {
+            std::mem::swap(&mut mesh.positions, &mut positions);
+            let outcome = fair_mesh(
+                mesh,
+                topology,
+                &options,
+                mask.as_ref(),
+                textured,
+                measure,
+                hook,
+            );
+            std::mem::swap(&mut mesh.positions, &mut positions);
+            outcome
+        })?;
+        let report = report_dict(
+            py,
+            input,
+            &state.mesh,
+            &state.topology,
+            &options,
+            mask.as_ref(),
+            &outcome,
+        )?;
+        return Ok((
+            arrays::positions_array(py, positions, Precision::F64),
+            report,
+        ));
+    }
+    let Some(faces) = faces.filter(|f| !f.is_none()) else {
+        return Err(PyTypeError::new_err(
+            "faces is needed (an (m, 3) integer array) unless vertices is a fairmesh.Mesh",
+        ));
+    };
+    let (mut mesh, topology, precision) = from_arrays(vertices, faces)?;
+    let file_edges = match hard_edges {
+        Some(edges) if !edges.is_none() => read_edges(edges, mesh.vertex_count())?,
+        _ => Vec::new(),
+    };
+    let mask = read_mask(mask, mask_falloff, &mesh, &topology)?;
+    let options = args.method_options(metrics::mean_edge_length(&mesh), file_edges);
+    let outcome = run_detached(py, progress, threads, |hook| {
+        fair_mesh(
+            &mut mesh,
+            &topology,
+            &options,
+            mask.as_ref(),
+            false,
+            measure,
+            hook,
+        )
+    })?;
+    let report = report_dict(
+        py,
+        None,
+        &mesh,
+        &topology,
+        &options,
+        mask.as_ref(),
+        &outcome,
+    )?;
+    Ok((
+        arrays::positions_array(py, mesh.positions, precision),
+        report,
+    ))
+}
+
+/// `hard_edges`: (k, 2) vertex pairs.
+fn read_edges(edges: &Bound<'_, PyAny>, vertex_count: usize) -> PyResult<Vec<[u32; 2]>> {
+    let pairs: Vec<[i64; 2]> = edges.extract().map_err(|_| {
+        PyTypeError::new_err("hard_edges must be a (k, 2) array of vertex index pairs")
+    })?;
+    pairs
+        .iter()
+        .enumerate()
+        .map(|(i, &[a, b])| match (u32::try_from(a), u32::try_from(b)) {
+            (Ok(a), Ok(b)) if (a as usize) < vertex_count && (b as usize) < vertex_count => {
+                Ok([a.min(b), a.max(b)])
+            }
+            _ => Err(PyValueError::new_err(format!(
+                "hard_edges[{i}] = [{a}, {b}] names a vertex beyond the {vertex_count} vertices"
+            ))),
+        })
+        .collect()
+}

@@ -1,0 +1,251 @@
+//! `fairmesh.hierarchy`: the decimation hierarchy (paper section 4.1) as a [`Hierarchy`] object
+//! that gives its levels as arrays and runs multiresolution fairing (4.2) from any start level
+//! again and again, keeping each level's set-up between runs as the editor does.
+
+use crate::arrays::{self, Precision, VertexSelection};
+use crate::mesh::{from_arrays, Mesh};
+use crate::options;
+use crate::run::run_detached;
+use fairmesh::fairing::{creases::DEFAULT_CREASE_ANGLE, CreaseOptions, Mask};
+use fairmesh::hierarchy::{build_hierarchy_with_topology, HierarchyError, HierarchyOptions};
+use fairmesh::multires::{fair_multires, MultiresOptions, MultiresVariant, MultiresWorkspace};
+use fairmesh::Topology;
+use pyo3::exceptions::{PyTypeError, PyValueError};
+use pyo3::prelude::*;
+use std::sync::Mutex;
+
+/// The decimation hierarchy of a mesh (`fairmesh.hierarchy(...)`): level 0 is the mesh itself,
+/// each further level coarser. `multires(start_level)` fairs from a level down to full detail;
+/// the set-up of every level a run used is kept, so the next run only fairs.
+#[pyclass(name = "Hierarchy", module = "fairmesh", frozen)]
+pub struct Hierarchy {
+    hierarchy: fairmesh::hierarchy::Hierarchy,
+    /// M0's topology, for a mask's falloff.
+    topology: Topology,
+    workspace: Mutex<MultiresWorkspace>,
+    precision: Precision,
+}
+
+#[pymethods]
+impl Hierarchy {
+    /// Number of levels, level 0 (the input) included.
+    #[getter]
+    fn level_count(&self) -> usize {
+        self.hierarchy.level_count()
+    }
+
+    /// The coarsest level's index (`level_count - 1`).
+    #[getter]
+    fn coarsest_level(&self) -> usize {
+        self.hierarchy.coarsest_level()
+    }
+
+    /// (vertices, faces) of every level, level 0 first.
+    #[getter]
+    fn level_sizes(&self) -> Vec<(usize, usize)> {
+        (0..self.hierarchy.level_count())
+            .map(|level| {
+                let info = self.hierarchy.level_info(level);
+                (info.vertices, info.faces)
+            })
+            .collect()
+    }
+
+    /// Level `level` as arrays: (vertices (k, 3), faces (j, 3), original), where `original[i]`
+    /// is the index of vertex `i` in level 0 (the input), whose position it has.
+    fn level<'py>(
+        &self,
+        py: Python<'py>,
+        level: i64,
+    ) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyAny>, Bound<'py, PyAny>)> {
+        let level = options::count("level", level)?;
+        if level > self.hierarchy.coarsest_level() {
+            return Err(PyValueError::new_err(format!(
+                "level must be from 0 to {} (the coarsest), not {level}",
+                self.hierarchy.coarsest_level()
+            )));
+        }
+        let (mesh, origins, _) = self.hierarchy.level_for_export(level);
+        let original: Vec<i64> = origins.into_iter().map(i64::from).collect();
+        Ok((
+            arrays::positions_array(py, mesh.positions, self.precision),
+            arrays::triangles_array(py, &mesh.triangles),
+            arrays::vector(py, original),
+        ))
+    }
+
+    /// Multiresolution fairing from `start_level` (0: the input itself; beyond the coarsest,
+    /// the coarsest) down to full detail: the input's vertices, smoothed, as a new (n, 3)
+    /// array (the input's faces apply). Options as `fairmesh multires` names them.
+    #[pyo3(signature = (
+        start_level, *, iterations=5, rounds=1, boundary="curve", fair_finest=false,
+        variant="improved", mask=None, mask_falloff=0, progress=None, threads=None
+    ))]
+    #[allow(clippy::too_many_arguments)]
+    fn multires<'py>(
+        &self,
+        py: Python<'py>,
+        start_level: i64,
+        iterations: i64,
+        rounds: i64,
+        boundary: &str,
+        fair_finest: bool,
+        variant: &str,
+        mask: Option<&Bound<'py, PyAny>>,
+        mask_falloff: i64,
+        progress: Option<&Bound<'py, PyAny>>,
+        threads: Option<i64>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let threads = options::threads(threads)?;
+        let variant = match options::choice("variant", variant, &["improved", "paper"])? {
+            0 => MultiresVariant::Improved,
+            _ => MultiresVariant::Paper,
+        };
+        let mask_falloff = options::count("mask_falloff", mask_falloff)?;
+        let mask = self.mask(mask, mask_falloff)?;
+        let options = MultiresOptions::default()
+            .with_start_level(options::count("start_level", start_level)?)
+            .with_iterations(options::count("iterations", iterations)?)
+            .with_rounds(options::count("rounds", rounds)?)
+            .with_boundary(options::boundary(boundary)?)
+            .with_fair_finest(fair_finest)
+            .with_variant(variant)
+            .with_mask(mask);
+        let hierarchy = &self.hierarchy;
+        let workspace = &self.workspace;
+        let positions = run_detached(py, progress, threads, |hook| {
+            // A run cancelled half way leaves the workspace fit for the next one.
+            let mut workspace = workspace
+                .lock()
+                .unwrap_or_else(std::sync::PoisonError::into_inner);
+            fair_multires(hierarchy, &options, &mut workspace, hook)
+        })?;
+        Ok(arrays::positions_array(py, positions, self.precision))
+    }
+
+    fn __repr__(&self) -> String {
+        let base = self.hierarchy.base_mesh();
+        format!(
+            "<fairmesh.Hierarchy of {} vertices, {} faces: {} levels, the coarsest {} vertices>",
+            base.vertex_count(),
+            base.face_count(),
+            self.hierarchy.level_count(),
+            self.hierarchy
+                .level_info(self.hierarchy.coarsest_level())
+                .vertices
+        )
+    }
+}
+
+impl Hierarchy {
+    fn mask(&self, mask: Option<&Bound<'_, PyAny>>, falloff: usize) -> PyResult<Option<Mask>> {
+        let Some(mask) = mask.filter(|m| !m.is_none()) else {
+            if falloff > 0 {
+                return Err(PyValueError::new_err("mask_falloff needs a mask"));
+            }
+            return Ok(None);
+        };
+        let n = self.hierarchy.base_mesh().vertex_count();
+        let mask = match arrays::read_selection("mask", mask, n)? {
+            VertexSelection::Weights(weights) => {
+                Mask::new(weights).map_err(|e| PyValueError::new_err(format!("mask: {e}")))?
+            }
+            VertexSelection::Indices(vertices) => Mask::from_vertices(n, vertices),
+        };
+        if mask.painted_count() == 0 {
+            return Err(PyValueError::new_err(
+                "mask lets no vertex move, so nothing would be faired",
+            ));
+        }
+        Ok(Some(if falloff > 0 {
+            mask.with_falloff(&self.topology, falloff)
+        } else {
+            mask
+        }))
+    }
+}
+
+/// `fairmesh.hierarchy(vertices, faces, **options)`: builds the decimation hierarchy, with the
+/// options of `fairmesh hierarchy`; `vertices` may be a loaded `Mesh` (faces left out), whose
+/// file's sharp edges are then kept with the creases.
+#[pyfunction]
+#[pyo3(signature = (
+    vertices, faces=None, *, alpha=1.0, beta=0.01, min_vertices=100, max_levels=64,
+    keep_boundary=false, keep_creases=false, crease_angle=None, progress=None, threads=None
+))]
+#[allow(clippy::too_many_arguments)]
+pub fn hierarchy(
+    py: Python<'_>,
+    vertices: &Bound<'_, PyAny>,
+    faces: Option<&Bound<'_, PyAny>>,
+    alpha: f64,
+    beta: f64,
+    min_vertices: i64,
+    max_levels: i64,
+    keep_boundary: bool,
+    keep_creases: bool,
+    crease_angle: Option<f64>,
+    progress: Option<&Bound<'_, PyAny>>,
+    threads: Option<i64>,
+) -> PyResult<Hierarchy> {
+    let threads = options::threads(threads)?;
+    let crease_angle = crease_angle
+        .map(|a| options::number_in("crease_angle", a, 0.0, 180.0))
+        .transpose()?;
+    let mut options = HierarchyOptions::default()
+        .with_alpha(options::finite("alpha", alpha)?)
+        .with_beta(options::finite("beta", beta)?)
+        .with_min_vertices(options::count("min_vertices", min_vertices)?)
+        .with_max_levels(options::count("max_levels", max_levels)?)
+        .with_keep_boundary(keep_boundary)
+        .with_creases((keep_creases || crease_angle.is_some()).then(|| {
+            CreaseOptions::default()
+                .with_angle_degrees(crease_angle.unwrap_or(DEFAULT_CREASE_ANGLE))
+        }));
+    let (mesh, topology, precision, file_edges) = match vertices.cast::<Mesh>() {
+        Ok(loaded) => {
+            if faces.is_some_and(|f| !f.is_none()) {
+                return Err(PyTypeError::new_err(
+                    "faces must be left out when vertices is a fairmesh.Mesh (its faces are used)",
+                ));
+            }
+            let loaded = loaded.borrow();
+            let edges = loaded.file_hard_edges();
+            let state = &loaded.loaded;
+            (
+                state.mesh.clone(),
+                state.topology.clone(),
+                Precision::F64,
+                edges,
+            )
+        }
+        Err(_) => {
+            let Some(faces) = faces.filter(|f| !f.is_none()) else {
+                return Err(PyTypeError::new_err(
+                    "faces is needed (an (m, 3) integer array) unless vertices is a fairmesh.Mesh",
+                ));
+            };
+            let (mesh, topology, precision) = from_arrays(vertices, faces)?;
+            (mesh, topology, precision, Vec::new())
+        }
+    };
+    if let Some(creases) = &mut options.creases {
+        *creases = creases.clone().with_file_edges(file_edges);
+    }
+    let built = run_detached(
+        py,
+        progress,
+        threads,
+        |hook| match build_hierarchy_with_topology(&mesh, &topology, &options, hook) {
+            Err(HierarchyError::Cancelled) => None,
+            other => Some(other),
+        },
+    )?
+    .map_err(|e| PyValueError::new_err(e.to_string()))?;
+    Ok(Hierarchy {
+        hierarchy: built,
+        topology,
+        workspace: Mutex::new(MultiresWorkspace::new()),
+        precision,
+    })
+}

@@ -1,0 +1,36 @@
+"""Shared fixtures: the repository's meshes and the command-line tool to compare against."""
+
+import os
+import shutil
+from pathlib import Path
+
+import pytest
+
+import fairmesh
+
+REPOSITORY = Path(__file__).resolve().parents[2]
+BUNNY = REPOSITORY / "assets" / "bunny00.obj"
+
+
+@pytest.fixture(scope="session")
+def bunny():
+    return fairmesh.load(BUNNY)
+
+
+@pytest.fixture(scope="session")
+def cli():
+    """The `fairmesh` binary: $FAIRMESH_CLI (scripts/test_python.sh sets it), else one built in
+    the repository's target folder."""
+    named = os.environ.get("FAIRMESH_CLI")
+    if named:
+        assert Path(named).is_file(), f"FAIRMESH_CLI={named} is not a file"
+        return named
+    target = Path(os.environ.get("CARGO_TARGET_DIR", REPOSITORY / "target"))
+    for profile in ("debug", "release"):
+        candidate = target / profile / "fairmesh"
+        if candidate.is_file():
+            return str(candidate)
+    found = shutil.which("fairmesh")
+    if found:
+        return found
+    pytest.skip("no fairmesh binary: build it (cargo build) or set FAIRMESH_CLI")

@@ -1,0 +1,155 @@
+"""Long calls release the GIL, report progress, and stop on Ctrl+C or when asked."""
+
+import _thread
+import hashlib
+import threading
+import time
+
+import numpy as np
+import pytest
+
+import fairmesh
+
+
+@pytest.fixture(scope="module")
+def noisy(bunny):
+    return fairmesh.noise(bunny.vertices, bunny.faces, sigma=0.3, seed=1)
+
+
+def test_python_threads_run_while_fair_works(bunny, noisy):
+    counted = []
+    stop = threading.Event()
+
+    def count():
+        n = 0
+        while not stop.is_set():
+            n += 1
+            if n % 1000 == 0:
+                counted.append(time.perf_counter())
+
+    worker = threading.Thread(target=count)
+    worker.start()
+    try:
+        time.sleep(0.05)
+        started = time.perf_counter()
+        fairmesh.fair(noisy, bunny.faces, rounds=30)
+        ended = time.perf_counter()
+    finally:
+        stop.set()
+        worker.join()
+    during = [t for t in counted if started < t < ended]
+    # Held, the GIL would let the counter run only before and after the call.
+    assert ended - started > 0.1
+    assert len(during) > 10, f"{len(during)} counts in {ended - started:.2f} s"
+
+
+def test_two_fairings_from_two_threads_run_at_the_same_time(bunny, noisy):
+    # Each call's report times its fairing; the fairings of two threads overlap in time only if
+    # neither holds the GIL while it works (held, the second could not start before the first
+    # returned). This holds however busy the machine is.
+    spans = []
+
+    def one():
+        _, report = fairmesh.fair(noisy, bunny.faces, rounds=15, threads=1)
+        ended = time.perf_counter()
+        spans.append((ended - report["time_ms"] / 1e3, ended))
+
+    threads = [threading.Thread(target=one) for _ in range(2)]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join()
+    (start_a, end_a), (start_b, end_b) = spans
+    overlap = min(end_a, end_b) - max(start_a, start_b)
+    shorter = min(end_a - start_a, end_b - start_b)
+    assert overlap > 0.5 * shorter, f"fairings {spans} overlap by {overlap:.3f} s"
+
+
+def at_once(work, runs=3):
+    """Best wall time of `work` alone, and of two threads running it at once."""
+
+    def best(job):
+        times = []
+        for _ in range(runs):
+            started = time.perf_counter()
+            job()
+            times.append(time.perf_counter() - started)
+        return min(times)
+
+    def two():
+        threads = [threading.Thread(target=work) for _ in range(2)]
+        for t in threads:
+            t.start()
+        for t in threads:
+            t.join()
+
+    return best(work), best(two)
+
+
+def test_two_threads_fairing_at_once_take_less_than_twice_one(bunny, noisy):
+    # One core a call (`threads=1`): on the shared pool one call already keeps every core busy,
+    # and two calls would share them whatever the GIL does.
+    data = bytes(32 << 20)
+
+    def control():
+        # hashlib releases the GIL on large buffers: what two threads can gain here now.
+        for _ in range(4):
+            hashlib.sha256(data).digest()
+
+    alone, together = at_once(control)
+    if together > 1.6 * alone:
+        pytest.skip(f"two cores are not free now: two threads hashing at once took "
+                    f"{together / alone:.2f} times one")
+
+    def one():
+        fairmesh.fair(noisy, bunny.faces, rounds=15, threads=1)
+
+    single, double = at_once(one)
+    assert double < 1.9 * single, f"one: {single:.3f} s, two at once: {double:.3f} s " \
+        f"(hashing: {together / alone:.2f} times one)"
+
+
+def test_progress_is_reported_and_can_cancel(bunny, noisy):
+    fractions = []
+    fairmesh.hierarchy(noisy, bunny.faces, progress=fractions.append)
+    assert fractions and fractions[-1] == 1.0
+    assert fractions == sorted(fractions)
+    with pytest.raises(fairmesh.Cancelled):
+        fairmesh.hierarchy(noisy, bunny.faces, progress=lambda fraction: False)
+    levels = fairmesh.hierarchy(noisy, bunny.faces)
+    with pytest.raises(ZeroDivisionError):
+        levels.multires(10, progress=lambda fraction: 1 / 0)
+    # The object stays usable after a cancelled run.
+    first = levels.multires(10)
+    np.testing.assert_array_equal(first, levels.multires(10))
+
+
+def test_fair_reports_every_round_and_stops_when_told(bunny, noisy):
+    fractions = []
+    fairmesh.fair(noisy, bunny.faces, rounds=60, progress=fractions.append)
+    assert fractions[-1] == 1.0 and fractions == sorted(fractions) and len(fractions) > 2
+    heard = []
+
+    def stop_soon(fraction):
+        heard.append(fraction)
+        return fraction < 0.05
+
+    with pytest.raises(fairmesh.Cancelled):
+        fairmesh.fair(noisy, bunny.faces, rounds=2000, progress=stop_soon)
+    assert heard[-1] >= 0.05 and heard[-1] < 0.5
+
+
+def test_ctrl_c_stops_a_long_fair(bunny, noisy):
+    quick = time.perf_counter()
+    fairmesh.fair(noisy, bunny.faces, rounds=20)
+    per_round = (time.perf_counter() - quick) / 20
+    timer = threading.Timer(0.3, _thread.interrupt_main)
+    timer.start()
+    started = time.perf_counter()
+    with pytest.raises(KeyboardInterrupt):
+        fairmesh.fair(noisy, bunny.faces, rounds=2000)
+    stopped = time.perf_counter() - started
+    timer.join()
+    # 2000 rounds would take about 2000 * per_round; it stops within a few rounds of 0.3 s.
+    assert stopped < 0.3 + 20 * per_round + 1.0, f"{stopped:.2f} s ({per_round:.4f} s a round)"
+    assert stopped < 0.25 * 2000 * per_round
