@@ -682,6 +682,7 @@ mod tests {
             // Watching changes nothing (but the time taken).
             let untimed = |report: FairReport| FairReport {
                 detection_ms: 0.0,
+                phases: Default::default(),
                 ..report
             };
             assert_eq!(report.map(untimed), Some(untimed(expected)));
