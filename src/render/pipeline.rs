@@ -338,7 +338,7 @@ impl MeshRenderer {
                                 buffers.write_per_vertex(queue, &buffers.mask, &mask);
                             }
                         }
-                        self.mesh = Some(buffers);
+                        self.mesh = Some(*buffers);
                         self.redraw();
                     }
                 }

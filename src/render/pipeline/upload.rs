@@ -43,7 +43,9 @@ impl UploadJob {
                 generation,
                 source,
                 with_lines,
-            } => Uploaded::Mesh(MeshBuffers::create(device, source, with_lines, generation)),
+            } => Uploaded::Mesh(Box::new(MeshBuffers::create(
+                device, source, with_lines, generation,
+            ))),
             UploadJob::Lines { generation, source } => Uploaded::Lines {
                 generation,
                 lines: line_buffer(device, &draw_triangles(source.as_ref())),
@@ -63,7 +65,7 @@ impl UploadJob {
 }
 
 pub(super) enum Uploaded {
-    Mesh(MeshBuffers),
+    Mesh(Box<MeshBuffers>),
     /// Filling the buffers of `generation` panicked inside wgpu.
     Failed {
         generation: u64,
