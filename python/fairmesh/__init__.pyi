@@ -104,15 +104,18 @@ class Hierarchy:
         iterations: int = 5,
         rounds: int = 1,
         boundary: Literal["curve", "fixed"] = "curve",
-        fair_finest: bool = False,
+        fair_finest: bool = True,
         variant: Literal["improved", "paper"] = "improved",
         mask: Optional[npt.ArrayLike] = None,
         mask_falloff: int = 0,
         progress: Optional[Progress] = None,
         threads: Optional[int] = None,
     ) -> npt.NDArray[np.floating]:
-        """Multiresolution fairing (``fairmesh multires --level START_LEVEL``): fair from
+        """Multiresolution fairing (``fairmesh multires --level START_LEVEL --denoise off``,
+        on the hierarchy as built, with its creases only if ``hierarchy`` kept them): fair from
         ``start_level`` (the coarser, the smoother; 0 is level 0 itself) down to full detail.
+        To denoise first as the editor and ``fairmesh multires`` do, build the hierarchy on the
+        vertices ``fair`` returns.
         Returns level 0's vertices smoothed, (n, 3); level 0's faces apply. ``mask``: per-vertex
         weights (0 to 1, or bools) or the indices of the vertices to fair; the rest keep their
         positions exactly. Releases the GIL; ``progress`` and Ctrl+C stop it."""

@@ -76,9 +76,11 @@ impl Hierarchy {
 
     /// Multiresolution fairing from `start_level` (0: the input itself; beyond the coarsest,
     /// the coarsest) down to full detail: the input's vertices, smoothed, as a new (n, 3)
-    /// array (the input's faces apply). Options as `fairmesh multires` names them.
+    /// array (the input's faces apply). Options as `fairmesh multires` names them; the
+    /// hierarchy is the one built, without `fairmesh multires`'s denoise before it
+    /// (`--denoise off`).
     #[pyo3(signature = (
-        start_level, *, iterations=5, rounds=1, boundary="curve", fair_finest=false,
+        start_level, *, iterations=5, rounds=1, boundary="curve", fair_finest=true,
         variant="improved", mask=None, mask_falloff=0, progress=None, threads=None
     ))]
     #[allow(clippy::too_many_arguments)]

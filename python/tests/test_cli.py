@@ -60,7 +60,8 @@ def test_options_reach_the_fairing_as_the_command_line_passes_them(cli, tmp_path
 
 def test_multires_matches_the_command_line(cli, tmp_path, bunny):
     out = tmp_path / "multires.ply"
-    run(cli, "multires", BUNNY, "--level", "9", "-o", out)
+    # The hierarchy as `fairmesh hierarchy` builds it (no creases unless asked), no denoise.
+    run(cli, "multires", BUNNY, "--level", "9", "-o", out, "--denoise", "off", "--no-creases")
     levels = fairmesh.hierarchy(bunny)
     np.testing.assert_array_equal(fairmesh.load(out).vertices, levels.multires(9))
     listed = json.loads(run(cli, "hierarchy", BUNNY, "--json"))["levels"]
