@@ -132,7 +132,7 @@ def fair(
     no_creases: bool = False,
     tangential: Optional[float] = None,
     no_volume_correction: bool = False,
-    tolerance: float = 0.0,
+    tolerance: Optional[float] = None,
     boundary: Literal["curve", "fixed"] = "curve",
     variant: Literal["normal-projected", "paper"] = "normal-projected",
     lambda_: Optional[float] = None,
@@ -158,7 +158,7 @@ def fair(
     no_creases: bool = False,
     tangential: Optional[float] = None,
     no_volume_correction: bool = False,
-    tolerance: float = 0.0,
+    tolerance: Optional[float] = None,
     boundary: Literal["curve", "fixed"] = "curve",
     variant: Literal["normal-projected", "paper"] = "normal-projected",
     lambda_: Optional[float] = None,
@@ -192,7 +192,8 @@ def fair(
     - ``tangential``: weight 0 to 1 of the relaxation along the surface, at every vertex (None:
       0.1 where needed).
     - ``no_volume_correction``: do not give each part its volume back after every round.
-    - ``tolerance``: stop a round once no vertex moves more than this many mean edge lengths.
+    - ``tolerance``: stop a round once no vertex moves more than this many mean edge lengths
+      (None: once it has settled, 0.001; 0: run every iteration).
     - ``boundary``: "curve" (boundary loops smoothed as curves) or "fixed".
     - ``variant``: "normal-projected" (default) or "paper" (the paper's method exactly).
     - ``lambda_``, ``mu`` (Laplacian, Taubin), ``alpha``, ``beta`` (HC): the baselines' steps.

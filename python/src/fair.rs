@@ -25,7 +25,8 @@ pub struct FairArgs {
     pub no_creases: bool,
     pub tangential: Option<f64>,
     pub no_volume_correction: bool,
-    pub tolerance: f64,
+    /// `None`: the default (a round ends once settled, `fairing::ROUND_SETTLED`).
+    pub tolerance: Option<f64>,
     pub boundary: fairing::BoundaryMode,
     pub paper_variant: bool,
     pub lambda: Option<f64>,
@@ -86,8 +87,12 @@ impl FairArgs {
                 };
                 let mut options = base
                     .with_iterations(self.iterations)
-                    .with_tolerance(self.tolerance * mean_edge_length)
                     .with_boundary(boundary);
+                if let Some(tolerance) = self.tolerance {
+                    options = options
+                        .with_tolerance(tolerance * mean_edge_length)
+                        .with_settled(tolerance);
+                }
                 if let Some(rounds) = self.rounds {
                     options = options.with_rounds(rounds);
                 }
@@ -207,6 +212,13 @@ fn report_dict<'py>(
     dict.set_item("loose_triangles", report.loose_triangles)?;
     dict.set_item("time_ms", outcome.time_ms)?;
     dict.set_item("detection_ms", report.detection_ms)?;
+    // As `fair --json` writes them: where the run's time went.
+    let phases = PyDict::new(py);
+    phases.set_item("set_up", report.phases.set_up)?;
+    phases.set_item("iterations", report.phases.iterations)?;
+    phases.set_item("volume", report.phases.volume)?;
+    phases.set_item("risk", report.phases.risk)?;
+    dict.set_item("phases_ms", phases)?;
     dict.set_item("risk_by_round", report.risk_by_round.clone())?;
     dict.set_item("volume_change_percent", outcome.volume_change_percent)?;
     dict.set_item("max_move", report.max_move)?;
@@ -230,7 +242,7 @@ fn report_dict<'py>(
 #[pyo3(signature = (
     vertices, faces=None, *, method="constrained", iterations=10, rounds=None,
     crease_angle=DEFAULT_CREASE_ANGLE, no_creases=false, tangential=None,
-    no_volume_correction=false, tolerance=0.0, boundary="curve", variant="normal-projected",
+    no_volume_correction=false, tolerance=None, boundary="curve", variant="normal-projected",
     lambda_=None, mu=None, alpha=None, beta=None, mask=None, mask_falloff=0, hard_edges=None,
     measure=false, progress=None, threads=None
 ))]
@@ -246,7 +258,7 @@ pub fn fair<'py>(
     no_creases: bool,
     tangential: Option<f64>,
     no_volume_correction: bool,
-    tolerance: f64,
+    tolerance: Option<f64>,
     boundary: &str,
     variant: &str,
     lambda_: Option<f64>,
@@ -281,7 +293,9 @@ pub fn fair<'py>(
             .map(|t| options::number_in("tangential", t, 0.0, 1.0))
             .transpose()?,
         no_volume_correction,
-        tolerance: options::number_in("tolerance", tolerance, 0.0, f64::MAX)?,
+        tolerance: tolerance
+            .map(|t| options::number_in("tolerance", t, 0.0, f64::MAX))
+            .transpose()?,
         boundary: options::boundary(boundary)?,
         paper_variant: options::choice("variant", variant, &["normal-projected", "paper"])? == 1,
         lambda: lambda_.map(|v| options::finite("lambda_", v)).transpose()?,

@@ -32,6 +32,7 @@ def test_noise_and_fair_match_the_command_line(cli, tmp_path, bunny):
     for field in ("noise_estimate", "max_move", "volume_change_percent"):
         assert report[field] == cli_report[field], field
     assert report["risk_by_round"] == cli_report["risk_by_round"]
+    assert set(report["phases_ms"]) == set(cli_report["phases_ms"])
     assert report["input"] == str(noisy_file)
     # From arrays the same (the bunny's file marks no sharp edges).
     from_arrays, array_report = fairmesh.fair(noisy, bunny.faces)
