@@ -92,6 +92,10 @@ class Hierarchy:
     @property
     def level_sizes(self) -> List[Tuple[int, int]]:
         """(vertices, faces) of every level, level 0 first."""
+    @property
+    def denoise(self) -> Optional[Dict[str, Any]]:
+        """What the denoise before the build found (``rounds_run``, ``noise_estimate``,
+        ``crease_edges``), or None when the hierarchy was built without one."""
     def level(
         self, level: int
     ) -> Tuple[npt.NDArray[np.floating], npt.NDArray[np.int64], npt.NDArray[np.int64]]:
@@ -111,11 +115,10 @@ class Hierarchy:
         progress: Optional[Progress] = None,
         threads: Optional[int] = None,
     ) -> npt.NDArray[np.floating]:
-        """Multiresolution fairing (``fairmesh multires --level START_LEVEL --denoise off``,
-        on the hierarchy as built, with its creases only if ``hierarchy`` kept them): fair from
+        """Multiresolution fairing (``fairmesh multires --level START_LEVEL``, on the hierarchy
+        as built: denoised first only if ``hierarchy`` was given ``denoise``): fair from
         ``start_level`` (the coarser, the smoother; 0 is level 0 itself) down to full detail.
-        To denoise first as the editor and ``fairmesh multires`` do, build the hierarchy on the
-        vertices ``fair`` returns.
+        After a denoise, ``mask`` fades the result into the input itself.
         Returns level 0's vertices smoothed, (n, 3); level 0's faces apply. ``mask``: per-vertex
         weights (0 to 1, or bools) or the indices of the vertices to fair; the rest keep their
         positions exactly. Releases the GIL; ``progress`` and Ctrl+C stop it."""
@@ -243,6 +246,7 @@ def hierarchy(
     keep_boundary: bool = False,
     keep_creases: bool = False,
     crease_angle: Optional[float] = None,
+    denoise: Union[None, Literal["auto", "off"], int] = None,
     progress: Optional[Progress] = None,
     threads: Optional[int] = None,
 ) -> Hierarchy: ...
@@ -258,11 +262,16 @@ def hierarchy(
     keep_boundary: bool = False,
     keep_creases: bool = False,
     crease_angle: Optional[float] = None,
+    denoise: Union[None, Literal["auto", "off"], int] = None,
     progress: Optional[Progress] = None,
     threads: Optional[int] = None,
 ) -> Hierarchy:
     """Build the decimation hierarchy (``fairmesh hierarchy``), with its options; then
-    ``Hierarchy.multires(start_level)`` fairs from any level, again and again."""
+    ``Hierarchy.multires(start_level)`` fairs from any level, again and again.
+    ``denoise="auto"`` (or a number of rounds) first denoises the mesh as ``fair`` does and
+    builds the levels on the result, as the editor and ``fairmesh multires`` do (with
+    ``keep_creases=True`` for their defaults): ``multires(0)`` is then ``fair``'s result and
+    ``Hierarchy.denoise`` says what the denoise found."""
 
 def load(path: PathLike, *, weld: bool = True, progress: Optional[Progress] = None) -> Mesh:
     """Read a mesh file (.obj .gltf .glb .ply .stl .off; ``"@bunny"``: the bundled bunny),

@@ -149,7 +149,7 @@ fn fair_mesh(
 }
 
 /// The mask of `mask` (weights or vertex indices) on `mesh`, faded over `falloff` rings.
-fn read_mask(
+pub(crate) fn read_mask(
     mask: Option<&Bound<'_, PyAny>>,
     falloff: usize,
     mesh: &TriMesh,

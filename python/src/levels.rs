@@ -2,16 +2,19 @@
 //! that gives its levels as arrays and runs multiresolution fairing (4.2) from any start level
 //! again and again, keeping each level's set-up between runs as the editor does.
 
-use crate::arrays::{self, Precision, VertexSelection};
+use crate::arrays::{self, Precision};
 use crate::mesh::{from_arrays, Mesh};
 use crate::options;
 use crate::run::run_detached;
-use fairmesh::fairing::{creases::DEFAULT_CREASE_ANGLE, CreaseOptions, Mask};
+use fairmesh::fairing::{creases::DEFAULT_CREASE_ANGLE, CreaseOptions, FairReport};
 use fairmesh::hierarchy::{build_hierarchy_with_topology, HierarchyError, HierarchyOptions};
-use fairmesh::multires::{fair_multires, MultiresOptions, MultiresVariant, MultiresWorkspace};
+use fairmesh::multires::{
+    fair_multires, Denoise, DenoiseOptions, MultiresOptions, MultiresVariant, MultiresWorkspace,
+};
 use fairmesh::Topology;
 use pyo3::exceptions::{PyTypeError, PyValueError};
 use pyo3::prelude::*;
+use pyo3::types::{PyBool, PyDict};
 use std::sync::Mutex;
 
 /// The decimation hierarchy of a mesh (`fairmesh.hierarchy(...)`): level 0 is the mesh itself,
@@ -24,6 +27,9 @@ pub struct Hierarchy {
     topology: Topology,
     workspace: Mutex<MultiresWorkspace>,
     precision: Precision,
+    /// With `denoise`: what the denoise before the build did, and the input's own positions
+    /// (the hierarchy's level 0 is the denoised mesh; a mask fades results into the input).
+    denoised: Option<(FairReport, Vec<[f32; 3]>)>,
 }
 
 #[pymethods]
@@ -38,6 +44,20 @@ impl Hierarchy {
     #[getter]
     fn coarsest_level(&self) -> usize {
         self.hierarchy.coarsest_level()
+    }
+
+    /// What the denoise before the build found (`hierarchy(..., denoise=...)`): a dict of
+    /// `rounds_run`, `noise_estimate` and `crease_edges`, or None without a denoise.
+    #[getter]
+    fn denoise<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyDict>>> {
+        let Some((report, _)) = &self.denoised else {
+            return Ok(None);
+        };
+        let dict = PyDict::new(py);
+        dict.set_item("rounds_run", report.rounds_run)?;
+        dict.set_item("noise_estimate", report.noise_estimate)?;
+        dict.set_item("crease_edges", report.crease_edges)?;
+        Ok(Some(dict))
     }
 
     /// (vertices, faces) of every level, level 0 first.
@@ -104,9 +124,20 @@ impl Hierarchy {
             _ => MultiresVariant::Paper,
         };
         let mask_falloff = options::count("mask_falloff", mask_falloff)?;
-        let mask = self.mask(mask, mask_falloff)?;
+        let mask = crate::fair::read_mask(
+            mask,
+            mask_falloff,
+            self.hierarchy.base_mesh(),
+            &self.topology,
+        )?;
+        // After a denoise the mask fades the result into the input itself, below.
+        let (mask, fade_into) = match &self.denoised {
+            Some((_, input)) => (None, mask.map(|mask| (mask, input))),
+            None => (mask, None),
+        };
+        let start_level = options::count("start_level", start_level)?;
         let options = MultiresOptions::default()
-            .with_start_level(options::count("start_level", start_level)?)
+            .with_start_level(start_level)
             .with_iterations(options::count("iterations", iterations)?)
             .with_rounds(options::count("rounds", rounds)?)
             .with_boundary(options::boundary(boundary)?)
@@ -115,13 +146,21 @@ impl Hierarchy {
             .with_mask(mask);
         let hierarchy = &self.hierarchy;
         let workspace = &self.workspace;
-        let positions = run_detached(py, progress, threads, |hook| {
+        let denoised_level_0 = self.denoised.is_some() && start_level == 0;
+        let mut positions = run_detached(py, progress, threads, |hook| {
+            if denoised_level_0 {
+                // Level 0 is the denoised mesh itself, `fair`'s result.
+                return Some(hierarchy.base_mesh().positions.clone());
+            }
             // A run cancelled half way leaves the workspace fit for the next one.
             let mut workspace = workspace
                 .lock()
                 .unwrap_or_else(std::sync::PoisonError::into_inner);
             fair_multires(hierarchy, &options, &mut workspace, hook)
         })?;
+        if let Some((mask, input)) = fade_into {
+            mask.blend(input, &mut positions);
+        }
         Ok(arrays::positions_array(py, positions, self.precision))
     }
 
@@ -139,41 +178,14 @@ impl Hierarchy {
     }
 }
 
-impl Hierarchy {
-    fn mask(&self, mask: Option<&Bound<'_, PyAny>>, falloff: usize) -> PyResult<Option<Mask>> {
-        let Some(mask) = mask.filter(|m| !m.is_none()) else {
-            if falloff > 0 {
-                return Err(PyValueError::new_err("mask_falloff needs a mask"));
-            }
-            return Ok(None);
-        };
-        let n = self.hierarchy.base_mesh().vertex_count();
-        let mask = match arrays::read_selection("mask", mask, n)? {
-            VertexSelection::Weights(weights) => {
-                Mask::new(weights).map_err(|e| PyValueError::new_err(format!("mask: {e}")))?
-            }
-            VertexSelection::Indices(vertices) => Mask::from_vertices(n, vertices),
-        };
-        if mask.painted_count() == 0 {
-            return Err(PyValueError::new_err(
-                "mask lets no vertex move, so nothing would be faired",
-            ));
-        }
-        Ok(Some(if falloff > 0 {
-            mask.with_falloff(&self.topology, falloff)
-        } else {
-            mask
-        }))
-    }
-}
-
 /// `fairmesh.hierarchy(vertices, faces, **options)`: builds the decimation hierarchy, with the
 /// options of `fairmesh hierarchy`; `vertices` may be a loaded `Mesh` (faces left out), whose
 /// file's sharp edges are then kept with the creases.
 #[pyfunction]
 #[pyo3(signature = (
     vertices, faces=None, *, alpha=1.0, beta=0.01, min_vertices=100, max_levels=64,
-    keep_boundary=false, keep_creases=false, crease_angle=None, progress=None, threads=None
+    keep_boundary=false, keep_creases=false, crease_angle=None, denoise=None, progress=None,
+    threads=None
 ))]
 #[allow(clippy::too_many_arguments)]
 pub fn hierarchy(
@@ -187,10 +199,12 @@ pub fn hierarchy(
     keep_boundary: bool,
     keep_creases: bool,
     crease_angle: Option<f64>,
+    denoise: Option<&Bound<'_, PyAny>>,
     progress: Option<&Bound<'_, PyAny>>,
     threads: Option<i64>,
 ) -> PyResult<Hierarchy> {
     let threads = options::threads(threads)?;
+    let denoise_choice = denoise_choice(denoise)?;
     let crease_angle = crease_angle
         .map(|a| options::number_in("crease_angle", a, 0.0, 180.0))
         .transpose()?;
@@ -234,20 +248,53 @@ pub fn hierarchy(
     if let Some(creases) = &mut options.creases {
         *creases = creases.clone().with_file_edges(file_edges);
     }
-    let built = run_detached(
-        py,
-        progress,
-        threads,
-        |hook| match build_hierarchy_with_topology(&mesh, &topology, &options, hook) {
+    // The denoise keeps the creases the hierarchy keeps, as `fairmesh multires` does.
+    let denoise_options = denoise_choice.map(|choice| DenoiseOptions {
+        denoise: choice,
+        creases: options.creases.clone(),
+        boundary: fairmesh::fairing::BoundaryMode::Curve,
+    });
+    let (built, report) = run_detached(py, progress, threads, |hook| {
+        let denoised = match &denoise_options {
+            Some(denoise_options) => {
+                fairmesh::multires::denoise(&mesh, &topology, denoise_options, hook)?
+            }
+            None => None,
+        };
+        let built_on = denoised.as_ref().map_or(&mesh, |d| &d.mesh);
+        match build_hierarchy_with_topology(built_on, &topology, &options, hook) {
             Err(HierarchyError::Cancelled) => None,
-            other => Some(other),
-        },
-    )?
-    .map_err(|e| PyValueError::new_err(e.to_string()))?;
+            other => Some((other, denoised.map(|d| d.report))),
+        }
+    })?;
+    let built = built.map_err(|e| PyValueError::new_err(e.to_string()))?;
     Ok(Hierarchy {
         hierarchy: built,
         topology,
         workspace: Mutex::new(MultiresWorkspace::new()),
         precision,
+        denoised: report.map(|report| (report, mesh.positions)),
     })
+}
+
+/// `denoise=`: None or "off" (none), "auto" (the automatic strength), or a number of rounds.
+fn denoise_choice(value: Option<&Bound<'_, PyAny>>) -> PyResult<Option<Denoise>> {
+    const EXPECTED: &str = "denoise must be None, \"auto\", \"off\" or a number of rounds";
+    let Some(value) = value.filter(|v| !v.is_none()) else {
+        return Ok(None);
+    };
+    if let Ok(text) = value.extract::<String>() {
+        return match text.as_str() {
+            "auto" => Ok(Some(Denoise::Automatic)),
+            "off" => Ok(None),
+            _ => Err(PyValueError::new_err(format!("{EXPECTED}, not {text:?}"))),
+        };
+    }
+    if value.is_instance_of::<PyBool>() {
+        return Err(PyTypeError::new_err(EXPECTED));
+    }
+    let rounds: i64 = value
+        .extract()
+        .map_err(|_| PyTypeError::new_err(EXPECTED))?;
+    Ok(Some(Denoise::Rounds(options::count("denoise", rounds)?)))
 }

@@ -69,6 +69,23 @@ def test_multires_matches_the_command_line(cli, tmp_path, bunny):
     assert [(level["vertices"], level["faces"]) for level in listed] == levels.level_sizes
 
 
+def test_a_hierarchy_denoised_first_is_the_command_lines_multires(cli, tmp_path):
+    # The editor's pipeline: denoised as `fair` does, then the levels built on the result.
+    noisy_file = tmp_path / "noisy.ply"
+    run(cli, "noise", BUNNY, "-o", noisy_file, "--sigma", "0.3")
+    noisy = fairmesh.load(noisy_file)
+    levels = fairmesh.hierarchy(noisy, denoise="auto", keep_creases=True)
+    faired_file = tmp_path / "fair.ply"
+    report = json.loads(run(cli, "fair", noisy_file, "-o", faired_file, "--json"))
+    assert levels.denoise["rounds_run"] == report["rounds_run"] > 0
+    assert levels.denoise["crease_edges"] == report["crease_edges"]
+    np.testing.assert_array_equal(levels.multires(0), fairmesh.load(faired_file).vertices)
+    coarse_file = tmp_path / "level4.ply"
+    run(cli, "multires", noisy_file, "--level", "4", "-o", coarse_file)
+    np.testing.assert_array_equal(levels.multires(4), fairmesh.load(coarse_file).vertices)
+    assert fairmesh.hierarchy(noisy).denoise is None
+
+
 def test_compare_matches_the_command_line(cli, tmp_path, bunny):
     noisy_file = tmp_path / "noisy.ply"
     run(cli, "noise", BUNNY, "-o", noisy_file)

@@ -66,6 +66,10 @@ def test_bad_hierarchy_and_multires_arguments(bunny):
         levels.multires(-1)
     with pytest.raises(ValueError, match="variant must be one of \"improved\", \"paper\""):
         levels.multires(3, variant="exact")
+    with pytest.raises(ValueError, match="denoise must be None, \"auto\", \"off\" or a number"):
+        fairmesh.hierarchy(bunny, denoise="lots")
+    with pytest.raises(TypeError, match="denoise must be"):
+        fairmesh.hierarchy(bunny, denoise=True)
 
 
 def test_a_missing_file_is_a_file_not_found_error_naming_it(tmp_path):
