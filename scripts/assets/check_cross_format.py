@@ -8,7 +8,7 @@ Usage (from the repository root, after building fairmesh):
     target/release/fairmesh fair tests/data/roundtrip/textured.obj -o $OUT/textured.glb
     target/release/fairmesh fair tests/data/roundtrip/textured.obj -o $OUT/sub/textured.gltf
     target/release/fairmesh fair tests/data/roundtrip/scene.glb -o $OUT/scene.ply
-    /work/venv/bin/python scripts/assets/check_cross_format.py $OUT
+    .venv/bin/python scripts/assets/check_cross_format.py $OUT
 
 It asserts what the outputs must keep: glTF -> OBJ: the node names as objects, the
 two materials with the texture image beside the .mtl, UVs; OBJ -> glTF: named nodes and meshes,

@@ -3,8 +3,8 @@
 
 Usage (from the repository root):
 
-    /work/venv/bin/python scripts/assets/inspect_mesh.py FILE [FILE...]
-    /work/venv/bin/python scripts/assets/inspect_mesh.py --json FILE   # one JSON object per file
+    .venv/bin/python scripts/assets/inspect_mesh.py FILE [FILE...]
+    .venv/bin/python scripts/assets/inspect_mesh.py --json FILE   # one JSON object per file
 
 For every file it prints what trimesh loads (geometries, vertex/face counts, UVs, normals,
 colours, materials, closed or not after welding by position) and a format-level view:

@@ -3,7 +3,7 @@
 
 Run from the repository root:
 
-    /work/venv/bin/python scripts/assets/make_roundtrip_assets.py
+    .venv/bin/python scripts/assets/make_roundtrip_assets.py
 
 (any virtual environment with scripts/assets/requirements.txt installed works).
 The output is deterministic: no random state without a fixed seed, no time stamps,
