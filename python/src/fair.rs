@@ -7,8 +7,8 @@ use crate::mesh::{from_arrays, Mesh};
 use crate::options;
 use crate::run::run_detached;
 use fairmesh::fairing::{
-    self, creases::DEFAULT_CREASE_ANGLE, CreaseOptions, FairOptions, FairReport, FairVariant,
-    HcOptions, LaplacianOptions, Mask, Method, MethodOptions, Relaxation, TaubinOptions,
+    self, creases::DEFAULT_CREASE_ANGLE, FairReport, FairVariant, Mask, Method, MethodChoices,
+    MethodOptions,
 };
 use fairmesh::{metrics, Topology, TriMesh};
 use pyo3::exceptions::{PyTypeError, PyValueError};
@@ -16,91 +16,9 @@ use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use std::time::Instant;
 
-/// The keyword arguments of `fair`, as the command line's `fair` names them.
-pub struct FairArgs {
-    pub method: Method,
-    pub iterations: usize,
-    pub rounds: Option<usize>,
-    pub crease_angle: f64,
-    pub no_creases: bool,
-    pub tangential: Option<f64>,
-    pub no_volume_correction: bool,
-    /// `None`: the default (a round ends once settled, `fairing::ROUND_SETTLED`).
-    pub tolerance: Option<f64>,
-    pub boundary: fairing::BoundaryMode,
-    pub paper_variant: bool,
-    pub lambda: Option<f64>,
-    pub mu: Option<f64>,
-    pub alpha: Option<f64>,
-    pub beta: Option<f64>,
-}
-
-impl FairArgs {
-    /// The options of the chosen method, as `fairmesh fair` builds them (`src/cli/fair.rs`),
-    /// with `hard_edges` (the file's sharp edges) as creases too.
-    fn method_options(&self, mean_edge_length: f64, hard_edges: Vec<[u32; 2]>) -> MethodOptions {
-        let boundary = self.boundary;
-        match self.method {
-            Method::Laplacian => {
-                let defaults = LaplacianOptions::default();
-                MethodOptions::Laplacian(LaplacianOptions {
-                    iterations: self.iterations,
-                    lambda: self.lambda.unwrap_or(defaults.lambda),
-                    boundary,
-                })
-            }
-            Method::Taubin => {
-                let defaults = TaubinOptions::default();
-                MethodOptions::Taubin(TaubinOptions {
-                    iterations: self.iterations,
-                    lambda: self.lambda.unwrap_or(defaults.lambda),
-                    mu: self.mu.unwrap_or(defaults.mu),
-                    boundary,
-                })
-            }
-            Method::Hc => {
-                let defaults = HcOptions::default();
-                MethodOptions::Hc(HcOptions {
-                    iterations: self.iterations,
-                    alpha: self.alpha.unwrap_or(defaults.alpha),
-                    beta: self.beta.unwrap_or(defaults.beta),
-                    boundary,
-                })
-            }
-            _ => {
-                let base = if self.paper_variant {
-                    FairOptions::paper()
-                } else {
-                    let options = FairOptions::default()
-                        .with_keep_volume(!self.no_volume_correction)
-                        .with_creases((!self.no_creases).then(|| {
-                            CreaseOptions::default()
-                                .with_angle_degrees(self.crease_angle)
-                                .with_file_edges(hard_edges)
-                        }));
-                    match self.tangential {
-                        Some(weight) => options
-                            .with_tangential_relaxation(weight)
-                            .with_relaxation(Relaxation::Everywhere),
-                        None => options,
-                    }
-                };
-                let mut options = base
-                    .with_iterations(self.iterations)
-                    .with_boundary(boundary);
-                if let Some(tolerance) = self.tolerance {
-                    options = options
-                        .with_tolerance(tolerance * mean_edge_length)
-                        .with_settled(tolerance);
-                }
-                if let Some(rounds) = self.rounds {
-                    options = options.with_rounds(rounds);
-                }
-                MethodOptions::Constrained(options)
-            }
-        }
-    }
-}
+/// The keyword arguments of `fair`, as the command line's `fair` names them: the library's
+/// [`MethodChoices`], which `fairmesh fair` maps its options to as well.
+pub type FairArgs = MethodChoices;
 
 /// What one fairing did, for the report.
 struct Outcome {
@@ -326,7 +244,7 @@ pub fn fair<'py>(
         let state = &mut loaded.loaded;
         let mask = read_mask(mask, mask_falloff, &state.mesh, &state.topology)?;
         let edge = metrics::mean_edge_length(&state.mesh);
-        let options = args.method_options(edge, file_edges);
+        let options = args.options(edge, || file_edges);
         // The loaded mesh is faired in place on a copy of its positions, which are put back.
         let mut positions = state.mesh.positions.clone();
         let (mesh, topology) = (&mut state.mesh, &state.topology);
@@ -369,7 +287,7 @@ pub fn fair<'py>(
         _ => Vec::new(),
     };
     let mask = read_mask(mask, mask_falloff, &mesh, &topology)?;
-    let options = args.method_options(metrics::mean_edge_length(&mesh), file_edges);
+    let options = args.options(metrics::mean_edge_length(&mesh), || file_edges);
     let outcome = run_detached(py, progress, threads, |hook| {
         fair_mesh(
             &mut mesh,

@@ -2,9 +2,8 @@
 //! baselines, and write the result; `bench_rows` gives `fairmesh bench` its fairing timings.
 use clap::{Args, ValueEnum};
 use fairmesh::fairing::{
-    self, baseline::UmbrellaStencil, BoundaryMode, ConstrainedFairing, CreaseOptions, FairOptions,
-    FairReport, FairVariant, HcOptions, LaplacianOptions, Mask, MethodOptions, Relaxation,
-    Strength, TaubinOptions,
+    self, baseline::UmbrellaStencil, BoundaryMode, ConstrainedFairing, CreaseOptions, FairReport,
+    FairVariant, Mask, Method, MethodChoices, MethodOptions, Strength,
 };
 use fairmesh::io::Source;
 use fairmesh::metrics::Comparison;
@@ -128,81 +127,33 @@ impl FairArgs {
     /// `mean_edge_length`): the file's own sharp edges (split normals, material boundaries) are
     /// creases too.
     fn options_for(&self, mesh: &TriMesh, source: &Source, mean_edge_length: f64) -> MethodOptions {
-        let mut options = self.method_options(mean_edge_length);
-        if let MethodOptions::Constrained(FairOptions {
-            creases: Some(creases),
-            ..
-        }) = &mut options
-        {
-            *creases = creases.clone().with_file_edges(source.hard_edges(mesh));
-        }
-        options
+        self.choices()
+            .options(mean_edge_length, || source.hard_edges(mesh))
     }
 
-    fn method_options(&self, mean_edge_length: f64) -> MethodOptions {
-        let boundary = BoundaryMode::from(self.boundary);
-        match self.method {
-            MethodArg::Constrained => {
-                // `--variant paper` is the paper's method (`FairOptions::paper`): one round, no
-                // creases, no tangential relaxation, no volume correction; --crease-angle,
-                // --no-creases, --tangential and --no-volume-correction do not apply to it,
-                // --rounds does.
-                let base = match self.variant {
-                    VariantArg::Paper => FairOptions::paper(),
-                    VariantArg::NormalProjected => {
-                        let options = FairOptions::default()
-                            .with_keep_volume(!self.no_volume_correction)
-                            .with_creases((!self.no_creases).then(|| {
-                                CreaseOptions::default().with_angle_degrees(self.crease_angle)
-                            }));
-                        // --tangential W: that weight at every vertex.
-                        match self.tangential {
-                            Some(weight) => options
-                                .with_tangential_relaxation(weight)
-                                .with_relaxation(Relaxation::Everywhere),
-                            None => options,
-                        }
-                    }
-                };
-                let mut options = base
-                    .with_iterations(self.iterations)
-                    .with_boundary(boundary);
-                if let Some(tolerance) = self.tolerance {
-                    options = options
-                        .with_tolerance(tolerance * mean_edge_length)
-                        .with_settled(tolerance);
-                }
-                if let Some(rounds) = self.rounds {
-                    options = options.with_rounds(rounds);
-                }
-                MethodOptions::Constrained(options)
-            }
-            MethodArg::Laplacian => {
-                let defaults = LaplacianOptions::default();
-                MethodOptions::Laplacian(LaplacianOptions {
-                    iterations: self.iterations,
-                    lambda: self.lambda.unwrap_or(defaults.lambda),
-                    boundary,
-                })
-            }
-            MethodArg::Taubin => {
-                let defaults = TaubinOptions::default();
-                MethodOptions::Taubin(TaubinOptions {
-                    iterations: self.iterations,
-                    lambda: self.lambda.unwrap_or(defaults.lambda),
-                    mu: self.mu.unwrap_or(defaults.mu),
-                    boundary,
-                })
-            }
-            MethodArg::Hc => {
-                let defaults = HcOptions::default();
-                MethodOptions::Hc(HcOptions {
-                    iterations: self.iterations,
-                    alpha: self.alpha.unwrap_or(defaults.alpha),
-                    beta: self.beta.unwrap_or(defaults.beta),
-                    boundary,
-                })
-            }
+    /// The options as the library takes them ([`MethodChoices`], shared with the Python
+    /// package).
+    fn choices(&self) -> MethodChoices {
+        MethodChoices {
+            method: match self.method {
+                MethodArg::Constrained => Method::Constrained,
+                MethodArg::Laplacian => Method::Laplacian,
+                MethodArg::Taubin => Method::Taubin,
+                MethodArg::Hc => Method::Hc,
+            },
+            iterations: self.iterations,
+            rounds: self.rounds,
+            crease_angle: self.crease_angle,
+            no_creases: self.no_creases,
+            tangential: self.tangential,
+            no_volume_correction: self.no_volume_correction,
+            tolerance: self.tolerance,
+            boundary: BoundaryMode::from(self.boundary),
+            paper_variant: self.variant == VariantArg::Paper,
+            lambda: self.lambda,
+            mu: self.mu,
+            alpha: self.alpha,
+            beta: self.beta,
         }
     }
 }

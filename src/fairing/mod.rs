@@ -57,6 +57,7 @@
 
 pub mod baseline;
 pub mod boundary;
+pub mod choices;
 pub mod constrained;
 pub mod creases;
 mod feature_edges;
@@ -70,6 +71,7 @@ use crate::mesh::{Topology, TriMesh};
 pub use baseline::{
     fair_hc, fair_laplacian, fair_taubin, HcOptions, LaplacianOptions, TaubinOptions,
 };
+pub use choices::MethodChoices;
 pub use constrained::{fair_constrained, fair_constrained_with_progress, ConstrainedFairing};
 pub use creases::{detect_creases, CreaseOptions, Creases, FeatureClass};
 pub use mask::{Mask, MaskError};
