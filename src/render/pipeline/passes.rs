@@ -548,70 +548,33 @@ impl Pipelines {
     }
 }
 
+/// One attribute per vertex buffer, at the shader locations the layouts below give them.
+const POSITION: [wgpu::VertexAttribute; 1] = wgpu::vertex_attr_array![0 => Float32x3];
+const SCALAR: [wgpu::VertexAttribute; 1] = wgpu::vertex_attr_array![1 => Float32];
+const NORMAL: [wgpu::VertexAttribute; 1] = wgpu::vertex_attr_array![2 => Float32x3];
+const MASK: [wgpu::VertexAttribute; 1] = wgpu::vertex_attr_array![3 => Float32];
+const UV: [wgpu::VertexAttribute; 1] = wgpu::vertex_attr_array![4 => Float32x2];
+const COLOUR: [wgpu::VertexAttribute; 1] = wgpu::vertex_attr_array![5 => Float32x4];
+
+/// A vertex buffer holding `attribute` alone, tightly packed.
+fn per_vertex(attribute: &'static [wgpu::VertexAttribute; 1]) -> wgpu::VertexBufferLayout<'static> {
+    wgpu::VertexBufferLayout {
+        array_stride: attribute[0].format.size(),
+        step_mode: wgpu::VertexStepMode::Vertex,
+        attributes: attribute,
+    }
+}
+
 /// The vertex buffers' layouts: positions (location 0), scalars (1), normals (2), mask
 /// weights (3), texture coordinates (4), colours (5).
 fn vertex_layouts() -> [wgpu::VertexBufferLayout<'static>; 6] {
-    let position_layout = wgpu::VertexBufferLayout {
-        array_stride: 12,
-        step_mode: wgpu::VertexStepMode::Vertex,
-        attributes: &[wgpu::VertexAttribute {
-            format: wgpu::VertexFormat::Float32x3,
-            offset: 0,
-            shader_location: 0,
-        }],
-    };
-    let scalar_layout = wgpu::VertexBufferLayout {
-        array_stride: 4,
-        step_mode: wgpu::VertexStepMode::Vertex,
-        attributes: &[wgpu::VertexAttribute {
-            format: wgpu::VertexFormat::Float32,
-            offset: 0,
-            shader_location: 1,
-        }],
-    };
-    let normal_layout = wgpu::VertexBufferLayout {
-        array_stride: 12,
-        step_mode: wgpu::VertexStepMode::Vertex,
-        attributes: &[wgpu::VertexAttribute {
-            format: wgpu::VertexFormat::Float32x3,
-            offset: 0,
-            shader_location: 2,
-        }],
-    };
-    let mask_layout = wgpu::VertexBufferLayout {
-        array_stride: 4,
-        step_mode: wgpu::VertexStepMode::Vertex,
-        attributes: &[wgpu::VertexAttribute {
-            format: wgpu::VertexFormat::Float32,
-            offset: 0,
-            shader_location: 3,
-        }],
-    };
-    let uv_layout = wgpu::VertexBufferLayout {
-        array_stride: 8,
-        step_mode: wgpu::VertexStepMode::Vertex,
-        attributes: &[wgpu::VertexAttribute {
-            format: wgpu::VertexFormat::Float32x2,
-            offset: 0,
-            shader_location: 4,
-        }],
-    };
-    let colour_layout = wgpu::VertexBufferLayout {
-        array_stride: 16,
-        step_mode: wgpu::VertexStepMode::Vertex,
-        attributes: &[wgpu::VertexAttribute {
-            format: wgpu::VertexFormat::Float32x4,
-            offset: 0,
-            shader_location: 5,
-        }],
-    };
     [
-        position_layout,
-        scalar_layout,
-        normal_layout,
-        mask_layout,
-        uv_layout,
-        colour_layout,
+        per_vertex(&POSITION),
+        per_vertex(&SCALAR),
+        per_vertex(&NORMAL),
+        per_vertex(&MASK),
+        per_vertex(&UV),
+        per_vertex(&COLOUR),
     ]
 }
 
