@@ -198,6 +198,33 @@ impl ConstrainedFairing {
             });
     }
 
+    /// Moves every vertex that is not held (off the boundary, the creases and the mask's pins)
+    /// `step` times as far from the anchors as the iterations since the last [`Self::load`] or
+    /// [`Self::reanchor`] took it: a round's move extrapolated
+    /// ([`crate::fairing::strength::DOUBLED_FROM_ROUND`]). Held vertices keep their iterations'
+    /// positions (a boundary or crease curve's own move).
+    pub fn extrapolate(&mut self, step: f32) {
+        let (order, held) = (&self.order, &self.held);
+        let ws = &mut self.workspace;
+        if ws.current.len() != order.len() {
+            return;
+        }
+        let anchors = &ws.anchors;
+        ws.current
+            .par_chunks_mut(CHUNK)
+            .enumerate()
+            .for_each(|(chunk, out)| {
+                let start = chunk * CHUNK;
+                for (i, state) in out.iter_mut().enumerate() {
+                    let v = start + i;
+                    if !held[order[v] as usize] {
+                        let anchor = anchors[v];
+                        *state = anchor + (*state - anchor) * step;
+                    }
+                }
+            });
+    }
+
     /// Re-imposes the constraints on the current state (the start of a new round).
     pub fn reanchor(&mut self) {
         self.buffers();
@@ -517,6 +544,57 @@ mod tests {
                 }
             }
         }
+    }
+
+    #[test]
+    fn an_extrapolated_round_moves_the_free_vertices_its_step_times_as_far_and_the_held_ones_not() {
+        // A noisy cube with its creases held: free vertices on the faces, held ones on the edges.
+        let clean = crate::mesh::shapes::cuboid([1.0, 1.0, 1.0], 0.1);
+        let topology = Topology::build(&clean);
+        let creases = crate::fairing::creases::detect_creases(
+            &clean,
+            &topology,
+            &crate::fairing::creases::CreaseOptions::default(),
+        );
+        let mut noisy = clean.clone();
+        crate::noise::add_noise(&mut noisy, &Default::default());
+        let start = noisy.positions.clone();
+        let options = FairOptions {
+            rounds: 1,
+            ..Default::default()
+        };
+        let mut fairing = ConstrainedFairing::with_creases(
+            &noisy,
+            &topology,
+            FairVariant::NormalProjected,
+            BoundaryMode::Curve,
+            &creases,
+        );
+        let mut report = Default::default();
+        let mut plain = start.clone();
+        fairing.load(&plain);
+        fairing.run_round(&options, &mut report);
+        fairing.store(&mut plain);
+        let mut doubled = start.clone();
+        fairing.load(&doubled);
+        fairing.run_round(&options, &mut report);
+        fairing.extrapolate(2.0);
+        fairing.store(&mut doubled);
+        let (mut free, mut held) = (0, 0);
+        for v in 0..start.len() {
+            if creases.is_feature(v as u32) {
+                held += 1;
+                assert_eq!(doubled[v], plain[v], "held vertex {v}");
+            } else {
+                free += 1;
+                for k in 0..3 {
+                    let twice = start[v][k] + 2.0 * (plain[v][k] - start[v][k]);
+                    assert!((doubled[v][k] - twice).abs() < 1e-6, "free vertex {v}");
+                }
+            }
+        }
+        assert!(free > 0 && held > 0, "{free} free, {held} held");
+        assert_ne!(doubled, plain);
     }
 
     #[test]

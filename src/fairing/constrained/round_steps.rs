@@ -11,7 +11,9 @@ use crate::fairing::creases::{
     detect_creases_with_estimate, CreaseOptions, Creases, FaceRingCache, FeatureClass,
 };
 use crate::fairing::relaxation::{self, read_tangential_noise};
-use crate::fairing::strength::{normal_filtering_for, RoundRisk, RISK_MIN_FALL, RISK_PATIENCE};
+use crate::fairing::strength::{
+    normal_filtering_for, RoundRisk, DOUBLED_FROM_ROUND, DOUBLED_STEP, RISK_MIN_FALL, RISK_PATIENCE,
+};
 use crate::fairing::volume::VolumeKeeper;
 use crate::fairing::{FairOptions, FairReport, FairVariant, Relaxation};
 use crate::mesh::{FanRings, Topology, TriMesh};
@@ -70,6 +72,16 @@ pub(super) struct RoundLoop<'a> {
 }
 
 impl RoundLoop<'_> {
+    /// How far round `round` moves the vertices, in its iterations' moves: automatic strength
+    /// doubles the rounds from [`DOUBLED_FROM_ROUND`] on, a fixed strength runs plain rounds.
+    pub(super) fn step(&self, round: usize) -> f32 {
+        if self.judge.is_some() && round >= DOUBLED_FROM_ROUND {
+            DOUBLED_STEP
+        } else {
+            1.0
+        }
+    }
+
     /// Round `round` on `mesh`, counted in `report`: the creases found again when they are due
     /// (the operator set up again for them when they changed), the relaxation's shares, the
     /// operator's iterations, the volume given back, and, with automatic strength, the risk
@@ -105,6 +117,10 @@ impl RoundLoop<'_> {
             .before_round(&mut self.fairing, round, at, fans, report);
         let started = std::time::Instant::now();
         let iterations = self.fairing.run_round(self.options, report);
+        let step = self.step(round);
+        if step != 1.0 {
+            self.fairing.extrapolate(step);
+        }
         self.fairing.store(&mut mesh.positions);
         iterations_ms += milliseconds(started);
         report.phases.iterations += iterations_ms;
@@ -128,7 +144,12 @@ impl RoundLoop<'_> {
         };
         let started = std::time::Instant::now();
         let volume_kept = self.volume.is_some();
-        judge.fair_copy(&mut self.fairing, iterations, &mesh.positions, volume_kept);
+        let copy_round = CopyRound {
+            iterations,
+            step,
+            volume_kept,
+        };
+        judge.fair_copy(&mut self.fairing, copy_round, &mesh.positions);
         let edges = self.tracked.creases.as_ref().map_or(0, |c| c.edges.len());
         let stop = judge.stops_after(round, (mesh, topology), edges, report);
         report.phases.risk += milliseconds(started);
@@ -267,6 +288,16 @@ impl RelaxationPlan {
     }
 }
 
+/// What the risk's copy repeats of the mesh's round ([`RiskJudge::fair_copy`]).
+pub(super) struct CopyRound {
+    /// The iterations the mesh's round ran.
+    pub(super) iterations: usize,
+    /// The round's step ([`RoundLoop::step`]).
+    pub(super) step: f32,
+    /// Whether the mesh's volume was given back after the round.
+    pub(super) volume_kept: bool,
+}
+
 /// Automatic strength: round by round while the estimated risk of the result falls (see
 /// [`crate::fairing::strength`]): a copy of the input, moved a little along its normals, goes
 /// through the same rounds, and the mesh goes back to the last round that lowered the risk
@@ -316,8 +347,9 @@ impl RiskJudge {
         }
     }
 
-    /// The copy's round, with the same operator (and creases) as the mesh's and its `iterations`
-    /// (the mesh's round settled after that many: the copy goes through the same map). The volume
+    /// The copy's round, with the same operator (and creases) as the mesh's, its iterations
+    /// (the mesh's round settled after that many: the copy goes through the same map) and its
+    /// step ([`ConstrainedFairing::extrapolate`]). The volume
     /// correction (when `volume_kept`) offsets every vertex by one distance per part along its
     /// normal; the copy takes the mesh's offsets (`after` less the positions before the
     /// correction): what its own correction would give, but for a change of the distance that
@@ -326,12 +358,19 @@ impl RiskJudge {
     pub(super) fn fair_copy(
         &mut self,
         fairing: &mut ConstrainedFairing,
-        iterations: usize,
+        round: CopyRound,
         after: &[[f32; 3]],
-        volume_kept: bool,
     ) {
+        let CopyRound {
+            iterations,
+            step,
+            volume_kept,
+        } = round;
         fairing.load(&self.copy);
         fairing.run_iterations(iterations, &mut self.copy_report);
+        if step != 1.0 {
+            fairing.extrapolate(step);
+        }
         fairing.store(&mut self.copy);
         if volume_kept {
             self.copy

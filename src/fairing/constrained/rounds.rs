@@ -464,12 +464,15 @@ fn fair_rounds(
         volume,
         judge,
     };
+    // Doubled rounds count as their step against the cap.
+    let mut covered = 0.0f32;
     for round in 0..max_rounds {
         let stop = rounds.run(mesh, round, &mut report);
+        covered += rounds.step(round);
         if !progress.report(round_fraction(round + 1, max_rounds, auto_noise.is_some())) {
             return None;
         }
-        if stop {
+        if stop || covered >= max_rounds as f32 {
             break;
         }
     }

@@ -77,8 +77,25 @@ pub use scan::NOISE_GAIN;
 /// edge lengths; clean scans and CAD parts measure 0.000 to 0.035, see `docs/measurements.md`).
 pub const CLEAN_NOISE: f64 = 0.04;
 
-/// At most this many rounds in automatic mode.
+/// At most this many rounds in automatic mode, a doubled round ([`DOUBLED_FROM_ROUND`]) counting
+/// as [`DOUBLED_STEP`].
 pub const MAX_AUTO_ROUNDS: usize = 60;
+
+/// Automatic strength: from this round on (counted from 0), every round moves the vertices
+/// [`DOUBLED_STEP`] times as far as its iterations took them (the round's move extrapolated),
+/// so the rounds that crawl on a finely sampled mesh cover the same ground in about half as
+/// many. A round multiplies each shape mode of the surface by about 1 − λ (λ in [0, 1]: the
+/// noise's modes near 1, the shape's near 0); a doubled round by 1 − 2λ, which is (1 − λ)² to
+/// first order for the slow modes and stays within [−1, 1] for every mode, so nothing grows; by
+/// this round the fast modes are gone (the rounds before it are plain, and the coarsely sampled
+/// scans, which stop after 2 to 6 rounds, never reach it). Only vertices off the creases and the
+/// boundary are extrapolated: curves and corners keep their rounds' own moves. The risk's copy
+/// takes the same steps, so the rule that stops the rounds reads the map that made the mesh
+/// (`docs/measurements.md`, "Doubled rounds").
+pub const DOUBLED_FROM_ROUND: usize = 14;
+
+/// The step of a doubled round ([`DOUBLED_FROM_ROUND`]).
+pub const DOUBLED_STEP: f32 = 2.0;
 
 /// Normal-filter passes crease detection gets for a mesh with this noise estimate: none
 /// for a clean mesh, more the noisier it is.
