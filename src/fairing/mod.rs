@@ -129,8 +129,9 @@ pub struct FairOptions {
     /// Stop a round when the largest vertex move is below this (model units); 0 disables.
     pub tolerance: f64,
     /// [`fair_constrained`] also stops a round once it has settled: once no vertex moved by more
-    /// than this many mean edge lengths in an iteration (default [`ROUND_SETTLED`]; 0 runs every
-    /// iteration). [`ConstrainedFairing::run`] does not read it.
+    /// than this many mean edge lengths in an iteration, along its normal and by a tenth of its
+    /// tangential relaxation (default [`ROUND_SETTLED`]; 0 runs every iteration).
+    /// [`ConstrainedFairing::run`] does not read it.
     pub settled: f64,
     /// Number of rounds; each round re-imposes the constraints on the current positions. With
     /// [`Strength::Auto`] the rounds are chosen from the mesh's noise instead.
@@ -215,7 +216,9 @@ impl Default for FairOptions {
 }
 
 /// The default [`FairOptions::settled`], in mean edge lengths: a round of [`fair_constrained`]
-/// ends once no vertex moves by more than this in an iteration. A round's iterations converge to
+/// ends once no vertex moves by more than this in an iteration (its tangential relaxation counted
+/// at a tenth: a slow drift along the surface that the next rounds carry on). A round's
+/// iterations converge to
 /// its fixed point (the paper's "5 to 10 iterations"), the worst vertex last; past this the moves
 /// left change the result by well under a percent, and on finely sampled meshes most rounds
 /// settle in 2 to 5 iterations of the 10 (`docs/measurements.md`, "A round ends once it has
@@ -264,7 +267,8 @@ pub struct FairReport {
     /// lowered the estimated error by [`strength::RISK_MIN_FALL`] of the second round's fall;
     /// up to [`strength::RISK_PATIENCE`] more were run and undone).
     pub rounds_run: usize,
-    /// Largest single-vertex move in the last iteration (model units).
+    /// Largest single-vertex move in the last iteration (model units; the tangential relaxation's
+    /// part of a move counted at a tenth, as a round's settling reads it).
     pub max_move: f64,
     /// The input's estimated noise in mean edge lengths ([`strength::estimate_noise`]), when the
     /// run estimated it ([`Strength::Auto`], or creases kept).

@@ -14,6 +14,15 @@ use rayon::prelude::*;
 /// Vertices per parallel work item: 256 and 512 are the fastest on meshes of 75k and 1.2M faces
 /// (`docs/measurements.md`).
 pub(super) const CHUNK: usize = 512;
+/// How much of a move's tangential relaxation counts when a round reads whether it has settled
+/// (the largest move, [`ConstrainedFairing::step`]): the normal move is the round's problem, and
+/// it settles in a few iterations; the relaxation is a slow drift along the surface (a tenth of
+/// the umbrella vector's tangential part per iteration) that the next rounds carry on, and at the
+/// thin triangles, which get all of it, it kept every round of a finely sampled mesh at its 10
+/// iterations for a few hundred vertices (`docs/measurements.md`, "A round ends once it has
+/// settled").
+pub(super) const RELAXATION_SETTLING: f32 = 0.1;
+
 /// Evaluates `$body` with `$stencil` bound to `$fairing`'s one-ring stencil, whichever width its
 /// weight index has (one monomorphised kernel per width).
 macro_rules! with_stencil {
@@ -235,7 +244,8 @@ impl ConstrainedFairing {
     }
 
     /// One Jacobi iteration of the current state (anchors from the last [`Self::load`] or
-    /// [`Self::reanchor`]). Returns the largest vertex move.
+    /// [`Self::reanchor`]). Returns the largest vertex move, the tangential relaxation's part of
+    /// a move counted at [`RELAXATION_SETTLING`] of its length (what a round's settling reads).
     pub fn step(&mut self) -> f64 {
         let project = self.variant == FairVariant::NormalProjected;
         self.buffers();
@@ -329,7 +339,7 @@ impl<I: Copy + Into<u32> + Sync> Stencil<'_, I> {
     /// only the part of the move x̃_v − x_v along the normal of their fan of umbrella means (centre
     /// m_v, ring m_u, gathered anyway for the update), plus `tangential` (times the vertex's
     /// `share` unless that is empty) of the tangential part of its umbrella vector. Returns the
-    /// largest squared move.
+    /// largest squared move, the relaxation's part counted at [`RELAXATION_SETTLING`].
     fn averaged_solutions<const PROJECT: bool>(
         &self,
         pairs: &[PositionAndMean],
@@ -385,6 +395,9 @@ impl<I: Copy + Into<u32> + Sync> Stencil<'_, I> {
                     }
                     let normal = w.yzx();
                     let mut step = sum - p;
+                    // What the move counts for the round's settling: all of it, but for the
+                    // tangential relaxation, which counts a tenth.
+                    let mut settling = None;
                     if PROJECT && closed_fan[v] {
                         let length_squared = normal.length_squared();
                         step = if length_squared > 0.0 && length_squared.is_finite() {
@@ -393,7 +406,12 @@ impl<I: Copy + Into<u32> + Sync> Stencil<'_, I> {
                             if tangential > 0.0 {
                                 let umbrella = m - p;
                                 let across = normal * (normal.dot(umbrella) / length_squared);
-                                along + (umbrella - across) * tangential
+                                let relaxing = (umbrella - across) * tangential;
+                                settling = Some(along.length_squared().max(
+                                    relaxing.length_squared()
+                                        * (RELAXATION_SETTLING * RELAXATION_SETTLING),
+                                ));
+                                along + relaxing
                             } else {
                                 along
                             }
@@ -401,7 +419,7 @@ impl<I: Copy + Into<u32> + Sync> Stencil<'_, I> {
                             Vec3A::ZERO
                         };
                     }
-                    let squared = step.length_squared();
+                    let squared = settling.unwrap_or_else(|| step.length_squared());
                     if squared > max_squared {
                         max_squared = squared;
                     }
@@ -595,6 +613,42 @@ mod tests {
         }
         assert!(free > 0 && held > 0, "{free} free, {held} held");
         assert_ne!(doubled, plain);
+    }
+
+    #[test]
+    fn the_tangential_relaxation_counts_a_tenth_toward_settling() {
+        // A flat grid with its inner vertices jittered within the plane: the normal move is
+        // nil, the relaxation evens the triangles out along the plane.
+        let mut mesh = crate::mesh::fixtures::grid(8);
+        for (v, p) in mesh.positions.iter_mut().enumerate() {
+            let jitter = ((v * 37) % 11) as f32 * 0.004 - 0.02;
+            p[0] += jitter;
+            p[1] -= 0.5 * jitter;
+        }
+        assert!(mesh.positions.iter().all(|p| p[2] == 0.0), "a flat grid");
+        let topology = Topology::build(&mesh);
+        let mut fairing = ConstrainedFairing::new(
+            &mesh,
+            &topology,
+            FairVariant::NormalProjected,
+            BoundaryMode::Fixed,
+        );
+        fairing.set_tangential_relaxation(1.0);
+        fairing.load(&mesh.positions);
+        let reported = fairing.step();
+        let mut after = mesh.positions.clone();
+        fairing.store(&mut after);
+        let moved = after
+            .iter()
+            .zip(&mesh.positions)
+            .map(|(a, b)| (0..3).map(|k| (a[k] - b[k]).powi(2)).sum::<f32>().sqrt())
+            .fold(0.0f32, f32::max) as f64;
+        assert!(moved > 1e-3, "the relaxation moved the vertices ({moved})");
+        let expected = moved * RELAXATION_SETTLING as f64;
+        assert!(
+            (reported - expected).abs() <= 1e-3 * expected,
+            "reported {reported}, moved {moved}"
+        );
     }
 
     #[test]
