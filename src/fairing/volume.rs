@@ -186,35 +186,38 @@ impl VolumeKeeper {
         self.restore_with_normals(mesh, topology, held).0
     }
 
-    /// [`Self::restore`], also giving back every vertex's unit normal (area-weighted; zero where
-    /// the faces' normals sum to zero, and for a vertex with no face) before the offsets: the
-    /// offsets move the surface by a small fraction of an edge length, uniformly, so these are
-    /// the restored mesh's normals but for that fraction times its curvature (the risk estimate
-    /// reads them instead of another pass over the faces).
+    /// [`Self::restore`], also giving back the offsets it applied ([`Offsets`]: every vertex's
+    /// unit normal and each part's distance), to read the normals again or to offset another
+    /// state of the mesh the same way ([`Self::offset`]).
     pub fn restore_with_normals(
         &self,
         mesh: &mut TriMesh,
         topology: &Topology,
         held: impl Fn(usize) -> bool + Sync,
-    ) -> (f64, Vec<Vec3A>) {
+    ) -> (f64, Offsets) {
         let moves = |v: usize| self.movable[v] && !held(v);
         let positions = &mesh.positions;
         let point = |v: u32| Vec3A::from_array(positions[v as usize]);
-        // Each vertex's unit normal: the sum of its faces' area normals N_f (computed here from
-        // its own corner, (a − v) × (b − v)); the offsets take them for the movable vertices and
-        // zero for the vertices that stay.
+        // Each vertex's unit normal: the sum of its faces' area normals N_f = (b − a) × (c − a),
+        // each computed once (a pass over the faces, then one over the vertices); the offsets
+        // take them for the movable vertices and zero for the vertices that stay.
+        let face_normals: Vec<Vec3A> = mesh
+            .triangles
+            .par_iter()
+            .with_min_len(BLOCK)
+            .map(|t| {
+                let [a, b, c] = t.map(point);
+                (b - a).cross(c - a)
+            })
+            .collect();
         let normals: Vec<Vec3A> = (0..positions.len())
             .into_par_iter()
             .with_min_len(BLOCK)
             .map(|v| {
-                let p = point(v as u32);
-                let mut sum = Vec3A::ZERO;
-                for &f in topology.faces_of(v as u32) {
-                    let t = mesh.triangles[f as usize];
-                    let k = t.iter().position(|&c| c as usize == v).unwrap_or(0);
-                    let (a, b) = (point(t[(k + 1) % 3]), point(t[(k + 2) % 3]));
-                    sum += (a - p).cross(b - p);
-                }
+                let sum = topology
+                    .faces_of(v as u32)
+                    .iter()
+                    .fold(Vec3A::ZERO, |sum, &f| sum + face_normals[f as usize]);
                 let length = sum.length();
                 if length > 0.0 && length.is_finite() {
                     sum / length
@@ -223,28 +226,59 @@ impl VolumeKeeper {
                 }
             })
             .collect();
+        drop(face_normals);
         // Per part, the coefficients of V(δ) = c0 + c1 δ + c2 δ² + c3 δ³.
         let cubic = self.volume_cubics(mesh, Some((&normals, &moves)));
-        let offsets: Vec<f64> = cubic
-            .iter()
-            .zip(&self.target)
-            .map(|(c, &target)| offset_for(c, target))
-            .collect();
-        mesh.positions
+        let offsets = Offsets {
+            normals,
+            distances: cubic
+                .iter()
+                .zip(&self.target)
+                .map(|(c, &target)| offset_for(c, target))
+                .collect(),
+        };
+        self.offset(&mut mesh.positions, &offsets, held);
+        let largest = offsets.distances.iter().fold(0.0f64, |m, d| m.max(d.abs()));
+        (largest, offsets)
+    }
+
+    /// Moves `positions` (the mesh's, or another state of the same connectivity) by `offsets`:
+    /// every movable vertex for which `held` is false by its part's distance along its normal.
+    pub fn offset(
+        &self,
+        positions: &mut [[f32; 3]],
+        offsets: &Offsets,
+        held: impl Fn(usize) -> bool + Sync,
+    ) {
+        let moves = |v: usize| self.movable[v] && !held(v);
+        let distances = &offsets.distances;
+        positions
             .par_iter_mut()
-            .zip(&normals)
+            .zip(&offsets.normals)
             .zip(&self.vertex_part)
             .enumerate()
             .with_min_len(BLOCK)
             .for_each(|(v, ((position, normal), &part))| {
-                let offset = offsets[part as usize];
+                let offset = distances[part as usize];
                 if *normal != Vec3A::ZERO && offset != 0.0 && moves(v) {
                     let moved = DVec3::from(position.map(f64::from)) + normal.as_dvec3() * offset;
                     *position = moved.as_vec3().to_array();
                 }
             });
-        (offsets.iter().fold(0.0, |m, d| m.max(d.abs())), normals)
     }
+}
+
+/// What one volume correction applied ([`VolumeKeeper::restore_with_normals`]).
+#[derive(Clone, Debug, Default)]
+pub struct Offsets {
+    /// Every vertex's unit normal (area-weighted; zero where its faces' normals sum to zero,
+    /// and for a vertex with no face) before the offsets: the offsets move the surface by a
+    /// small fraction of an edge length, uniformly, so these are the corrected mesh's normals
+    /// but for that fraction times its curvature (the risk estimate reads them instead of
+    /// another pass over the faces).
+    pub normals: Vec<Vec3A>,
+    /// Each part's distance along the normals.
+    pub distances: Vec<f64>,
 }
 
 /// The root nearest zero of c0 + c1 δ + c2 δ² + c3 δ³ = `target` (Newton's method from zero;

@@ -4,7 +4,6 @@
 //! estimate read after every round, which keeps the best round and stops the rounds
 //! ([`RiskJudge`]).
 
-use super::kernel::CHUNK;
 use super::weights::held_flags;
 use super::ConstrainedFairing;
 use crate::fairing::creases::{
@@ -18,7 +17,6 @@ use crate::fairing::volume::VolumeKeeper;
 use crate::fairing::{FairOptions, FairReport, FairVariant, Relaxation};
 use crate::mesh::{FanRings, Topology, TriMesh};
 use glam::Vec3A;
-use rayon::prelude::*;
 
 /// Once two detections in a row found the creases unchanged (or settled, see
 /// [`CREASE_SETTLED`]), [`fair_constrained`] finds them again only in every this many rounds.
@@ -125,31 +123,26 @@ impl RoundLoop<'_> {
         iterations_ms += milliseconds(started);
         report.phases.iterations += iterations_ms;
         let started = std::time::Instant::now();
-        if let Some(volume) = &self.volume {
-            if let Some(judge) = &mut self.judge {
-                judge.before_restore.clone_from(&mesh.positions);
-            }
-            let class = self.tracked.creases.as_ref().map(|c| c.class.as_slice());
-            let class = class.unwrap_or(&[]);
-            let (_, normals) = volume.restore_with_normals(mesh, topology, |v| {
-                class.get(v) == Some(&FeatureClass::Corner)
-            });
-            if let Some(judge) = &mut self.judge {
-                judge.normals = Some(normals);
-            }
-        }
+        let class = self.tracked.creases.as_ref().map(|c| c.class.as_slice());
+        let class = class.unwrap_or(&[]);
+        let held = |v: usize| class.get(v) == Some(&FeatureClass::Corner);
+        let offsets = self
+            .volume
+            .as_ref()
+            .map(|volume| volume.restore_with_normals(mesh, topology, held).1);
         report.phases.volume += milliseconds(started);
         let Some(judge) = &mut self.judge else {
             return false;
         };
         let started = std::time::Instant::now();
-        let volume_kept = self.volume.is_some();
-        let copy_round = CopyRound {
-            iterations,
-            step,
-            volume_kept,
-        };
-        judge.fair_copy(&mut self.fairing, copy_round, &mesh.positions);
+        judge.fair_copy(&mut self.fairing, iterations, step);
+        // The copy takes the mesh's volume offsets: what its own correction would give, but for a
+        // change of the distance that sums a part's volume change, of order 1/N per vertex
+        // against the local response the risk reads.
+        if let (Some(volume), Some(offsets)) = (&self.volume, offsets) {
+            volume.offset(&mut judge.copy, &offsets, held);
+            judge.normals = Some(offsets.normals);
+        }
         let edges = self.tracked.creases.as_ref().map_or(0, |c| c.edges.len());
         let stop = judge.stops_after(round, (mesh, topology), edges, report);
         report.phases.risk += milliseconds(started);
@@ -288,16 +281,6 @@ impl RelaxationPlan {
     }
 }
 
-/// What the risk's copy repeats of the mesh's round ([`RiskJudge::fair_copy`]).
-pub(super) struct CopyRound {
-    /// The iterations the mesh's round ran.
-    pub(super) iterations: usize,
-    /// The round's step ([`RoundLoop::step`]).
-    pub(super) step: f32,
-    /// Whether the mesh's volume was given back after the round.
-    pub(super) volume_kept: bool,
-}
-
 /// Automatic strength: round by round while the estimated risk of the result falls (see
 /// [`crate::fairing::strength`]): a copy of the input, moved a little along its normals, goes
 /// through the same rounds, and the mesh goes back to the last round that lowered the risk
@@ -309,8 +292,6 @@ pub(super) struct RiskJudge {
     /// The risk's copy of the mesh, faired round by round beside it.
     pub(super) copy: Vec<[f32; 3]>,
     pub(super) copy_report: FairReport,
-    /// The mesh's positions before this round's volume correction.
-    pub(super) before_restore: Vec<[f32; 3]>,
     /// The mesh's unit vertex normals from this round's volume correction, if it ran.
     pub(super) normals: Option<Vec<Vec3A>>,
     /// The last round kept: its number and risk, its positions and crease count.
@@ -338,7 +319,6 @@ impl RiskJudge {
             risk,
             copy,
             copy_report: FairReport::default(),
-            before_restore: Vec::new(),
             normals: None,
             kept_round: None,
             kept_positions: Vec::new(),
@@ -347,44 +327,21 @@ impl RiskJudge {
         }
     }
 
-    /// The copy's round, with the same operator (and creases) as the mesh's, its iterations
+    /// The copy's round, with the same operator (and creases) as the mesh's, its `iterations`
     /// (the mesh's round settled after that many: the copy goes through the same map) and its
-    /// step ([`ConstrainedFairing::extrapolate`]). The volume
-    /// correction (when `volume_kept`) offsets every vertex by one distance per part along its
-    /// normal; the copy takes the mesh's offsets (`after` less the positions before the
-    /// correction): what its own correction would give, but for a change of the distance that
-    /// sums a part's volume change, of order 1/N per vertex against the local response the risk
-    /// reads.
+    /// `step` ([`ConstrainedFairing::extrapolate`]).
     pub(super) fn fair_copy(
         &mut self,
         fairing: &mut ConstrainedFairing,
-        round: CopyRound,
-        after: &[[f32; 3]],
+        iterations: usize,
+        step: f32,
     ) {
-        let CopyRound {
-            iterations,
-            step,
-            volume_kept,
-        } = round;
         fairing.load(&self.copy);
         fairing.run_iterations(iterations, &mut self.copy_report);
         if step != 1.0 {
             fairing.extrapolate(step);
         }
         fairing.store(&mut self.copy);
-        if volume_kept {
-            self.copy
-                .par_chunks_mut(CHUNK)
-                .zip(after.par_chunks(CHUNK))
-                .zip(self.before_restore.par_chunks(CHUNK))
-                .for_each(|((copy, after), before)| {
-                    for ((c, a), b) in copy.iter_mut().zip(after).zip(before) {
-                        for k in 0..3 {
-                            c[k] += a[k] - b[k];
-                        }
-                    }
-                });
-        }
     }
 
     /// Reads the risk after round `round` (the mesh with `crease_edges` crease edges) into
