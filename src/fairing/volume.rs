@@ -175,8 +175,8 @@ impl VolumeKeeper {
     /// four coefficients per part, and the part's δ is the root of its cubic nearest zero
     /// (Newton's method from zero, on the polynomial: no pass over the mesh per step). So the
     /// volume is restored exactly (to rounding), where two linearised steps left a remainder of
-    /// second order, and the mesh is read three times (normals, coefficients, offsets) instead
-    /// of seven.
+    /// second order, and the mesh is read four times (face normals, vertex normals, coefficients,
+    /// offsets) instead of seven.
     pub fn restore(
         &self,
         mesh: &mut TriMesh,
