@@ -265,7 +265,8 @@ pub struct FairReport {
     pub iterations_run: usize,
     /// Rounds that made the result (with [`Strength::Auto`], the last round kept: the last that
     /// lowered the estimated error by [`strength::RISK_MIN_FALL`] of the second round's fall;
-    /// up to [`strength::RISK_PATIENCE`] more were run and undone).
+    /// up to [`strength::RISK_PATIENCE`] more were run and undone; from
+    /// [`strength::DOUBLED_FROM_ROUND`] on, each round moved twice as far).
     pub rounds_run: usize,
     /// Largest single-vertex move in the last iteration (model units; the tangential relaxation's
     /// part of a move counted at a tenth, as a round's settling reads it).
