@@ -245,7 +245,7 @@ impl ConstrainedFairing {
 
     /// One Jacobi iteration of the current state (anchors from the last [`Self::load`] or
     /// [`Self::reanchor`]). Returns the largest vertex move, the tangential relaxation's part of
-    /// a move counted at [`RELAXATION_SETTLING`] of its length (what a round's settling reads).
+    /// a move counted at a tenth of its length (what a round's settling reads).
     pub fn step(&mut self) -> f64 {
         let project = self.variant == FairVariant::NormalProjected;
         self.buffers();
