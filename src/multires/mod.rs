@@ -64,6 +64,7 @@
 
 pub mod denoise;
 mod refine;
+mod unfold;
 
 pub use denoise::{denoise, Denoise, DenoiseOptions, Denoised};
 
@@ -158,6 +159,9 @@ struct LevelData {
     /// The precomputed fairing operator of this connectivity, for the variant and boundary mode
     /// it was made with.
     fairing: Option<ConstrainedFairing>,
+    /// M0 only, once a run from a coarser level needed them: its edges with two faces and which
+    /// of them bend to a right angle or beyond on M0 itself ([`unfold`]).
+    folds: Option<(Vec<[u32; 4]>, Vec<bool>)>,
 }
 
 /// Buffers reused between runs (the editor runs this on every slider move).
@@ -335,6 +339,7 @@ impl LevelData {
             }
         }
         LevelData {
+            folds: None,
             mesh,
             topology,
             loop_neighbors,
@@ -448,6 +453,9 @@ fn fair_multires_on_worker(
             return None;
         }
     }
+    if start > 0 {
+        unfold_new_folds(hierarchy, workspace);
+    }
     if release {
         workspace.levels[0] = None;
     }
@@ -458,6 +466,32 @@ fn fair_multires_on_worker(
         result[hierarchy.original_vertex(v as u32) as usize] = *p;
     }
     Some(result)
+}
+
+/// The last step of a run from a coarser level ([`unfold`]): the edges it left folded where M0
+/// was not are unfolded.
+fn unfold_new_folds(hierarchy: &Hierarchy, workspace: &mut MultiresWorkspace) {
+    let level = workspace.levels[0].get_or_insert_with(|| LevelData::build(hierarchy, 0));
+    let LevelData {
+        mesh,
+        topology,
+        folds,
+        creases,
+        loop_neighbors,
+        ..
+    } = level;
+    let (edges, reference) = folds.get_or_insert_with(|| {
+        let edges = unfold::two_face_edges(mesh, topology);
+        let reference = unfold::bent_to_right_angle(&mesh.positions, mesh, &edges);
+        (edges, reference)
+    });
+    let level = unfold::Level {
+        mesh,
+        topology,
+        creases: creases.as_ref(),
+        loop_neighbors,
+    };
+    unfold::unfold(&mut workspace.positions, &level, edges, reference);
 }
 
 /// Sets `workspace` up for a run from level `start`: the levels it needs now (all it touches, or
