@@ -61,6 +61,8 @@
 //!   automatic default of constrained fairing, once; the hierarchy is built on its result).
 //! - `refine`: the steps between two levels (the shrinkage taken back, the split vertices
 //!   placed).
+//! - `unfold`: the last step of a run from a coarser level: the edges it left folded where M0 is
+//!   not, unfolded.
 
 pub mod denoise;
 mod refine;
