@@ -101,6 +101,9 @@ pub struct MultiresOptions {
     pub boundary: BoundaryMode,
     /// Also fair M0 after the last refinement.
     pub fair_finest: bool,
+    /// After a run from a coarser level, unfold the edges it left folded where M0 is not
+    /// ([`unfold`]; on by default). Off, the result is the levels' fairing and placements alone.
+    pub unfold: bool,
     pub variant: MultiresVariant,
     /// Where to fair ([`crate::fairing::mask`]), one weight per M0 vertex in the base mesh's
     /// numbering: the run fairs the whole mesh and blends the result back by the weights, so
@@ -115,6 +118,7 @@ with_setters!(MultiresOptions {
     with_rounds => rounds: usize,
     with_boundary => boundary: BoundaryMode,
     with_fair_finest => fair_finest: bool,
+    with_unfold => unfold: bool,
     with_variant => variant: MultiresVariant,
     with_mask => mask: Option<Mask>,
 });
@@ -127,6 +131,7 @@ impl Default for MultiresOptions {
             rounds: 1,
             boundary: BoundaryMode::Curve,
             fair_finest: false,
+            unfold: true,
             variant: MultiresVariant::Improved,
             mask: None,
         }
@@ -455,7 +460,7 @@ fn fair_multires_on_worker(
             return None;
         }
     }
-    if start > 0 {
+    if start > 0 && options.unfold {
         unfold_new_folds(hierarchy, workspace);
     }
     if release {

@@ -396,6 +396,7 @@ impl Settings {
             rounds: self.rounds.clamp(1, 100),
             boundary: self.boundary,
             fair_finest: self.fair_finest,
+            unfold: true,
             variant: self.variant,
             mask: None,
         }
