@@ -41,6 +41,11 @@ fn built_in() -> Vec<(String, Result<TriMesh, String>)> {
         ("coarse cylinder", shapes::cylinder(0.5, 1.5, 0.2)),
         ("gear", shapes::gear(16, 1.0, 1.25, 0.3, 0.04)),
         ("d prism", shapes::d_prism(1.0, 0.7, 0.5, 0.05)),
+        ("cad cylinder 12", shapes::cad_cylinder(12, 0.5, 1.5)),
+        ("cad cylinder 16", shapes::cad_cylinder(16, 0.5, 1.5)),
+        ("cad cylinder 32", shapes::cad_cylinder(32, 0.5, 1.5)),
+        ("cad cylinder 40", shapes::cad_cylinder(40, 0.5, 1.5)),
+        ("cad cylinder 64", shapes::cad_cylinder(64, 0.5, 1.5)),
     ];
     list.extend(
         shapes
