@@ -116,8 +116,13 @@ impl App {
                 self.refresh_view();
             }
             Command::SetViewMode(mode) => {
-                self.settings.view_mode = mode;
-                self.refresh_view();
+                let previous = std::mem::replace(&mut self.settings.view_mode, mode);
+                // The input mesh and the result are both shown from the fairing asked for
+                // whenever a setting changed: switching between them asks for nothing new.
+                let fairs = |mode| matches!(mode, ViewMode::Faired | ViewMode::Original);
+                if !(fairs(previous) && fairs(mode)) {
+                    self.refresh_view();
+                }
             }
             Command::CancelHierarchy => {
                 self.hierarchy_generation.bump();

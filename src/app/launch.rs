@@ -186,6 +186,7 @@ impl App {
             shown: None,
             shown_before: None,
             heat_max: [None; 2],
+            held_views: Default::default(),
             appearance: None,
             show_before: false,
             shown_counts: (0, 0),

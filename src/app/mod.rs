@@ -45,6 +45,7 @@ mod confirm_replace;
 mod export_panel;
 mod fairing_panel;
 mod frame_stats;
+mod held_views;
 mod hierarchy_panel;
 pub mod history;
 mod input;
@@ -143,6 +144,8 @@ pub struct App {
     fitted_camera: Option<OrbitCamera>,
     shown: Option<Shown>,
     shown_before: Option<Shown>,
+    /// Per slot, the meshes its renderer holds on the GPU and what was uploaded with them.
+    held_views: [Vec<held_views::HeldView>; 2],
     /// Largest heat-map scalar uploaded per slot (the legend's and the colour map's top).
     heat_max: [Option<f32>; 2],
     /// The file's colours as the viewport draws them, made once per loaded file (keyed by its

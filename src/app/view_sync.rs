@@ -5,6 +5,7 @@
 use std::sync::Arc;
 
 use crate::app::camera::OrbitCamera;
+use crate::app::held_views::HeldView;
 use crate::app::state::{
     self, CompareView, Document, HeatReference, HierarchyState, Settings, ViewMode,
 };
@@ -74,18 +75,6 @@ pub(in crate::app) enum ShownMesh {
     Original,
     Faired { serial: u64 },
     Level { level: usize },
-}
-
-impl ShownMesh {
-    /// Meshes with the same key share connectivity, so only positions need uploading.
-    pub(in crate::app) fn connectivity(self, base_matches_original: bool) -> (u8, usize) {
-        match self {
-            ShownMesh::Original => (0, 0),
-            ShownMesh::Faired { .. } if base_matches_original => (0, 0),
-            ShownMesh::Faired { .. } => (1, 0),
-            ShownMesh::Level { level } => (2, level),
-        }
-    }
 }
 
 /// The heat map's top: the 99th percentile of the distances above zero, so a few outliers do
@@ -334,27 +323,37 @@ impl App {
         }
     }
 
-    /// Uploads the wanted mesh (and heat-map scalars) when they differ from what is on the GPU.
+    /// Shows the wanted mesh: from the GPU when the viewport holds it, otherwise uploaded (and
+    /// its heat-map scalars and mask weights when they differ from what is on the GPU).
     pub(super) fn sync_slot(&mut self, slot: Slot) {
         let Some(wanted) = self.wanted_mesh(slot) else {
             return;
         };
-        let shown = match slot {
+        let mut shown = match slot {
             Slot::Main => self.shown,
             Slot::Before => self.shown_before,
         };
         if shown == Some(wanted) || self.document.is_none() {
             return;
         }
-        let mesh_changed =
+        let mut mesh_changed =
             shown.is_none_or(|s| (s.document, s.what) != (wanted.document, wanted.what));
         let mut counts = None;
         if mesh_changed {
-            self.make_appearance();
-            let Some(uploaded) = self.upload_mesh(slot, shown, wanted) else {
-                return;
-            };
-            counts = Some(uploaded);
+            if let Some(held) = self.show_held(slot, wanted) {
+                // Its scalars and weights are on the GPU with it: written again only if the
+                // wanted ones differ.
+                shown = Some(held.shown);
+                self.heat_max[slot as usize] = held.heat_max;
+                counts = Some(held.counts);
+                mesh_changed = false;
+            } else {
+                self.make_appearance();
+                let Some(uploaded) = self.upload_mesh(slot, wanted) else {
+                    return;
+                };
+                counts = Some(uploaded);
+            }
         }
         // New buffers start with zero scalars and weights: both are written again.
         let mut uploaded = wanted;
@@ -368,15 +367,21 @@ impl App {
         if mesh_changed || shown.is_none_or(|s| s.mask != wanted.mask) {
             self.upload_mask(slot, wanted);
         }
+        let counts = counts.unwrap_or(self.shown_counts);
         match slot {
             Slot::Main => {
-                if let Some(counts) = counts {
-                    self.shown_counts = counts;
-                }
+                self.shown_counts = counts;
                 self.shown = Some(uploaded);
             }
             Slot::Before => self.shown_before = Some(uploaded),
         }
+        let view = HeldView {
+            key: self.held_key(uploaded),
+            shown: uploaded,
+            heat_max: self.heat_max[slot as usize],
+            counts,
+        };
+        self.remember_view(slot, view);
     }
 
     /// Makes the document's file's colours for the viewport, once per loaded file.
@@ -392,22 +397,17 @@ impl App {
     }
 
     /// The slot's renderer handle, when there is a wgpu renderer.
-    fn slot_viewport(&self, slot: Slot) -> Option<&Viewport3d> {
+    pub(super) fn slot_viewport(&self, slot: Slot) -> Option<&Viewport3d> {
         match slot {
             Slot::Main => self.viewport.as_ref(),
             Slot::Before => self.viewport_before.as_ref(),
         }
     }
 
-    /// Uploads the wanted mesh to the slot's viewport (only its positions when the GPU holds its
-    /// triangles already, from `shown`); its vertex and face counts, or `None` when that mesh
-    /// is not there (yet).
-    fn upload_mesh(
-        &self,
-        slot: Slot,
-        shown: Option<Shown>,
-        wanted: Shown,
-    ) -> Option<(usize, usize)> {
+    /// Uploads the wanted mesh to the slot's viewport (only its positions when the GPU holds an
+    /// older version of it, such as the previous result); its vertex and face counts, or `None`
+    /// when that mesh is not there (yet).
+    fn upload_mesh(&self, slot: Slot, wanted: Shown) -> Option<(usize, usize)> {
         let document = self.document.as_ref()?;
         let base = match &document.hierarchy {
             HierarchyState::Ready {
@@ -417,18 +417,14 @@ impl App {
             } => Some((hierarchy.clone(), *base_matches_original)),
             _ => None,
         };
-        let matches = base.as_ref().is_none_or(|b| b.1);
-        let same_connectivity = shown.is_some_and(|shown| {
-            shown.document == wanted.document
-                && shown.what.connectivity(matches) == wanted.what.connectivity(matches)
-        });
+        let key = self.held_key(wanted);
         let appearance = self.appearance.as_ref().and_then(|(_, a)| a.clone());
         let source = view_mesh(document, wanted.what, base, appearance)?;
         let counts = (source.positions().len(), source.triangles().len());
         if let Some(viewport) = self.slot_viewport(slot) {
             let source: Arc<dyn MeshSource> = Arc::new(source);
-            if !(same_connectivity && viewport.set_positions(source.clone())) {
-                viewport.set_mesh(source);
+            if !viewport.set_positions_keyed(source.clone(), key) {
+                viewport.set_mesh_keyed(source, key);
             }
         }
         Some(counts)

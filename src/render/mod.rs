@@ -15,7 +15,10 @@ pub mod normals;
 pub mod pipeline;
 pub mod shading;
 
-pub use pipeline::{DrawParams, MeshRenderer, MeshSource, SOFTWARE_SINGLE_SAMPLE_FACES};
+pub use pipeline::{
+    DrawParams, MeshKey, MeshRenderer, MeshSource, UploadCounts, MAX_HELD_MESHES,
+    SOFTWARE_SINGLE_SAMPLE_FACES,
+};
 pub use shading::{Lighting, Shading};
 
 use egui_wgpu::wgpu;
@@ -77,6 +80,44 @@ impl Viewport3d {
     pub fn set_mesh(&self, source: Arc<dyn MeshSource>) {
         let device = &self.state.device;
         self.with_renderer(|r| r.set_mesh(device, source));
+    }
+
+    /// Shows a mesh the renderer keeps on the GPU under `key` (its family's mesh replaced);
+    /// see [`MeshRenderer::set_mesh_keyed`].
+    pub fn set_mesh_keyed(&self, source: Arc<dyn MeshSource>, key: MeshKey) {
+        let device = &self.state.device;
+        self.with_renderer(|r| r.set_mesh_keyed(device, source, Some(key)));
+    }
+
+    /// Shows the held mesh `key` without uploading anything; `false` when it is not held.
+    pub fn show_held(&self, key: MeshKey) -> bool {
+        let queue = &self.state.queue;
+        self.with_renderer(|r| r.show_held(queue, key))
+            .unwrap_or(false)
+    }
+
+    /// Moves `key`'s family's held mesh to `source`'s positions and shows it; `false` when none
+    /// with that vertex count is held.
+    pub fn set_positions_keyed(&self, source: Arc<dyn MeshSource>, key: MeshKey) -> bool {
+        let queue = &self.state.queue;
+        self.with_renderer(|r| r.set_positions_keyed(queue, source, key))
+            .unwrap_or(false)
+    }
+
+    /// Drops the held meshes (not the one on screen) whose key `keep` refuses.
+    pub fn retain_held(&self, keep: impl Fn(MeshKey) -> bool) {
+        self.with_renderer(|r| r.retain_held(keep));
+    }
+
+    /// What this renderer has written to the GPU so far.
+    pub fn uploads(&self) -> UploadCounts {
+        self.with_renderer(|r| r.uploads).unwrap_or_default()
+    }
+
+    /// Meshes held on the GPU (the one on screen included) and the bytes they take.
+    pub fn held_meshes(&self) -> (usize, u64) {
+        self.with_renderer(|r| (r.meshes_held(), r.mesh_bytes()))
+            .unwrap_or_default()
     }
 
     /// Why the mesh (or its wireframe, when on) is not drawn: too big for this GPU's buffers.

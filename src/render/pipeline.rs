@@ -1,8 +1,10 @@
 //! The mesh renderer: [`MeshRenderer`] owns the pipelines, the mesh's GPU buffers and an
 //! offscreen colour + depth target it draws into. One file per concern beside it:
 //! `pipeline/passes.rs` (the pipelines, `shaders/mesh.wgsl`, the uniforms, the target and the
-//! render pass), `pipeline/buffers.rs` (a mesh's buffers and its wireframe edges) and
-//! `pipeline/upload.rs` (the upload thread for big meshes).
+//! render pass), `pipeline/buffers.rs` (a mesh's buffers and its wireframe edges),
+//! `pipeline/upload.rs` (the upload thread for big meshes) and `pipeline/held.rs` (meshes kept
+//! on the GPU besides the one on screen, keyed by what they show, so that showing one again
+//! uploads nothing: [`MeshRenderer::show_held`]).
 //!
 //! Buffers are written only when the mesh changes ([`MeshRenderer::set_mesh`] for new
 //! connectivity, [`MeshRenderer::set_positions`] when only the positions move; both recompute
@@ -17,8 +19,11 @@
 //! (~30 ms for 1.2M faces). The previous image stays until the upload lands.
 
 mod buffers;
+mod held;
 mod passes;
 mod upload;
+
+pub use held::{MeshKey, UploadCounts, MAX_HELD_MESHES};
 
 use std::sync::Arc;
 use std::time::Duration;
@@ -26,8 +31,7 @@ use std::time::Duration;
 use super::appearance::Appearance;
 use super::normals::vertex_normals;
 use super::shading::{Lighting, Shading};
-use buffers::MaterialGroup;
-use buffers::{draw_triangles, line_buffer, MeshBuffers};
+use buffers::MeshBuffers;
 use passes::{MaterialKit, Part, Pipelines, Target, Uniforms};
 use upload::{PendingMesh, UploadJob, Uploaded, Uploader};
 
@@ -125,6 +129,11 @@ pub struct MeshRenderer {
     /// mesh's sampling before its upload lands, so its first image is drawn once.
     newest_faces: usize,
     mesh: Option<MeshBuffers>,
+    /// Meshes kept on the GPU besides the one on screen, to show again without uploading
+    /// (see [`Self::show_held`]); at most [`MAX_HELD_MESHES`] with `mesh`.
+    held: Vec<MeshBuffers>,
+    /// What was written to the GPU so far (tests and the performance readout).
+    pub uploads: UploadCounts,
     target: Option<Target>,
     /// Parameters of the image now in the target; `None` forces a redraw.
     drawn: Option<DrawParams>,
@@ -185,6 +194,8 @@ impl MeshRenderer {
             software: false,
             newest_faces: 0,
             mesh: None,
+            held: Vec::new(),
+            uploads: UploadCounts::default(),
             target: None,
             drawn: None,
             faces_per_frame: usize::MAX,
@@ -264,6 +275,18 @@ impl MeshRenderer {
     /// stays on screen (it appears in the first frame after the upload lands; see
     /// [`Self::upload_pending`]).
     pub fn set_mesh(&mut self, device: &wgpu::Device, source: Arc<dyn MeshSource>) {
+        self.set_mesh_keyed(device, source, None);
+    }
+
+    /// [`Self::set_mesh`] for a mesh the renderer keeps on the GPU while `key`'s family is
+    /// current (it replaces that family's mesh; see [`Self::show_held`]).
+    pub fn set_mesh_keyed(
+        &mut self,
+        device: &wgpu::Device,
+        source: Arc<dyn MeshSource>,
+        key: Option<MeshKey>,
+    ) {
+        self.drop_family(key);
         self.generation += 1;
         self.pending = None;
         self.pending_move = None;
@@ -280,6 +303,7 @@ impl MeshRenderer {
             self.redraw();
             return;
         }
+        self.uploads.count_mesh(vertex_count, face_count);
         let generation = self.generation;
         let mut source = source;
         if (vertex_count + face_count) * 12 >= self.async_upload_bytes {
@@ -293,6 +317,7 @@ impl MeshRenderer {
                     Ok(()) => {
                         self.pending = Some(PendingMesh {
                             generation,
+                            key,
                             vertex_count,
                             scalars: None,
                             mask: None,
@@ -309,8 +334,9 @@ impl MeshRenderer {
                 }
             }
         }
-        self.mesh = Some(MeshBuffers::create(device, source, false, generation));
-        self.redraw();
+        let mut buffers = MeshBuffers::create(device, source, false, generation);
+        buffers.key = key;
+        self.replace_current(buffers);
     }
 
     /// Takes in the uploads that landed since the last call (a stale one is dropped).
@@ -324,13 +350,14 @@ impl MeshRenderer {
         };
         for uploaded in landed {
             match uploaded {
-                Uploaded::Mesh(buffers) => {
+                Uploaded::Mesh(mut buffers) => {
                     if self
                         .pending
                         .as_ref()
                         .is_some_and(|p| p.generation == buffers.generation)
                     {
                         if let Some(pending) = self.pending.take() {
+                            buffers.key = pending.key;
                             if let Some(scalars) = pending.scalars {
                                 buffers.write_per_vertex(queue, &buffers.scalars, &scalars);
                             }
@@ -338,8 +365,7 @@ impl MeshRenderer {
                                 buffers.write_per_vertex(queue, &buffers.mask, &mask);
                             }
                         }
-                        self.mesh = Some(*buffers);
-                        self.redraw();
+                        self.replace_current(*buffers);
                     }
                 }
                 Uploaded::Failed { generation } => {
@@ -421,6 +447,7 @@ impl MeshRenderer {
             return false;
         }
         self.move_serial += 1;
+        self.uploads.count_positions(vertex_count);
         let faces = mesh.index_count as usize / 3;
         if (vertex_count + faces) * 12 >= self.async_upload_bytes {
             if let Some(uploader) = &self.uploader {
@@ -510,6 +537,7 @@ impl MeshRenderer {
                 true => pending.mask = Some(values.to_vec()),
                 false => pending.scalars = Some(values.to_vec()),
             }
+            self.uploads.count_per_vertex(values.len());
             return true;
         }
         let Some(mesh) = self
@@ -524,10 +552,12 @@ impl MeshRenderer {
                 true => self.move_mask = Some(values.to_vec()),
                 false => self.move_scalars = Some(values.to_vec()),
             }
+            self.uploads.count_per_vertex(values.len());
             return true;
         }
         let buffer = if mask { &mesh.mask } else { &mesh.scalars };
         mesh.write_per_vertex(queue, buffer, values);
+        self.uploads.count_per_vertex(values.len());
         self.redraw();
         true
     }
@@ -746,63 +776,5 @@ impl MeshRenderer {
         self.progress = None;
         self.last_draw_time = recording;
         PartDrawn::Complete
-    }
-
-    /// Uploads the textures and uniforms of the mesh's materials, and the "no material" group,
-    /// when they are not on the GPU yet.
-    fn ensure_materials(&mut self, device: &wgpu::Device, queue: &wgpu::Queue) {
-        if self.materials.plain.is_none() {
-            self.materials.plain = Some(self.materials.group(device, queue, None));
-        }
-        if let Some(mesh) = &mut self.mesh {
-            if mesh.materials.is_none() {
-                let looks = mesh
-                    .appearance
-                    .as_ref()
-                    .map_or(&[][..], |a| &a.materials[..]);
-                mesh.materials = Some(
-                    looks
-                        .iter()
-                        .map(|look| MaterialGroup {
-                            bind_group: self.materials.group(device, queue, Some(look)),
-                        })
-                        .collect(),
-                );
-            }
-        }
-    }
-
-    /// Builds the wireframe's edges of the mesh on screen when they are missing and fit: a big
-    /// mesh's on the upload thread (the image shows the mesh without them meanwhile), a small
-    /// one's here.
-    fn ensure_lines(&mut self, device: &wgpu::Device) {
-        if let Some(mesh) = &mut self.mesh {
-            let faces = mesh.index_count as usize / 3;
-            let fits = faces as u64 * 24 <= self.max_buffer_size;
-            if fits
-                && !self.lines_failed
-                && mesh.lines.is_none()
-                && self.lines_requested != Some(mesh.generation)
-            {
-                // A big mesh's edges are built on the upload thread (the image shows the
-                // mesh without them meanwhile); a small one's here.
-                let bytes = (mesh.vertex_count + faces) * 12;
-                let job = UploadJob::Lines {
-                    generation: mesh.generation,
-                    source: mesh.source.clone(),
-                };
-                let sent = match &self.uploader {
-                    Some(uploader) if bytes >= self.async_upload_bytes => {
-                        uploader.send(job).is_ok()
-                    }
-                    _ => false,
-                };
-                if sent {
-                    self.lines_requested = Some(mesh.generation);
-                } else {
-                    mesh.lines = Some(line_buffer(device, &draw_triangles(mesh.source.as_ref())));
-                }
-            }
-        }
     }
 }

@@ -43,6 +43,9 @@ pub(super) struct MeshBuffers {
     pub(super) materials: Option<Vec<MaterialGroup>>,
     /// Which `MeshRenderer::set_mesh` call this mesh answers.
     pub(super) generation: u64,
+    /// What the caller said these buffers show (see [`super::MeshKey`]); `None`: not kept once
+    /// another mesh is shown.
+    pub(super) key: Option<super::MeshKey>,
 }
 
 /// One material's bind group (its uniform, texture and sampler).
@@ -192,7 +195,23 @@ impl MeshBuffers {
             materials: None,
             source,
             generation,
+            key: None,
         }
+    }
+
+    /// Bytes of GPU memory these buffers take.
+    pub(super) fn gpu_bytes(&self) -> u64 {
+        let buffers = [
+            &self.positions,
+            &self.normals,
+            &self.scalars,
+            &self.mask,
+            &self.uvs,
+            &self.colours,
+            &self.triangles,
+        ];
+        let lines = self.lines.as_ref().map_or(0, |(buffer, _)| buffer.size());
+        buffers.iter().map(|b| b.size()).sum::<u64>() + lines
     }
 }
 
@@ -230,4 +249,65 @@ pub(super) fn line_buffer(device: &wgpu::Device, triangles: &[[u32; 3]]) -> (wgp
     }
     buffer.unmap();
     (buffer, count as u32)
+}
+
+/// Parts of a mesh's buffers made when first drawn.
+impl super::MeshRenderer {
+    /// Uploads the textures and uniforms of the mesh's materials, and the "no material" group,
+    /// when they are not on the GPU yet.
+    pub(super) fn ensure_materials(&mut self, device: &wgpu::Device, queue: &wgpu::Queue) {
+        if self.materials.plain.is_none() {
+            self.materials.plain = Some(self.materials.group(device, queue, None));
+        }
+        if let Some(mesh) = &mut self.mesh {
+            if mesh.materials.is_none() {
+                let looks = mesh
+                    .appearance
+                    .as_ref()
+                    .map_or(&[][..], |a| &a.materials[..]);
+                mesh.materials = Some(
+                    looks
+                        .iter()
+                        .map(|look| MaterialGroup {
+                            bind_group: self.materials.group(device, queue, Some(look)),
+                        })
+                        .collect(),
+                );
+            }
+        }
+    }
+
+    /// Builds the wireframe's edges of the mesh on screen when they are missing and fit: a big
+    /// mesh's on the upload thread (the image shows the mesh without them meanwhile), a small
+    /// one's here.
+    pub(super) fn ensure_lines(&mut self, device: &wgpu::Device) {
+        if let Some(mesh) = &mut self.mesh {
+            let faces = mesh.index_count as usize / 3;
+            let fits = faces as u64 * 24 <= self.max_buffer_size;
+            if fits
+                && !self.lines_failed
+                && mesh.lines.is_none()
+                && self.lines_requested != Some(mesh.generation)
+            {
+                // A big mesh's edges are built on the upload thread (the image shows the
+                // mesh without them meanwhile); a small one's here.
+                let bytes = (mesh.vertex_count + faces) * 12;
+                let job = super::upload::UploadJob::Lines {
+                    generation: mesh.generation,
+                    source: mesh.source.clone(),
+                };
+                let sent = match &self.uploader {
+                    Some(uploader) if bytes >= self.async_upload_bytes => {
+                        uploader.send(job).is_ok()
+                    }
+                    _ => false,
+                };
+                if sent {
+                    self.lines_requested = Some(mesh.generation);
+                } else {
+                    mesh.lines = Some(line_buffer(device, &draw_triangles(mesh.source.as_ref())));
+                }
+            }
+        }
+    }
 }

@@ -158,6 +158,8 @@ impl Drop for Uploader {
 /// A mesh whose buffers the upload thread is filling.
 pub(super) struct PendingMesh {
     pub(super) generation: u64,
+    /// What the mesh shows (kept as the buffers' key when it lands).
+    pub(super) key: Option<super::MeshKey>,
     pub(super) vertex_count: usize,
     /// Scalars set while the upload was in flight, written once it lands.
     pub(super) scalars: Option<Vec<f32>>,
