@@ -4,8 +4,8 @@
 //! uploaded with it (heat-map scalars, mask tint), so the colours shown with a held mesh are
 //! always those written for that very mesh.
 
+use crate::app::shown::{Shown, ShownMesh, Slot};
 use crate::app::state::HierarchyState;
-use crate::app::view_sync::{Shown, ShownMesh, Slot};
 use crate::app::App;
 use crate::render::{MeshKey, MAX_HELD_MESHES};
 

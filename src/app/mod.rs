@@ -62,6 +62,7 @@ mod priority;
 mod recent;
 mod results;
 mod sharp_edges;
+mod shown;
 pub mod state;
 mod status;
 mod status_bar;
@@ -76,8 +77,8 @@ mod widgets;
 pub use command::{Command, PanelChange};
 pub use frame_stats::FrameStats;
 pub use launch::{run, AppOptions};
+pub use shown::Slot;
 pub use status::AppStatus;
-pub use view_sync::Slot;
 pub use viewport_panel::COMPUTING;
 
 use std::path::PathBuf;
@@ -91,9 +92,9 @@ use crate::render::Viewport3d;
 use camera::OrbitCamera;
 use history::History;
 use jobs::{Generation, JobCounter, JobResult, JobTicket, SharedProgress, Worker};
+use shown::Shown;
 use state::{CompareView, Document, DocumentSnapshot, Settings};
 use tasks::measure::MeasureRequest;
-use view_sync::Shown;
 
 /// The editor: its settings, the document, the workers and what the viewports show. The frame
 /// (`ui` below) runs in this order: poll results, input, panels, apply commands, sync the view.

@@ -147,7 +147,7 @@ impl App {
             images_drawn: self.viewport.as_ref().map_or(0, Viewport3d::images_drawn),
             drawing: self.drawing(),
             shown_serial: self.shown.and_then(|s| match s.what {
-                super::view_sync::ShownMesh::Faired { serial } => Some(serial),
+                super::shown::ShownMesh::Faired { serial } => Some(serial),
                 _ => None,
             }),
             heat_shown: self.shown.is_some_and(|s| s.heat.is_some())

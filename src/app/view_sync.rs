@@ -6,6 +6,7 @@ use std::sync::Arc;
 
 use crate::app::camera::OrbitCamera;
 use crate::app::held_views::HeldView;
+use crate::app::shown::{Shown, ShownMesh, Slot};
 use crate::app::state::{
     self, CompareView, Document, HeatReference, HierarchyState, Settings, ViewMode,
 };
@@ -14,19 +15,6 @@ use crate::hierarchy;
 use crate::render::appearance::Appearance;
 use crate::render::{DrawParams, MeshSource, Viewport3d};
 use crate::TriMesh;
-
-/// What a viewport has uploaded, to know when to upload again: one record per viewport, so
-/// that its shape, its heat map and its mask tint are always of one result.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub(in crate::app) struct Shown {
-    pub(in crate::app) document: u64,
-    pub(in crate::app) what: ShownMesh,
-    /// The heat map's reference, when the scalars on the GPU are `what`'s own distances from
-    /// it (never another result's).
-    pub(in crate::app) heat: Option<HeatReference>,
-    /// The painted mask's revision, when its weights are tinted over the mesh.
-    pub(in crate::app) mask: Option<u64>,
-}
 
 /// How one viewport's image is coloured, apart from the camera and the settings: the heat map's
 /// range and the painted mask's tint (see [`App::slot_look`]).
@@ -60,21 +48,6 @@ impl SlotLook {
             size: [0, 0],
         }
     }
-}
-
-/// The two viewports: the main one (the view mode's mesh: the result, a level, the original)
-/// and the "before" one (the document's mesh) for the toggle, split and side-by-side views.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Slot {
-    Main = 0,
-    Before = 1,
-}
-
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub(in crate::app) enum ShownMesh {
-    Original,
-    Faired { serial: u64 },
-    Level { level: usize },
 }
 
 /// The heat map's top: the 99th percentile of the distances above zero, so a few outliers do

@@ -166,3 +166,40 @@ pub(super) struct PendingMesh {
     /// Mask weights set while the upload was in flight, written once it lands.
     pub(super) mask: Option<Vec<f32>>,
 }
+
+/// The wireframe's edges, made when first drawn.
+impl super::MeshRenderer {
+    /// Builds the wireframe's edges of the mesh on screen when they are missing and fit: a big
+    /// mesh's on the upload thread (the image shows the mesh without them meanwhile), a small
+    /// one's here.
+    pub(super) fn ensure_lines(&mut self, device: &wgpu::Device) {
+        if let Some(mesh) = &mut self.mesh {
+            let faces = mesh.index_count as usize / 3;
+            let fits = faces as u64 * 24 <= self.max_buffer_size;
+            if fits
+                && !self.lines_failed
+                && mesh.lines.is_none()
+                && self.lines_requested != Some(mesh.generation)
+            {
+                // A big mesh's edges are built on the upload thread (the image shows the
+                // mesh without them meanwhile); a small one's here.
+                let bytes = (mesh.vertex_count + faces) * 12;
+                let job = UploadJob::Lines {
+                    generation: mesh.generation,
+                    source: mesh.source.clone(),
+                };
+                let sent = match &self.uploader {
+                    Some(uploader) if bytes >= self.async_upload_bytes => {
+                        uploader.send(job).is_ok()
+                    }
+                    _ => false,
+                };
+                if sent {
+                    self.lines_requested = Some(mesh.generation);
+                } else {
+                    mesh.lines = Some(line_buffer(device, &draw_triangles(mesh.source.as_ref())));
+                }
+            }
+        }
+    }
+}
