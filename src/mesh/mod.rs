@@ -36,7 +36,7 @@ pub use overlay::{loose_triangles, without_loose_triangles};
 pub(crate) use reorder::morton_code;
 pub use reorder::{breadth_first_order, inverse_permutation};
 pub use subdivide::subdivide_loop;
-pub use topology::{ComponentInfo, Topology};
+pub use topology::{two_face_edges, ComponentInfo, Topology};
 
 /// An indexed triangle mesh. Positions are stored in f32 (what every supported file format
 /// holds); algorithms that need more precision compute in f64 internally.

@@ -391,6 +391,28 @@ impl Topology {
     }
 }
 
+/// The edges exactly two of `triangles` share, each as `[lower corner, higher corner, first
+/// triangle, second triangle]` (triangles in ascending order), in ascending order of their
+/// corners: one sort of every triangle's three edges.
+pub fn two_face_edges(triangles: &[[u32; 3]]) -> Vec<[u32; 4]> {
+    let mut edges: Vec<(u32, u32, u32)> = triangles
+        .iter()
+        .enumerate()
+        .flat_map(|(t, tri)| {
+            (0..3).map(move |k| {
+                let (a, b) = (tri[k], tri[(k + 1) % 3]);
+                (a.min(b), a.max(b), t as u32)
+            })
+        })
+        .collect();
+    edges.par_sort_unstable();
+    edges
+        .chunk_by(|x, y| (x.0, x.1) == (y.0, y.1))
+        .filter(|shared| shared.len() == 2)
+        .map(|shared| [shared[0].0, shared[0].1, shared[0].2, shared[1].2])
+        .collect()
+}
+
 #[inline]
 fn next_in_face(t: [u32; 3], v: u32) -> u32 {
     if t[0] == v {
@@ -552,6 +574,19 @@ mod tests {
 
     fn octahedron() -> TriMesh {
         crate::mesh::fixtures::octahedron(1.0)
+    }
+
+    #[test]
+    fn two_face_edges_are_the_edges_exactly_two_triangles_share() {
+        // Two squares side by side, each cut into [0, 1, 4], [0, 4, 3] and [1, 2, 5], [1, 5, 4]:
+        // 9 edges, of which the two diagonals and the middle edge have two faces.
+        let grid = crate::mesh::fixtures::grid(2);
+        let one_row: Vec<[u32; 3]> = grid.triangles[..4].to_vec();
+        let edges = two_face_edges(&one_row);
+        assert_eq!(edges, vec![[0, 4, 0, 1], [1, 4, 0, 3], [1, 5, 2, 3]]);
+        // Three triangles on one edge: that edge is no two-face edge.
+        let fin = crate::mesh::fixtures::three_triangles_on_one_edge();
+        assert!(two_face_edges(&fin.triangles).is_empty());
     }
 
     #[test]

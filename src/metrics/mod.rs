@@ -257,30 +257,14 @@ pub fn sharpened_edges(reference: &TriMesh, other: &TriMesh) -> Option<usize> {
     if !same_connectivity(reference, other) {
         return None;
     }
-    // (lower corner, higher corner, triangle) for every edge of every triangle, sorted so that
-    // an edge's triangles sit side by side.
-    let mut edges: Vec<(u32, u32, u32)> = reference
-        .triangles
-        .iter()
-        .enumerate()
-        .flat_map(|(t, tri)| {
-            (0..3).map(move |k| {
-                let (a, b) = (tri[k], tri[(k + 1) % 3]);
-                (a.min(b), a.max(b), t as u32)
-            })
-        })
-        .collect();
-    edges.sort_unstable();
     let bend = |mesh: &TriMesh, s: u32, t: u32| {
         let (a, b) = (mesh.face_normal(s as usize), mesh.face_normal(t as usize));
         (a.length_squared() > 0.0 && b.length_squared() > 0.0)
             .then(|| a.angle_between(b).to_degrees())
     };
-    let sharpened = edges
-        .chunk_by(|x, y| (x.0, x.1) == (y.0, y.1))
-        .filter(|shared| shared.len() == 2)
-        .filter(|shared| {
-            let (s, t) = (shared[0].2, shared[1].2);
+    let sharpened = crate::mesh::two_face_edges(&reference.triangles)
+        .into_iter()
+        .filter(|&[_, _, s, t]| {
             matches!(
                 (bend(reference, s, t), bend(other, s, t)),
                 (Some(before), Some(after)) if after - before > SHARPENED_DEGREES

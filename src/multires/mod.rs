@@ -488,7 +488,7 @@ fn unfold_new_folds(hierarchy: &Hierarchy, workspace: &mut MultiresWorkspace) {
         ..
     } = level;
     let (edges, reference) = folds.get_or_insert_with(|| {
-        let edges = unfold::two_face_edges(mesh, topology);
+        let edges = crate::mesh::two_face_edges(&mesh.triangles);
         let reference = unfold::bent_to_right_angle(&mesh.positions, mesh, &edges);
         (edges, reference)
     });

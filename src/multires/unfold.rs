@@ -31,27 +31,6 @@ pub const UNFOLD_PASSES: usize = 8;
 /// Umbrella sweeps over the folded edges' corners in each pass.
 const SWEEPS: usize = 3;
 
-/// The edges of `mesh` with exactly two faces, as (lower vertex, higher vertex, face, face).
-pub(super) fn two_face_edges(mesh: &TriMesh, topology: &Topology) -> Vec<[u32; 4]> {
-    let mut edges = Vec::new();
-    for (f, t) in mesh.triangles.iter().enumerate() {
-        for k in 0..3 {
-            let (a, b) = (t[k], t[(k + 1) % 3]);
-            if a > b {
-                continue;
-            }
-            let mut shared = topology
-                .faces_of(a)
-                .iter()
-                .filter(|&&g| g as usize != f && mesh.triangles[g as usize].contains(&b));
-            if let (Some(&g), None) = (shared.next(), shared.next()) {
-                edges.push([a, b, f as u32, g]);
-            }
-        }
-    }
-    edges
-}
-
 /// Whether each of `edges` folds beyond 90° with `positions` (its faces' normals more than a
 /// right angle apart; a face with no area folds nothing).
 pub(super) fn folded(positions: &[[f32; 3]], mesh: &TriMesh, edges: &[[u32; 4]]) -> Vec<bool> {
@@ -176,6 +155,7 @@ pub(super) fn unfold(
 mod tests {
     use super::*;
     use crate::mesh::fixtures::grid;
+    use crate::mesh::two_face_edges;
 
     fn level<'a>(mesh: &'a TriMesh, topology: &'a Topology) -> Level<'a> {
         Level {
@@ -192,7 +172,7 @@ mod tests {
         // plane: its triangles flip over their edges.
         let mesh = grid(6);
         let topology = Topology::build(&mesh);
-        let edges = two_face_edges(&mesh, &topology);
+        let edges = two_face_edges(&mesh.triangles);
         let reference = folded(&mesh.positions, &mesh, &edges);
         assert!(reference.iter().all(|&f| !f), "the flat grid folds nothing");
         let v = 3 * 7 + 3;
@@ -215,7 +195,7 @@ mod tests {
         // The same push, but taken as the reference: nothing is new, nothing moves.
         let mesh = grid(6);
         let topology = Topology::build(&mesh);
-        let edges = two_face_edges(&mesh, &topology);
+        let edges = two_face_edges(&mesh.triangles);
         let mut positions = mesh.positions.clone();
         positions[3 * 7 + 3][0] += 1.6;
         let reference = folded(&positions, &mesh, &edges);
