@@ -46,6 +46,18 @@ fn built_in() -> Vec<(String, Result<TriMesh, String>)> {
         ("cad cylinder 32", shapes::cad_cylinder(32, 0.5, 1.5)),
         ("cad cylinder 40", shapes::cad_cylinder(40, 0.5, 1.5)),
         ("cad cylinder 64", shapes::cad_cylinder(64, 0.5, 1.5)),
+        (
+            "cad box with holes 16",
+            shapes::cad_box_with_holes([2.0, 1.4, 1.0], 0.05, 0.25, 16),
+        ),
+        (
+            "cad box with holes 32",
+            shapes::cad_box_with_holes([2.0, 1.4, 1.0], 0.05, 0.25, 32),
+        ),
+        (
+            "cad box with holes 64, thin",
+            shapes::cad_box_with_holes([2.0, 1.4, 1.0], 0.02, 0.3, 64),
+        ),
     ];
     list.extend(
         shapes

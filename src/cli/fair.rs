@@ -5,6 +5,7 @@ use fairmesh::fairing::{
     self, baseline::UmbrellaStencil, BoundaryMode, ConstrainedFairing, CreaseOptions, FairReport,
     FairVariant, Mask, Method, MethodChoices, MethodOptions, Strength,
 };
+use fairmesh::fairing::strength::CLEAN_NOISE;
 use fairmesh::io::Source;
 use fairmesh::metrics::Comparison;
 use fairmesh::{Topology, TriMesh};
@@ -429,7 +430,13 @@ fn sentence(
 fn strength_words(report: &FairReport, options: &MethodOptions) -> String {
     match (report.noise_estimate, options) {
         (Some(noise), MethodOptions::Constrained(o)) if o.strength == Strength::Auto => {
-            if report.rounds_run == 0 {
+            if report.rounds_run == 0 && noise > CLEAN_NOISE {
+                format!(
+                    "noise estimate {noise:.3} edge lengths, all of it at sharp edges or in \
+                     faces that still lie flat (a CAD part): clean, left as it is (--rounds N \
+                     fairs anyway); "
+                )
+            } else if report.rounds_run == 0 {
                 format!(
                     "noise estimate {noise:.3} edge lengths: clean, left as it is (--rounds N \
                      fairs anyway); "

@@ -198,6 +198,139 @@ pub fn cad_cylinder(segments: usize, radius: f64, height: f64) -> TriMesh {
     TriMesh::new(positions, triangles)
 }
 
+/// An open-topped box with thin walls and a round hole through each wall, as CAD exporters write
+/// it: `size` outside (x, y, z; open at z = `size[2]`), walls and floor `wall` thick, each hole
+/// of `radius` with `segments` sides (rounded up to a multiple of 4) centred halfway up its wall.
+/// Each flat face has only its corners and its hole's vertices, the hole's rim joined to the
+/// nearest corner by fans of long thin triangles; each hole's tunnel is one quad (two triangles)
+/// per side. Closed, oriented outwards, genus 4 (one handle per hole).
+pub fn cad_box_with_holes(size: [f64; 3], wall: f64, radius: f64, segments: usize) -> TriMesh {
+    let sides = segments.max(4).div_ceil(4) * 4;
+    let [w, d, _] = size.map(|x| x / 2.0);
+    let mut shape = Faces::default();
+    // The floor underneath and on top, and the rim between the outer and inner top edges.
+    let (inner_w, inner_d) = (w - wall, d - wall);
+    let corners = |a: f64, b: f64, z: f64| [[-a, -b, z], [a, -b, z], [a, b, z], [-a, b, z]];
+    let bottom = corners(w, d, 0.0);
+    shape.polygon(&bottom, [0.0, 0.0, -1.0]);
+    shape.polygon(&corners(inner_w, inner_d, wall), [0.0, 0.0, 1.0]);
+    let (outer_top, inner_top) = (corners(w, d, size[2]), corners(inner_w, inner_d, size[2]));
+    for k in 0..4 {
+        let l = (k + 1) % 4;
+        shape.polygon(
+            &[outer_top[k], outer_top[l], inner_top[l], inner_top[k]],
+            [0.0, 0.0, 1.0],
+        );
+    }
+    // The walls: (outward normal, the wall's horizontal direction, its half width outside and
+    // inside, its distance from the centre outside).
+    let walls = [
+        ([0.0, -1.0, 0.0], [1.0, 0.0, 0.0], w, inner_w, d),
+        ([1.0, 0.0, 0.0], [0.0, 1.0, 0.0], d, inner_d, w),
+        ([0.0, 1.0, 0.0], [-1.0, 0.0, 0.0], w, inner_w, d),
+        ([-1.0, 0.0, 0.0], [0.0, -1.0, 0.0], d, inner_d, w),
+    ];
+    let at = |normal: [f64; 3], along: [f64; 3], distance: f64, u: f64, z: f64| {
+        [0, 1, 2].map(|i| normal[i] * distance + along[i] * u + if i == 2 { z } else { 0.0 })
+    };
+    let centre_z = size[2] / 2.0;
+    for (normal, along, half, inner_half, distance) in walls {
+        let hole = |distance: f64| -> Vec<[f64; 3]> {
+            (0..sides)
+                .map(|i| {
+                    let a = TAU * (i as f64 + 0.5) / sides as f64;
+                    at(normal, along, distance, radius * a.cos(), centre_z + radius * a.sin())
+                })
+                .collect()
+        };
+        let (outer_hole, inner_hole) = (hole(distance), hole(distance - wall));
+        // Corners counter-clockwise seen from outside, from the upper one in the first quadrant.
+        let outer = [(half, size[2]), (-half, size[2]), (-half, 0.0), (half, 0.0)]
+            .map(|(u, z)| at(normal, along, distance, u, z));
+        let inner = [(inner_half, size[2]), (-inner_half, size[2])]
+            .into_iter()
+            .chain([(-inner_half, wall), (inner_half, wall)])
+            .map(|(u, z)| at(normal, along, distance - wall, u, z))
+            .collect::<Vec<_>>();
+        let inward = normal.map(|x| -x);
+        shape.face_with_hole(&outer, &outer_hole, normal);
+        shape.face_with_hole(&inner, &inner_hole, inward);
+        // The tunnel, facing the hole's axis.
+        for i in 0..sides {
+            let j = (i + 1) % sides;
+            let axis = at(normal, along, distance, 0.0, centre_z);
+            let facing = [0, 1, 2].map(|k| axis[k] - outer_hole[i][k]);
+            shape.polygon(
+                &[outer_hole[i], outer_hole[j], inner_hole[j], inner_hole[i]],
+                [facing[0], facing[1], facing[2]],
+            );
+        }
+    }
+    shape.mesh()
+}
+
+/// Faces given by their corners, vertices shared where positions are equal, each triangle turned
+/// to face the way its face is meant to.
+#[derive(Default)]
+struct Faces {
+    positions: Vec<[f32; 3]>,
+    index: std::collections::HashMap<[u32; 3], u32>,
+    triangles: Vec<[u32; 3]>,
+}
+
+impl Faces {
+    fn vertex(&mut self, p: [f64; 3]) -> u32 {
+        let p = p.map(|x| x as f32);
+        let next = self.positions.len() as u32;
+        let index = *self.index.entry(p.map(f32::to_bits)).or_insert(next);
+        if index == next {
+            self.positions.push(p);
+        }
+        index
+    }
+
+    fn triangle(&mut self, corners: [[f64; 3]; 3], facing: [f64; 3]) {
+        let [a, b, c] = corners;
+        let (e, f) = ([0, 1, 2].map(|i| b[i] - a[i]), [0, 1, 2].map(|i| c[i] - a[i]));
+        let n = [
+            e[1] * f[2] - e[2] * f[1],
+            e[2] * f[0] - e[0] * f[2],
+            e[0] * f[1] - e[1] * f[0],
+        ];
+        let along = n[0] * facing[0] + n[1] * facing[1] + n[2] * facing[2];
+        let corners = if along < 0.0 { [a, c, b] } else { [a, b, c] };
+        let triangle = corners.map(|p| self.vertex(p));
+        self.triangles.push(triangle);
+    }
+
+    /// A convex polygon, fanned from its first corner.
+    fn polygon(&mut self, corners: &[[f64; 3]], facing: [f64; 3]) {
+        for k in 1..corners.len() - 1 {
+            self.triangle([corners[0], corners[k], corners[k + 1]], facing);
+        }
+    }
+
+    /// A rectangle (`corners` counter-clockwise, the first in the first quadrant seen from the
+    /// hole's centre) with a convex hole (`hole` counter-clockwise, a quarter of its vertices in
+    /// each quadrant), each of the hole's vertices joined to the corner of its quadrant, and each
+    /// side to the hole's first vertex past it.
+    fn face_with_hole(&mut self, corners: &[[f64; 3]], hole: &[[f64; 3]], facing: [f64; 3]) {
+        let quarter = hole.len() / 4;
+        for i in 0..hole.len() {
+            let j = (i + 1) % hole.len();
+            let (q, next) = (i / quarter, j / quarter);
+            self.triangle([hole[i], corners[q], hole[j]], facing);
+            if next != q {
+                self.triangle([corners[q], corners[next], hole[j]], facing);
+            }
+        }
+    }
+
+    fn mesh(self) -> TriMesh {
+        TriMesh::new(self.positions, self.triangles)
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -218,6 +351,17 @@ mod tests {
             assert_eq!(topology.euler_characteristic(), 2, "{name}");
             assert!(crate::metrics::signed_volume(&mesh) > 0.0, "{name}");
         }
+        // Four holes: four handles. The volume is the walls' and the floor's, less the holes'.
+        let (size, wall, radius) = ([2.0, 1.4, 1.0], 0.05, 0.25);
+        let part = cad_box_with_holes(size, wall, radius, 24);
+        let topology = Topology::build(&part);
+        assert!(topology.is_closed() && topology.is_oriented_manifold());
+        assert_eq!(topology.euler_characteristic(), 2 - 2 * 4);
+        let solid = size[0] * size[1] * size[2]
+            - (size[0] - 2.0 * wall) * (size[1] - 2.0 * wall) * (size[2] - wall);
+        let holes = 4.0 * wall * 24.0 / 2.0 * radius * radius * (TAU / 24.0).sin();
+        let volume = crate::metrics::signed_volume(&part);
+        assert!((volume - (solid - holes)).abs() < 1e-4, "{volume} against {}", solid - holes);
         let size = [2.0, 1.0, 0.5];
         let volume = crate::metrics::signed_volume(&cuboid(size, 0.1));
         assert!((volume - 1.0).abs() < 1e-5, "cuboid volume {volume}");

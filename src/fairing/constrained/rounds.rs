@@ -345,10 +345,11 @@ fn first_reading(
     }
 }
 
-/// Automatic strength: the noise to fair, `None` for a mesh left as it is: a clean one, or one
+/// Automatic strength: the noise to fair, `None` for a mesh left as it is: a clean one, one
 /// that reads noisy only because of its sharp edges (a coarse CAD part: most of its vertices lie
 /// on or beside an edge, and those make the median read noise; away from the edges it reads
-/// clean).
+/// clean), or one that reads clean on the vertices noise could have moved (off its flat edges:
+/// a CAD part written as exporters write it, every vertex on a rim).
 fn noisy(
     estimate: Option<f64>,
     reading: Option<&NoiseReading>,
@@ -359,7 +360,12 @@ fn noisy(
             .and_then(|reading| reading.away_from_edges(topology))
             .is_some_and(|away| away <= CLEAN_NOISE)
     };
-    estimate.filter(|&noise| noise > CLEAN_NOISE && !clean_away_from_edges())
+    let clean_off_flat_edges = || {
+        reading.is_some_and(|reading| reading.clean_off_flat_edges(topology, CLEAN_NOISE))
+    };
+    estimate.filter(|&noise| {
+        noise > CLEAN_NOISE && !clean_away_from_edges() && !clean_off_flat_edges()
+    })
 }
 
 /// What [`fair_rounds`] takes from the decision to fair.

@@ -7,8 +7,10 @@
 //! finely sampled ones and on CAD parts), while a clean mesh should not be touched at all. So the
 //! default measures the noise before fairing (at or below [`CLEAN_NOISE`] it does nothing; nor
 //! when the mesh reads that clean once the vertices on its sharp edges are left out,
-//! `NoiseReading::away_from_edges`), and a noisy mesh is faired round by round while Stein's
-//! unbiased risk estimate of the result goes down (`RoundRisk`).
+//! `NoiseReading::away_from_edges`, or once the corners of its flat edges are, which noise would
+//! have moved out of their faces' common plane, `NoiseReading::clean_off_flat_edges`), and a
+//! noisy mesh is faired round by round while Stein's unbiased risk estimate of the result goes
+//! down (`RoundRisk`).
 //!
 //! # The noise estimate
 //! Per vertex v with a closed fan: h_v = n_v · (m_v − x_v), the normal component of
@@ -59,7 +61,8 @@
 //! # Files
 //! - `scan`: the fused gather over the fan-ordered one-rings: h_v, the mean edge length and the
 //!   faces' own feature edges at once (`scan_fans`, which crease detection uses too).
-//! - `noise`: the noise estimate from it ([`estimate_noise`]).
+//! - `noise`: the noise estimate from it ([`estimate_noise`]), and the readings that tell a CAD
+//!   part from a noisy mesh.
 //! - `risk`: Stein's unbiased risk estimate that stops the automatic rounds.
 
 mod noise;

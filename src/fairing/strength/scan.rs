@@ -53,7 +53,7 @@ pub(crate) fn scan_fans(
         estimate,
     );
     FanScan {
-        noise: heights.and_then(|h| h.spread(topology, None)),
+        noise: heights.and_then(|h| h.spread(topology, LeftOut::Nothing)),
         edges,
     }
 }
@@ -61,6 +61,64 @@ pub(crate) fn scan_fans(
 /// Vertices per block of the estimate's gather (each block's edge-length sum and feature edges
 /// are kept apart and joined in order, so nothing depends on the thread count).
 pub(super) const VERTEX_BLOCK: usize = 4096;
+
+/// The sine of the angle between two faces' normals below which their edge counts as flat, its
+/// four corners as untouched by noise ([`Marks::exact`]): 0.06°. Noise of 0.04 mean edge lengths
+/// along the normals (the least [`super::CLEAN_NOISE`] reads as noise) tilts two fair triangles
+/// apart by about 3°, fifty times more, so on a noisy mesh only a few edges in a hundred come
+/// out flat by chance; rounding positions to f32 tilts them by about 1e-7 over 1e-4 of an
+/// edge's length relative to the coordinates, so a flat CAD face stays flat.
+pub(super) const FLAT_SINE: f32 = 1e-3;
+
+/// Per-vertex marks the gather sets for [`super::NoiseReading`].
+pub(super) struct Marks {
+    /// An end of a sharp edge (an edge where the faces' own normals turn by more than the crease
+    /// angle).
+    pub on_edge: Vec<AtomicBool>,
+    /// A corner of a flat edge: one whose two faces lie in one plane, to [`FLAT_SINE`]. Noise
+    /// moves each vertex on its own, so four vertices that still lie in one plane were not moved
+    /// across it: a CAD part's flat faces and the quads of its curved ones (each two triangles in
+    /// one plane) mark every one of their vertices, a noisy surface almost none.
+    pub exact: Vec<AtomicBool>,
+}
+
+impl Marks {
+    /// No vertex marked, for `n` vertices.
+    pub fn new(n: usize) -> Self {
+        let none = || {
+            (0..n)
+                .into_par_iter()
+                .with_min_len(VERTEX_BLOCK)
+                .map(|_| AtomicBool::new(false))
+                .collect()
+        };
+        Marks {
+            on_edge: none(),
+            exact: none(),
+        }
+    }
+
+    /// Marks the corners of the flat edges (v, u) with u > v of v's closed fan: `faces[k]` is the
+    /// area normal of the face (v, ring[k − 1], ring[k]), so faces k and k + 1 share the edge
+    /// (v, ring[k]), and their corners are v and ring[k − 1], ring[k], ring[k + 1].
+    fn mark_flat_edges(&self, v: u32, ring: &[u32], faces: &[Vec3A]) {
+        let n = ring.len();
+        for (k, &u) in ring.iter().enumerate() {
+            let (a, b) = (faces[k], faces[(k + 1) % n]);
+            let scale = a.length_squared() * b.length_squared();
+            if u > v
+                && a.dot(b) > 0.0
+                && scale > 0.0
+                && scale.is_finite()
+                && a.cross(b).length_squared() <= FLAT_SINE * FLAT_SINE * scale
+            {
+                for w in [v, ring[(k + n - 1) % n], u, ring[(k + 1) % n]] {
+                    self.exact[w as usize].store(true, Ordering::Relaxed);
+                }
+            }
+        }
+    }
+}
 
 /// Every vertex's h_v and the mean edge length, from one gather (see the module docs).
 pub(super) struct Heights {
@@ -73,14 +131,15 @@ pub(super) struct Heights {
 /// The gather behind the estimates: [`Heights`] (`None` when the mean edge length is not
 /// positive and finite; the mean edge length is summed in the same gather, as
 /// [`crate::metrics::mean_edge_length`] defines it) and, with a crease angle, the feature edges,
-/// or, with `on_edge` too, no list but both ends of every feature edge marked there. Without
-/// `want_heights` no heights are taken (`None`).
+/// or, with `marks` too, no list but both ends of every feature edge marked in `marks.on_edge`
+/// and the four corners of every flat edge in `marks.exact` ([`Marks`]). Without `want_heights`
+/// no heights are taken (`None`).
 pub(super) fn gather(
     mesh: &TriMesh,
     topology: &Topology,
     fans: Option<&FanRings>,
     crease_angle: Option<f64>,
-    on_edge: Option<&[AtomicBool]>,
+    marks: Option<&Marks>,
     want_heights: bool,
 ) -> (Option<Heights>, Vec<FeatureEdge>) {
     let n = mesh.positions.len();
@@ -125,13 +184,14 @@ pub(super) fn gather(
                             }
                             previous = dk;
                         }
-                        match (threshold, on_edge) {
-                            (Some(threshold), Some(on_edge)) => {
+                        match (threshold, marks) {
+                            (Some(threshold), Some(marks)) => {
                                 let faces = &faces[..valence];
                                 for (u, _) in fan_feature_neighbors(v, ring, faces, threshold) {
-                                    on_edge[v as usize].store(true, Ordering::Relaxed);
-                                    on_edge[u as usize].store(true, Ordering::Relaxed);
+                                    marks.on_edge[v as usize].store(true, Ordering::Relaxed);
+                                    marks.on_edge[u as usize].store(true, Ordering::Relaxed);
                                 }
+                                marks.mark_flat_edges(v, ring, faces);
                             }
                             (Some(threshold), None) => {
                                 fan_feature_edges(v, ring, &faces[..valence], threshold, &mut edges)
@@ -155,10 +215,10 @@ pub(super) fn gather(
                             let normal = |f: u32| area_normal(mesh, f);
                             let first = edges.len();
                             vertex_feature_edges(mesh, topology, v, normal, threshold, &mut edges);
-                            if let Some(on_edge) = on_edge {
+                            if let Some(marks) = marks {
                                 for ([a, b], _) in edges.drain(first..) {
-                                    on_edge[a as usize].store(true, Ordering::Relaxed);
-                                    on_edge[b as usize].store(true, Ordering::Relaxed);
+                                    marks.on_edge[a as usize].store(true, Ordering::Relaxed);
+                                    marks.on_edge[b as usize].store(true, Ordering::Relaxed);
                                 }
                             }
                         }
@@ -181,20 +241,37 @@ pub(super) fn gather(
     (heights, edges)
 }
 
+/// Which vertices a noise reading ([`Heights::spread`]) leaves out.
+#[derive(Clone, Copy)]
+pub(super) enum LeftOut<'a> {
+    /// None: every vertex with a defined h is read.
+    Nothing,
+    /// The vertices on a sharp edge (`on_edge`), neither counted nor taken into their
+    /// neighbours' means (on a flat face beside a crease h is 0 but for the crease's own
+    /// vertices); with `beside` the vertices beside one are not counted either. The reading is
+    /// `None` when fewer than a quarter of the vertices with a defined h are left.
+    Edges { on_edge: &'a [bool], beside: bool },
+    /// The vertices marked `exact` are not counted, but stay in their neighbours' means (their h
+    /// is the clean surface's).
+    Exact(&'a [bool]),
+}
+
 impl Heights {
-    /// The noise level: the robust spread of r_v (see the module docs), `None` with fewer than
-    /// 16 vertices to read. With `away = Some((on_edge, beside))` the vertices on a feature edge
-    /// are left out (neither counted nor taken into their neighbours' means: on a flat face
-    /// beside a crease h is 0 but for the crease's own vertices), with `beside` the vertices
-    /// beside one are not counted either, and `None` comes back when fewer than a quarter of the
-    /// vertices with a defined h are left.
-    pub(super) fn spread(&self, topology: &Topology, away: Option<(&[bool], bool)>) -> Option<f64> {
+    /// The noise level: the robust spread of r_v (see the module docs) over the vertices that
+    /// `left_out` does not leave out, `None` with fewer than 16 of them to read.
+    pub(super) fn spread(&self, topology: &Topology, left_out: LeftOut) -> Option<f64> {
         let heights = &self.heights;
-        let skip = |v: u32| away.is_some_and(|(on_edge, _)| on_edge[v as usize]);
-        let beside = |v: u32| {
-            away.is_some_and(|(on_edge, beside)| {
-                beside && topology.neighbors(v).iter().any(|&u| on_edge[u as usize])
-            })
+        let skip = |v: u32| match left_out {
+            LeftOut::Edges { on_edge, .. } => on_edge[v as usize],
+            _ => false,
+        };
+        let uncounted = |v: u32| match left_out {
+            LeftOut::Nothing => false,
+            LeftOut::Edges { on_edge, beside } => {
+                on_edge[v as usize]
+                    || beside && topology.neighbors(v).iter().any(|&u| on_edge[u as usize])
+            }
+            LeftOut::Exact(exact) => exact[v as usize],
         };
         // Every vertex's |r_v|, a positive NaN where it is not read (left out, no neighbour
         // counted, or no h at it or a neighbour). (A filtered parallel collect of the read ones
@@ -204,7 +281,7 @@ impl Heights {
             .into_par_iter()
             .with_min_len(VERTEX_BLOCK)
             .map(|v| {
-                if skip(v) || beside(v) {
+                if uncounted(v) {
                     return f32::NAN;
                 }
                 let own = heights[v as usize];
@@ -229,8 +306,9 @@ impl Heights {
             .filter(|r| !r.is_nan())
             .count();
         // Only a reading away from the edges needs the count (the per-round estimate skips it).
+        let edges = matches!(left_out, LeftOut::Edges { .. });
         if read < 16
-            || away.is_some() && 4 * read < heights.par_iter().filter(|h| h.is_finite()).count()
+            || edges && 4 * read < heights.par_iter().filter(|h| h.is_finite()).count()
         {
             return None;
         }
