@@ -461,7 +461,8 @@ fn fair_multires_on_worker(
         }
     }
     if start > 0 && options.unfold {
-        unfold_new_folds(hierarchy, workspace);
+        let keep_volume = options.variant == MultiresVariant::Improved;
+        unfold_new_folds(hierarchy, workspace, keep_volume);
     }
     if release {
         workspace.levels[0] = None;
@@ -477,7 +478,7 @@ fn fair_multires_on_worker(
 
 /// The last step of a run from a coarser level ([`unfold`]): the edges it left folded where M0
 /// was not are unfolded.
-fn unfold_new_folds(hierarchy: &Hierarchy, workspace: &mut MultiresWorkspace) {
+fn unfold_new_folds(hierarchy: &Hierarchy, workspace: &mut MultiresWorkspace, keep_volume: bool) {
     let level = workspace.levels[0].get_or_insert_with(|| LevelData::build(hierarchy, 0));
     let LevelData {
         mesh,
@@ -497,6 +498,7 @@ fn unfold_new_folds(hierarchy: &Hierarchy, workspace: &mut MultiresWorkspace) {
         topology,
         creases: creases.as_ref(),
         loop_neighbors,
+        keep_volume,
     };
     unfold::unfold(&mut workspace.positions, &level, edges, reference);
 }
