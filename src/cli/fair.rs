@@ -1,11 +1,11 @@
 //! `fairmesh fair`: smooth a mesh with constrained fairing (the paper's method) or one of the
 //! baselines, and write the result; `bench_rows` gives `fairmesh bench` its fairing timings.
 use clap::{Args, ValueEnum};
+use fairmesh::fairing::strength::CLEAN_NOISE;
 use fairmesh::fairing::{
     self, baseline::UmbrellaStencil, BoundaryMode, ConstrainedFairing, CreaseOptions, FairReport,
     FairVariant, Mask, Method, MethodChoices, MethodOptions, Strength,
 };
-use fairmesh::fairing::strength::CLEAN_NOISE;
 use fairmesh::io::Source;
 use fairmesh::metrics::Comparison;
 use fairmesh::{Topology, TriMesh};

@@ -239,7 +239,13 @@ pub fn cad_box_with_holes(size: [f64; 3], wall: f64, radius: f64, segments: usiz
             (0..sides)
                 .map(|i| {
                     let a = TAU * (i as f64 + 0.5) / sides as f64;
-                    at(normal, along, distance, radius * a.cos(), centre_z + radius * a.sin())
+                    at(
+                        normal,
+                        along,
+                        distance,
+                        radius * a.cos(),
+                        centre_z + radius * a.sin(),
+                    )
                 })
                 .collect()
         };
@@ -291,7 +297,10 @@ impl Faces {
 
     fn triangle(&mut self, corners: [[f64; 3]; 3], facing: [f64; 3]) {
         let [a, b, c] = corners;
-        let (e, f) = ([0, 1, 2].map(|i| b[i] - a[i]), [0, 1, 2].map(|i| c[i] - a[i]));
+        let (e, f) = (
+            [0, 1, 2].map(|i| b[i] - a[i]),
+            [0, 1, 2].map(|i| c[i] - a[i]),
+        );
         let n = [
             e[1] * f[2] - e[2] * f[1],
             e[2] * f[0] - e[0] * f[2],
@@ -361,7 +370,11 @@ mod tests {
             - (size[0] - 2.0 * wall) * (size[1] - 2.0 * wall) * (size[2] - wall);
         let holes = 4.0 * wall * 24.0 / 2.0 * radius * radius * (TAU / 24.0).sin();
         let volume = crate::metrics::signed_volume(&part);
-        assert!((volume - (solid - holes)).abs() < 1e-4, "{volume} against {}", solid - holes);
+        assert!(
+            (volume - (solid - holes)).abs() < 1e-4,
+            "{volume} against {}",
+            solid - holes
+        );
         let size = [2.0, 1.0, 0.5];
         let volume = crate::metrics::signed_volume(&cuboid(size, 0.1));
         assert!((volume - 1.0).abs() < 1e-5, "cuboid volume {volume}");

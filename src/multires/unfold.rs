@@ -166,52 +166,51 @@ pub(super) fn unfold(
     let mut region: Vec<u32> = Vec::new();
     // The vertices put back to M0 (below), which stay there.
     let mut back = vec![false; positions.len()];
-    let passes = |positions: &mut [[f32; 3]],
-                  region: &mut Vec<u32>,
-                  moving: &mut [bool],
-                  back: &[bool]| {
-        for _ in 0..UNFOLD_PASSES {
-            let now = folded(positions, mesh, edges);
-            let mut grew = false;
-            for ((edge, &folded), &was) in edges.iter().zip(&now).zip(reference) {
-                if !folded || was {
-                    continue;
+    let passes =
+        |positions: &mut [[f32; 3]], region: &mut Vec<u32>, moving: &mut [bool], back: &[bool]| {
+            for _ in 0..UNFOLD_PASSES {
+                let now = folded(positions, mesh, edges);
+                let mut grew = false;
+                for ((edge, &folded), &was) in edges.iter().zip(&now).zip(reference) {
+                    if !folded || was {
+                        continue;
+                    }
+                    for v in fold_corners(mesh, edge) {
+                        if !moving[v as usize] && !stays(v) {
+                            moving[v as usize] = true;
+                            region.push(v);
+                            grew = true;
+                        }
+                    }
                 }
-                for v in fold_corners(mesh, edge) {
-                    if !moving[v as usize] && !stays(v) {
-                        moving[v as usize] = true;
-                        region.push(v);
-                        grew = true;
+                if !grew && !now.iter().zip(reference).any(|(&n, &r)| n && !r) {
+                    return;
+                }
+                for _ in 0..SWEEPS {
+                    let means: Vec<[f32; 3]> = region
+                        .iter()
+                        .map(|&v| {
+                            if back[v as usize] {
+                                return positions[v as usize];
+                            }
+                            if let Some([p, n]) = on_crease(v) {
+                                let [p, n] =
+                                    [p, n].map(|u| Vec3A::from_array(positions[u as usize]));
+                                return ((p + n) * 0.5).to_array();
+                            }
+                            let ring = topology.neighbors(v);
+                            let sum = ring.iter().fold(Vec3A::ZERO, |sum, &u| {
+                                sum + Vec3A::from_array(positions[u as usize])
+                            });
+                            (sum / ring.len().max(1) as f32).to_array()
+                        })
+                        .collect();
+                    for (&v, mean) in region.iter().zip(means) {
+                        positions[v as usize] = mean;
                     }
                 }
             }
-            if !grew && !now.iter().zip(reference).any(|(&n, &r)| n && !r) {
-                return;
-            }
-            for _ in 0..SWEEPS {
-                let means: Vec<[f32; 3]> = region
-                    .iter()
-                    .map(|&v| {
-                        if back[v as usize] {
-                            return positions[v as usize];
-                        }
-                        if let Some([p, n]) = on_crease(v) {
-                            let [p, n] = [p, n].map(|u| Vec3A::from_array(positions[u as usize]));
-                            return ((p + n) * 0.5).to_array();
-                        }
-                        let ring = topology.neighbors(v);
-                        let sum = ring.iter().fold(Vec3A::ZERO, |sum, &u| {
-                            sum + Vec3A::from_array(positions[u as usize])
-                        });
-                        (sum / ring.len().max(1) as f32).to_array()
-                    })
-                    .collect();
-                for (&v, mean) in region.iter().zip(means) {
-                    positions[v as usize] = mean;
-                }
-            }
-        }
-    };
+        };
     passes(positions, &mut region, &mut moving, &back);
     // What the neighbours' means cannot undo (a fold whose corners all stay, or one the levels
     // pressed in too deep): its corners, corners of creases among them, go back to where M0 has
@@ -322,7 +321,11 @@ mod tests {
         // Back to M0 but for the volume's offsets (within a hundredth of the diagonal, where the
         // push moved it 1.3 diagonals).
         let off = (0..3).map(|i| (positions[corner][i] - mesh.positions[corner][i]).powi(2));
-        assert!(off.sum::<f32>().sqrt() < 0.01 * 3f32.sqrt(), "{:?}", positions[corner]);
+        assert!(
+            off.sum::<f32>().sqrt() < 0.01 * 3f32.sqrt(),
+            "{:?}",
+            positions[corner]
+        );
         let volume = |positions: &[[f32; 3]]| {
             crate::metrics::signed_volume(&TriMesh::new(positions.to_vec(), mesh.triangles.clone()))
         };

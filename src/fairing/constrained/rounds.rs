@@ -360,12 +360,10 @@ fn noisy(
             .and_then(|reading| reading.away_from_edges(topology))
             .is_some_and(|away| away <= CLEAN_NOISE)
     };
-    let clean_off_flat_edges = || {
-        reading.is_some_and(|reading| reading.clean_off_flat_edges(topology, CLEAN_NOISE))
-    };
-    estimate.filter(|&noise| {
-        noise > CLEAN_NOISE && !clean_away_from_edges() && !clean_off_flat_edges()
-    })
+    let clean_off_flat_edges =
+        || reading.is_some_and(|reading| reading.clean_off_flat_edges(topology, CLEAN_NOISE));
+    estimate
+        .filter(|&noise| noise > CLEAN_NOISE && !clean_away_from_edges() && !clean_off_flat_edges())
 }
 
 /// What [`fair_rounds`] takes from the decision to fair.

@@ -307,9 +307,7 @@ impl Heights {
             .count();
         // Only a reading away from the edges needs the count (the per-round estimate skips it).
         let edges = matches!(left_out, LeftOut::Edges { .. });
-        if read < 16
-            || edges && 4 * read < heights.par_iter().filter(|h| h.is_finite()).count()
-        {
+        if read < 16 || edges && 4 * read < heights.par_iter().filter(|h| h.is_finite()).count() {
             return None;
         }
         let median = select_non_negative(&residuals, read / 2)?;
