@@ -34,7 +34,7 @@ impl DenoiseSummary {
         if report.rounds_run == 0 {
             return match report.noise_estimate {
                 Some(noise) if noise > CLEAN_NOISE => format!(
-                    "No noise to remove: what reads as noise (about {noise:.2} edge lengths) lies \
+                    "No noise to remove: what reads as noise (about {noise:.3} edge lengths) lies \
                      at sharp edges or in faces that still lie flat, as in a CAD part: the mesh \
                      is used as it is"
                 ),
