@@ -43,6 +43,10 @@ pub struct PanelView<'a> {
     pub shown_counts: (usize, usize),
     pub frame_stats: &'a FrameStats,
     pub viewport: Option<&'a Viewport3d>,
+    /// The Before view's renderer (the split and side-by-side views, B).
+    pub viewport_before: Option<&'a Viewport3d>,
+    /// What each viewport's held meshes show (indexed by [`Slot`]).
+    pub(super) held_views: &'a [Vec<super::held_views::HeldView>; 2],
     /// Where "Export levels" writes (the typed folder, or one beside the document).
     pub levels_folder: Option<PathBuf>,
     /// An export waits for the user to say whether this existing file may be replaced.
@@ -78,6 +82,8 @@ impl App {
             shown_counts: self.shown_counts,
             frame_stats: &self.frame_stats,
             viewport: self.viewport.as_ref(),
+            viewport_before: self.viewport_before.as_ref(),
+            held_views: &self.held_views,
             levels_folder: self.levels_folder(),
             confirm_replace: self.confirm_replace.as_deref(),
         };

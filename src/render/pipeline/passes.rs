@@ -169,9 +169,45 @@ impl Target {
 
     /// Records copying this target's image into `other`'s (the same size).
     pub(super) fn copy_image_to(&self, encoder: &mut wgpu::CommandEncoder, other: &Target) {
+        self.copy_image_into(encoder, &other.resolved_texture);
+    }
+
+    /// A texture that can hold this target's image (a held mesh's kept image).
+    pub(super) fn image_texture(&self, device: &wgpu::Device) -> wgpu::Texture {
+        device.create_texture(&wgpu::TextureDescriptor {
+            label: Some("fairmesh kept image"),
+            size: self.resolved_texture.size(),
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format: COLOR_FORMAT,
+            usage: wgpu::TextureUsages::COPY_SRC | wgpu::TextureUsages::COPY_DST,
+            view_formats: &[],
+        })
+    }
+
+    /// Records copying this target's image into `texture` (of [`Self::image_texture`]).
+    pub(super) fn copy_image_into(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        texture: &wgpu::Texture,
+    ) {
         encoder.copy_texture_to_texture(
             self.resolved_texture.as_image_copy(),
-            other.resolved_texture.as_image_copy(),
+            texture.as_image_copy(),
+            self.resolved_texture.size(),
+        );
+    }
+
+    /// Records copying `texture` (of [`Self::image_texture`]) into this target's image.
+    pub(super) fn copy_image_from(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        texture: &wgpu::Texture,
+    ) {
+        encoder.copy_texture_to_texture(
+            texture.as_image_copy(),
+            self.resolved_texture.as_image_copy(),
             self.resolved_texture.size(),
         );
     }
