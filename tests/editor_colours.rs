@@ -128,3 +128,64 @@ fn an_obj_with_a_textured_material_shows_its_texture() {
     );
     snapshot(&coloured, "viewport_textured_obj");
 }
+
+/// scene.gltf with its checker texture as a JPEG (written here from checker.png) in a folder of
+/// its own; `bytes` turns the JPEG's bytes into those the file gets (a cut-off copy).
+fn scene_with_jpeg(folder: &std::path::Path, bytes: impl Fn(Vec<u8>) -> Vec<u8>) {
+    let checker = image::open(asset("checker.png"))
+        .expect("checker.png")
+        .to_rgb8();
+    let mut jpeg = Vec::new();
+    image::codecs::jpeg::JpegEncoder::new_with_quality(&mut jpeg, 95)
+        .encode_image(&checker)
+        .expect("encoded");
+    std::fs::write(folder.join("checker.jpg"), bytes(jpeg)).unwrap();
+    std::fs::copy(asset("scene.bin"), folder.join("scene.bin")).unwrap();
+    let gltf = std::fs::read_to_string(asset("scene.gltf")).unwrap();
+    let mut json: serde_json::Value = serde_json::from_str(&gltf).unwrap();
+    json["images"][0] = serde_json::json!({ "mimeType": "image/jpeg", "uri": "checker.jpg" });
+    std::fs::write(folder.join("scene.gltf"), json.to_string()).unwrap();
+}
+
+#[test]
+fn a_jpeg_texture_is_drawn_and_a_cut_off_one_leaves_a_warning_and_the_base_colour() {
+    let folder = tempfile::tempdir().unwrap();
+    scene_with_jpeg(folder.path(), |jpeg| jpeg);
+    let mut harness = harness_for(folder.path().join("scene.gltf"));
+    settle(&mut harness);
+    let coloured = viewport_image(&mut harness);
+    assert!(
+        blue_pixels(&coloured) > 1500,
+        "the JPEG checker on the ball: {} px",
+        blue_pixels(&coloured)
+    );
+    assert!(red_pixels(&coloured) > 1500, "the painted box");
+    assert!(harness.state().appearance_warnings().is_empty());
+
+    let cut = tempfile::tempdir().unwrap();
+    scene_with_jpeg(cut.path(), |jpeg| jpeg[..jpeg.len() * 2 / 3].to_vec());
+    let mut harness = harness_for(cut.path().join("scene.gltf"));
+    settle(&mut harness);
+    let plain = viewport_image(&mut harness);
+    assert_eq!(
+        blue_pixels(&plain),
+        0,
+        "no texture: the base colour (white)"
+    );
+    assert!(
+        red_pixels(&plain) > 1500,
+        "the painted box keeps its colour"
+    );
+    let warnings = harness.state().appearance_warnings().to_vec();
+    assert_eq!(warnings.len(), 1, "{warnings:?}");
+    for named in [
+        "scene.gltf",
+        "checker.jpg",
+        "'checker'",
+        "base colour alone",
+    ] {
+        assert!(warnings[0].contains(named), "{named} in {}", warnings[0]);
+    }
+    // The Mesh section says it.
+    harness.get_by_label(&format!("Warning: {}", warnings[0]));
+}

@@ -156,6 +156,9 @@ pub struct App {
         Arc<crate::io::Source>,
         Option<Arc<crate::render::appearance::Appearance>>,
     )>,
+    /// What could not be shown of the file's colours (a texture that did not decode), said in
+    /// the Mesh section; made with [`Self::appearance`].
+    appearance_warnings: Vec<String>,
     /// The single view shows "before" instead of "after" (toggled with B).
     show_before: bool,
     shown_counts: (usize, usize),
