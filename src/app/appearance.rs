@@ -1,6 +1,6 @@
 //! The viewport's colours from the loaded file ([`appearance_of`]): its materials' base colour
-//! factors and base colour textures (decoded PNG or JPEG, with the glTF sampler's filters and
-//! wrapping), its texture coordinates and its vertex colours (glTF COLOR_0, PLY colours; OBJ has
+//! factors and base colour textures (decoded PNG or JPEG, with the glTF sampler's filters,
+//! mipmaps and wrapping, and its `KHR_texture_transform`), its texture coordinates and its vertex colours (glTF COLOR_0, PLY colours; OBJ has
 //! none), as the renderer's [`Appearance`]. A texture that cannot be decoded (a broken or cut-off
 //! file, a format other than PNG and JPEG) leaves its material's base colour alone, and a warning
 //! that names the file and the image. The io layer keeps the file ([`crate::io::Source`]); this
@@ -8,9 +8,11 @@
 
 use std::collections::BTreeMap;
 
-use crate::io::scene::{Scene, TextureSampler, TextureWrap};
+use crate::io::scene::{Material, MipmapFilter, Scene, TextureSampler, TextureWrap};
 use crate::io::{Format, Source};
-use crate::render::appearance::{Appearance, Batch, MaterialLook, Sampling, TextureImage, Wrap};
+use crate::render::appearance::{
+    Appearance, Batch, MaterialLook, Mipmaps, Sampling, TextureImage, Wrap, UV_IDENTITY,
+};
 use crate::TriMesh;
 
 /// What the viewport shows of `source`'s colours over `mesh` (the mesh loaded from it, or one
@@ -87,31 +89,45 @@ fn from_scene(
             .iter()
             .map(|m| MaterialLook {
                 base_colour: m.base_colour,
-                texture: m.texture.as_ref().and_then(|image| {
-                    let decoded = match image.data.bytes() {
-                        Ok(bytes) => decode_texture(&bytes),
-                        Err(error) => Err(format!("it could not be read: {error}")),
-                    };
-                    match decoded {
-                        Ok((width, height, rgba)) => Some(TextureImage {
-                            width,
-                            height,
-                            rgba,
-                            sampling: sampling(m.sampler),
-                        }),
-                        Err(why) => {
-                            warnings.push(format!(
-                                "{file}: the base colour texture '{}' of material '{}' is not \
-                                 shown ({why}); the material shows its base colour alone",
-                                image.name, m.name
-                            ));
-                            None
-                        }
-                    }
-                }),
+                texture: texture_of(m, file, warnings),
+                uv_transform: m
+                    .texture_transform
+                    .as_ref()
+                    .map_or(UV_IDENTITY, |t| t.rows()),
             })
             .collect(),
     })
+}
+
+/// `material`'s base colour texture, decoded; `None` (and a warning naming `file` and the
+/// image) when it cannot be read or decoded, or reads texture coordinates other than the first
+/// set (the only one the viewport has).
+fn texture_of(material: &Material, file: &str, warnings: &mut Vec<String>) -> Option<TextureImage> {
+    let image = material.texture.as_ref()?;
+    let decoded = match image.data.bytes() {
+        Ok(_) if material.tex_coord != 0 => Err(format!(
+            "it reads texture coordinates TEXCOORD_{}; the viewport has TEXCOORD_0 alone",
+            material.tex_coord
+        )),
+        Ok(bytes) => decode_texture(&bytes),
+        Err(error) => Err(format!("it could not be read: {error}")),
+    };
+    match decoded {
+        Ok((width, height, rgba)) => Some(TextureImage {
+            width,
+            height,
+            rgba,
+            sampling: sampling(material.sampler),
+        }),
+        Err(why) => {
+            warnings.push(format!(
+                "{file}: the base colour texture '{}' of material '{}' is not shown ({why}); \
+                 the material shows its base colour alone",
+                image.name, material.name
+            ));
+            None
+        }
+    }
 }
 
 /// A PLY's colours, one per welded vertex (the mesh's own vertices and triangles).
@@ -150,6 +166,11 @@ fn sampling(sampler: TextureSampler) -> Sampling {
         mag_linear: sampler.mag_linear,
         min_linear: sampler.min_linear,
         wrap: [wrap(sampler.wrap[0]), wrap(sampler.wrap[1])],
+        mipmaps: match sampler.mipmaps {
+            MipmapFilter::Off => Mipmaps::Off,
+            MipmapFilter::Nearest => Mipmaps::Nearest,
+            MipmapFilter::Linear => Mipmaps::Linear,
+        },
     }
 }
 

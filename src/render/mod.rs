@@ -11,6 +11,7 @@
 
 pub mod appearance;
 pub mod colormap;
+pub mod mipmaps;
 pub mod normals;
 pub mod pipeline;
 pub mod shading;
