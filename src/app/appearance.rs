@@ -8,7 +8,9 @@
 
 use std::collections::BTreeMap;
 
-use crate::io::scene::{Material, MipmapFilter, Scene, TextureSampler, TextureWrap};
+use crate::io::scene::{
+    Material, MipmapFilter, Scene, TextureSampler, TextureTransform, TextureWrap,
+};
 use crate::io::{Format, Source};
 use crate::render::appearance::{
     Appearance, Batch, MaterialLook, Mipmaps, Sampling, TextureImage, Wrap, UV_IDENTITY,
@@ -90,13 +92,22 @@ fn from_scene(
             .map(|m| MaterialLook {
                 base_colour: m.base_colour,
                 texture: texture_of(m, file, warnings),
-                uv_transform: m
-                    .texture_transform
-                    .as_ref()
-                    .map_or(UV_IDENTITY, |t| t.rows()),
+                uv_transform: m.texture_transform.as_ref().map_or(UV_IDENTITY, uv_rows),
             })
             .collect(),
     })
+}
+
+/// A texture transform as the two rows of a 3×3 matrix over (u, v, 1): translation × rotation ×
+/// scale, as the extension defines it, the rotation taking (u, v) to
+/// (u cos r + v sin r, −u sin r + v cos r). That is the direction of the extension's example
+/// (offset (0, 1), a quarter turn and scale ½ read the lower left quadrant) and of three.js; the
+/// extension's GLSL snippet, read as GLSL's column-major `mat3`, turns the other way.
+fn uv_rows(transform: &TextureTransform) -> [[f32; 3]; 2] {
+    let (sin, cos) = transform.rotation.sin_cos();
+    let [sx, sy] = transform.scale;
+    let [ox, oy] = transform.offset;
+    [[cos * sx, sin * sy, ox], [-sin * sx, cos * sy, oy]]
 }
 
 /// `material`'s base colour texture, decoded; `None` (and a warning naming `file` and the
@@ -243,7 +254,39 @@ fn decode_png(bytes: &[u8]) -> Option<(u32, u32, Vec<u8>)> {
 
 #[cfg(test)]
 mod tests {
-    use super::decode_texture;
+    use super::{decode_texture, uv_rows};
+    use crate::io::scene::TextureTransform;
+
+    #[test]
+    fn a_texture_transform_is_composed_as_the_extension_says() {
+        let read = |json: &str| {
+            let transform = TextureTransform::from_gltf(&serde_json::from_str(json).unwrap());
+            uv_rows(&transform.unwrap())
+        };
+        assert_eq!(read("{}"), [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0]]);
+        // The extension's example: the lower left quadrant of the image (v down), turned a
+        // quarter clockwise.
+        let [u, v] = read(r#"{"offset": [0, 1], "rotation": 1.57079632679, "scale": [0.5, 0.5]}"#);
+        let at = |(x, y): (f32, f32)| {
+            let row = |r: [f32; 3]| r[0] * x + r[1] * y + r[2];
+            [row(u), row(v)]
+        };
+        for (corner, read_at) in [
+            ((0.0, 0.0), [0.0, 1.0]),
+            ((1.0, 0.0), [0.0, 0.5]),
+            ((0.0, 1.0), [0.5, 1.0]),
+            ((1.0, 1.0), [0.5, 0.5]),
+        ] {
+            let got = at(corner);
+            assert!(
+                (got[0] - read_at[0]).abs() < 1e-6 && (got[1] - read_at[1]).abs() < 1e-6,
+                "{corner:?}: {got:?}"
+            );
+        }
+        // Scale, then offset, with no rotation.
+        let moved = read(r#"{"offset": [0.25, 0.5], "scale": [2, 3]}"#);
+        assert_eq!(moved, [[2.0, 0.0, 0.25], [0.0, 3.0, 0.5]]);
+    }
 
     /// A 64×32 JPEG of a left-to-right red ramp over green with blue stripes, as an encoder
     /// writes it.

@@ -140,18 +140,6 @@ impl TextureTransform {
             json: json.clone(),
         })
     }
-
-    /// The transform as the two rows of a 3×3 matrix over (u, v, 1): translation × rotation ×
-    /// scale, as the extension defines it, the rotation taking (u, v) to
-    /// (u cos r + v sin r, −u sin r + v cos r). That is the direction of the extension's example
-    /// (offset (0, 1), a quarter turn and scale ½ read the lower left quadrant) and of three.js;
-    /// the extension's GLSL snippet, read as GLSL's column-major `mat3`, turns the other way.
-    pub fn rows(&self) -> [[f32; 3]; 2] {
-        let (sin, cos) = self.rotation.sin_cos();
-        let [sx, sy] = self.scale;
-        let [ox, oy] = self.offset;
-        [[cos * sx, sin * sy, ox], [-sin * sx, cos * sy, oy]]
-    }
 }
 
 /// How a texture is sampled, as a glTF sampler says (an MTL says nothing: the defaults).
@@ -757,35 +745,19 @@ mod tests {
     }
 
     #[test]
-    fn a_texture_transform_is_read_with_its_defaults_and_composed_as_the_extension_says() {
+    fn a_texture_transform_is_read_with_its_defaults() {
         let read = |json: &str| TextureTransform::from_gltf(&serde_json::from_str(json).unwrap());
         let plain = read("{}").unwrap();
-        assert_eq!(plain.rows(), [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0]]);
+        assert_eq!(
+            (plain.offset, plain.rotation, plain.scale),
+            ([0.0; 2], 0.0, [1.0; 2])
+        );
         assert!(read("[1, 2]").is_none());
-        // The extension's example: the lower left quadrant of the image (v down), turned a
-        // quarter clockwise.
-        let json = r#"{"offset": [0, 1], "rotation": 1.57079632679, "scale": [0.5, 0.5]}"#;
-        let quadrant = read(json).unwrap();
-        let [u, v] = quadrant.rows();
-        let at = |(x, y): (f32, f32)| {
-            let row = |r: [f32; 3]| r[0] * x + r[1] * y + r[2];
-            [row(u), row(v)]
-        };
-        for (corner, read_at) in [
-            ((0.0, 0.0), [0.0, 1.0]),
-            ((1.0, 0.0), [0.0, 0.5]),
-            ((0.0, 1.0), [0.5, 1.0]),
-            ((1.0, 1.0), [0.5, 0.5]),
-        ] {
-            let got = at(corner);
-            assert!(
-                (got[0] - read_at[0]).abs() < 1e-6 && (got[1] - read_at[1]).abs() < 1e-6,
-                "{corner:?}: {got:?}"
-            );
-        }
-        // Scale, then offset, with no rotation.
-        let moved = read(r#"{"offset": [0.25, 0.5], "scale": [2, 3]}"#).unwrap();
-        assert_eq!(moved.rows(), [[2.0, 0.0, 0.25], [0.0, 3.0, 0.5]]);
+        let moved = read(r#"{"offset": [0.25, 0.5], "scale": [2, 3], "rotation": 1}"#).unwrap();
+        assert_eq!(
+            (moved.offset, moved.rotation, moved.scale),
+            ([0.25, 0.5], 1.0, [2.0, 3.0])
+        );
         assert_eq!(moved.json["scale"], serde_json::json!([2, 3]));
     }
 }
