@@ -34,6 +34,10 @@ struct Material {
     base_colour: vec4<f32>,
     // x: 1 when the material has a base colour texture.
     flags: vec4<f32>,
+    // The texture transform (KHR_texture_transform): the texture is read at
+    // (dot(uv_u.xyz, (u, v, 1)), dot(uv_v.xyz, (u, v, 1))).
+    uv_u: vec4<f32>,
+    uv_v: vec4<f32>,
 };
 
 @group(1) @binding(0) var<uniform> material: Material;
@@ -173,7 +177,12 @@ fn fs_mesh(in: MeshOut, @builtin(front_facing) front: bool) -> @location(0) vec4
     let normal = surface_normal(in, front, to_eye);
     // Sampled before any branch (implicit derivatives need every pixel of the quad); a mesh
     // with no material samples a white texel.
-    let texel = textureSample(base_texture, base_sampler, in.uv);
+    let placed = vec3<f32>(in.uv, 1.0);
+    let texel = textureSample(
+        base_texture,
+        base_sampler,
+        vec2<f32>(dot(material.uv_u.xyz, placed), dot(material.uv_v.xyz, placed)),
+    );
     var albedo = u.base_color.rgb;
     if (u.look.z > 0.5) {
         albedo = material.base_colour.rgb;

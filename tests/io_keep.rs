@@ -1896,3 +1896,91 @@ fn a_texture_whose_image_is_webp_only_is_loaded_and_carried() {
     assert!(map.ends_with(".webp"), "{map}");
     assert_eq!(std::fs::read(dir.path().join(map)).unwrap(), WEBP_CHECKER);
 }
+
+#[test]
+fn a_texture_transform_is_written_back_carried_into_a_new_gltf_and_named_for_obj() {
+    // scene.glb with the checker texture placed by KHR_texture_transform (and the extension
+    // required, as exporters without a fallback set of texture coordinates write it).
+    let dir = tempfile::tempdir().unwrap();
+    let mut input = read_gltf(&data("scene.glb"));
+    let transform =
+        serde_json::json!({"offset": [0.25, 0.5], "rotation": 0.3, "scale": [2.0, 2.0]});
+    let json = &mut input.json;
+    assert_eq!(json["materials"][0]["name"], "checker");
+    json["materials"][0]["pbrMetallicRoughness"]["baseColorTexture"]["extensions"] =
+        serde_json::json!({ "KHR_texture_transform": transform });
+    for key in ["extensionsUsed", "extensionsRequired"] {
+        json[key] = serde_json::json!(["KHR_texture_transform"]);
+    }
+    let placed = dir.path().join("placed.glb");
+    write_glb(&input, &placed);
+
+    let loaded = io::load(&placed).expect("a required KHR_texture_transform is read");
+    let mesh = faired(&loaded);
+    // Written back: the materials and the extension lists as they were.
+    let back = dir.path().join("faired.glb");
+    io::save_with_source(&back, &mesh, &loaded.source).unwrap();
+    let output = read_gltf(&back);
+    assert_eq!(output.json["materials"], input.json["materials"]);
+    assert_eq!(
+        output.json["extensionsRequired"],
+        input.json["extensionsRequired"]
+    );
+
+    // A coarse level is a new document: the transform is carried as it came, and not named.
+    use fairmesh::hierarchy::{build_hierarchy, HierarchyOptions};
+    let hierarchy = build_hierarchy(
+        &loaded.mesh,
+        &HierarchyOptions::default(),
+        &mut fairmesh::NoProgress,
+    )
+    .unwrap();
+    let level = (hierarchy.coarsest_level() / 2).max(1);
+    let (vertex_origin, face_origin) = hierarchy.level_origins(level);
+    let derivation = io::Derivation {
+        base: hierarchy.base_mesh(),
+        vertex_origin: &vertex_origin,
+        face_origin: &face_origin,
+    };
+    let coarse = dir.path().join("level.glb");
+    let report = io::save_derived_with_source(
+        &coarse,
+        &hierarchy.level_mesh(level),
+        &derivation,
+        &loaded.source,
+    )
+    .unwrap();
+    let written = read_gltf(&coarse);
+    let checker = (written.json["materials"].as_array().unwrap().iter())
+        .find(|m| m["name"] == "checker")
+        .expect("the checker material");
+    assert_eq!(
+        checker["pbrMetallicRoughness"]["baseColorTexture"]["extensions"]["KHR_texture_transform"],
+        transform
+    );
+    assert_eq!(
+        written.json["extensionsUsed"],
+        serde_json::json!(["KHR_texture_transform"])
+    );
+    assert!(
+        !report
+            .warnings
+            .iter()
+            .any(|w| w.contains("KHR_texture_transform")),
+        "{:?}",
+        report.warnings
+    );
+    validate(&[placed, back, coarse]);
+
+    // As OBJ, which has no rotation for a texture: named as not kept.
+    let obj = dir.path().join("faired.obj");
+    let report = io::save_with_source(&obj, &mesh, &loaded.source).unwrap();
+    assert!(
+        report
+            .warnings
+            .iter()
+            .any(|w| w.contains("KHR_texture_transform")),
+        "{:?}",
+        report.warnings
+    );
+}

@@ -346,3 +346,104 @@ fn a_software_renderer_draws_big_meshes_with_one_sample_and_small_ones_with_four
     assert_eq!(renderer.samples(), 4);
     draw(&mut renderer, &device, &queue, [64, 48]);
 }
+
+/// Renders frames with `params` until the image in progress is complete.
+fn finish_image(
+    renderer: &mut MeshRenderer,
+    device: &wgpu::Device,
+    queue: &wgpu::Queue,
+    params: &fairmesh::render::DrawParams,
+) {
+    render_once(renderer, device, queue, params);
+    for _ in 0..1000 {
+        if !renderer.drawing() {
+            return;
+        }
+        render_once(renderer, device, queue, params);
+    }
+    panic!("the image was never completed");
+}
+
+#[test]
+fn a_held_mesh_shows_its_kept_image_again_only_while_nothing_changed() {
+    use fairmesh::render::{ImageCounts, MeshKey};
+    let (device, queue) = device();
+    let mut renderer = MeshRenderer::new(&device, Arc::new(|| {}));
+    renderer.set_async_upload_bytes(usize::MAX);
+    let size = [96, 80];
+    renderer.ensure_target(&device, size);
+    let view = params(size, 1.0, false);
+    let (dome, plane) = (
+        MeshKey {
+            family: 1,
+            version: 0,
+        },
+        MeshKey {
+            family: 2,
+            version: 0,
+        },
+    );
+    // Images take several frames (6400 faces in parts of 1000), but for the target's first.
+    renderer.set_faces_per_frame(1000);
+    renderer.set_mesh_keyed(&device, Arc::new(Grid::dome_over_plane(40)), Some(dome));
+    finish_image(&mut renderer, &device, &queue, &view);
+    let dome_image = renderer.read_back_image(&device, &queue).unwrap();
+    renderer.set_mesh_keyed(&device, Arc::new(Grid::new(40)), Some(plane));
+    finish_image(&mut renderer, &device, &queue, &view);
+    let plane_image = renderer.read_back_image(&device, &queue).unwrap();
+    assert_ne!(dome_image, plane_image);
+
+    // Each comes back in one frame, nothing drawn.
+    let counts = renderer.image_counts();
+    assert!(renderer.show_held(&queue, dome));
+    assert!(render_once(&mut renderer, &device, &queue, &view));
+    assert!(!renderer.drawing());
+    assert!(renderer.read_back_image(&device, &queue).unwrap() == dome_image);
+    assert!(renderer.show_held(&queue, plane));
+    assert!(render_once(&mut renderer, &device, &queue, &view));
+    assert!(renderer.read_back_image(&device, &queue).unwrap() == plane_image);
+    let restored_twice = ImageCounts {
+        restored: counts.restored + 2,
+        ..counts
+    };
+    assert_eq!(renderer.image_counts(), restored_twice);
+    assert_eq!(
+        renderer.image_bytes(),
+        2 * 96 * 80 * 4,
+        "one image per mesh"
+    );
+
+    // There and back before a frame: the target still shows the plane, nothing to do.
+    assert!(renderer.show_held(&queue, dome));
+    assert!(renderer.show_held(&queue, plane));
+    assert!(!render_once(&mut renderer, &device, &queue, &view));
+    assert!(renderer.read_back_image(&device, &queue).unwrap() == plane_image);
+
+    // Another view: drawn, not the kept image.
+    let closer = params(size, 2.0, false);
+    assert!(renderer.show_held(&queue, dome));
+    render_once(&mut renderer, &device, &queue, &closer);
+    assert!(renderer.drawing(), "a new view is drawn in parts");
+    finish_image(&mut renderer, &device, &queue, &closer);
+    assert_eq!(renderer.image_counts().restored, restored_twice.restored);
+    assert!(renderer.read_back_image(&device, &queue).unwrap() != dome_image);
+
+    // Its buffers change (the heat map's scalars) and it leaves before its next image: its
+    // kept image is not shown again.
+    assert!(renderer.show_held(&queue, plane));
+    finish_image(&mut renderer, &device, &queue, &view);
+    assert!(renderer.set_scalars(&queue, &vec![0.5; 41 * 41]));
+    assert!(renderer.show_held(&queue, dome));
+    finish_image(&mut renderer, &device, &queue, &view);
+    let restored = renderer.image_counts().restored;
+    assert!(renderer.show_held(&queue, plane));
+    render_once(&mut renderer, &device, &queue, &view);
+    assert!(renderer.drawing(), "drawn again after its scalars changed");
+    assert_eq!(renderer.image_counts().restored, restored);
+
+    // An image goes with its mesh.
+    finish_image(&mut renderer, &device, &queue, &view);
+    renderer.retain_held(|key| key == plane);
+    assert_eq!(renderer.image_bytes(), 96 * 80 * 4);
+    assert_eq!(renderer.meshes_held(), 1);
+}

@@ -14,8 +14,9 @@ pub struct FrameStats {
     pub frames: u64,
     /// Frames over this are printed to standard error (`AppOptions::log_frames_over`).
     pub(super) log_over: Option<Duration>,
-    /// The main viewport's image count at the last frame (to tell whether it drew since).
-    pub(super) images_seen: u64,
+    /// The main viewport's image counts at the last frame (to tell whether it drew an image,
+    /// or showed a held mesh's kept one, since).
+    pub(super) images_seen: crate::render::ImageCounts,
     /// When the previous frame began (for the wait of input, see [`FrameStats::record_start`]).
     previous_start: Option<Instant>,
     /// When the first frame began (the log says when each late frame came).

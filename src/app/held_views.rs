@@ -7,7 +7,7 @@
 use crate::app::shown::{Shown, ShownMesh, Slot};
 use crate::app::state::HierarchyState;
 use crate::app::App;
-use crate::render::{MeshKey, MAX_HELD_MESHES};
+use crate::render::{MeshKey, Viewport3d, MAX_HELD_MESHES};
 
 /// A mesh a viewport holds on the GPU, and what was uploaded with it.
 #[derive(Clone, Copy, Debug)]
@@ -102,4 +102,63 @@ impl App {
     pub fn held_meshes(&self, slot: Slot) -> Option<(usize, u64)> {
         self.slot_viewport(slot).map(|v| v.held_meshes())
     }
+
+    /// What a viewport's renderer has put in its image so far: images drawn, parts of images
+    /// drawn over several frames, held meshes' kept images shown again (`None` without a
+    /// renderer).
+    pub fn image_counts(&self, slot: Slot) -> Option<crate::render::ImageCounts> {
+        self.slot_viewport(slot).map(|v| v.image_counts())
+    }
+
+    /// Bytes of the kept images (the held meshes' last complete images) of a viewport's
+    /// renderer (`None` without a renderer).
+    pub fn kept_image_bytes(&self, slot: Slot) -> Option<u64> {
+        self.slot_viewport(slot).map(|v| v.image_bytes())
+    }
+}
+
+/// One line of the Performance section's list of the meshes held on the GPU.
+#[derive(Clone, Debug, PartialEq)]
+pub(in crate::app) struct HeldLine {
+    /// The mesh as the toolbar names it ("Faired", "Level mesh M3", "Input mesh"), and the
+    /// view holding it when that is the Before view.
+    pub(in crate::app) name: String,
+    /// Bytes of its buffers.
+    pub(in crate::app) bytes: u64,
+    /// Bytes of its kept image (0 without one).
+    pub(in crate::app) image_bytes: u64,
+    pub(in crate::app) on_screen: bool,
+}
+
+/// The meshes the viewports hold on the GPU (`views`: what the app recorded for each slot), the
+/// main view's first and each view's mesh on screen first.
+pub(in crate::app) fn held_lines(
+    views: &[Vec<HeldView>; 2],
+    viewports: [Option<&Viewport3d>; 2],
+) -> Vec<HeldLine> {
+    let mut lines = Vec::new();
+    for (slot, viewport) in viewports.into_iter().enumerate() {
+        let Some(viewport) = viewport else {
+            continue;
+        };
+        for held in viewport.held_list() {
+            let view = views[slot].iter().find(|v| Some(v.key) == held.key);
+            let name = match view.map(|v| v.shown.what) {
+                Some(ShownMesh::Original) => "Input mesh".to_owned(),
+                Some(ShownMesh::Faired { .. }) => "Faired".to_owned(),
+                Some(ShownMesh::Level { level }) => format!("Level mesh M{level}"),
+                None => "A mesh being replaced".to_owned(),
+            };
+            lines.push(HeldLine {
+                name: match slot == Slot::Before as usize {
+                    true => format!("{name} (Before view)"),
+                    false => name,
+                },
+                bytes: held.bytes,
+                image_bytes: held.image_bytes,
+                on_screen: held.on_screen,
+            });
+        }
+    }
+    lines
 }

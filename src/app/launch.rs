@@ -187,6 +187,7 @@ impl App {
             shown_before: None,
             heat_max: [None; 2],
             held_views: Default::default(),
+            appearance_warnings: Vec::new(),
             appearance: None,
             show_before: false,
             shown_counts: (0, 0),

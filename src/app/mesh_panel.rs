@@ -43,7 +43,7 @@ pub(super) fn mesh_section(ui: &mut egui::Ui, view: &PanelView) {
             report.removed_unreferenced_vertices
         ));
     }
-    for warning in &report.warnings {
+    for warning in report.warnings.iter().chain(view.appearance_warnings) {
         ui.small(format!("Warning: {warning}"));
     }
 

@@ -156,6 +156,9 @@ pub struct App {
         Arc<crate::io::Source>,
         Option<Arc<crate::render::appearance::Appearance>>,
     )>,
+    /// What could not be shown of the file's colours (a texture that did not decode), said in
+    /// the Mesh section; made with [`Self::appearance`].
+    appearance_warnings: Vec<String>,
     /// The single view shows "before" instead of "after" (toggled with B).
     show_before: bool,
     shown_counts: (usize, usize),
@@ -250,14 +253,17 @@ impl App {
         }
     }
 
-    /// The viewport's draw of the previous frame, if it drew a new image.
+    /// The viewport's draw of the previous frame, if it drew a new image. A held mesh's kept
+    /// image shown again is logged too (the frame log times view switches by both).
     fn new_image_draw_time(&mut self) -> Duration {
         match &self.viewport {
             Some(viewport) => {
-                let images = viewport.images_drawn();
-                let drew = images != self.frame_stats.images_seen;
-                self.frame_stats.images_seen = images;
-                if drew {
+                let images = viewport.image_counts();
+                let seen = std::mem::replace(&mut self.frame_stats.images_seen, images);
+                if images.restored != seen.restored {
+                    self.frame_stats.log_arrival("a kept image of the 3D view");
+                }
+                if images.drawn != seen.drawn {
                     self.frame_stats.log_arrival("a new image of the 3D view");
                     viewport.last_draw_time()
                 } else {

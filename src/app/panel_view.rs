@@ -43,6 +43,12 @@ pub struct PanelView<'a> {
     pub shown_counts: (usize, usize),
     pub frame_stats: &'a FrameStats,
     pub viewport: Option<&'a Viewport3d>,
+    /// The Before view's renderer (the split and side-by-side views, B).
+    pub viewport_before: Option<&'a Viewport3d>,
+    /// What each viewport's held meshes show (indexed by [`Slot`]).
+    pub(super) held_views: &'a [Vec<super::held_views::HeldView>; 2],
+    /// What could not be shown of the file's colours (a texture that did not decode).
+    pub appearance_warnings: &'a [String],
     /// Where "Export levels" writes (the typed folder, or one beside the document).
     pub levels_folder: Option<PathBuf>,
     /// An export waits for the user to say whether this existing file may be replaced.
@@ -78,6 +84,14 @@ impl App {
             shown_counts: self.shown_counts,
             frame_stats: &self.frame_stats,
             viewport: self.viewport.as_ref(),
+            viewport_before: self.viewport_before.as_ref(),
+            held_views: &self.held_views,
+            appearance_warnings: match (&self.appearance, &self.document) {
+                (Some((source, _)), Some(d)) if std::sync::Arc::ptr_eq(source, &d.source) => {
+                    &self.appearance_warnings
+                }
+                _ => &[],
+            },
             levels_folder: self.levels_folder(),
             confirm_replace: self.confirm_replace.as_deref(),
         };

@@ -62,6 +62,19 @@ impl App {
         &mut self.frame_stats
     }
 
+    /// What could not be shown of the loaded file's colours (a base colour texture that did
+    /// not decode), as the Mesh section says it; empty until the viewport drew the file.
+    pub fn appearance_warnings(&self) -> &[String] {
+        let current = match (&self.appearance, &self.document) {
+            (Some((source, _)), Some(document)) => Arc::ptr_eq(source, &document.source),
+            _ => false,
+        };
+        match current {
+            true => &self.appearance_warnings,
+            false => &[],
+        }
+    }
+
     pub fn settings(&self) -> &Settings {
         &self.settings
     }

@@ -123,3 +123,15 @@ pub const NOISE_ROW: &str = "Mean distance of the input mesh from the clean mesh
 
 /// The formats Export writes, as the README lists them.
 pub const EXPORT_FORMATS: &str = "GLB, glTF, OBJ, PLY, STL or OFF, by extension";
+pub const HELD_MESHES: &str = "The meshes the 3D view keeps on the graphics card: the one \
+    shown, and those you switched away from (Faired, Level mesh, Input mesh), so that switching \
+    back uploads nothing. A new result or level takes the place of the old one; the Before \
+    view keeps its own copy of the input mesh.";
+pub const KEPT_IMAGE: &str = "The last image drawn of each held mesh. Switching back to a \
+    mesh while the view is as it was (the same camera, window size and display settings) shows \
+    this image at once instead of drawing the mesh again. It takes 4 bytes a pixel of the 3D \
+    view.";
+pub const VIEWPORT_IMAGES: &str = "Images of the 3D view drawn so far, and how many times a \
+    held mesh's kept image was shown instead of drawing the mesh again.";
+pub const RESET_MAX: &str = "Forget the longest frame while working, to measure the next \
+    piece of work on its own.";

@@ -365,8 +365,14 @@ impl App {
         if (self.appearance.as_ref()).is_some_and(|(s, _)| Arc::ptr_eq(s, &document.source)) {
             return;
         }
-        let appearance = super::appearance::appearance_of(&document.source, &document.original);
+        let file = document.path.file_name().map_or_else(
+            || document.path.display().to_string(),
+            |name| name.to_string_lossy().into_owned(),
+        );
+        let (appearance, warnings) =
+            super::appearance::appearance_of(&document.source, &document.original, &file);
         self.appearance = Some((document.source.clone(), appearance.map(Arc::new)));
+        self.appearance_warnings = warnings;
     }
 
     /// The slot's renderer handle, when there is a wgpu renderer.

@@ -97,6 +97,49 @@ pub(crate) struct Material {
     pub texture: Option<Image>,
     /// How the base colour texture is sampled (a glTF texture's sampler; defaults otherwise).
     pub sampler: TextureSampler,
+    /// Which set of texture coordinates the base colour texture reads (glTF `texCoord`, 0 for
+    /// `TEXCOORD_0`; the texture transform's own `texCoord` where it has one).
+    pub tex_coord: u32,
+    /// The base colour texture's `KHR_texture_transform`, where the file has one.
+    pub texture_transform: Option<TextureTransform>,
+}
+
+/// A glTF base colour texture's `KHR_texture_transform`: its texture coordinates are scaled,
+/// then rotated, then offset before the texture is sampled.
+#[derive(Clone, Debug, PartialEq)]
+pub struct TextureTransform {
+    pub offset: [f32; 2],
+    /// Radians: the texture coordinates turn counter-clockwise, the image clockwise.
+    pub rotation: f32,
+    pub scale: [f32; 2],
+    /// The extension's object as the file wrote it, carried into a glTF output as it came.
+    pub json: serde_json::Value,
+}
+
+impl TextureTransform {
+    /// The extension's object (`None` when it is no object); fields it leaves out take the
+    /// extension's defaults (offset 0, rotation 0, scale 1).
+    pub(crate) fn from_gltf(json: &serde_json::Value) -> Option<TextureTransform> {
+        json.as_object()?;
+        let pair = |key: &str, default: f32| {
+            let list = json.get(key).and_then(serde_json::Value::as_array);
+            let at = |i: usize| {
+                list.and_then(|l| l.get(i))
+                    .and_then(serde_json::Value::as_f64)
+                    .filter(|v| v.is_finite())
+                    .map_or(default, |v| v as f32)
+            };
+            [at(0), at(1)]
+        };
+        Some(TextureTransform {
+            offset: pair("offset", 0.0),
+            rotation: (json.get("rotation").and_then(serde_json::Value::as_f64))
+                .filter(|v| v.is_finite())
+                .map_or(0.0, |v| v as f32),
+            scale: pair("scale", 1.0),
+            json: json.clone(),
+        })
+    }
 }
 
 /// How a texture is sampled, as a glTF sampler says (an MTL says nothing: the defaults).
@@ -108,17 +151,34 @@ pub struct TextureSampler {
     pub min_linear: bool,
     /// How texture coordinates outside 0..1 wrap, along u (wrapS) and v (wrapT).
     pub wrap: [TextureWrap; 2],
+    /// Whether a minified texture reads from its mipmaps (its halved copies), and how it goes
+    /// between two of them.
+    pub mipmaps: MipmapFilter,
 }
 
 impl Default for TextureSampler {
-    /// glTF's defaults where a sampler leaves a field out: linear filters, repeat.
+    /// glTF's defaults where a sampler leaves a field out: linear filters, repeat. Where the
+    /// minification filter is left out glTF lets the reader choose: mipmaps, blended between
+    /// levels (LINEAR_MIPMAP_LINEAR), as most viewers do.
     fn default() -> Self {
         TextureSampler {
             mag_linear: true,
             min_linear: true,
             wrap: [TextureWrap::Repeat; 2],
+            mipmaps: MipmapFilter::Linear,
         }
     }
+}
+
+/// The mipmaps a glTF minification filter asks for.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum MipmapFilter {
+    /// NEAREST or LINEAR: the full-size texture alone.
+    Off,
+    /// NEAREST_MIPMAP_NEAREST, LINEAR_MIPMAP_NEAREST: the nearest level.
+    Nearest,
+    /// NEAREST_MIPMAP_LINEAR, LINEAR_MIPMAP_LINEAR: the two nearest levels blended.
+    Linear,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -143,6 +203,11 @@ impl TextureSampler {
             mag_linear: number("magFilter") != Some(9728),
             min_linear: !matches!(number("minFilter"), Some(9728 | 9984 | 9986)),
             wrap: [wrap("wrapS"), wrap("wrapT")],
+            mipmaps: match number("minFilter") {
+                Some(9728 | 9729) => MipmapFilter::Off,
+                Some(9984 | 9985) => MipmapFilter::Nearest,
+                _ => MipmapFilter::Linear,
+            },
         }
     }
 }
@@ -458,10 +523,21 @@ impl Scene {
                     roughness: m.roughness,
                     texture: m.texture.clone(),
                     sampler: m.sampler,
+                    tex_coord: m.tex_coord,
+                    texture_transform: m.texture_transform.clone(),
                 })
                 .collect(),
             ..Scene::default()
         }
+    }
+
+    /// Whether a glTF written from this scene carries the source's `KHR_texture_transform`:
+    /// some base colour texture has one over TEXCOORD_0 (the one set of texture coordinates
+    /// written; a transform over another set is named in the warnings when read).
+    pub(crate) fn texture_transforms_carried(&self) -> bool {
+        self.materials
+            .iter()
+            .any(|m| m.texture.is_some() && m.texture_transform.is_some() && m.tex_coord == 0)
     }
 
     /// How many triangles in all.
@@ -647,10 +723,41 @@ mod tests {
                 mag_linear: false,
                 min_linear: false,
                 wrap: [TextureWrap::ClampToEdge, TextureWrap::MirroredRepeat],
+                mipmaps: MipmapFilter::Nearest,
             }
         );
         let smooth = sampler(r#"{"magFilter": 9729, "minFilter": 9987, "wrapS": 10497}"#);
         assert!(smooth.mag_linear && smooth.min_linear);
         assert_eq!(smooth.wrap, [TextureWrap::Repeat; 2]);
+        assert_eq!(smooth.mipmaps, MipmapFilter::Linear);
+        // Each minification filter's mipmaps: none, the nearest level, or two blended.
+        for (filter, mipmaps) in [
+            (9728, MipmapFilter::Off),
+            (9729, MipmapFilter::Off),
+            (9984, MipmapFilter::Nearest),
+            (9985, MipmapFilter::Nearest),
+            (9986, MipmapFilter::Linear),
+            (9987, MipmapFilter::Linear),
+        ] {
+            let read = sampler(&format!(r#"{{"minFilter": {filter}}}"#));
+            assert_eq!(read.mipmaps, mipmaps, "{filter}");
+        }
+    }
+
+    #[test]
+    fn a_texture_transform_is_read_with_its_defaults() {
+        let read = |json: &str| TextureTransform::from_gltf(&serde_json::from_str(json).unwrap());
+        let plain = read("{}").unwrap();
+        assert_eq!(
+            (plain.offset, plain.rotation, plain.scale),
+            ([0.0; 2], 0.0, [1.0; 2])
+        );
+        assert!(read("[1, 2]").is_none());
+        let moved = read(r#"{"offset": [0.25, 0.5], "scale": [2, 3], "rotation": 1}"#).unwrap();
+        assert_eq!(
+            (moved.offset, moved.rotation, moved.scale),
+            ([0.25, 0.5], 1.0, [2.0, 3.0])
+        );
+        assert_eq!(moved.json["scale"], serde_json::json!([2, 3]));
     }
 }

@@ -257,6 +257,15 @@ impl Source {
                 if carried {
                     return None;
                 }
+                if let Some(list) = item.strip_prefix("extensions ") {
+                    let carried = |name: &str| {
+                        name == "KHR_texture_transform"
+                            && format != Format::Obj
+                            && scene.texture_transforms_carried()
+                    };
+                    let left: Vec<&str> = list.split(", ").filter(|n| !carried(n)).collect();
+                    return (!left.is_empty()).then(|| format!("extensions {}", left.join(", ")));
+                }
                 if item.starts_with("the node tree") && format == Format::Obj {
                     return Some(
                         "the node tree's hierarchy and transforms (node names became `o` names and mesh names `g` names; the transforms are baked into the positions)".into(),

@@ -17,6 +17,9 @@ pub struct Sampling {
     pub min_linear: bool,
     /// Along u and v.
     pub wrap: [Wrap; 2],
+    /// Whether a minified texture reads its mipmaps (made on upload, see
+    /// [`crate::render::mipmaps`]), and how it goes between two of them.
+    pub mipmaps: Mipmaps,
 }
 
 impl Default for Sampling {
@@ -25,8 +28,20 @@ impl Default for Sampling {
             mag_linear: true,
             min_linear: true,
             wrap: [Wrap::Repeat; 2],
+            mipmaps: Mipmaps::Linear,
         }
     }
+}
+
+/// A texture's mipmaps as its sampler asks for them.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Mipmaps {
+    /// The full-size texture alone.
+    Off,
+    /// The nearest level.
+    Nearest,
+    /// The two nearest levels, blended.
+    Linear,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -51,7 +66,13 @@ pub struct MaterialLook {
     /// Linear RGBA (glTF baseColorFactor, an MTL's Kd).
     pub base_colour: [f32; 4],
     pub texture: Option<TextureImage>,
+    /// Where the texture is read for texture coordinates (u, v): at the two rows of this 3×3
+    /// matrix times (u, v, 1) (glTF `KHR_texture_transform`; [`UV_IDENTITY`] without one).
+    pub uv_transform: [[f32; 3]; 2],
 }
+
+/// Texture coordinates read as they are.
+pub const UV_IDENTITY: [[f32; 3]; 2] = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0]];
 
 /// A run of [`Appearance::triangles`] drawn with one material.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

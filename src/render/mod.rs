@@ -11,13 +11,14 @@
 
 pub mod appearance;
 pub mod colormap;
+pub mod mipmaps;
 pub mod normals;
 pub mod pipeline;
 pub mod shading;
 
 pub use pipeline::{
-    DrawParams, MeshKey, MeshRenderer, MeshSource, UploadCounts, MAX_HELD_MESHES,
-    SOFTWARE_SINGLE_SAMPLE_FACES,
+    DrawParams, HeldMesh, ImageCounts, MeshKey, MeshRenderer, MeshSource, UploadCounts,
+    MAX_HELD_MESHES, SOFTWARE_SINGLE_SAMPLE_FACES,
 };
 pub use shading::{Lighting, Shading};
 
@@ -120,6 +121,17 @@ impl Viewport3d {
             .unwrap_or_default()
     }
 
+    /// The meshes held on the GPU, the one on screen first, with their bytes and their kept
+    /// images' bytes.
+    pub fn held_list(&self) -> Vec<HeldMesh> {
+        self.with_renderer(|r| r.held_list()).unwrap_or_default()
+    }
+
+    /// Bytes of the held meshes' kept images (their last complete images).
+    pub fn image_bytes(&self) -> u64 {
+        self.with_renderer(|r| r.image_bytes()).unwrap_or(0)
+    }
+
     /// Why the mesh (or its wireframe, when on) is not drawn: too big for this GPU's buffers.
     pub fn problem(&self, wireframe: bool) -> Option<String> {
         self.with_renderer(|r| r.problem(wireframe)).flatten()
@@ -181,6 +193,12 @@ impl Viewport3d {
     /// Offscreen images drawn so far.
     pub fn images_drawn(&self) -> u64 {
         self.with_renderer(|r| r.images_drawn).unwrap_or(0)
+    }
+
+    /// Images drawn, parts of images drawn over several frames, and images shown again from a
+    /// held mesh's kept image, so far.
+    pub fn image_counts(&self) -> ImageCounts {
+        self.with_renderer(|r| r.image_counts()).unwrap_or_default()
     }
 
     /// CPU time of the last offscreen draw (see [`MeshRenderer::last_draw_time`]).

@@ -4,7 +4,8 @@
 //! render pass), `pipeline/buffers.rs` (a mesh's buffers and its wireframe edges),
 //! `pipeline/upload.rs` (the upload thread for big meshes) and `pipeline/held.rs` (meshes kept
 //! on the GPU besides the one on screen, keyed by what they show, so that showing one again
-//! uploads nothing: [`MeshRenderer::show_held`]).
+//! uploads nothing: [`MeshRenderer::show_held`]) and `pipeline/kept.rs` (each held mesh's last
+//! complete image, so that showing it again with an unchanged view draws nothing either).
 //!
 //! Buffers are written only when the mesh changes ([`MeshRenderer::set_mesh`] for new
 //! connectivity, [`MeshRenderer::set_positions`] when only the positions move; both recompute
@@ -20,10 +21,12 @@
 
 mod buffers;
 mod held;
+mod kept;
 mod passes;
 mod upload;
 
-pub use held::{MeshKey, UploadCounts, MAX_HELD_MESHES};
+pub use held::{HeldMesh, MeshKey, UploadCounts, MAX_HELD_MESHES};
+pub use kept::ImageCounts;
 
 use std::sync::Arc;
 use std::time::Duration;
@@ -32,6 +35,7 @@ use super::appearance::Appearance;
 use super::normals::vertex_normals;
 use super::shading::{Lighting, Shading};
 use buffers::MeshBuffers;
+use kept::KeptImage;
 use passes::{MaterialKit, Part, Pipelines, Target, Uniforms};
 use upload::{PendingMesh, UploadJob, Uploaded, Uploader};
 
@@ -151,6 +155,15 @@ pub struct MeshRenderer {
     repaint: Arc<dyn Fn() + Send + Sync>,
     /// Offscreen images drawn so far (for tests and the performance readout).
     pub images_drawn: u64,
+    /// Parts drawn of images drawn over several frames (see [`Self::set_faces_per_frame`]).
+    pub parts_drawn: u64,
+    /// Images shown again from a held mesh's kept image instead of drawn (`pipeline/kept.rs`).
+    pub images_restored: u64,
+    /// The last complete image of each held mesh (and of the one on screen, when it has one).
+    kept: Vec<KeptImage>,
+    /// A mesh that left the screen (its generation) whose complete image, drawn with these
+    /// parameters, is still in the target: the next render copies it into its kept image.
+    keep_request: Option<(u64, DrawParams)>,
     uploader: Option<Uploader>,
     /// Counts [`Self::set_mesh`] calls; an upload that lands for an older one is dropped.
     generation: u64,
@@ -204,6 +217,10 @@ impl MeshRenderer {
             work: None,
             repaint: on_upload_done.clone(),
             images_drawn: 0,
+            parts_drawn: 0,
+            images_restored: 0,
+            kept: Vec::new(),
+            keep_request: None,
             last_draw_time: Duration::ZERO,
             // Without the thread (it failed to start) every upload happens in the calling frame.
             uploader: Uploader::spawn(device.clone(), on_upload_done),
@@ -448,6 +465,8 @@ impl MeshRenderer {
         }
         self.move_serial += 1;
         self.uploads.count_positions(vertex_count);
+        // The mesh is about to move: its kept image shows where it was.
+        kept::forget_image(&mut self.kept, mesh.generation);
         let faces = mesh.index_count as usize / 3;
         if (vertex_count + faces) * 12 >= self.async_upload_bytes {
             if let Some(uploader) = &self.uploader {
@@ -592,11 +611,12 @@ impl MeshRenderer {
         self.progress.is_some()
     }
 
-    /// The image in the target no longer shows the mesh as it is: draw it again, and drop an
-    /// image half drawn from the old buffers.
+    /// The image in the target no longer shows the mesh as it is: draw it again, drop an
+    /// image half drawn from the old buffers, and forget the mesh's kept image.
     fn redraw(&mut self) {
         self.drawn = None;
         self.progress = None;
+        self.forget_current_image();
     }
 
     /// Samples per pixel the newest mesh is drawn with (4, or 1 for a big mesh on a software
@@ -627,7 +647,11 @@ impl MeshRenderer {
         }
         self.target = Some(Target::new(device, size, samples));
         self.target_has_image = false;
-        self.redraw();
+        // The image in the old target is gone (the meshes and their kept images are as they
+        // were: a kept image of this size is shown again).
+        self.drawn = None;
+        self.progress = None;
+        self.keep_request = None;
         true
     }
 
@@ -656,9 +680,19 @@ impl MeshRenderer {
         if wrong_size {
             return false;
         }
+        // The image of the mesh that just left the screen, before anything is drawn over it.
+        self.keep_outgoing_image(device, encoder);
+        self.prune_images();
+        if self.progress.is_none() && self.drawn.as_ref() == Some(params) {
+            return false;
+        }
+        // The mesh's kept image, when it shows exactly this (an image half drawn with older
+        // parameters is dropped for it).
+        if self.drawn.as_ref() != Some(params) && self.restore_kept_image(encoder, params) {
+            return true;
+        }
         let params = match &self.progress {
             Some(progress) => progress.params,
-            None if self.drawn.as_ref() == Some(params) => return false,
             None => *params,
         };
         self.wireframe = params.wireframe;
@@ -758,6 +792,7 @@ impl MeshRenderer {
             &part,
             last,
         );
+        self.parts_drawn += 1;
         let recording = self
             .progress
             .as_ref()

@@ -9,7 +9,7 @@ use crate::io::normals::dvec;
 use crate::io::origin::Origin;
 use crate::io::scene::{
     image_file_name, image_mime_type, Image, ImageData, Material, Part, Primitive, Scene,
-    SceneVertex, TextureSampler,
+    SceneVertex, TextureSampler, TextureTransform,
 };
 use crate::mesh::TriMesh;
 use glam::{DMat3, DMat4};
@@ -186,10 +186,18 @@ impl GltfSource {
                         }
                     }
                 }
-                let texture_entry = pbr
-                    .and_then(|p| p.get("baseColorTexture"))
+                let texture_info = pbr.and_then(|p| p.get("baseColorTexture"));
+                let texture_entry = texture_info
                     .and_then(|t| index(t, "index"))
                     .and_then(|t| self.array("textures").get(t));
+                let transform_json = texture_info
+                    .and_then(|t| t.get("extensions"))
+                    .and_then(|e| e.get("KHR_texture_transform"));
+                let texture_transform = transform_json.and_then(TextureTransform::from_gltf);
+                let tex_coord = transform_json
+                    .and_then(|t| index(t, "texCoord"))
+                    .or_else(|| texture_info.and_then(|t| index(t, "texCoord")))
+                    .unwrap_or(0) as u32;
                 let sampler = texture_entry
                     .and_then(|t| index(t, "sampler"))
                     .and_then(|s| self.array("samplers").get(s))
@@ -218,6 +226,11 @@ impl GltfSource {
                 if pbr.is_some_and(|p| p.get("metallicRoughnessTexture").is_some()) {
                     unkept.push("metallic-roughness map");
                 }
+                if tex_coord != 0 && texture.is_some() {
+                    unkept.push(
+                        "its base colour texture's own texture coordinates (TEXCOORD_0 is kept)",
+                    );
+                }
                 if !unkept.is_empty() {
                     others.push(format!("'{name}': {}", unkept.join(", ")));
                 }
@@ -228,6 +241,8 @@ impl GltfSource {
                     roughness: factor("roughnessFactor"),
                     texture,
                     sampler,
+                    tex_coord,
+                    texture_transform,
                 }
             })
             .collect();

@@ -88,10 +88,13 @@ pub(super) fn older_gltf(bytes: &[u8], path: &Path) -> Option<IoError> {
 
 /// Required extensions fairmesh reads itself (the `gltf` crate, as built here, refuses them):
 /// KHR_mesh_quantization only lets attributes be stored as integers, which the accessor reading
-/// decodes (and the write-back encodes again); the others give a texture an image in another
-/// format (KTX2, WebP, AVIF, DDS), and fairmesh never decodes images: it carries their bytes.
+/// decodes (and the write-back encodes again); KHR_texture_transform places a texture on its
+/// texture coordinates (the editor draws it so, outputs keep it); the others give a texture an
+/// image in another format (KTX2, WebP, AVIF, DDS), and fairmesh never decodes those: it
+/// carries their bytes.
 fn read_here(extension: &str) -> bool {
-    extension == "KHR_mesh_quantization" || IMAGE_FORMATS.contains(&extension)
+    matches!(extension, "KHR_mesh_quantization" | "KHR_texture_transform")
+        || IMAGE_FORMATS.contains(&extension)
 }
 
 /// Texture extensions whose `source` names a texture's image in their format (the texture's own

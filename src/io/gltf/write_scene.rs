@@ -77,6 +77,9 @@ struct Document {
     image_of: HashMap<String, usize>,
     textures: Vec<Value>,
     materials: Vec<Value>,
+    /// Extensions the document uses (`extensionsUsed`): KHR_texture_transform where a base
+    /// colour texture carried one.
+    extensions_used: Vec<&'static str>,
 }
 
 /// Little-endian bytes of float vectors.
@@ -285,6 +288,17 @@ impl Document {
             self.image_of.insert(key, index);
             self.textures.push(json!({ "source": index }));
             pbr["baseColorTexture"] = json!({ "index": self.textures.len() - 1 });
+            // The texture transform as the source had it; only over TEXCOORD_0, the one set of
+            // texture coordinates written (see `Scene::texture_transforms_carried`).
+            if let Some(transform) = material.texture_transform.as_ref() {
+                if material.tex_coord == 0 {
+                    pbr["baseColorTexture"]["extensions"] =
+                        json!({ "KHR_texture_transform": transform.json });
+                    if !self.extensions_used.contains(&"KHR_texture_transform") {
+                        self.extensions_used.push("KHR_texture_transform");
+                    }
+                }
+            }
         }
         let mut out = json!({"name": material.name, "pbrMetallicRoughness": pbr});
         if a.clamp(0.0, 1.0) < 1.0 {
@@ -307,6 +321,9 @@ impl Document {
             "bufferViews": self.views,
             "buffers": [{"byteLength": self.bin.len()}],
         });
+        if !self.extensions_used.is_empty() {
+            root["extensionsUsed"] = json!(self.extensions_used);
+        }
         for (key, list) in [
             ("materials", self.materials),
             ("textures", self.textures),

@@ -25,6 +25,8 @@ pub(super) fn read_materials(
             roughness: 1.0,
             texture: None,
             sampler: Default::default(),
+            tex_coord: 0,
+            texture_transform: None,
         })
         .collect();
     if names.is_empty() {

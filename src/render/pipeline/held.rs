@@ -10,7 +10,7 @@
 //! goes first.
 
 use super::buffers::MeshBuffers;
-use super::{MeshRenderer, MeshSource};
+use super::{DrawParams, MeshRenderer, MeshSource};
 use egui_wgpu::wgpu;
 use std::sync::Arc;
 
@@ -24,6 +24,20 @@ pub const MAX_HELD_MESHES: usize = 3;
 pub struct MeshKey {
     pub family: u64,
     pub version: u64,
+}
+
+/// A mesh a renderer holds on the GPU ([`MeshRenderer::held_list`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct HeldMesh {
+    /// What the caller said it shows (`None`: a mesh given without a key, not held once
+    /// another is shown).
+    pub key: Option<MeshKey>,
+    /// Bytes of its buffers.
+    pub bytes: u64,
+    /// Bytes of its kept image (its last complete image; 0 without one).
+    pub image_bytes: u64,
+    /// It is the mesh on screen.
+    pub on_screen: bool,
 }
 
 /// What a renderer has written to the GPU: whole meshes and bytes of any kind (positions,
@@ -112,6 +126,7 @@ impl MeshRenderer {
     /// Keeps only the held meshes whose key `keep` accepts (the one on screen stays).
     pub fn retain_held(&mut self, keep: impl Fn(MeshKey) -> bool) {
         self.held.retain(|m| m.key.is_some_and(&keep));
+        self.prune_images();
     }
 
     /// Bytes of GPU memory the meshes take: the one on screen and the held ones.
@@ -125,9 +140,25 @@ impl MeshRenderer {
         self.held.len() + usize::from(self.mesh.is_some())
     }
 
+    /// The meshes held on the GPU, the one on screen first, with their bytes and their kept
+    /// images' bytes.
+    pub fn held_list(&self) -> Vec<HeldMesh> {
+        let entry = |mesh: &MeshBuffers, on_screen| HeldMesh {
+            key: mesh.key,
+            bytes: mesh.gpu_bytes(),
+            image_bytes: self.image_bytes_of(mesh.generation),
+            on_screen,
+        };
+        let current = self.mesh.iter().map(|m| entry(m, true));
+        current
+            .chain(self.held.iter().map(|m| entry(m, false)))
+            .collect()
+    }
+
     /// Puts `mesh` on screen; the mesh there is held unless it is of `mesh`'s family (replaced)
     /// or has no key, or its new positions are still on their way (its buffers do not show
-    /// its key's version yet).
+    /// its key's version yet). A held mesh keeps the complete image of it the target holds
+    /// (`kept.rs`); `mesh`'s own kept image, if any, is shown again when the view is unchanged.
     pub(super) fn replace_current(&mut self, mesh: MeshBuffers) {
         let moving = self.pending_move.take().is_some();
         self.move_scalars = None;
@@ -136,15 +167,26 @@ impl MeshRenderer {
         self.lines_failed = false;
         self.problem = None;
         self.newest_faces = mesh.index_count as usize / 3;
+        // The target's complete image shows the mesh leaving (an image half drawn is dropped).
+        let image = self.drawn.take();
+        self.progress = None;
         let family = mesh.key.map(|k| k.family);
+        let generation = mesh.generation;
         if let Some(old) = self.mesh.replace(mesh) {
             let old_family = old.key.map(|k| k.family);
             if !moving && old_family.is_some() && old_family != family {
+                // An image drawn with the wireframe on before its edges were built lacks them.
+                let complete = |p: &DrawParams| !p.wireframe || old.lines.is_some();
+                if let Some(params) = image.filter(complete) {
+                    self.keep_image_of(old.generation, params);
+                }
                 self.held.insert(0, old);
             }
         }
         self.held.truncate(MAX_HELD_MESHES - 1);
-        self.redraw();
+        // Back before anything was drawn since it left: its image is still in the target.
+        self.drawn = self.image_still_in_target(generation);
+        self.prune_images();
     }
 
     /// Drops the held mesh of `key`'s family: a new version replaces it.
@@ -160,5 +202,6 @@ impl MeshRenderer {
             self.held
                 .retain(|m| m.key.is_none_or(|k| k.family != key.family));
         }
+        self.prune_images();
     }
 }

@@ -8,7 +8,12 @@ use std::ops::Range;
 
 use super::buffers::MeshBuffers;
 use super::{DrawParams, COLOR_FORMAT, DEPTH_FORMAT};
-use crate::render::appearance::{Batch, MaterialLook, Sampling, TextureImage, Wrap};
+use std::borrow::Cow;
+
+use crate::render::appearance::{
+    Batch, MaterialLook, Mipmaps, Sampling, TextureImage, Wrap, UV_IDENTITY,
+};
+use crate::render::mipmaps::mip_chain;
 use crate::render::shading::{Lighting, Shading};
 
 #[repr(C)]
@@ -169,9 +174,45 @@ impl Target {
 
     /// Records copying this target's image into `other`'s (the same size).
     pub(super) fn copy_image_to(&self, encoder: &mut wgpu::CommandEncoder, other: &Target) {
+        self.copy_image_into(encoder, &other.resolved_texture);
+    }
+
+    /// A texture that can hold this target's image (a held mesh's kept image).
+    pub(super) fn image_texture(&self, device: &wgpu::Device) -> wgpu::Texture {
+        device.create_texture(&wgpu::TextureDescriptor {
+            label: Some("fairmesh kept image"),
+            size: self.resolved_texture.size(),
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format: COLOR_FORMAT,
+            usage: wgpu::TextureUsages::COPY_SRC | wgpu::TextureUsages::COPY_DST,
+            view_formats: &[],
+        })
+    }
+
+    /// Records copying this target's image into `texture` (of [`Self::image_texture`]).
+    pub(super) fn copy_image_into(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        texture: &wgpu::Texture,
+    ) {
         encoder.copy_texture_to_texture(
             self.resolved_texture.as_image_copy(),
-            other.resolved_texture.as_image_copy(),
+            texture.as_image_copy(),
+            self.resolved_texture.size(),
+        );
+    }
+
+    /// Records copying `texture` (of [`Self::image_texture`]) into this target's image.
+    pub(super) fn copy_image_from(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        texture: &wgpu::Texture,
+    ) {
+        encoder.copy_texture_to_texture(
+            texture.as_image_copy(),
+            self.resolved_texture.as_image_copy(),
             self.resolved_texture.size(),
         );
     }
@@ -232,12 +273,15 @@ pub(super) struct MaterialKit {
     pub(super) plain: Option<wgpu::BindGroup>,
 }
 
-/// A material's uniform: its base colour factor and whether it has a texture (x of `flags`).
+/// A material's uniform: its base colour factor, whether it has a texture (x of `flags`), and
+/// the texture transform's two rows (xyz of `uv_u` and `uv_v`, times (u, v, 1)).
 #[repr(C)]
 #[derive(Clone, Copy, Pod, Zeroable)]
 struct MaterialUniform {
     base_colour: [f32; 4],
     flags: [f32; 4],
+    uv_u: [f32; 4],
+    uv_v: [f32; 4],
 }
 
 impl MaterialKit {
@@ -279,8 +323,9 @@ impl MaterialKit {
         }
     }
 
-    /// The bind group of `material` (`None`: no material, white): its base colour factor, its
-    /// texture uploaded (sRGB) with its sampler's filters and wrapping, or a white texel.
+    /// The bind group of `material` (`None`: no material, white): its base colour factor and
+    /// texture transform, its texture uploaded (sRGB, with its mipmaps unless its sampler
+    /// wants none) with its sampler's filters and wrapping, or a white texel.
     pub(super) fn group(
         &self,
         device: &wgpu::Device,
@@ -296,34 +341,55 @@ impl MaterialKit {
         };
         let texture = material.and_then(|m| m.texture.as_ref());
         let image = texture.unwrap_or(&white);
+        let [uv_u, uv_v] = material.map_or(UV_IDENTITY, |m| m.uv_transform);
         let uniform = MaterialUniform {
             base_colour: material.map_or([1.0; 4], |m| m.base_colour),
             flags: [f32::from(u8::from(texture.is_some())), 0.0, 0.0, 0.0],
+            uv_u: [uv_u[0], uv_u[1], uv_u[2], 0.0],
+            uv_v: [uv_v[0], uv_v[1], uv_v[2], 0.0],
         };
         let buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("fairmesh material"),
             contents: bytemuck::bytes_of(&uniform),
             usage: wgpu::BufferUsages::UNIFORM,
         });
-        let texture = device.create_texture_with_data(
-            queue,
-            &wgpu::TextureDescriptor {
-                label: Some("fairmesh base colour"),
-                size: wgpu::Extent3d {
-                    width: image.width,
-                    height: image.height,
+        let sampling = image.sampling;
+        let levels = texture_levels(image, device.limits().max_texture_dimension_2d);
+        let texture = device.create_texture(&wgpu::TextureDescriptor {
+            label: Some("fairmesh base colour"),
+            size: wgpu::Extent3d {
+                width: levels[0].0,
+                height: levels[0].1,
+                depth_or_array_layers: 1,
+            },
+            mip_level_count: levels.len() as u32,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format: wgpu::TextureFormat::Rgba8UnormSrgb,
+            usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
+            view_formats: &[],
+        });
+        for (level, (width, height, rgba)) in levels.iter().enumerate() {
+            queue.write_texture(
+                wgpu::TexelCopyTextureInfo {
+                    texture: &texture,
+                    mip_level: level as u32,
+                    origin: wgpu::Origin3d::ZERO,
+                    aspect: wgpu::TextureAspect::All,
+                },
+                rgba,
+                wgpu::TexelCopyBufferLayout {
+                    offset: 0,
+                    bytes_per_row: Some(width * 4),
+                    rows_per_image: Some(*height),
+                },
+                wgpu::Extent3d {
+                    width: *width,
+                    height: *height,
                     depth_or_array_layers: 1,
                 },
-                mip_level_count: 1,
-                sample_count: 1,
-                dimension: wgpu::TextureDimension::D2,
-                format: wgpu::TextureFormat::Rgba8UnormSrgb,
-                usage: wgpu::TextureUsages::TEXTURE_BINDING,
-                view_formats: &[],
-            },
-            wgpu::util::TextureDataOrder::LayerMajor,
-            &image.rgba,
-        );
+            );
+        }
         let filter = |linear| match linear {
             true => wgpu::FilterMode::Linear,
             false => wgpu::FilterMode::Nearest,
@@ -333,13 +399,16 @@ impl MaterialKit {
             Wrap::MirroredRepeat => wgpu::AddressMode::MirrorRepeat,
             Wrap::ClampToEdge => wgpu::AddressMode::ClampToEdge,
         };
-        let sampling = image.sampling;
         let sampler = device.create_sampler(&wgpu::SamplerDescriptor {
             label: Some("fairmesh base colour"),
             address_mode_u: address(sampling.wrap[0]),
             address_mode_v: address(sampling.wrap[1]),
             mag_filter: filter(sampling.mag_linear),
             min_filter: filter(sampling.min_linear),
+            mipmap_filter: match sampling.mipmaps {
+                Mipmaps::Linear => wgpu::MipmapFilterMode::Linear,
+                Mipmaps::Nearest | Mipmaps::Off => wgpu::MipmapFilterMode::Nearest,
+            },
             ..Default::default()
         });
         let view = texture.create_view(&Default::default());
@@ -362,6 +431,33 @@ impl MaterialKit {
             ],
         })
     }
+}
+
+/// The levels a texture is uploaded with (width, height, sRGB RGBA rows): the image and its
+/// mipmaps, or the image alone when its sampler wants none; levels wider or taller than the
+/// device allows (`max_side`) are left out, so a too-big texture shows at the largest size the
+/// GPU takes.
+fn texture_levels(image: &TextureImage, max_side: u32) -> Vec<(u32, u32, Cow<'_, [u8]>)> {
+    let fits = |w: u32, h: u32| w <= max_side && h <= max_side;
+    let wanted = image.sampling.mipmaps != Mipmaps::Off;
+    let mut levels = vec![(image.width, image.height, Cow::Borrowed(&image.rgba[..]))];
+    if wanted || !fits(image.width, image.height) {
+        let chain = mip_chain(image.width, image.height, &image.rgba);
+        levels.extend(
+            chain
+                .into_iter()
+                .map(|l| (l.width, l.height, Cow::Owned(l.rgba))),
+        );
+    }
+    let first = levels
+        .iter()
+        .position(|(w, h, _)| fits(*w, *h))
+        .unwrap_or(levels.len() - 1);
+    levels.drain(..first);
+    if !wanted {
+        levels.truncate(1);
+    }
+    levels
 }
 
 /// The pipelines and their uniforms, made once per renderer.
@@ -689,4 +785,47 @@ fn line_pipeline(
         multiview_mask: None,
         cache: None,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn image(width: u32, height: u32, mipmaps: Mipmaps) -> TextureImage {
+        TextureImage {
+            width,
+            height,
+            rgba: vec![128; (width * height * 4) as usize],
+            sampling: Sampling {
+                mipmaps,
+                ..Sampling::default()
+            },
+        }
+    }
+
+    fn sizes(levels: &[(u32, u32, Cow<'_, [u8]>)]) -> Vec<(u32, u32)> {
+        levels.iter().map(|(w, h, _)| (*w, *h)).collect()
+    }
+
+    #[test]
+    fn a_texture_is_uploaded_with_its_mipmaps_unless_its_sampler_wants_none() {
+        let mipmapped = image(8, 4, Mipmaps::Linear);
+        let all = [(8, 4), (4, 2), (2, 1), (1, 1)];
+        assert_eq!(sizes(&texture_levels(&mipmapped, 8192)), all);
+        let nearest = image(8, 4, Mipmaps::Nearest);
+        assert_eq!(sizes(&texture_levels(&nearest, 8192)), all);
+        let alone = image(8, 4, Mipmaps::Off);
+        assert_eq!(sizes(&texture_levels(&alone, 8192)), [(8, 4)]);
+    }
+
+    #[test]
+    fn a_texture_too_big_for_the_gpu_starts_at_the_largest_level_that_fits() {
+        let mipmapped = image(8, 4, Mipmaps::Linear);
+        assert_eq!(
+            sizes(&texture_levels(&mipmapped, 4)),
+            [(4, 2), (2, 1), (1, 1)]
+        );
+        let alone = image(8, 4, Mipmaps::Off);
+        assert_eq!(sizes(&texture_levels(&alone, 2)), [(2, 1)]);
+    }
 }
