@@ -2,6 +2,7 @@
 
 import _thread
 import hashlib
+import signal
 import threading
 import time
 
@@ -140,6 +141,16 @@ def test_fair_reports_every_round_and_stops_when_told(bunny, noisy):
 
 
 def test_ctrl_c_stops_a_long_fair(bunny, noisy):
+    # A process started in the background (`cmd &`, some CI runners) inherits SIGINT ignored, and
+    # Python then ignores Ctrl+C and `interrupt_main` alike; the test needs Python's own handler.
+    previous = signal.signal(signal.SIGINT, signal.default_int_handler)
+    try:
+        _ctrl_c_stops_a_long_fair(bunny, noisy)
+    finally:
+        signal.signal(signal.SIGINT, previous)
+
+
+def _ctrl_c_stops_a_long_fair(bunny, noisy):
     quick = time.perf_counter()
     fairmesh.fair(noisy, bunny.faces, rounds=20)
     per_round = (time.perf_counter() - quick) / 20
