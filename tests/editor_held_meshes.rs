@@ -97,14 +97,20 @@ fn gpu_shows_the_newest_result(harness: &Harness) {
     assert_eq!(off, 0, "normals of another result on the GPU");
 }
 
+/// Once the editor has settled, shows the faired mesh, then the input mesh, each drawn whole:
+/// both are then held. Their images, in that order.
+fn faired_then_input(harness: &mut Harness) -> (image::RgbaImage, image::RgbaImage) {
+    settle(harness);
+    show(harness, "Faired");
+    let faired = viewport_image(harness);
+    show(harness, "Input mesh");
+    (faired, viewport_image(harness))
+}
+
 #[test]
 fn switching_back_to_a_held_mesh_uploads_nothing_and_shows_the_same_picture() {
     let mut harness = harness_for(bunny());
-    settle(&mut harness);
-    show(&mut harness, "Faired");
-    let faired = viewport_image(&mut harness);
-    show(&mut harness, "Input mesh");
-    let input = viewport_image(&mut harness);
+    let (faired, input) = faired_then_input(&mut harness);
     assert!(
         differing_pixels(&faired, &input) > 1_000,
         "the input mesh looks different from the faired one"
@@ -193,11 +199,7 @@ fn a_new_result_replaces_the_held_one() {
 #[test]
 fn a_held_mesh_comes_back_in_one_frame_while_the_view_is_unchanged() {
     let mut harness = harness_for(bunny());
-    settle(&mut harness);
-    show(&mut harness, "Faired");
-    let faired = viewport_image(&mut harness);
-    show(&mut harness, "Input mesh");
-    let input = viewport_image(&mut harness);
+    let (faired, input) = faired_then_input(&mut harness);
     let uploaded = uploads(&harness);
 
     // Back to the result: its last image, in the frame of the click, nothing drawn.
@@ -265,11 +267,7 @@ fn a_held_mesh_comes_back_in_one_frame_while_the_view_is_unchanged() {
 fn the_performance_section_lists_the_held_meshes() {
     use fairmesh::app::panels::tips;
     let mut harness = editor_common::harness_sized(bunny(), egui::vec2(1200.0, 1800.0));
-    settle(&mut harness);
-    show(&mut harness, "Faired");
-    viewport_image(&mut harness);
-    show(&mut harness, "Input mesh");
-    viewport_image(&mut harness);
+    faired_then_input(&mut harness);
     harness.get_by_label("Performance").click();
     settle(&mut harness);
     harness.get_by_label("Input mesh (shown)");
