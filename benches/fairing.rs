@@ -1,8 +1,10 @@
-//! Criterion benchmarks of one fairing iteration: constrained (both variants) and Laplacian, on
+//! Criterion benchmarks of one fairing iteration: constrained (both variants) and Laplacian, and
+//! of the tangential relaxation's shares set before every round of the default, on
 //! `assets/bunny00.obj` (75k faces) and on it Loop-subdivided twice (1.2M faces) with noise.
 //! Run: `cargo bench --no-default-features --bench fairing`.
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion};
+use fairmesh::fairing::relaxation::Slivers;
 use fairmesh::fairing::{baseline::UmbrellaStencil, BoundaryMode, ConstrainedFairing, FairVariant};
 use fairmesh::noise::{add_noise, NoiseOptions};
 use fairmesh::{Topology, TriMesh};
@@ -33,6 +35,14 @@ fn fairing_iteration(c: &mut Criterion) {
                 BenchmarkId::new(format!("constrained_{}", variant.name()), name),
                 |b| b.iter(|| black_box(fairing.step())),
             );
+            if variant == FairVariant::NormalProjected {
+                // The shares of the default's later rounds: the relaxation only at thin
+                // triangles (every one, as with creases).
+                fairing.load(&positions);
+                group.bench_function(BenchmarkId::new("relax_where_needed", name), |b| {
+                    b.iter(|| fairing.relax_where_needed(black_box(0.0), Slivers::All))
+                });
+            }
         }
         let stencil = UmbrellaStencil::new(&topology, BoundaryMode::Curve);
         let positions = mesh.positions.clone();

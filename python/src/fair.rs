@@ -135,6 +135,7 @@ fn report_dict<'py>(
     phases.set_item("set_up", report.phases.set_up)?;
     phases.set_item("iterations", report.phases.iterations)?;
     phases.set_item("volume", report.phases.volume)?;
+    phases.set_item("relaxation", report.phases.relaxation)?;
     phases.set_item("risk", report.phases.risk)?;
     dict.set_item("phases_ms", phases)?;
     dict.set_item("risk_by_round", report.risk_by_round.clone())?;

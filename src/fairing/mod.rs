@@ -308,6 +308,9 @@ pub struct FairPhases {
     pub iterations: f64,
     /// The volume correction after every round.
     pub volume: f64,
+    /// The tangential relaxation's shares: reading the noise along the surface, and before
+    /// every round the pass that finds the thin triangles.
+    pub relaxation: f64,
     /// Automatic strength: the risk estimate (its copy's iterations, its reading, keeping the
     /// best round's positions).
     pub risk: f64,

@@ -111,8 +111,10 @@ impl RoundLoop<'_> {
         let mut iterations_ms = milliseconds(started);
         let fans = self.fans.as_ref();
         let at = (&*mesh, topology);
+        let started = std::time::Instant::now();
         self.relaxation
-            .before_round(&mut self.fairing, round, at, fans, report);
+            .before_round(&mut self.fairing, round, at, fans);
+        report.phases.relaxation += milliseconds(started);
         let started = std::time::Instant::now();
         let iterations = self.fairing.run_round(self.options, report);
         let step = self.step(round);
@@ -256,24 +258,21 @@ impl RelaxationPlan {
     /// Gives `fairing` (loaded with the positions round `round` starts from) its shares. Once
     /// the noise along the surface is gone (the mesh reads as even as a relaxed one), the
     /// relaxation keeps to the thin triangles ([`relaxation::still_needed_share`]), read with
-    /// `fans` (the time counted in `report`).
+    /// `fans`.
     pub(super) fn before_round(
         &mut self,
         fairing: &mut ConstrainedFairing,
         round: usize,
         (mesh, topology): (&TriMesh, &Topology),
         fans: Option<&FanRings>,
-        report: &mut FairReport,
     ) {
         let Some(share) = &mut self.everywhere else {
             return;
         };
         if round > 0 && *share > 0.0 {
             if let Some(fans) = fans {
-                let started = std::time::Instant::now();
                 let reading = read_tangential_noise(mesh, topology, fans);
                 *share = share.min(relaxation::still_needed_share(reading));
-                report.detection_ms += milliseconds(started);
             }
         }
         // From the mesh's state: the risk's copy is faired with the same shares.

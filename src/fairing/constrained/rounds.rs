@@ -433,12 +433,13 @@ fn fair_rounds(
         .keep_volume
         .then(|| VolumeKeeper::new(mesh, topology, pinned));
     let mut report = FairReport {
-        detection_ms: first_detection_ms + reading_ms,
+        detection_ms: first_detection_ms,
         tangential_noise: relaxation.tangential_noise,
         ..FairReport::default()
     };
     report.phases.volume = milliseconds(started);
     report.phases.set_up = set_up_ms;
+    report.phases.relaxation = reading_ms;
     let started = std::time::Instant::now();
     let judge = auto_noise.map(|noise| RiskJudge::new(mesh, topology, noise, creases.as_ref()));
     report.phases.risk = milliseconds(started);
@@ -661,6 +662,16 @@ mod tests {
             assert_eq!(*after, moved(before));
         }
         assert_eq!(faired.triangles, mesh.triangles);
+    }
+
+    #[test]
+    fn the_report_times_the_relaxations_shares_apart() {
+        let mut noisy = irregular_sphere();
+        crate::noise::add_noise(&mut noisy, &crate::noise::NoiseOptions::default());
+        let topology = Topology::build(&noisy);
+        let report = fair_constrained(&mut noisy, &topology, &FairOptions::default());
+        assert!(report.rounds_run > 0, "the noisy sphere is faired");
+        assert!(report.phases.relaxation > 0.0, "{:?}", report.phases);
     }
 
     #[test]
