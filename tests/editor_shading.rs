@@ -1,8 +1,9 @@
 //! Headless tests of the View section's Shading (Flat / Smooth) and "Studio lighting":
 //! the controls are there and explain themselves, choosing one changes the setting, the draw
 //! parameters and the image, smooth shading draws with the area-weighted vertex normals of the
-//! mesh on screen (read back from the GPU buffer), the heat map is lit in every view, and the
-//! S key switches between Flat and Smooth.
+//! mesh on screen (read back from the GPU buffer) and keeps a CAD part's sharp edges crisp
+//! (its flat sides lit as Flat lights them, its round holes smooth), the heat map is lit in
+//! every view, and the S key switches between Flat and Smooth.
 #![cfg(feature = "gui")]
 
 use egui_kittest::kittest::{NodeT, Queryable};
@@ -11,7 +12,7 @@ mod editor_common;
 use editor_common::{bunny, harness_for, settle, viewport_image};
 use fairmesh::app::view_panel::{tips, STUDIO_LIGHTING};
 use fairmesh::app::{App, Slot};
-use fairmesh::render::normals::vertex_normals;
+use fairmesh::render::normals::{vertex_normals, SHARP_EDGE_ANGLE};
 use fairmesh::render::{Lighting, Shading};
 
 type Harness = egui_kittest::Harness<'static, App>;
@@ -131,6 +132,78 @@ fn the_viewport_uploads_the_meshs_vertex_normals() {
         bent * 2 > uploaded.len(),
         "{bent} of {} vertex normals differ from a face normal",
         uploaded.len()
+    );
+}
+
+/// A CAD part as exporters write it (every vertex on a rim, sides fanned from slivers), from an
+/// OBJ without normals, in Smooth shading: each corner of a flat side is lit with the side's own
+/// normal (before, every vertex's normal averaged the sides meeting there and the part shaded
+/// like a soft blob), while the holes' round walls stay smooth; so the picture is the Flat one
+/// except on those walls.
+#[test]
+fn smooth_shading_keeps_a_cad_parts_edges_crisp() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("box_with_holes.obj");
+    let part = fairmesh::mesh::shapes::cad_box_with_holes([4.0, 3.0, 2.0], 0.2, 0.5, 16);
+    fairmesh::io::save(&path, &part).unwrap();
+    assert!(!std::fs::read_to_string(&path).unwrap().contains("vn "));
+    let mut harness = harness_for(path);
+    settle(&mut harness);
+    click_and_settle(&mut harness, "Input mesh");
+    assert_eq!(harness.state().settings().shading, Shading::Smooth);
+    let angle = format!("more than {}°", SHARP_EDGE_ANGLE);
+    assert!(tips::SMOOTH.contains(&angle), "the tip names the angle");
+
+    let mesh = harness.state().document_mesh().unwrap();
+    let corners = harness
+        .state()
+        .uploaded_corner_normals(Slot::Main)
+        .expect("the main viewport has a mesh");
+    assert_eq!(corners.len(), mesh.triangles.len());
+    let (mut flat_corners, mut round_corners) = (0, 0);
+    for (drawn, t) in corners.iter().zip(0..) {
+        assert_eq!(drawn.vertices, mesh.triangles[t]);
+        let face = mesh.face_normal(t).normalize().as_vec3();
+        // The holes' walls have every corner on a hole (halfway up the part, within the
+        // radius); every other triangle lies in a flat side, floor, base or rim.
+        let on_hole = |v: u32| (0.4..1.6).contains(&mesh.positions[v as usize][2]);
+        let flat = !mesh.triangles[t].iter().all(|&v| on_hole(v));
+        for normal in drawn.normals {
+            let off = face
+                .angle_between(glam::Vec3::from_array(normal))
+                .to_degrees();
+            if flat {
+                flat_corners += 1;
+                assert!(off < 0.01, "triangle {t}: {off}° off its side's normal");
+            } else if off > 5.0 {
+                round_corners += 1;
+            }
+        }
+    }
+    assert!(flat_corners > 300, "{flat_corners}");
+    // A wall's corners lean halfway to the next wall (11.25° for 16 sides).
+    assert!(round_corners > 300, "{round_corners}");
+
+    let smooth = viewport_image(&mut harness);
+    egui_kittest::image_snapshot_options(
+        &smooth,
+        "viewport_cad_part_smooth",
+        &egui_kittest::SnapshotOptions::new()
+            .threshold(2.0)
+            .max_failed_pixels(2500),
+    );
+    click_and_settle(&mut harness, "Flat");
+    let flat = viewport_image(&mut harness);
+    let background = *flat.get_pixel(3, flat.height() / 2);
+    let part_pixels = flat.pixels().filter(|p| **p != background).count();
+    let unlike = smooth
+        .pixels()
+        .zip(flat.pixels())
+        .filter(|(a, b)| (0..3).any(|i| a[i].abs_diff(b[i]) > 6))
+        .count();
+    assert!(
+        unlike * 10 < part_pixels,
+        "{unlike} of the part's {part_pixels} pixels differ between Smooth and Flat"
     );
 }
 

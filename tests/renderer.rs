@@ -2,7 +2,8 @@
 //! llvmpipe, as in the editor tests): the newest mesh wins over uploads still in flight, and an
 //! upload that panics inside the upload thread leaves a notice and a working renderer, not a
 //! mesh that never arrives; the vertex normals smooth shading is drawn with are the ones of the
-//! positions on screen, whether computed in the frame or on the upload thread.
+//! positions on screen, whether computed in the frame or on the upload thread, and a move that
+//! makes an edge sharp splits them there.
 #![cfg(feature = "gui")]
 
 use std::sync::atomic::{AtomicUsize, Ordering};
@@ -69,6 +70,20 @@ impl Grid {
         for p in &mut grid.positions {
             let (dx, dy) = (p[0] - centre, p[1] - centre);
             p[2] = -(dx * dx + dy * dy) / n as f32;
+        }
+        grid
+    }
+}
+
+impl Grid {
+    /// The grid folded up by 90° along its middle column: the half beyond it stands upright.
+    fn folded(n: u32) -> Self {
+        let mut grid = Self::new(n);
+        let middle = (n / 2) as f32;
+        for p in &mut grid.positions {
+            if p[0] > middle {
+                *p = [middle, p[1], p[0] - middle];
+            }
         }
         grid
     }
@@ -188,6 +203,54 @@ fn uploaded_normals_follow_the_positions_on_screen() {
         assert!(moved[0][2] < 0.95 && moved[0][0] < 0.0 && moved[0][1] < 0.0);
         let centre = (n / 2 * (n + 1) + n / 2) as usize;
         assert!(moved[centre][2] > 0.999);
+    }
+}
+
+/// A move that folds the flat grid sharply splits the shading at the fold: each side is lit with
+/// its own normal up to the fold, so the mesh gets buffers with one more draw vertex per fold
+/// vertex, in the frame and on the upload thread; unfolded again, it is drawn over its own
+/// vertices with their normals, as before. It stays the same mesh throughout (moves, not new
+/// meshes), and takes heat-map values per mesh vertex as ever.
+#[test]
+fn a_move_that_folds_the_mesh_splits_its_shading_at_the_fold() {
+    let (device, queue) = device();
+    let mut renderer = MeshRenderer::new(&device, Arc::new(|| {}));
+    let n = 8;
+    let count = ((n + 1) * (n + 1)) as usize;
+    for async_bytes in [usize::MAX, 0] {
+        renderer.set_async_upload_bytes(async_bytes);
+        renderer.set_mesh(&device, Arc::new(Grid::new(n)));
+        wait_for_uploads(&mut renderer, &queue);
+        let meshes = renderer.uploads.meshes;
+        let folded = Grid::folded(n);
+        assert!(renderer.set_positions(&queue, Arc::new(Grid::folded(n))));
+        assert!(renderer.set_scalars(&queue, &vec![0.5; count]));
+        wait_for_uploads(&mut renderer, &queue);
+        let normals = renderer.read_back_normals(&device, &queue).unwrap();
+        assert_eq!(normals.len(), count + (n + 1) as usize);
+        let corners = renderer.read_back_corner_normals(&device, &queue).unwrap();
+        assert_eq!(corners.len(), folded.triangles.len());
+        for (drawn, t) in corners.iter().zip(&folded.triangles) {
+            assert_eq!(drawn.vertices, *t);
+            let [a, b, c] = t.map(|v| glam::Vec3::from_array(folded.positions[v as usize]));
+            let face = (b - a).cross(c - a).normalize();
+            for normal in drawn.normals {
+                let off = (glam::Vec3::from_array(normal) - face).length();
+                assert!(off < 1e-5, "{t:?}: {normal:?} against {face}");
+            }
+        }
+        assert!(renderer.set_positions(&queue, Arc::new(Grid::new(n))));
+        wait_for_uploads(&mut renderer, &queue);
+        let flat = renderer.read_back_normals(&device, &queue).unwrap();
+        assert_eq!(flat.len(), count);
+        assert!(flat.iter().all(|n| *n == [0.0, 0.0, 1.0]));
+        assert_eq!(
+            renderer.uploads.meshes,
+            meshes,
+            "async: {}",
+            async_bytes == 0
+        );
+        assert!(renderer.set_scalars(&queue, &vec![0.5; count]));
     }
 }
 

@@ -253,7 +253,9 @@ fn triangle_normal(positions: &[[f32; 3]], t: &[u32; 3]) -> Vec3 {
     (corner(t[1]) - corner(t[0])).cross(corner(t[2]) - corner(t[0]))
 }
 
-/// Area-weighted vertex normals of the `candidates` only, in their order.
+/// Area-weighted vertex normals of the `candidates` only, in their order. One per vertex, never
+/// split at a sharp edge as smooth shading's are (`render::normals`): a vertex has one mask
+/// weight, so a vertex on a rim faces the eye or not by the mean of the sides that meet there.
 fn vertex_normals(
     positions: &[[f32; 3]],
     triangles: &[[u32; 3]],

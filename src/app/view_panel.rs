@@ -16,7 +16,9 @@ pub mod tips {
         it is. Use it to judge the triangles themselves. S switches between Flat and Smooth";
     pub const SMOOTH: &str = "Blend the light across triangles from normals at the corners: \
         the surface looks as a render would show it. Bumps that remain show as wobbly \
-        highlights. S switches between Flat and Smooth";
+        highlights. Sharp edges stay crisp: where two faces meet at more than 80° (the rim \
+        of a machined part, the edge of a box) each side keeps its own light. S switches \
+        between Flat and Smooth";
     pub const STUDIO: &str = "On: a warm key light, a cool fill light and a rim light along \
         the outline, with a soft highlight: uneven spots show as kinks in the highlight. Off: \
         one plain light from above left of you";

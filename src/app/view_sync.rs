@@ -13,7 +13,7 @@ use crate::app::state::{
 use crate::app::App;
 use crate::hierarchy;
 use crate::render::appearance::Appearance;
-use crate::render::{DrawParams, MeshSource, Viewport3d};
+use crate::render::{CornerNormals, DrawParams, MeshSource, Viewport3d};
 use crate::TriMesh;
 
 /// How one viewport's image is coloured, apart from the camera and the settings: the heat map's
@@ -450,14 +450,25 @@ impl App {
         Some(self.draw_params(self.viewport_rect?, Slot::Main))
     }
 
-    /// The vertex normals uploaded to a viewport's GPU buffer for the mesh it shows (tests;
-    /// waits for the GPU).
+    /// The vertex normals uploaded to a viewport's GPU buffer for the mesh it shows, one per
+    /// draw vertex (the mesh's vertices unless the file's appearance or a split at sharp edges
+    /// gives others; tests; waits for the GPU).
     pub fn uploaded_normals(&self, slot: Slot) -> Option<Vec<[f32; 3]>> {
         match slot {
             Slot::Main => self.viewport.as_ref(),
             Slot::Before => self.viewport_before.as_ref(),
         }?
         .read_back_normals()
+    }
+
+    /// Each drawn triangle's mesh vertices and the normals its corners are lit with in smooth
+    /// shading, read back from a viewport's GPU buffer (tests; waits for the GPU).
+    pub fn uploaded_corner_normals(&self, slot: Slot) -> Option<Vec<CornerNormals>> {
+        match slot {
+            Slot::Main => self.viewport.as_ref(),
+            Slot::Before => self.viewport_before.as_ref(),
+        }?
+        .read_back_corner_normals()
     }
 
     pub(super) fn draw_params(&self, rect: egui::Rect, slot: Slot) -> DrawParams {

@@ -9,6 +9,15 @@
 //! normal, heat-map value and mask weight it takes: so a moved (faired) mesh carries its
 //! texture with it, as the file's texture coordinates say, and smooth shading stays smooth
 //! across a seam.
+//!
+//! Where smooth shading splits at a sharp edge ([`crate::render::normals`]), the draw vertices
+//! split further, one per file vertex and smoothing group ([`Appearance::split_for_shading`]):
+//! the same kind of draw vertices, standing on mesh vertices, so positions, heat-map values and
+//! mask weights reach them the same way. A mesh with no appearance gets a plain one for that.
+
+use std::sync::Arc;
+
+use super::normals::SharpSplit;
 
 /// How a texture's texels are filtered and wrapped.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -97,7 +106,8 @@ pub struct Appearance {
     /// Runs of the triangles (the draw triangles, or the mesh's) by material, in order, covering
     /// them all.
     pub batches: Vec<Batch>,
-    pub materials: Vec<MaterialLook>,
+    /// Shared: a split for shading ([`Self::split_for_shading`]) draws the same materials.
+    pub materials: Arc<[MaterialLook]>,
 }
 
 impl Appearance {
@@ -127,4 +137,89 @@ impl Appearance {
             None => values.to_vec(),
         }
     }
+
+    /// The draw vertices of `look` (the mesh's own vertices when `None`) split where `split`
+    /// splits the shading, over `split`'s triangles (those of `look`, or the mesh's, welded:
+    /// each draw corner on its mesh vertex, in the same order). A draw vertex whose corners lie
+    /// in one smoothing group stays as it is; each further group it meets adds a copy (same
+    /// texture coordinates and colour). Beside the appearance, the shading vertex of each new
+    /// draw vertex, when they are not the same ones (a `look` with draw vertices of its own).
+    pub fn split_for_shading(
+        look: Option<&Appearance>,
+        split: &SharpSplit,
+    ) -> (Appearance, Option<Vec<u32>>) {
+        let (Some(look), Some(draw_triangles)) = (look, look.and_then(|l| l.triangles.as_ref()))
+        else {
+            // The draw vertices are the mesh's: they become the shading vertices.
+            let uvs = look.and_then(|l| l.uvs.as_deref());
+            let colours = look.and_then(|l| l.colours.as_deref());
+            let appearance = Appearance {
+                vertex_of: Some(split.vertex_of().to_vec()),
+                uvs: uvs.map(|u| gather_by(u, split.vertex_of())),
+                colours: colours.map(|c| gather_by(c, split.vertex_of())),
+                triangles: Some(split.triangles().to_vec()),
+                batches: look.map_or_else(Vec::new, |l| l.batches.clone()),
+                materials: look.map_or_else(|| Arc::from([]), |l| l.materials.clone()),
+            };
+            return (appearance, None);
+        };
+        let draw_count = look.draw_vertex_count(split.vertex_of().len());
+        // The shading vertex each draw vertex keeps (its first corner's); a later corner in
+        // another group makes or finds the copy for that group.
+        let mut shading_of = vec![u32::MAX; draw_count];
+        let mut copies: std::collections::HashMap<(u32, u32), u32> = Default::default();
+        let mut original_of: Vec<u32> = (0..draw_count as u32).collect();
+        let mut triangles = Vec::with_capacity(draw_triangles.len());
+        for (t, s) in draw_triangles.iter().zip(split.triangles()) {
+            let mut corners = *t;
+            for (d, &s) in corners.iter_mut().zip(s) {
+                let Some(kept) = shading_of.get_mut(*d as usize) else {
+                    continue; // a corner on no draw vertex: drawn as it was
+                };
+                if *kept == u32::MAX {
+                    *kept = s;
+                } else if *kept != s {
+                    let next = original_of.len() as u32;
+                    *d = *copies.entry((*d, s)).or_insert_with(|| {
+                        original_of.push(*d);
+                        next
+                    });
+                }
+            }
+            triangles.push(corners);
+        }
+        let mut normal_of: Vec<u32> = original_of
+            .iter()
+            .map(|&d| shading_of[d as usize])
+            .collect();
+        for (&(_, s), &copy) in &copies {
+            normal_of[copy as usize] = s;
+        }
+        // A draw vertex no triangle uses stands for its mesh vertex's first group.
+        let mesh_vertex = |d: u32| {
+            let map = look.vertex_of.as_deref();
+            map.map_or(d, |map| map.get(d as usize).copied().unwrap_or(0))
+        };
+        for (d, s) in normal_of.iter_mut().enumerate() {
+            if *s == u32::MAX {
+                *s = mesh_vertex(d as u32);
+            }
+        }
+        let appearance = Appearance {
+            vertex_of: Some(original_of.iter().map(|&d| mesh_vertex(d)).collect()),
+            uvs: look.uvs.as_deref().map(|u| gather_by(u, &original_of)),
+            colours: look.colours.as_deref().map(|c| gather_by(c, &original_of)),
+            triangles: Some(triangles),
+            batches: look.batches.clone(),
+            materials: look.materials.clone(),
+        };
+        (appearance, Some(normal_of))
+    }
+}
+
+/// `values[i]` for each index `i` of `by` (the default where there is none).
+fn gather_by<T: Copy + Default>(values: &[T], by: &[u32]) -> Vec<T> {
+    by.iter()
+        .map(|&i| values.get(i as usize).copied().unwrap_or_default())
+        .collect()
 }

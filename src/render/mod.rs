@@ -17,8 +17,8 @@ pub mod pipeline;
 pub mod shading;
 
 pub use pipeline::{
-    DrawParams, HeldMesh, ImageCounts, MeshKey, MeshRenderer, MeshSource, UploadCounts,
-    MAX_HELD_MESHES, SOFTWARE_SINGLE_SAMPLE_FACES,
+    CornerNormals, DrawParams, HeldMesh, ImageCounts, MeshKey, MeshRenderer, MeshSource,
+    UploadCounts, MAX_HELD_MESHES, SOFTWARE_SINGLE_SAMPLE_FACES,
 };
 pub use shading::{Lighting, Shading};
 
@@ -173,6 +173,13 @@ impl Viewport3d {
     pub fn read_back_normals(&self) -> Option<Vec<[f32; 3]>> {
         let (device, queue) = (&self.state.device, &self.state.queue);
         self.with_renderer(|r| r.read_back_normals(device, queue))
+            .flatten()
+    }
+
+    /// Each drawn triangle's mesh vertices and its corners' normals (tests; waits for the GPU).
+    pub fn read_back_corner_normals(&self) -> Option<Vec<CornerNormals>> {
+        let (device, queue) = (&self.state.device, &self.state.queue);
+        self.with_renderer(|r| r.read_back_corner_normals(device, queue))
             .flatten()
     }
 

@@ -9,7 +9,8 @@
 //!
 //! Buffers are written only when the mesh changes ([`MeshRenderer::set_mesh`] for new
 //! connectivity, [`MeshRenderer::set_positions`] when only the positions move; both recompute
-//! the vertex normals smooth shading needs, `super::normals`), and the offscreen
+//! the vertex normals smooth shading needs, `super::normals`, and where they split at sharp
+//! edges: a move that splits them elsewhere gets new buffers, as a new mesh does), and the offscreen
 //! image is redrawn only when the view, the mesh or the target size changed, so a large mesh costs
 //! nothing per frame while nothing moves.
 //!
@@ -17,7 +18,8 @@
 //! wireframe edges are filled into buffers on the renderer's own upload thread: for a 1.2M-face
 //! mesh that is ~30 ms of copying and page faults (positions, triangles) and ~20 ms (edges) that
 //! would otherwise stall one UI frame. New positions of a big mesh get their normals there too
-//! (~30 ms for 1.2M faces). The previous image stays until the upload lands.
+//! (20-40 ms for 1.2M faces with no sharp edge, the edges tested; about 100 ms when noise
+//! splits many vertices, which then get new buffers too). The previous image stays until the upload lands.
 
 mod buffers;
 mod held;
@@ -32,12 +34,11 @@ use std::sync::Arc;
 use std::time::Duration;
 
 use super::appearance::Appearance;
-use super::normals::vertex_normals;
 use super::shading::{Lighting, Shading};
 use buffers::MeshBuffers;
 use kept::KeptImage;
 use passes::{MaterialKit, Part, Pipelines, Target, Uniforms};
-use upload::{PendingMesh, UploadJob, Uploaded, Uploader};
+use upload::{MoveJob, Moved, PendingMesh, UploadJob, Uploaded, Uploader};
 
 /// Format of the image the mesh is drawn into (and that egui then samples).
 pub const COLOR_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8UnormSrgb;
@@ -85,6 +86,15 @@ pub struct DrawParams {
     pub size: [u32; 2],
 }
 
+/// One drawn triangle as smooth shading lights it ([`MeshRenderer::read_back_corner_normals`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct CornerNormals {
+    /// Its corners' mesh vertices.
+    pub vertices: [u32; 3],
+    /// Its corners' unit normals.
+    pub normals: [[f32; 3]; 3],
+}
+
 /// Mesh data the renderer may read on its upload thread (shared, never copied on the UI thread).
 pub trait MeshSource: Send + Sync + 'static {
     fn positions(&self) -> &[[f32; 3]];
@@ -121,6 +131,8 @@ enum PartDrawn {
 
 /// Owns the pipelines, the mesh buffers and the offscreen target. Knows nothing of fairing.
 pub struct MeshRenderer {
+    /// The device the buffers are made on (a move may need new ones).
+    device: wgpu::Device,
     /// The materials' bind group layout (shared by both samplings' pipelines) and the group of
     /// "no material".
     materials: MaterialKit,
@@ -201,6 +213,7 @@ impl MeshRenderer {
     pub fn new(device: &wgpu::Device, on_upload_done: Arc<dyn Fn() + Send + Sync>) -> Self {
         let materials = MaterialKit::new(device);
         Self {
+            device: device.clone(),
             pipelines: Pipelines::new(device, SAMPLE_COUNT, &materials),
             materials,
             single_sample: None,
@@ -376,10 +389,10 @@ impl MeshRenderer {
                         if let Some(pending) = self.pending.take() {
                             buffers.key = pending.key;
                             if let Some(scalars) = pending.scalars {
-                                buffers.write_per_vertex(queue, &buffers.scalars, &scalars);
+                                buffers.write_per_vertex(queue, &scalars, false);
                             }
                             if let Some(mask) = pending.mask {
-                                buffers.write_per_vertex(queue, &buffers.mask, &mask);
+                                buffers.write_per_vertex(queue, &mask, true);
                             }
                         }
                         self.replace_current(*buffers);
@@ -415,23 +428,37 @@ impl MeshRenderer {
                     generation,
                     serial,
                     source,
-                    normals,
+                    moved,
                 } => {
                     if self.pending_move != Some(serial) {
                         continue;
                     }
                     self.pending_move = None;
-                    if let Some(mesh) = self.mesh.as_mut().filter(|m| m.generation == generation) {
-                        mesh.write_positions(queue, source, &normals);
-                        self.redraw();
+                    if self
+                        .mesh
+                        .as_ref()
+                        .is_some_and(|m| m.generation == generation)
+                    {
+                        self.apply_move(queue, source, moved);
                     }
                     self.write_move_tints(queue);
                 }
-                Uploaded::Lines { generation, lines } => {
+                Uploaded::Lines {
+                    generation,
+                    look,
+                    lines,
+                } => {
                     if self.lines_requested == Some(generation) {
                         self.lines_requested = None;
                     }
-                    if let Some(mesh) = self.mesh.as_mut().filter(|m| m.generation == generation) {
+                    let same_look = |m: &&mut MeshBuffers| match (&m.appearance, &look) {
+                        (Some(a), Some(b)) => Arc::ptr_eq(a, b),
+                        (a, b) => a.is_none() && b.is_none(),
+                    };
+                    if let Some(mesh) = (self.mesh.as_mut())
+                        .filter(|m| m.generation == generation)
+                        .filter(same_look)
+                    {
                         mesh.lines = Some(lines);
                         self.redraw();
                     }
@@ -468,36 +495,62 @@ impl MeshRenderer {
         // The mesh is about to move: its kept image shows where it was.
         kept::forget_image(&mut self.kept, mesh.generation);
         let faces = mesh.index_count as usize / 3;
+        let job = MoveJob {
+            generation: mesh.generation,
+            serial: self.move_serial,
+            source: source.clone(),
+            corners: mesh.corners.clone(),
+            layout: mesh.layout.clone(),
+        };
+        let mut job = Box::new(job);
         if (vertex_count + faces) * 12 >= self.async_upload_bytes {
             if let Some(uploader) = &self.uploader {
-                let job = UploadJob::Move {
-                    generation: mesh.generation,
-                    serial: self.move_serial,
-                    source: source.clone(),
-                };
-                if uploader.send(job).is_ok() {
-                    self.pending_move = Some(self.move_serial);
-                    return true;
+                match uploader.send(UploadJob::Move(job)) {
+                    Ok(()) => {
+                        self.pending_move = Some(self.move_serial);
+                        return true;
+                    }
+                    // The thread is gone: the move is made here.
+                    Err(UploadJob::Move(back)) => job = back,
+                    Err(_) => return false, // `send` gives back the job it was given
                 }
             }
         }
         self.pending_move = None;
-        let normals = vertex_normals(source.positions(), source.triangles());
-        mesh.write_positions(queue, source, &normals);
-        self.redraw();
+        let moved = job.run(&self.device);
+        self.apply_move(queue, source, moved);
         self.write_move_tints(queue);
         true
+    }
+
+    /// Shows the mesh on screen at `source`'s positions: their normals written into its
+    /// buffers, or its new buffers in their place (the shading splits elsewhere now; the
+    /// wireframe's edges are then built again).
+    fn apply_move(&mut self, queue: &wgpu::Queue, source: Arc<dyn MeshSource>, moved: Moved) {
+        let Some(mesh) = self.mesh.as_mut() else {
+            return;
+        };
+        match moved {
+            Moved::Normals(normals) => mesh.write_positions(queue, source, &normals),
+            Moved::Rebuilt(mut buffers) => {
+                buffers.take_place_of(queue, mesh);
+                *mesh = *buffers;
+                self.lines_requested = None;
+                self.lines_failed = false;
+            }
+        }
+        self.redraw();
     }
 
     /// Writes the scalars and mask weights that waited for a move's positions.
     fn write_move_tints(&mut self, queue: &wgpu::Queue) {
         let (scalars, mask) = (self.move_scalars.take(), self.move_mask.take());
-        if let Some(mesh) = &self.mesh {
+        if let Some(mesh) = &mut self.mesh {
             if let Some(scalars) = scalars.filter(|s| s.len() == mesh.vertex_count) {
-                mesh.write_per_vertex(queue, &mesh.scalars, &scalars);
+                mesh.write_per_vertex(queue, &scalars, false);
             }
             if let Some(mask) = mask.filter(|m| m.len() == mesh.vertex_count) {
-                mesh.write_per_vertex(queue, &mesh.mask, &mask);
+                mesh.write_per_vertex(queue, &mask, true);
             }
             self.redraw();
         }
@@ -525,6 +578,33 @@ impl MeshRenderer {
         passes::read_mapped(device, &staging, |bytes| {
             bytemuck::cast_slice::<u8, [f32; 3]>(bytes).to_vec()
         })
+    }
+
+    /// Reads back the normals each drawn triangle's corners are lit with (tests: where smooth
+    /// shading splits), with the triangle's mesh vertices; in draw order (the mesh's own order
+    /// for a mesh without an appearance). Waits for the GPU.
+    pub fn read_back_corner_normals(
+        &mut self,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+    ) -> Option<Vec<CornerNormals>> {
+        let normals = self.read_back_normals(device, queue)?;
+        let mesh = self.mesh.as_ref()?;
+        let look = mesh.appearance.as_deref();
+        let triangles = buffers::draw_triangles(mesh.source.as_ref(), look);
+        let vertex_of = |d: u32| {
+            look.and_then(|l| l.vertex_of.as_ref())
+                .map_or(d, |m| m[d as usize])
+        };
+        Some(
+            triangles
+                .iter()
+                .map(|t| CornerNormals {
+                    vertices: t.map(vertex_of),
+                    normals: t.map(|d| normals[d as usize]),
+                })
+                .collect(),
+        )
     }
 
     /// Reads back the image in the target (RGBA, sRGB, rows top to bottom; tests). Waits for
@@ -561,7 +641,7 @@ impl MeshRenderer {
         }
         let Some(mesh) = self
             .mesh
-            .as_ref()
+            .as_mut()
             .filter(|m| m.vertex_count == values.len())
         else {
             return false;
@@ -574,8 +654,7 @@ impl MeshRenderer {
             self.uploads.count_per_vertex(values.len());
             return true;
         }
-        let buffer = if mask { &mesh.mask } else { &mesh.scalars };
-        mesh.write_per_vertex(queue, buffer, values);
+        mesh.write_per_vertex(queue, values, mask);
         self.uploads.count_per_vertex(values.len());
         self.redraw();
         true

@@ -12,7 +12,8 @@ pub enum Shading {
     /// One normal per triangle: every facet shows, as it is.
     Flat,
     /// Area-weighted vertex normals blended across each triangle: a fair surface looks smooth
-    /// and its highlights run evenly.
+    /// and its highlights run evenly; split at sharp edges
+    /// ([`crate::render::normals::SHARP_EDGE_ANGLE`]), which stay crisp.
     #[default]
     Smooth,
 }

@@ -1,6 +1,8 @@
 //! The GPU copies of one mesh ([`MeshBuffers`]: positions, vertex normals, heat-map scalars,
 //! painted-mask weights, texture coordinates and colours, triangles and, once the wireframe is
-//! wanted, its edges) and how they are filled.
+//! wanted, its edges) and how they are filled; the draw vertices they are over and those
+//! vertices' smooth-shading normals ([`DrawLayout`], [`draw_normals`]): the file's own vertices
+//! (its appearance) or the mesh's, split where the shading splits at sharp edges.
 
 use std::sync::Arc;
 
@@ -8,14 +10,17 @@ use wgpu::util::DeviceExt;
 
 use super::MeshSource;
 use crate::render::appearance::Appearance;
-use crate::render::normals::vertex_normals;
+use crate::render::normals::{
+    shading_normals, vertex_normals, CornerTable, SharpSplit, SHARP_EDGE_ANGLE,
+};
 
 /// GPU copies of one mesh, over its draw vertices (the file's own vertices when it has an
 /// [`Appearance`], otherwise the mesh's).
 pub(super) struct MeshBuffers {
     pub(super) positions: wgpu::Buffer,
-    /// Area-weighted unit vertex normals of the positions now in `positions` (computed on the
-    /// mesh's vertices, so they are smooth across the file's seams).
+    /// Smooth shading's unit normals of the positions now in `positions`, per draw vertex
+    /// (area-weighted over the mesh's vertices, so smooth across the file's seams, and split at
+    /// sharp edges: [`draw_normals`]).
     pub(super) normals: wgpu::Buffer,
     /// The heat map's per-vertex values.
     pub(super) scalars: wgpu::Buffer,
@@ -36,8 +41,17 @@ pub(super) struct MeshBuffers {
     pub(super) lines: Option<(wgpu::Buffer, u32)>,
     /// The mesh on screen: its triangles, and the positions last written.
     pub(super) source: Arc<dyn MeshSource>,
-    /// The file's materials, texture coordinates and colours, when it has any to show.
+    /// The draw vertices' appearance: the file's materials, texture coordinates and colours,
+    /// split at sharp edges where the shading splits (`layout.look`).
     pub(super) appearance: Option<Arc<Appearance>>,
+    /// How the draw vertices came from the mesh's and get their normals.
+    pub(super) layout: Arc<DrawLayout>,
+    /// The corners around each vertex of the welded draw triangles, kept for every move.
+    pub(super) corners: Arc<CornerTable>,
+    /// The heat-map values and mask weights last written (per mesh vertex), written again if
+    /// the draw vertices change ([`MeshBuffers::take_values`]).
+    pub(super) scalar_values: Option<Vec<f32>>,
+    pub(super) mask_values: Option<Vec<f32>>,
     /// The materials' textures and uniforms on the GPU, made on the render thread when first
     /// drawn (they need the queue).
     pub(super) materials: Option<Vec<MaterialGroup>>,
@@ -53,20 +67,109 @@ pub(super) struct MaterialGroup {
     pub(super) bind_group: wgpu::BindGroup,
 }
 
-/// The triangles the renderer draws for `source`: its appearance's (over the draw vertices) or
-/// its own.
-pub(super) fn draw_triangles(source: &dyn MeshSource) -> std::borrow::Cow<'_, [[u32; 3]]> {
-    match source.appearance() {
-        Some(appearance) => match &appearance.triangles {
-            Some(triangles) => std::borrow::Cow::Owned(triangles.clone()),
-            None => std::borrow::Cow::Borrowed(source.triangles()),
-        },
-        None => std::borrow::Cow::Borrowed(source.triangles()),
+/// The triangles the renderer draws for `source` with the draw vertices of `look`: its
+/// triangles (over the draw vertices) or the mesh's own.
+pub(super) fn draw_triangles<'a>(
+    source: &'a dyn MeshSource,
+    look: Option<&'a Appearance>,
+) -> &'a [[u32; 3]] {
+    look.and_then(|l| l.triangles.as_deref())
+        .unwrap_or(source.triangles())
+}
+
+/// Where a mesh's draw vertices come from: the file's (its appearance) or the mesh's own,
+/// split where smooth shading splits at sharp edges.
+pub(super) struct DrawLayout {
+    /// What is drawn: the file's appearance, that appearance split further
+    /// ([`Appearance::split_for_shading`]), or, for a mesh with none that splits, a plain one
+    /// over its shading vertices; `None`: the mesh's own vertices and triangles.
+    pub(super) look: Option<Arc<Appearance>>,
+    /// The split, when the shading splits, and the shading vertex of each draw vertex when they
+    /// are not the same ones.
+    split: Option<(SharpSplit, Option<Vec<u32>>)>,
+}
+
+/// A mesh's draw layout and the normals of its draw vertices for its positions now.
+pub(super) struct DrawNormals {
+    pub(super) layout: Arc<DrawLayout>,
+    pub(super) normals: Vec<[f32; 3]>,
+}
+
+/// The triangles of `look` (or the mesh's) welded: each corner on its mesh vertex.
+pub(super) fn welded_triangles<'a>(
+    source: &'a dyn MeshSource,
+    look: Option<&Appearance>,
+) -> std::borrow::Cow<'a, [[u32; 3]]> {
+    match look {
+        Some(look) if look.triangles.is_some() => {
+            let triangles = look.triangles.as_deref().unwrap_or_default();
+            std::borrow::Cow::Owned(match &look.vertex_of {
+                Some(map) => triangles
+                    .iter()
+                    .map(|t| t.map(|d| map.get(d as usize).copied().unwrap_or(u32::MAX)))
+                    .collect(),
+                None => triangles.to_vec(),
+            })
+        }
+        _ => std::borrow::Cow::Borrowed(source.triangles()),
     }
 }
 
+/// The smooth-shading normals of `source`'s draw vertices for its positions, with the layout
+/// they are for: `current` (the buffers' layout) when the shading splits as it does, a new one
+/// otherwise (the buffers must then be made again). `corners` is the table of the welded draw
+/// triangles. With no sharp edge the normals are the mesh's area-weighted vertex normals taken
+/// onto the file's vertices, exactly as without any split.
+pub(super) fn draw_normals(
+    source: &dyn MeshSource,
+    corners: &CornerTable,
+    current: Option<&Arc<DrawLayout>>,
+) -> DrawNormals {
+    let positions = source.positions();
+    let original = source.appearance();
+    let welded = welded_triangles(source, original.as_deref());
+    let (split, shading) = shading_normals(positions, &welded, Some(corners), SHARP_EDGE_ANGLE);
+    let Some(split) = split else {
+        // The file's vertices take their mesh vertices' normals, as they always have.
+        let normals = match &original {
+            Some(look) if look.vertex_of.is_some() => {
+                look.gather(&vertex_normals(positions, source.triangles()))
+            }
+            _ => shading,
+        };
+        let layout = match current.filter(|c| c.split.is_none()) {
+            Some(current) => current.clone(),
+            None => Arc::new(DrawLayout {
+                look: original,
+                split: None,
+            }),
+        };
+        return DrawNormals { layout, normals };
+    };
+    let same = current.filter(|c| c.split.as_ref().is_some_and(|(s, _)| *s == split));
+    let layout = match same {
+        Some(current) => current.clone(),
+        None => {
+            let (look, normal_of) = Appearance::split_for_shading(original.as_deref(), &split);
+            Arc::new(DrawLayout {
+                look: Some(Arc::new(look)),
+                split: Some((split, normal_of)),
+            })
+        }
+    };
+    let normals = match layout.split.as_ref().and_then(|(_, n)| n.as_ref()) {
+        Some(normal_of) => normal_of
+            .iter()
+            .map(|&s| shading.get(s as usize).copied().unwrap_or_default())
+            .collect(),
+        None => shading,
+    };
+    DrawNormals { layout, normals }
+}
+
 impl MeshBuffers {
-    /// Writes new positions of the same connectivity and their normals (per mesh vertex).
+    /// Writes new positions of the same connectivity and their normals (per draw vertex, for
+    /// these buffers' layout).
     pub(super) fn write_positions(
         &mut self,
         queue: &wgpu::Queue,
@@ -77,33 +180,42 @@ impl MeshBuffers {
             Some(look) if look.vertex_of.is_some() => {
                 let positions = look.gather(source.positions());
                 queue.write_buffer(&self.positions, 0, bytemuck::cast_slice(&positions));
-                queue.write_buffer(
-                    &self.normals,
-                    0,
-                    bytemuck::cast_slice(&look.gather(normals)),
-                );
             }
-            _ => {
-                queue.write_buffer(&self.positions, 0, bytemuck::cast_slice(source.positions()));
-                queue.write_buffer(&self.normals, 0, bytemuck::cast_slice(normals));
-            }
+            _ => queue.write_buffer(&self.positions, 0, bytemuck::cast_slice(source.positions())),
         }
+        queue.write_buffer(&self.normals, 0, bytemuck::cast_slice(normals));
         self.source = source;
     }
 
-    /// Writes per-mesh-vertex `values` (scalars or mask weights) into `buffer`, taken onto the
-    /// draw vertices.
-    pub(super) fn write_per_vertex(
-        &self,
-        queue: &wgpu::Queue,
-        buffer: &wgpu::Buffer,
-        values: &[f32],
-    ) {
+    /// Writes per-mesh-vertex `values` (heat-map scalars, or mask weights when `mask`) into
+    /// their buffer, taken onto the draw vertices, and keeps them.
+    pub(super) fn write_per_vertex(&mut self, queue: &wgpu::Queue, values: &[f32], mask: bool) {
+        let buffer = if mask { &self.mask } else { &self.scalars };
         match &self.appearance {
             Some(look) if look.vertex_of.is_some() => {
                 queue.write_buffer(buffer, 0, bytemuck::cast_slice(&look.gather(values)));
             }
             _ => queue.write_buffer(buffer, 0, bytemuck::cast_slice(values)),
+        }
+        let kept = if mask {
+            &mut self.mask_values
+        } else {
+            &mut self.scalar_values
+        };
+        *kept = Some(values.to_vec());
+    }
+
+    /// Takes over the place of `old`, these buffers being the same mesh with other draw
+    /// vertices (a move changed where the shading splits): its key, generation and the heat-map
+    /// values and mask weights written into it.
+    pub(super) fn take_place_of(&mut self, queue: &wgpu::Queue, old: &mut MeshBuffers) {
+        self.key = old.key;
+        self.generation = old.generation;
+        if let Some(values) = old.scalar_values.take() {
+            self.write_per_vertex(queue, &values, false);
+        }
+        if let Some(values) = old.mask_values.take() {
+            self.write_per_vertex(queue, &values, true);
         }
     }
 
@@ -115,18 +227,32 @@ impl MeshBuffers {
         with_lines: bool,
         generation: u64,
     ) -> Self {
+        let welded = welded_triangles(source.as_ref(), source.appearance().as_deref());
+        let corners = Arc::new(CornerTable::new(source.positions().len(), &welded));
+        drop(welded);
+        let drawn = draw_normals(source.as_ref(), &corners, None);
+        Self::create_with(device, source, corners, drawn, with_lines, generation)
+    }
+
+    /// [`Self::create`] with the corner table and the draw normals already made (a move that
+    /// changed the draw vertices).
+    pub(super) fn create_with(
+        device: &wgpu::Device,
+        source: Arc<dyn MeshSource>,
+        corners: Arc<CornerTable>,
+        drawn: DrawNormals,
+        with_lines: bool,
+        generation: u64,
+    ) -> Self {
         let positions = source.positions();
-        let mesh_triangles = source.triangles();
-        let appearance = source.appearance();
-        let normals = vertex_normals(positions, mesh_triangles);
-        let (draw_positions, draw_normals) = match &appearance {
-            Some(look) if look.vertex_of.is_some() => {
-                (Some(look.gather(positions)), Some(look.gather(&normals)))
-            }
-            _ => (None, None),
+        let DrawNormals { layout, normals } = drawn;
+        let appearance = layout.look.clone();
+        let draw_positions = match &appearance {
+            Some(look) if look.vertex_of.is_some() => Some(look.gather(positions)),
+            _ => None,
         };
         let draw_count = draw_positions.as_ref().map_or(positions.len(), Vec::len);
-        let triangles = draw_triangles(source.as_ref());
+        let triangles = draw_triangles(source.as_ref(), appearance.as_deref());
         let positions_buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("fairmesh positions"),
             contents: bytemuck::cast_slice(draw_positions.as_deref().unwrap_or(positions)),
@@ -134,7 +260,7 @@ impl MeshBuffers {
         });
         let normals_buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("fairmesh normals"),
-            contents: bytemuck::cast_slice(draw_normals.as_deref().unwrap_or(&normals)),
+            contents: bytemuck::cast_slice(&normals),
             // COPY_SRC: tests read back what was uploaded.
             usage: wgpu::BufferUsages::VERTEX
                 | wgpu::BufferUsages::COPY_DST
@@ -175,10 +301,10 @@ impl MeshBuffers {
         );
         let triangles_buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("fairmesh triangles"),
-            contents: bytemuck::cast_slice(&triangles),
+            contents: bytemuck::cast_slice(triangles),
             usage: wgpu::BufferUsages::INDEX,
         });
-        let lines = with_lines.then(|| line_buffer(device, &triangles));
+        let lines = with_lines.then(|| line_buffer(device, triangles));
         Self {
             positions: positions_buffer,
             normals: normals_buffer,
@@ -192,6 +318,10 @@ impl MeshBuffers {
             index_count: (triangles.len() * 3) as u32,
             lines,
             appearance,
+            layout,
+            corners,
+            scalar_values: None,
+            mask_values: None,
             materials: None,
             source,
             generation,

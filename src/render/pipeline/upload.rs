@@ -1,13 +1,15 @@
 //! The renderer's upload thread ([`Uploader`]): the jobs it takes ([`UploadJob`]: a big mesh's
-//! buffers, its wireframe edges, new positions' normals), what comes back ([`Uploaded`]), and
-//! the upload in flight ([`PendingMesh`]).
+//! buffers, its wireframe edges, new positions' normals, and new buffers when the positions
+//! split the shading elsewhere), what comes back ([`Uploaded`]), and the upload in flight
+//! ([`PendingMesh`]).
 
 use std::sync::mpsc::{self, Receiver, Sender};
 use std::sync::{Arc, Mutex};
 
-use super::buffers::{draw_triangles, line_buffer, MeshBuffers};
+use super::buffers::{draw_normals, draw_triangles, line_buffer, DrawLayout, MeshBuffers};
 use super::MeshSource;
-use crate::render::normals::vertex_normals;
+use crate::render::appearance::Appearance;
+use crate::render::normals::CornerTable;
 
 /// Work for the upload thread.
 pub(super) enum UploadJob {
@@ -16,24 +18,55 @@ pub(super) enum UploadJob {
         source: Arc<dyn MeshSource>,
         with_lines: bool,
     },
+    /// The wireframe's edges of the draw triangles of `look` (or the mesh's).
     Lines {
         generation: u64,
         source: Arc<dyn MeshSource>,
+        look: Option<Arc<Appearance>>,
     },
-    /// New positions for the mesh of `generation`: their normals.
-    Move {
-        generation: u64,
-        serial: u64,
-        source: Arc<dyn MeshSource>,
-    },
+    /// New positions for the mesh of `generation`, whose buffers have `layout`: their normals.
+    Move(Box<MoveJob>),
+}
+
+/// New positions for the mesh of `generation` (drawn with `layout`, its welded triangles'
+/// corners `corners`): their normals, and new buffers when the shading splits elsewhere now.
+pub(super) struct MoveJob {
+    pub(super) generation: u64,
+    pub(super) serial: u64,
+    pub(super) source: Arc<dyn MeshSource>,
+    pub(super) corners: Arc<CornerTable>,
+    pub(super) layout: Arc<DrawLayout>,
+}
+
+/// What a move gives: normals for the buffers' layout, or new buffers.
+pub(super) enum Moved {
+    Normals(Vec<[f32; 3]>),
+    Rebuilt(Box<MeshBuffers>),
+}
+
+impl MoveJob {
+    /// The move's normals, or new buffers (made on `device`) when its draw vertices changed.
+    pub(super) fn run(&self, device: &wgpu::Device) -> Moved {
+        let drawn = draw_normals(self.source.as_ref(), &self.corners, Some(&self.layout));
+        if Arc::ptr_eq(&drawn.layout, &self.layout) {
+            return Moved::Normals(drawn.normals);
+        }
+        Moved::Rebuilt(Box::new(MeshBuffers::create_with(
+            device,
+            self.source.clone(),
+            self.corners.clone(),
+            drawn,
+            false,
+            self.generation,
+        )))
+    }
 }
 
 impl UploadJob {
     fn generation(&self) -> u64 {
         match self {
-            Self::Mesh { generation, .. }
-            | Self::Lines { generation, .. }
-            | Self::Move { generation, .. } => *generation,
+            Self::Mesh { generation, .. } | Self::Lines { generation, .. } => *generation,
+            Self::Move(job) => job.generation,
         }
     }
 
@@ -46,19 +79,20 @@ impl UploadJob {
             } => Uploaded::Mesh(Box::new(MeshBuffers::create(
                 device, source, with_lines, generation,
             ))),
-            UploadJob::Lines { generation, source } => Uploaded::Lines {
+            UploadJob::Lines {
                 generation,
-                lines: line_buffer(device, &draw_triangles(source.as_ref())),
+                source,
+                look,
+            } => Uploaded::Lines {
+                generation,
+                lines: line_buffer(device, draw_triangles(source.as_ref(), look.as_deref())),
+                look,
             },
-            UploadJob::Move {
-                generation,
-                serial,
-                source,
-            } => Uploaded::Moved {
-                generation,
-                serial,
-                normals: vertex_normals(source.positions(), source.triangles()),
-                source,
+            UploadJob::Move(job) => Uploaded::Moved {
+                generation: job.generation,
+                serial: job.serial,
+                moved: job.run(device),
+                source: job.source,
             },
         }
     }
@@ -70,15 +104,17 @@ pub(super) enum Uploaded {
     Failed {
         generation: u64,
     },
+    /// Edges of the draw triangles of `look` (dropped if the mesh is drawn with other ones).
     Lines {
         generation: u64,
+        look: Option<Arc<Appearance>>,
         lines: (wgpu::Buffer, u32),
     },
     Moved {
         generation: u64,
         serial: u64,
         source: Arc<dyn MeshSource>,
-        normals: Vec<[f32; 3]>,
+        moved: Moved,
     },
 }
 
@@ -108,10 +144,10 @@ impl Uploader {
                     // Only the last move counts: the positions before it are already old.
                     let last_move = batch
                         .iter()
-                        .rposition(|job| matches!(job, UploadJob::Move { .. }));
+                        .rposition(|job| matches!(job, UploadJob::Move(_)));
                     for (index, job) in batch.into_iter().enumerate() {
                         let old_move =
-                            matches!(job, UploadJob::Move { .. }) && Some(index) != last_move;
+                            matches!(job, UploadJob::Move(_)) && Some(index) != last_move;
                         if Some(job.generation()) != newest || old_move {
                             continue;
                         }
@@ -187,6 +223,7 @@ impl super::MeshRenderer {
                 let job = UploadJob::Lines {
                     generation: mesh.generation,
                     source: mesh.source.clone(),
+                    look: mesh.appearance.clone(),
                 };
                 let sent = match &self.uploader {
                     Some(uploader) if bytes >= self.async_upload_bytes => {
@@ -197,7 +234,9 @@ impl super::MeshRenderer {
                 if sent {
                     self.lines_requested = Some(mesh.generation);
                 } else {
-                    mesh.lines = Some(line_buffer(device, &draw_triangles(mesh.source.as_ref())));
+                    let triangles =
+                        draw_triangles(mesh.source.as_ref(), mesh.appearance.as_deref());
+                    mesh.lines = Some(line_buffer(device, triangles));
                 }
             }
         }
