@@ -6,89 +6,18 @@ use fairmesh::fairing::{
     fair, fair_constrained, fair_hc, fair_laplacian, fair_taubin, BoundaryMode, FairOptions,
     FairVariant, HcOptions, LaplacianOptions, MethodOptions, TaubinOptions, ROUND_SETTLED,
 };
+use fairmesh::mesh::shapes;
 use fairmesh::metrics::{mean_edge_length, signed_volume};
 use fairmesh::noise::{add_noise, NoiseMode, NoiseOptions};
 use fairmesh::{Topology, TriMesh};
-use std::collections::HashMap;
 
 const VARIANTS: [FairVariant; 2] = [FairVariant::Paper, FairVariant::NormalProjected];
-
-/// Unit icosphere: an icosahedron, each triangle split in four `levels` times, every new vertex
-/// projected to the unit sphere.
-fn icosphere(levels: usize) -> TriMesh {
-    let t = (1.0 + 5f64.sqrt()) / 2.0;
-    let mut positions: Vec<[f64; 3]> = vec![
-        [-1.0, t, 0.0],
-        [1.0, t, 0.0],
-        [-1.0, -t, 0.0],
-        [1.0, -t, 0.0],
-        [0.0, -1.0, t],
-        [0.0, 1.0, t],
-        [0.0, -1.0, -t],
-        [0.0, 1.0, -t],
-        [t, 0.0, -1.0],
-        [t, 0.0, 1.0],
-        [-t, 0.0, -1.0],
-        [-t, 0.0, 1.0],
-    ];
-    let normalize = |p: [f64; 3]| {
-        let l = (p[0] * p[0] + p[1] * p[1] + p[2] * p[2]).sqrt();
-        p.map(|x| x / l)
-    };
-    for p in &mut positions {
-        *p = normalize(*p);
-    }
-    let mut triangles: Vec<[u32; 3]> = vec![
-        [0, 11, 5],
-        [0, 5, 1],
-        [0, 1, 7],
-        [0, 7, 10],
-        [0, 10, 11],
-        [1, 5, 9],
-        [5, 11, 4],
-        [11, 10, 2],
-        [10, 7, 6],
-        [7, 1, 8],
-        [3, 9, 4],
-        [3, 4, 2],
-        [3, 2, 6],
-        [3, 6, 8],
-        [3, 8, 9],
-        [4, 9, 5],
-        [2, 4, 11],
-        [6, 2, 10],
-        [8, 6, 7],
-        [9, 8, 1],
-    ];
-    for _ in 0..levels {
-        let mut midpoints: HashMap<(u32, u32), u32> = HashMap::new();
-        let mut midpoint = |a: u32, b: u32, positions: &mut Vec<[f64; 3]>| {
-            *midpoints.entry((a.min(b), a.max(b))).or_insert_with(|| {
-                let (pa, pb) = (positions[a as usize], positions[b as usize]);
-                positions.push(normalize(std::array::from_fn(|k| pa[k] + pb[k])));
-                positions.len() as u32 - 1
-            })
-        };
-        let mut finer = Vec::with_capacity(triangles.len() * 4);
-        for [a, b, c] in triangles {
-            let ab = midpoint(a, b, &mut positions);
-            let bc = midpoint(b, c, &mut positions);
-            let ca = midpoint(c, a, &mut positions);
-            finer.extend([[a, ab, ca], [b, bc, ab], [c, ca, bc], [ab, bc, ca]]);
-        }
-        triangles = finer;
-    }
-    TriMesh::new(
-        positions.iter().map(|p| p.map(|x| x as f32)).collect(),
-        triangles,
-    )
-}
 
 /// The part of the icosphere whose triangles have their centroid above z = 0.1, reindexed, with
 /// the boundary vertices snapped onto one horizontal circle of the sphere (so that the clean
 /// boundary is a smooth curve, not the zigzag the cut leaves).
 fn hemisphere(levels: usize) -> TriMesh {
-    let sphere = icosphere(levels);
+    let sphere = shapes::icosphere(levels);
     let kept: Vec<[u32; 3]> = sphere
         .triangles
         .iter()
@@ -162,7 +91,7 @@ fn constrained_fairing_keeps_the_volume_of_a_noisy_sphere() {
     // The operators alone (one round, no tangential relaxation, which changes the volume to second
     // order; the default's volume is checked in
     // `a_clean_mesh_is_left_alone_and_a_noisy_one_is_faired_by_default`).
-    let mesh = noisy(icosphere(4), 0.3, 1);
+    let mesh = noisy(shapes::icosphere(4), 0.3, 1);
     let topology = Topology::build(&mesh);
     assert!(topology.is_closed());
     for variant in VARIANTS {
@@ -200,7 +129,7 @@ fn constrained_fairing_keeps_the_volume_of_a_noisy_sphere() {
 #[test]
 fn constrained_fairing_removes_noise_from_the_sphere() {
     // The radius error (distance to the unit sphere) must drop clearly.
-    let mesh = noisy(icosphere(4), 0.3, 1);
+    let mesh = noisy(shapes::icosphere(4), 0.3, 1);
     let topology = Topology::build(&mesh);
     let radius_error = |m: &TriMesh| {
         (0..m.positions.len() as u32)
@@ -226,7 +155,7 @@ fn constrained_fairing_removes_noise_from_the_sphere() {
 
 #[test]
 fn tolerance_stops_early() {
-    let mesh = noisy(icosphere(4), 0.3, 1);
+    let mesh = noisy(shapes::icosphere(4), 0.3, 1);
     let topology = Topology::build(&mesh);
     let tolerance = 1e-4 * mean_edge_length(&mesh);
     for variant in VARIANTS {
@@ -249,7 +178,7 @@ fn tolerance_stops_early() {
 
 #[test]
 fn a_round_ends_once_it_has_settled_and_ends_where_all_its_iterations_would() {
-    let mesh = noisy(icosphere(4), 0.3, 1);
+    let mesh = noisy(shapes::icosphere(4), 0.3, 1);
     let topology = Topology::build(&mesh);
     let edge = mean_edge_length(&mesh);
     let options = FairOptions::default().with_rounds(3);
@@ -278,7 +207,7 @@ fn a_round_ends_once_it_has_settled_and_ends_where_all_its_iterations_would() {
 
 #[test]
 fn rounds_smooth_further_and_still_keep_the_volume() {
-    let mesh = noisy(icosphere(4), 0.3, 1);
+    let mesh = noisy(shapes::icosphere(4), 0.3, 1);
     let topology = Topology::build(&mesh);
     let roughness = |m: &TriMesh| {
         // Mean distance of a vertex to its neighbours' mean.
@@ -492,7 +421,7 @@ fn equivariant_under_translation_rotation_and_scale() {
 
 #[test]
 fn bit_identical_for_one_and_two_threads() {
-    let closed = noisy(icosphere(5), 0.3, 4);
+    let closed = noisy(shapes::icosphere(5), 0.3, 4);
     let open = noisy(hemisphere(5), 0.3, 5);
     let all_methods = |boundary: BoundaryMode| {
         vec![
@@ -851,7 +780,7 @@ fn a_noisy_cube_keeps_straight_edges_and_its_corners_with_creases() {
 
 #[test]
 fn a_clean_mesh_is_left_alone_and_a_noisy_one_is_faired_by_default() {
-    let sphere = icosphere(4);
+    let sphere = shapes::icosphere(4);
     let topology = Topology::build(&sphere);
     let mut clean = sphere.clone();
     let report = fair_constrained(&mut clean, &topology, &FairOptions::default());
@@ -989,7 +918,7 @@ fn automatic_strength_stops_near_the_best_round_count_on_a_coarse_scan_and_on_a_
     let elephant = fairmesh::io::load(&path).unwrap().mesh;
     let mut rounds = Vec::new();
     let mut best_rounds_elephant = 0;
-    for (name, clean) in [("elephant", elephant), ("sphere", icosphere(5))] {
+    for (name, clean) in [("elephant", elephant), ("sphere", shapes::icosphere(5))] {
         let topology = Topology::build(&clean);
         let input = noisy(clean.clone(), 0.3, 1);
         let distance = |mesh: &TriMesh| {
@@ -1140,7 +1069,7 @@ fn triangles_lying_loose_over_a_fan_do_not_hold_their_corners() {
     // triangle (v, a, c) lying over v's two fan triangles (v, a, b) and (v, b, c). Its edges v-a
     // and v-c get a third triangle and a-c is its own, so v, a and c read as boundary and
     // non-manifold; smoothed as such they kept their noise.
-    let input = noisy(icosphere(4), 0.3, 3);
+    let input = noisy(shapes::icosphere(4), 0.3, 3);
     let topology = Topology::build(&input);
     let n = input.vertex_count();
     let mut taken = vec![false; n];
@@ -1214,7 +1143,7 @@ fn a_fin_hanging_from_a_non_manifold_edge_lets_its_base_be_smoothed() {
     // sphere, the fin held its base (the edges a-tip and tip-v made v and a boundary vertices
     // on a two-vertex chain that no boundary curve runs through). Left out as loose, the base
     // is smoothed like the rest; the tip, which nothing else uses, stays where it is.
-    let input = noisy(icosphere(4), 0.3, 4);
+    let input = noisy(shapes::icosphere(4), 0.3, 4);
     let topology = Topology::build(&input);
     let n = input.vertex_count();
     let mut taken = vec![false; n];

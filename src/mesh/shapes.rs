@@ -1,5 +1,6 @@
 //! CAD-like test shapes with sharp edges: prisms made by extruding a closed outline (a square, a
-//! circle, a gear, a D made of a half-disc on a rectangle), with evenly sampled sides and caps.
+//! circle, a gear, a D made of a half-disc on a rectangle), with evenly sampled sides and caps;
+//! CAD parts as exporters write them; and, for contrast, a smooth icosphere.
 //!
 //! Not part of the paper: the fairing's crease handling and its clean-mesh bounds are measured on
 //! these (the tests, `examples/fairing_quality.rs`), since scanned meshes have few sharp edges.
@@ -340,6 +341,78 @@ impl Faces {
     }
 }
 
+/// A unit icosphere, a smooth shape with no sharp edge: an icosahedron, each triangle split in
+/// four `levels` times, every new vertex projected to the unit sphere (computed in f64).
+pub fn icosphere(levels: usize) -> TriMesh {
+    let t = (1.0 + 5f64.sqrt()) / 2.0;
+    let mut positions: Vec<[f64; 3]> = vec![
+        [-1.0, t, 0.0],
+        [1.0, t, 0.0],
+        [-1.0, -t, 0.0],
+        [1.0, -t, 0.0],
+        [0.0, -1.0, t],
+        [0.0, 1.0, t],
+        [0.0, -1.0, -t],
+        [0.0, 1.0, -t],
+        [t, 0.0, -1.0],
+        [t, 0.0, 1.0],
+        [-t, 0.0, -1.0],
+        [-t, 0.0, 1.0],
+    ];
+    let normalize = |p: [f64; 3]| {
+        let l = (p[0] * p[0] + p[1] * p[1] + p[2] * p[2]).sqrt();
+        p.map(|x| x / l)
+    };
+    for p in &mut positions {
+        *p = normalize(*p);
+    }
+    let mut triangles: Vec<[u32; 3]> = vec![
+        [0, 11, 5],
+        [0, 5, 1],
+        [0, 1, 7],
+        [0, 7, 10],
+        [0, 10, 11],
+        [1, 5, 9],
+        [5, 11, 4],
+        [11, 10, 2],
+        [10, 7, 6],
+        [7, 1, 8],
+        [3, 9, 4],
+        [3, 4, 2],
+        [3, 2, 6],
+        [3, 6, 8],
+        [3, 8, 9],
+        [4, 9, 5],
+        [2, 4, 11],
+        [6, 2, 10],
+        [8, 6, 7],
+        [9, 8, 1],
+    ];
+    for _ in 0..levels {
+        let mut midpoints: std::collections::HashMap<(u32, u32), u32> =
+            std::collections::HashMap::new();
+        let mut midpoint = |a: u32, b: u32, positions: &mut Vec<[f64; 3]>| {
+            *midpoints.entry((a.min(b), a.max(b))).or_insert_with(|| {
+                let (pa, pb) = (positions[a as usize], positions[b as usize]);
+                positions.push(normalize(std::array::from_fn(|k| pa[k] + pb[k])));
+                positions.len() as u32 - 1
+            })
+        };
+        let mut finer = Vec::with_capacity(triangles.len() * 4);
+        for [a, b, c] in triangles {
+            let ab = midpoint(a, b, &mut positions);
+            let bc = midpoint(b, c, &mut positions);
+            let ca = midpoint(c, a, &mut positions);
+            finer.extend([[a, ab, ca], [b, bc, ab], [c, ca, bc], [ab, bc, ca]]);
+        }
+        triangles = finer;
+    }
+    TriMesh::new(
+        positions.iter().map(|p| p.map(|x| x as f32)).collect(),
+        triangles,
+    )
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -353,6 +426,7 @@ mod tests {
             ("gear", gear(12, 1.0, 1.3, 0.4, 0.06)),
             ("d", d_prism(1.0, 0.8, 0.6, 0.1)),
             ("cad cylinder", cad_cylinder(32, 0.5, 1.5)),
+            ("icosphere", icosphere(2)),
         ] {
             let topology = Topology::build(&mesh);
             assert!(topology.is_closed(), "{name}");
@@ -375,6 +449,13 @@ mod tests {
             "{volume} against {}",
             solid - holes
         );
+        // Every vertex on the unit sphere, each level four times the faces.
+        let ball = icosphere(2);
+        assert_eq!(ball.triangles.len(), 20 * 16);
+        for p in &ball.positions {
+            let length = p.iter().map(|x| x * x).sum::<f32>().sqrt();
+            assert!((length - 1.0).abs() < 1e-6, "{p:?}");
+        }
         let size = [2.0, 1.0, 0.5];
         let volume = crate::metrics::signed_volume(&cuboid(size, 0.1));
         assert!((volume - 1.0).abs() < 1e-5, "cuboid volume {volume}");
