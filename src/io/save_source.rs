@@ -20,7 +20,7 @@ use std::path::Path;
 /// where the format holds them (glTF, OBJ: one value per welded vertex); when `mesh` no longer
 /// has the source's connectivity (a level of the hierarchy, a subdivided copy), it is written
 /// bare. Either way the report names what the output does not keep. The write is atomic, as with
-/// [`save`].
+/// [`crate::io::save`].
 pub fn save_with_source(
     path: impl AsRef<Path>,
     mesh: &TriMesh,

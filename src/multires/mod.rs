@@ -101,8 +101,9 @@ pub struct MultiresOptions {
     pub boundary: BoundaryMode,
     /// Also fair M0 after the last refinement.
     pub fair_finest: bool,
-    /// After a run from a coarser level, unfold the edges it left folded where M0 is not
-    /// ([`unfold`]; on by default). Off, the result is the levels' fairing and placements alone.
+    /// After a run from a coarser level, unfold the edges it left folded where M0 is not (the
+    /// `unfold` step; on by default). Off, the result is the levels' fairing and placements
+    /// alone.
     pub unfold: bool,
     pub variant: MultiresVariant,
     /// Where to fair ([`crate::fairing::mask`]), one weight per M0 vertex in the base mesh's

@@ -17,7 +17,7 @@ use crate::TriMesh;
 
 use super::Measures;
 
-/// What the denoise before the hierarchy found ([`crate::multires::denoise`]); the denoised
+/// What the denoise before the hierarchy found ([`crate::multires::denoise()`]); the denoised
 /// positions are the hierarchy's M0.
 #[derive(Clone, Debug)]
 pub struct DenoiseSummary {

@@ -144,7 +144,7 @@ pub struct Settings {
     /// colours left out.
     pub clay: bool,
     /// "Remove noise first": how much the mesh is denoised before the hierarchy is built on it
-    /// ([`crate::multires::denoise`]): automatically (the default of `fairmesh fair`), a fixed
+    /// ([`crate::multires::denoise()`]): automatically (the default of `fairmesh fair`), a fixed
     /// number of rounds, or not at all (the paper's multires alone).
     pub denoise: Denoise,
     /// Which defaults the settings were saved under (missing in files saved before there was
