@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # The checks that keep the code as it is meant to be, run by CI after the tests (it reuses the
 # test build): clippy with no warning, with and without the editor, and on the Python package
-# (the lints of Cargo.toml's `[lints]` table); no import cycle between the files of a module
+# (the lints of Cargo.toml's `[lints]` table); the API docs with no broken link (rustdoc, the
+# crate alone); no import cycle between the files of a module
 # (scripts/import_cycles.py); every file the `fairmesh` binary writes on the repository's meshes byte-identical to
 # scripts/output_sums.txt (scripts/check_outputs.sh).
 set -euo pipefail
@@ -14,6 +15,8 @@ if cargo clippy --version >/dev/null 2>&1; then
 else
   echo "check_code: cargo clippy is not installed (rustup component add clippy); lints not checked" >&2
 fi
+# Every intra-doc link resolves (the crate's own docs: a few seconds on the test build).
+RUSTDOCFLAGS="-D warnings" cargo doc --quiet --no-deps
 python3 scripts/import_cycles.py
 # The test build's binary (default features); built here when the tests did not build it.
 cargo build --quiet --bin fairmesh
