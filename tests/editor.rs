@@ -1113,3 +1113,24 @@ fn a_box_keeps_its_corners_at_the_opening_level() {
         assert!(moved <= 0.01 * diagonal, "corner {v} moved {moved}");
     }
 }
+
+/// A clean CAD part as exporters write it (every vertex on a rim, sides fanned from slivers),
+/// which the denoise leaves alone, opens at level 0: its result is the part as it is, where a
+/// middle level's smoothing tore its rims and slivers apart. Coarser levels stay the user's
+/// choice.
+#[test]
+fn a_clean_cad_part_opens_as_it_is() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("box_with_holes.obj");
+    let part = fairmesh::mesh::shapes::cad_box_with_holes([4.0, 3.0, 2.0], 0.2, 0.5, 16);
+    fairmesh::io::save(&path, &part).unwrap();
+    let mut harness = harness_for(path);
+    settle(&mut harness);
+    harness.get_by_label_contains("as in a CAD part");
+    let status = harness.state().status();
+    assert!(status.level_count > 1, "coarser levels to choose from");
+    assert_eq!(status.level, 0);
+    let faired = harness.state().faired_positions().unwrap();
+    let input = harness.state().document_mesh().unwrap();
+    assert!(faired.as_slice() == input.positions.as_slice());
+}

@@ -27,13 +27,24 @@ pub struct DenoiseSummary {
 }
 
 impl DenoiseSummary {
+    /// Whether the denoise left the mesh alone although its noise estimate read above the clean
+    /// threshold: all of what reads as noise lies at sharp edges or in faces that still lie flat,
+    /// as in a CAD part as exporters write it.
+    pub fn reads_as_cad_part(&self) -> bool {
+        self.report.rounds_run == 0
+            && self
+                .report
+                .noise_estimate
+                .is_some_and(|noise| noise > CLEAN_NOISE)
+    }
+
     /// What the denoise found, in a few words for the panel: "Noise about 0.23 edge lengths:
     /// 31 rounds; 49 sharp edges kept", or that it found none.
     pub fn describe(&self) -> String {
         let report = &self.report;
         if report.rounds_run == 0 {
             return match report.noise_estimate {
-                Some(noise) if noise > CLEAN_NOISE => format!(
+                Some(noise) if self.reads_as_cad_part() => format!(
                     "No noise to remove: what reads as noise (about {noise:.3} edge lengths) lies \
                      at sharp edges or in faces that still lie flat, as in a CAD part: the mesh \
                      is used as it is"

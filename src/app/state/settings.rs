@@ -256,14 +256,17 @@ impl Settings {
     }
 
     /// The start level to open `path` at, with `level_count` levels: the one last chosen for
-    /// it, or a middle level (level 0 would show the input unchanged as the result).
-    pub fn start_level_for(&self, path: &Path, level_count: usize) -> usize {
+    /// it, or a middle level (level 0 would show the input unchanged as the result), or level 0
+    /// for a `cad_part` (a clean CAD part, whose rims and slivers a coarse level's smoothing
+    /// wrecks: it opens as it is, and a coarser level is the user's choice).
+    pub fn start_level_for(&self, path: &Path, level_count: usize, cad_part: bool) -> usize {
         let top = level_count.saturating_sub(1);
+        let first = if cad_part { 0 } else { top / 2 };
         self.start_levels
             .iter()
             .rev()
             .find(|(remembered, _)| remembered == path)
-            .map_or(top / 2, |&(_, level)| level)
+            .map_or(first, |&(_, level)| level)
             .min(top)
     }
 
@@ -526,17 +529,19 @@ mod tests {
     }
 
     #[test]
-    fn start_level_is_the_files_last_choice_or_a_middle_one() {
+    fn start_level_is_the_files_last_choice_or_a_middle_one_or_0_for_a_cad_part() {
         let mut settings = Settings::default();
         let (bunny, scan) = (Path::new("/a/bunny.obj"), Path::new("/b/scan.ply"));
-        assert_eq!(settings.start_level_for(bunny, 20), 9);
-        assert_eq!(settings.start_level_for(bunny, 1), 0);
+        assert_eq!(settings.start_level_for(bunny, 20, false), 9);
+        assert_eq!(settings.start_level_for(bunny, 20, true), 0);
+        assert_eq!(settings.start_level_for(bunny, 1, false), 0);
         settings.remember_start_level(bunny, 3);
         settings.remember_start_level(scan, 12);
         settings.remember_start_level(bunny, 5);
-        assert_eq!(settings.start_level_for(bunny, 20), 5);
+        assert_eq!(settings.start_level_for(bunny, 20, false), 5);
+        assert_eq!(settings.start_level_for(bunny, 20, true), 5);
         assert_eq!(
-            settings.start_level_for(scan, 8),
+            settings.start_level_for(scan, 8, false),
             7,
             "clamped to the levels there are"
         );
@@ -545,7 +550,7 @@ mod tests {
         }
         assert_eq!(settings.start_levels.len(), Settings::REMEMBERED_FILES);
         assert_eq!(
-            settings.start_level_for(bunny, 20),
+            settings.start_level_for(bunny, 20, false),
             9,
             "the oldest are forgotten"
         );
