@@ -1,7 +1,7 @@
 //! Criterion benchmarks of one fairing iteration: constrained (both variants) and Laplacian, and
 //! of the tangential relaxation's shares set before every round of the default, on
 //! `assets/bunny00.obj` (75k faces) and on it Loop-subdivided twice (1.2M faces) with noise.
-//! Run: `cargo bench --no-default-features --bench fairing`.
+//! Run: `cargo bench --bench fairing`.
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion};
 use fairmesh::fairing::relaxation::Slivers;

@@ -1,7 +1,7 @@
 //! Criterion benchmarks of the decimation hierarchy (section 4.1) and multiresolution fairing
 //! (4.2) on bunny00 and on bunny00 Loop-subdivided twice (about 1.2M faces).
 //!
-//! `cargo bench --no-default-features --bench hierarchy`
+//! `cargo bench --bench hierarchy`
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use fairmesh::hierarchy::{build_hierarchy, HierarchyOptions};
@@ -25,7 +25,7 @@ fn bench_mesh(c: &mut Criterion, name: &str, mesh: &TriMesh) {
     for (label, level) in [("coarsest", coarsest), ("middle", coarsest / 2)] {
         let options = MultiresOptions::default().with_start_level(level);
         // The first run builds the per-level connectivity into the workspace.
-        fair_multires(&hierarchy, &options, &mut workspace, &mut NoProgress);
+        let _ = fair_multires(&hierarchy, &options, &mut workspace, &mut NoProgress);
         c.bench_function(
             &format!("multires {name} from {label} level {level}"),
             |b| b.iter(|| fair_multires(&hierarchy, &options, &mut workspace, &mut NoProgress)),

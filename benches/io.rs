@@ -1,4 +1,4 @@
-//! Load and save benchmarks for the io module: `cargo bench --no-default-features --bench io`.
+//! Load and save benchmarks for the io module: `cargo bench --bench io`.
 //!
 //! On bunny00 (75k faces) in OBJ, binary PLY and GLB (the PLY and GLB copies are written to a
 //! temporary directory at start). "load" is the whole of `io::load`: read, parse, weld, clean,

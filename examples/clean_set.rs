@@ -3,7 +3,7 @@
 //! mean surface distance (both ways) at most 0.02 mean edge lengths, Hausdorff distance at most
 //! 0.25 mean edge lengths, |volume change| at most 0.1 %.
 //!
-//! Run: `cargo run --release --no-default-features --example clean_set [-- FILE_OR_FOLDER...]`.
+//! Run: `cargo run --release --example clean_set [-- FILE_OR_FOLDER...]`.
 //! Built in: the meshes shipped with the repository (`assets/bunny00.obj`, `tests/data/*.obj`) and
 //! CAD-like parts from `mesh::shapes` (fine and coarse). Any further meshes named on the command
 //! line (files, or folders whose OBJ/PLY/OFF/STL/glTF files are all taken) are added: the

@@ -3,7 +3,7 @@
 //! default `fair` round on the 1.2M-face mesh, and at most 10 % to the hierarchy build), phase by
 //! phase, against the memory floor of each phase.
 //!
-//! Run: `cargo run --release --no-default-features --example crease_speed [-- RUNS [phases|end]]`
+//! Run: `cargo run --release --example crease_speed [-- RUNS [phases|end]]`
 //! (`phases` or `end`: only the phase rows or only the end-to-end rows).
 //!
 //! The mesh is `assets/bunny00.obj` Loop-subdivided twice (603k vertices, 1.2M faces), clean and

@@ -3,7 +3,7 @@
 //! default `fair` (automatic strength, creases kept) ends from the clean surface, next to the
 //! previous default (one round of 10 iterations, no creases) and to fixed round counts.
 //!
-//! Run: `cargo run --release --no-default-features --example fairing_default [-- --trace]`
+//! Run: `cargo run --release --example fairing_default [-- --trace]`
 //! (`--only gear,cube` runs just those meshes; `--files a.obj,b.ply` adds meshes from files, named
 //! by their stem; `--sigma 0.15` changes the noise, `--seed 2` its draw (1 unless told); `--default-only` prints the default's row
 //! alone; `--save DIR` writes the clean meshes as PLY files and stops; `--tangential 0.1` gives the

@@ -3,7 +3,7 @@
 //! variants) with each baseline at its best iteration count (scanned), against the clean mesh.
 //! Also measures how far each variant moves the vertices of the noise-free mesh.
 //!
-//! Run: `cargo run --release --no-default-features --example fairing_quality [DATA_DIR]`
+//! Run: `cargo run --release --example fairing_quality [DATA_DIR]`
 //! (meshes bunny00, elephant, mushroom_open: read from DATA_DIR when given, otherwise from the
 //! repository's `assets/` and `tests/data/`). `docs/measurements.md` holds the tables it printed.
 //!

@@ -1,7 +1,7 @@
 //! Speed of one fairing iteration against the memory floor, on `assets/bunny00.obj` and on it
 //! Loop-subdivided twice (about 1.2M faces) with noise.
 //!
-//! Run: `cargo run --release --no-default-features --example fairing_speed`
+//! Run: `cargo run --release --example fairing_speed`
 //!
 //! For each mesh and operator: median wall time per iteration (rayon's default pool), the
 //! process CPU time per iteration (from /proc/self/stat, robust when other processes share the

@@ -3,7 +3,7 @@
 //! decimation hierarchy), print how close each result comes back to the clean mesh and how much
 //! volume it lost, and write the best one.
 //!
-//! Run: `cargo run --release --no-default-features --example quickstart [MESH] [OUT]`
+//! Run: `cargo run --release --example quickstart [MESH] [OUT]`
 //! (MESH defaults to the bunny compiled into the library; OUT, when given, receives the
 //! multiresolution result, in the format its extension names).
 
@@ -71,8 +71,7 @@ fn run() -> Result<(), Box<dyn std::error::Error>> {
     let start_level = hierarchy.coarsest_level() / 2;
     let options = MultiresOptions::default().with_start_level(start_level);
     let mut workspace = MultiresWorkspace::default();
-    let positions = fair_multires(&hierarchy, &options, &mut workspace, &mut NoProgress)
-        .ok_or("multiresolution fairing was cancelled")?;
+    let positions = fair_multires(&hierarchy, &options, &mut workspace, &mut NoProgress)?;
     // The positions come back in the input's vertex order, for the input's triangles.
     let multires = TriMesh::new(positions, hierarchy.base_mesh().triangles.clone());
     report(

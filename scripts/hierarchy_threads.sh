@@ -9,7 +9,7 @@
 # round), so that a shared machine's drift from minute to minute falls on all alike; prints the
 # median `total_ms` (the build alone, loading excluded) per binary and thread count, every run
 # sorted, and the ratio of the medians. BINARY defaults to target/release/fairmesh (build it
-# with `cargo build --release --no-default-features --features cli`). Needs python3 for the JSON.
+# with `cargo build --release -p fairmesh-cli --no-default-features`). Needs python3 for the JSON.
 set -euo pipefail
 if [ $# -lt 2 ]; then
     echo "usage: $0 MESH RUNS [BINARY...]" >&2

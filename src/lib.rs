@@ -9,7 +9,6 @@
 //! - [`multires`]: multiresolution fairing from a chosen coarse level (4.2).
 //! - [`noise`], [`metrics`]: seeded noise; volume, area, surface distance and other comparisons.
 //! - [`bundled`]: the Stanford bunny compiled into the library, so the binary needs no files.
-//! - `app`, `render` (feature `gui`): the editor; nothing else imports egui or wgpu.
 //!
 //! The library never prints and never spawns long-lived threads (rayon's pool aside); long
 //! operations take a [`Progress`] hook to report progress and to be cancelled.
@@ -18,12 +17,11 @@
 //! paper lives and how the editor is tested without a GPU; `docs/paper.md` is the reading of the
 //! paper that the code follows; `docs/measurements.md` holds the measurements behind the defaults.
 //!
-//! # Features
-//! - `cli` (default): the `fairmesh` command-line tool (clap, anyhow); the binary needs it.
-//! - `gui` (default): the editor, modules `app` and `render` (eframe, egui, wgpu, rfd).
-//!
-//! With `default-features = false` the library alone builds, with its own few dependencies
-//! (glam, rayon, gltf, serde, thiserror, rand).
+//! # The workspace around it
+//! The library has no GUI and no command-line dependency. Beside it, in the same repository:
+//! the editor (crate `fairmesh-editor`, eframe, egui and wgpu), the `fairmesh` binary (crate
+//! `fairmesh-cli`: the command-line tool, and the editor when given no subcommand) and the
+//! Python package (`python/`). Each of them uses this library's public API only.
 //!
 //! # Public dependencies
 //! Points and vectors in the API are [glam](https://docs.rs/glam/0.34) 0.34 types (`DVec3` in
@@ -80,11 +78,6 @@ pub mod metrics;
 pub mod multires;
 pub mod noise;
 
-#[cfg(feature = "gui")]
-pub mod app;
-#[cfg(feature = "gui")]
-pub mod render;
-
 pub use mesh::{Topology, TriMesh};
 
 /// The glam version the API uses (0.34), for callers that build or read its points.
@@ -95,7 +88,30 @@ pub use glam;
 /// so that operations can run their whole body on a worker of the rayon pool.
 pub trait Progress: Send {
     fn report(&mut self, fraction: f32) -> bool;
+
+    /// [`report`](Self::report) as a `Result`: `Err(Cancelled)` when the hook asks to stop, so
+    /// that an operation passes the stop on with `?`.
+    fn check(&mut self, fraction: f32) -> Result<(), Cancelled> {
+        if self.report(fraction) {
+            Ok(())
+        } else {
+            Err(Cancelled)
+        }
+    }
 }
+
+/// A long operation stopped part-way because its [`Progress`] hook asked it to. What it was
+/// changing in place is left part-way: the caller drops it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Cancelled;
+
+impl std::fmt::Display for Cancelled {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str("cancelled")
+    }
+}
+
+impl std::error::Error for Cancelled {}
 
 impl<F: FnMut(f32) -> bool + Send> Progress for F {
     fn report(&mut self, fraction: f32) -> bool {

@@ -15,8 +15,9 @@ use crate::metrics;
 use rand::{Rng, SeedableRng};
 use rand_distr::{Distribution, Normal, StandardNormal};
 
+/// Exhaustive on purpose: the editor, the CLI and the Python package each name every choice, so a
+/// new one is a breaking change that they all take up.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
-#[non_exhaustive]
 pub enum NoiseMode {
     /// Random unit direction, Gaussian distance.
     Direction,

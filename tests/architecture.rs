@@ -1,5 +1,6 @@
-//! `docs/architecture.md` matches the tree: its "Source files" list names every Rust file under
-//! `src/` by its path, and every path it names there exists.
+//! `docs/architecture.md` matches the tree: its "Source files" list names every Rust file of the
+//! library (`src/`), the editor (`editor/src/`) and the binary (`cli/src/`) by its path from the
+//! repository's root, and every path it names there exists.
 
 use std::collections::BTreeSet;
 use std::path::Path;
@@ -10,14 +11,17 @@ fn rust_files(dir: &Path, root: &Path, found: &mut BTreeSet<String>) {
         if path.is_dir() {
             rust_files(&path, root, found);
         } else if path.extension().is_some_and(|e| e == "rs") {
-            let relative = path.strip_prefix(root).expect("under src/");
+            let relative = path.strip_prefix(root).expect("under the repository");
             found.insert(relative.to_string_lossy().replace('\\', "/"));
         }
     }
 }
 
-/// The `src/...rs` paths named in the "Source files" section (between its heading and the next
-/// `## ` heading), each written as `` `src/PATH.rs` ``.
+/// The folders whose Rust files the page lists, from the repository's root.
+const SOURCE_FOLDERS: [&str; 3] = ["src/", "editor/src/", "cli/src/"];
+
+/// The `.rs` paths under [`SOURCE_FOLDERS`] named in the "Source files" section (between its
+/// heading and the next `## ` heading), each written as `` `FOLDER/PATH.rs` ``.
 fn named_files(doc: &str) -> BTreeSet<String> {
     let start = doc
         .find("\n## Source files")
@@ -26,10 +30,8 @@ fn named_files(doc: &str) -> BTreeSet<String> {
     let end = section[3..].find("\n## ").map_or(section.len(), |i| i + 3);
     let mut named = BTreeSet::new();
     for piece in section[..end].split('`').skip(1).step_by(2) {
-        if let Some(path) = piece.strip_prefix("src/") {
-            if path.ends_with(".rs") {
-                named.insert(path.to_string());
-            }
+        if piece.ends_with(".rs") && SOURCE_FOLDERS.iter().any(|f| piece.starts_with(f)) {
+            named.insert(piece.to_string());
         }
     }
     named
@@ -39,18 +41,51 @@ fn named_files(doc: &str) -> BTreeSet<String> {
 fn the_architecture_page_names_every_source_file_and_no_other() {
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
     let mut files = BTreeSet::new();
-    rust_files(&root.join("src"), &root.join("src"), &mut files);
+    for folder in SOURCE_FOLDERS {
+        rust_files(&root.join(folder), root, &mut files);
+    }
     let doc = std::fs::read_to_string(root.join("docs/architecture.md")).expect("the page exists");
     let named = named_files(&doc);
     let missing: Vec<_> = files.difference(&named).collect();
     let stale: Vec<_> = named.difference(&files).collect();
     assert!(
         missing.is_empty() && stale.is_empty(),
-        "docs/architecture.md, 'Source files': not named: {missing:?}; named but not in src/: {stale:?}"
+        "docs/architecture.md, 'Source files': not named: {missing:?}; named but not in the tree: {stale:?}"
     );
     assert!(
-        files.len() > 50,
-        "found only {} files under src/",
+        files.len() > 150,
+        "found only {} source files",
         files.len()
     );
+}
+
+/// The library stands alone: none of the GUI stack is among its dependencies, direct or
+/// transitive (the editor is a crate of its own, `fairmesh-editor`, that uses the library). Reads
+/// `cargo tree` of the package offline, from `Cargo.lock`.
+#[test]
+fn the_library_depends_on_no_gui_crate() {
+    let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".to_string());
+    let output = std::process::Command::new(cargo)
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .args(["tree", "--offline", "--locked", "-p", "fairmesh", "-e", "normal"])
+        .args(["--prefix", "none", "--format", "{p}"])
+        .output()
+        .expect("cargo runs");
+    assert!(
+        output.status.success(),
+        "cargo tree failed: {}",
+        String::from_utf8_lossy(&output.stderr)
+    );
+    let tree = String::from_utf8_lossy(&output.stdout);
+    let crates: BTreeSet<&str> = tree
+        .lines()
+        .filter_map(|line| line.split_whitespace().next())
+        .collect();
+    assert!(crates.contains("glam") && crates.contains("rayon"), "{tree}");
+    for gui in ["eframe", "egui", "egui-wgpu", "wgpu", "winit", "rfd", "clap", "anyhow"] {
+        assert!(
+            !crates.contains(gui),
+            "the library depends on {gui}:\n{tree}"
+        );
+    }
 }

@@ -581,52 +581,6 @@ fn normal_projection_stops_sliding_on_the_clean_bunny() {
     assert!(projected_volume < 1e-4 && paper_volume < 1e-4);
 }
 
-/// `fairmesh fair --json` end to end on a mesh shipped in the repository.
-#[test]
-#[cfg(feature = "cli")] // runs the binary
-fn cli_fair_writes_the_mesh_and_reports_json() {
-    let directory = tempfile::tempdir().unwrap();
-    let output = directory.path().join("faired.obj");
-    for (method, extra) in [
-        ("constrained", vec!["--rounds", "2", "--tolerance", "1e-4"]),
-        ("laplacian", vec!["--lambda", "0.4"]),
-        ("taubin", vec!["--mu", "-0.55"]),
-        ("hc", vec!["--boundary", "fixed"]),
-    ] {
-        let mut args = vec![
-            "fair",
-            "tests/data/mushroom_open.obj",
-            "-o",
-            output.to_str().unwrap(),
-            "--method",
-            method,
-            "--json",
-        ];
-        args.extend(extra);
-        let result = std::process::Command::new(env!("CARGO_BIN_EXE_fairmesh"))
-            .args(&args)
-            .output()
-            .unwrap();
-        assert!(
-            result.status.success(),
-            "{args:?}: {}",
-            String::from_utf8_lossy(&result.stderr)
-        );
-        let json: serde_json::Value = serde_json::from_slice(&result.stdout).unwrap();
-        assert_eq!(json["method"], method);
-        for key in [
-            "iterations_run",
-            "time_ms",
-            "volume_change_percent",
-            "max_move",
-        ] {
-            assert!(json[key].is_number(), "{method}: {key} missing in {json}");
-        }
-        let written = fairmesh::io::load(&output).unwrap();
-        assert_eq!(written.mesh.face_count(), 4608);
-    }
-}
-
 /// Distance from `p` to the nearest edge of the axis-aligned unit cube [0, 1]³.
 fn distance_to_cube_edge(p: [f32; 3]) -> f64 {
     let p = p.map(|c| c as f64);

@@ -808,40 +808,6 @@ fn non_manifold_input_loads_with_warnings() {
     );
 }
 
-#[test]
-fn cli_info_reports_load_errors_with_exit_code_1() {
-    let dir = tempfile::tempdir().unwrap();
-    let path = dir.path().join("broken.obj");
-    std::fs::write(&path, "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 4\n").unwrap();
-    let output = std::process::Command::new(env!("CARGO_BIN_EXE_fairmesh"))
-        .arg("info")
-        .arg(&path)
-        .output()
-        .unwrap();
-    assert_eq!(output.status.code(), Some(1));
-    let stderr = String::from_utf8_lossy(&output.stderr);
-    assert!(
-        stderr.contains(&format!(
-            "{}: line 4: face 1: vertex index 4 is out of range",
-            path.display()
-        )),
-        "{stderr}"
-    );
-
-    let good = dir.path().join("good.off");
-    std::fs::write(&good, "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n").unwrap();
-    let output = std::process::Command::new(env!("CARGO_BIN_EXE_fairmesh"))
-        .arg("info")
-        .arg(&good)
-        .output()
-        .unwrap();
-    assert!(
-        output.status.success(),
-        "{}",
-        String::from_utf8_lossy(&output.stderr)
-    );
-}
-
 fn listing(dir: &Path) -> Vec<String> {
     let mut names: Vec<String> = std::fs::read_dir(dir)
         .unwrap()

@@ -46,7 +46,7 @@ fn fair_mesh(
         && o.variant == FairVariant::NormalProjected);
     let textured_input = (slides && textured).then(|| mesh.positions.clone());
     let start = Instant::now();
-    let report = fairing::fair_with_progress(mesh, topology, options, mask, progress)?;
+    let report = fairing::fair_with_progress(mesh, topology, options, mask, progress).ok()?;
     let time_ms = start.elapsed().as_secs_f64() * 1e3;
     let volume_after = metrics::signed_volume(mesh);
     let volume_change_percent = (volume_before != 0.0)

@@ -156,7 +156,7 @@ impl Hierarchy {
             let mut workspace = workspace
                 .lock()
                 .unwrap_or_else(std::sync::PoisonError::into_inner);
-            fair_multires(hierarchy, &options, &mut workspace, hook)
+            fair_multires(hierarchy, &options, &mut workspace, hook).ok()
         })?;
         if let Some((mask, input)) = fade_into {
             mask.blend(input, &mut positions);
@@ -257,7 +257,7 @@ pub fn hierarchy(
     let (built, report) = run_detached(py, progress, threads, |hook| {
         let denoised = match &denoise_options {
             Some(denoise_options) => {
-                fairmesh::multires::denoise(&mesh, &topology, denoise_options, hook)?
+                fairmesh::multires::denoise(&mesh, &topology, denoise_options, hook).ok()?
             }
             None => None,
         };

@@ -31,7 +31,7 @@ several it ends with each mesh and mode over the seeds. Prints a Markdown table 
 against the best peer's, and in how many cases `fair` ends closer. The set of clean meshes the
 project measures on (the repository's, the CAD-like parts, and those `docs/measurements.md` names)
 is written as PLY files by
-    cargo run --release --no-default-features --example fairing_default -- --save DIR --files ...
+    cargo run --release --example fairing_default -- --save DIR --files ...
 """
 
 import argparse

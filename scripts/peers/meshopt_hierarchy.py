@@ -8,7 +8,7 @@ busy machine slows both alike.
 
 Install (meshoptimizer's Python package builds its C++ code; numpy reads the mesh):
     python3 -m venv venv && venv/bin/pip install numpy meshoptimizer
-Run from the repository root after `cargo build --release --no-default-features --features cli`:
+Run from the repository root after `cargo build --release -p fairmesh-cli --no-default-features`:
     venv/bin/python scripts/peers/meshopt_hierarchy.py MESH [--runs 3] [--threads 2]
 MESH is any file fairmesh reads (it is converted to a binary PLY once, outside the timings).
 Prints each run's times and the ratio of the medians.

@@ -78,8 +78,9 @@ pub use mask::{Mask, MaskError};
 pub use strength::estimate_noise;
 
 /// How boundary vertices of open meshes move.
+/// Exhaustive on purpose: the editor, the CLI and the Python package each name every choice, so a
+/// new one is a breaking change that they all take up.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
-#[non_exhaustive]
 pub enum BoundaryMode {
     /// Each boundary loop is smoothed as a closed curve (section 3.3).
     #[default]
@@ -317,8 +318,9 @@ pub struct FairPhases {
 }
 
 /// The smoothing methods offered by the CLI and the editor.
+/// Exhaustive on purpose: the editor, the CLI and the Python package each name every choice, so a
+/// new one is a breaking change that they all take up.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
-#[non_exhaustive]
 pub enum Method {
     /// Constrained fairing (the paper's method).
     #[default]
@@ -403,9 +405,9 @@ pub fn fair(mesh: &mut TriMesh, topology: &Topology, options: &MethodOptions) ->
 }
 
 /// [`fair`], or [`fair_masked`] with a `mask`, reporting to `progress` and stopping when it
-/// returns false (`None` then, with `mesh` left part-way: the caller drops it). Constrained
-/// fairing reports after every round ([`fair_constrained_with_progress`]); a baseline, whose
-/// iterations take a fraction of that, reports when it is done. Not cancelled, the result is
+/// returns false ([`Cancelled`](crate::Cancelled) then, with `mesh` left part-way: the caller
+/// drops it). Constrained fairing reports after every round ([`fair_constrained_with_progress`]);
+/// a baseline, whose iterations take a fraction of that, reports when it is done. Not cancelled, the result is
 /// the same as [`fair`]'s or [`fair_masked`]'s, bit for bit.
 pub fn fair_with_progress(
     mesh: &mut TriMesh,
@@ -413,10 +415,11 @@ pub fn fair_with_progress(
     options: &MethodOptions,
     mask: Option<&Mask>,
     progress: &mut dyn crate::Progress,
-) -> Option<FairReport> {
+) -> Result<FairReport, crate::Cancelled> {
     if let (MethodOptions::Constrained(o), Some(mask)) = (options, mask) {
         if mask.check_fits(mesh.positions.len()).is_err() {
-            return progress.report(1.0).then(FairReport::default);
+            progress.check(1.0)?;
+            return Ok(FairReport::default());
         }
         let masked = o.clone().with_mask(Some(mask.clone()));
         return fair_constrained_with_progress(mesh, topology, &masked, progress);
@@ -428,7 +431,8 @@ pub fn fair_with_progress(
         Some(mask) => fair_masked(mesh, topology, options, mask),
         None => fair(mesh, topology, options),
     };
-    progress.report(1.0).then_some(report)
+    progress.check(1.0)?;
+    Ok(report)
 }
 
 /// [`fair`] changing the mesh only where `mask` allows ([`mask`]): constrained fairing holds the

@@ -105,8 +105,11 @@ pub(crate) fn stage_copy(from: &Path, to: &Path) -> Result<Staged, IoError> {
     stage(to, |w| w.write_all(&bytes))
 }
 
-/// Write `path` atomically with `fill`, which writes the whole content.
-pub(crate) fn write(
+/// Writes `path` atomically with `fill`, which writes the whole content: into a temporary file
+/// beside it, renamed over `path` once complete, so that a failure leaves an existing `path` as it
+/// was and nothing behind (exported as `fairmesh::io::write_atomically`, for files that front
+/// ends write themselves, such as a picture of the view).
+pub fn write(
     path: &Path,
     fill: impl FnOnce(&mut dyn Write) -> std::io::Result<()>,
 ) -> Result<(), IoError> {

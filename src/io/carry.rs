@@ -12,7 +12,7 @@
 
 /// Per welded vertex: UVs and RGBA colours (0..1), each present when the source had them.
 #[derive(Debug, Default)]
-pub(crate) struct VertexAttributes {
+pub struct VertexAttributes {
     pub uvs: Option<Vec<[f32; 2]>>,
     pub colours: Option<Vec<[f32; 4]>>,
     /// Welded vertices whose file vertices had different UVs / colours (the first was kept).

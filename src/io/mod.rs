@@ -33,13 +33,15 @@ mod ply;
 mod report;
 mod save;
 mod save_source;
-pub(crate) mod scene;
+pub mod scene;
 mod source;
 mod stl;
 mod text;
 mod uv_follow;
 mod vertex_list;
 
+pub use atomic::write as write_atomically;
+pub use carry::VertexAttributes;
 pub use error::{IoError, Location};
 pub use finish::{finish, LoadOptions, Loaded};
 pub use format::Format;

@@ -14,6 +14,9 @@
 //! split normals (hard edges, UV seams) stay split, smooth ones stay smooth. A file with no
 //! normals gets none in OBJ and area-weighted smooth ones in glTF (which wants them).
 //!
+//! Front ends read a loaded file's [`Scene`] through [`Source::scene`](super::Source::scene) to
+//! draw its materials; building and writing one stays inside the library.
+//!
 //! Images: an external image file is copied beside the output when it is not in the output's
 //! folder already (as `<output stem>_<name>` when another file of that name is there), and
 //! referred to by its file name; an image stored inside a glTF (buffer view or data: URI) is
@@ -26,7 +29,7 @@ use std::path::{Path, PathBuf};
 
 /// A source's structure, for writing it in another format.
 #[derive(Debug, Default)]
-pub(crate) struct Scene {
+pub struct Scene {
     pub vertices: Vec<SceneVertex>,
     /// Whether the file had UVs, colours and normals (on any of its parts).
     pub uvs: bool,
@@ -43,7 +46,7 @@ pub(crate) struct Scene {
 
 /// One file vertex.
 #[derive(Clone, Copy, Debug)]
-pub(crate) struct SceneVertex {
+pub struct SceneVertex {
     /// The welded vertex it became (its position in the faired mesh); `u32::MAX` if dropped.
     pub welded: u32,
     /// Its position as the file had it, in world space (for turning the normals).
@@ -72,7 +75,7 @@ impl SceneVertex {
 
 /// A named part: a glTF node with its mesh, or the faces under one OBJ `o` and `g`.
 #[derive(Debug, Default)]
-pub(crate) struct Part {
+pub struct Part {
     /// The glTF node's name, or the OBJ `o` name.
     pub object: Option<String>,
     /// The glTF mesh's name, or the OBJ `g` name.
@@ -82,13 +85,13 @@ pub(crate) struct Part {
 
 /// Triangles of one material, corners as indices into [`Scene::vertices`].
 #[derive(Debug, Default)]
-pub(crate) struct Primitive {
+pub struct Primitive {
     pub material: Option<usize>,
     pub triangles: Vec<[u32; 3]>,
 }
 
 #[derive(Debug)]
-pub(crate) struct Material {
+pub struct Material {
     pub name: String,
     /// Linear RGBA (glTF baseColorFactor; an MTL's Kd and d).
     pub base_colour: [f32; 4],
@@ -119,7 +122,7 @@ pub struct TextureTransform {
 impl TextureTransform {
     /// The extension's object (`None` when it is no object); fields it leaves out take the
     /// extension's defaults (offset 0, rotation 0, scale 1).
-    pub(crate) fn from_gltf(json: &serde_json::Value) -> Option<TextureTransform> {
+    pub fn from_gltf(json: &serde_json::Value) -> Option<TextureTransform> {
         json.as_object()?;
         let pair = |key: &str, default: f32| {
             let list = json.get(key).and_then(serde_json::Value::as_array);
@@ -213,14 +216,14 @@ impl TextureSampler {
 }
 
 #[derive(Debug, Clone)]
-pub(crate) struct Image {
+pub struct Image {
     /// The file name it gets beside the output (and had, for an external file).
     pub name: String,
     pub data: ImageData,
 }
 
 #[derive(Debug, Clone)]
-pub(crate) enum ImageData {
+pub enum ImageData {
     /// An external file, resolved against the input's folder.
     File(PathBuf),
     /// Bytes stored inside the input.
@@ -228,7 +231,8 @@ pub(crate) enum ImageData {
 }
 
 impl ImageData {
-    pub(crate) fn bytes(&self) -> std::io::Result<std::borrow::Cow<'_, [u8]>> {
+    /// The image file's bytes: read from its file, or borrowed from the input that stored it.
+    pub fn bytes(&self) -> std::io::Result<std::borrow::Cow<'_, [u8]>> {
         match self {
             ImageData::File(path) => std::fs::read(path).map(std::borrow::Cow::Owned),
             ImageData::Bytes(bytes) => Ok(std::borrow::Cow::Borrowed(bytes)),

@@ -121,7 +121,7 @@ impl Source {
 
     /// The file's UVs and vertex colours per welded vertex (see [`super::carry`]), for writing
     /// another format.
-    pub(crate) fn vertex_attributes(&self) -> VertexAttributes {
+    pub fn vertex_attributes(&self) -> VertexAttributes {
         match &self.data {
             SourceData::Obj(bytes) => super::obj::vertex_attributes(bytes, &self.origin),
             SourceData::Ply(bytes) => super::ply::vertex_attributes(bytes, &self.origin),
@@ -132,8 +132,8 @@ impl Source {
 
     /// The file's parts, materials and file vertices (see [`super::scene`]) for writing another
     /// format, with normals turned to `mesh`'s positions; `None` for a format with no structure
-    /// to carry (PLY, STL, OFF).
-    pub(crate) fn scene(&self, mesh: &TriMesh) -> Option<Scene> {
+    /// to carry (PLY, STL, OFF). Front ends read it to draw the file's materials.
+    pub fn scene(&self, mesh: &TriMesh) -> Option<Scene> {
         match &self.data {
             SourceData::Obj(bytes) => Some(super::obj::scene(bytes, &self.origin, mesh)),
             SourceData::Gltf(gltf) => Some(gltf.scene(&self.origin, mesh)),

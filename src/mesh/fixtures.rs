@@ -28,24 +28,9 @@ pub(crate) fn octahedron(scale: f32) -> TriMesh {
     )
 }
 
-/// A flat grid of `n`×`n` squares of side 1 in the plane z = 0, each cut into two triangles
-/// (valence 6 inside); vertex (x, y) is y·(n + 1) + x.
+/// A flat grid of `n`×`n` squares of side 1 ([`super::shapes::grid`]).
 pub(crate) fn grid(n: usize) -> TriMesh {
-    let mut positions = Vec::new();
-    for y in 0..=n {
-        for x in 0..=n {
-            positions.push([x as f32, y as f32, 0.0]);
-        }
-    }
-    let at = |x: usize, y: usize| (y * (n + 1) + x) as u32;
-    let mut triangles = Vec::new();
-    for y in 0..n {
-        for x in 0..n {
-            triangles.push([at(x, y), at(x + 1, y), at(x + 1, y + 1)]);
-            triangles.push([at(x, y), at(x + 1, y + 1), at(x, y + 1)]);
-        }
-    }
-    TriMesh::new(positions, triangles)
+    super::shapes::grid(n)
 }
 
 /// Three triangles sharing the edge (0, 1): the smallest non-manifold mesh.

@@ -1,6 +1,6 @@
 //! CAD-like test shapes with sharp edges: prisms made by extruding a closed outline (a square, a
 //! circle, a gear, a D made of a half-disc on a rectangle), with evenly sampled sides and caps;
-//! CAD parts as exporters write them; and, for contrast, a smooth icosphere.
+//! CAD parts as exporters write them; and, for contrast, a smooth icosphere and a flat grid.
 //!
 //! Not part of the paper: the fairing's crease handling and its clean-mesh bounds are measured on
 //! these (the tests, `examples/fairing_quality.rs`), since scanned meshes have few sharp edges.
@@ -339,6 +339,26 @@ impl Faces {
     fn mesh(self) -> TriMesh {
         TriMesh::new(self.positions, self.triangles)
     }
+}
+
+/// A flat grid of `n`×`n` squares of side 1 in the plane z = 0, each cut into two triangles
+/// (valence 6 inside); vertex (x, y) is y·(n + 1) + x.
+pub fn grid(n: usize) -> TriMesh {
+    let mut positions = Vec::new();
+    for y in 0..=n {
+        for x in 0..=n {
+            positions.push([x as f32, y as f32, 0.0]);
+        }
+    }
+    let at = |x: usize, y: usize| (y * (n + 1) + x) as u32;
+    let mut triangles = Vec::new();
+    for y in 0..n {
+        for x in 0..n {
+            triangles.push([at(x, y), at(x + 1, y), at(x + 1, y + 1)]);
+            triangles.push([at(x, y), at(x + 1, y + 1), at(x, y + 1)]);
+        }
+    }
+    TriMesh::new(positions, triangles)
 }
 
 /// A unit icosphere, a smooth shape with no sharp edge: an icosahedron, each triangle split in

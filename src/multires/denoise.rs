@@ -17,7 +17,7 @@ use crate::fairing::{
     fair_constrained_with_progress, BoundaryMode, CreaseOptions, FairOptions, FairReport,
 };
 use crate::mesh::{Topology, TriMesh};
-use crate::Progress;
+use crate::{Cancelled, Progress};
 
 /// How much the first stage fairs.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
@@ -79,20 +79,21 @@ pub struct Denoised {
 }
 
 /// Runs the first stage on a copy of `mesh` (`topology` built from it), reporting to
-/// `progress`: `Some(None)` when `options` ask for no stage ([`Denoise::Off`], no rounds),
-/// `None` when `progress` cancelled it.
+/// `progress`: `Ok(None)` when `options` ask for no stage ([`Denoise::Off`], no rounds),
+/// [`Cancelled`] when `progress` cancelled it.
 pub fn denoise(
     mesh: &TriMesh,
     topology: &Topology,
     options: &DenoiseOptions,
     progress: &mut dyn Progress,
-) -> Option<Option<Denoised>> {
+) -> Result<Option<Denoised>, Cancelled> {
     let Some(fair_options) = options.fair_options() else {
-        return progress.report(1.0).then_some(None);
+        progress.check(1.0)?;
+        return Ok(None);
     };
     let mut denoised = mesh.clone();
     let report = fair_constrained_with_progress(&mut denoised, topology, &fair_options, progress)?;
-    Some(Some(Denoised {
+    Ok(Some(Denoised {
         mesh: denoised,
         report,
     }))
@@ -125,17 +126,17 @@ mod tests {
                 ..DenoiseOptions::default()
             };
             let none = denoise(&noisy, &topology, &options, &mut crate::NoProgress);
-            assert!(matches!(none, Some(None)), "{off:?}");
+            assert!(matches!(none, Ok(None)), "{off:?}");
         }
         let two = DenoiseOptions {
             denoise: Denoise::Rounds(2),
             ..DenoiseOptions::default()
         };
         let fixed = denoise(&noisy, &topology, &two, &mut crate::NoProgress)
-            .flatten()
+            .expect("not cancelled")
             .expect("two rounds");
         assert_eq!(fixed.report.rounds_run, 2);
         let cancelled = denoise(&noisy, &topology, &options, &mut |_: f32| false);
-        assert!(cancelled.is_none());
+        assert_eq!(cancelled.err(), Some(Cancelled));
     }
 }

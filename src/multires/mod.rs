@@ -73,13 +73,17 @@ pub use denoise::{denoise, Denoise, DenoiseOptions, Denoised};
 use crate::fairing::{BoundaryMode, ConstrainedFairing, Creases, FairOptions, FairVariant, Mask};
 use crate::hierarchy::Hierarchy;
 use crate::mesh::{FanRings, Topology, TriMesh};
-use crate::Progress;
+use crate::{Cancelled, Progress};
 use glam::Vec3A;
 use rayon::prelude::*;
 use refine::{refine_positions, remove_low_frequency_shrinkage};
 
+/// Which multiresolution recipe runs: `Paper`, section 4 as the paper writes it, or `Improved`
+/// (the default), which also takes each level's shrinkage back.
+///
+/// Exhaustive on purpose: the editor, the CLI and the Python package each name every choice, so a
+/// new one is a breaking change that they all take up.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
-#[non_exhaustive]
 pub enum MultiresVariant {
     Paper,
     #[default]
@@ -383,7 +387,7 @@ fn level_fair_options(options: &MultiresOptions) -> FairOptions {
 }
 
 /// Returns M0's positions after fairing (M0's triangles are `hierarchy.base_mesh().triangles`),
-/// or `None` when `progress` cancelled the run.
+/// or [`Cancelled`] when `progress` cancelled the run.
 ///
 /// ```
 /// use fairmesh::hierarchy::{build_hierarchy, HierarchyOptions};
@@ -407,14 +411,15 @@ pub fn fair_multires(
     options: &MultiresOptions,
     workspace: &mut MultiresWorkspace,
     progress: &mut dyn Progress,
-) -> Option<Vec<[f32; 3]>> {
+) -> Result<Vec<[f32; 3]>, Cancelled> {
     // A run makes a dozen small parallel calls per level. Issued from outside the pool, each one
     // is handed to a worker and waited for (a futex round trip); from a worker they run in place
     // or are stolen, so the whole run goes to the pool once.
     let original = &hierarchy.base_mesh().positions;
     if let Some(mask) = &options.mask {
         if mask.check_fits(original.len()).is_err() || mask.painted_count() == 0 {
-            return progress.report(1.0).then(|| original.clone());
+            progress.check(1.0)?;
+            return Ok(original.clone());
         }
     }
     let mut result =
@@ -422,7 +427,7 @@ pub fn fair_multires(
     if let Some(mask) = &options.mask {
         mask.blend(original, &mut result);
     }
-    Some(result)
+    Ok(result)
 }
 
 /// [`fair_multires`] on the calling thread: from the start level down, each level faired (and,
@@ -432,7 +437,7 @@ fn fair_multires_on_worker(
     options: &MultiresOptions,
     workspace: &mut MultiresWorkspace,
     progress: &mut dyn Progress,
-) -> Option<Vec<[f32; 3]>> {
+) -> Result<Vec<[f32; 3]>, Cancelled> {
     let start = options.start_level.min(hierarchy.coarsest_level());
     let fair_options = level_fair_options(options);
     let operator = (fair_options.variant, fair_options.boundary);
@@ -447,9 +452,7 @@ fn fair_multires_on_worker(
     for level in (1..=start).rev() {
         to_finer_level(hierarchy, options, &fair_options, workspace, level, &fixed);
         done += hierarchy.level_info(level).vertices as f64;
-        if !progress.report((done / total) as f32) {
-            return None;
-        }
+        progress.check((done / total) as f32)?;
     }
     if start == 0 || options.fair_finest {
         if release {
@@ -457,9 +460,7 @@ fn fair_multires_on_worker(
             workspace.prepare_levels(hierarchy, 0..=0, |_| Some(operator));
         }
         fair_level(workspace, 0, &fair_options);
-        if !progress.report(1.0) {
-            return None;
-        }
+        progress.check(1.0)?;
     }
     if start > 0 && options.unfold {
         let keep_volume = options.variant == MultiresVariant::Improved;
@@ -474,7 +475,7 @@ fn fair_multires_on_worker(
     for (v, p) in workspace.positions.iter().enumerate() {
         result[hierarchy.original_vertex(v as u32) as usize] = *p;
     }
-    Some(result)
+    Ok(result)
 }
 
 /// The last step of a run from a coarser level ([`unfold`]): the edges it left folded where M0

@@ -91,30 +91,40 @@ pub fn invert3(a: &Matrix3) -> Option<Matrix3> {
     }))
 }
 
-/// How triangle `t` gets a local solution: `Some(None)` with every corner free (none held:
-/// `held` flags the boundary, crease and pinned vertices), `Some(Some(h))` with corner h held
-/// where it is (see the module docs: the one held corner, held by a crease, not by the boundary,
-/// which the paper leaves unsolved, nor pinned), `None` for no solution (two or three corners
-/// held, or the one held by the boundary or pinned). Only a triangle whose corners are distinct
-/// and of valence three or more (so that A is invertible) is solved.
+/// How a triangle gets its local solution ([`triangle_solve`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub(super) enum LocalSolve {
+    /// Every corner free: the paper's solution ([`corner_weights`]).
+    AllFree,
+    /// The corner at this index (0, 1 or 2) held where it is, the other two solved
+    /// ([`held_corner_weights`]).
+    CornerHeld(usize),
+}
+
+/// How triangle `t` gets a local solution: [`LocalSolve::AllFree`] with every corner free (none
+/// held: `held` flags the boundary, crease and pinned vertices), [`LocalSolve::CornerHeld`] with
+/// one corner held where it is (see the module docs: the one held corner, held by a crease, not
+/// by the boundary, which the paper leaves unsolved, nor pinned), `None` for no solution (two or
+/// three corners held, or the one held by the boundary or pinned). Only a triangle whose corners
+/// are distinct and of valence three or more (so that A is invertible) is solved.
 pub(super) fn triangle_solve(
     t: &[u32; 3],
     held: &[bool],
     topology: &Topology,
     pinned: &[bool],
-) -> Option<Option<usize>> {
+) -> Option<LocalSolve> {
     let distinct = t[0] != t[1] && t[1] != t[2] && t[0] != t[2];
     if !distinct || t.iter().any(|&c| topology.valence(c) < 3) {
         return None;
     }
     let mut held_at = (0..3).filter(|&k| held[t[k] as usize]);
     match (held_at.next(), held_at.next()) {
-        (None, _) => Some(None),
+        (None, _) => Some(LocalSolve::AllFree),
         (Some(h), None) => {
             let c = t[h];
             let by_crease = !topology.is_boundary_vertex(c)
                 && !pinned.get(c as usize).copied().unwrap_or(false);
-            by_crease.then_some(Some(h))
+            by_crease.then_some(LocalSolve::CornerHeld(h))
         }
         _ => None,
     }

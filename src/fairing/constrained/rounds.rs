@@ -16,7 +16,7 @@ use crate::fairing::strength::{
 use crate::fairing::volume::VolumeKeeper;
 use crate::fairing::{FairOptions, FairReport, FairVariant, Strength};
 use crate::mesh::{breadth_first_order, inverse_permutation, FanRings, Topology, TriMesh};
-use crate::Progress;
+use crate::{Cancelled, Progress};
 use rayon::prelude::*;
 
 /// Constrained fairing of `mesh` in place (sections 3.2 and 3.3); `topology` must be built from
@@ -56,28 +56,27 @@ pub fn fair_constrained(
 /// [`fair_constrained`] reporting to `progress` after every round (a fraction of the rounds
 /// asked for; with automatic strength, whose number of rounds is not known beforehand, a
 /// fraction that rises with every round and nears 1 as the rounds run out), and stopping when it
-/// returns false: `None` then, with `mesh` left part-way (the caller drops it). The result of a
-/// run that is not cancelled is the same as [`fair_constrained`]'s, bit for bit.
+/// returns false: [`Cancelled`] then, with `mesh` left part-way (the caller drops it). The result
+/// of a run that is not cancelled is the same as [`fair_constrained`]'s, bit for bit.
 pub fn fair_constrained_with_progress(
     mesh: &mut TriMesh,
     topology: &Topology,
     options: &FairOptions,
     progress: &mut dyn Progress,
-) -> Option<FairReport> {
-    if options.iterations == 0 || mesh.positions.is_empty() {
-        return progress.report(1.0).then(FairReport::default);
+) -> Result<FairReport, Cancelled> {
+    let nothing_to_do = options.iterations == 0
+        || mesh.positions.is_empty()
+        || (options.strength == Strength::Fixed && options.rounds == 0)
+        // A mask that does not fit, or pins everything: nothing may move.
+        || options.mask.as_ref().is_some_and(|mask| {
+            mask.check_fits(mesh.positions.len()).is_err() || mask.painted_count() == 0
+        });
+    if nothing_to_do {
+        progress.check(1.0)?;
+        return Ok(FairReport::default());
     }
-    if options.strength == Strength::Fixed && options.rounds == 0 {
-        return progress.report(1.0).then(FairReport::default);
-    }
-    // A mask that does not fit, or pins everything: nothing may move.
-    if let Some(mask) = &options.mask {
-        if mask.check_fits(mesh.positions.len()).is_err() || mask.painted_count() == 0 {
-            return progress.report(1.0).then(FairReport::default);
-        }
-    }
-    if let Some(report) = fair_without_loose_triangles(mesh, topology, options, progress) {
-        return report;
+    if let Some(report) = fair_without_loose_triangles(mesh, topology, options, progress)? {
+        return Ok(report);
     }
     let original = options.mask.as_ref().map(|_| mesh.positions.clone());
     let pinned = options
@@ -103,7 +102,8 @@ pub fn fair_constrained_with_progress(
     if let (Some(mask), Some(original)) = (&options.mask, &original) {
         mask.blend(original, &mut mesh.positions);
     }
-    progress.report(1.0).then_some(report)
+    progress.check(1.0)?;
+    Ok(report)
 }
 
 /// A non-manifold scan is faired as the surface it stands for: without the triangles its
@@ -111,19 +111,22 @@ pub fn fair_constrained_with_progress(
 /// would make their corners boundary vertices on chains no boundary curve runs through, and so
 /// hold them with their noise (`crate::mesh::loose_triangles`, `docs/measurements.md`). Same
 /// vertices, nothing renumbered; a corner only loose triangles use (a fin's tip) stays where it
-/// is. `None` when the default variant has no loose triangles to leave out.
-/// The outer `Option` says whether there were loose triangles to leave out, the inner one
-/// whether the run went to its end (`None`: cancelled through `progress`).
+/// is. `Ok(None)` when the default variant has no loose triangles to leave out: the caller fairs
+/// the mesh as it is.
 fn fair_without_loose_triangles(
     mesh: &mut TriMesh,
     topology: &Topology,
     options: &FairOptions,
     progress: &mut dyn Progress,
-) -> Option<Option<FairReport>> {
+) -> Result<Option<FairReport>, Cancelled> {
     if options.variant != FairVariant::NormalProjected || topology.non_manifold_edges.is_empty() {
-        return None;
+        return Ok(None);
     }
-    let (loose, mut kept, kept_topology) = crate::mesh::without_loose_triangles(mesh, topology)?;
+    let Some((loose, mut kept, kept_topology)) =
+        crate::mesh::without_loose_triangles(mesh, topology)
+    else {
+        return Ok(None);
+    };
     // The volume kept is the file's, loose triangles included: they follow their corners, and
     // their own (cone) volume changes with them; one more uniform offset takes that back.
     let pinned = options
@@ -134,17 +137,13 @@ fn fair_without_loose_triangles(
     let volume = options
         .keep_volume
         .then(|| VolumeKeeper::new(mesh, topology, &pinned));
-    let Some(mut report) =
-        fair_constrained_with_progress(&mut kept, &kept_topology, options, progress)
-    else {
-        return Some(None);
-    };
+    let mut report = fair_constrained_with_progress(&mut kept, &kept_topology, options, progress)?;
     mesh.positions = kept.positions;
     if let Some(volume) = volume.filter(|_| report.rounds_run > 0) {
         volume.restore(mesh, topology, |v| pinned.get(v).copied().unwrap_or(false));
     }
     report.loose_triangles += loose.len();
-    Some(Some(report))
+    Ok(Some(report))
 }
 
 /// Rounds from which a run in the locality order pays for making it (see [`in_local_order`]).
@@ -164,8 +163,8 @@ fn in_local_order(
     topology: &Topology,
     options: &FairOptions,
     pinned: &[bool],
-    fair: impl FnOnce(&mut TriMesh, &Topology, &FairOptions, &[bool]) -> Option<FairReport>,
-) -> Option<FairReport> {
+    fair: impl FnOnce(&mut TriMesh, &Topology, &FairOptions, &[bool]) -> Result<FairReport, Cancelled>,
+) -> Result<FairReport, Cancelled> {
     let started = std::time::Instant::now();
     let (offsets, neighbors) = topology.neighbor_csr();
     let order = breadth_first_order(offsets, neighbors);
@@ -226,13 +225,13 @@ fn in_local_order(
         mesh.positions[v as usize] = *p;
     }
     report.phases.set_up += set_up_ms + milliseconds(started);
-    Some(report)
+    Ok(report)
 }
 
 /// The noise estimate, the decision to fair at all (automatic strength leaves a clean mesh as it
 /// is), the first creases, then the rounds. With `may_reorder`, automatic strength on a noisy
-/// mesh runs its rounds in the locality order ([`in_local_order`]). `None` when `progress`
-/// cancelled the run.
+/// mesh runs its rounds in the locality order ([`in_local_order`]). [`Cancelled`] when
+/// `progress` cancelled the run.
 fn decide_and_fair(
     mesh: &mut TriMesh,
     topology: &Topology,
@@ -240,7 +239,7 @@ fn decide_and_fair(
     pinned: &[bool],
     may_reorder: bool,
     progress: &mut dyn Progress,
-) -> Option<FairReport> {
+) -> Result<FairReport, Cancelled> {
     // The fan-ordered one-rings the operator is built from serve the noise estimate and the
     // crease detection first (`read_noise`, `detect_creases_with_estimate`).
     let fans = FanRings::new(&mesh.triangles, topology);
@@ -257,7 +256,7 @@ fn decide_and_fair(
         Strength::Auto => match noisy(estimate, reading.as_ref(), topology) {
             Some(noise) => Some(noise),
             None => {
-                return Some(FairReport {
+                return Ok(FairReport {
                     noise_estimate: estimate,
                     detection_ms: milliseconds(started),
                     ..FairReport::default()
@@ -305,7 +304,7 @@ fn decide_and_fair(
         )
     }?;
     report.detection_ms += decided_ms;
-    Some(report)
+    Ok(report)
 }
 
 /// The first reading of the input: the noise estimate, which decides the strength (automatic)
@@ -384,7 +383,7 @@ struct Rounds<'a> {
 /// when they are due ([`Creases`]), sets the relaxation's shares ([`RelaxationPlan`]), runs the
 /// operator, gives the volume back and, with automatic strength, reads the risk ([`RiskJudge`]),
 /// which may stop the rounds and undo the last ones. `progress` hears after every round;
-/// `None` when it cancelled the run.
+/// [`Cancelled`] when it cancelled the run.
 fn fair_rounds(
     mesh: &mut TriMesh,
     topology: &Topology,
@@ -393,7 +392,7 @@ fn fair_rounds(
     options: &FairOptions,
     rounds: Rounds,
     progress: &mut dyn Progress,
-) -> Option<FairReport> {
+) -> Result<FairReport, Cancelled> {
     let Rounds {
         estimate,
         auto_noise,
@@ -474,9 +473,7 @@ fn fair_rounds(
     for round in 0..max_rounds {
         let stop = rounds.run(mesh, round, &mut report);
         covered += rounds.step(round);
-        if !progress.report(round_fraction(round + 1, max_rounds, auto_noise.is_some())) {
-            return None;
-        }
+        progress.check(round_fraction(round + 1, max_rounds, auto_noise.is_some()))?;
         if stop || covered >= max_rounds as f32 {
             break;
         }
@@ -489,7 +486,7 @@ fn fair_rounds(
     }
     report.noise_estimate = estimate;
     report.crease_edges = crease_edges;
-    Some(report)
+    Ok(report)
 }
 
 /// The progress after `done` rounds of at most `max_rounds`: their share, or with automatic
@@ -650,7 +647,7 @@ mod tests {
                 for p in &mut local.positions {
                     *p = moved(*p);
                 }
-                Some(FairReport {
+                Ok(FairReport {
                     rounds_run: 7,
                     ..FairReport::default()
                 })
@@ -703,7 +700,7 @@ mod tests {
                 phases: Default::default(),
                 ..report
             };
-            assert_eq!(report.map(untimed), Some(untimed(expected)));
+            assert_eq!(report.map(untimed), Ok(untimed(expected)));
             assert_eq!(watched.positions, plain.positions);
             assert!(reported.len() >= 2, "{reported:?}");
             assert!(reported.windows(2).all(|w| w[0] <= w[1]), "{reported:?}");
@@ -720,7 +717,7 @@ mod tests {
                     false
                 },
             );
-            assert_eq!(cancelled, None);
+            assert_eq!(cancelled, Err(crate::Cancelled));
             assert_eq!(calls, 1, "no round runs after the refusal");
         }
     }

@@ -5,7 +5,7 @@
 //! the update of an operator for other creases ([`ConstrainedFairing::for_other_creases`]).
 
 use super::kernel::{EntryWeightIndex, Workspace};
-use super::operator::{corner_weights, held_corner_weights, triangle_solve};
+use super::operator::{corner_weights, held_corner_weights, triangle_solve, LocalSolve};
 use super::rows::{deduplicate_chunk, join_deduplicated, renumber_by_first_use, row_key, RowMap};
 use super::ConstrainedFairing;
 use crate::fairing::boundary::BoundaryCurves;
@@ -215,9 +215,11 @@ impl ConstrainedFairing {
                 let t = &triangles[f as usize];
                 let valences = t.map(|c| topology.valence(c));
                 match triangle_solve(t, held, topology, pinned)? {
-                    None => Some(corner_weights(valences)),
+                    LocalSolve::AllFree => Some(corner_weights(valences)),
                     // v itself, when it is the held corner, gets no solution from the triangle.
-                    Some(h) => (t[h] as usize != v).then(|| held_corner_weights(valences, h)),
+                    LocalSolve::CornerHeld(h) => {
+                        (t[h] as usize != v).then(|| held_corner_weights(valences, h))
+                    }
                 }
             };
             gather_rows(v, ring_v, topology, triangles, operator, rows)
@@ -401,7 +403,7 @@ impl OperatorTable {
     ) -> OperatorTable {
         let valence = |v: u32| topology.valence(v);
         let table_index = |n: [usize; 3]| (n[0] * TABLE_VALENCE + n[1]) * TABLE_VALENCE + n[2];
-        let triangle_valences: Vec<Option<([usize; 3], Option<usize>)>> = triangles
+        let triangle_valences: Vec<Option<([usize; 3], LocalSolve)>> = triangles
             .par_iter()
             .map(|t| triangle_solve(t, held, topology, pinned).map(|h| (t.map(valence), h)))
             .collect();
@@ -409,8 +411,8 @@ impl OperatorTable {
         let mut held_corner_slot: HashMap<([usize; 3], usize), u32> = HashMap::new();
         let mut operators: Vec<[[[f64; 3]; 3]; 3]> = Vec::new();
         let mut operator_held: Vec<u8> = Vec::new();
-        let mut operator_slot = |(n, held_at): ([usize; 3], Option<usize>)| -> u32 {
-            if let Some(h) = held_at {
+        let mut operator_slot = |(n, solve): ([usize; 3], LocalSolve)| -> u32 {
+            if let LocalSolve::CornerHeld(h) = solve {
                 return *held_corner_slot.entry((n, h)).or_insert_with(|| {
                     operators.push(held_corner_weights(n, h));
                     operator_held.push(h as u8);

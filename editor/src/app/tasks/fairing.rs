@@ -1,0 +1,269 @@
+//! Fairing the document from the start level (or a baseline method), and the level meshes of
+//! the level view, on the compute worker: launch and result.
+
+use std::sync::{Arc, Mutex, PoisonError};
+use std::time::{Duration, Instant};
+
+use crate::app::jobs::{Faired, JobResult};
+use crate::app::state::{FairedResult, HierarchyState, ViewMode};
+use crate::app::tasks::measure::MeasureRequest;
+use crate::app::App;
+use fairmesh::fairing::{Mask, Method, MethodOptions};
+use fairmesh::multires::{self, MultiresOptions, MultiresWorkspace};
+use fairmesh::{hierarchy, metrics, Topology, TriMesh};
+
+/// Rings of vertices over which a painted mask always fades out at its edge.
+const MASK_EDGE_RINGS: usize = 3;
+
+impl App {
+    /// Asks for what the current view mode needs at the current level and options.
+    pub(in crate::app) fn refresh_view(&mut self) {
+        let Some(document) = &self.document else {
+            return;
+        };
+        let HierarchyState::Ready { hierarchy, .. } = &document.hierarchy else {
+            return;
+        };
+        let hierarchy = hierarchy.clone();
+        let level = document.level;
+        let document_generation = document.generation;
+        let applied = document.applied;
+        let view = self.view_generation.bump();
+        match self.settings.view_mode {
+            ViewMode::Level => self.request_level_mesh(hierarchy, document_generation, level, view),
+            // An applied result is shown as it is until a setting changes.
+            ViewMode::Faired | ViewMode::Original if applied => {}
+            ViewMode::Faired | ViewMode::Original => {
+                self.request_fairing(hierarchy, document_generation, level, view)
+            }
+        }
+    }
+
+    /// Fairs the document from `level` (or with the baseline method) on the compute worker, the
+    /// result coming back as [`JobResult::Faired`] for `view`.
+    pub(in crate::app) fn request_fairing(
+        &mut self,
+        hierarchy: Arc<hierarchy::Hierarchy>,
+        document: u64,
+        level: usize,
+        view: u64,
+    ) {
+        let Some(job) = self.fair_job(hierarchy, level) else {
+            return;
+        };
+        let document_generation = self.document_generation.clone();
+        let progress_out = self.fair_progress.clone();
+        let workspace = self.workspace.clone();
+        let (tx, ctx, ticket) = (self.results_tx.clone(), self.ctx.clone(), self.jobs.start());
+        self.fair_in_flight = true;
+        self.fair_view = view;
+        self.fair_progress.set(0.0);
+        self.compute.submit_latest("fair", move || {
+            if !document_generation.is_current(document) {
+                return;
+            }
+            // A newer slider value does not cancel this run: while dragging, finished runs are
+            // what keeps the view moving. Only a new document makes it pointless.
+            let progress = |fraction: f32| {
+                progress_out.set(fraction);
+                document_generation.is_current(document)
+            };
+            let result = job.run(&workspace, progress);
+            let message = JobResult::Faired {
+                document,
+                view,
+                level,
+                result,
+            };
+            Self::send_result(&tx, &ctx, message, ticket);
+        });
+    }
+
+    /// What fairing the document from `level` with the current settings needs.
+    fn fair_job(&self, hierarchy: Arc<hierarchy::Hierarchy>, level: usize) -> Option<FairJob> {
+        let document = self.document.as_ref()?;
+        let denoised = matches!(
+            document.hierarchy,
+            HierarchyState::Ready {
+                denoise: Some(_),
+                ..
+            }
+        );
+        Some(FairJob {
+            hierarchy,
+            original: document.original.clone(),
+            denoised,
+            mask: document.mask.clone(),
+            topology: document.topology.clone(),
+            options: self.settings.multires_options(level),
+            baseline: self.settings.baseline_options(),
+            method: self.settings.method,
+        })
+    }
+
+    pub(in crate::app) fn request_level_mesh(
+        &mut self,
+        hierarchy: Arc<hierarchy::Hierarchy>,
+        document: u64,
+        level: usize,
+        view: u64,
+    ) {
+        let document_generation = self.document_generation.clone();
+        let (tx, ctx, ticket) = (self.results_tx.clone(), self.ctx.clone(), self.jobs.start());
+        self.compute.submit_latest("level", move || {
+            if !document_generation.is_current(document) {
+                return;
+            }
+            let mesh = Arc::new(hierarchy.level_mesh(level));
+            let message = JobResult::LevelMesh {
+                document,
+                view,
+                level,
+                mesh,
+            };
+            Self::send_result(&tx, &ctx, message, ticket);
+        });
+    }
+
+    /// A fairing finished: its result goes on screen unless a newer one is there.
+    pub(in crate::app) fn on_faired(
+        &mut self,
+        document: u64,
+        view: u64,
+        level: usize,
+        result: Option<Faired>,
+    ) {
+        // The newest fairing asked for has answered (a view change to the level mesh
+        // since does not make it any less finished).
+        if view >= self.fair_view {
+            self.fair_in_flight = false;
+        }
+        let Some(current) = self.document.as_mut().filter(|d| d.generation == document) else {
+            return;
+        };
+        // Older than what is on screen: stale.
+        if view <= self.applied_view {
+            return;
+        }
+        if let Some(faired) = result {
+            self.applied_view = view;
+            self.next_serial += 1;
+            // The previous result's measures stay on screen until this one's arrive.
+            let previous = current.faired.take();
+            let positions = Arc::new(faired.positions);
+            current.faired = Some(FairedResult {
+                positions: positions.clone(),
+                level,
+                method: faired.method,
+                volume_change: faired.volume_change,
+                rms_displacement: faired.rms_displacement,
+                elapsed: faired.elapsed,
+                serial: self.next_serial,
+                against_document: previous.as_ref().and_then(|p| p.against_document.clone()),
+                against_clean: previous.and_then(|p| p.against_clean),
+                measure_time: Duration::ZERO,
+                measures_pending: true,
+            });
+            self.measure_wanted = Some(MeasureRequest {
+                document,
+                serial: self.next_serial,
+                positions,
+                arrived: Instant::now(),
+            });
+        }
+    }
+
+    /// A level mesh for the level view arrived.
+    pub(in crate::app) fn on_level_mesh(
+        &mut self,
+        document: u64,
+        view: u64,
+        level: usize,
+        mesh: Arc<TriMesh>,
+    ) {
+        let Some(current) = self.document.as_mut().filter(|d| d.generation == document) else {
+            return;
+        };
+        if view <= self.applied_level_view {
+            return;
+        }
+        self.applied_level_view = view;
+        current.level_mesh = Some((level, mesh));
+    }
+}
+
+/// One fairing of the document, as the compute worker runs it: taken from the app when it is
+/// asked for, so that the worker reads nothing of the app.
+struct FairJob {
+    /// Built on the denoised mesh when `denoised`, else on the document's mesh.
+    hierarchy: Arc<hierarchy::Hierarchy>,
+    /// The document's mesh: what a baseline smooths, what a mask fades the result into, what
+    /// the result is measured against.
+    original: Arc<TriMesh>,
+    /// The hierarchy's M0 is the denoised mesh ("Remove noise first"): start level 0 is that
+    /// mesh as it is.
+    denoised: bool,
+    /// The painted mask, if any (its edge fades out over [`MASK_EDGE_RINGS`] when the job runs).
+    mask: Option<Mask>,
+    /// The document's connectivity.
+    topology: Arc<Topology>,
+    options: MultiresOptions,
+    /// The baseline method's options; `None` for the paper's method.
+    baseline: Option<MethodOptions>,
+    method: Method,
+}
+
+impl FairJob {
+    /// Fairs, reporting to `progress` (which returns false to cancel): the result, or `None`
+    /// when cancelled.
+    fn run(
+        self,
+        workspace: &Mutex<MultiresWorkspace>,
+        mut progress: impl FnMut(f32) -> bool + Send,
+    ) -> Option<Faired> {
+        let started = Instant::now();
+        let FairJob {
+            hierarchy,
+            original,
+            denoised,
+            mask,
+            topology,
+            options,
+            baseline,
+            method,
+        } = self;
+        // A few rings of fade inside the painted region's edge, whatever the brush left: where
+        // the brush stopped at a silhouette the mask drops from 1 to 0 at once, and the
+        // result would show a step there.
+        let mask = mask.map(|mask| mask.with_falloff(&topology, MASK_EDGE_RINGS));
+        let mut positions = match &baseline {
+            // A baseline smooths the document's mesh itself; the level does not apply.
+            Some(method) => {
+                let mut mesh = original.as_ref().clone();
+                fairmesh::fairing::fair(&mut mesh, &topology, method);
+                progress(1.0).then_some(mesh.positions)?
+            }
+            // Start level 0 of a hierarchy built on the denoised mesh: that mesh.
+            None if denoised && options.start_level == 0 => {
+                progress(1.0).then(|| hierarchy.base_mesh().positions.clone())?
+            }
+            None => {
+                let mut workspace = workspace.lock().unwrap_or_else(PoisonError::into_inner);
+                multires::fair_multires(&hierarchy, &options, &mut workspace, &mut progress).ok()?
+            }
+        };
+        // The mask fades the result into the document's mesh (not into the denoised one the
+        // levels start from): unpainted vertices keep their positions exactly.
+        if let Some(mask) = mask.filter(|mask| mask.check_fits(positions.len()).is_ok()) {
+            mask.blend(&original.positions, &mut positions);
+        }
+        let (volume_change, rms_displacement) = metrics::change_of_positions(&original, &positions);
+        Some(Faired {
+            positions,
+            volume_change,
+            rms_displacement,
+            elapsed: started.elapsed(),
+            method,
+        })
+    }
+}

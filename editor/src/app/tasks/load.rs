@@ -1,0 +1,192 @@
+//! Loading a file (on the io worker) and the file dialogs: launch and result.
+
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+use std::time::{Duration, Instant};
+
+use crate::app::jobs::{DialogPurpose, JobResult, LoadedMesh};
+use crate::app::state::{self, DocumentSnapshot};
+use crate::app::App;
+
+impl App {
+    /// Starts loading `path` on the io worker; the current mesh stays until it arrives.
+    pub(in crate::app) fn open(&mut self, path: PathBuf) {
+        let generation = self.load_generation.bump();
+        self.loading = Some(path.clone());
+        self.open_path = path.display().to_string();
+        let (tx, ctx, ticket) = (self.results_tx.clone(), self.ctx.clone(), self.jobs.start());
+        self.io.submit(move || {
+            let started = Instant::now();
+            // The bundled bunny comes from the binary itself; it is named by its file name, so
+            // its default export is `bunny00_faired.glb` in the working directory.
+            let (path, loaded) = if fairmesh::bundled::is_bunny_pseudo_path(&path) {
+                let loaded = fairmesh::bundled::load_bunny(&fairmesh::io::LoadOptions::default());
+                (PathBuf::from(fairmesh::bundled::BUNNY_FILE_NAME), loaded)
+            } else {
+                let loaded = fairmesh::io::load(&path);
+                (path, loaded)
+            };
+            let result = loaded
+                .map_err(|error| error.to_string())
+                .and_then(|loaded| {
+                    if loaded.mesh.triangles.is_empty() {
+                        Err(format!("{}: the file holds no triangles", path.display()))
+                    } else {
+                        Ok(Box::new(LoadedMesh {
+                            mesh: loaded.mesh,
+                            topology: Arc::new(loaded.topology),
+                            report: loaded.report,
+                            source: loaded.source,
+                        }))
+                    }
+                });
+            let message = JobResult::Loaded {
+                load_generation: generation,
+                path,
+                result,
+                elapsed: started.elapsed(),
+            };
+            Self::send_result(&tx, &ctx, message, ticket);
+        });
+    }
+
+    pub(in crate::app) fn open_dialog(&mut self, purpose: DialogPurpose) {
+        if self.dialog_open {
+            return;
+        }
+        let start_dir = self.settings.last_dir.clone().or_else(|| {
+            self.document
+                .as_ref()
+                .and_then(|d| d.path.parent().map(Path::to_path_buf))
+        });
+        let default_name = self.document.as_ref().and_then(|d| {
+            PathBuf::from(&d.export_path)
+                .file_name()
+                .map(|n| n.to_string_lossy().into_owned())
+        });
+        let (tx, ctx) = (self.results_tx.clone(), self.ctx.clone());
+        let ticket = self.jobs.start();
+        let spawned = std::thread::Builder::new()
+            .name("fairmesh-dialog".into())
+            .spawn(move || {
+                let mut dialog = rfd::FileDialog::new();
+                if let Some(dir) = start_dir {
+                    dialog = dialog.set_directory(dir);
+                }
+                let path = match purpose {
+                    DialogPurpose::Open => dialog
+                        .add_filter("Meshes", &["obj", "glb", "gltf", "ply", "stl", "off"])
+                        .add_filter("All files", &["*"])
+                        .pick_file(),
+                    DialogPurpose::Export => {
+                        if let Some(name) = default_name {
+                            dialog = dialog.set_file_name(name);
+                        }
+                        dialog
+                            .add_filter("glTF binary", &["glb"])
+                            .add_filter("glTF", &["gltf"])
+                            .add_filter("Wavefront OBJ", &["obj"])
+                            .add_filter("PLY", &["ply"])
+                            .add_filter("STL", &["stl"])
+                            .add_filter("OFF", &["off"])
+                            .save_file()
+                    }
+                };
+                Self::send_result(&tx, &ctx, JobResult::DialogPicked { purpose, path }, ticket);
+            });
+        match spawned {
+            Ok(_) => self.dialog_open = true,
+            Err(error) => self.error = Some(format!("Cannot open a file dialog: {error}")),
+        }
+    }
+
+    /// A file finished loading (or failed to): it becomes the document.
+    pub(in crate::app) fn on_loaded(
+        &mut self,
+        load_generation: u64,
+        path: PathBuf,
+        result: Result<Box<LoadedMesh>, String>,
+        elapsed: Duration,
+    ) {
+        if !self.load_generation.is_current(load_generation) {
+            return;
+        }
+        let requested = self.loading.take();
+        match result {
+            Ok(loaded) => {
+                if let Some(requested) = requested {
+                    // The path as asked for (`@bunny` for the bundled one), made absolute.
+                    let requested = if fairmesh::bundled::is_bunny_pseudo_path(&requested) {
+                        requested
+                    } else {
+                        std::path::absolute(&requested).unwrap_or(requested)
+                    };
+                    self.settings.remember_recent(&requested);
+                }
+                if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
+                    self.settings.last_dir = Some(dir.to_path_buf());
+                }
+                let loaded = *loaded;
+                let name = path
+                    .file_name()
+                    .map(|n| n.to_string_lossy().into_owned())
+                    .unwrap_or_else(|| path.display().to_string());
+                // The mask last painted on this file comes back with it.
+                let mask = self
+                    .settings
+                    .paint
+                    .mask_for(&path, loaded.mesh.positions.len());
+                let snapshot = DocumentSnapshot {
+                    mask,
+                    export_path: state::default_export_path(&path).display().to_string(),
+                    path,
+                    mesh: Arc::new(loaded.mesh),
+                    topology: loaded.topology,
+                    source: loaded.source,
+                    clean: None,
+                    against_clean: None,
+                    report: loaded.report,
+                    load_time: elapsed,
+                    level: 0,
+                    hierarchy: None,
+                    applied: false,
+                    camera: None,
+                };
+                self.install(snapshot, Some(format!("Open {name}")));
+                if let Some(document) = &mut self.document {
+                    document.pick_start_level = true;
+                }
+                self.error = None;
+                // What the status bar said was about the previous file.
+                self.message = None;
+                self.fit_view();
+            }
+            Err(error) => {
+                self.error = Some(format!("Could not open the file: {error}"));
+            }
+        }
+    }
+
+    /// A file dialog closed.
+    pub(in crate::app) fn on_dialog_picked(
+        &mut self,
+        purpose: DialogPurpose,
+        path: Option<PathBuf>,
+    ) {
+        self.dialog_open = false;
+        match (purpose, path) {
+            (DialogPurpose::Open, Some(path)) => self.open(path),
+            (DialogPurpose::Export, Some(path)) => {
+                if let Some(document) = &mut self.document {
+                    document.export_path = path.display().to_string();
+                }
+                // The system's save dialog asked about replacing an existing file already.
+                self.write_export(path);
+            }
+            (_, None) => {
+                self.message =
+                    Some("No file chosen (if no dialog appeared, type a path instead)".into());
+            }
+        }
+    }
+}

@@ -1,0 +1,164 @@
+//! Measuring a faired result against the input and clean meshes (surface distances, on the
+//! measuring worker and its own one-thread pool), once the result has rested on screen: launch
+//! and result.
+
+use std::sync::Arc;
+use std::time::{Duration, Instant};
+
+use crate::app::jobs::JobResult;
+use crate::app::state::{HierarchyState, Measures};
+use crate::app::App;
+use fairmesh::TriMesh;
+
+/// A faired result is measured once it has been on screen this long with no fairing in flight:
+/// measuring takes a core for 0.1-0.3 s on the bunny (seconds on a 1M-face mesh), and while the
+/// slider is dragged it would compete with the next value's fairing for the cores. The numbers
+/// follow when the user pauses.
+pub(in crate::app) const MEASURE_DELAY: Duration = Duration::from_millis(100);
+
+/// A faired result waiting to be measured.
+pub(in crate::app) struct MeasureRequest {
+    pub(in crate::app) document: u64,
+    pub(in crate::app) serial: u64,
+    pub(in crate::app) positions: Arc<Vec<[f32; 3]>>,
+    /// When the result arrived.
+    pub(in crate::app) arrived: Instant,
+}
+
+impl App {
+    /// Hands the waiting result to the measuring worker once no fairing is in flight and it has
+    /// waited [`MEASURE_DELAY`]; until then asks for a frame when the delay is up.
+    pub(in crate::app) fn start_waiting_measure(&mut self) {
+        let Some(request) = &self.measure_wanted else {
+            return;
+        };
+        let waited = request.arrived.elapsed();
+        if self.fair_in_flight {
+            return;
+        }
+        if waited < MEASURE_DELAY {
+            self.ctx.request_repaint_after(MEASURE_DELAY - waited);
+            return;
+        }
+        if let Some(request) = self.measure_wanted.take() {
+            self.request_measures(request.document, request.serial, request.positions);
+        }
+    }
+
+    /// Measures the faired result `serial` against the document's mesh and the clean one on the
+    /// measuring worker (a newer result replaces a waiting request).
+    pub(in crate::app) fn request_measures(
+        &mut self,
+        document: u64,
+        serial: u64,
+        positions: Arc<Vec<[f32; 3]>>,
+    ) {
+        let Some(current) = self.document.as_ref().filter(|d| d.generation == document) else {
+            return;
+        };
+        if !matches!(current.hierarchy, HierarchyState::Ready { .. }) {
+            return;
+        }
+        // Measured against the document's mesh (the hierarchy's M0 may be its denoised copy),
+        // with its triangles.
+        let base = current.original.clone();
+        let clean = current.clean.clone();
+        let pool = self.measure_pool.clone();
+        let document_generation = self.document_generation.clone();
+        // A slider move, an option or a view change bumps the view generation: the result
+        // being measured is then about to be replaced, so measuring it stops and gives the
+        // cores to the next fairing.
+        let (view_generation, view) =
+            (self.view_generation.clone(), self.view_generation.current());
+        let (tx, ctx, ticket) = (self.results_tx.clone(), self.ctx.clone(), self.jobs.start());
+        self.measure.submit_latest("measure", move || {
+            if !document_generation.is_current(document) {
+                return;
+            }
+            let started = Instant::now();
+            let base = base.as_ref();
+            let faired = TriMesh {
+                positions: positions.as_ref().clone(),
+                triangles: base.triangles.clone(),
+            };
+            let stop =
+                || !view_generation.is_current(view) || !document_generation.is_current(document);
+            let measure = || {
+                let against_document = Measures::of_unless(base, &faired, &stop)?;
+                let against_clean = match clean.as_deref() {
+                    Some(clean) => Some(Measures::of_unless(clean, &faired, &stop)?),
+                    None => None,
+                };
+                Some((against_document, against_clean))
+            };
+            let measured = match &pool {
+                Some(pool) => pool.install(measure),
+                None => measure(),
+            };
+            let message = match measured {
+                Some((against_document, against_clean)) => JobResult::Measured {
+                    document,
+                    serial,
+                    against_document: Some(against_document),
+                    against_clean,
+                    measure_time: started.elapsed(),
+                },
+                None => JobResult::MeasureStopped {
+                    document,
+                    serial,
+                    positions,
+                },
+            };
+            Self::send_result(&tx, &ctx, message, ticket);
+        });
+    }
+
+    /// A result's measures arrived.
+    pub(in crate::app) fn on_measured(
+        &mut self,
+        document: u64,
+        serial: u64,
+        against_document: Option<Measures>,
+        against_clean: Option<Measures>,
+        measure_time: Duration,
+    ) {
+        let Some(faired) = self
+            .document
+            .as_mut()
+            .filter(|d| d.generation == document)
+            .and_then(|d| d.faired.as_mut())
+            .filter(|f| f.serial == serial)
+        else {
+            return;
+        };
+        faired.against_document = against_document;
+        faired.against_clean = against_clean;
+        faired.measure_time = measure_time;
+        faired.measures_pending = false;
+    }
+
+    /// A measuring stopped because the view moved on: measured again later if still shown.
+    pub(in crate::app) fn on_measure_stopped(
+        &mut self,
+        document: u64,
+        serial: u64,
+        positions: Arc<Vec<[f32; 3]>>,
+    ) {
+        self.measures_stopped += 1;
+        let still_shown = self
+            .document
+            .as_ref()
+            .filter(|d| d.generation == document)
+            .and_then(|d| d.faired.as_ref())
+            .is_some_and(|f| f.serial == serial);
+        // A newer result has its own request already; this one is measured again.
+        if still_shown && self.measure_wanted.is_none() {
+            self.measure_wanted = Some(MeasureRequest {
+                document,
+                serial,
+                positions,
+                arrived: Instant::now(),
+            });
+        }
+    }
+}
