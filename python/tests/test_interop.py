@@ -143,6 +143,34 @@ def test_a_scene_keeps_its_transforms_and_fairs_each_geometry_in_its_own_place()
     np.testing.assert_allclose(faired_world.vertices, expected.vertices, atol=1e-5)
 
 
+def test_a_geometry_placed_twice_is_faired_alone_and_stays_one_geometry():
+    trimesh = pytest.importorskip("trimesh")
+    import fairmesh.trimesh
+
+    part = noisy_copy(trimesh.load(TEXTURED, force="mesh", process=False), seed=7)
+    other = noisy_copy(trimesh.creation.icosphere(subdivisions=2), seed=8)
+    scene = trimesh.Scene()
+    moved = trimesh.transformations.translation_matrix([5.0, 0.0, 0.0])
+    scene.add_geometry(part, geom_name="part", node_name="left")
+    scene.graph.update(frame_to="right", frame_from=scene.graph.base_frame, matrix=moved,
+                       geometry="part")
+    scene.add_geometry(other, geom_name="ball", node_name="ball", transform=moved)
+    smooth, reports = fairmesh.trimesh.fair(scene, rounds=2)
+    assert set(smooth.geometry) == {"part", "ball"}
+    for node in ("left", "right", "ball"):
+        np.testing.assert_array_equal(smooth.graph.get(node)[0], scene.graph.get(node)[0])
+    # Placed twice: faired in its own coordinates, as the mesh alone is.
+    alone, report = fairmesh.trimesh.fair(part, rounds=2)
+    np.testing.assert_array_equal(smooth.geometry["part"].vertices, alone.vertices)
+    assert reports["part"]["vertices"] == report["vertices"] == 386
+    # Placed once: faired where the scene puts it, and given back in its own coordinates.
+    there = other.copy()
+    there.apply_transform(moved)
+    faired_there, _ = fairmesh.trimesh.fair(there, rounds=2)
+    np.testing.assert_allclose(smooth.geometry["ball"].vertices + [5.0, 0.0, 0.0],
+                               faired_there.vertices, atol=1e-6)
+
+
 def test_what_is_not_a_mesh_is_refused_by_name():
     trimesh = pytest.importorskip("trimesh")
     import fairmesh.trimesh

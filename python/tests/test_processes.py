@@ -23,8 +23,9 @@ HANG = 600
 
 def every_entry_point(path):
     """Every call of the package on one file, as arrays a parent can compare: load, noise,
-    compare, fair (arrays and Mesh, with threads=1 and without), hierarchy, multires, level,
-    Mesh.save and save (into the temporary folder beside the result)."""
+    compare, fair (arrays and Mesh, with threads=1 and without), hierarchy (arrays, and Mesh
+    with a denoise), multires (with a mask too), level, hard_edges (``saved_and_read_back``:
+    Mesh.save and save)."""
     mesh = fairmesh.load(path)
     noisy = fairmesh.noise(mesh.vertices, mesh.faces, sigma=0.3, seed=5)
     smooth, report = fairmesh.fair(noisy, mesh.faces, rounds=3)
@@ -34,6 +35,8 @@ def every_entry_point(path):
     levels = fairmesh.hierarchy(noisy, mesh.faces, min_vertices=200)
     multires = levels.multires(2)
     coarse, _, _ = levels.level(levels.coarsest_level)
+    denoised = fairmesh.hierarchy(mesh, keep_creases=True, denoise="auto", min_vertices=200)
+    from_file = denoised.multires(2, mask=mesh.vertices[:, 1] > 0)
     return {
         "noisy": noisy,
         "smooth": smooth,
@@ -43,6 +46,7 @@ def every_entry_point(path):
         "hausdorff": distances["hausdorff"],
         "multires": multires,
         "coarse": coarse,
+        "from_file": from_file,
         "hard_edges": mesh.hard_edges,
     }
 
