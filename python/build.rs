@@ -176,6 +176,13 @@ fn docstring(lines: &[&str], first: usize, body: &str) -> (String, usize) {
         raw.push_str(lines[i]);
     }
     let end = raw.find("\"\"\"").unwrap_or(raw.len());
+    // Copied as written: an escape would read differently here and in Python.
+    assert!(
+        !raw[..end].contains('\\'),
+        "{STUBS}: a docstring holds a backslash, which the run-time docs would not read as \
+         Python does: {}",
+        &raw[..end]
+    );
     (clean(&raw[..end]), i + 1)
 }
 

@@ -70,7 +70,8 @@ class Welded:
             return edges
         if len(array) and (array.min() < 0 or array.max() >= self.count):
             return edges
-        return self.of_row[array.astype(np.int64)]
+        pairs = self.of_row[array.astype(np.int64)]
+        return pairs[pairs[:, 0] != pairs[:, 1]]  # an edge between copies is no edge
 
 
 def fair(vertices: np.ndarray, faces: np.ndarray,

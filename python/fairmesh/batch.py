@@ -21,7 +21,9 @@ batch::
             print(source, outcome["rounds_run"], outcome["volume_change_percent"])
 
 Any start method works, ``fork`` included, before or after this process used fairmesh (each
-process runs its own thread pool). Ctrl+C in the terminal stops the batch: every worker gets the
+process runs its own thread pool; the ``DeprecationWarning`` Python 3.12 and newer give when a
+process with threads forks is about other threads: fairmesh's own are not copied and not
+needed in the child). Ctrl+C in the terminal stops the batch: every worker gets the
 signal and its call stops at the next round, and ``fair_files`` cancels what has not started and
 raises ``KeyboardInterrupt``.
 

@@ -92,6 +92,22 @@ def test_a_mask_over_the_copies_is_read_over_the_welded_vertices():
     assert (by_bools.vertices[upper] != mesh.vertices[upper]).any()
 
 
+def test_hard_edges_over_the_copies_are_kept_over_the_welded_vertices():
+    trimesh = pytest.importorskip("trimesh")
+    import fairmesh.trimesh
+    from fairmesh._welding import Welded
+
+    mesh = noisy_copy(trimesh.load(TEXTURED, force="mesh", process=False), seed=9)
+    welded = Welded(mesh.vertices)
+    rows = mesh.edges_unique[::7]
+    kept, _ = fairmesh.trimesh.fair(mesh, rounds=2, hard_edges=rows)
+    expected, _ = fairmesh.fair(welded.positions, welded.faces(mesh.faces), rounds=2,
+                                hard_edges=welded.of_row[rows])
+    np.testing.assert_array_equal(kept.vertices, expected[welded.of_row])
+    plain, _ = fairmesh.trimesh.fair(mesh, rounds=2)
+    assert (plain.vertices != kept.vertices).any()
+
+
 def test_a_scene_split_by_material_is_faired_whole_with_its_parts_kept():
     trimesh = pytest.importorskip("trimesh")
     import fairmesh.trimesh
