@@ -12,8 +12,9 @@ Seams: ``trimesh.load`` gives a textured or normal-split mesh one vertex per sid
 normal seam. Those copies of a position are faired as one vertex, as ``fairmesh.load`` welds a
 file, and every copy gets the result, so no seam opens. A ``mask`` or ``hard_edges`` over the
 copies is read over the welded vertices (a position is faired as much as its most faired
-copy). Texture coordinates stay as they are (``fairmesh.load`` and ``Mesh.save`` make them
-follow the vertices' slide along the surface in files).
+copy). Texture coordinates follow the vertices' slide along the surface, as ``Mesh.save``
+makes them follow in files: each moves to what the texture held where its vertex slid to, so
+the texture stays where it was on the surface.
 
 A ``trimesh.Scene`` (what ``trimesh.load`` gives for .glb and many .obj files) is faired geometry
 by geometry: the result is a copy of the scene with the same graph (every transform kept) and
@@ -33,7 +34,7 @@ from typing import Any, Dict, Tuple, Union
 import numpy as np
 
 import fairmesh
-from fairmesh import _welding
+from fairmesh import _texture, _welding
 
 
 def _trimesh():
@@ -62,8 +63,17 @@ def fair(mesh: Union["trimesh.Trimesh", "trimesh.Scene"],
         raise _refuse(mesh, "fair")
     vertices, report = _welding.fair(mesh.vertices, mesh.faces, options)
     result = mesh.copy()
-    result.vertices = vertices
+    _move(result, vertices)
     return result, report
+
+
+def _move(geometry, vertices):
+    """Gives ``geometry`` its new ``vertices``, its texture coordinates following the slide."""
+    visual = geometry.visual
+    uv = getattr(visual, "uv", None) if getattr(visual, "kind", None) == "texture" else None
+    if uv is not None and len(uv) == len(vertices):
+        visual.uv = _texture.follow(geometry.vertices, vertices, geometry.faces, uv)
+    geometry.vertices = vertices
 
 
 def _fair_scene(trimesh, scene, options):
@@ -86,13 +96,13 @@ def _fair_scene(trimesh, scene, options):
                                 for (name, _), offset in zip(once, offsets)])
         vertices, report = _welding.fair(np.concatenate(parts), faces, options)
         for (name, transform), start, end in zip(once, offsets[:-1], offsets[1:]):
-            result.geometry[name].vertices = _from_world(vertices[start:end], transform)
+            _move(result.geometry[name], _from_world(vertices[start:end], transform))
             reports[name] = report
     # One placed several times is faired in its own coordinates, so that its copies stay alike.
     for name in (name for name, transforms in placed.items() if len(transforms) > 1):
         geometry = result.geometry[name]
-        geometry.vertices, reports[name] = _welding.fair(geometry.vertices, geometry.faces,
-                                                         options)
+        vertices, reports[name] = _welding.fair(geometry.vertices, geometry.faces, options)
+        _move(geometry, vertices)
     return result, reports
 
 
