@@ -29,4 +29,5 @@ rm -rf python/dist
 "$venv/bin/python" -m pip install --quiet --force-reinstall --no-deps python/dist/fairmesh-*.whl
 # From the tests' folder, so that `import fairmesh` finds the installed wheel, not python/fairmesh.
 cd python/tests
-FAIRMESH_CLI="$FAIRMESH_CLI" "../../$venv/bin/python" -m pytest -q
+# -rs: every skipped test says why (open3d, for one, is not installed here).
+FAIRMESH_CLI="$FAIRMESH_CLI" "../../$venv/bin/python" -m pytest -q -rs

@@ -17,11 +17,16 @@ array of vertex indices; results are new numpy arrays and the inputs are never c
   level and can be run again and again without building anything again.
 - ``load`` / ``Mesh.save``: files kept as the command line keeps them (written back into
   their own format with only the positions changed); ``save`` writes a bare mesh.
-- ``fairmesh.trimesh`` and ``fairmesh.open3d``: the same on trimesh and Open3D meshes.
+- ``fairmesh.trimesh`` and ``fairmesh.open3d``: the same on trimesh meshes and scenes and on
+  Open3D meshes, with the copies of a position across UV and normal seams faired as one.
+- ``FairReport``, ``CompareReport``, ``DenoiseReport``: the keys and types of the dicts returned.
 
 Long calls release the GIL (other Python threads run meanwhile), take ``progress=callable``
-(called with the fraction done; returning False stops the call with ``Cancelled``) and stop on
-Ctrl+C with ``KeyboardInterrupt``.
+(called with every new fraction done; returning False stops the call with ``Cancelled``) and
+stop on Ctrl+C with ``KeyboardInterrupt`` when called on the main thread. Every process runs its
+own thread pool, so a ``multiprocessing`` pool works with any start method (``fork`` included),
+before or after the parent used fairmesh; a ``Mesh`` pickles (as its file, read again). For
+batches of files, see ``help(fairmesh.batch)``.
 """
 
 from ._fairmesh import (
@@ -38,9 +43,15 @@ from ._fairmesh import (
     noise,
     save,
 )
+from ._reports import CompareReport, DenoiseReport, Distance, FairPhases, FairReport
 
 __all__ = [
     "Cancelled",
+    "CompareReport",
+    "DenoiseReport",
+    "Distance",
+    "FairPhases",
+    "FairReport",
     "Hierarchy",
     "Mesh",
     "MeshFileError",

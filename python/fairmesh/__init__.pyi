@@ -6,10 +6,16 @@ arrays; vertex results keep the float type of the vertices given (a loaded ``Mes
 """
 
 import os
-from typing import Any, Callable, Dict, List, Literal, Optional, Tuple, Union, overload
+from typing import Any, Callable, List, Literal, Optional, Tuple, Union, overload
 
 import numpy as np
 import numpy.typing as npt
+
+from ._reports import CompareReport as CompareReport
+from ._reports import DenoiseReport as DenoiseReport
+from ._reports import Distance as Distance
+from ._reports import FairPhases as FairPhases
+from ._reports import FairReport as FairReport
 
 __version__: str
 
@@ -17,8 +23,17 @@ Vertices = npt.ArrayLike
 Faces = npt.ArrayLike
 PathLike = Union[str, os.PathLike]
 Progress = Callable[[float], Optional[bool]]
-"""Called with the fraction done (0 to 1) on the calling thread; returning False stops the
-call, which then raises ``Cancelled``."""
+"""Called on the calling thread with every new fraction done (0 to 1) that the work reports, in
+order, then with 1.0 when the call completes (unless the work reported it last): ``fair`` reports
+after every round, ``hierarchy`` as it removes vertices, ``multires`` after every level. The work
+does not wait for the callback, which is called between polls (every 40 ms) with what came
+since. Returning False stops the call at the work's next report: it then raises ``Cancelled``."""
+Mask = npt.ArrayLike
+"""Which vertices to fair, one of: a bool array of one value per vertex (True: fair it); a float
+array of one weight per vertex (0: kept exactly, 1: faired fully, between: faded); an integer
+array of the indices of the vertices to fair. An integer array of one 0 or 1 per vertex could be
+read either way and is refused: write it as bools (``mask.astype(bool)``) or as indices
+(``mask.nonzero()[0]``)."""
 
 class MeshFileError(ValueError):
     """A mesh file whose content cannot be read or written: the message names the file, the
@@ -40,7 +55,11 @@ class Mesh:
     ``fair(mesh)`` works on the loaded mesh itself (no array made, nothing copied but the
     result), so one ``Mesh`` serves one such call at a time: another thread's call on the same
     object meanwhile raises ``RuntimeError`` (``fair(mesh.vertices, mesh.faces)`` has no such
-    limit)."""
+    limit).
+
+    A ``Mesh`` pickles as its file (for a process pool): unpickling reads the file again, by
+    its absolute path, so it must be readable there, and refuses it with ``ValueError`` if it
+    changed since."""
 
     @property
     def vertices(self) -> npt.NDArray[np.float64]:
@@ -93,7 +112,7 @@ class Hierarchy:
     def level_sizes(self) -> List[Tuple[int, int]]:
         """(vertices, faces) of every level, level 0 first."""
     @property
-    def denoise(self) -> Optional[Dict[str, Any]]:
+    def denoise(self) -> Optional[DenoiseReport]:
         """What the denoise before the build found (``rounds_run``, ``noise_estimate``,
         ``crease_edges``), or None when the hierarchy was built without one."""
     def level(
@@ -110,18 +129,25 @@ class Hierarchy:
         boundary: Literal["curve", "fixed"] = "curve",
         fair_finest: bool = True,
         variant: Literal["improved", "paper"] = "improved",
-        mask: Optional[npt.ArrayLike] = None,
+        mask: Optional[Mask] = None,
         mask_falloff: int = 0,
         progress: Optional[Progress] = None,
         threads: Optional[int] = None,
     ) -> npt.NDArray[np.floating]:
         """Multiresolution fairing (``fairmesh multires --level START_LEVEL``, on the hierarchy
         as built: denoised first only if ``hierarchy`` was given ``denoise``): fair from
-        ``start_level`` (the coarser, the smoother; 0 is level 0 itself) down to full detail.
-        After a denoise, ``mask`` fades the result into the input itself.
-        Returns level 0's vertices smoothed, (n, 3); level 0's faces apply. ``mask``: per-vertex
-        weights (0 to 1, or bools) or the indices of the vertices to fair; the rest keep their
-        positions exactly. Releases the GIL; ``progress`` and Ctrl+C stop it."""
+        ``start_level`` (the coarser, the smoother; 0 is level 0 itself; beyond the coarsest,
+        the coarsest) down to full detail. Returns level 0's vertices smoothed, (n, 3); level
+        0's faces apply.
+
+        - ``iterations`` (5), ``rounds`` (1): constrained fairing on each level.
+        - ``boundary``: "curve" or "fixed", as for ``fair``.
+        - ``fair_finest``: also fair level 0 itself at the end.
+        - ``variant``: "improved" (default: split vertices placed by Kobbelt's rule, and the
+          shrinkage of the low frequencies given back) or "paper" (the paper's placement).
+        - ``mask`` (see ``Mask``), ``mask_falloff``: as for ``fair``; the vertices outside keep
+          their positions exactly. After a denoise, the result is faded into the input itself.
+        - ``progress``, ``threads``: as for ``fair``; Ctrl+C stops it too."""
 
 @overload
 def fair(
@@ -137,18 +163,18 @@ def fair(
     no_volume_correction: bool = False,
     tolerance: Optional[float] = None,
     boundary: Literal["curve", "fixed"] = "curve",
-    variant: Literal["normal-projected", "paper"] = "normal-projected",
+    variant: Literal["projected", "paper", "normal-projected"] = "projected",
     lambda_: Optional[float] = None,
     mu: Optional[float] = None,
     alpha: Optional[float] = None,
     beta: Optional[float] = None,
-    mask: Optional[npt.ArrayLike] = None,
+    mask: Optional[Mask] = None,
     mask_falloff: int = 0,
     hard_edges: Optional[npt.ArrayLike] = None,
     measure: bool = False,
     progress: Optional[Progress] = None,
     threads: Optional[int] = None,
-) -> Tuple[npt.NDArray[np.float64], Dict[str, Any]]: ...
+) -> Tuple[npt.NDArray[np.float64], FairReport]: ...
 @overload
 def fair(
     vertices: Vertices,
@@ -163,32 +189,34 @@ def fair(
     no_volume_correction: bool = False,
     tolerance: Optional[float] = None,
     boundary: Literal["curve", "fixed"] = "curve",
-    variant: Literal["normal-projected", "paper"] = "normal-projected",
+    variant: Literal["projected", "paper", "normal-projected"] = "projected",
     lambda_: Optional[float] = None,
     mu: Optional[float] = None,
     alpha: Optional[float] = None,
     beta: Optional[float] = None,
-    mask: Optional[npt.ArrayLike] = None,
+    mask: Optional[Mask] = None,
     mask_falloff: int = 0,
     hard_edges: Optional[npt.ArrayLike] = None,
     measure: bool = False,
     progress: Optional[Progress] = None,
     threads: Optional[int] = None,
-) -> Tuple[npt.NDArray[np.floating], Dict[str, Any]]:
+) -> Tuple[npt.NDArray[np.floating], FairReport]:
     """Smooth a mesh without shrinking it: ``fairmesh fair`` on arrays.
 
     Returns ``(vertices, report)``: the smoothed vertices (a new (n, 3) array, float32 for
-    float32 input, else float64) and a dict with the fields of ``fairmesh fair --json``
-    (``rounds_run``, ``iterations_run``, ``noise_estimate``, ``volume_change_percent``,
-    ``time_ms``, ...; ``input`` is the loaded file's path or None, ``output`` None).
+    float32 input, else float64) and a ``FairReport`` dict with the fields of
+    ``fairmesh fair --json`` (``rounds_run``, ``iterations_run``, ``noise_estimate``,
+    ``volume_change_percent``, ``time_ms``, ...; ``input`` is the loaded file's path or None,
+    ``output`` None).
 
     ``vertices`` may be a loaded ``Mesh`` (``faces`` left out): its file's sharp edges are then
     kept too, exactly as the command line does.
 
     Options (the command line's, ``--no-creases`` as ``no_creases=True``):
+
     - ``method``: "constrained" (the paper's, default) or a baseline that shrinks:
       "laplacian", "taubin", "hc".
-    - ``iterations``: per round for constrained fairing (10).
+    - ``iterations``: per round for constrained fairing (10); for a baseline, its steps.
     - ``rounds``: None (default) estimates the noise (a clean mesh is left as it is) and fairs
       round by round while the estimated error falls; a number fairs exactly that many rounds.
     - ``crease_angle`` (40 degrees) / ``no_creases``: sharp edges kept, or faired across.
@@ -198,17 +226,29 @@ def fair(
     - ``tolerance``: stop a round once no vertex moves more than this many mean edge lengths
       (None: once it has settled, 0.001; 0: run every iteration).
     - ``boundary``: "curve" (boundary loops smoothed as curves) or "fixed".
-    - ``variant``: "normal-projected" (default) or "paper" (the paper's method exactly).
-    - ``lambda_``, ``mu`` (Laplacian, Taubin), ``alpha``, ``beta`` (HC): the baselines' steps.
-    - ``mask``: fair only these vertices: per-vertex weights (0 to 1, or bools) or vertex
-      indices; ``mask_falloff`` fades the edge over that many rings.
+    - ``variant``: "projected" (default: the paper's update kept along the normal, so vertices
+      do not slide along the surface) or "paper" (the paper's operator exactly). The old name
+      "normal-projected" is accepted; the report names the variant as ``fairmesh fair --json``
+      does ("normal-projected" or "paper").
+    - ``lambda_``, ``mu``: the Laplacian and Taubin steps; ``alpha``, ``beta`` (0 to 1): HC's
+      weight of the input in the pull back, and of a vertex's own correction against its
+      neighbours' (``hierarchy``'s ``alpha`` and ``beta`` are something else).
+    - ``mask``: fair only these vertices (see ``Mask``): one bool or float weight (0 to 1) per
+      vertex, or vertex indices; ``mask_falloff`` fades its edge over that many rings.
     - ``hard_edges``: (k, 2) vertex pairs kept sharp with the creases found.
     - ``measure``: add the distances to the input (``mean_surface_distance``, ``hausdorff``,
       ``rms``, ``normal_error_deg``) to the report.
-    - ``progress``: called with the fraction done (before every round); return False to stop
-      (raises ``Cancelled``). Ctrl+C raises ``KeyboardInterrupt``. The GIL is released.
-    - ``threads``: None uses every core; a number runs the call on that many threads of its
-      own (``threads=1`` to fair many meshes side by side from Python threads).
+    - ``progress``: called with the fraction done after every round (see ``Progress``); return
+      False to stop (raises ``Cancelled``).
+    - ``threads``: None runs on this process's pool (every core); a number runs the call on that
+      many threads of its own (``threads=1`` to fair many meshes side by side).
+
+    Threads and processes: the GIL is released while the call works, so Python threads run
+    meanwhile. Ctrl+C raises ``KeyboardInterrupt`` in a call made on the main thread; Python
+    delivers signals to the main thread only, so a call in another thread runs on until its
+    ``progress`` callback returns False (have the main thread set a ``threading.Event`` that
+    the callback reads). Processes made by ``fork``, ``forkserver`` or ``spawn`` all work, before
+    or after the parent used fairmesh: each process runs its own thread pool.
 
     Raises ``ValueError`` or ``TypeError`` naming the argument at fault."""
 
@@ -220,19 +260,26 @@ def noise(
     seed: int = 1,
     mode: Literal["normal", "direction", "iso"] = "normal",
 ) -> npt.NDArray[np.floating]:
-    """Seeded Gaussian noise (``fairmesh noise``): sigma in mean edge lengths; the same seed
-    gives the same noise on every machine. Returns new vertices."""
+    """Seeded Gaussian noise (``fairmesh noise``): returns new vertices, the input's moved.
+
+    - ``sigma``: the noise's standard deviation, in mean edge lengths (0 or more).
+    - ``seed``: the same seed gives the same noise on every machine.
+    - ``mode``: "normal" (along each vertex normal), "direction" (along one random direction per
+      vertex) or "iso" (a Gaussian on each coordinate)."""
 
 def compare(
     reference_vertices: Vertices,
     reference_faces: Faces,
     vertices: Vertices,
     faces: Optional[Faces] = None,
-) -> Dict[str, Any]:
-    """Measure a mesh against a reference (``fairmesh compare --json``): two-way surface
-    distance (``mean_surface_distance``, ``hausdorff``), ``volume_change_percent``, and with
-    the same connectivity (``faces`` None: the reference's) ``rms``, ``max_distance``,
-    ``normal_error_deg``, ``barycenter_drift`` and ``sharpened_edges``."""
+) -> CompareReport:
+    """Measure a mesh against a reference (``fairmesh compare --json``), as a
+    ``CompareReport``: two-way surface distance (``mean_surface_distance``, ``hausdorff``),
+    ``volume_change_percent``, and with the same connectivity ``rms``, ``max_distance``,
+    ``normal_error_deg``, ``barycenter_drift`` and ``sharpened_edges``.
+
+    ``faces`` None: ``vertices`` are the reference's, moved (one row per reference vertex); a
+    mesh of other connectivity needs its own ``faces``."""
 
 @overload
 def hierarchy(
@@ -266,12 +313,28 @@ def hierarchy(
     progress: Optional[Progress] = None,
     threads: Optional[int] = None,
 ) -> Hierarchy:
-    """Build the decimation hierarchy (``fairmesh hierarchy``), with its options; then
+    """Build the decimation hierarchy (``fairmesh hierarchy``; the paper's section 4.1); then
     ``Hierarchy.multires(start_level)`` fairs from any level, again and again.
-    ``denoise="auto"`` (or a number of rounds) first denoises the mesh as ``fair`` does and
-    builds the levels on the result, as the editor and ``fairmesh multires`` do (with
-    ``keep_creases=True`` for their defaults): ``multires(0)`` is then ``fair``'s result and
-    ``Hierarchy.denoise`` says what the denoise found."""
+
+    Each level removes an independent set of vertices from the one below by half-edge
+    collapses, cheapest first, keeping every level a manifold with the input's boundary loops.
+    Options (the command line's):
+
+    - ``alpha`` (1.0), ``beta`` (0.01): the weights of a vertex's shortest and longest edge in
+      its removal cost, ``alpha * shortest + beta * longest``: vertices in dense regions go
+      first. (Not ``fair``'s HC ``alpha``/``beta``.)
+    - ``min_vertices`` (100): no level has fewer vertices than this.
+    - ``max_levels`` (64): at most this many levels above level 0.
+    - ``keep_boundary``: boundary vertices never collapse (the outline stays exact on every
+      level).
+    - ``keep_creases``: sharp creases (found at ``crease_angle``, 40 degrees unless given; the
+      file's own sharp edges too for a loaded ``Mesh``) stay on every level: a crease vertex
+      collapses only along its crease and corners never do. Giving ``crease_angle`` implies it.
+    - ``denoise``: None or "off" (none), "auto" or a number of rounds: first denoise the mesh as
+      ``fair`` does and build the levels on the result, as the editor and ``fairmesh multires``
+      do (with ``keep_creases=True`` for their defaults): ``multires(0)`` is then ``fair``'s
+      result and ``Hierarchy.denoise`` says what the denoise found.
+    - ``progress``, ``threads``: as for ``fair``."""
 
 def load(path: PathLike, *, weld: bool = True, progress: Optional[Progress] = None) -> Mesh:
     """Read a mesh file (.obj .gltf .glb .ply .stl .off; ``"@bunny"``: the bundled bunny),

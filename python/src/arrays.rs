@@ -159,7 +159,8 @@ pub enum VertexSelection {
 }
 
 /// `mask`: a float or bool array of one weight (0 to 1) per vertex, or an integer array of the
-/// vertex indices to fair.
+/// vertex indices to fair. An integer array that could be either (one 0 or 1 per vertex) is
+/// refused, with how to write each: read as indices it would name at most two vertices.
 pub fn read_selection(
     name: &str,
     object: &Bound<'_, PyAny>,
@@ -186,6 +187,14 @@ pub fn read_selection(
         }
         "i" | "u" => {
             let indices: Vec<i64> = array.call_method1("astype", ("int64",))?.extract()?;
+            if indices.len() == vertex_count && indices.iter().all(|&i| i == 0 || i == 1) {
+                return Err(PyValueError::new_err(format!(
+                    "{name} is an integer array of {vertex_count} values, each 0 or 1, one per \
+                     vertex: it could be weights or vertex indices. For one weight per vertex \
+                     pass bools or floats ({name}.astype(bool)); for the vertices to fair pass \
+                     their indices ({name}.nonzero()[0])"
+                )));
+            }
             let mut vertices = Vec::with_capacity(indices.len());
             for (i, &index) in indices.iter().enumerate() {
                 match usize::try_from(index) {

@@ -11,8 +11,7 @@ pyo3::create_exception!(
     fairmesh,
     MeshFileError,
     PyValueError,
-    "A mesh file that cannot be read or written as it is: the message names the file, the \
-     place in it (line, byte or element) and what is wrong; `filename` is the path."
+    include_str!(concat!(env!("OUT_DIR"), "/doc/MeshFileError.txt"))
 );
 
 /// `error` as the exception a Python caller expects.

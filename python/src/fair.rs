@@ -155,16 +155,15 @@ fn report_dict<'py>(
     Ok(dict)
 }
 
-/// `fairmesh.fair(vertices, faces, **options)`; `vertices` may be a loaded `Mesh` instead,
-/// with `faces` left out: its file's sharp edges are then kept, as the command line keeps them.
+#[doc = include_str!(concat!(env!("OUT_DIR"), "/doc/fair.txt"))]
 #[pyfunction]
 #[pyo3(signature = (
     vertices, faces=None, *, method="constrained", iterations=10, rounds=None,
     crease_angle=DEFAULT_CREASE_ANGLE, no_creases=false, tangential=None,
-    no_volume_correction=false, tolerance=None, boundary="curve", variant="normal-projected",
+    no_volume_correction=false, tolerance=None, boundary="curve", variant="projected",
     lambda_=None, mu=None, alpha=None, beta=None, mask=None, mask_falloff=0, hard_edges=None,
     measure=false, progress=None, threads=None
-))]
+), text_signature = None)]
 #[allow(clippy::too_many_arguments)]
 pub fn fair<'py>(
     py: Python<'py>,
@@ -213,10 +212,15 @@ pub fn fair<'py>(
             .transpose()?,
         no_volume_correction,
         tolerance: tolerance
-            .map(|t| options::number_in("tolerance", t, 0.0, f64::MAX))
+            .map(|t| options::at_least("tolerance", t, 0.0))
             .transpose()?,
         boundary: options::boundary(boundary)?,
-        paper_variant: options::choice("variant", variant, &["normal-projected", "paper"])? == 1,
+        paper_variant: options::choice_or_old_name(
+            "variant",
+            variant,
+            &["projected", "paper"],
+            &[("normal-projected", 0)],
+        )? == 1,
         lambda: lambda_.map(|v| options::finite("lambda_", v)).transpose()?,
         mu: mu.map(|v| options::finite("mu", v)).transpose()?,
         alpha: alpha

@@ -17,9 +17,7 @@ use pyo3::prelude::*;
 use pyo3::types::{PyBool, PyDict};
 use std::sync::Mutex;
 
-/// The decimation hierarchy of a mesh (`fairmesh.hierarchy(...)`): level 0 is the mesh itself,
-/// each further level coarser. `multires(start_level)` fairs from a level down to full detail;
-/// the set-up of every level a run used is kept, so the next run only fairs.
+#[doc = include_str!(concat!(env!("OUT_DIR"), "/doc/Hierarchy.txt"))]
 #[pyclass(name = "Hierarchy", module = "fairmesh", frozen)]
 pub struct Hierarchy {
     hierarchy: fairmesh::hierarchy::Hierarchy,
@@ -34,20 +32,19 @@ pub struct Hierarchy {
 
 #[pymethods]
 impl Hierarchy {
-    /// Number of levels, level 0 (the input) included.
+    #[doc = include_str!(concat!(env!("OUT_DIR"), "/doc/Hierarchy.level_count.txt"))]
     #[getter]
     fn level_count(&self) -> usize {
         self.hierarchy.level_count()
     }
 
-    /// The coarsest level's index (`level_count - 1`).
+    #[doc = include_str!(concat!(env!("OUT_DIR"), "/doc/Hierarchy.coarsest_level.txt"))]
     #[getter]
     fn coarsest_level(&self) -> usize {
         self.hierarchy.coarsest_level()
     }
 
-    /// What the denoise before the build found (`hierarchy(..., denoise=...)`): a dict of
-    /// `rounds_run`, `noise_estimate` and `crease_edges`, or None without a denoise.
+    #[doc = include_str!(concat!(env!("OUT_DIR"), "/doc/Hierarchy.denoise.txt"))]
     #[getter]
     fn denoise<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyDict>>> {
         let Some((report, _)) = &self.denoised else {
@@ -60,7 +57,7 @@ impl Hierarchy {
         Ok(Some(dict))
     }
 
-    /// (vertices, faces) of every level, level 0 first.
+    #[doc = include_str!(concat!(env!("OUT_DIR"), "/doc/Hierarchy.level_sizes.txt"))]
     #[getter]
     fn level_sizes(&self) -> Vec<(usize, usize)> {
         (0..self.hierarchy.level_count())
@@ -71,8 +68,8 @@ impl Hierarchy {
             .collect()
     }
 
-    /// Level `level` as arrays: (vertices (k, 3), faces (j, 3), original), where `original[i]`
-    /// is the index of vertex `i` in level 0 (the input), whose position it has.
+    #[doc = include_str!(concat!(env!("OUT_DIR"), "/doc/Hierarchy.level.txt"))]
+    #[pyo3(text_signature = None)]
     fn level<'py>(
         &self,
         py: Python<'py>,
@@ -94,15 +91,11 @@ impl Hierarchy {
         ))
     }
 
-    /// Multiresolution fairing from `start_level` (0: the input itself; beyond the coarsest,
-    /// the coarsest) down to full detail: the input's vertices, smoothed, as a new (n, 3)
-    /// array (the input's faces apply). Options as `fairmesh multires` names them; the
-    /// hierarchy is the one built, without `fairmesh multires`'s denoise before it
-    /// (`--denoise off`).
+    #[doc = include_str!(concat!(env!("OUT_DIR"), "/doc/Hierarchy.multires.txt"))]
     #[pyo3(signature = (
         start_level, *, iterations=5, rounds=1, boundary="curve", fair_finest=true,
         variant="improved", mask=None, mask_falloff=0, progress=None, threads=None
-    ))]
+    ), text_signature = None)]
     #[allow(clippy::too_many_arguments)]
     fn multires<'py>(
         &self,
@@ -178,15 +171,13 @@ impl Hierarchy {
     }
 }
 
-/// `fairmesh.hierarchy(vertices, faces, **options)`: builds the decimation hierarchy, with the
-/// options of `fairmesh hierarchy`; `vertices` may be a loaded `Mesh` (faces left out), whose
-/// file's sharp edges are then kept with the creases.
+#[doc = include_str!(concat!(env!("OUT_DIR"), "/doc/hierarchy.txt"))]
 #[pyfunction]
 #[pyo3(signature = (
     vertices, faces=None, *, alpha=1.0, beta=0.01, min_vertices=100, max_levels=64,
     keep_boundary=false, keep_creases=false, crease_angle=None, denoise=None, progress=None,
     threads=None
-))]
+), text_signature = None)]
 #[allow(clippy::too_many_arguments)]
 pub fn hierarchy(
     py: Python<'_>,

@@ -8,6 +8,7 @@
 //! - `levels.rs`: `hierarchy` and its `Hierarchy` object, which runs `multires` again and again.
 //! - `measure.rs`: `noise` and `compare`.
 //! - `run.rs`: long calls without the GIL, with a progress callback and Ctrl+C.
+//! - `pool.rs`: the rayon pool every call runs in, one per process (so a forked child works).
 //! - `options.rs`, `errors.rs`: keyword arguments checked, the library's errors as exceptions.
 
 mod arrays;
@@ -17,6 +18,7 @@ mod levels;
 mod measure;
 mod mesh;
 mod options;
+mod pool;
 mod run;
 
 use pyo3::prelude::*;
@@ -30,6 +32,7 @@ fn _fairmesh(module: &Bound<'_, PyModule>) -> PyResult<()> {
     module.add_function(wrap_pyfunction!(levels::hierarchy, module)?)?;
     module.add_function(wrap_pyfunction!(mesh::load, module)?)?;
     module.add_function(wrap_pyfunction!(mesh::save, module)?)?;
+    module.add_function(wrap_pyfunction!(mesh::load_pickled, module)?)?;
     module.add_class::<mesh::Mesh>()?;
     module.add_class::<levels::Hierarchy>()?;
     module.add("MeshFileError", py.get_type::<errors::MeshFileError>())?;

@@ -6,13 +6,13 @@ use crate::options;
 use crate::run::run_detached;
 use fairmesh::metrics;
 use fairmesh::noise::{add_noise, NoiseMode, NoiseOptions};
+use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
-/// `fairmesh.noise(vertices, faces, sigma=0.3, seed=1, mode="normal")`: the vertices with
-/// seeded Gaussian noise (sigma in mean edge lengths), as a new array.
+#[doc = include_str!(concat!(env!("OUT_DIR"), "/doc/noise.txt"))]
 #[pyfunction]
-#[pyo3(signature = (vertices, faces, *, sigma=0.3, seed=1, mode="normal"))]
+#[pyo3(signature = (vertices, faces, *, sigma=0.3, seed=1, mode="normal"), text_signature = None)]
 pub fn noise<'py>(
     py: Python<'py>,
     vertices: &Bound<'py, PyAny>,
@@ -21,7 +21,7 @@ pub fn noise<'py>(
     seed: u64,
     mode: &str,
 ) -> PyResult<Bound<'py, PyAny>> {
-    let sigma = options::number_in("sigma", sigma, 0.0, f64::MAX)?;
+    let sigma = options::at_least("sigma", sigma, 0.0)?;
     let mode = match options::choice("mode", mode, &["normal", "direction", "iso"])? {
         0 => NoiseMode::Normal,
         1 => NoiseMode::Direction,
@@ -36,10 +36,9 @@ pub fn noise<'py>(
     Ok(arrays::positions_array(py, mesh.positions, precision))
 }
 
-/// `fairmesh.compare(reference_vertices, reference_faces, vertices, faces=None)`: the fields of
-/// `fairmesh compare --json` (without the file names) as a dict.
+#[doc = include_str!(concat!(env!("OUT_DIR"), "/doc/compare.txt"))]
 #[pyfunction]
-#[pyo3(signature = (reference_vertices, reference_faces, vertices, faces=None))]
+#[pyo3(signature = (reference_vertices, reference_faces, vertices, faces=None), text_signature = None)]
 pub fn compare<'py>(
     py: Python<'py>,
     reference_vertices: &Bound<'py, PyAny>,
@@ -48,6 +47,20 @@ pub fn compare<'py>(
     faces: Option<&Bound<'py, PyAny>>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let (reference, ..) = from_arrays(reference_vertices, reference_faces)?;
+    let faces = faces.filter(|f| !f.is_none());
+    if faces.is_none() {
+        // The reference's faces then index `vertices`: say so before they name a vertex beyond.
+        if let Ok(rows) = vertices.len() {
+            if rows != reference.vertex_count() {
+                return Err(PyValueError::new_err(format!(
+                    "vertices has {rows} rows but the reference has {} vertices: without \
+                     faces, vertices must be the reference's moved; pass faces= for a mesh of \
+                     other connectivity",
+                    reference.vertex_count()
+                )));
+            }
+        }
+    }
     let (other, ..) = from_arrays(vertices, faces.unwrap_or(reference_faces))?;
     let (result, sharpened, edge) = run_detached(py, None, None, |_| {
         Some((

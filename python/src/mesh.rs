@@ -18,7 +18,7 @@ pyo3::create_exception!(
     fairmesh,
     MeshWarning,
     pyo3::exceptions::PyUserWarning,
-    "What loading read leniently or repaired, and what saving could not keep from the file."
+    include_str!(concat!(env!("OUT_DIR"), "/doc/MeshWarning.txt"))
 );
 
 /// A mesh from `vertices` and `faces` arrays, made ready as loading makes a file's mesh ready,
@@ -44,38 +44,37 @@ pub fn from_arrays(
     let positions = read.positions;
     let precision = read.precision;
     let py = vertices.py();
-    py.detach(move || {
-        catching(move || {
-            let mut mesh = TriMesh::new(positions, triangles);
-            let mut topology = Topology::build(&mesh);
-            if !topology.repeated_triangles.is_empty() {
-                let mut repeated = vec![false; mesh.triangles.len()];
-                for &t in &topology.repeated_triangles {
-                    repeated[t as usize] = true;
-                }
-                let mut index = 0;
-                mesh.triangles.retain(|_| {
-                    index += 1;
-                    !repeated[index - 1]
-                });
-                topology = Topology::build(&mesh);
+    catching(py, move || {
+        let mut mesh = TriMesh::new(positions, triangles);
+        let mut topology = Topology::build(&mesh);
+        if !topology.repeated_triangles.is_empty() {
+            let mut repeated = vec![false; mesh.triangles.len()];
+            for &t in &topology.repeated_triangles {
+                repeated[t as usize] = true;
             }
-            if topology.inconsistent_edges > 0
-                && fairmesh::mesh::orient_consistently(&mut mesh, &topology).flipped_faces > 0
-            {
-                topology = Topology::build(&mesh);
-            }
-            Ok((mesh, topology, precision))
-        })
+            let mut index = 0;
+            mesh.triangles.retain(|_| {
+                index += 1;
+                !repeated[index - 1]
+            });
+            topology = Topology::build(&mesh);
+        }
+        if topology.inconsistent_edges > 0
+            && fairmesh::mesh::orient_consistently(&mut mesh, &topology).flipped_faces > 0
+        {
+            topology = Topology::build(&mesh);
+        }
+        Ok((mesh, topology, precision))
     })
 }
 
-/// A mesh loaded from a file (`fairmesh.load`): its vertices and faces as arrays, and the file
-/// it came from, so that `save` writes it back with only the positions changed.
+#[doc = include_str!(concat!(env!("OUT_DIR"), "/doc/Mesh.txt"))]
 #[pyclass(name = "Mesh", module = "fairmesh")]
 pub struct Mesh {
     pub loaded: Loaded,
     path: PathBuf,
+    /// `load`'s `weld`, to load it again when unpickled.
+    weld: bool,
     /// The arrays, made on first use: `fair(mesh)` and `save` need neither.
     vertices: OnceLock<Py<PyAny>>,
     faces: OnceLock<Py<PyAny>>,
@@ -96,7 +95,7 @@ impl Mesh {
 
 #[pymethods]
 impl Mesh {
-    /// The welded vertices, (n, 3) float64, read-only (a result is a new array).
+    #[doc = include_str!(concat!(env!("OUT_DIR"), "/doc/Mesh.vertices.txt"))]
     #[getter]
     fn vertices(&self, py: Python<'_>) -> PyResult<Py<PyAny>> {
         if let Some(array) = self.vertices.get() {
@@ -107,7 +106,7 @@ impl Mesh {
         Ok(self.vertices.get_or_init(|| array).clone_ref(py))
     }
 
-    /// The triangles, (m, 3) int64 indices into `vertices`, read-only.
+    #[doc = include_str!(concat!(env!("OUT_DIR"), "/doc/Mesh.faces.txt"))]
     #[getter]
     fn faces(&self, py: Python<'_>) -> PyResult<Py<PyAny>> {
         if let Some(array) = self.faces.get() {
@@ -117,8 +116,7 @@ impl Mesh {
         Ok(self.faces.get_or_init(|| array).clone_ref(py))
     }
 
-    /// The file's sharp edges ((k, 2) int64 vertex pairs): split normals and material
-    /// boundaries of an OBJ or glTF; `fair(mesh)` keeps them sharp, as the command line does.
+    #[doc = include_str!(concat!(env!("OUT_DIR"), "/doc/Mesh.hard_edges.txt"))]
     #[getter]
     fn hard_edges<'py>(&self, py: Python<'py>) -> Bound<'py, PyAny> {
         let edges: Vec<i64> = self
@@ -133,49 +131,44 @@ impl Mesh {
             .into_any()
     }
 
-    /// The path the mesh was loaded from.
+    #[doc = include_str!(concat!(env!("OUT_DIR"), "/doc/Mesh.path.txt"))]
     #[getter(path)]
     fn path_text(&self) -> String {
         self.path().display().to_string()
     }
 
-    /// The file's format: "obj", "gltf", "glb", "ply", "stl" or "off".
+    #[doc = include_str!(concat!(env!("OUT_DIR"), "/doc/Mesh.format.txt"))]
     #[getter]
     fn format(&self) -> String {
         self.loaded.source.format().extension().to_string()
     }
 
-    /// What loading read leniently or repaired, in words (also given as `MeshWarning`s).
+    #[doc = include_str!(concat!(env!("OUT_DIR"), "/doc/Mesh.warnings.txt"))]
     #[getter]
     fn warnings(&self) -> Vec<String> {
         self.loaded.report.warnings.clone()
     }
 
-    /// What the file holds beyond positions and triangles (UVs, normals, materials, ...),
-    /// kept when it is saved back into its format.
+    #[doc = include_str!(concat!(env!("OUT_DIR"), "/doc/Mesh.contents.txt"))]
     #[getter]
     fn contents(&self) -> Vec<String> {
         self.loaded.source.contents()
     }
 
-    /// How many vertices loading merged because they had the same position.
+    #[doc = include_str!(concat!(env!("OUT_DIR"), "/doc/Mesh.welded_vertices.txt"))]
     #[getter]
     fn welded_vertices(&self) -> usize {
         self.loaded.report.welded_vertices
     }
 
-    /// Whether every edge has two triangles (the volume change then means something).
+    #[doc = include_str!(concat!(env!("OUT_DIR"), "/doc/Mesh.closed.txt"))]
     #[getter]
     fn closed(&self) -> bool {
         self.loaded.topology.is_closed()
     }
 
-    /// Writes the mesh with `vertices` (the loaded ones when None) as its positions into
-    /// `path` (format by extension). Into the file's own format the file comes back with only
-    /// the positions (and what follows them: normals, texture coordinates) changed; into
-    /// another, what that format can hold is carried. What could not be kept is given as a
-    /// `MeshWarning`. The write is atomic: a failed save leaves no file.
-    #[pyo3(signature = (path, vertices=None))]
+    #[doc = include_str!(concat!(env!("OUT_DIR"), "/doc/Mesh.save.txt"))]
+    #[pyo3(signature = (path, vertices=None), text_signature = None)]
     fn save(
         &mut self,
         py: Python<'_>,
@@ -197,24 +190,42 @@ impl Mesh {
             None => None,
         };
         let loaded = &mut self.loaded;
-        let outcome = py.detach(|| {
-            catching(|| {
-                // The new positions stand in for the loaded ones while the file is written.
-                if let Some(new) = &mut positions {
-                    std::mem::swap(&mut loaded.mesh.positions, new);
-                }
-                let saved = fairmesh::io::save_with_source(&path, &loaded.mesh, &loaded.source);
-                if let Some(new) = &mut positions {
-                    std::mem::swap(&mut loaded.mesh.positions, new);
-                }
-                Ok(saved)
-            })
+        let outcome = catching(py, || {
+            // The new positions stand in for the loaded ones while the file is written.
+            if let Some(new) = &mut positions {
+                std::mem::swap(&mut loaded.mesh.positions, new);
+            }
+            let saved = fairmesh::io::save_with_source(&path, &loaded.mesh, &loaded.source);
+            if let Some(new) = &mut positions {
+                std::mem::swap(&mut loaded.mesh.positions, new);
+            }
+            Ok(saved)
         })?;
         let report = outcome.map_err(|e| io_error(py, &e))?;
         for warning in &report.warnings {
             warn(py, &format!("{}: {warning}", path.display()))?;
         }
         Ok(())
+    }
+
+    /// Pickles as its file, read again when unpickled (so the file must be readable there, as
+    /// the same path); a file that changed since is refused when unpickled.
+    fn __reduce__<'py>(&self, py: Python<'py>) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyAny>)> {
+        let path = if fairmesh::bundled::is_bunny_pseudo_path(&self.path) {
+            self.path.clone()
+        } else {
+            std::path::absolute(&self.path).unwrap_or_else(|_| self.path.clone())
+        };
+        let reload = py.import("fairmesh._fairmesh")?.getattr("_load_pickled")?;
+        let mesh = &self.loaded.mesh;
+        let arguments = (
+            path,
+            self.weld,
+            mesh.vertex_count(),
+            mesh.face_count(),
+            fingerprint(mesh),
+        );
+        Ok((reload, arguments.into_pyobject(py)?.into_any()))
     }
 
     fn __repr__(&self) -> String {
@@ -237,10 +248,24 @@ pub fn warn(py: Python<'_>, message: &str) -> PyResult<()> {
     )
 }
 
-/// `fairmesh.load`: reads a mesh file (or `@bunny`, the bundled Stanford bunny).
+#[doc = include_str!(concat!(env!("OUT_DIR"), "/doc/load.txt"))]
 #[pyfunction]
-#[pyo3(signature = (path, *, weld=true, progress=None))]
+#[pyo3(signature = (path, *, weld=true, progress=None), text_signature = None)]
 pub fn load(
+    py: Python<'_>,
+    path: PathBuf,
+    weld: bool,
+    progress: Option<&Bound<'_, PyAny>>,
+) -> PyResult<Mesh> {
+    let mesh = load_file(py, path, weld, progress)?;
+    for warning in &mesh.loaded.report.warnings {
+        warn(py, &format!("{}: {warning}", mesh.path.display()))?;
+    }
+    Ok(mesh)
+}
+
+/// `path` read as `load` reads it, without the warnings.
+fn load_file(
     py: Python<'_>,
     path: PathBuf,
     weld: bool,
@@ -255,19 +280,59 @@ pub fn load(
         })
     })?
     .map_err(|e| io_error(py, &e))?;
-    for warning in &loaded.report.warnings {
-        warn(py, &format!("{}: {warning}", path.display()))?;
-    }
     Ok(Mesh {
         loaded,
         path,
+        weld,
         vertices: OnceLock::new(),
         faces: OnceLock::new(),
     })
 }
 
-/// `fairmesh.save`: writes a bare mesh from arrays (format by extension).
+/// A pickled `Mesh` (see `Mesh.__reduce__`): its file read again (its warnings were given when
+/// it was first loaded), refused if it is no longer the mesh that was pickled.
 #[pyfunction]
+#[pyo3(name = "_load_pickled")]
+pub fn load_pickled(
+    py: Python<'_>,
+    path: PathBuf,
+    weld: bool,
+    vertices: usize,
+    faces: usize,
+    fingerprint_then: u64,
+) -> PyResult<Mesh> {
+    let mesh = load_file(py, path, weld, None)?;
+    let now = &mesh.loaded.mesh;
+    if now.vertex_count() != vertices
+        || now.face_count() != faces
+        || fingerprint(now) != fingerprint_then
+    {
+        return Err(PyValueError::new_err(format!(
+            "{} changed since this fairmesh.Mesh was pickled ({vertices} vertices, {faces} \
+             faces then; {} vertices, {} faces now): a Mesh pickles as its file, read again \
+             when unpickled",
+            mesh.path.display(),
+            now.vertex_count(),
+            now.face_count()
+        )));
+    }
+    Ok(mesh)
+}
+
+/// A hash of `mesh`'s positions and triangles (the same in every process of one build).
+fn fingerprint(mesh: &TriMesh) -> u64 {
+    use std::hash::{Hash, Hasher};
+    let mut hasher = std::collections::hash_map::DefaultHasher::new();
+    for p in &mesh.positions {
+        p.map(f32::to_bits).hash(&mut hasher);
+    }
+    mesh.triangles.hash(&mut hasher);
+    hasher.finish()
+}
+
+#[doc = include_str!(concat!(env!("OUT_DIR"), "/doc/save.txt"))]
+#[pyfunction]
+#[pyo3(text_signature = None)]
 pub fn save(
     py: Python<'_>,
     path: PathBuf,
@@ -277,8 +342,7 @@ pub fn save(
     let read = arrays::read_vertices("vertices", vertices)?;
     let triangles = arrays::read_faces("faces", faces, read.positions.len())?;
     let mesh = TriMesh::new(read.positions, triangles);
-    py.detach(|| catching(|| Ok(fairmesh::io::save(&path, &mesh))))?
-        .map_err(|e| io_error(py, &e))
+    catching(py, || Ok(fairmesh::io::save(&path, &mesh)))?.map_err(|e| io_error(py, &e))
 }
 
 /// `array` made read-only, as a handle.

@@ -22,6 +22,17 @@ pub fn number_in(name: &str, value: f64, low: f64, high: f64) -> PyResult<f64> {
     }
 }
 
+/// A finite number of `low` or more.
+pub fn at_least(name: &str, value: f64, low: f64) -> PyResult<f64> {
+    if value.is_finite() && value >= low {
+        Ok(value)
+    } else {
+        Err(PyValueError::new_err(format!(
+            "{name} must be a finite number of {low} or more, not {value}"
+        )))
+    }
+}
+
 /// A finite number.
 pub fn finite(name: &str, value: f64) -> PyResult<f64> {
     if value.is_finite() {
@@ -35,17 +46,36 @@ pub fn finite(name: &str, value: f64) -> PyResult<f64> {
 
 /// One of `choices` (compared without case; `_` stands for `-`), as its index.
 pub fn choice(name: &str, value: &str, choices: &[&str]) -> PyResult<usize> {
+    choice_or_old_name(name, value, choices, &[])
+}
+
+/// [`choice`], also accepting the old names of `old_names` (name, index of the choice it means);
+/// the error lists only the current names.
+pub fn choice_or_old_name(
+    name: &str,
+    value: &str,
+    choices: &[&str],
+    old_names: &[(&str, usize)],
+) -> PyResult<usize> {
     let wanted = value.to_ascii_lowercase().replace('_', "-");
-    choices.iter().position(|c| *c == wanted).ok_or_else(|| {
-        PyValueError::new_err(format!(
-            "{name} must be one of {}, not {value:?}",
-            choices
-                .iter()
-                .map(|c| format!("{c:?}"))
-                .collect::<Vec<_>>()
-                .join(", ")
-        ))
-    })
+    let old = old_names
+        .iter()
+        .find(|(old, _)| *old == wanted)
+        .map(|&(_, index)| index);
+    choices
+        .iter()
+        .position(|c| *c == wanted)
+        .or(old)
+        .ok_or_else(|| {
+            PyValueError::new_err(format!(
+                "{name} must be one of {}, not {value:?}",
+                choices
+                    .iter()
+                    .map(|c| format!("{c:?}"))
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            ))
+        })
 }
 
 /// `boundary`: "curve" or "fixed".

@@ -1,12 +1,15 @@
-//! Running long library calls without the GIL: the work runs on a thread of its own while the
+//! Running long library calls without the GIL: the work runs on a thread of its own, inside a
+//! rayon pool (this process's, or one of its own for `threads=`: see [`crate::pool`]), while the
 //! calling thread waits with the GIL released, waking every few hundredths of a second to check
 //! for Ctrl+C (Python handles signals on its main thread, in the interpreter) and to call the
-//! `progress` callback. Either one stops the work at its next progress report, through the
-//! library's [`fairmesh::Progress`] hook; a panic in the library comes back as an exception.
+//! `progress` callback with every fraction the work reported since. Either one stops the work at
+//! its next progress report, through the library's [`fairmesh::Progress`] hook; a panic in the
+//! library comes back as an exception.
 
+use crate::pool;
 use pyo3::exceptions::PyRuntimeError;
 use pyo3::prelude::*;
-use std::sync::atomic::{AtomicBool, AtomicU32, Ordering};
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Condvar, Mutex};
 use std::time::Duration;
 
@@ -17,14 +20,22 @@ pyo3::create_exception!(
     fairmesh,
     Cancelled,
     pyo3::exceptions::PyException,
-    "The progress callback returned False: the call stopped and gave no result."
+    include_str!(concat!(env!("OUT_DIR"), "/doc/Cancelled.txt"))
 );
 
 /// What the working thread and the waiting one share.
 struct Shared {
-    /// The last fraction reported, as f32 bits.
-    fraction: AtomicU32,
+    /// The fractions reported and not yet given to the callback (only kept with a callback).
+    reported: Option<Mutex<Reported>>,
     cancel: AtomicBool,
+}
+
+/// Fractions reported by the work, in order.
+#[derive(Default)]
+struct Reported {
+    waiting: Vec<f32>,
+    /// The last fraction queued, so that a repeated one is not given twice.
+    last: Option<f32>,
 }
 
 /// The [`fairmesh::Progress`] the work reports to.
@@ -34,19 +45,28 @@ pub struct Hook<'a> {
 
 impl fairmesh::Progress for Hook<'_> {
     fn report(&mut self, fraction: f32) -> bool {
-        self.shared
-            .fraction
-            .store(fraction.clamp(0.0, 1.0).to_bits(), Ordering::Relaxed);
+        if let Some(reported) = &self.shared.reported {
+            let fraction = fraction.clamp(0.0, 1.0);
+            let mut reported = reported
+                .lock()
+                .unwrap_or_else(std::sync::PoisonError::into_inner);
+            if reported.last != Some(fraction) {
+                reported.last = Some(fraction);
+                reported.waiting.push(fraction);
+            }
+        }
         !self.shared.cancel.load(Ordering::Relaxed)
     }
 }
 
 /// Runs `work` without the GIL; `progress` (a Python callable taking the fraction done, or
-/// None) is called on the calling thread as the work reports. `work` returns `None` when it
-/// stopped because its hook asked it to. Ctrl+C raises `KeyboardInterrupt`, a callback that
-/// returns False raises [`Cancelled`], one that raises passes its exception on; in each case
-/// the work is stopped first. With `threads`, the work runs in a rayon pool of that many threads
-/// of its own instead of the shared one (for running several calls side by side).
+/// None) is called on the calling thread with every new fraction the work reports, in order
+/// (the work does not wait for it), and with 1.0 at the end unless the work reported it last.
+/// `work` returns `None` when it stopped because its hook asked it to. Ctrl+C raises
+/// `KeyboardInterrupt`, a callback that returns False raises [`Cancelled`], one that raises
+/// passes its exception on; in each case the work is stopped first. The work runs in this
+/// process's pool, or with `threads` in a rayon pool of that many threads of its own (for
+/// running several calls side by side).
 pub fn run_detached<T, W>(
     py: Python<'_>,
     progress: Option<&Bound<'_, PyAny>>,
@@ -58,18 +78,16 @@ where
     W: FnOnce(&mut Hook<'_>) -> Option<T> + Send,
 {
     let shared = Shared {
-        fraction: AtomicU32::new(0f32.to_bits()),
+        reported: progress.map(|_| Mutex::new(Reported::default())),
         cancel: AtomicBool::new(false),
     };
-    let pool = threads
-        .map(|n| {
-            rayon::ThreadPoolBuilder::new()
-                .num_threads(n)
-                .thread_name(|i| format!("fairmesh-python-{i}"))
-                .build()
-                .map_err(|e| PyRuntimeError::new_err(format!("cannot start {n} threads: {e}")))
-        })
+    let own_pool = threads
+        .map(|n| pool::build(Some(n), "fairmesh-call"))
         .transpose()?;
+    let pool = match &own_pool {
+        Some(pool) => pool,
+        None => pool::shared()?,
+    };
     // Set by the worker when it ends, panicking or not.
     let finished = (Mutex::new(false), Condvar::new());
     std::thread::scope(|scope| {
@@ -78,14 +96,11 @@ where
             .spawn_scoped(scope, || {
                 let _signal = FinishedSignal(&finished);
                 let mut hook = Hook { shared: &shared };
-                match &pool {
-                    Some(pool) => pool.install(|| work(&mut hook)),
-                    None => work(&mut hook),
-                }
+                pool.install(|| work(&mut hook))
             })
             .map_err(|e| PyRuntimeError::new_err(format!("cannot start a thread: {e}")))?;
         let mut stopped_by: Option<PyErr> = None;
-        let mut reported = f32::NAN;
+        let mut delivered: Option<f32> = None;
         loop {
             let ended = py.detach(|| {
                 let (done, signal) = &finished;
@@ -97,33 +112,24 @@ where
                     .unwrap_or_else(std::sync::PoisonError::into_inner);
                 *guard
             });
+            if stopped_by.is_none() {
+                let outcome = py
+                    .check_signals()
+                    .and_then(|()| deliver(progress, &shared, &mut delivered));
+                match outcome {
+                    Ok(true) => {}
+                    Ok(false) => {
+                        stopped_by = Some(Cancelled::new_err("cancelled by the progress callback"));
+                        shared.cancel.store(true, Ordering::Relaxed);
+                    }
+                    Err(error) => {
+                        stopped_by = Some(error);
+                        shared.cancel.store(true, Ordering::Relaxed);
+                    }
+                }
+            }
             if ended {
                 break;
-            }
-            if stopped_by.is_some() {
-                continue;
-            }
-            let outcome = py.check_signals().and_then(|()| match progress {
-                Some(callback) => {
-                    let fraction = f32::from_bits(shared.fraction.load(Ordering::Relaxed));
-                    if fraction == reported {
-                        return Ok(true);
-                    }
-                    reported = fraction;
-                    keep_going(callback, fraction)
-                }
-                None => Ok(true),
-            });
-            match outcome {
-                Ok(true) => {}
-                Ok(false) => {
-                    stopped_by = Some(Cancelled::new_err("cancelled by the progress callback"));
-                    shared.cancel.store(true, Ordering::Relaxed);
-                }
-                Err(error) => {
-                    stopped_by = Some(error);
-                    shared.cancel.store(true, Ordering::Relaxed);
-                }
             }
         }
         let result = py.detach(|| worker.join()).map_err(panic_error)?;
@@ -131,12 +137,37 @@ where
             return Err(error);
         }
         if let (Some(callback), Some(_)) = (progress, &result) {
-            if !keep_going(callback, 1.0)? {
+            if delivered != Some(1.0) && !keep_going(callback, 1.0)? {
                 return Err(Cancelled::new_err("cancelled by the progress callback"));
             }
         }
         result.ok_or_else(|| Cancelled::new_err("cancelled"))
     })
+}
+
+/// Gives `progress` every fraction reported since the last call, in order; false once it
+/// returned False (the rest are dropped).
+fn deliver(
+    progress: Option<&Bound<'_, PyAny>>,
+    shared: &Shared,
+    delivered: &mut Option<f32>,
+) -> PyResult<bool> {
+    let (Some(callback), Some(reported)) = (progress, &shared.reported) else {
+        return Ok(true);
+    };
+    let waiting = std::mem::take(
+        &mut reported
+            .lock()
+            .unwrap_or_else(std::sync::PoisonError::into_inner)
+            .waiting,
+    );
+    for fraction in waiting {
+        *delivered = Some(fraction);
+        if !keep_going(callback, fraction)? {
+            return Ok(false);
+        }
+    }
+    Ok(true)
 }
 
 /// Tells the waiting thread that the worker ended, when dropped (so also when the work panics).
@@ -170,9 +201,12 @@ pub fn panic_error(payload: Box<dyn std::any::Any + Send>) -> PyErr {
     ))
 }
 
-/// Runs `work` on the calling thread, turning a panic into an exception (short calls that keep
-/// the GIL, such as building a mesh from arrays).
-pub fn catching<T>(work: impl FnOnce() -> PyResult<T>) -> PyResult<T> {
-    std::panic::catch_unwind(std::panic::AssertUnwindSafe(work))
-        .unwrap_or_else(|p| Err(panic_error(p)))
+/// Runs `work` in this process's pool without the GIL, waiting for it and turning a panic into
+/// an exception (short calls, such as building a mesh from arrays).
+pub fn catching<T: Send>(py: Python<'_>, work: impl FnOnce() -> PyResult<T> + Send) -> PyResult<T> {
+    py.detach(|| {
+        std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| pool::run(work)))
+            .unwrap_or_else(|p| Err(panic_error(p)))
+            .and_then(|result| result)
+    })
 }

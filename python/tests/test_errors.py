@@ -107,3 +107,53 @@ def test_saving_checks_the_vertices_and_warns_what_it_cannot_keep(tmp_path, bunn
     nowhere = tmp_path / "no" / "such" / "folder.ply"
     with pytest.raises(OSError, match=f"{nowhere}: cannot write the file: the folder .* does not"):
         fairmesh.save(nowhere, bunny.vertices, bunny.faces)
+
+
+def test_a_mask_is_unambiguous(bunny):
+    v, f = bunny.vertices, bunny.faces
+    upper = v[:, 1] > np.median(v[:, 1])
+    # Bools, float weights and the indices of the same vertices are the same mask.
+    by_bools, report = fairmesh.fair(v, f, rounds=1, mask=upper)
+    assert report["masked_vertices"] == upper.sum()
+    for same in (upper.astype(np.float32), np.flatnonzero(upper), upper.tolist()):
+        result, _ = fairmesh.fair(v, f, rounds=1, mask=same)
+        np.testing.assert_array_equal(result, by_bools)
+    # One 0 or 1 per vertex as integers could be either: refused, with how to write each.
+    for ambiguous in (upper.astype(np.int64), upper.astype(np.uint8), upper.astype(int).tolist()):
+        with pytest.raises(ValueError, match=r"mask is an integer array of 37706 values, each 0 "
+                                             r"or 1, one per vertex: it could be weights or "
+                                             r"vertex indices\. .*mask\.astype\(bool\).*"
+                                             r"mask\.nonzero\(\)\[0\]"):
+            fairmesh.fair(v, f, rounds=1, mask=ambiguous)
+    levels = fairmesh.hierarchy(v, f)
+    with pytest.raises(ValueError, match="mask is an integer array of 37706 values"):
+        levels.multires(3, mask=upper.astype(np.int32))
+    # Indices that are not one a vertex are indices, as before.
+    few, _ = fairmesh.fair(v, f, rounds=1, mask=np.array([0, 1, 1, 0]))
+    assert (few[2:] == v[2:]).all()
+
+
+def test_old_variant_names_are_accepted_and_numbers_read_plainly(bunny):
+    v, f = bunny.vertices, bunny.faces
+    new, report = fairmesh.fair(v, f, rounds=1, variant="projected")
+    for old in ("normal-projected", "normal_projected"):
+        result, _ = fairmesh.fair(v, f, rounds=1, variant=old)
+        np.testing.assert_array_equal(result, new)
+    assert report["variant"] == "normal-projected"  # as `fairmesh fair --json` names it
+    with pytest.raises(ValueError, match=r'variant must be one of "projected", "paper", not '
+                                         r'"exact"$'):
+        fairmesh.fair(v, f, variant="exact")
+    with pytest.raises(ValueError, match=r"sigma must be a finite number of 0 or more, not -1$"):
+        fairmesh.noise(v, f, sigma=-1)
+    with pytest.raises(ValueError, match=r"tolerance must be a finite number of 0 or more, not "
+                                         r"-0\.5$"):
+        fairmesh.fair(v, f, tolerance=-0.5)
+
+
+def test_compare_with_other_vertices_asks_for_their_faces(bunny):
+    other = fairmesh.load(bunny.path.replace("assets/bunny00.obj", "tests/data/elephant.obj"))
+    with pytest.raises(ValueError, match=r"vertices has 2775 rows but the reference has 37706 "
+                                         r"vertices: without faces, .* pass faces="):
+        fairmesh.compare(bunny.vertices, bunny.faces, other.vertices)
+    result = fairmesh.compare(bunny.vertices, bunny.faces, other.vertices, other.faces)
+    assert not result["same_connectivity"]

@@ -127,8 +127,15 @@ def test_progress_is_reported_and_can_cancel(bunny, noisy):
 
 def test_fair_reports_every_round_and_stops_when_told(bunny, noisy):
     fractions = []
-    fairmesh.fair(noisy, bunny.faces, rounds=60, progress=fractions.append)
-    assert fractions[-1] == 1.0 and fractions == sorted(fractions) and len(fractions) > 2
+    fairmesh.fair(noisy, bunny.faces, rounds=29, progress=fractions.append)
+    # After every round, however fast the rounds come: rounds done / rounds asked for.
+    assert fractions == [float(np.float32(done / 29)) for done in range(1, 30)]
+    automatic = []
+    _, report = fairmesh.fair(noisy, bunny.faces, progress=automatic.append)
+    # The automatic strength: one report a round run (the error estimated after each), then
+    # 1.0 once the best round is kept.
+    assert len(automatic) == len(report["risk_by_round"]) + 1
+    assert automatic[-1] == 1.0 and automatic == sorted(set(automatic))
     heard = []
 
     def stop_soon(fraction):
@@ -164,3 +171,32 @@ def _ctrl_c_stops_a_long_fair(bunny, noisy):
     # 2000 rounds would take about 2000 * per_round; it stops within a few rounds of 0.3 s.
     assert stopped < 0.3 + 20 * per_round + 1.0, f"{stopped:.2f} s ({per_round:.4f} s a round)"
     assert stopped < 0.25 * 2000 * per_round
+
+
+def test_a_call_in_a_worker_thread_stops_when_the_main_thread_asks(bunny, noisy):
+    # Python gives Ctrl+C to the main thread only; the documented way to stop a call in another
+    # thread is a progress callback that reads an event the main thread sets.
+    stop = threading.Event()
+    started = threading.Event()
+    heard = []
+    outcome = []
+
+    def keep_going(fraction):
+        heard.append(fraction)
+        started.set()
+        return not stop.is_set()
+
+    def work():
+        try:
+            fairmesh.fair(noisy, bunny.faces, rounds=2000, progress=keep_going)
+            outcome.append("finished")
+        except fairmesh.Cancelled as cancelled:
+            outcome.append(cancelled)
+
+    worker = threading.Thread(target=work)
+    worker.start()
+    started.wait()
+    stop.set()  # what the main thread does on KeyboardInterrupt
+    worker.join()
+    assert isinstance(outcome[0], fairmesh.Cancelled)
+    assert heard[-1] < 0.5, f"{len(heard)} rounds ran"
