@@ -52,11 +52,7 @@ fn the_architecture_page_names_every_source_file_and_no_other() {
         missing.is_empty() && stale.is_empty(),
         "docs/architecture.md, 'Source files': not named: {missing:?}; named but not in the tree: {stale:?}"
     );
-    assert!(
-        files.len() > 150,
-        "found only {} source files",
-        files.len()
-    );
+    assert!(files.len() > 150, "found only {} source files", files.len());
 }
 
 /// The library stands alone: none of the GUI stack is among its dependencies, direct or
@@ -67,7 +63,15 @@ fn the_library_depends_on_no_gui_crate() {
     let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".to_string());
     let output = std::process::Command::new(cargo)
         .current_dir(env!("CARGO_MANIFEST_DIR"))
-        .args(["tree", "--offline", "--locked", "-p", "fairmesh", "-e", "normal"])
+        .args([
+            "tree",
+            "--offline",
+            "--locked",
+            "-p",
+            "fairmesh",
+            "-e",
+            "normal",
+        ])
         .args(["--prefix", "none", "--format", "{p}"])
         .output()
         .expect("cargo runs");
@@ -81,8 +85,20 @@ fn the_library_depends_on_no_gui_crate() {
         .lines()
         .filter_map(|line| line.split_whitespace().next())
         .collect();
-    assert!(crates.contains("glam") && crates.contains("rayon"), "{tree}");
-    for gui in ["eframe", "egui", "egui-wgpu", "wgpu", "winit", "rfd", "clap", "anyhow"] {
+    assert!(
+        crates.contains("glam") && crates.contains("rayon"),
+        "{tree}"
+    );
+    for gui in [
+        "eframe",
+        "egui",
+        "egui-wgpu",
+        "wgpu",
+        "winit",
+        "rfd",
+        "clap",
+        "anyhow",
+    ] {
         assert!(
             !crates.contains(gui),
             "the library depends on {gui}:\n{tree}"

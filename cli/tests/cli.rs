@@ -24,7 +24,9 @@ fn json_of(args: &[&str]) -> Value {
 }
 
 fn data(name: &str) -> String {
-    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).parent().expect("the repository holds the crate");
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .parent()
+        .expect("the repository holds the crate");
     let path: PathBuf = if name == "bunny00.obj" {
         dir.join("assets").join(name)
     } else {
@@ -1012,7 +1014,10 @@ fn fair_and_the_hierarchy_keep_the_files_hard_edges_as_creases() {
 #[test]
 fn fair_warns_when_the_relaxation_slides_a_textured_files_vertices() {
     let dir = tempfile::tempdir().unwrap();
-    let textured = Path::new(env!("CARGO_MANIFEST_DIR")).parent().expect("the repository holds the crate").join("tests/data/roundtrip/textured.obj");
+    let textured = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .parent()
+        .expect("the repository holds the crate")
+        .join("tests/data/roundtrip/textured.obj");
     let noisy = dir.path().join("textured_noisy.obj");
     let noisy = noisy.to_str().unwrap();
     let out = fairmesh(&[
@@ -1547,7 +1552,14 @@ fn fair_with_no_option_is_the_library_default() {
     let noisy = dir.path().join("noisy.ply");
     let faired = dir.path().join("faired.ply");
     let (noisy_arg, faired_arg) = (noisy.to_str().unwrap(), faired.to_str().unwrap());
-    let out = fairmesh(&["noise", &data("bunny00.obj"), "-o", noisy_arg, "--sigma", "0.3"]);
+    let out = fairmesh(&[
+        "noise",
+        &data("bunny00.obj"),
+        "-o",
+        noisy_arg,
+        "--sigma",
+        "0.3",
+    ]);
     assert!(out.status.success(), "{out:?}");
     let out = fairmesh(&["fair", noisy_arg, "-o", faired_arg]);
     assert!(out.status.success(), "{out:?}");

@@ -10,8 +10,8 @@
 
 use fairmesh::mesh::{shapes, subdivide_loop, two_face_edges};
 use fairmesh::noise::{add_noise, NoiseMode, NoiseOptions};
-use fairmesh_editor::render::normals::sharp_split;
 use fairmesh::TriMesh;
+use fairmesh_editor::render::normals::sharp_split;
 
 /// Every two-face edge's turn between its faces' normals, in degrees, ascending (edges with a
 /// face without area left out).

@@ -12,8 +12,10 @@
 //! default 7, after one warm-up run).
 
 use fairmesh::noise::{add_noise, NoiseOptions};
-use fairmesh_editor::render::normals::{shading_normals, vertex_normals, CornerTable, SHARP_EDGE_ANGLE};
 use fairmesh::TriMesh;
+use fairmesh_editor::render::normals::{
+    shading_normals, vertex_normals, CornerTable, SHARP_EDGE_ANGLE,
+};
 use std::hint::black_box;
 use std::time::Instant;
 

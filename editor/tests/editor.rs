@@ -210,7 +210,10 @@ fn exports_and_reloads_the_result() {
 #[test]
 fn export_writes_an_artists_file_back_with_its_materials_groups_and_uvs() {
     let dir = tempfile::tempdir().unwrap();
-    let data = Path::new(env!("CARGO_MANIFEST_DIR")).parent().expect("the repository holds the crate").join("tests/data/roundtrip");
+    let data = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .parent()
+        .expect("the repository holds the crate")
+        .join("tests/data/roundtrip");
     let input = dir.path().join("textured.obj");
     std::fs::copy(data.join("textured.obj"), &input).unwrap();
     let mut harness = harness_for(input.clone());
@@ -346,7 +349,10 @@ fn a_long_error_wraps_inside_the_window() {
 /// only pastes what was copied inside the editor.
 #[test]
 fn a_pasted_path_opens_with_load() {
-    let mushroom = Path::new(env!("CARGO_MANIFEST_DIR")).parent().expect("the repository holds the crate").join("tests/data/mushroom_open.obj");
+    let mushroom = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .parent()
+        .expect("the repository holds the crate")
+        .join("tests/data/mushroom_open.obj");
     let mut harness = harness_for(bunny());
     settle(&mut harness);
     harness
@@ -723,12 +729,13 @@ fn fairing_controls_explain_themselves_and_say_why_they_are_off() {
     // Tall enough that the whole side panel is on screen.
     let mut harness = harness_sized(bunny(), egui::vec2(1200.0, 1600.0));
     settle(&mut harness);
-    let description =
-        |harness: &egui_kittest::Harness<'_, fairmesh_editor::app::App>, role: Role, label: &str| {
-            let node = harness.get_by_role_and_label(role, label);
-            let node = node.accesskit_node();
-            (node.description().unwrap_or_default(), node.is_disabled())
-        };
+    let description = |harness: &egui_kittest::Harness<'_, fairmesh_editor::app::App>,
+                       role: Role,
+                       label: &str| {
+        let node = harness.get_by_role_and_label(role, label);
+        let node = node.accesskit_node();
+        (node.description().unwrap_or_default(), node.is_disabled())
+    };
     use fairmesh_editor::app::panels::tips;
     let controls = [
         (Role::Slider, "Start level", tips::START_LEVEL),

@@ -186,7 +186,10 @@ fn the_words_say_what_is_on_screen() {
         harness.state().status().message.as_deref(),
         Some("Undone: Paint mask")
     );
-    let other = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).parent().expect("the repository holds the crate").join("tests/data/elephant.obj");
+    let other = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .parent()
+        .expect("the repository holds the crate")
+        .join("tests/data/elephant.obj");
     harness
         .state_mut()
         .push_command(fairmesh_editor::app::Command::Open(other));

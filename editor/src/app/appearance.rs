@@ -8,13 +8,13 @@
 
 use std::collections::BTreeMap;
 
+use crate::render::appearance::{
+    Appearance, Batch, MaterialLook, Mipmaps, Sampling, TextureImage, Wrap, UV_IDENTITY,
+};
 use fairmesh::io::scene::{
     Material, MipmapFilter, Scene, TextureSampler, TextureTransform, TextureWrap,
 };
 use fairmesh::io::{Format, Source};
-use crate::render::appearance::{
-    Appearance, Batch, MaterialLook, Mipmaps, Sampling, TextureImage, Wrap, UV_IDENTITY,
-};
 use fairmesh::TriMesh;
 
 /// What the viewport shows of `source`'s colours over `mesh` (the mesh loaded from it, or one

@@ -125,7 +125,7 @@ impl App {
                 }
             }
             Command::CancelHierarchy => {
-                self.hierarchy_generation.bump();
+                self.work.hierarchy_generation.bump();
                 if let Some(document) = &mut self.document {
                     if matches!(document.hierarchy, HierarchyState::Building) {
                         document.hierarchy = HierarchyState::Failed("cancelled".into());
@@ -172,18 +172,19 @@ impl App {
                 false
             }
             PanelChange::ToggleBefore => {
-                self.show_before = !self.show_before;
+                self.view.show_before = !self.view.show_before;
                 true
             }
             PanelChange::PaintMode(on) => {
-                self.paint_mode = on;
+                self.painting.paint_mode = on;
                 true
             }
             PanelChange::ShowSharpEdgesUntil(until) => {
                 let shown = self
+                    .view
                     .sharp_edges_shown_until
                     .is_some_and(|shown| shown > std::time::Instant::now());
-                self.sharp_edges_shown_until = Some(until);
+                self.view.sharp_edges_shown_until = Some(until);
                 // Drawn from the next frame; one already drawing them repaints on its own.
                 !shown
             }

@@ -32,7 +32,7 @@ pub(in crate::app) fn mesh_key(shown: Shown, base_matches_original: bool) -> Mes
         ShownMesh::Level { level } => (3, level as u64),
     };
     MeshKey {
-        family: shown.document << 2 | which,
+        family: shown.document.get() << 2 | which,
         version,
     }
 }
@@ -59,11 +59,11 @@ impl App {
     /// with it, or `None` (then it must be uploaded).
     pub(in crate::app) fn show_held(&mut self, slot: Slot, wanted: Shown) -> Option<HeldView> {
         let key = self.held_key(wanted);
-        let views = &mut self.held_views[slot as usize];
+        let views = &mut self.view.held_views[slot as usize];
         let index = views.iter().position(|h| h.key == key)?;
         let viewport = match slot {
-            Slot::Main => self.viewport.as_ref(),
-            Slot::Before => self.viewport_before.as_ref(),
+            Slot::Main => self.view.viewport.as_ref(),
+            Slot::Before => self.view.viewport_before.as_ref(),
         }?;
         if viewport.show_held(key) {
             Some(views[index])
@@ -77,13 +77,13 @@ impl App {
     /// the meshes of other documents, here and on the GPU.
     pub(in crate::app) fn remember_view(&mut self, slot: Slot, view: HeldView) {
         let document = document_of(view.key);
-        let views = &mut self.held_views[slot as usize];
+        let views = &mut self.view.held_views[slot as usize];
         views.retain(|h| h.key.family != view.key.family && document_of(h.key) == document);
         views.insert(0, view);
         views.truncate(MAX_HELD_MESHES);
         let viewport = match slot {
-            Slot::Main => self.viewport.as_ref(),
-            Slot::Before => self.viewport_before.as_ref(),
+            Slot::Main => self.view.viewport.as_ref(),
+            Slot::Before => self.view.viewport_before.as_ref(),
         };
         if let Some(viewport) = viewport {
             viewport.retain_held(|key| document_of(key) == document);

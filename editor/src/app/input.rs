@@ -83,8 +83,8 @@ impl App {
             self.settings.clay = !self.settings.clay;
         }
         if paint {
-            self.paint_mode = !self.paint_mode;
-            if !self.paint_mode {
+            self.painting.paint_mode = !self.painting.paint_mode;
+            if !self.painting.paint_mode {
                 self.commands.push(Command::EndStroke);
             }
         }
@@ -95,7 +95,7 @@ impl App {
             self.settings.wireframe = !self.settings.wireframe;
         }
         if before {
-            self.show_before = !self.show_before;
+            self.view.show_before = !self.view.show_before;
         }
         if heat {
             self.settings.heat_map = !self.settings.heat_map;

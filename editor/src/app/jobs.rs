@@ -10,7 +10,9 @@
 //!   UI bumps the counter (a new file, a newer slider value) the job's progress hook sees the
 //!   change and cancels, and the UI ignores a result whose generation is not the current one.
 //! - Jobs send a [`JobResult`] over a channel and call `request_repaint`, so the UI wakes up even
-//!   when nothing else moves.
+//!   when nothing else moves. A job that panics sends nothing; its worker survives it and tells
+//!   its [`PanicReport`] which kind of job it was ([`JobKind`]) and what the panic said,
+//!   so that the UI can say so and clear what the job held (see [`JobResult::JobFailed`]).
 
 use std::collections::VecDeque;
 use std::path::PathBuf;
@@ -26,6 +28,47 @@ use super::state::{KeptHierarchy, Measures};
 
 type Job = Box<dyn FnOnce() + Send + 'static>;
 
+/// What a background job does: a worker keeps one waiting job of a kind submitted with
+/// [`Worker::submit_latest`], and a job that panics is reported by its kind.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum JobKind {
+    Load,
+    /// Freeing a replaced document's mesh and hierarchy.
+    Free,
+    Noise,
+    Hierarchy,
+    /// Setting up the hierarchy's levels for fairing, while nothing else waits.
+    LevelSetUp,
+    Fair,
+    LevelMesh,
+    Measure,
+    Export,
+    LevelChain,
+    ViewImage,
+}
+
+impl JobKind {
+    /// What the job was doing, in words that follow "while".
+    pub fn doing(self) -> &'static str {
+        match self {
+            JobKind::Load => "loading the file",
+            JobKind::Free => "freeing the previous file",
+            JobKind::Noise => "adding noise",
+            JobKind::Hierarchy => "building the hierarchy",
+            JobKind::LevelSetUp => "setting up the levels",
+            JobKind::Fair => "fairing",
+            JobKind::LevelMesh => "making the level's mesh",
+            JobKind::Measure => "measuring the result",
+            JobKind::Export => "exporting",
+            JobKind::LevelChain => "exporting the level chain",
+            JobKind::ViewImage => "saving the image of the view",
+        }
+    }
+}
+
+/// Told, on the worker's thread, when a job panicked: the job's kind and the panic's message.
+pub type PanicReport = Box<dyn Fn(JobKind, String) + Send + 'static>;
+
 /// A loaded mesh as the UI takes it, with the loader's connectivity (shared, never rebuilt:
 /// noise and Apply move positions only, and the hierarchy build and baseline or masked
 /// fairings read it; ~185 ms to build again on a 1.2M-face mesh).
@@ -38,7 +81,8 @@ pub struct LoadedMesh {
 }
 
 struct Queued {
-    slot: Option<&'static str>,
+    /// What the job is.
+    kind: JobKind,
     job: Job,
     /// Runs only when no other job waits.
     idle: bool,
@@ -62,7 +106,8 @@ pub struct Worker {
 }
 
 impl Worker {
-    pub fn spawn(name: &str) -> std::io::Result<Self> {
+    /// Starts the thread `name`; a job that panics is reported to `on_panic`.
+    pub fn spawn(name: &str, on_panic: PanicReport) -> std::io::Result<Self> {
         let shared = Arc::new(Shared {
             queue: Mutex::new(Queue::default()),
             wake: Condvar::new(),
@@ -70,7 +115,7 @@ impl Worker {
         let thread_shared = shared.clone();
         std::thread::Builder::new()
             .name(name.to_owned())
-            .spawn(move || worker_loop(&thread_shared))?;
+            .spawn(move || worker_loop(&thread_shared, &on_panic))?;
         Ok(Self { shared })
     }
 
@@ -81,30 +126,30 @@ impl Worker {
             .unwrap_or_else(PoisonError::into_inner)
     }
 
-    /// Queues `job` behind the others.
-    pub fn submit(&self, job: impl FnOnce() + Send + 'static) {
-        self.push(None, job, false);
+    /// Queues `job`, a job of `kind`, behind the others.
+    pub fn submit(&self, kind: JobKind, job: impl FnOnce() + Send + 'static) {
+        self.push(kind, false, job, false);
     }
 
     /// Queues `job` to run when no other job waits (idle jobs run in the order submitted).
-    pub fn submit_idle(&self, job: impl FnOnce() + Send + 'static) {
-        self.push(None, job, true);
+    pub fn submit_idle(&self, kind: JobKind, job: impl FnOnce() + Send + 'static) {
+        self.push(kind, false, job, true);
     }
 
-    /// Queues `job`, dropping any job of the same `slot` that has not started yet.
-    pub fn submit_latest(&self, slot: &'static str, job: impl FnOnce() + Send + 'static) {
-        self.push(Some(slot), job, false);
+    /// Queues `job`, dropping any job of the same `kind` that has not started yet.
+    pub fn submit_latest(&self, kind: JobKind, job: impl FnOnce() + Send + 'static) {
+        self.push(kind, true, job, false);
     }
 
-    /// Queues `job` (`idle` or not) and wakes the thread; with a `slot`, first drops the jobs of
-    /// that slot that have not started yet.
-    fn push(&self, slot: Option<&'static str>, job: impl FnOnce() + Send + 'static, idle: bool) {
+    /// Queues `job` (`idle` or not) and wakes the thread; with `latest`, first drops the jobs
+    /// of that kind that have not started yet.
+    fn push(&self, kind: JobKind, latest: bool, job: impl FnOnce() + Send + 'static, idle: bool) {
         let mut queue = self.lock();
-        if slot.is_some() {
-            queue.jobs.retain(|queued| queued.slot != slot);
+        if latest {
+            queue.jobs.retain(|queued| queued.kind != kind);
         }
         queue.jobs.push_back(Queued {
-            slot,
+            kind,
             job: Box::new(job),
             idle,
         });
@@ -131,7 +176,7 @@ impl Drop for Worker {
     }
 }
 
-fn worker_loop(shared: &Shared) {
+fn worker_loop(shared: &Shared, on_panic: &PanicReport) {
     // The window comes first: jobs run at background priority (see `priority`).
     super::priority::lower_this_thread();
     loop {
@@ -145,7 +190,7 @@ fn worker_loop(shared: &Shared) {
                 let next = queue.jobs.iter().position(|queued| !queued.idle);
                 if let Some(queued) = queue.jobs.remove(next.unwrap_or(0)) {
                     queue.running += 1;
-                    break queued.job;
+                    break queued;
                 }
                 queue = shared
                     .wake
@@ -153,10 +198,15 @@ fn worker_loop(shared: &Shared) {
                     .unwrap_or_else(PoisonError::into_inner);
             }
         };
-        // A panicking job must not take the worker down with it; its result is simply missing.
-        let _ = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+        // A panicking job must not take the worker down with it; its result is missing, and
+        // the UI is told which job it was.
+        let Queued { kind, job, .. } = job;
+        let ran = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
             super::priority::run_in_background(job)
         }));
+        if let Err(payload) = ran {
+            on_panic(kind, panic_message(payload.as_ref()));
+        }
         shared
             .queue
             .lock()
@@ -165,19 +215,44 @@ fn worker_loop(shared: &Shared) {
     }
 }
 
-/// A generation counter shared between the UI and the jobs.
+/// What a panic said (its payload, when it is text).
+fn panic_message(payload: &(dyn std::any::Any + Send)) -> String {
+    if let Some(text) = payload.downcast_ref::<&str>() {
+        (*text).to_owned()
+    } else if let Some(text) = payload.downcast_ref::<String>() {
+        text.clone()
+    } else {
+        "no message".to_owned()
+    }
+}
+
+/// A generation counter shared between the UI and the jobs: latest wins. The UI bumps it for
+/// each new request (a file, a document change, a slider value); a job started under an older
+/// [`GenerationId`] stops, and its result is dropped.
 #[derive(Clone, Default)]
 pub struct Generation(Arc<AtomicU64>);
 
+/// One value of a [`Generation`]: what a job was started under, or what a result on screen came
+/// from. A later value compares greater; the default (0) is older than any bumped one.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, PartialOrd, Ord, Hash)]
+pub struct GenerationId(u64);
+
+impl GenerationId {
+    /// The number, for keys that outlive the app's types (the renderer's mesh keys).
+    pub fn get(self) -> u64 {
+        self.0
+    }
+}
+
 impl Generation {
-    /// Starts a new generation and returns its number.
-    pub fn bump(&self) -> u64 {
-        self.0.fetch_add(1, Ordering::SeqCst) + 1
+    /// Starts a new generation and returns it.
+    pub fn bump(&self) -> GenerationId {
+        GenerationId(self.0.fetch_add(1, Ordering::SeqCst) + 1)
     }
-    pub fn current(&self) -> u64 {
-        self.0.load(Ordering::SeqCst)
+    pub fn current(&self) -> GenerationId {
+        GenerationId(self.0.load(Ordering::SeqCst))
     }
-    pub fn is_current(&self, generation: u64) -> bool {
+    pub fn is_current(&self, generation: GenerationId) -> bool {
         self.current() == generation
     }
 }
@@ -234,34 +309,34 @@ pub struct Faired {
 /// A job's answer to the UI. Each carries the generation it was started under.
 pub enum JobResult {
     Loaded {
-        load_generation: u64,
+        load_generation: GenerationId,
         path: PathBuf,
         result: Result<Box<LoadedMesh>, String>,
         elapsed: Duration,
     },
     Hierarchy {
-        document: u64,
-        hierarchy: u64,
+        document: GenerationId,
+        hierarchy: GenerationId,
         /// The hierarchy (built on the denoised mesh when there was a denoise), whether its M0
         /// has the loaded mesh's triangles, and the time the denoise and the build took.
         result: Result<KeptHierarchy, HierarchyError>,
     },
     Faired {
-        document: u64,
-        view: u64,
+        document: GenerationId,
+        view: GenerationId,
         level: usize,
         /// `None`: cancelled or failed.
         result: Option<Faired>,
     },
     LevelMesh {
-        document: u64,
-        view: u64,
+        document: GenerationId,
+        view: GenerationId,
         level: usize,
         mesh: Arc<TriMesh>,
     },
     /// The measures of the faired result with `serial`.
     Measured {
-        document: u64,
+        document: GenerationId,
         serial: u64,
         against_document: Option<Measures>,
         against_clean: Option<Measures>,
@@ -270,13 +345,13 @@ pub enum JobResult {
     /// Measuring the faired result `serial` stopped half way: the view moved on meanwhile. The
     /// result is measured again once the slider rests, if it is still the one on screen.
     MeasureStopped {
-        document: u64,
+        document: GenerationId,
         serial: u64,
         positions: Arc<Vec<[f32; 3]>>,
     },
     /// Noise was added to a copy of the document's mesh.
     Noised {
-        document: u64,
+        document: GenerationId,
         label: String,
         noisy: Arc<TriMesh>,
         clean: Arc<TriMesh>,
@@ -296,6 +371,9 @@ pub enum JobResult {
         result: Result<(Vec<PathBuf>, Vec<String>), String>,
         elapsed: Duration,
     },
+    /// A job panicked (a bug): `kind` says which, `message` what the panic said. Whatever the
+    /// job held (a fairing in flight, a hierarchy being built, a file loading) is cleared.
+    JobFailed { kind: JobKind, message: String },
     /// The window's pixels, asked for by "Save image": the view's part goes to a PNG.
     ViewCaptured {
         image: Arc<egui::ColorImage>,
@@ -330,6 +408,7 @@ impl JobResult {
             JobResult::ViewCaptured { .. } => "the window's pixels",
             JobResult::ViewImageSaved { .. } => "a saved view image",
             JobResult::DialogPicked { .. } => "a file dialog's answer",
+            JobResult::JobFailed { .. } => "a failed job",
         }
     }
 }
@@ -347,11 +426,11 @@ mod tests {
 
     #[test]
     fn worker_runs_jobs_in_order_in_the_background_pool() {
-        let worker = Worker::spawn("fairmesh-test-worker").unwrap();
+        let worker = Worker::spawn("fairmesh-test-worker", Box::new(|_, _| {})).unwrap();
         let (tx, rx) = mpsc::channel();
         for i in 0..3 {
             let tx = tx.clone();
-            worker.submit(move || {
+            worker.submit(JobKind::Load, move || {
                 let name = std::thread::current().name().map(str::to_owned);
                 tx.send((i, name)).unwrap();
             });
@@ -370,9 +449,9 @@ mod tests {
     /// A worker busy with a job that waits for the returned sender, so that the jobs submitted
     /// next wait in the queue until the test releases it.
     fn blocked_worker(name: &str) -> (Worker, mpsc::Sender<()>) {
-        let worker = Worker::spawn(name).unwrap();
+        let worker = Worker::spawn(name, Box::new(|_, _| {})).unwrap();
         let (release, released) = mpsc::channel::<()>();
-        worker.submit(move || {
+        worker.submit(JobKind::Load, move || {
             released.recv_timeout(Duration::from_secs(5)).ok();
         });
         (worker, release)
@@ -384,7 +463,7 @@ mod tests {
         let (tx, rx) = mpsc::channel();
         for i in 0..5 {
             let tx = tx.clone();
-            worker.submit_latest("fair", move || tx.send(i).unwrap());
+            worker.submit_latest(JobKind::Fair, move || tx.send(i).unwrap());
         }
         release.send(()).unwrap();
         assert_eq!(rx.recv_timeout(Duration::from_secs(5)).unwrap(), 4);
@@ -397,16 +476,36 @@ mod tests {
         let (tx, rx) = mpsc::channel();
         for name in ["idle 1", "idle 2"] {
             let tx = tx.clone();
-            worker.submit_idle(move || tx.send(name).unwrap());
+            worker.submit_idle(JobKind::LevelSetUp, move || tx.send(name).unwrap());
         }
         let tx2 = tx.clone();
-        worker.submit(move || tx2.send("normal").unwrap());
-        worker.submit_latest("fair", move || tx.send("latest").unwrap());
+        worker.submit(JobKind::Load, move || tx2.send("normal").unwrap());
+        worker.submit_latest(JobKind::Fair, move || tx.send("latest").unwrap());
         release.send(()).unwrap();
         let order: Vec<_> = (0..4)
             .map(|_| rx.recv_timeout(Duration::from_secs(5)).unwrap())
             .collect();
         assert_eq!(order, ["normal", "latest", "idle 1", "idle 2"]);
+    }
+
+    #[test]
+    fn a_job_that_panics_is_reported_by_its_kind_and_the_worker_goes_on() {
+        let (report, reports) = mpsc::channel();
+        let worker = Worker::spawn(
+            "fairmesh-test-panic",
+            Box::new(move |kind, message| report.send((kind, message)).unwrap()),
+        )
+        .unwrap();
+        let (tx, rx) = mpsc::channel();
+        worker.submit(JobKind::Fair, || {
+            panic!("index out of bounds: the len is 3 but the index is 7")
+        });
+        worker.submit(JobKind::Export, move || tx.send("ran").unwrap());
+        let (kind, message) = reports.recv_timeout(Duration::from_secs(5)).unwrap();
+        assert_eq!(kind, JobKind::Fair);
+        assert!(message.contains("the index is 7"), "{message}");
+        assert_eq!(rx.recv_timeout(Duration::from_secs(5)).unwrap(), "ran");
+        assert!(reports.recv_timeout(Duration::from_millis(200)).is_err());
     }
 
     #[test]

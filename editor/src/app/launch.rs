@@ -3,17 +3,15 @@
 //! first file.
 
 use std::path::PathBuf;
-use std::sync::mpsc;
-use std::sync::{Arc, Mutex};
+use std::sync::Arc;
 use std::time::Duration;
 
-use fairmesh::multires::MultiresWorkspace;
-use crate::render::Viewport3d;
-
-use super::camera::OrbitCamera;
 use super::history::History;
-use super::jobs::{Generation, JobCounter, SharedProgress, Worker};
+use super::in_flight::InFlight;
+use super::paint::Painting;
 use super::state::Settings;
+use super::view_state::ViewState;
+use super::workers::Workers;
 use super::{App, FrameStats};
 
 /// Opens the editor window on `options.file`, or on the bundled bunny.
@@ -82,39 +80,6 @@ pub struct AppOptions {
 /// Memory the undo history may keep alive.
 const HISTORY_BUDGET_BYTES: usize = 1 << 30;
 
-/// The worker threads an app runs its jobs on.
-struct Workers {
-    io: Worker,
-    compute: Worker,
-    measure: Worker,
-    measure_pool: Option<Arc<rayon::ThreadPool>>,
-}
-
-impl Workers {
-    /// Starts the editor's named threads and the measuring worker's one-thread pool.
-    fn spawn() -> Self {
-        // Without threads the editor cannot work at all; failing to start one is fatal.
-        let io = Worker::spawn("fairmesh-io").expect("cannot start the fairmesh-io thread");
-        let compute =
-            Worker::spawn("fairmesh-compute").expect("cannot start the fairmesh-compute thread");
-        let measure =
-            Worker::spawn("fairmesh-measure").expect("cannot start the fairmesh-measure thread");
-        let measure_pool = rayon::ThreadPoolBuilder::new()
-            .num_threads(1)
-            .thread_name(|_| "fairmesh-measure-pool".into())
-            .start_handler(|_| super::priority::lower_this_thread())
-            .build()
-            .ok()
-            .map(Arc::new);
-        Self {
-            io,
-            compute,
-            measure,
-            measure_pool,
-        }
-    }
-}
-
 impl App {
     /// The app as the window runs it: settings from eframe's storage when `persistence` is on.
     pub fn with_options(cc: &eframe::CreationContext<'_>, options: AppOptions) -> Self {
@@ -143,73 +108,24 @@ impl App {
         options: &AppOptions,
         file: &std::path::Path,
     ) -> Self {
-        let (results_tx, results_rx) = mpsc::channel();
-        let Workers {
-            io,
-            compute,
-            measure,
-            measure_pool,
-        } = Workers::spawn();
         Self {
             settings,
             persistence: options.persistence,
             document: None,
-            loading: None,
-            load_generation: Generation::default(),
-            document_generation: Generation::default(),
-            hierarchy_generation: Generation::default(),
-            view_generation: Generation::default(),
-            applied_view: 0,
-            applied_level_view: 0,
-            hierarchy_progress: SharedProgress::default(),
-            hierarchy_denoising: Default::default(),
-            fair_progress: SharedProgress::default(),
-            fair_in_flight: false,
-            fair_view: 0,
-            workspace: Arc::new(Mutex::new(MultiresWorkspace::default())),
-            io,
-            compute,
-            measure,
-            measure_pool,
-            measure_wanted: None,
-            measures_stopped: 0,
-            jobs: JobCounter::default(),
-            results_tx,
-            results_rx,
+            history: History::new(HISTORY_BUDGET_BYTES),
+            workers: Workers::spawn(&cc.egui_ctx),
+            work: InFlight::default(),
+            view: ViewState::new(cc),
+            painting: Painting::default(),
             dialog_open: false,
             ctx: cc.egui_ctx.clone(),
-            viewport: (cc.wgpu_render_state.as_ref()).map(|s| Viewport3d::new(s, &cc.egui_ctx)),
-            viewport_before: (cc.wgpu_render_state.as_ref())
-                .map(|s| Viewport3d::new(s, &cc.egui_ctx)),
-            camera: OrbitCamera::default(),
-            fitted_camera: None,
-            shown: None,
-            shown_before: None,
-            heat_max: [None; 2],
-            held_views: Default::default(),
-            appearance_warnings: Vec::new(),
-            appearance: None,
-            show_before: false,
-            shown_counts: (0, 0),
             error: None,
             message: None,
             open_path: file.display().to_string(),
             commands: Vec::new(),
-            next_serial: 0,
             frame_stats: FrameStats::logging_over(options.log_frames_over),
             exit_when_settled: options.exit_when_settled,
-            viewport_rect: None,
-            history: History::new(HISTORY_BUDGET_BYTES),
-            paint_mode: false,
-            stroke: None,
-            last_dab: None,
-            mask_revision: 0,
-            hierarchy_built_with: None,
-            sharp_edges_shown_until: None,
-            sharp_edges_drawn: 0,
             confirm_replace: None,
-            capture_next_frame: false,
-            capturing_view: false,
         }
     }
 

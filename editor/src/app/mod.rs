@@ -10,7 +10,11 @@
 //! - [`state`]: persisted [`state::Settings`] and the [`state::Document`] (mesh and results);
 //! - `tasks/`: one file per kind of background task (load, document changes, hierarchy,
 //!   fairing, measure, export), each holding its launch and the handling of its result;
-//! - [`jobs`]: worker threads, generation numbers, job results;
+//! - [`App`] holds its state in owned parts: `workers.rs` (the threads and the results'
+//!   channel), `in_flight.rs` (generations, progress, what is on screen), `view_state.rs` (the
+//!   viewports, camera and what they hold), [`paint`]'s `Painting`, and the document with its
+//!   [`history`];
+//! - [`jobs`]: worker threads, generation numbers, job results (a job that panics is reported);
 //! - `view_sync.rs`: keeps the viewports' GPU buffers in step with what should be shown;
 //!   `appearance.rs`: the loaded file's materials, textures and colours as the viewport draws
 //!   them;
@@ -48,6 +52,7 @@ mod frame_stats;
 mod held_views;
 mod hierarchy_panel;
 pub mod history;
+mod in_flight;
 mod input;
 pub mod jobs;
 mod launch;
@@ -70,9 +75,11 @@ mod tasks;
 pub mod tips;
 mod toolbar;
 pub mod view_panel;
+mod view_state;
 mod view_sync;
 mod viewport_panel;
 mod widgets;
+mod workers;
 
 pub use command::{Command, PanelChange};
 pub use frame_stats::FrameStats;
@@ -82,19 +89,16 @@ pub use status::AppStatus;
 pub use viewport_panel::COMPUTING;
 
 use std::path::PathBuf;
-use std::sync::mpsc::{Receiver, Sender};
-use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
 
-use fairmesh::multires::MultiresWorkspace;
 use crate::render::Viewport3d;
 
-use camera::OrbitCamera;
 use history::History;
-use jobs::{Generation, JobCounter, JobResult, JobTicket, SharedProgress, Worker};
-use shown::Shown;
+use in_flight::InFlight;
+use paint::Painting;
 use state::{CompareView, Document, DocumentSnapshot, Settings};
-use tasks::measure::MeasureRequest;
+use view_state::ViewState;
+use workers::Workers;
 
 /// The editor: its settings, the document, the workers and what the viewports show. The frame
 /// (`ui` below) runs in this order: poll results, input, panels, apply commands, sync the view.
@@ -102,100 +106,28 @@ pub struct App {
     settings: Settings,
     persistence: bool,
     document: Option<Document>,
-    /// The file being loaded, while it loads.
-    loading: Option<PathBuf>,
-    load_generation: Generation,
-    document_generation: Generation,
-    hierarchy_generation: Generation,
-    view_generation: Generation,
-    /// View generation of the faired result on screen (newer results replace it, older don't).
-    applied_view: u64,
-    applied_level_view: u64,
-    hierarchy_progress: SharedProgress,
-    /// The hierarchy's job is still denoising (its progress is the denoise's).
-    hierarchy_denoising: Arc<std::sync::atomic::AtomicBool>,
-    fair_progress: SharedProgress,
-    fair_in_flight: bool,
-    /// View generation of the newest fairing asked for.
-    fair_view: u64,
-    workspace: Arc<Mutex<MultiresWorkspace>>,
-    io: Worker,
-    compute: Worker,
-    /// Measures faired results (surface distances need two BVHs per reference: 0.1-0.3 s on the
-    /// bunny), so that the compute worker hands each result to the view at once and is free for
-    /// the next slider value.
-    measure: Worker,
-    /// The measuring worker's own one-thread rayon pool (`None` if it could not be started: it
-    /// then shares the global pool), so that the next slider value's fairing keeps the global
-    /// pool (sharing it doubled the time to the next result on the bunny).
-    measure_pool: Option<Arc<rayon::ThreadPool>>,
-    /// The faired result to measure next; see [`MEASURE_DELAY`].
-    measure_wanted: Option<MeasureRequest>,
-    measures_stopped: u64,
-    jobs: JobCounter,
-    results_tx: Sender<(JobResult, JobTicket)>,
-    results_rx: Receiver<(JobResult, JobTicket)>,
+    /// Earlier and later document states (noise, applied results, loading, mask changes).
+    history: History<DocumentSnapshot>,
+    /// The background threads and the results coming back from them.
+    workers: Workers,
+    /// What runs for the document and which of its results are on screen.
+    work: InFlight,
+    /// What the 3D views show.
+    view: ViewState,
+    /// The brush and the stroke being painted.
+    painting: Painting,
     dialog_open: bool,
     ctx: egui::Context,
-    viewport: Option<Viewport3d>,
-    viewport_before: Option<Viewport3d>,
-    camera: OrbitCamera,
-    /// The camera as the last fit left it: while the user has not moved it since, switching to
-    /// or from the side-by-side view fits it again (the halves are narrower than tall).
-    fitted_camera: Option<OrbitCamera>,
-    shown: Option<Shown>,
-    shown_before: Option<Shown>,
-    /// Per slot, the meshes its renderer holds on the GPU and what was uploaded with them.
-    held_views: [Vec<held_views::HeldView>; 2],
-    /// Largest heat-map scalar uploaded per slot (the legend's and the colour map's top).
-    heat_max: [Option<f32>; 2],
-    /// The file's colours as the viewport draws them, made once per loaded file (keyed by its
-    /// [`fairmesh::io::Source`], held so that it is never mistaken for another); `None` inside when
-    /// the file has none.
-    appearance: Option<(
-        Arc<fairmesh::io::Source>,
-        Option<Arc<crate::render::appearance::Appearance>>,
-    )>,
-    /// What could not be shown of the file's colours (a texture that did not decode), said in
-    /// the Mesh section; made with [`Self::appearance`].
-    appearance_warnings: Vec<String>,
-    /// The single view shows "before" instead of "after" (toggled with B).
-    show_before: bool,
-    shown_counts: (usize, usize),
     error: Option<String>,
     message: Option<String>,
     /// The typed path field for opening files.
     open_path: String,
     commands: Vec<Command>,
-    next_serial: u64,
     frame_stats: FrameStats,
     /// [`AppOptions::exit_when_settled`], until it has fired.
     exit_when_settled: bool,
-    /// Where the viewport was drawn in the last frame (points).
-    viewport_rect: Option<egui::Rect>,
-    /// Earlier and later document states (noise, applied results, loading, mask changes).
-    history: History<DocumentSnapshot>,
-    /// The left button paints the mask instead of orbiting.
-    paint_mode: bool,
-    /// The mask's weights while a stroke is being painted.
-    stroke: Option<Vec<f32>>,
-    /// Where the brush's last dab of the stroke was (screen points).
-    last_dab: Option<egui::Pos2>,
-    /// Bumped with every change of the document's mask, so that its tint is uploaded again.
-    mask_revision: u64,
-    /// The sharp-edge settings the current hierarchy was asked for (see
-    /// [`Settings::hierarchy_key`]): a change builds it again.
-    hierarchy_built_with: Option<state::HierarchyKey>,
-    /// Draw the kept sharp edges over the mesh until then (their controls are hovered or were
-    /// just changed).
-    sharp_edges_shown_until: Option<std::time::Instant>,
-    sharp_edges_drawn: usize,
     /// An export waits for the user to say whether this existing file may be replaced.
     confirm_replace: Option<PathBuf>,
-    /// "Save image" was asked for: the next frame is drawn without the mouse hints and captured.
-    capture_next_frame: bool,
-    /// This frame is the one captured for "Save image".
-    capturing_view: bool,
 }
 
 impl App {
@@ -206,10 +138,10 @@ impl App {
 
     /// No job running or waiting and every result applied.
     pub fn is_settled(&self) -> bool {
-        self.jobs.in_flight() == 0
+        self.workers.jobs.in_flight() == 0
             && self.commands.is_empty()
-            && self.measure_wanted.is_none()
-            && !self.capture_next_frame
+            && self.work.measure_wanted.is_none()
+            && !self.view.capture_next_frame
             && !self.upload_pending()
             && !self.drawing()
     }
@@ -226,14 +158,12 @@ impl App {
 
     /// The viewports there are (none without a wgpu render state).
     fn viewports(&self) -> impl Iterator<Item = &Viewport3d> {
-        [&self.viewport, &self.viewport_before]
-            .into_iter()
-            .flatten()
+        self.view.viewports()
     }
 
     /// A job is running or waiting.
     fn busy(&self) -> bool {
-        self.jobs.in_flight() > 0 || self.measure_wanted.is_some()
+        self.workers.jobs.in_flight() > 0 || self.work.measure_wanted.is_some()
     }
 }
 
@@ -247,7 +177,7 @@ impl App {
         }
         let side_by_side = |view| view == CompareView::SideBySide;
         if side_by_side(self.settings.compare) != side_by_side(compare)
-            && self.fitted_camera == Some(self.camera)
+            && self.view.fitted_camera == Some(self.view.camera)
         {
             self.fit_view();
         }
@@ -256,7 +186,7 @@ impl App {
     /// The viewport's draw of the previous frame, if it drew a new image. A held mesh's kept
     /// image shown again is logged too (the frame log times view switches by both).
     fn new_image_draw_time(&mut self) -> Duration {
-        match &self.viewport {
+        match &self.view.viewport {
             Some(viewport) => {
                 let images = viewport.image_counts();
                 let seen = std::mem::replace(&mut self.frame_stats.images_seen, images);
@@ -277,7 +207,7 @@ impl App {
     /// [`AppOptions::exit_when_settled`]: once the first mesh is in and nothing runs, says so
     /// and closes the window.
     fn exit_if_settled(&mut self, ctx: &egui::Context, busy: bool) {
-        if self.exit_when_settled && !busy && self.is_settled() && self.loading.is_none() {
+        if self.exit_when_settled && !busy && self.is_settled() && self.work.loading.is_none() {
             self.exit_when_settled = false;
             let status = self.status();
             match (&status.document, &status.error) {
@@ -314,10 +244,10 @@ impl eframe::App for App {
         let upload_done = Instant::now();
         let compare = self.settings.compare;
         // A saved view waits for an image being drawn over several frames to be complete.
-        self.capturing_view = self.capture_next_frame && !self.drawing();
-        self.capture_next_frame &= !self.capturing_view;
+        self.view.capturing_view = self.view.capture_next_frame && !self.drawing();
+        self.view.capture_next_frame &= !self.view.capturing_view;
         panels::show(self, ui);
-        if self.capturing_view {
+        if self.view.capturing_view {
             self.capture_view(&ctx);
         }
         self.panel(|view, _, commands| confirm_replace::show(&ctx, view, commands));
@@ -353,8 +283,6 @@ impl eframe::App for App {
 impl Drop for App {
     fn drop(&mut self) {
         // Cancel whatever still runs for this app.
-        self.document_generation.bump();
-        self.hierarchy_generation.bump();
-        self.load_generation.bump();
+        self.work.cancel_all();
     }
 }

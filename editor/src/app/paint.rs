@@ -13,7 +13,21 @@ use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
 
-use crate::fairing::Mask;
+use fairmesh::fairing::Mask;
+
+/// The brush in use: whether the left button paints, the stroke being painted and the mask's
+/// revision (its tint is uploaded again when it changes). `tasks/mask.rs` changes it.
+#[derive(Debug, Default)]
+pub(in crate::app) struct Painting {
+    /// The left button paints the mask instead of orbiting.
+    pub(in crate::app) paint_mode: bool,
+    /// The mask's weights while a stroke is being painted.
+    pub(in crate::app) stroke: Option<Vec<f32>>,
+    /// Where the brush's last dab of the stroke was (screen points).
+    pub(in crate::app) last_dab: Option<egui::Pos2>,
+    /// Bumped with every change of the document's mask, so that its tint is uploaded again.
+    pub(in crate::app) mask_revision: u64,
+}
 
 /// The brush and the remembered masks (part of the persisted settings).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]

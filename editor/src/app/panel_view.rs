@@ -67,28 +67,29 @@ impl App {
     ) -> R {
         let view = PanelView {
             document: self.document.as_ref(),
-            loading: self.loading.as_deref(),
+            loading: self.work.loading.as_deref(),
             error: self.error.as_deref(),
             message: self.message.as_deref(),
             open_path: &self.open_path,
             history: &self.history,
-            hierarchy_progress: self.hierarchy_progress.get(),
+            hierarchy_progress: self.work.hierarchy_progress.get(),
             hierarchy_denoising: self
+                .work
                 .hierarchy_denoising
                 .load(std::sync::atomic::Ordering::Relaxed),
-            fair_in_flight: self.fair_in_flight,
-            fair_progress: self.fair_progress.get(),
-            hierarchy_built_with: self.hierarchy_built_with,
-            show_before: self.show_before,
-            paint_mode: self.paint_mode,
-            shown_counts: self.shown_counts,
+            fair_in_flight: self.work.fair_in_flight,
+            fair_progress: self.work.fair_progress.get(),
+            hierarchy_built_with: self.work.hierarchy_built_with,
+            show_before: self.view.show_before,
+            paint_mode: self.painting.paint_mode,
+            shown_counts: self.view.shown_counts,
             frame_stats: &self.frame_stats,
-            viewport: self.viewport.as_ref(),
-            viewport_before: self.viewport_before.as_ref(),
-            held_views: &self.held_views,
-            appearance_warnings: match (&self.appearance, &self.document) {
+            viewport: self.view.viewport.as_ref(),
+            viewport_before: self.view.viewport_before.as_ref(),
+            held_views: &self.view.held_views,
+            appearance_warnings: match (&self.view.appearance, &self.document) {
                 (Some((source, _)), Some(d)) if std::sync::Arc::ptr_eq(source, &d.source) => {
-                    &self.appearance_warnings
+                    &self.view.appearance_warnings
                 }
                 _ => &[],
             },
@@ -164,22 +165,25 @@ impl App {
         let looks = [self.slot_look(Slot::Main), self.slot_look(Slot::Before)];
         let view = ViewportView {
             document: self.document.as_ref(),
-            show_before: self.show_before,
-            paint_mode: self.paint_mode,
-            stroking: self.stroke.is_some(),
-            capturing_view: self.capturing_view,
+            show_before: self.view.show_before,
+            paint_mode: self.painting.paint_mode,
+            stroking: self.painting.stroke.is_some(),
+            capturing_view: self.view.capturing_view,
             heat_legend,
             looks,
             main_behind: self.main_view_behind(),
-            sharp_edges_shown_until: self.sharp_edges_shown_until,
+            sharp_edges_shown_until: self.view.sharp_edges_shown_until,
         };
         let mut state = ViewportState {
-            camera: &mut self.camera,
-            last_dab: &mut self.last_dab,
-            viewports: [self.viewport.as_mut(), self.viewport_before.as_mut()],
+            camera: &mut self.view.camera,
+            last_dab: &mut self.painting.last_dab,
+            viewports: [
+                self.view.viewport.as_mut(),
+                self.view.viewport_before.as_mut(),
+            ],
         };
         let drawn = section(&view, &mut state, &mut self.settings, &mut self.commands);
-        self.viewport_rect = Some(drawn.rect);
-        self.sharp_edges_drawn = drawn.sharp_edges_drawn;
+        self.view.viewport_rect = Some(drawn.rect);
+        self.view.sharp_edges_drawn = drawn.sharp_edges_drawn;
     }
 }

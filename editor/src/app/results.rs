@@ -3,7 +3,8 @@
 
 use std::sync::mpsc::Sender;
 
-use super::jobs::{JobResult, JobTicket};
+use super::jobs::{JobKind, JobResult, JobTicket};
+use super::state::HierarchyState;
 use super::App;
 
 impl App {
@@ -21,7 +22,7 @@ impl App {
 
     /// Applies every result that has come back since the last frame.
     pub(super) fn poll_results(&mut self) {
-        while let Ok((result, ticket)) = self.results_rx.try_recv() {
+        while let Ok((result, ticket)) = self.workers.results_rx.try_recv() {
             self.frame_stats.log_arrival(result.describe());
             self.apply_result(result);
             // The job counts as finished only once its result is applied.
@@ -97,6 +98,43 @@ impl App {
                 beside,
             } => self.on_view_captured(image, rect, pixels_per_point, beside),
             JobResult::ViewImageSaved { result } => self.on_view_image_saved(result),
+            JobResult::JobFailed { kind, message } => self.on_job_failed(kind, message),
         }
+    }
+
+    /// A job panicked: what it held is cleared so that the editor carries on (the slider fairs
+    /// again, another file loads, the hierarchy can be built again), and the error says what
+    /// stopped. The document and the result on screen stay.
+    pub(in crate::app) fn on_job_failed(&mut self, kind: JobKind, message: String) {
+        match kind {
+            JobKind::Load => self.work.loading = None,
+            JobKind::Fair => self.work.fair_in_flight = false,
+            JobKind::Hierarchy => {
+                if let Some(document) = &mut self.document {
+                    if matches!(document.hierarchy, HierarchyState::Building) {
+                        document.hierarchy =
+                            HierarchyState::Failed(format!("an internal error: {message}"));
+                    }
+                }
+            }
+            JobKind::Measure => {
+                let measured = self.document.as_mut().and_then(|d| d.faired.as_mut());
+                if let Some(faired) = measured {
+                    faired.measures_pending = false;
+                }
+            }
+            JobKind::Free
+            | JobKind::Noise
+            | JobKind::LevelSetUp
+            | JobKind::LevelMesh
+            | JobKind::Export
+            | JobKind::LevelChain
+            | JobKind::ViewImage => {}
+        }
+        self.error = Some(format!(
+            "An internal error stopped the editor while {}: {message}. This is a bug in fairmesh; \
+             your file is untouched.",
+            kind.doing()
+        ));
     }
 }

@@ -2,13 +2,14 @@
 //! input, a level, a result) and with which colours ([`Shown`]), the record the view syncing
 //! ([`super::view_sync`]) and the meshes held on the GPU ([`super::held_views`]) both keep.
 
+use crate::app::jobs::GenerationId;
 use crate::app::state::HeatReference;
 
 /// What a viewport has uploaded, to know when to upload again: one record per viewport, so
 /// that its shape, its heat map and its mask tint are always of one result.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub(in crate::app) struct Shown {
-    pub(in crate::app) document: u64,
+    pub(in crate::app) document: GenerationId,
     pub(in crate::app) what: ShownMesh,
     /// The heat map's reference, when the scalars on the GPU are `what`'s own distances from
     /// it (never another result's).

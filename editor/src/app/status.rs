@@ -65,12 +65,12 @@ impl App {
     /// What could not be shown of the loaded file's colours (a base colour texture that did
     /// not decode), as the Mesh section says it; empty until the viewport drew the file.
     pub fn appearance_warnings(&self) -> &[String] {
-        let current = match (&self.appearance, &self.document) {
+        let current = match (&self.view.appearance, &self.document) {
             (Some((source, _)), Some(document)) => Arc::ptr_eq(source, &document.source),
             _ => false,
         };
         match current {
-            true => &self.appearance_warnings,
+            true => &self.view.appearance_warnings,
             false => &[],
         }
     }
@@ -81,7 +81,7 @@ impl App {
 
     /// Whether the single view shows "before" (the document's mesh) instead of the result.
     pub fn showing_before(&self) -> bool {
-        self.show_before
+        self.view.show_before
     }
 
     /// The heat map's top value (the legend's range is 0 to this), while the heat map is shown.
@@ -91,11 +91,11 @@ impl App {
 
     /// Where the 3D view was drawn in the last frame, in points.
     pub fn viewport_rect(&self) -> Option<egui::Rect> {
-        self.viewport_rect
+        self.view.viewport_rect
     }
 
     pub fn camera(&self) -> &OrbitCamera {
-        &self.camera
+        &self.view.camera
     }
 
     /// The document's mesh (as loaded, noisy, or an applied result).
@@ -143,29 +143,34 @@ impl App {
         let faired = document.and_then(|d| d.faired.as_ref());
         AppStatus {
             document: document.map(|d| d.path.clone()),
-            loading: self.loading.is_some(),
+            loading: self.work.loading.is_some(),
             hierarchy_ready: document.and_then(Document::level_count).is_some(),
             level_count: document.and_then(Document::level_count).unwrap_or(0),
             level: document.map(|d| d.level).unwrap_or(0),
-            shown_vertices: self.shown_counts.0,
-            shown_faces: self.shown_counts.1,
+            shown_vertices: self.view.shown_counts.0,
+            shown_faces: self.view.shown_counts.1,
             faired_serial: faired.map(|f| f.serial),
             faired_level: faired.map(|f| f.level),
-            measuring: faired.is_some_and(|f| f.measures_pending) && self.measure_wanted.is_none(),
-            measures_stopped: self.measures_stopped,
+            measuring: faired.is_some_and(|f| f.measures_pending)
+                && self.work.measure_wanted.is_none(),
+            measures_stopped: self.work.measures_stopped,
             volume_change: faired.map(|f| f.volume_change),
             rms_displacement: faired.map(|f| f.rms_displacement),
             error: self.error.clone(),
             message: self.message.clone(),
-            images_drawn: self.viewport.as_ref().map_or(0, Viewport3d::images_drawn),
+            images_drawn: self
+                .view
+                .viewport
+                .as_ref()
+                .map_or(0, Viewport3d::images_drawn),
             drawing: self.drawing(),
-            shown_serial: self.shown.and_then(|s| match s.what {
+            shown_serial: self.view.shown.and_then(|s| match s.what {
                 super::shown::ShownMesh::Faired { serial } => Some(serial),
                 _ => None,
             }),
-            heat_shown: self.shown.is_some_and(|s| s.heat.is_some())
+            heat_shown: self.view.shown.is_some_and(|s| s.heat.is_some())
                 && self.slot_look(super::Slot::Main).scalar_range.is_some(),
-            mask_shown: self.shown.is_some_and(|s| s.mask.is_some()),
+            mask_shown: self.view.shown.is_some_and(|s| s.mask.is_some()),
             view_behind: self.main_view_behind(),
             caption: super::viewport_panel::main_caption(
                 self.settings.view_mode,
@@ -175,7 +180,7 @@ impl App {
                 HierarchyState::Ready { hierarchy, .. } => hierarchy.crease_edge_count(),
                 _ => 0,
             }),
-            sharp_edges_drawn: self.sharp_edges_drawn,
+            sharp_edges_drawn: self.view.sharp_edges_drawn,
         }
     }
 }

@@ -11,9 +11,9 @@ use crate::app::state::{
     self, CompareView, Document, HeatReference, HierarchyState, Settings, ViewMode,
 };
 use crate::app::App;
-use fairmesh::hierarchy;
 use crate::render::appearance::Appearance;
 use crate::render::{CornerNormals, DrawParams, MeshSource, Viewport3d};
+use fairmesh::hierarchy;
 use fairmesh::TriMesh;
 
 /// How one viewport's image is coloured, apart from the camera and the settings: the heat map's
@@ -163,7 +163,7 @@ impl App {
 
     /// Whether the before viewport is on screen.
     pub(super) fn before_needed(&self) -> bool {
-        self.settings.compare != CompareView::Single || self.show_before
+        self.settings.compare != CompareView::Single || self.view.show_before
     }
 
     /// What a viewport should show now: for the main one the view mode's mesh when it exists,
@@ -183,7 +183,10 @@ impl App {
                 mask,
             });
         }
-        let previous = self.shown.filter(|s| s.document == document.generation);
+        let previous = self
+            .view
+            .shown
+            .filter(|s| s.document == document.generation);
         let what = self.newest_mesh(document, previous.map(|s| s.what));
         // A level mesh has other vertices than the mask's.
         let mask = mask.filter(|_| !matches!(what, ShownMesh::Level { .. }));
@@ -232,7 +235,10 @@ impl App {
         let Some(document) = &self.document else {
             return false;
         };
-        let shown = self.shown.filter(|s| s.document == document.generation);
+        let shown = self
+            .view
+            .shown
+            .filter(|s| s.document == document.generation);
         match self.settings.view_mode {
             ViewMode::Original => shown.is_none_or(|s| s.what != ShownMesh::Original),
             ViewMode::Level => {
@@ -246,7 +252,7 @@ impl App {
                 let newest = self.newest_mesh(document, None);
                 let heat_waits = self.heat_reference().is_some()
                     && shown.is_some_and(|s| s.heat != self.heat_reference());
-                self.fair_in_flight
+                self.work.fair_in_flight
                     || matches!(document.hierarchy, HierarchyState::Building)
                     || shown.is_none_or(|s| s.what != newest)
                     || heat_waits
@@ -303,8 +309,8 @@ impl App {
             return;
         };
         let mut shown = match slot {
-            Slot::Main => self.shown,
-            Slot::Before => self.shown_before,
+            Slot::Main => self.view.shown,
+            Slot::Before => self.view.shown_before,
         };
         if shown == Some(wanted) || self.document.is_none() {
             return;
@@ -317,7 +323,7 @@ impl App {
                 // Its scalars and weights are on the GPU with it: written again only if the
                 // wanted ones differ.
                 shown = Some(held.shown);
-                self.heat_max[slot as usize] = held.heat_max;
+                self.view.heat_max[slot as usize] = held.heat_max;
                 counts = Some(held.counts);
                 mesh_changed = false;
             } else {
@@ -331,27 +337,27 @@ impl App {
         // New buffers start with zero scalars and weights: both are written again.
         let mut uploaded = wanted;
         if mesh_changed || shown.is_none_or(|s| s.heat != wanted.heat) {
-            self.heat_max[slot as usize] = self.upload_heat(slot, wanted);
+            self.view.heat_max[slot as usize] = self.upload_heat(slot, wanted);
             // Scalars that are not there yet are asked for again next frame.
-            if self.heat_max[slot as usize].is_none() {
+            if self.view.heat_max[slot as usize].is_none() {
                 uploaded.heat = None;
             }
         }
         if mesh_changed || shown.is_none_or(|s| s.mask != wanted.mask) {
             self.upload_mask(slot, wanted);
         }
-        let counts = counts.unwrap_or(self.shown_counts);
+        let counts = counts.unwrap_or(self.view.shown_counts);
         match slot {
             Slot::Main => {
-                self.shown_counts = counts;
-                self.shown = Some(uploaded);
+                self.view.shown_counts = counts;
+                self.view.shown = Some(uploaded);
             }
-            Slot::Before => self.shown_before = Some(uploaded),
+            Slot::Before => self.view.shown_before = Some(uploaded),
         }
         let view = HeldView {
             key: self.held_key(uploaded),
             shown: uploaded,
-            heat_max: self.heat_max[slot as usize],
+            heat_max: self.view.heat_max[slot as usize],
             counts,
         };
         self.remember_view(slot, view);
@@ -362,7 +368,7 @@ impl App {
         let Some(document) = &self.document else {
             return;
         };
-        if (self.appearance.as_ref()).is_some_and(|(s, _)| Arc::ptr_eq(s, &document.source)) {
+        if (self.view.appearance.as_ref()).is_some_and(|(s, _)| Arc::ptr_eq(s, &document.source)) {
             return;
         }
         let file = document.path.file_name().map_or_else(
@@ -371,15 +377,15 @@ impl App {
         );
         let (appearance, warnings) =
             super::appearance::appearance_of(&document.source, &document.original, &file);
-        self.appearance = Some((document.source.clone(), appearance.map(Arc::new)));
-        self.appearance_warnings = warnings;
+        self.view.appearance = Some((document.source.clone(), appearance.map(Arc::new)));
+        self.view.appearance_warnings = warnings;
     }
 
     /// The slot's renderer handle, when there is a wgpu renderer.
     pub(super) fn slot_viewport(&self, slot: Slot) -> Option<&Viewport3d> {
         match slot {
-            Slot::Main => self.viewport.as_ref(),
-            Slot::Before => self.viewport_before.as_ref(),
+            Slot::Main => self.view.viewport.as_ref(),
+            Slot::Before => self.view.viewport_before.as_ref(),
         }
     }
 
@@ -397,7 +403,7 @@ impl App {
             _ => None,
         };
         let key = self.held_key(wanted);
-        let appearance = self.appearance.as_ref().and_then(|(_, a)| a.clone());
+        let appearance = self.view.appearance.as_ref().and_then(|(_, a)| a.clone());
         let source = view_mesh(document, wanted.what, base, appearance)?;
         let counts = (source.positions().len(), source.triangles().len());
         if let Some(viewport) = self.slot_viewport(slot) {
@@ -433,10 +439,10 @@ impl App {
     /// The heat map's top value for the slots on screen (shared, so the colours compare).
     pub(super) fn heat_top(&self) -> Option<f32> {
         self.heat_reference()?;
-        let main = self.heat_max[Slot::Main as usize];
+        let main = self.view.heat_max[Slot::Main as usize];
         let before = self
             .before_needed()
-            .then(|| self.heat_max[Slot::Before as usize])
+            .then(|| self.view.heat_max[Slot::Before as usize])
             .flatten();
         match (main, before) {
             (Some(a), Some(b)) => Some(a.max(b)),
@@ -447,7 +453,7 @@ impl App {
 
     /// What the main viewport's renderer is asked to draw with now (tests).
     pub fn main_draw_params(&self) -> Option<DrawParams> {
-        Some(self.draw_params(self.viewport_rect?, Slot::Main))
+        Some(self.draw_params(self.view.viewport_rect?, Slot::Main))
     }
 
     /// The vertex normals uploaded to a viewport's GPU buffer for the mesh it shows, one per
@@ -455,8 +461,8 @@ impl App {
     /// gives others; tests; waits for the GPU).
     pub fn uploaded_normals(&self, slot: Slot) -> Option<Vec<[f32; 3]>> {
         match slot {
-            Slot::Main => self.viewport.as_ref(),
-            Slot::Before => self.viewport_before.as_ref(),
+            Slot::Main => self.view.viewport.as_ref(),
+            Slot::Before => self.view.viewport_before.as_ref(),
         }?
         .read_back_normals()
     }
@@ -465,25 +471,27 @@ impl App {
     /// shading, read back from a viewport's GPU buffer (tests; waits for the GPU).
     pub fn uploaded_corner_normals(&self, slot: Slot) -> Option<Vec<CornerNormals>> {
         match slot {
-            Slot::Main => self.viewport.as_ref(),
-            Slot::Before => self.viewport_before.as_ref(),
+            Slot::Main => self.view.viewport.as_ref(),
+            Slot::Before => self.view.viewport_before.as_ref(),
         }?
         .read_back_corner_normals()
     }
 
     pub(super) fn draw_params(&self, rect: egui::Rect, slot: Slot) -> DrawParams {
         self.slot_look(slot)
-            .draw_params(&self.camera, &self.settings, rect)
+            .draw_params(&self.view.camera, &self.settings, rect)
     }
 
     /// How a viewport's image is coloured now (the heat map's range, the mask's tint): from
     /// what the viewport has uploaded, so the colours are always those of the shape shown.
     pub(super) fn slot_look(&self, slot: Slot) -> SlotLook {
         let top = self.heat_top();
-        let scalar_range = self.heat_max[slot as usize].and(top).map(|top| [0.0, top]);
+        let scalar_range = self.view.heat_max[slot as usize]
+            .and(top)
+            .map(|top| [0.0, top]);
         let shown = match slot {
-            Slot::Main => self.shown,
-            Slot::Before => self.shown_before,
+            Slot::Main => self.view.shown,
+            Slot::Before => self.view.shown_before,
         };
         let mask_tint = shown.is_some_and(|s| s.mask.is_some());
         SlotLook {
@@ -501,18 +509,18 @@ impl App {
             _ => document.bounds,
         };
         // Each side-by-side half is half the view's width.
-        let aspect = self.viewport_rect.map_or(1.0, |rect| {
+        let aspect = self.view.viewport_rect.map_or(1.0, |rect| {
             let width = match self.settings.compare {
                 CompareView::SideBySide => rect.width() * 0.5,
                 CompareView::Single | CompareView::Split => rect.width(),
             };
             width / rect.height().max(1.0)
         });
-        self.camera.fit(
+        self.view.camera.fit(
             glam::Vec3::from_array(lo),
             glam::Vec3::from_array(hi),
             aspect,
         );
-        self.fitted_camera = Some(self.camera);
+        self.view.fitted_camera = Some(self.view.camera);
     }
 }

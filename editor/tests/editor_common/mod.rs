@@ -12,7 +12,10 @@ use egui_kittest::Harness;
 use fairmesh_editor::app::{App, AppOptions};
 
 pub fn bunny() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).parent().expect("the repository holds the crate").join("assets/bunny00.obj")
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .parent()
+        .expect("the repository holds the crate")
+        .join("assets/bunny00.obj")
 }
 
 pub fn harness_for(path: PathBuf) -> Harness<'static, App> {

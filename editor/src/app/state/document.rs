@@ -8,6 +8,7 @@ use std::sync::Arc;
 use std::time::Duration;
 
 use crate::app::history::SizeInBytes;
+use crate::app::jobs::GenerationId;
 use crate::app::sharp_edges::SharpEdgeLines;
 use fairmesh::fairing::strength::CLEAN_NOISE;
 use fairmesh::fairing::{FairReport, Mask, Method};
@@ -128,7 +129,7 @@ pub struct FairedResult {
 pub struct Document {
     pub path: PathBuf,
     /// Bumped for every document; jobs for older documents are stale.
-    pub generation: u64,
+    pub generation: GenerationId,
     /// The document's mesh: as loaded, or as noise or an applied result made it.
     pub original: Arc<TriMesh>,
     /// The connectivity of `original`'s triangles (the same for every snapshot of one file:
@@ -165,7 +166,7 @@ pub struct Document {
 impl Document {
     pub fn new(
         path: PathBuf,
-        generation: u64,
+        generation: GenerationId,
         original: TriMesh,
         report: LoadReport,
         load_time: Duration,
@@ -301,7 +302,7 @@ impl Document {
 
     /// A document made from a snapshot; its hierarchy is ready when the snapshot kept one
     /// (otherwise `Building`: the caller starts the build).
-    pub fn from_snapshot(snapshot: DocumentSnapshot, generation: u64) -> Self {
+    pub fn from_snapshot(snapshot: DocumentSnapshot, generation: GenerationId) -> Self {
         let bounds = bounds_of(&snapshot.mesh.positions);
         let hierarchy = match snapshot.hierarchy {
             Some(kept) => HierarchyState::Ready {

@@ -6,6 +6,7 @@ use std::path::{Path, PathBuf};
 
 use serde::{Deserialize, Serialize};
 
+use crate::render::{Lighting, Shading};
 use fairmesh::fairing::creases::{CreaseOptions, DEFAULT_CREASE_ANGLE};
 use fairmesh::fairing::{
     BoundaryMode, HcOptions, LaplacianOptions, Method, MethodOptions, TaubinOptions,
@@ -13,7 +14,6 @@ use fairmesh::fairing::{
 use fairmesh::hierarchy::HierarchyOptions;
 use fairmesh::multires::{Denoise, DenoiseOptions, MultiresOptions, MultiresVariant};
 use fairmesh::noise::{NoiseMode, NoiseOptions};
-use crate::render::{Lighting, Shading};
 
 /// What the editor says about a smoothing method: the paper's (coarse to fine over the
 /// hierarchy) or a baseline run on the document's mesh, to see its shrinkage next to the

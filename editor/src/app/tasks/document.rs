@@ -3,7 +3,7 @@
 
 use std::sync::Arc;
 
-use crate::app::jobs::JobResult;
+use crate::app::jobs::{GenerationId, JobKind, JobResult};
 use crate::app::state::{Document, DocumentSnapshot, HierarchyState, Measures, MethodChoice};
 use crate::app::App;
 use fairmesh::TriMesh;
@@ -15,7 +15,7 @@ impl App {
     pub(in crate::app) fn install(&mut self, snapshot: DocumentSnapshot, record: Option<String>) {
         if let (Some(label), Some(current)) = (record, &self.document) {
             let mut previous = current.snapshot();
-            previous.camera = Some(self.camera);
+            previous.camera = Some(self.view.camera);
             self.history.record(label, previous);
         }
         // The camera follows the document: another file's comes back with it (undo and redo
@@ -29,22 +29,22 @@ impl App {
         // Freeing a big mesh and its hierarchy takes tens of milliseconds: not on the UI thread
         // (what the history keeps is shared, so this frees only what nobody else holds).
         if previous.is_some() {
-            self.io.submit(move || drop(previous));
+            self.workers
+                .io
+                .submit(JobKind::Free, move || drop(previous));
         }
-        let generation = self.document_generation.bump();
+        let generation = self.work.document_generation.bump();
         let document = Document::from_snapshot(snapshot, generation);
         let needs_build = matches!(document.hierarchy, HierarchyState::Building);
         self.document = Some(document);
         // Undo and redo may bring back another mask: it is the file's mask from now on.
-        self.stroke = None;
-        self.mask_revision += 1;
+        self.painting.stroke = None;
+        self.painting.mask_revision += 1;
         self.remember_mask();
-        self.applied_view = 0;
-        self.applied_level_view = 0;
-        self.fair_in_flight = false;
+        self.work.forget_results();
         if other_file {
             match camera {
-                Some(camera) => self.camera = camera,
+                Some(camera) => self.view.camera = camera,
                 None => self.fit_view(),
             }
         }
@@ -52,7 +52,7 @@ impl App {
             self.start_hierarchy();
         } else {
             // Whatever was building belonged to the document just replaced.
-            self.hierarchy_generation.bump();
+            self.work.hierarchy_generation.bump();
             self.refresh_view();
         }
     }
@@ -71,14 +71,18 @@ impl App {
         let mesh = document.original.clone();
         let clean = document.clean.clone().unwrap_or_else(|| mesh.clone());
         let document = document.generation;
-        let document_generation = self.document_generation.clone();
+        let document_generation = self.work.document_generation.clone();
         let label = format!(
             "Noise σ {} × edge, seed {}, {:?}",
             options.sigma, options.seed, options.mode
         );
         self.message = Some(format!("Adding noise ({label}) …"));
-        let (tx, ctx, ticket) = (self.results_tx.clone(), self.ctx.clone(), self.jobs.start());
-        self.io.submit(move || {
+        let (tx, ctx, ticket) = (
+            self.workers.results_tx.clone(),
+            self.ctx.clone(),
+            self.workers.jobs.start(),
+        );
+        self.workers.io.submit(JobKind::Noise, move || {
             if !document_generation.is_current(document) {
                 return;
             }
@@ -133,7 +137,7 @@ impl App {
     /// The current document as undo and redo keep it, with the view of it.
     pub(in crate::app) fn current_snapshot(&self) -> Option<DocumentSnapshot> {
         let mut snapshot = self.document.as_ref()?.snapshot();
-        snapshot.camera = Some(self.camera);
+        snapshot.camera = Some(self.view.camera);
         Some(snapshot)
     }
 
@@ -162,7 +166,7 @@ impl App {
     /// Noise was added: the noisy mesh becomes the document (undoable).
     pub(in crate::app) fn on_noised(
         &mut self,
-        document: u64,
+        document: GenerationId,
         label: String,
         noisy: Arc<TriMesh>,
         clean: Arc<TriMesh>,

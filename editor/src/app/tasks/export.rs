@@ -3,7 +3,7 @@
 use std::path::PathBuf;
 use std::time::{Duration, Instant};
 
-use crate::app::jobs::JobResult;
+use crate::app::jobs::{JobKind, JobResult};
 use crate::app::state::HierarchyState;
 use crate::app::view_sync::SharedMesh;
 use crate::app::App;
@@ -53,9 +53,13 @@ impl App {
             ),
             _ => (None, SharedMesh::Mesh(document.original.clone())),
         };
-        let (tx, ctx, ticket) = (self.results_tx.clone(), self.ctx.clone(), self.jobs.start());
+        let (tx, ctx, ticket) = (
+            self.workers.results_tx.clone(),
+            self.ctx.clone(),
+            self.workers.jobs.start(),
+        );
         self.message = Some(format!("Exporting to {} …", path.display()));
-        self.io.submit(move || {
+        self.workers.io.submit(JobKind::Export, move || {
             let started = Instant::now();
             let source = triangles_source.mesh();
             let mesh = match positions {
@@ -115,8 +119,12 @@ impl App {
             "Exporting levels M{from} … M{to} to {} …",
             folder.display()
         ));
-        let (tx, ctx, ticket) = (self.results_tx.clone(), self.ctx.clone(), self.jobs.start());
-        self.io.submit(move || {
+        let (tx, ctx, ticket) = (
+            self.workers.results_tx.clone(),
+            self.ctx.clone(),
+            self.workers.jobs.start(),
+        );
+        self.workers.io.submit(JobKind::LevelChain, move || {
             let started = Instant::now();
             let result = std::fs::create_dir_all(&folder)
                 .map_err(|error| format!("cannot create {}: {error}", folder.display()))

@@ -4,7 +4,7 @@
 use std::sync::{Arc, Mutex, PoisonError};
 use std::time::{Duration, Instant};
 
-use crate::app::jobs::{Faired, JobResult};
+use crate::app::jobs::{Faired, GenerationId, JobKind, JobResult};
 use crate::app::state::{FairedResult, HierarchyState, ViewMode};
 use crate::app::tasks::measure::MeasureRequest;
 use crate::app::App;
@@ -28,7 +28,7 @@ impl App {
         let level = document.level;
         let document_generation = document.generation;
         let applied = document.applied;
-        let view = self.view_generation.bump();
+        let view = self.work.view_generation.bump();
         match self.settings.view_mode {
             ViewMode::Level => self.request_level_mesh(hierarchy, document_generation, level, view),
             // An applied result is shown as it is until a setting changes.
@@ -44,21 +44,25 @@ impl App {
     pub(in crate::app) fn request_fairing(
         &mut self,
         hierarchy: Arc<hierarchy::Hierarchy>,
-        document: u64,
+        document: GenerationId,
         level: usize,
-        view: u64,
+        view: GenerationId,
     ) {
         let Some(job) = self.fair_job(hierarchy, level) else {
             return;
         };
-        let document_generation = self.document_generation.clone();
-        let progress_out = self.fair_progress.clone();
-        let workspace = self.workspace.clone();
-        let (tx, ctx, ticket) = (self.results_tx.clone(), self.ctx.clone(), self.jobs.start());
-        self.fair_in_flight = true;
-        self.fair_view = view;
-        self.fair_progress.set(0.0);
-        self.compute.submit_latest("fair", move || {
+        let document_generation = self.work.document_generation.clone();
+        let progress_out = self.work.fair_progress.clone();
+        let workspace = self.work.workspace.clone();
+        let (tx, ctx, ticket) = (
+            self.workers.results_tx.clone(),
+            self.ctx.clone(),
+            self.workers.jobs.start(),
+        );
+        self.work.fair_in_flight = true;
+        self.work.fair_view = view;
+        self.work.fair_progress.set(0.0);
+        self.workers.compute.submit_latest(JobKind::Fair, move || {
             if !document_generation.is_current(document) {
                 return;
             }
@@ -104,50 +108,56 @@ impl App {
     pub(in crate::app) fn request_level_mesh(
         &mut self,
         hierarchy: Arc<hierarchy::Hierarchy>,
-        document: u64,
+        document: GenerationId,
         level: usize,
-        view: u64,
+        view: GenerationId,
     ) {
-        let document_generation = self.document_generation.clone();
-        let (tx, ctx, ticket) = (self.results_tx.clone(), self.ctx.clone(), self.jobs.start());
-        self.compute.submit_latest("level", move || {
-            if !document_generation.is_current(document) {
-                return;
-            }
-            let mesh = Arc::new(hierarchy.level_mesh(level));
-            let message = JobResult::LevelMesh {
-                document,
-                view,
-                level,
-                mesh,
-            };
-            Self::send_result(&tx, &ctx, message, ticket);
-        });
+        let document_generation = self.work.document_generation.clone();
+        let (tx, ctx, ticket) = (
+            self.workers.results_tx.clone(),
+            self.ctx.clone(),
+            self.workers.jobs.start(),
+        );
+        self.workers
+            .compute
+            .submit_latest(JobKind::LevelMesh, move || {
+                if !document_generation.is_current(document) {
+                    return;
+                }
+                let mesh = Arc::new(hierarchy.level_mesh(level));
+                let message = JobResult::LevelMesh {
+                    document,
+                    view,
+                    level,
+                    mesh,
+                };
+                Self::send_result(&tx, &ctx, message, ticket);
+            });
     }
 
     /// A fairing finished: its result goes on screen unless a newer one is there.
     pub(in crate::app) fn on_faired(
         &mut self,
-        document: u64,
-        view: u64,
+        document: GenerationId,
+        view: GenerationId,
         level: usize,
         result: Option<Faired>,
     ) {
         // The newest fairing asked for has answered (a view change to the level mesh
         // since does not make it any less finished).
-        if view >= self.fair_view {
-            self.fair_in_flight = false;
+        if view >= self.work.fair_view {
+            self.work.fair_in_flight = false;
         }
         let Some(current) = self.document.as_mut().filter(|d| d.generation == document) else {
             return;
         };
         // Older than what is on screen: stale.
-        if view <= self.applied_view {
+        if view <= self.work.applied_view {
             return;
         }
         if let Some(faired) = result {
-            self.applied_view = view;
-            self.next_serial += 1;
+            self.work.applied_view = view;
+            self.work.next_serial += 1;
             // The previous result's measures stay on screen until this one's arrive.
             let previous = current.faired.take();
             let positions = Arc::new(faired.positions);
@@ -158,15 +168,15 @@ impl App {
                 volume_change: faired.volume_change,
                 rms_displacement: faired.rms_displacement,
                 elapsed: faired.elapsed,
-                serial: self.next_serial,
+                serial: self.work.next_serial,
                 against_document: previous.as_ref().and_then(|p| p.against_document.clone()),
                 against_clean: previous.and_then(|p| p.against_clean),
                 measure_time: Duration::ZERO,
                 measures_pending: true,
             });
-            self.measure_wanted = Some(MeasureRequest {
+            self.work.measure_wanted = Some(MeasureRequest {
                 document,
-                serial: self.next_serial,
+                serial: self.work.next_serial,
                 positions,
                 arrived: Instant::now(),
             });
@@ -176,18 +186,18 @@ impl App {
     /// A level mesh for the level view arrived.
     pub(in crate::app) fn on_level_mesh(
         &mut self,
-        document: u64,
-        view: u64,
+        document: GenerationId,
+        view: GenerationId,
         level: usize,
         mesh: Arc<TriMesh>,
     ) {
         let Some(current) = self.document.as_mut().filter(|d| d.generation == document) else {
             return;
         };
-        if view <= self.applied_level_view {
+        if view <= self.work.applied_level_view {
             return;
         }
-        self.applied_level_view = view;
+        self.work.applied_level_view = view;
         current.level_mesh = Some((level, mesh));
     }
 }

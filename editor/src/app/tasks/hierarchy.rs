@@ -5,7 +5,7 @@ use std::sync::atomic::Ordering;
 use std::sync::{Arc, PoisonError};
 use std::time::Instant;
 
-use crate::app::jobs::JobResult;
+use crate::app::jobs::{GenerationId, JobKind, JobResult};
 use crate::app::sharp_edges::SharpEdgeLines;
 use crate::app::state::{DenoiseSummary, HierarchyState, KeptHierarchy};
 use crate::app::App;
@@ -40,25 +40,29 @@ impl App {
     /// hierarchy's progress (the denoise first, flagged in `hierarchy_denoising`) and are
     /// cancelled together.
     pub(in crate::app) fn start_hierarchy(&mut self) {
-        self.hierarchy_built_with = Some(self.settings.hierarchy_key());
+        self.work.hierarchy_built_with = Some(self.settings.hierarchy_key());
         let Some(document) = &mut self.document else {
             return;
         };
-        let generation = self.hierarchy_generation.bump();
+        let generation = self.work.hierarchy_generation.bump();
         document.hierarchy = HierarchyState::Building;
-        self.hierarchy_progress.set(0.0);
+        self.work.hierarchy_progress.set(0.0);
         let mesh = document.original.clone();
         let topology = document.topology.clone();
         let mut options = self.settings.hierarchy_options();
         let mut denoise_options = self.settings.denoise_options();
         let source = document.source.clone();
         let document_generation = document.generation;
-        let hierarchy_generation = self.hierarchy_generation.clone();
-        let progress_out = self.hierarchy_progress.clone();
-        let denoising = self.hierarchy_denoising.clone();
+        let hierarchy_generation = self.work.hierarchy_generation.clone();
+        let progress_out = self.work.hierarchy_progress.clone();
+        let denoising = self.work.hierarchy_denoising.clone();
         denoising.store(denoise_options.fair_options().is_some(), Ordering::Relaxed);
-        let (tx, ctx, ticket) = (self.results_tx.clone(), self.ctx.clone(), self.jobs.start());
-        self.compute.submit(move || {
+        let (tx, ctx, ticket) = (
+            self.workers.results_tx.clone(),
+            self.ctx.clone(),
+            self.workers.jobs.start(),
+        );
+        self.workers.compute.submit(JobKind::Hierarchy, move || {
             if !hierarchy_generation.is_current(generation) {
                 return;
             }
@@ -118,35 +122,37 @@ impl App {
     pub(in crate::app) fn prepare_levels(
         &mut self,
         hierarchy: Arc<hierarchy::Hierarchy>,
-        document: u64,
+        document: GenerationId,
     ) {
         for level in 1..hierarchy.level_count() {
             let options = self.settings.multires_options(level);
-            let document_generation = self.document_generation.clone();
-            let workspace = self.workspace.clone();
+            let document_generation = self.work.document_generation.clone();
+            let workspace = self.work.workspace.clone();
             let hierarchy = hierarchy.clone();
-            let ticket = self.jobs.start();
-            self.compute.submit_idle(move || {
-                let _ticket = ticket;
-                if !document_generation.is_current(document) {
-                    return;
-                }
-                let mut workspace = workspace.lock().unwrap_or_else(PoisonError::into_inner);
-                // Levels below `level` are there already (the first fairing or the jobs
-                // before this one): this builds `level` and its fairing operator.
-                workspace.prepare_for(&hierarchy, &options);
-            });
+            let ticket = self.workers.jobs.start();
+            self.workers
+                .compute
+                .submit_idle(JobKind::LevelSetUp, move || {
+                    let _ticket = ticket;
+                    if !document_generation.is_current(document) {
+                        return;
+                    }
+                    let mut workspace = workspace.lock().unwrap_or_else(PoisonError::into_inner);
+                    // Levels below `level` are there already (the first fairing or the jobs
+                    // before this one): this builds `level` and its fairing operator.
+                    workspace.prepare_for(&hierarchy, &options);
+                });
         }
     }
 
     /// The hierarchy build finished: the view asks for its first result, the levels are set up.
     pub(in crate::app) fn on_hierarchy(
         &mut self,
-        document: u64,
-        hierarchy: u64,
+        document: GenerationId,
+        hierarchy: GenerationId,
         result: Result<KeptHierarchy, HierarchyError>,
     ) {
-        if !self.hierarchy_generation.is_current(hierarchy) {
+        if !self.work.hierarchy_generation.is_current(hierarchy) {
             return;
         }
         let Some(current) = self.document.as_mut().filter(|d| d.generation == document) else {

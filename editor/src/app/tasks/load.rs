@@ -4,18 +4,22 @@ use std::path::{Path, PathBuf};
 use std::sync::Arc;
 use std::time::{Duration, Instant};
 
-use crate::app::jobs::{DialogPurpose, JobResult, LoadedMesh};
+use crate::app::jobs::{DialogPurpose, GenerationId, JobKind, JobResult, LoadedMesh};
 use crate::app::state::{self, DocumentSnapshot};
 use crate::app::App;
 
 impl App {
     /// Starts loading `path` on the io worker; the current mesh stays until it arrives.
     pub(in crate::app) fn open(&mut self, path: PathBuf) {
-        let generation = self.load_generation.bump();
-        self.loading = Some(path.clone());
+        let generation = self.work.load_generation.bump();
+        self.work.loading = Some(path.clone());
         self.open_path = path.display().to_string();
-        let (tx, ctx, ticket) = (self.results_tx.clone(), self.ctx.clone(), self.jobs.start());
-        self.io.submit(move || {
+        let (tx, ctx, ticket) = (
+            self.workers.results_tx.clone(),
+            self.ctx.clone(),
+            self.workers.jobs.start(),
+        );
+        self.workers.io.submit(JobKind::Load, move || {
             let started = Instant::now();
             // The bundled bunny comes from the binary itself; it is named by its file name, so
             // its default export is `bunny00_faired.glb` in the working directory.
@@ -64,8 +68,8 @@ impl App {
                 .file_name()
                 .map(|n| n.to_string_lossy().into_owned())
         });
-        let (tx, ctx) = (self.results_tx.clone(), self.ctx.clone());
-        let ticket = self.jobs.start();
+        let (tx, ctx) = (self.workers.results_tx.clone(), self.ctx.clone());
+        let ticket = self.workers.jobs.start();
         let spawned = std::thread::Builder::new()
             .name("fairmesh-dialog".into())
             .spawn(move || {
@@ -103,15 +107,15 @@ impl App {
     /// A file finished loading (or failed to): it becomes the document.
     pub(in crate::app) fn on_loaded(
         &mut self,
-        load_generation: u64,
+        load_generation: GenerationId,
         path: PathBuf,
         result: Result<Box<LoadedMesh>, String>,
         elapsed: Duration,
     ) {
-        if !self.load_generation.is_current(load_generation) {
+        if !self.work.load_generation.is_current(load_generation) {
             return;
         }
-        let requested = self.loading.take();
+        let requested = self.work.loading.take();
         match result {
             Ok(loaded) => {
                 if let Some(requested) = requested {

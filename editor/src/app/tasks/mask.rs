@@ -15,11 +15,11 @@ impl App {
 
     /// Whether the left button paints (instead of orbiting).
     pub fn paint_mode(&self) -> bool {
-        self.paint_mode
+        self.painting.paint_mode
     }
 
     pub fn set_paint_mode(&mut self, on: bool) {
-        self.paint_mode = on;
+        self.painting.paint_mode = on;
     }
 
     /// One dab of the brush at `view.cursor`: raises (or, erasing, lowers) the mask under it.
@@ -44,7 +44,7 @@ impl App {
             _ => mesh.positions.as_slice(),
         };
         let hits = brush_hits(positions, &mesh.triangles, view);
-        if self.stroke.is_none() {
+        if self.painting.stroke.is_none() {
             if hits.is_empty() {
                 return;
             }
@@ -54,12 +54,12 @@ impl App {
             }
             // Erasing with no mask starts from "fair everything": it protects what it touches.
             let start = if erase { 1.0 } else { 0.0 };
-            self.stroke = Some(match &document.mask {
+            self.painting.stroke = Some(match &document.mask {
                 Some(mask) => mask.weights().to_vec(),
                 None => vec![start; mesh.positions.len()],
             });
         }
-        let Some(weights) = self.stroke.as_mut() else {
+        let Some(weights) = self.painting.stroke.as_mut() else {
             return;
         };
         for (v, fraction) in hits {
@@ -77,12 +77,12 @@ impl App {
         if let Some(document) = &mut self.document {
             document.mask = mask;
         }
-        self.mask_revision += 1;
+        self.painting.mask_revision += 1;
     }
 
     /// The stroke ended: the mask is remembered for the file and the mesh faired with it.
     pub(in crate::app) fn end_stroke(&mut self) {
-        if self.stroke.take().is_none() {
+        if self.painting.stroke.take().is_none() {
             return;
         }
         self.remember_mask();
@@ -107,7 +107,7 @@ impl App {
         }
         document.mask = changed;
         self.history.record(label, previous);
-        self.mask_revision += 1;
+        self.painting.mask_revision += 1;
         self.message = Some(format!("{label} (undo with Ctrl+Z)"));
         self.remember_mask();
         self.refair_with_mask();
@@ -142,6 +142,7 @@ impl App {
     /// The mask's revision while it is tinted over the mesh.
     pub(in crate::app) fn mask_tint(&self) -> Option<u64> {
         let document = self.document.as_ref()?;
-        (self.settings.paint.show_mask && document.mask.is_some()).then_some(self.mask_revision)
+        (self.settings.paint.show_mask && document.mask.is_some())
+            .then_some(self.painting.mask_revision)
     }
 }

@@ -5,7 +5,7 @@
 use std::sync::Arc;
 use std::time::{Duration, Instant};
 
-use crate::app::jobs::JobResult;
+use crate::app::jobs::{GenerationId, JobKind, JobResult};
 use crate::app::state::{HierarchyState, Measures};
 use crate::app::App;
 use fairmesh::TriMesh;
@@ -18,7 +18,7 @@ pub(in crate::app) const MEASURE_DELAY: Duration = Duration::from_millis(100);
 
 /// A faired result waiting to be measured.
 pub(in crate::app) struct MeasureRequest {
-    pub(in crate::app) document: u64,
+    pub(in crate::app) document: GenerationId,
     pub(in crate::app) serial: u64,
     pub(in crate::app) positions: Arc<Vec<[f32; 3]>>,
     /// When the result arrived.
@@ -29,18 +29,18 @@ impl App {
     /// Hands the waiting result to the measuring worker once no fairing is in flight and it has
     /// waited [`MEASURE_DELAY`]; until then asks for a frame when the delay is up.
     pub(in crate::app) fn start_waiting_measure(&mut self) {
-        let Some(request) = &self.measure_wanted else {
+        let Some(request) = &self.work.measure_wanted else {
             return;
         };
         let waited = request.arrived.elapsed();
-        if self.fair_in_flight {
+        if self.work.fair_in_flight {
             return;
         }
         if waited < MEASURE_DELAY {
             self.ctx.request_repaint_after(MEASURE_DELAY - waited);
             return;
         }
-        if let Some(request) = self.measure_wanted.take() {
+        if let Some(request) = self.work.measure_wanted.take() {
             self.request_measures(request.document, request.serial, request.positions);
         }
     }
@@ -49,7 +49,7 @@ impl App {
     /// measuring worker (a newer result replaces a waiting request).
     pub(in crate::app) fn request_measures(
         &mut self,
-        document: u64,
+        document: GenerationId,
         serial: u64,
         positions: Arc<Vec<[f32; 3]>>,
     ) {
@@ -63,60 +63,69 @@ impl App {
         // with its triangles.
         let base = current.original.clone();
         let clean = current.clean.clone();
-        let pool = self.measure_pool.clone();
-        let document_generation = self.document_generation.clone();
+        let pool = self.workers.measure_pool.clone();
+        let document_generation = self.work.document_generation.clone();
         // A slider move, an option or a view change bumps the view generation: the result
         // being measured is then about to be replaced, so measuring it stops and gives the
         // cores to the next fairing.
-        let (view_generation, view) =
-            (self.view_generation.clone(), self.view_generation.current());
-        let (tx, ctx, ticket) = (self.results_tx.clone(), self.ctx.clone(), self.jobs.start());
-        self.measure.submit_latest("measure", move || {
-            if !document_generation.is_current(document) {
-                return;
-            }
-            let started = Instant::now();
-            let base = base.as_ref();
-            let faired = TriMesh {
-                positions: positions.as_ref().clone(),
-                triangles: base.triangles.clone(),
-            };
-            let stop =
-                || !view_generation.is_current(view) || !document_generation.is_current(document);
-            let measure = || {
-                let against_document = Measures::of_unless(base, &faired, &stop)?;
-                let against_clean = match clean.as_deref() {
-                    Some(clean) => Some(Measures::of_unless(clean, &faired, &stop)?),
-                    None => None,
+        let (view_generation, view) = (
+            self.work.view_generation.clone(),
+            self.work.view_generation.current(),
+        );
+        let (tx, ctx, ticket) = (
+            self.workers.results_tx.clone(),
+            self.ctx.clone(),
+            self.workers.jobs.start(),
+        );
+        self.workers
+            .measure
+            .submit_latest(JobKind::Measure, move || {
+                if !document_generation.is_current(document) {
+                    return;
+                }
+                let started = Instant::now();
+                let base = base.as_ref();
+                let faired = TriMesh {
+                    positions: positions.as_ref().clone(),
+                    triangles: base.triangles.clone(),
                 };
-                Some((against_document, against_clean))
-            };
-            let measured = match &pool {
-                Some(pool) => pool.install(measure),
-                None => measure(),
-            };
-            let message = match measured {
-                Some((against_document, against_clean)) => JobResult::Measured {
-                    document,
-                    serial,
-                    against_document: Some(against_document),
-                    against_clean,
-                    measure_time: started.elapsed(),
-                },
-                None => JobResult::MeasureStopped {
-                    document,
-                    serial,
-                    positions,
-                },
-            };
-            Self::send_result(&tx, &ctx, message, ticket);
-        });
+                let stop = || {
+                    !view_generation.is_current(view) || !document_generation.is_current(document)
+                };
+                let measure = || {
+                    let against_document = Measures::of_unless(base, &faired, &stop)?;
+                    let against_clean = match clean.as_deref() {
+                        Some(clean) => Some(Measures::of_unless(clean, &faired, &stop)?),
+                        None => None,
+                    };
+                    Some((against_document, against_clean))
+                };
+                let measured = match &pool {
+                    Some(pool) => pool.install(measure),
+                    None => measure(),
+                };
+                let message = match measured {
+                    Some((against_document, against_clean)) => JobResult::Measured {
+                        document,
+                        serial,
+                        against_document: Some(against_document),
+                        against_clean,
+                        measure_time: started.elapsed(),
+                    },
+                    None => JobResult::MeasureStopped {
+                        document,
+                        serial,
+                        positions,
+                    },
+                };
+                Self::send_result(&tx, &ctx, message, ticket);
+            });
     }
 
     /// A result's measures arrived.
     pub(in crate::app) fn on_measured(
         &mut self,
-        document: u64,
+        document: GenerationId,
         serial: u64,
         against_document: Option<Measures>,
         against_clean: Option<Measures>,
@@ -140,11 +149,11 @@ impl App {
     /// A measuring stopped because the view moved on: measured again later if still shown.
     pub(in crate::app) fn on_measure_stopped(
         &mut self,
-        document: u64,
+        document: GenerationId,
         serial: u64,
         positions: Arc<Vec<[f32; 3]>>,
     ) {
-        self.measures_stopped += 1;
+        self.work.measures_stopped += 1;
         let still_shown = self
             .document
             .as_ref()
@@ -152,8 +161,8 @@ impl App {
             .and_then(|d| d.faired.as_ref())
             .is_some_and(|f| f.serial == serial);
         // A newer result has its own request already; this one is measured again.
-        if still_shown && self.measure_wanted.is_none() {
-            self.measure_wanted = Some(MeasureRequest {
+        if still_shown && self.work.measure_wanted.is_none() {
+            self.work.measure_wanted = Some(MeasureRequest {
                 document,
                 serial,
                 positions,

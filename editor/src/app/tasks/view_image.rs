@@ -6,7 +6,7 @@
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
-use crate::app::jobs::JobResult;
+use crate::app::jobs::{JobKind, JobResult};
 use crate::app::panel_view::{Commands, PanelView};
 use crate::app::{App, Command};
 
@@ -31,18 +31,22 @@ impl App {
             self.error = Some("Save image: no mesh is loaded".into());
             return;
         }
-        self.capture_next_frame = true;
+        self.view.capture_next_frame = true;
         self.ctx.request_repaint();
     }
 
     /// Sends the screenshot command for this frame; its image comes back as a job result.
     pub(in crate::app) fn capture_view(&mut self, ctx: &egui::Context) {
-        let (Some(document), Some(rect)) = (&self.document, self.viewport_rect) else {
+        let (Some(document), Some(rect)) = (&self.document, self.view.viewport_rect) else {
             return;
         };
         let beside = document.path.clone();
         let pixels_per_point = ctx.pixels_per_point();
-        let (tx, repaint, ticket) = (self.results_tx.clone(), ctx.clone(), self.jobs.start());
+        let (tx, repaint, ticket) = (
+            self.workers.results_tx.clone(),
+            ctx.clone(),
+            self.workers.jobs.start(),
+        );
         let callback = egui::ScreenshotCallback::new(move |image| {
             let message = JobResult::ViewCaptured {
                 image,
@@ -64,8 +68,12 @@ impl App {
         pixels_per_point: f32,
         beside: PathBuf,
     ) {
-        let (tx, ctx, ticket) = (self.results_tx.clone(), self.ctx.clone(), self.jobs.start());
-        self.io.submit(move || {
+        let (tx, ctx, ticket) = (
+            self.workers.results_tx.clone(),
+            self.ctx.clone(),
+            self.workers.jobs.start(),
+        );
+        self.workers.io.submit(JobKind::ViewImage, move || {
             let path = free_image_path(&beside);
             let result = write_png(&path, &crop(&image, rect, pixels_per_point))
                 .map(|()| path)
