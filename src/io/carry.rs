@@ -73,13 +73,10 @@ impl VertexAttributes {
 /// ([`super::uv_follow`]): each vertex's one UV walks over the faces around it. A vertex that did
 /// not move keeps its UV exactly.
 pub(crate) fn follow_slide(uvs: &mut [[f32; 2]], before: &[[f32; 3]], mesh: &TriMesh) {
-    if uvs.len() != mesh.positions.len() || before.len() != uvs.len() || before == mesh.positions
-    {
+    if uvs.len() != mesh.positions.len() || before.len() != uvs.len() || before == mesh.positions {
         return;
     }
-    let triangles: Vec<UvTriangle> = (mesh.triangles.iter())
-        .map(|t| t.map(|v| [v, v]))
-        .collect();
+    let triangles: Vec<UvTriangle> = (mesh.triangles.iter()).map(|t| t.map(|v| [v, v])).collect();
     let values: Vec<[f64; 2]> = uvs.iter().map(|uv| uv.map(f64::from)).collect();
     let followed = super::uv_follow::follow(before, &mesh.positions, &triangles, &values);
     for (uv, moved) in uvs.iter_mut().zip(followed.moved) {

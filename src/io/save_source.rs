@@ -107,7 +107,9 @@ fn write_back(
                 Ok(())
             })?;
             if ply::has_face_texture_coordinates(bytes)
-                && source.loaded_positions(mesh).is_some_and(|p| p != mesh.positions)
+                && source
+                    .loaded_positions(mesh)
+                    .is_some_and(|p| p != mesh.positions)
             {
                 report.warnings.push(format!(
                     "the per-face texture coordinates (texcoord) of {} stay with their corners,                      so the texture slides with the vertices that moved (only per-vertex texture                      coordinates follow the slide)",
@@ -418,10 +420,9 @@ fn write_derived_attributes(
         uv_splits_merged: full.uv_splits_merged,
         colour_splits_merged: full.colour_splits_merged,
     };
-    if let (Some(uvs), Some(loaded)) = (
-        extra.uvs.as_mut(),
-        source.loaded_positions(derivation.base),
-    ) {
+    if let (Some(uvs), Some(loaded)) =
+        (extra.uvs.as_mut(), source.loaded_positions(derivation.base))
+    {
         // Each kept vertex's UV follows its move from where it was loaded to the level's
         // position, over the level's own faces as they lay before.
         let before: Vec<[f32; 3]> = (derivation.vertex_origin.iter())

@@ -611,7 +611,10 @@ impl Scene {
         let triangles: Vec<UvTriangle> = (self.parts.iter())
             .flat_map(|part| &part.primitives)
             .flat_map(|p| &p.triangles)
-            .filter(|t| t.iter().all(|&c| slot_of.get(c as usize).is_some_and(|&s| s != NO_UV)))
+            .filter(|t| {
+                t.iter()
+                    .all(|&c| slot_of.get(c as usize).is_some_and(|&s| s != NO_UV))
+            })
             .map(|t| t.map(|c| [vertices[c as usize].welded, slot_of[c as usize]]))
             .collect();
         let followed = super::uv_follow::follow(&before, &mesh.positions, &triangles, &uvs);
