@@ -167,7 +167,7 @@ fn write_glb(dir: &Path) -> PathBuf {
     let mut bin = Vec::new();
     let mut views = Vec::new();
     let mut add = |bytes: Vec<u8>, bin: &mut Vec<u8>| {
-        while bin.len() % 4 != 0 {
+        while !bin.len().is_multiple_of(4) {
             bin.push(0);
         }
         views.push(json!({"buffer": 0, "byteOffset": bin.len(), "byteLength": bytes.len()}));
@@ -201,7 +201,7 @@ fn write_glb(dir: &Path) -> PathBuf {
         &mut bin,
     );
     let image_view = add(image_png(), &mut bin);
-    while bin.len() % 4 != 0 {
+    while !bin.len().is_multiple_of(4) {
         bin.push(0);
     }
     let document = json!({
@@ -226,7 +226,7 @@ fn write_glb(dir: &Path) -> PathBuf {
         "buffers": [{"byteLength": bin.len()}]
     });
     let mut text = serde_json::to_vec(&document).unwrap();
-    while text.len() % 4 != 0 {
+    while !text.len().is_multiple_of(4) {
         text.push(b' ');
     }
     let mut glb = Vec::new();
@@ -584,14 +584,10 @@ fn a_faired_plane_keeps_its_texture_in_place_in_every_format() {
     assert_right_way_up(&out, 1e-4);
 }
 
-/// A glTF primitive without a material, after one with a textured material, gets glTF's
-/// default material in the OBJ: its own `usemtl`, and a `.mtl` entry that is white, fully
-/// metallic and rough, with no texture.
-#[test]
-fn a_part_of_a_gltf_scene_without_a_material_gets_one_without_a_texture_in_obj() {
-    let dir = tempfile::tempdir().unwrap();
-    let glb = write_glb(dir.path());
-    // A second node, moved aside: a mesh of its own over the same accessors, with no material.
+/// `scene.glb` in `dir`: the plane's GLB with a second node, moved aside, whose mesh (over the
+/// same accessors) has no material.
+fn write_two_part_scene(dir: &Path) -> PathBuf {
+    let glb = write_glb(dir);
     let bytes = std::fs::read(&glb).unwrap();
     let length = u32::from_le_bytes(bytes[12..16].try_into().unwrap()) as usize;
     let mut json: Value = serde_json::from_slice(&bytes[20..20 + length]).unwrap();
@@ -606,7 +602,7 @@ fn a_part_of_a_gltf_scene_without_a_material_gets_one_without_a_texture_in_obj()
         .push(json!({"mesh": 1, "name": "box", "translation": [0.0, 0.0, 2.0]}));
     json["scenes"][0]["nodes"] = json!([0, 1]);
     let mut text = serde_json::to_vec(&json).unwrap();
-    while text.len() % 4 != 0 {
+    while !text.len().is_multiple_of(4) {
         text.push(b' ');
     }
     let bin = bytes[20 + length..].to_vec();
@@ -618,12 +614,16 @@ fn a_part_of_a_gltf_scene_without_a_material_gets_one_without_a_texture_in_obj()
     out.extend(b"JSON");
     out.extend(text);
     out.extend(bin);
-    let scene = dir.path().join("scene.glb");
+    let scene = dir.join("scene.glb");
     std::fs::write(&scene, out).unwrap();
-    let obj = dir.path().join("scene.obj");
-    convert(&scene, &obj);
-    let text = std::fs::read_to_string(&obj).unwrap();
-    // Every group's faces are preceded by a `usemtl` of their own.
+    scene
+}
+
+/// The OBJ at `obj` states a material before every group's faces, and the material-less part's
+/// is glTF's default in the `.mtl`: white, fully metallic and rough, with no texture; the
+/// textured part's has its texture.
+fn assert_every_part_states_its_material(obj: &Path) {
+    let text = std::fs::read_to_string(obj).unwrap();
     let mut materials_of_groups: Vec<(String, Option<String>)> = Vec::new();
     for line in text.lines() {
         if let Some(group) = line.strip_prefix("g ") {
@@ -661,6 +661,55 @@ fn a_part_of_a_gltf_scene_without_a_material_gets_one_without_a_texture_in_obj()
     assert!(entry(&plane_material)
         .iter()
         .any(|l| l.starts_with("map_Kd")));
+}
+
+/// A glTF primitive without a material, after one with a textured material, gets glTF's
+/// default material in the OBJ: its own `usemtl`, and a `.mtl` entry that is white, fully
+/// metallic and rough, with no texture (before, it took the textured part's `usemtl`).
+#[test]
+fn a_part_of_a_gltf_scene_without_a_material_gets_one_without_a_texture_in_obj() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = write_two_part_scene(dir.path());
+    let obj = dir.path().join("scene.obj");
+    convert(&scene, &obj);
+    assert_every_part_states_its_material(&obj);
+    assert_right_way_up(&obj, 1e-6);
+}
+
+/// The level chain does the same: a coarser level of the two-part scene written as OBJ states
+/// every part's material, and its kept vertices' UVs show red above blue in OBJ, GLB and PLY.
+#[test]
+fn a_coarser_level_states_every_parts_material_and_keeps_its_texture_in_place() {
+    use fairmesh::hierarchy::{build_hierarchy, HierarchyOptions};
+    let dir = tempfile::tempdir().unwrap();
+    let loaded = io::load(write_two_part_scene(dir.path())).unwrap();
+    // A small plane: levels down to a few vertices; its edges kept, so that every level lies
+    // on the plane, where the input's texture map is known exactly.
+    let options = HierarchyOptions::default()
+        .with_min_vertices(8)
+        .with_keep_boundary(true);
+    let hierarchy = build_hierarchy(&loaded.mesh, &options, &mut fairmesh::NoProgress).unwrap();
+    assert!(
+        hierarchy.coarsest_level() >= 1,
+        "the plane has coarser levels"
+    );
+    let level = hierarchy.coarsest_level().clamp(1, 2);
+    let mesh = hierarchy.level_mesh(level);
+    assert!(mesh.vertex_count() < loaded.mesh.vertex_count());
+    let (vertex_origin, face_origin) = hierarchy.level_origins(level);
+    let derivation = io::Derivation {
+        base: hierarchy.base_mesh(),
+        vertex_origin: &vertex_origin,
+        face_origin: &face_origin,
+    };
+    for name in ["level.obj", "level.glb", "level.ply"] {
+        let out = dir.path().join(name);
+        let report =
+            io::save_derived_with_source(&out, &mesh, &derivation, &loaded.source).unwrap();
+        assert!(report.texture_coordinates_follow, "{name}");
+        assert_right_way_up(&out, 1e-4);
+    }
+    assert_every_part_states_its_material(&dir.path().join("level.obj"));
 }
 
 /// Vertex colours that are not opaque lose their alpha in OBJ, and the save says so.

@@ -102,7 +102,8 @@ fn default_material_name(scene: &Scene) -> Option<String> {
         .iter()
         .flat_map(|part| &part.primitives)
         .any(|p| p.material.is_none_or(|m| m >= scene.materials.len()));
-    if !without || !(scene.material_less_is_gltf_default || !scene.materials.is_empty()) {
+    let others_would_lend_theirs = !scene.materials.is_empty();
+    if !without || !(scene.material_less_is_gltf_default || others_would_lend_theirs) {
         return None;
     }
     let taken = |name: &str| scene.materials.iter().any(|m| name_token(&m.name) == name);
