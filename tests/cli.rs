@@ -1052,6 +1052,12 @@ fn fair_reports_the_slide_of_a_textured_files_vertices_and_the_texture_follows_i
     let (json, stderr) = fair(noisy, "faired.glb", &[]);
     assert_eq!(json["texture_follows"], true, "{json}");
     assert!(!stderr.contains("relaxation slid"), "stderr: {stderr}");
+    // Into STL, which holds none, the save names the texture coordinates as not kept; no word
+    // of a texture that moved.
+    let (json, stderr) = fair(noisy, "faired.stl", &[]);
+    assert_eq!(json["texture_follows"], false, "{json}");
+    assert!(!stderr.contains("relaxation slid"), "stderr: {stderr}");
+    assert!(stderr.contains("texture coordinates ("), "stderr: {stderr}");
     // Without the relaxation nothing slides, and nothing is said; nor for a file with no
     // texture coordinates.
     let (json, stderr) = fair(noisy, "faired.glb", &["--tangential", "0"]);
