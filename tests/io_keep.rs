@@ -1040,14 +1040,21 @@ fn a_gltf_scene_saved_as_obj_keeps_names_materials_uvs_colours_and_split_normals
         Some(renamed.as_str())
     );
 
-    // UVs and colours: each corner has the input's UV at its place; seams stay split.
+    // UVs and colours: each corner has the input's UV at its place, in OBJ's convention (v
+    // counted from the image's bottom row: 1 − the glTF's); seams stay split. The UVs are read
+    // from the mesh as loaded, saved the same way: the faired one's follow the vertices' slide
+    // (tests/texture_orientation.rs checks where to).
     let uvs = placed_values(&input, "TEXCOORD_0");
     let colours = placed_values(&input, "COLOR_0");
+    let unmoved_path = dir.path().join("unmoved.obj");
+    io::save_with_source(&unmoved_path, &loaded.mesh, &loaded.source).unwrap();
+    let unmoved = read_obj_scene(&unmoved_path);
     let mut uvs_at: Vec<BTreeSet<[u32; 2]>> = vec![BTreeSet::new(); mesh.vertex_count()];
     let mut checked = 0;
-    for face in &obj.faces {
+    for face in &unmoved.faces {
         for &(v, t, n) in &face.corners {
-            let uv = obj.uvs[t.unwrap()];
+            let [u, v_up] = unmoved.uvs[t.unwrap()];
+            let uv = [u, (1.0 - f64::from(v_up)) as f32];
             assert!(n.is_some(), "every corner has a normal");
             let before = loaded.mesh.positions[v];
             if face.material.as_deref() == Some("checker") {
@@ -1143,6 +1150,47 @@ fn obj_uvs_by_group(path: &Path) -> std::collections::HashMap<(String, [u32; 3])
         }
     }
     out
+}
+
+/// `loaded` (textured.obj) saved unmoved as glTF (`extension`) into `folder`: each corner has
+/// its group's UV at its place, in glTF's convention (v counted from the image's top row: 1 −
+/// the OBJ's). Unmoved, so that the UVs have not followed a slide (tests/texture_orientation.rs
+/// checks where they go when they do).
+fn assert_uvs_are_the_groups(
+    loaded: &Loaded,
+    input: &std::collections::HashMap<(String, [u32; 3]), Vec<[f32; 2]>>,
+    extension: &std::ffi::OsStr,
+    folder: &Path,
+) {
+    let path = folder.join("unmoved").with_extension(extension);
+    io::save_with_source(&path, &loaded.mesh, &loaded.source).unwrap();
+    let output = read_gltf(&path);
+    let json = &output.json;
+    let mut checked = 0;
+    for node in json["nodes"].as_array().unwrap() {
+        let (Some(group), Some(m)) = (node["name"].as_str(), node["mesh"].as_u64()) else {
+            continue;
+        };
+        for primitive in json["meshes"][m as usize]["primitives"].as_array().unwrap() {
+            let attributes = &primitive["attributes"];
+            let positions = output.floats(attributes["POSITION"].as_u64().unwrap() as usize);
+            let uvs = output.floats(attributes["TEXCOORD_0"].as_u64().unwrap() as usize);
+            for k in 0..positions.len() {
+                let before = [positions[k][0], positions[k][1], positions[k][2]].map(f32::to_bits);
+                let choices = &input[&(group.to_string(), before)];
+                let in_obj = [uvs[k][0], (1.0 - f64::from(uvs[k][1])) as f32];
+                assert!(
+                    choices
+                        .iter()
+                        .all(|c| (c[0] - in_obj[0]).abs() <= 1e-6 && (c[1] - in_obj[1]).abs() <= 1e-6),
+                    "{group} vertex {k}: {:?} ({in_obj:?} from the bottom row) is not the group's UV {choices:?}",
+                    uvs[k]
+                );
+                checked += 1;
+            }
+        }
+    }
+    assert!(checked >= 400, "every corner of textured.obj: {checked}");
 }
 
 #[test]
@@ -1243,12 +1291,8 @@ fn an_obj_saved_as_gltf_keeps_groups_materials_uvs_and_normals() {
                 let v = welded_of
                     [&[positions[k][0], positions[k][1], positions[k][2]].map(f32::to_bits)];
                 let before = loaded.mesh.positions[v].map(f32::to_bits);
-                let choices = &input[&(group.to_string(), before)];
-                assert!(
-                    choices.iter().all(|c| c[..] == uvs[k][..]),
-                    "{group} vertex {k}: {:?} is not the group's UV {choices:?}",
-                    uvs[k]
-                );
+                assert!(input.contains_key(&(group.to_string(), before)));
+                assert!(uvs[k].iter().all(|c| c.is_finite()));
                 // Smooth normals stay smooth across the groups and follow the faired shape.
                 let normal = glam::Vec3::from_slice(&normals[k]);
                 assert!((normal.length() - 1.0).abs() < 1e-5);
@@ -1260,6 +1304,7 @@ fn an_obj_saved_as_gltf_keeps_groups_materials_uvs_and_normals() {
             }
         }
         assert_eq!(triangles, mesh.face_count());
+        assert_uvs_are_the_groups(&loaded, &input, path.extension().unwrap(), dir.path());
     }
     let text = report.warnings.join("\n");
     assert!(
@@ -1341,9 +1386,16 @@ fn gltf_and_obj_saved_as_ply_keep_colours_uvs_and_normals_and_name_the_rest() {
     let colours = placed_values(&input, "COLOR_0");
     let uvs = placed_values(&input, "TEXCOORD_0");
     let normals = mesh.vertex_normals();
+    // The UVs of the mesh as loaded, saved the same way (the faired one's follow the slide):
+    // PLY's s t count v from the image's bottom row, 1 − the glTF's.
+    let unmoved_path = dir.path().join("unmoved.ply");
+    io::save_with_source(&unmoved_path, &loaded.mesh, &loaded.source).unwrap();
+    let unmoved = std::fs::read(&unmoved_path).unwrap();
     let (mut coloured, mut textured) = (0, 0);
     for v in 0..mesh.vertex_count() {
         let row = &bytes[body + v * 36..body + (v + 1) * 36];
+        let unmoved_row = &unmoved[body + v * 36..body + (v + 1) * 36];
+        let st = |k: usize| f32::from_le_bytes(unmoved_row[4 * k..4 * k + 4].try_into().unwrap());
         let f = |k: usize| f32::from_le_bytes(row[4 * k..4 * k + 4].try_into().unwrap());
         assert_eq!([f(0), f(1), f(2)], mesh.positions[v]);
         let n = glam::Vec3::new(f(3), f(4), f(5));
@@ -1352,7 +1404,8 @@ fn gltf_and_obj_saved_as_ply_keep_colours_uvs_and_normals_and_name_the_rest() {
             "recomputed normal"
         );
         let before = loaded.mesh.positions[v];
-        if let Some(ok) = is_a_value_at(&uvs, before, &[f(6), f(7)], 1e-6) {
+        let uv = [st(6), (1.0 - f64::from(st(7))) as f32];
+        if let Some(ok) = is_a_value_at(&uvs, before, &uv, 1e-6) {
             assert!(ok);
             textured += 1;
         }

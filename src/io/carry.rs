@@ -9,6 +9,11 @@
 //! their split. Normals are not carried but recomputed by the writers from the moved mesh.
 //! Values that are not finite are never written: such a vertex gets zero. A vertex that had no
 //! value (a part of a glTF scene with no COLOR_0 beside one with colours) gets white, or UV 0 0.
+//! UVs are in the library's convention (`uv_convention.rs`) and follow their vertices' slide
+//! along the surface ([`follow_slide`]), as the write-backs make them do.
+
+use super::uv_follow::UvTriangle;
+use crate::mesh::TriMesh;
 
 /// Per welded vertex: UVs and RGBA colours (0..1), each present when the source had them.
 #[derive(Debug, Default)]
@@ -61,6 +66,39 @@ impl VertexAttributes {
         }
         (kept, lost)
     }
+}
+
+/// Moves `uvs` (one per vertex of `mesh`, in the library's convention) so that the texture stays
+/// where it was on the surface while the vertices moved from `before` to `mesh`'s positions
+/// ([`super::uv_follow`]): each vertex's one UV walks over the faces around it. A vertex that did
+/// not move keeps its UV exactly.
+pub(crate) fn follow_slide(uvs: &mut [[f32; 2]], before: &[[f32; 3]], mesh: &TriMesh) {
+    if uvs.len() != mesh.positions.len() || before.len() != uvs.len() || before == mesh.positions {
+        return;
+    }
+    let triangles: Vec<UvTriangle> = (mesh.triangles.iter()).map(|t| t.map(|v| [v, v])).collect();
+    let values: Vec<[f64; 2]> = uvs.iter().map(|uv| uv.map(f64::from)).collect();
+    let followed = super::uv_follow::follow(before, &mesh.positions, &triangles, &values);
+    for (uv, moved) in uvs.iter_mut().zip(followed.moved) {
+        if let Some(moved) = moved {
+            *uv = moved.map(|c| c as f32);
+        }
+    }
+}
+
+/// What an OBJ loses of vertex colours whose alpha is below 1 at `vertices` vertices (an OBJ
+/// vertex colour is `r g b` alone); `None` when every colour is opaque.
+pub(crate) fn alpha_lost_in_obj(vertices: usize) -> Option<String> {
+    (vertices > 0).then(|| {
+        format!(
+            "the vertex colours' alpha at {vertices} vertices that are not opaque (an OBJ vertex colour is r g b alone)"
+        )
+    })
+}
+
+/// How many of `colours` are not opaque.
+pub(crate) fn translucent(colours: &[[f32; 4]]) -> usize {
+    colours.iter().filter(|c| c[3] < 1.0).count()
 }
 
 /// Gathers file-vertex values onto welded vertices, first value wins.

@@ -17,6 +17,9 @@
 //! - Writes are atomic (`atomic.rs`): a temporary file beside the target is renamed into place, so a
 //!   failed export never leaves a partial file or damages an existing one. Meshes with non-finite
 //!   positions or out-of-range indices are refused before anything is written.
+//! - Texture coordinates have one convention inside the library, glTF's (v counted down from the
+//!   image's top row); readers of OBJ and PLY turn theirs (v from the bottom row) into it and
+//!   writers turn them back (`uv_convention.rs`, [`Format::texture_v_origin`]).
 
 pub(crate) mod atomic;
 mod carry;
@@ -37,6 +40,7 @@ pub mod scene;
 mod source;
 mod stl;
 mod text;
+mod uv_convention;
 mod uv_follow;
 mod vertex_list;
 
@@ -50,6 +54,7 @@ pub use report::{LoadReport, SaveReport};
 pub use save::{save, save_as, write_to};
 pub use save_source::{save_derived_with_source, save_with_source, Derivation};
 pub use source::Source;
+pub use uv_convention::TextureVOrigin;
 pub use vertex_list::{loaded_vertices, parse_vertex_list, read_vertex_list, VertexListError};
 
 use crate::mesh::TriMesh;

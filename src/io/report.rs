@@ -17,9 +17,10 @@ pub struct LoadReport {
 #[non_exhaustive]
 pub struct SaveReport {
     pub warnings: Vec<String>,
-    /// The file was written back into its own format (OBJ, glTF/GLB, a PLY with per-vertex
-    /// texture coordinates), its texture coordinates following their vertices' slide along the
-    /// surface so that the texture stays where it was; otherwise texture coordinates stay with
-    /// their vertices.
+    /// The output holds the file's texture coordinates and they followed their vertices' slide
+    /// along the surface, so that the texture stays where it was: written back into its own
+    /// format (OBJ, glTF/GLB, a PLY with per-vertex texture coordinates) or carried into another
+    /// that holds them (OBJ, glTF/GLB, PLY), a coarser level's kept vertices' included.
+    /// Otherwise (an output with no texture coordinates, a mesh written bare) they are not kept.
     pub texture_coordinates_follow: bool,
 }

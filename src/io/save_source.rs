@@ -106,6 +106,16 @@ fn write_back(
                 report.texture_coordinates_follow = ply::write_back(w, bytes, origin, mesh)?;
                 Ok(())
             })?;
+            if ply::has_face_texture_coordinates(bytes)
+                && source
+                    .loaded_positions(mesh)
+                    .is_some_and(|p| p != mesh.positions)
+            {
+                report.warnings.push(format!(
+                    "the per-face texture coordinates (texcoord) of {} stay with their corners,                      so the texture slides with the vertices that moved (only per-vertex texture                      coordinates follow the slide)",
+                    origin.path.display()
+                ));
+            }
         }
         SourceData::Gltf(gltf) => gltf::write_back(path, format, gltf, origin, mesh, report)?,
         SourceData::Plain | SourceData::Unkept(_) | SourceData::Stl(_) => {
@@ -115,7 +125,8 @@ fn write_back(
     Ok(())
 }
 
-/// A glTF scene or an OBJ into OBJ or glTF: its parts, materials, UVs, normals and colours.
+/// A glTF scene or an OBJ into OBJ or glTF: its parts, materials, UVs (following the slide),
+/// normals and colours.
 fn write_carried_scene(
     path: &Path,
     format: Format,
@@ -124,10 +135,14 @@ fn write_carried_scene(
     mut scene: Scene,
     report: &mut SaveReport,
 ) -> Result<(), IoError> {
+    report.texture_coordinates_follow = scene.follow_slide(mesh);
     let merged_colours = write_scene(path, format, &mut scene, mesh)?;
     let mut lost = source.contents_beyond_scene(&scene, format);
     if merged_colours > 0 {
         lost.push(merged_colour_borders(merged_colours));
+    }
+    if format == Format::Obj {
+        lost.extend(carry::alpha_lost_in_obj(scene.translucent_vertices()));
     }
     lost.append(&mut scene.warnings);
     if !lost.is_empty() {
@@ -142,7 +157,8 @@ fn write_carried_scene(
 }
 
 /// Otherwise what the format can hold per vertex (UVs, colours; normals into PLY) is carried
-/// when the mesh still has the source's vertices (`carries`); the rest is named.
+/// when the mesh still has the source's vertices (`carries`), the UVs following the slide; the
+/// rest is named.
 fn write_carried_attributes(
     path: &Path,
     format: Format,
@@ -155,11 +171,17 @@ fn write_carried_attributes(
         format,
         Format::Obj | Format::Glb | Format::Gltf | Format::Ply
     );
-    let extra = if carries && holds {
+    let mut extra = if carries && holds {
         source.vertex_attributes()
     } else {
         carry::VertexAttributes::default()
     };
+    if let Some(uvs) = extra.uvs.as_mut() {
+        if let Some(before) = source.loaded_positions(mesh) {
+            carry::follow_slide(uvs, &before, mesh);
+            report.texture_coordinates_follow = true;
+        }
+    }
     let (mut kept, mut lost) = extra.describe();
     let mut beyond = source.contents_beyond(&extra);
     if format == Format::Ply && carries {
@@ -184,6 +206,10 @@ fn write_carried_attributes(
         }
     } else {
         write_with_attributes(path, format, mesh, &extra)?;
+    }
+    if format == Format::Obj {
+        let translucent = extra.colours.as_deref().map_or(0, carry::translucent);
+        lost.extend(carry::alpha_lost_in_obj(translucent));
     }
     lost.extend(beyond);
     if !lost.is_empty() {
@@ -269,7 +295,9 @@ impl Derivation<'_> {
 /// Save a mesh derived from the loaded one by removing vertices (a coarse level of the
 /// hierarchy), keeping what can be kept per surviving vertex: into OBJ or glTF, from a glTF or
 /// OBJ source, its part names, materials (and textures), and the UVs and colours of the kept
-/// vertices (a corner moved onto another vertex takes that vertex's UV in the same material);
+/// vertices (a corner moved onto another vertex takes that vertex's UV in the same material; a
+/// kept vertex the level placed anew has its UVs follow it over the level's faces as they lay
+/// at the loaded positions, as a write-back has them follow);
 /// into OBJ, glTF or PLY from any source, the UVs and colours of the kept vertices. Normals are
 /// recomputed, smooth, from the coarse shape. The report names what is not kept (split normals,
 /// morph targets, the node tree's transforms, ...). A derivation that does not fit `mesh` or
@@ -296,6 +324,7 @@ pub fn save_derived_with_source(
         Some(scene) => write_derived_scene(path, format, mesh, derivation, source, scene)?,
         None => write_derived_attributes(path, format, mesh, derivation, source)?,
     };
+    report.texture_coordinates_follow = kept.contains(&"UVs");
     if !lost.is_empty() {
         let how = if kept.is_empty() {
             format!("it is written as a bare {format} mesh")
@@ -330,6 +359,9 @@ fn write_derived_scene(
         derivation.vertex_origin,
         derivation.face_origin,
     );
+    // Each kept vertex's file vertex holds where it was loaded: the UVs follow its move to the
+    // level's position over the level's own faces as they lay before.
+    derived.follow_slide(mesh);
     let merged_colours = write_scene(path, format, &mut derived, mesh)?;
     let mut lost: Vec<String> = Vec::new();
     if unplaced > 0 {
@@ -339,6 +371,9 @@ fn write_derived_scene(
     }
     if merged_colours > 0 {
         lost.push(merged_colour_borders(merged_colours));
+    }
+    if format == Format::Obj {
+        lost.extend(carry::alpha_lost_in_obj(derived.translucent_vertices()));
     }
     if scene.normals {
         lost.push("the file's own normals and their split (hard edges): they are recomputed, smooth, from the coarse shape".into());
@@ -373,7 +408,7 @@ fn write_derived_attributes(
             .map(|&v| values[v as usize])
             .collect()
     };
-    let extra = carry::VertexAttributes {
+    let mut extra = carry::VertexAttributes {
         uvs: full.uvs.as_deref().map(pick),
         colours: full.colours.as_ref().map(|values| {
             derivation
@@ -385,6 +420,16 @@ fn write_derived_attributes(
         uv_splits_merged: full.uv_splits_merged,
         colour_splits_merged: full.colour_splits_merged,
     };
+    if let (Some(uvs), Some(loaded)) =
+        (extra.uvs.as_mut(), source.loaded_positions(derivation.base))
+    {
+        // Each kept vertex's UV follows its move from where it was loaded to the level's
+        // position, over the level's own faces as they lay before.
+        let before: Vec<[f32; 3]> = (derivation.vertex_origin.iter())
+            .map(|&v| loaded[v as usize])
+            .collect();
+        carry::follow_slide(uvs, &before, mesh);
+    }
     let (carried, mut merged) = extra.describe();
     write_with_attributes(path, format, mesh, &extra)?;
     let holds = matches!(
@@ -396,6 +441,10 @@ fn write_derived_attributes(
     }
     let mut lost = Vec::new();
     lost.append(&mut merged);
+    if format == Format::Obj {
+        let translucent = extra.colours.as_deref().map_or(0, carry::translucent);
+        lost.extend(carry::alpha_lost_in_obj(translucent));
+    }
     lost.extend(source.contents_beyond(&extra));
     Ok((carried, lost))
 }

@@ -10,12 +10,16 @@
 //!
 //! Positions come from the faired mesh in world space (OBJ has no transforms; glTF nodes are
 //! written with none). Normals are the file's own, brought to world space and then turned with
-//! their faces exactly as the same-format writers turn them ([`super::source::NormalTurns`]):
+//! their faces exactly as the same-format writers turn them (`super::source::NormalTurns`):
 //! split normals (hard edges, UV seams) stay split, smooth ones stay smooth. A file with no
 //! normals gets none in OBJ and area-weighted smooth ones in glTF (which wants them).
 //!
 //! Front ends read a loaded file's [`Scene`] through [`Source::scene`](super::Source::scene) to
 //! draw its materials; building and writing one stays inside the library.
+//!
+//! Texture coordinates are in the library's convention (`uv_convention.rs`); written into another
+//! format they follow their vertices' slide along the surface (`Scene::follow_slide`), as the
+//! write-backs make them do.
 //!
 //! Images: an external image file is copied beside the output when it is not in the output's
 //! folder already (as `<output stem>_<name>` when another file of that name is there), and
@@ -23,6 +27,7 @@
 //! written out as a file beside an OBJ's `.mtl` or a `.gltf`. A GLB embeds every image.
 
 use super::normals::{dvec, NormalTurns, SmoothGroups};
+use super::uv_follow::{UvTriangle, NO_UV};
 use crate::mesh::TriMesh;
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
@@ -40,6 +45,11 @@ pub struct Scene {
     /// node per object over a node per group. Otherwise (a glTF's nodes) a part is one node.
     pub groups_under_objects: bool,
     pub materials: Vec<Material>,
+    /// Whether a primitive without a material is drawn with glTF's default material (a glTF's
+    /// primitives), rather than with whatever its reader takes (an OBJ's faces before any
+    /// `usemtl`). An OBJ written from the scene then names that material for it
+    /// (`Material::gltf_default`).
+    pub material_less_is_gltf_default: bool,
     /// What could not be read while building the scene (a missing `.mtl`, an unreadable image).
     pub warnings: Vec<String>,
 }
@@ -53,10 +63,10 @@ pub struct SceneVertex {
     pub before: [f32; 3],
     pub uv: [f32; 2],
     pub colour: [f32; 4],
-    /// In world space; turned with its faces by [`Scene::turn_normals`].
+    /// In world space; turned with its faces by `Scene::turn_normals`.
     pub normal: [f32; 3],
-    /// The slot its normal turns in ([`NormalTurns`]): the OBJ `vn` line, or for glTF given by
-    /// [`SmoothGroups`]; `usize::MAX` for a vertex without a normal.
+    /// The slot its normal turns in (`NormalTurns`): the OBJ `vn` line, or for glTF given by
+    /// `SmoothGroups`; `usize::MAX` for a vertex without a normal.
     pub slot: usize,
 }
 
@@ -105,6 +115,23 @@ pub struct Material {
     pub tex_coord: u32,
     /// The base colour texture's `KHR_texture_transform`, where the file has one.
     pub texture_transform: Option<TextureTransform>,
+}
+
+impl Material {
+    /// glTF's default material (glTF 2.0, "Materials": a primitive without one is drawn white,
+    /// fully metallic and fully rough), under `name`.
+    pub(crate) fn gltf_default(name: String) -> Material {
+        Material {
+            name,
+            base_colour: [1.0; 4],
+            metallic: 1.0,
+            roughness: 1.0,
+            texture: None,
+            sampler: TextureSampler::default(),
+            tex_coord: 0,
+            texture_transform: None,
+        }
+    }
 }
 
 /// A glTF base colour texture's `KHR_texture_transform`: its texture coordinates are scaled,
@@ -276,7 +303,7 @@ impl Scene {
         self.parts.retain(|p| !p.primitives.is_empty());
     }
 
-    /// Give each file normal that has no slot yet one from [`SmoothGroups`] (a normal that is the
+    /// Give each file normal that has no slot yet one from `SmoothGroups` (a normal that is the
     /// normal of its own faces gets a slot of its own, so flat parts stay flat per face).
     pub(crate) fn assign_smooth_slots(&mut self) {
         let mut own = NormalTurns::new(self.vertices.len());
@@ -501,6 +528,7 @@ impl Scene {
             colours: self.colours,
             normals: self.normals,
             groups_under_objects: self.groups_under_objects,
+            material_less_is_gltf_default: self.material_less_is_gltf_default,
             parts: self
                 .parts
                 .iter()
@@ -542,6 +570,83 @@ impl Scene {
         self.materials
             .iter()
             .any(|m| m.texture.is_some() && m.texture_transform.is_some() && m.tex_coord == 0)
+    }
+
+    /// Moves the texture coordinates of the file vertices whose welded vertex moved (from their
+    /// `before` to `mesh`'s position) so that the texture stays where it was on the surface, as
+    /// the write-backs do ([`super::uv_follow`]). A texture coordinate here is one welded vertex's
+    /// UV value: the file vertices of one welded vertex with the same UV (an OBJ corner's other
+    /// normals, a glTF vertex repeated in another primitive) walk as one, and each side of a UV
+    /// seam walks in its own chart. Returns whether the UVs followed (the scene has UVs).
+    pub(crate) fn follow_slide(&mut self, mesh: &TriMesh) -> bool {
+        if !self.uvs {
+            return false;
+        }
+        let n = mesh.positions.len();
+        let mut before = mesh.positions.clone();
+        let mut seen = vec![false; n];
+        for vertex in &self.vertices {
+            let w = vertex.welded as usize;
+            if w < n && !seen[w] {
+                before[w] = vertex.before;
+                seen[w] = true;
+            }
+        }
+        if before == mesh.positions {
+            return true;
+        }
+        let mut slots: HashMap<(u32, [u32; 2]), u32> = HashMap::new();
+        let mut uvs: Vec<[f64; 2]> = Vec::new();
+        let slot_of: Vec<u32> = self
+            .vertices
+            .iter()
+            .map(|vertex| {
+                if vertex.welded as usize >= n {
+                    return NO_UV;
+                }
+                let key = (vertex.welded, vertex.uv.map(f32::to_bits));
+                *slots.entry(key).or_insert_with(|| {
+                    uvs.push(vertex.uv.map(f64::from));
+                    (uvs.len() - 1) as u32
+                })
+            })
+            .collect();
+        let vertices = &self.vertices;
+        let triangles: Vec<UvTriangle> = (self.parts.iter())
+            .flat_map(|part| &part.primitives)
+            .flat_map(|p| &p.triangles)
+            .filter(|t| {
+                t.iter()
+                    .all(|&c| slot_of.get(c as usize).is_some_and(|&s| s != NO_UV))
+            })
+            .map(|t| t.map(|c| [vertices[c as usize].welded, slot_of[c as usize]]))
+            .collect();
+        let followed = super::uv_follow::follow(&before, &mesh.positions, &triangles, &uvs);
+        for (vertex, &slot) in self.vertices.iter_mut().zip(&slot_of) {
+            if let Some(Some(uv)) = followed.moved.get(slot as usize) {
+                vertex.uv = uv.map(|c| c as f32);
+            }
+        }
+        true
+    }
+
+    /// How many welded vertices have a colour that is not opaque (alpha below 1), among the
+    /// file vertices the triangles use.
+    pub(crate) fn translucent_vertices(&self) -> usize {
+        if !self.colours {
+            return 0;
+        }
+        let mut seen = std::collections::HashSet::new();
+        for primitive in self.parts.iter().flat_map(|p| &p.primitives) {
+            for &v in primitive.triangles.iter().flatten() {
+                if let Some(vertex) = self.vertices.get(v as usize) {
+                    if vertex.colour[3] < 1.0 && vertex.welded != u32::MAX {
+                        seen.insert(vertex.welded);
+                    }
+                }
+            }
+        }
+        seen.len()
     }
 
     /// How many triangles in all.

@@ -21,8 +21,9 @@
 //! are recomputed. A vertex that did not move keeps its bytes (or its text) exactly, and so does
 //! a normal whose faces did not move.
 //! Saving to another format writes the mesh with what that format can hold per vertex (UVs and
-//! vertex colours into glTF and OBJ, see [`super::carry`]) and names, in the [`super::SaveReport`],
-//! everything else it cannot keep.
+//! vertex colours into glTF and OBJ, see [`super::carry`]; UVs turned into the output's own
+//! convention, see `uv_convention.rs`, and following the slide as in a write-back) and names, in
+//! the [`super::SaveReport`], everything else it cannot keep.
 
 use super::carry::VertexAttributes;
 use super::normals::{dvec, is_own_normal};
@@ -107,9 +108,9 @@ impl Source {
     }
 
     /// Whether the file gives its vertices texture coordinates (OBJ `vt`, PLY `u`/`v` or
-    /// `s`/`t`, glTF `TEXCOORD_0`). Written back into the file's own format they follow their
-    /// vertices' slide along the surface; written into another, they stay with their vertices,
-    /// so whatever slid a vertex along the surface moves the texture with it.
+    /// `s`/`t`, glTF `TEXCOORD_0`). Written back into the file's own format, or carried into
+    /// another that holds them, they follow their vertices' slide along the surface (see
+    /// [`super::SaveReport::texture_coordinates_follow`]).
     pub fn has_texture_coordinates(&self) -> bool {
         match &self.data {
             SourceData::Obj(bytes) => super::obj::has_texture_coordinates(bytes),
@@ -119,7 +120,7 @@ impl Source {
         }
     }
 
-    /// The file's UVs and vertex colours per welded vertex (see [`super::carry`]), for writing
+    /// The file's UVs and vertex colours per welded vertex (see `carry.rs`), for writing
     /// another format.
     pub fn vertex_attributes(&self) -> VertexAttributes {
         match &self.data {
@@ -128,6 +129,39 @@ impl Source {
             SourceData::Gltf(gltf) => gltf.vertex_attributes(&self.origin),
             _ => VertexAttributes::default(),
         }
+    }
+
+    /// The positions the mesh was loaded with, per welded vertex (a vertex no file vertex became
+    /// keeps `mesh`'s), for following a slide from them to `mesh`'s; `None` for a format that
+    /// holds no texture coordinates, or a file that cannot be read again.
+    pub(crate) fn loaded_positions(&self, mesh: &TriMesh) -> Option<Vec<[f32; 3]>> {
+        let mut before = mesh.positions.clone();
+        let mut seen = vec![false; before.len()];
+        let mut put = |welded: Option<usize>, position: [f32; 3]| {
+            if let Some(w) = welded.filter(|&w| w < seen.len() && !seen[w]) {
+                before[w] = position;
+                seen[w] = true;
+            }
+        };
+        match &self.data {
+            SourceData::Ply(bytes) => {
+                let parsed = super::ply::parse(bytes, &self.origin.path).ok()?;
+                for (k, &p) in parsed.mesh.positions.iter().enumerate() {
+                    put(self.origin.welded(k), p);
+                }
+            }
+            SourceData::Obj(_) | SourceData::Gltf(_) => {
+                let scene = self.scene(mesh)?;
+                for vertex in &scene.vertices {
+                    put(
+                        (vertex.welded != u32::MAX).then_some(vertex.welded as usize),
+                        vertex.before,
+                    );
+                }
+            }
+            _ => return None,
+        }
+        Some(before)
     }
 
     /// The file's parts, materials and file vertices (see [`super::scene`]) for writing another

@@ -1,4 +1,6 @@
-//! Texture coordinates that follow their vertices' slide along the surface, for the write-backs.
+//! Texture coordinates that follow their vertices' slide along the surface, for the write-backs
+//! (and, through [`crate::io::scene::Scene::follow_slide`] and `carry::follow_slide`, for what is
+//! carried into another format).
 //!
 //! Not from the paper: the default fairing's tangential relaxation (and the normal-projected
 //! iteration, a little) moves vertices *along* the surface, and a texture coordinate that stays

@@ -6,7 +6,7 @@ use fairmesh::fairing::{
     self, baseline::UmbrellaStencil, BoundaryMode, ConstrainedFairing, CreaseOptions, FairReport,
     FairVariant, Mask, Method, MethodChoices, MethodOptions, Strength,
 };
-use fairmesh::io::Source;
+use fairmesh::io::{Format, Source};
 use fairmesh::metrics::Comparison;
 use fairmesh::{Topology, TriMesh};
 use std::path::{Path, PathBuf};
@@ -181,8 +181,8 @@ struct Outcome {
 struct TextureSlide {
     /// Root mean square, in mean edge lengths of the input.
     slide: f64,
-    /// Whether the written file's texture coordinates followed the slide (written back into its
-    /// own format); into another, they stayed with their vertices.
+    /// Whether the written file's texture coordinates followed the slide (into any format that
+    /// holds them, see `SaveReport::texture_coordinates_follow`).
     follows: bool,
 }
 
@@ -211,7 +211,7 @@ pub fn run(args: FairArgs) -> anyhow::Result<()> {
             slide,
             follows: saved.texture_coordinates_follow,
         });
-    warn_texture_slide(&args.input, texture);
+    warn_texture_slide(&args.input, &args.output, texture);
     note_loose_triangles(&args.input, report.loose_triangles);
     let measures = input.map(|input| {
         super::progress::Step::run("measuring against the input", || {
@@ -272,16 +272,21 @@ fn fair_timed(
     (report, time_ms)
 }
 
-/// Warns, on standard error, when the texture moved with vertices that slid along the surface.
-fn warn_texture_slide(input: &Path, texture: Option<TextureSlide>) {
+/// Warns, on standard error, when the texture moved with vertices that slid along the surface:
+/// the output holds texture coordinates (`output`'s format) and they did not follow. An output
+/// that holds none has them named among what it does not keep, by the save.
+fn warn_texture_slide(input: &Path, output: &Path, texture: Option<TextureSlide>) {
+    let holds = matches!(
+        Format::from_path(output),
+        Some(Format::Obj | Format::Ply | Format::Glb | Format::Gltf)
+    );
     if let Some(TextureSlide { slide, .. }) =
-        texture.filter(|t| t.slide >= TEXTURE_SLIDE_WARNING && !t.follows)
+        texture.filter(|t| t.slide >= TEXTURE_SLIDE_WARNING && !t.follows && holds)
     {
         eprintln!(
             "warning: {}: its texture coordinates stay with their vertices, and the tangential \
              relaxation slid the vertices along the surface by {slide:.2} mean edge lengths \
-             (root mean square): the texture moved with them. Written back into its own format, \
-             the texture coordinates follow the slide instead; `--tangential 0` keeps every \
+             (root mean square): the texture moved with them. `--tangential 0` keeps every \
              vertex on its normal line (noise that moved vertices along the surface then stays).",
             input.display()
         );

@@ -97,7 +97,8 @@ pub struct Batch {
 pub struct Appearance {
     /// The mesh vertex each draw vertex stands on; `None`: the draw vertices are the mesh's.
     pub vertex_of: Option<Vec<u32>>,
-    /// Per draw vertex; `None` when the file has none.
+    /// Per draw vertex, in the library's convention (v from the image's top row, as the texture
+    /// is uploaded and sampled; see `io::TextureVOrigin`); `None` when the file has none.
     pub uvs: Option<Vec<[f32; 2]>>,
     /// Per draw vertex, linear RGBA; `None` when the file has none.
     pub colours: Option<Vec<[f32; 4]>>,

@@ -25,6 +25,7 @@ impl GltfSource {
     pub(crate) fn scene(&self, origin: &Origin, mesh: &TriMesh) -> Scene {
         let mut scene = Scene {
             vertices: vec![SceneVertex::new(None, [0.0; 3]); origin.raw_vertices],
+            material_less_is_gltf_default: true,
             ..Scene::default()
         };
         scene.materials = self.materials(origin, &mut scene.warnings);

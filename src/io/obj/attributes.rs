@@ -5,6 +5,8 @@ use super::line::vertex_and_uv;
 use crate::io::carry::{Gather, VertexAttributes};
 use crate::io::origin::Origin;
 use crate::io::text::tokens;
+use crate::io::uv_convention::into_library;
+use crate::io::Format;
 
 /// Whether a face corner of the OBJ file names a texture coordinate (`v/vt`, `v/vt/vn`) that a
 /// `vt` line before it gives: what makes [`vertex_attributes`]' `uvs` `Some`, found without
@@ -33,7 +35,8 @@ pub(crate) fn has_texture_coordinates(bytes: &[u8]) -> bool {
 }
 
 /// The vertex colours (`v x y z r g b`) and texture coordinates (`vt`, through the faces'
-/// `v/vt` corners) of an OBJ file, per welded vertex, for saving it in another format.
+/// `v/vt` corners) of an OBJ file, per welded vertex, for saving it in another format; texture
+/// coordinates in the library's convention (see `io::uv_convention`).
 pub(crate) fn vertex_attributes(bytes: &[u8], origin: &Origin) -> VertexAttributes {
     let mut colours = Gather::<4>::new(origin.welded_vertices, [1.0; 4]);
     let mut uvs = Gather::<2>::new(origin.welded_vertices, [0.0; 2]);
@@ -61,7 +64,7 @@ pub(crate) fn vertex_attributes(bytes: &[u8], origin: &Origin) -> VertexAttribut
                     .next()
                     .and_then(crate::io::text::parse_f32)
                     .unwrap_or(0.0);
-                texture_coordinates.push([u, v]);
+                texture_coordinates.push(into_library(Format::Obj, [u, v]));
             }
             Some(b"f") => {
                 for corner in words {

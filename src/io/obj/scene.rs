@@ -1,11 +1,14 @@
 //! An OBJ file as a [`Scene`] (see [`crate::io::scene`]): its parts, file vertices, normals
-//! turned with their faces, and materials ([`super::materials`]).
+//! turned with their faces, and materials ([`super::materials`]). Texture coordinates are turned
+//! into the library's convention (`vt`'s v counts from the image's bottom row, the library's from
+//! its top: see `io::uv_convention`).
 
 use super::line::{resolve, rest_of, vertex_of};
 use super::materials::read_materials;
 use crate::io::origin::Origin;
 use crate::io::scene::{Part, Primitive, Scene, SceneVertex};
 use crate::io::text::tokens;
+use crate::io::Format;
 use crate::mesh::TriMesh;
 use std::collections::HashMap;
 
@@ -97,7 +100,10 @@ impl SceneReader<'_> {
                         .filter(|c| c.is_finite())
                         .unwrap_or(0.0)
                 };
-                self.uvs.push([number(), number()]);
+                // In the library's convention (v from the image's top row).
+                let uv = [number(), number()];
+                self.uvs
+                    .push(crate::io::uv_convention::into_library(Format::Obj, uv));
             }
             Some(b"vn") => self.normals.push(
                 vertex_of(words.take(3))

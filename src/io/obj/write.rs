@@ -1,8 +1,11 @@
 //! Writing a bare mesh as OBJ: `v x y z` with Rust's shortest round-trip float formatting, so
 //! every f32 reads back bit for bit, and `f a b c` with 1-based indices; per-vertex colours and
-//! UVs where given.
+//! UVs where given (turned from the library's texture-coordinate convention into `vt`'s, see
+//! `io::uv_convention`).
 
 use crate::io::carry::VertexAttributes;
+use crate::io::uv_convention::into_file;
+use crate::io::Format;
 use crate::mesh::TriMesh;
 use std::io::Write;
 
@@ -31,7 +34,8 @@ pub(crate) fn write_with(
             None => writeln!(out, "v {x} {y} {z}")?,
         }
     }
-    for [u, v] in uvs.into_iter().flatten() {
+    for &uv in uvs.into_iter().flatten() {
+        let [u, v] = into_file(Format::Obj, uv);
         writeln!(out, "vt {u} {v}")?;
     }
     for triangle in &mesh.triangles {

@@ -2,8 +2,9 @@
 
 use crate::io::atomic;
 use crate::io::carry::Gather;
-use crate::io::scene::{ImageData, PlacedImage, Scene, SceneVertex};
-use crate::io::IoError;
+use crate::io::scene::{ImageData, Material, PlacedImage, Scene, SceneVertex};
+use crate::io::uv_convention::into_file;
+use crate::io::{Format, IoError};
 use crate::mesh::TriMesh;
 use std::collections::HashMap;
 use std::io::Write;
@@ -11,9 +12,12 @@ use std::path::Path;
 
 /// An OBJ of `scene` at `path`, with a `.mtl` beside it (`<stem>.mtl`) when it has materials and
 /// their textures copied or written beside it (see [`Scene::place_images`]): `v` per welded
-/// vertex of `mesh` (with the vertex colour when the source had them), `vt` and `vn` per distinct
-/// value, `o`, `g` and `usemtl` per part and material. Every file is staged and renamed into
-/// place only when all are complete.
+/// vertex of `mesh` (with the vertex colour when the source had them), `vt` (in OBJ's convention)
+/// and `vn` per distinct value, `o`, `g` and `usemtl` per part and material. Every group's faces
+/// state their material: a primitive without one, in a scene whose materials are glTF's (or
+/// beside primitives with one, which would otherwise lend it theirs), takes glTF's default
+/// material under a name of its own ([`default_material_name`]). Every file is staged and
+/// renamed into place only when all are complete.
 pub(crate) fn write_scene(
     path: &Path,
     scene: &Scene,
@@ -26,6 +30,7 @@ pub(crate) fn write_scene(
         |n| n.to_string_lossy().into_owned(),
     );
     let placed = scene.place_images(path);
+    let default_material = default_material_name(scene);
     let used = |v: &&SceneVertex| v.welded != u32::MAX;
     // One colour per `v` line: the first file vertex's.
     let colours = scene.colours.then(|| {
@@ -44,6 +49,7 @@ pub(crate) fn write_scene(
         scene,
         mesh,
         mtl_name,
+        default_material: default_material.clone(),
         colours,
         uv_list,
         uv_index,
@@ -61,9 +67,9 @@ pub(crate) fn write_scene(
         })?;
         staged.push(atomic::stage(target, |w| w.write_all(&bytes))?);
     }
-    if !scene.materials.is_empty() {
+    if !scene.materials.is_empty() || default_material.is_some() {
         staged.push(atomic::stage(&mtl_path, |out| {
-            write_mtl(out, scene, &placed)
+            write_mtl(out, scene, &placed, default_material.as_deref())
         })?);
     }
     staged.push(atomic::stage(path, |out| text.write(out))?);
@@ -88,6 +94,28 @@ fn numbered<const N: usize>(
     (list, index)
 }
 
+/// The name the `.mtl` gives glTF's default material, when some primitive needs it (see
+/// [`write_scene`]): `gltf_default`, or `gltf_default_<n>` when a material has that name.
+fn default_material_name(scene: &Scene) -> Option<String> {
+    let without = scene
+        .parts
+        .iter()
+        .flat_map(|part| &part.primitives)
+        .any(|p| p.material.is_none_or(|m| m >= scene.materials.len()));
+    let others_would_lend_theirs = !scene.materials.is_empty();
+    if !without || !(scene.material_less_is_gltf_default || others_would_lend_theirs) {
+        return None;
+    }
+    let taken = |name: &str| scene.materials.iter().any(|m| name_token(&m.name) == name);
+    let mut name = "gltf_default".to_string();
+    let mut n = 1;
+    while taken(&name) {
+        n += 1;
+        name = format!("gltf_default_{n}");
+    }
+    Some(name)
+}
+
 /// A name as one OBJ token (its words joined by `_`).
 fn name_token(name: &str) -> String {
     name.split_whitespace().collect::<Vec<_>>().join("_")
@@ -99,6 +127,8 @@ struct ObjText<'a> {
     scene: &'a Scene,
     mesh: &'a TriMesh,
     mtl_name: String,
+    /// The `.mtl` name of the material for primitives without one, where they get one.
+    default_material: Option<String>,
     colours: Option<Vec<[f32; 4]>>,
     uv_list: Vec<[f32; 2]>,
     uv_index: HashMap<[u32; 2], usize>,
@@ -117,7 +147,7 @@ impl ObjText<'_> {
             mesh.positions.len(),
             scene.triangle_count()
         )?;
-        if !scene.materials.is_empty() {
+        if !scene.materials.is_empty() || self.default_material.is_some() {
             writeln!(out, "mtllib {}", self.mtl_name)?;
         }
         for (v, [x, y, z]) in mesh.positions.iter().enumerate() {
@@ -130,7 +160,8 @@ impl ObjText<'_> {
             }
         }
         if scene.uvs {
-            for [u, v] in &self.uv_list {
+            for &uv in &self.uv_list {
+                let [u, v] = into_file(Format::Obj, uv);
                 writeln!(out, "vt {u} {v}")?;
             }
         }
@@ -157,8 +188,13 @@ impl ObjText<'_> {
                 writeln!(out, "g {}", name_token(group))?;
             }
             for primitive in &part.primitives {
-                if let Some(m) = primitive.material {
-                    writeln!(out, "usemtl {}", name_token(&scene.materials[m].name))?;
+                match primitive.material.and_then(|m| scene.materials.get(m)) {
+                    Some(material) => writeln!(out, "usemtl {}", name_token(&material.name))?,
+                    None => {
+                        if let Some(name) = &self.default_material {
+                            writeln!(out, "usemtl {name}")?;
+                        }
+                    }
                 }
                 for t in &primitive.triangles {
                     out.write_all(b"f")?;
@@ -193,14 +229,17 @@ impl ObjText<'_> {
 }
 
 /// The `.mtl`: per material its name, base colour (`Kd`, `d`), metallic (`Pm`), roughness (`Pr`)
-/// and the base colour texture's file as `placed` beside the OBJ.
+/// and the base colour texture's file as `placed` beside the OBJ; then glTF's default material
+/// as `default_material` where the OBJ uses it.
 fn write_mtl(
     out: &mut dyn Write,
     scene: &Scene,
     placed: &[Option<PlacedImage>],
+    default_material: Option<&str>,
 ) -> std::io::Result<()> {
     writeln!(out, "# written by fairmesh")?;
-    for (m, material) in scene.materials.iter().enumerate() {
+    let default = default_material.map(|name| Material::gltf_default(name.to_string()));
+    for (m, material) in scene.materials.iter().chain(&default).enumerate() {
         let [r, g, b, a] = material.base_colour;
         writeln!(out, "\nnewmtl {}", name_token(&material.name))?;
         writeln!(out, "Kd {r} {g} {b}")?;

@@ -5,6 +5,8 @@ use super::header::{find_layout, parse_header, Element, Property, Scalar};
 use super::rows::{uv_properties, vertex_rows, vertex_triples};
 use crate::io::carry::{Gather, VertexAttributes};
 use crate::io::origin::Origin;
+use crate::io::uv_convention::into_library;
+use crate::io::Format;
 use std::path::Path;
 
 /// Whether the PLY file's vertices have texture coordinates ([`super::rows::uv_properties`]): what makes
@@ -20,8 +22,28 @@ pub(crate) fn has_texture_coordinates(bytes: &[u8]) -> bool {
     uv_properties(&header.elements[layout.vertex_element]).is_some()
 }
 
+/// Whether the PLY file's faces hold texture coordinates of their own (a `texcoord` list per
+/// face, as MeshLab writes a wedge-textured mesh): written back they stay as they are, so they
+/// cannot follow a slide of their vertices.
+pub(crate) fn has_face_texture_coordinates(bytes: &[u8]) -> bool {
+    let path = Path::new("");
+    let Ok(header) = parse_header(bytes, path) else {
+        return false;
+    };
+    let Ok(layout) = find_layout(&header, path) else {
+        return false;
+    };
+    layout.face_element.is_some_and(|f| {
+        header.elements[f]
+            .properties
+            .iter()
+            .any(|p| matches!(p, Property::List { name, .. } if name == b"texcoord"))
+    })
+}
+
 /// The vertex colours (red green blue [alpha]) and UVs (s t, u v or texture_u texture_v) of a
-/// PLY file, per welded vertex, for saving it in another format.
+/// PLY file, per welded vertex, for saving it in another format; UVs in the library's
+/// convention (a PLY's v counts from the image's bottom row, see `io::uv_convention`).
 pub(crate) fn vertex_attributes(bytes: &[u8], origin: &Origin) -> VertexAttributes {
     let path = Path::new("");
     let Ok(header) = parse_header(bytes, path) else {
@@ -75,7 +97,7 @@ pub(crate) fn vertex_attributes(bytes: &[u8], origin: &Origin) -> VertexAttribut
             .iter()
             .enumerate()
         {
-            gather.put(origin.welded(k), [uv[0], uv[1]]);
+            gather.put(origin.welded(k), into_library(Format::Ply, [uv[0], uv[1]]));
         }
         uvs_gathered = Some(gather);
     }

@@ -30,7 +30,9 @@ mod rows;
 mod write;
 mod writeback;
 
-pub(crate) use attributes::{contents, has_texture_coordinates, vertex_attributes};
+pub(crate) use attributes::{
+    contents, has_face_texture_coordinates, has_texture_coordinates, vertex_attributes,
+};
 pub(crate) use read::parse;
 pub(crate) use rows::can_write_back;
 pub(crate) use write::{write, write_with};

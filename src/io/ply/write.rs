@@ -1,7 +1,9 @@
 //! Writing a bare mesh as binary little endian PLY, with per-vertex normals, UVs and colours
-//! where given.
+//! where given (UVs turned from the library's convention into PLY's, see `io::uv_convention`).
 
 use crate::io::carry::VertexAttributes;
+use crate::io::uv_convention::into_file;
+use crate::io::Format;
 use crate::mesh::TriMesh;
 use std::io::Write;
 
@@ -51,8 +53,10 @@ pub(crate) fn write_with(
         for c in normals.map_or(&[][..], |normals| &normals[v][..]) {
             buffer.extend_from_slice(&c.to_le_bytes());
         }
-        for c in uvs.map_or(&[][..], |uvs| &uvs[v][..]) {
-            buffer.extend_from_slice(&c.to_le_bytes());
+        if let Some(uvs) = uvs {
+            for c in into_file(Format::Ply, uvs[v]) {
+                buffer.extend_from_slice(&c.to_le_bytes());
+            }
         }
         if let Some(colours) = colours {
             // 0..1 to 0..255, rounded; `Gather` keeps values finite.
