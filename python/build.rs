@@ -195,66 +195,61 @@ fn header_ends(header: &str) -> bool {
     trimmed.ends_with(':') || trimmed.ends_with(": ...")
 }
 
-/// Open brackets minus closed ones, outside strings.
-fn depth(text: &str) -> i32 {
+/// Each character of `text` with its byte index and, outside strings, the depth of the
+/// brackets open just after it (`None` for a quote or a character inside a string).
+fn scan(text: &str) -> impl Iterator<Item = (usize, char, Option<i32>)> + '_ {
     let mut depth = 0;
     let mut quote: Option<char> = None;
-    for c in text.chars() {
-        match (quote, c) {
-            (Some(q), c) if c == q => quote = None,
-            (Some(_), _) => {}
-            (None, '"' | '\'') => quote = Some(c),
-            (None, '(' | '[' | '{') => depth += 1,
-            (None, ')' | ']' | '}') => depth -= 1,
-            _ => {}
-        }
-    }
-    depth
+    text.char_indices().map(move |(i, c)| {
+        let outside = match (quote, c) {
+            (Some(q), c) if c == q => {
+                quote = None;
+                false
+            }
+            (Some(_), _) => false,
+            (None, '"' | '\'') => {
+                quote = Some(c);
+                false
+            }
+            (None, '(' | '[' | '{') => {
+                depth += 1;
+                true
+            }
+            (None, ')' | ']' | '}') => {
+                depth -= 1;
+                true
+            }
+            _ => true,
+        };
+        (i, c, outside.then_some(depth))
+    })
 }
 
+/// Open brackets minus closed ones, outside strings.
+fn depth(text: &str) -> i32 {
+    scan(text)
+        .filter_map(|(_, _, depth)| depth)
+        .last()
+        .unwrap_or(0)
+}
+
+/// The index of the bracket that closes the one at `open`.
 fn matching_paren(text: &str, open: usize) -> usize {
-    let mut level = 0;
-    let mut quote: Option<char> = None;
-    for (i, c) in text.char_indices().skip_while(|(i, _)| *i < open) {
-        match (quote, c) {
-            (Some(q), c) if c == q => quote = None,
-            (Some(_), _) => {}
-            (None, '"' | '\'') => quote = Some(c),
-            (None, '(' | '[' | '{') => level += 1,
-            (None, ')' | ']' | '}') => {
-                level -= 1;
-                if level == 0 {
-                    return i;
-                }
-            }
-            _ => {}
-        }
-    }
-    panic!("unclosed parameters in {STUBS}: {text}");
+    scan(&text[open..])
+        .find(|&(_, c, depth)| matches!(c, ')' | ']' | '}') && depth == Some(0))
+        .map(|(i, _, _)| open + i)
+        .unwrap_or_else(|| panic!("unclosed parameters in {STUBS}: {text}"))
 }
 
 /// The comma-separated parts of `text` outside brackets and strings, trimmed, empty ones left out.
 fn split_top_level(text: &str) -> Vec<String> {
-    let mut parts = Vec::new();
-    let mut current = String::new();
-    let mut level = 0;
-    let mut quote: Option<char> = None;
-    for c in text.chars() {
-        match (quote, c) {
-            (Some(q), c) if c == q => quote = None,
-            (Some(_), _) => {}
-            (None, '"' | '\'') => quote = Some(c),
-            (None, '(' | '[' | '{') => level += 1,
-            (None, ')' | ']' | '}') => level -= 1,
-            (None, ',') if level == 0 => {
-                parts.push(std::mem::take(&mut current));
-                continue;
-            }
-            _ => {}
+    let mut parts = vec![String::new()];
+    for (_, c, depth) in scan(text) {
+        match (c, depth) {
+            (',', Some(0)) => parts.push(String::new()),
+            _ => parts.last_mut().expect("one part at least").push(c),
         }
-        current.push(c);
     }
-    parts.push(current);
     parts
         .into_iter()
         .map(|p| p.trim().to_string())
@@ -274,20 +269,9 @@ fn parameter(text: &str) -> (String, Option<String>) {
 
 /// `text` split at the first `separator` outside brackets and strings.
 fn split_top_level_once(text: &str, separator: char) -> Option<(&str, &str)> {
-    let mut level = 0;
-    let mut quote: Option<char> = None;
-    for (i, c) in text.char_indices() {
-        match (quote, c) {
-            (Some(q), c) if c == q => quote = None,
-            (Some(_), _) => {}
-            (None, '"' | '\'') => quote = Some(c),
-            (None, '(' | '[' | '{') => level += 1,
-            (None, ')' | ']' | '}') => level -= 1,
-            (None, c) if c == separator && level == 0 => return Some((&text[..i], &text[i + 1..])),
-            _ => {}
-        }
-    }
-    None
+    scan(text)
+        .find(|&(_, c, depth)| c == separator && depth == Some(0))
+        .map(|(i, _, _)| (&text[..i], &text[i + separator.len_utf8()..]))
 }
 
 /// A docstring cleaned as `inspect.cleandoc` does: the first line stripped of leading spaces,

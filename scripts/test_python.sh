@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
 # The Python package's tests (python/): makes a virtual environment (python/.venv), installs
-# maturin, numpy, pytest and trimesh (for fairmesh.trimesh) into it, builds the wheel (release,
-# abi3), installs it and runs pytest, which compares results with the command-line tool built by
-# the Rust tests (target/debug/fairmesh, built here when missing; or $FAIRMESH_CLI). Run by .ci/run after them.
+# maturin, numpy, pytest, trimesh (for fairmesh.trimesh) and Pillow (trimesh's textures) into it,
+# builds the wheel (release, abi3), installs it and runs pytest, which compares results with the
+# command-line tool built by the Rust tests (target/debug/fairmesh, built here when missing; or
+# $FAIRMESH_CLI). Run by .ci/run after them.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 python=${PYTHON:-python3}
@@ -16,7 +17,7 @@ if ! "$python" -c 'import venv, ensurepip' >/dev/null 2>&1; then
 fi
 venv=python/.venv
 [ -x "$venv/bin/python" ] || "$python" -m venv "$venv"
-"$venv/bin/python" -m pip install --quiet --upgrade "maturin>=1.9.4,<2" numpy pytest trimesh
+"$venv/bin/python" -m pip install --quiet --upgrade "maturin>=1.9.4,<2" numpy pytest trimesh pillow
 target=${CARGO_TARGET_DIR:-target}
 # The command line the tests compare with: $FAIRMESH_CLI, else the test build's binary.
 if [ -z "${FAIRMESH_CLI:-}" ]; then

@@ -34,7 +34,7 @@ fn loads_the_bunny_builds_the_hierarchy_and_fairs() {
     assert!(status.hierarchy_ready);
     assert!(status.level_count >= 1);
     assert!(status.faired_serial.is_some(), "a first fairing ran");
-    assert!(status.shown_vertices > 30_000 && status.shown_faces > 70_000);
+    assert!(status.view.shown_vertices > 30_000 && status.view.shown_faces > 70_000);
     // Per-level counts and the numbers are on screen.
     harness.get_by_label("Level sizes");
     harness.get_by_label_contains(&format!("levels (M0 … M{})", status.level_count - 1));
@@ -54,7 +54,7 @@ fn no_file_opens_the_bundled_bunny() {
     assert_eq!(status.document.as_deref(), Some(Path::new("bunny00.obj")));
     assert!(status.hierarchy_ready);
     assert!(status.faired_serial.is_some(), "a first fairing ran");
-    assert!(status.shown_vertices > 30_000 && status.shown_faces > 70_000);
+    assert!(status.view.shown_vertices > 30_000 && status.view.shown_faces > 70_000);
 }
 
 #[test]
@@ -98,9 +98,9 @@ fn level_slider_refairs_and_updates_the_numbers() {
     settle(&mut harness);
     let level_view = harness.state().status();
     if level_before > 0 {
-        assert!(level_view.shown_faces < refaired.shown_faces);
+        assert!(level_view.view.shown_faces < refaired.view.shown_faces);
     } else {
-        assert_eq!(level_view.shown_faces, refaired.shown_faces);
+        assert_eq!(level_view.view.shown_faces, refaired.view.shown_faces);
     }
 }
 
@@ -203,8 +203,8 @@ fn exports_and_reloads_the_result() {
     let reloaded = harness.state().status();
     assert_eq!(reloaded.document.as_deref(), Some(target.as_path()));
     assert!(reloaded.error.is_none(), "{:?}", reloaded.error);
-    assert_eq!(reloaded.shown_faces, loaded.shown_faces);
-    assert_eq!(reloaded.shown_vertices, loaded.shown_vertices);
+    assert_eq!(reloaded.view.shown_faces, loaded.view.shown_faces);
+    assert_eq!(reloaded.view.shown_vertices, loaded.view.shown_vertices);
 }
 
 #[test]
@@ -291,7 +291,7 @@ fn a_broken_file_shows_an_error_and_keeps_the_mesh() {
         );
         harness.get_by_label_contains("Could not open the file");
         assert_eq!(after.document, before.document, "the old mesh stays");
-        assert_eq!(after.shown_faces, before.shown_faces);
+        assert_eq!(after.view.shown_faces, before.view.shown_faces);
         harness
             .get_by_role_and_label(Role::Button, "Dismiss")
             .click();
@@ -423,7 +423,7 @@ fn viewport_snapshots() {
     settle(&mut harness);
 
     let shaded = viewport_image(&mut harness);
-    assert!(harness.state().status().images_drawn >= 1);
+    assert!(harness.state().status().view.images_drawn >= 1);
     // The mesh covers the middle of the view, in many shades (one per facet orientation).
     let (w, h) = shaded.dimensions();
     let background = *shaded.get_pixel(3, 3);
@@ -965,7 +965,7 @@ fn keep_sharp_edges_keeps_a_boxs_edges_in_the_hierarchy_and_draws_them_while_poi
         .hover();
     harness.step();
     harness.step();
-    let drawn = harness.state().status().sharp_edges_drawn;
+    let drawn = harness.state().status().view.sharp_edges_drawn;
     assert!(drawn > 40 && drawn < 140, "{drawn} edges drawn");
 
     harness

@@ -7,7 +7,9 @@ use egui::accesskit::Role;
 use egui_kittest::kittest::Queryable;
 
 mod editor_common;
-use editor_common::{bunny, harness_for, harness_sized, retype, settle, viewport_image};
+use editor_common::{
+    bunny, export_by_shortcut, harness_for, harness_sized, retype, settle, viewport_image,
+};
 
 /// The bundled bunny copied into `dir` (what the editor writes beside it stays there).
 fn bunny_in(dir: &Path) -> PathBuf {
@@ -72,15 +74,7 @@ fn export_asks_before_replacing_a_file_and_cancel_writes_nothing() {
 
     // A new file is written at once, without a question.
     let fresh = dir.path().join("fresh.obj");
-    retype(
-        &mut harness,
-        |v| v.ends_with("_faired.obj"),
-        &fresh.display().to_string(),
-    );
-    harness.key_press(egui::Key::Escape);
-    harness.step();
-    harness.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::E);
-    settle(&mut harness);
+    export_by_shortcut(&mut harness, &fresh);
     assert!(harness.query_by_label("Replace fresh.obj?").is_none());
     assert!(fresh.is_file());
 }

@@ -10,7 +10,9 @@ use egui_kittest::Harness;
 use fairmesh_editor::app::{App, Command};
 
 mod editor_common;
-use editor_common::{bunny, drag, harness_for, harness_sized, retype, settle, viewport_image};
+use editor_common::{
+    bunny, drag, export_by_shortcut, harness_for, harness_sized, settle, viewport_image,
+};
 
 /// Loads the bunny, adds the default noise (sigma 0.3 of the mean edge, seed 1, along the
 /// normal) through the panel's button, and fairs from a middle level: M4 of the bunny's 19
@@ -200,15 +202,7 @@ fn an_applied_result_stays_on_screen_and_is_what_export_writes() {
     );
 
     let target = dir.path().join("applied.glb");
-    retype(
-        &mut harness,
-        |v| v.ends_with("_faired.obj"),
-        &target.display().to_string(),
-    );
-    harness.key_press(egui::Key::Escape);
-    harness.step();
-    harness.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::E);
-    settle(&mut harness);
+    export_by_shortcut(&mut harness, &target);
     let written = fairmesh::io::load(&target).unwrap().mesh;
     assert_eq!(written.positions.len(), result.len());
     let largest_move = written
@@ -467,15 +461,7 @@ fn shortcuts_export_and_persisted_settings_round_trip() {
     let mut harness = harness_for(bunny());
     settle(&mut harness);
     let target = dir.path().join("shortcut.glb");
-    retype(
-        &mut harness,
-        |v| v.ends_with("_faired.obj"),
-        &target.display().to_string(),
-    );
-    harness.key_press(egui::Key::Escape);
-    harness.step();
-    harness.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::E);
-    settle(&mut harness);
+    export_by_shortcut(&mut harness, &target);
     assert!(
         target.is_file(),
         "Ctrl+E exported: {:?}",

@@ -53,13 +53,16 @@ fn heat_pixels(harness: &mut Harness) -> usize {
 /// date. Returns the legend's top.
 fn heat_map_of_the_result_on_screen(harness: &mut Harness, step: &str) -> f32 {
     let status = harness.state().status();
-    assert!(status.heat_shown, "{step}: heat map ticked but not shown");
+    assert!(
+        status.view.heat_shown,
+        "{step}: heat map ticked but not shown"
+    );
     assert!(status.faired_serial.is_some(), "{step}: no result");
     assert_eq!(
-        status.shown_serial, status.faired_serial,
+        status.view.shown_serial, status.faired_serial,
         "{step}: the view shows another result than the newest"
     );
-    assert!(!status.view_behind, "{step}: the view says computing");
+    assert!(!status.view.view_behind, "{step}: the view says computing");
     let distances = harness
         .state()
         .faired_measures()
@@ -76,7 +79,7 @@ fn heat_map_of_the_result_on_screen(harness: &mut Harness, step: &str) -> f32 {
         heat_pixels(harness) > 2000,
         "{step}: heat-map colours on screen"
     );
-    assert_eq!(status.caption, "After (faired)", "{step}");
+    assert_eq!(status.view.caption, "After (faired)", "{step}");
     top
 }
 
@@ -103,7 +106,10 @@ fn heat_map_mask_and_shape_come_from_one_result_through_the_mask_steps() {
     harness.step();
     stroke(&mut harness, 0.0);
     assert!(harness.state().mask().is_some());
-    assert!(harness.state().status().mask_shown, "the mask is shown");
+    assert!(
+        harness.state().status().view.mask_shown,
+        "the mask is shown"
+    );
     assert!(harness.state().settings().heat_map);
     let masked = heat_map_of_the_result_on_screen(&mut harness, "after a stroke");
     assert!(masked != whole, "the masked result's map is its own");
@@ -150,13 +156,13 @@ fn the_caption_says_computing_while_the_picture_is_the_previous_one() {
     harness.step();
     harness.step();
     let status = harness.state().status();
-    assert!(status.view_behind, "{status:?}");
+    assert!(status.view.view_behind, "{status:?}");
     assert_eq!(
-        status.shown_serial, before.shown_serial,
+        status.view.shown_serial, before.view.shown_serial,
         "the previous picture"
     );
     assert_eq!(
-        status.caption,
+        status.view.caption,
         format!("After (faired): {}", fairmesh_editor::app::COMPUTING)
     );
     settle(&mut harness);

@@ -213,9 +213,9 @@ fn a_held_mesh_comes_back_in_one_frame_while_the_view_is_unchanged() {
         restored: 1,
     };
     assert_eq!(done, one_copy, "the kept image shown, nothing drawn");
-    assert!(!harness.state().status().drawing);
+    assert!(!harness.state().status().view.drawing);
     assert_eq!(differing_pixels(&faired, &image), 0, "the result's picture");
-    assert!(!harness.state().status().view_behind);
+    assert!(!harness.state().status().view.view_behind);
     let (image, done) = switch_in_one_frame(&mut harness, "Input mesh");
     assert_eq!(done, one_copy);
     assert_eq!(differing_pixels(&input, &image), 0, "the input's picture");

@@ -4,7 +4,7 @@
 //! in both; exported from the editor as GLB and loaded again, it still is.
 
 mod editor_common;
-use editor_common::{harness_for, retype, settle, viewport_image};
+use editor_common::{export_by_shortcut, harness_for, settle, viewport_image};
 use std::path::{Path, PathBuf};
 
 /// Quads per side of the plane (it lies in x, y at z = 0, facing the default camera).
@@ -113,15 +113,7 @@ fn the_editors_export_to_glb_keeps_the_plane_red_above_blue() {
     let mut harness = harness_for(obj);
     settle(&mut harness);
     let target = dir.path().join("exported.glb");
-    retype(
-        &mut harness,
-        |v| v.ends_with("_faired.obj"),
-        &target.display().to_string(),
-    );
-    harness.key_press(egui::Key::Escape);
-    harness.step();
-    harness.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::E);
-    settle(&mut harness);
+    export_by_shortcut(&mut harness, &target);
     let status = harness.state().status();
     assert!(status.error.is_none(), "{:?}", status.error);
     assert!(target.is_file(), "{:?}", status.message);

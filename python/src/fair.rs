@@ -7,29 +7,27 @@ use crate::mesh::{from_arrays, Mesh};
 use crate::options;
 use crate::run::run_detached;
 use fairmesh::fairing::{
-    self, creases::DEFAULT_CREASE_ANGLE, FairReport, FairVariant, Mask, Method, MethodChoices,
-    MethodOptions,
+    self, creases::DEFAULT_CREASE_ANGLE, FairOutcome, Mask, Method, MethodChoices, MethodOptions,
+    ReportContext,
 };
 use fairmesh::{metrics, Topology, TriMesh};
 use pyo3::exceptions::{PyTypeError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
-use std::time::Instant;
 
 /// The keyword arguments of `fair`, as the command line's `fair` names them: the library's
 /// [`MethodChoices`], which `fairmesh fair` maps its options to as well.
 pub type FairArgs = MethodChoices;
 
-/// What one fairing did, for the report.
+/// What one fairing did, for the report: the library's measures of the run, and the result
+/// measured against the input when asked for.
 struct Outcome {
-    report: FairReport,
-    time_ms: f64,
-    volume_change_percent: Option<f64>,
-    texture_slide: Option<f64>,
+    faired: FairOutcome,
     measures: Option<metrics::Comparison>,
 }
 
-/// Fairs `mesh` (within `mask`) as `fairmesh fair` does, timing the fairing alone.
+/// Fairs `mesh` (within `mask`) as `fairmesh fair` does ([`fairing::fair_measured`]), timing
+/// the fairing alone; `None` when `progress` cancelled it.
 fn fair_mesh(
     mesh: &mut TriMesh,
     topology: &Topology,
@@ -39,31 +37,10 @@ fn fair_mesh(
     measure: bool,
     progress: &mut dyn fairmesh::Progress,
 ) -> Option<Outcome> {
-    let edge = metrics::mean_edge_length(mesh);
-    let volume_before = metrics::signed_volume(mesh);
     let input = measure.then(|| mesh.clone());
-    let slides = matches!(options, MethodOptions::Constrained(o) if o.tangential_relaxation > 0.0
-        && o.variant == FairVariant::NormalProjected);
-    let textured_input = (slides && textured).then(|| mesh.positions.clone());
-    let start = Instant::now();
-    let report = fairing::fair_with_progress(mesh, topology, options, mask, progress).ok()?;
-    let time_ms = start.elapsed().as_secs_f64() * 1e3;
-    let volume_after = metrics::signed_volume(mesh);
-    let volume_change_percent = (volume_before != 0.0)
-        .then(|| 100.0 * (volume_after - volume_before) / volume_before.abs())
-        .filter(|change| change.is_finite());
-    let texture_slide = textured_input
-        .filter(|_| report.rounds_run > 0)
-        .map(|before| metrics::tangential_slide(&before, mesh) / edge)
-        .filter(|slide| slide.is_finite());
+    let faired = fairing::fair_measured(mesh, topology, options, mask, textured, progress).ok()?;
     let measures = input.map(|input| metrics::compare(&input, mesh));
-    Some(Outcome {
-        report,
-        time_ms,
-        volume_change_percent,
-        texture_slide,
-        measures,
-    })
+    Some(Outcome { faired, measures })
 }
 
 /// The mask of `mask` (weights or vertex indices) on `mesh`, faded over `falloff` rings.
@@ -98,8 +75,9 @@ pub(crate) fn read_mask(
     }))
 }
 
-/// The report, with the fields of `fairmesh fair --json` (`input`/`output`: the loaded file's
-/// path and None; `texture_follows`: None, as it depends on where the result is saved).
+/// The report: `fairmesh fair --json`'s, from the library's one report
+/// ([`FairOutcome::to_json`]), as a dict (`input`/`output`: the loaded file's path and None;
+/// `texture_follows`: None, as it depends on where the result is saved).
 fn report_dict<'py>(
     py: Python<'py>,
     input: Option<String>,
@@ -109,50 +87,44 @@ fn report_dict<'py>(
     mask: Option<&Mask>,
     outcome: &Outcome,
 ) -> PyResult<Bound<'py, PyDict>> {
-    let report = &outcome.report;
-    let variant = match options {
-        MethodOptions::Constrained(o) => Some(o.variant.name()),
-        _ => None,
+    let context = ReportContext {
+        input: input.as_deref(),
+        closed: topology.is_closed(),
+        mask,
+        measures: outcome.measures.as_ref(),
+        ..ReportContext::default()
     };
-    let dict = PyDict::new(py);
-    dict.set_item("method", options.method().name())?;
-    dict.set_item("variant", variant)?;
-    dict.set_item("input", input)?;
-    dict.set_item("output", py.None())?;
-    dict.set_item("vertices", mesh.vertex_count())?;
-    dict.set_item("faces", mesh.face_count())?;
-    dict.set_item("closed", topology.is_closed())?;
-    dict.set_item("iterations_run", report.iterations_run)?;
-    dict.set_item("rounds_run", report.rounds_run)?;
-    dict.set_item("noise_estimate", report.noise_estimate)?;
-    dict.set_item("tangential_noise", report.tangential_noise)?;
-    dict.set_item("crease_edges", report.crease_edges)?;
-    dict.set_item("loose_triangles", report.loose_triangles)?;
-    dict.set_item("time_ms", outcome.time_ms)?;
-    dict.set_item("detection_ms", report.detection_ms)?;
-    // As `fair --json` writes them: where the run's time went.
-    let phases = PyDict::new(py);
-    phases.set_item("set_up", report.phases.set_up)?;
-    phases.set_item("iterations", report.phases.iterations)?;
-    phases.set_item("volume", report.phases.volume)?;
-    phases.set_item("relaxation", report.phases.relaxation)?;
-    phases.set_item("risk", report.phases.risk)?;
-    dict.set_item("phases_ms", phases)?;
-    dict.set_item("risk_by_round", report.risk_by_round.clone())?;
-    dict.set_item("volume_change_percent", outcome.volume_change_percent)?;
-    dict.set_item("max_move", report.max_move)?;
-    dict.set_item("masked_vertices", mask.map(|m| m.painted_count()))?;
-    dict.set_item("texture_slide", outcome.texture_slide)?;
-    dict.set_item("texture_follows", py.None())?;
-    if let Some(m) = &outcome.measures {
-        dict.set_item("mean_surface_distance", m.mean_surface_distance)?;
-        dict.set_item("hausdorff", m.hausdorff)?;
-        if let Some(c) = &m.same_connectivity {
-            dict.set_item("rms", c.rms)?;
-            dict.set_item("normal_error_deg", c.normal_error_deg)?;
+    let json = outcome.faired.to_json(options, mesh, &context);
+    Ok(json_to_python(py, &json)?.cast_into::<PyDict>()?)
+}
+
+/// A JSON value as Python's `json.loads` would give it (objects keep their keys' order).
+fn json_to_python<'py>(py: Python<'py>, value: &serde_json::Value) -> PyResult<Bound<'py, PyAny>> {
+    use serde_json::Value;
+    Ok(match value {
+        Value::Null => py.None().into_bound(py),
+        Value::Bool(b) => b.into_pyobject(py)?.to_owned().into_any(),
+        Value::Number(n) => match (n.as_u64(), n.as_i64()) {
+            (Some(u), _) => u.into_pyobject(py)?.into_any(),
+            (None, Some(i)) => i.into_pyobject(py)?.into_any(),
+            _ => n.as_f64().unwrap_or(f64::NAN).into_pyobject(py)?.into_any(),
+        },
+        Value::String(text) => text.into_pyobject(py)?.into_any(),
+        Value::Array(items) => {
+            let list = pyo3::types::PyList::empty(py);
+            for item in items {
+                list.append(json_to_python(py, item)?)?;
+            }
+            list.into_any()
         }
-    }
-    Ok(dict)
+        Value::Object(map) => {
+            let dict = PyDict::new(py);
+            for (key, item) in map {
+                dict.set_item(key, json_to_python(py, item)?)?;
+            }
+            dict.into_any()
+        }
+    })
 }
 
 #[doc = include_str!(concat!(env!("OUT_DIR"), "/doc/fair.txt"))]

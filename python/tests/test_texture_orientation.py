@@ -6,35 +6,19 @@ the input's. A PLY holds no image: there trimesh's UVs (it keeps OBJ's conventio
 reads and writes PLY's `s t` as they are) must match the input's. Faired, each vertex's UV is
 the plane's map where the vertex went.
 
-Needs trimesh and Pillow, and the command-line tool (the `cli` fixture, or $FAIRMESH_CLI)."""
+Needs trimesh and Pillow (scripts/test_python.sh installs both) and the command-line tool (the
+`cli` fixture). A PLY converted into another format is checked by tests/texture_orientation.rs:
+trimesh keeps no UVs from an OBJ or glTF without a texture, which is what a PLY, naming no image,
+becomes."""
 
-import os
-import shutil
 import subprocess
-from pathlib import Path
 
 import numpy as np
 import pytest
-
-trimesh = pytest.importorskip("trimesh")
-Image = pytest.importorskip("PIL.Image")
+import trimesh
+from PIL import Image
 
 QUADS = 5
-
-
-def _cli():
-    named = os.environ.get("FAIRMESH_CLI")
-    if named:
-        return named
-    root = Path(__file__).resolve().parents[2]
-    target = Path(os.environ.get("CARGO_TARGET_DIR", root / "target"))
-    for profile in ("debug", "release"):
-        if (target / profile / "fairmesh").is_file():
-            return str(target / profile / "fairmesh")
-    found = shutil.which("fairmesh")
-    if not found:
-        pytest.skip("no fairmesh binary: build it (cargo build) or set FAIRMESH_CLI")
-    return found
 
 
 def _plane():
@@ -79,24 +63,20 @@ def _has_uvs(mesh):
     return getattr(mesh.visual, "uv", None) is not None
 
 
-@pytest.mark.parametrize("source", ["obj", "glb", "ply"])
-@pytest.mark.parametrize("target", ["obj", "glb", "gltf", "ply"])
-def test_conversions_keep_each_vertex_colour(tmp_path, source, target):
-    if source == target:
-        pytest.skip("same format: written back, not converted")
+@pytest.mark.parametrize(
+    ("source", "target"),
+    [(s, t) for s in ("obj", "glb") for t in ("obj", "glb", "gltf", "ply") if s != t],
+)
+def test_conversions_keep_each_vertex_colour(tmp_path, cli, source, target):
     plane = _plane()
     input_path = tmp_path / f"in.{source}"
     plane.export(str(input_path))
     output_path = tmp_path / f"out.{target}"
-    subprocess.run([_cli(), "convert", str(input_path), "-o", str(output_path)], check=True,
+    subprocess.run([cli, "convert", str(input_path), "-o", str(output_path)], check=True,
                    capture_output=True)
     before, after = _load(input_path), _load(output_path)
-    # What both say about the UVs in trimesh's one convention. (trimesh keeps no UVs from an
-    # OBJ or glTF without a texture: what fairmesh writes from a PLY, which names no image;
-    # tests/texture_orientation.rs reads those itself.)
-    if not _has_uvs(after):
-        assert source == "ply" and target != "ply"
-        pytest.skip("trimesh keeps no UVs without a texture")
+    # What both say about the UVs, in trimesh's one convention.
+    assert _has_uvs(after)
     assert _uvs(after) == _uvs(before)
     # A PLY names no image (trimesh gives it a grey one of its own): colours where both have it.
     if "ply" not in (source, target):
@@ -108,12 +88,12 @@ def test_conversions_keep_each_vertex_colour(tmp_path, source, target):
 
 
 @pytest.mark.parametrize("target", ["obj", "glb", "ply"])
-def test_fair_keeps_each_vertex_colour(tmp_path, target):
+def test_fair_keeps_each_vertex_colour(tmp_path, cli, target):
     plane = _plane()
     input_path = tmp_path / "in.obj"
     plane.export(str(input_path))
     output_path = tmp_path / f"out.{target}"
-    subprocess.run([_cli(), "fair", str(input_path), "-o", str(output_path)], check=True,
+    subprocess.run([cli, "fair", str(input_path), "-o", str(output_path)], check=True,
                    capture_output=True)
     after = _load(output_path)
     # Wherever a vertex went on the plane, its UV is the input's map there (u = x, v = y).

@@ -62,6 +62,7 @@ pub mod constrained;
 pub mod creases;
 mod feature_edges;
 pub mod mask;
+pub mod outcome;
 pub mod relaxation;
 pub mod strength;
 pub mod volume;
@@ -75,6 +76,7 @@ pub use choices::MethodChoices;
 pub use constrained::{fair_constrained, fair_constrained_with_progress, ConstrainedFairing};
 pub use creases::{detect_creases, CreaseOptions, Creases, FeatureClass};
 pub use mask::{Mask, MaskError};
+pub use outcome::{fair_measured, FairOutcome, ReportContext};
 pub use strength::estimate_noise;
 
 /// How boundary vertices of open meshes move.
@@ -390,6 +392,14 @@ impl MethodOptions {
             MethodOptions::Laplacian(_) => Method::Laplacian,
             MethodOptions::Taubin(_) => Method::Taubin,
             MethodOptions::Hc(_) => Method::Hc,
+        }
+    }
+
+    /// The constrained variant's name ([`FairVariant::name`]); `None` for a baseline.
+    pub fn variant_name(&self) -> Option<&'static str> {
+        match self {
+            MethodOptions::Constrained(o) => Some(o.variant.name()),
+            _ => None,
         }
     }
 }

@@ -1,16 +1,17 @@
 //! `fairmesh fair`: smooth a mesh with constrained fairing (the paper's method) or one of the
 //! baselines, and write the result; `bench_rows` gives `fairmesh bench` its fairing timings.
+use anyhow::Context;
 use clap::{Args, ValueEnum};
 use fairmesh::fairing::strength::CLEAN_NOISE;
 use fairmesh::fairing::{
-    self, baseline::UmbrellaStencil, BoundaryMode, ConstrainedFairing, CreaseOptions, FairReport,
-    FairVariant, Mask, Method, MethodChoices, MethodOptions, Strength,
+    self, baseline::UmbrellaStencil, BoundaryMode, ConstrainedFairing, CreaseOptions, FairOutcome,
+    FairReport, FairVariant, Mask, Method, MethodChoices, MethodOptions, ReportContext, Strength,
 };
 use fairmesh::io::{Format, Source};
 use fairmesh::metrics::Comparison;
+use fairmesh::NoProgress;
 use fairmesh::{Topology, TriMesh};
 use std::path::{Path, PathBuf};
-use std::time::Instant;
 
 use super::args::{BoundaryArg, StdioFormat};
 use super::common::{
@@ -166,12 +167,11 @@ const TEXTURE_SLIDE_WARNING: f64 = 0.02;
 /// What one fairing did, for the report: the fairing's own report and what the command measured
 /// around it.
 struct Outcome {
-    report: FairReport,
-    time_ms: f64,
+    /// The run as the library measured it (its volume change `None`, JSON null and "n/a" in
+    /// words, when the input encloses no volume to change).
+    faired: FairOutcome,
     /// Whether the mesh is closed (its volume change is then more than indicative).
     closed: bool,
-    /// None (JSON null, "n/a" in words) when the input encloses no volume to change.
-    volume_change_percent: Option<f64>,
     texture: Option<TextureSlide>,
     measures: Option<Comparison>,
 }
@@ -193,36 +193,35 @@ pub fn run(args: FairArgs) -> anyhow::Result<()> {
     let edge = fairmesh::metrics::mean_edge_length(&mesh);
     let options = args.options_for(&mesh, &source, edge);
     let mask = super::mask::load_for(&args.mask, &source, &mesh, Some(&topology))?;
-    let volume_before = fairmesh::metrics::signed_volume(&mesh);
     // The input is kept only to measure against it.
     let input = args.measure.then(|| mesh.clone());
-    let textured_input = textured_positions(&options, &source, &mesh);
-    let (report, time_ms) = fair_timed(&mut mesh, &topology, &options, mask.as_ref());
-    let volume_after = fairmesh::metrics::signed_volume(&mesh);
-    let volume_change_percent = (volume_before != 0.0)
-        .then(|| 100.0 * (volume_after - volume_before) / volume_before.abs())
-        .filter(|change| change.is_finite());
+    let step = super::progress::Step::start("fairing");
+    let textured = source.has_texture_coordinates();
+    let faired = fairing::fair_measured(
+        &mut mesh,
+        &topology,
+        &options,
+        mask.as_ref(),
+        textured,
+        &mut NoProgress,
+    )
+    .context("the fairing was cancelled")?;
+    drop(step);
     let saved = save_kept(&args.output, &mesh, &source, args.stdio.format)?;
-    let texture = textured_input
-        .filter(|_| report.rounds_run > 0)
-        .map(|before| fairmesh::metrics::tangential_slide(&before, &mesh) / edge)
-        .filter(|slide| slide.is_finite())
-        .map(|slide| TextureSlide {
-            slide,
-            follows: saved.texture_coordinates_follow,
-        });
+    let texture = faired.texture_slide.map(|slide| TextureSlide {
+        slide,
+        follows: saved.texture_coordinates_follow,
+    });
     warn_texture_slide(&args.input, &args.output, texture);
-    note_loose_triangles(&args.input, report.loose_triangles);
+    note_loose_triangles(&args.input, faired.report.loose_triangles);
     let measures = input.map(|input| {
         super::progress::Step::run("measuring against the input", || {
             fairmesh::metrics::compare(&input, &mesh)
         })
     });
     let outcome = Outcome {
-        report,
-        time_ms,
+        faired,
         closed: topology.is_closed(),
-        volume_change_percent,
         texture,
         measures,
     };
@@ -238,38 +237,6 @@ fn check_output(args: &FairArgs) -> anyhow::Result<()> {
     );
     check_output_format(&args.output, args.stdio.format)?;
     Ok(())
-}
-
-/// A textured file's positions before the fairing, kept to say how far the tangential
-/// relaxation slid the vertices, and the texture with them; `None` when nothing slides or the
-/// file has no texture coordinates.
-fn textured_positions(
-    options: &MethodOptions,
-    source: &Source,
-    mesh: &TriMesh,
-) -> Option<Vec<[f32; 3]>> {
-    let slides = matches!(options, MethodOptions::Constrained(o) if o.tangential_relaxation > 0.0
-        && o.variant == FairVariant::NormalProjected);
-    (slides && source.has_texture_coordinates()).then(|| mesh.positions.clone())
-}
-
-/// Fairs `mesh` (within `mask`, if any) under a progress line; the report and the time taken in
-/// milliseconds.
-fn fair_timed(
-    mesh: &mut TriMesh,
-    topology: &Topology,
-    options: &MethodOptions,
-    mask: Option<&Mask>,
-) -> (FairReport, f64) {
-    let step = super::progress::Step::start("fairing");
-    let start = Instant::now();
-    let report = match mask {
-        Some(mask) => fairing::fair_masked(mesh, topology, options, mask),
-        None => fairing::fair(mesh, topology, options),
-    };
-    let time_ms = start.elapsed().as_secs_f64() * 1e3;
-    drop(step);
-    (report, time_ms)
 }
 
 /// Warns, on standard error, when the texture moved with vertices that slid along the surface:
@@ -332,7 +299,7 @@ fn print_outcome(
     }
 }
 
-/// The `--json` report.
+/// The `--json` report: the library's, with this run's files.
 fn json_report(
     args: &FairArgs,
     mesh: &TriMesh,
@@ -340,51 +307,19 @@ fn json_report(
     mask: Option<&Mask>,
     outcome: &Outcome,
 ) -> serde_json::Value {
-    let report = &outcome.report;
-    let mut json = serde_json::json!({
-        "method": options.method().name(),
-        "variant": variant_name(options),
-        "input": args.input.display().to_string(),
-        "output": args.output.display().to_string(),
-        "vertices": mesh.vertex_count(),
-        "faces": mesh.face_count(),
-        "closed": outcome.closed,
-        "iterations_run": report.iterations_run,
-        "rounds_run": report.rounds_run,
-        "noise_estimate": report.noise_estimate,
-        "tangential_noise": report.tangential_noise,
-        "crease_edges": report.crease_edges,
-        "loose_triangles": report.loose_triangles,
-        "time_ms": outcome.time_ms,
-        "detection_ms": report.detection_ms,
-        "phases_ms": report.phases,
-        "risk_by_round": report.risk_by_round,
-        "volume_change_percent": outcome.volume_change_percent,
-        "max_move": report.max_move,
-        "masked_vertices": mask.map(|m| m.painted_count()),
-        "texture_slide": outcome.texture.map(|t| t.slide),
-        "texture_follows": outcome.texture.map(|t| t.follows),
-    });
-    if let (Some(m), Some(map)) = (&outcome.measures, json.as_object_mut()) {
-        map.insert(
-            "mean_surface_distance".into(),
-            m.mean_surface_distance.into(),
-        );
-        map.insert("hausdorff".into(), m.hausdorff.into());
-        if let Some(c) = &m.same_connectivity {
-            map.insert("rms".into(), c.rms.into());
-            map.insert("normal_error_deg".into(), c.normal_error_deg.into());
-        }
-    }
-    json
-}
-
-/// The constrained variant's name; none for a baseline.
-fn variant_name(options: &MethodOptions) -> Option<&'static str> {
-    match options {
-        MethodOptions::Constrained(o) => Some(o.variant.name()),
-        _ => None,
-    }
+    let (input, output) = (
+        args.input.display().to_string(),
+        args.output.display().to_string(),
+    );
+    let context = ReportContext {
+        input: Some(&input),
+        output: Some(&output),
+        closed: outcome.closed,
+        mask,
+        texture_follows: outcome.texture.map(|t| t.follows),
+        measures: outcome.measures.as_ref(),
+    };
+    outcome.faired.to_json(options, mesh, &context)
 }
 
 /// The report in words, one line.
@@ -394,8 +329,8 @@ fn sentence(
     mask: Option<&Mask>,
     outcome: &Outcome,
 ) -> String {
-    let report = &outcome.report;
-    let volume = match outcome.volume_change_percent {
+    let report = &outcome.faired.report;
+    let volume = match outcome.faired.volume_change_percent {
         Some(change) if outcome.closed => format!("{change:+.4}%"),
         Some(change) => format!("{change:+.4}% (the mesh is open: volume is only indicative)"),
         None => "n/a (the mesh encloses no volume)".to_string(),
@@ -419,12 +354,13 @@ fn sentence(
         "{}{}: {}{strength}{creases}{} iterations in {:.1} ms, volume change {volume}, last \
          largest move {:.3e}{}; wrote {}\n",
         options.method().name(),
-        variant_name(options)
+        options
+            .variant_name()
             .map(|v| format!(" ({v})"))
             .unwrap_or_default(),
         super::mask::describe(mask),
         report.iterations_run,
-        outcome.time_ms,
+        outcome.faired.time_ms,
         report.max_move,
         measured,
         display_output(&args.output)

@@ -235,10 +235,10 @@ fn boundary_and_variant(
 /// The fairing's progress while it runs, a note when the mesh is an `applied` result, and
 /// "Apply result".
 fn progress_and_apply(ui: &mut egui::Ui, view: &PanelView, commands: &mut Commands, applied: bool) {
-    if view.fair_in_flight {
+    if view.progress.fair_in_flight {
         ui.horizontal(|ui| {
             super::widgets::activity_spinner(ui);
-            ui.label(format!("fairing … {:.0} %", view.fair_progress * 100.0));
+            ui.label(format!("fairing … {:.0} %", view.progress.fair * 100.0));
         });
     }
     if applied {

@@ -17,7 +17,7 @@ pub(super) fn hierarchy_section(
     let mut top_level = 0;
     match &document.hierarchy {
         HierarchyState::Building => {
-            ui.label(if view.hierarchy_denoising {
+            ui.label(if view.progress.hierarchy_denoising {
                 "Removing noise first…"
             } else {
                 "Building the levels…"
@@ -25,7 +25,7 @@ pub(super) fn hierarchy_section(
             .on_hover_text(super::tips::HIERARCHY_BUILDING);
             ui.horizontal(|ui| {
                 ui.add(
-                    egui::ProgressBar::new(view.hierarchy_progress)
+                    egui::ProgressBar::new(view.progress.hierarchy)
                         .show_percentage()
                         // Narrow enough that the toolbar stays one row at 1200 points.
                         .desired_width(180.0),

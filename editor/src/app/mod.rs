@@ -85,7 +85,7 @@ pub use command::{Command, PanelChange};
 pub use frame_stats::FrameStats;
 pub use launch::{run, AppOptions};
 pub use shown::Slot;
-pub use status::AppStatus;
+pub use status::{AppStatus, ViewStatus};
 pub use viewport_panel::COMPUTING;
 
 use std::path::PathBuf;
@@ -215,8 +215,8 @@ impl App {
                     "editor: {} loaded, {} levels, {} vertices and {} faces on screen",
                     path.display(),
                     status.level_count,
-                    status.shown_vertices,
-                    status.shown_faces
+                    status.view.shown_vertices,
+                    status.view.shown_faces
                 ),
                 (_, Some(error)) => eprintln!("editor: {error}"),
                 (None, None) => eprintln!("editor: no mesh was loaded"),

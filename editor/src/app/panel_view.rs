@@ -28,11 +28,8 @@ pub struct PanelView<'a> {
     /// The typed path field for opening files.
     pub open_path: &'a str,
     pub history: &'a History<DocumentSnapshot>,
-    pub hierarchy_progress: f32,
-    /// The hierarchy's job is denoising the mesh before building on it.
-    pub hierarchy_denoising: bool,
-    pub fair_in_flight: bool,
-    pub fair_progress: f32,
+    /// How far the hierarchy and the fairing have come.
+    pub progress: WorkProgress,
     /// The sharp-edge settings the current hierarchy was built with.
     pub hierarchy_built_with: Option<super::state::HierarchyKey>,
     /// The single view shows "before" instead of "after".
@@ -55,6 +52,19 @@ pub struct PanelView<'a> {
     pub confirm_replace: Option<&'a Path>,
 }
 
+/// How far the background work has come, as the panels show it.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct WorkProgress {
+    /// The hierarchy's build (or the denoise before it), 0 to 1.
+    pub hierarchy: f32,
+    /// The hierarchy's job is denoising the mesh before building on it.
+    pub hierarchy_denoising: bool,
+    /// A fairing runs for the slider's value.
+    pub fair_in_flight: bool,
+    /// That fairing, 0 to 1.
+    pub fair: f32,
+}
+
 /// A section's commands go here; the app applies them after the frame's widgets.
 pub type Commands = Vec<Command>;
 
@@ -72,13 +82,13 @@ impl App {
             message: self.message.as_deref(),
             open_path: &self.open_path,
             history: &self.history,
-            hierarchy_progress: self.work.hierarchy_progress.get(),
-            hierarchy_denoising: self
-                .work
-                .hierarchy_denoising
-                .load(std::sync::atomic::Ordering::Relaxed),
-            fair_in_flight: self.work.fair_in_flight,
-            fair_progress: self.work.fair_progress.get(),
+            progress: WorkProgress {
+                hierarchy: self.work.hierarchy_progress.get(),
+                hierarchy_denoising: (self.work.hierarchy_denoising)
+                    .load(std::sync::atomic::Ordering::Relaxed),
+                fair_in_flight: self.work.fair_in_flight,
+                fair: self.work.fair_progress.get(),
+            },
             hierarchy_built_with: self.work.hierarchy_built_with,
             show_before: self.view.show_before,
             paint_mode: self.painting.paint_mode,

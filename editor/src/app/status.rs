@@ -19,8 +19,6 @@ pub struct AppStatus {
     pub hierarchy_ready: bool,
     pub level_count: usize,
     pub level: usize,
-    pub shown_vertices: usize,
-    pub shown_faces: usize,
     /// Serial number of the faired result on record (changes with every new result).
     pub faired_serial: Option<u64>,
     /// The start level of that result.
@@ -33,6 +31,17 @@ pub struct AppStatus {
     pub rms_displacement: Option<f64>,
     pub error: Option<String>,
     pub message: Option<String>,
+    /// Sharp edges the current hierarchy keeps (0 without "Keep sharp edges").
+    pub sharp_edges_kept: usize,
+    /// What the main view shows.
+    pub view: ViewStatus,
+}
+
+/// What the 3D view shows, as [`AppStatus::view`].
+#[derive(Clone, Debug, Default)]
+pub struct ViewStatus {
+    pub shown_vertices: usize,
+    pub shown_faces: usize,
     pub images_drawn: u64,
     /// A viewport is drawing a new image over several frames (a big mesh on a software
     /// renderer); the view shows the one before it.
@@ -47,8 +56,6 @@ pub struct AppStatus {
     pub view_behind: bool,
     /// The main view's caption (in the single view, unless it shows "Before").
     pub caption: String,
-    /// Sharp edges the current hierarchy keeps (0 without "Keep sharp edges").
-    pub sharp_edges_kept: usize,
     /// Sharp edges drawn over the mesh in the last frame (while their controls are pointed at).
     pub sharp_edges_drawn: usize,
 }
@@ -147,8 +154,6 @@ impl App {
             hierarchy_ready: document.and_then(Document::level_count).is_some(),
             level_count: document.and_then(Document::level_count).unwrap_or(0),
             level: document.map(|d| d.level).unwrap_or(0),
-            shown_vertices: self.view.shown_counts.0,
-            shown_faces: self.view.shown_counts.1,
             faired_serial: faired.map(|f| f.serial),
             faired_level: faired.map(|f| f.level),
             measuring: faired.is_some_and(|f| f.measures_pending)
@@ -158,29 +163,33 @@ impl App {
             rms_displacement: faired.map(|f| f.rms_displacement),
             error: self.error.clone(),
             message: self.message.clone(),
-            images_drawn: self
-                .view
-                .viewport
-                .as_ref()
-                .map_or(0, Viewport3d::images_drawn),
-            drawing: self.drawing(),
-            shown_serial: self.view.shown.and_then(|s| match s.what {
-                super::shown::ShownMesh::Faired { serial } => Some(serial),
-                _ => None,
-            }),
-            heat_shown: self.view.shown.is_some_and(|s| s.heat.is_some())
-                && self.slot_look(super::Slot::Main).scalar_range.is_some(),
-            mask_shown: self.view.shown.is_some_and(|s| s.mask.is_some()),
-            view_behind: self.main_view_behind(),
-            caption: super::viewport_panel::main_caption(
-                self.settings.view_mode,
-                self.main_view_behind(),
-            ),
             sharp_edges_kept: document.map_or(0, |d| match &d.hierarchy {
                 HierarchyState::Ready { hierarchy, .. } => hierarchy.crease_edge_count(),
                 _ => 0,
             }),
-            sharp_edges_drawn: self.view.sharp_edges_drawn,
+            view: ViewStatus {
+                shown_vertices: self.view.shown_counts.0,
+                shown_faces: self.view.shown_counts.1,
+                images_drawn: self
+                    .view
+                    .viewport
+                    .as_ref()
+                    .map_or(0, Viewport3d::images_drawn),
+                drawing: self.drawing(),
+                shown_serial: self.view.shown.and_then(|s| match s.what {
+                    super::shown::ShownMesh::Faired { serial } => Some(serial),
+                    _ => None,
+                }),
+                heat_shown: self.view.shown.is_some_and(|s| s.heat.is_some())
+                    && self.slot_look(super::Slot::Main).scalar_range.is_some(),
+                mask_shown: self.view.shown.is_some_and(|s| s.mask.is_some()),
+                view_behind: self.main_view_behind(),
+                caption: super::viewport_panel::main_caption(
+                    self.settings.view_mode,
+                    self.main_view_behind(),
+                ),
+                sharp_edges_drawn: self.view.sharp_edges_drawn,
+            },
         }
     }
 }

@@ -52,7 +52,7 @@ pub fn settle(harness: &mut Harness<'_, App>) {
     let deadline = Instant::now() + Duration::from_secs(300);
     for _ in 0..200_000 {
         harness.step();
-        if harness.state().status().drawing {
+        if harness.state().status().view.drawing {
             // A big image drawn over several frames (software renderers) advances when frames
             // are rendered, which `step` alone does not do.
             harness.render().expect("the wgpu test renderer renders");
@@ -75,16 +75,16 @@ pub fn settle(harness: &mut Harness<'_, App>) {
 /// to its end first: the pixels are those of the complete image.
 pub fn viewport_image(harness: &mut Harness<'_, App>) -> image::RgbaImage {
     let mut full = harness.render().expect("the wgpu test renderer renders");
-    if harness.state().status().drawing {
+    if harness.state().status().view.drawing {
         for _ in 0..10_000 {
             harness.step();
             harness.render().expect("the wgpu test renderer renders");
-            if !harness.state().status().drawing {
+            if !harness.state().status().view.drawing {
                 break;
             }
         }
         assert!(
-            !harness.state().status().drawing,
+            !harness.state().status().view.drawing,
             "the image was never completed"
         );
         // One more frame, whose panels know the image is complete (no "Drawing" caption).
@@ -127,6 +127,21 @@ pub fn drag(harness: &mut Harness<'_, App>, from: egui::Pos2, to: egui::Pos2, st
     }
     harness.drop_at(to);
     harness.step();
+}
+
+/// Exports the document to `target` with the shortcut, as a user would: types `target` into the
+/// export path (which holds the default `…_faired.obj`), leaves the field, presses Ctrl+E and
+/// waits until everything has settled.
+pub fn export_by_shortcut(harness: &mut Harness<'_, App>, target: &Path) {
+    retype(
+        harness,
+        |v| v.ends_with("_faired.obj"),
+        &target.display().to_string(),
+    );
+    harness.key_press(egui::Key::Escape);
+    harness.step();
+    harness.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::E);
+    settle(harness);
 }
 
 /// Replaces the text of the text field whose current value satisfies `which`.
