@@ -8,7 +8,8 @@ use std::sync::{Arc, Mutex};
 
 use fairmesh::multires::MultiresWorkspace;
 
-use super::jobs::{Generation, GenerationId, SharedProgress};
+use super::generation::{Generation, GenerationId};
+use super::jobs::SharedProgress;
 use super::state::HierarchyKey;
 use super::tasks::measure::MeasureRequest;
 

@@ -6,7 +6,7 @@
 //!   dragged queues at most one fairing run behind the one in flight. A job submitted with
 //!   [`Worker::submit_idle`] runs only when no other job waits: work for later (setting up the
 //!   hierarchy's levels) never delays what the user asked for by more than the idle job in hand.
-//! - [`Generation`] is a shared counter. A job remembers the value it was started under; when the
+//! - [`Generation`](super::generation::Generation) is a shared counter. A job remembers the value it was started under; when the
 //!   UI bumps the counter (a new file, a newer slider value) the job's progress hook sees the
 //!   change and cancels, and the UI ignores a result whose generation is not the current one.
 //! - Jobs send a [`JobResult`] over a channel and call `request_repaint`, so the UI wakes up even
@@ -16,7 +16,7 @@
 
 use std::collections::VecDeque;
 use std::path::PathBuf;
-use std::sync::atomic::{AtomicU32, AtomicU64, AtomicUsize, Ordering};
+use std::sync::atomic::{AtomicU32, AtomicUsize, Ordering};
 use std::sync::{Arc, Condvar, Mutex, PoisonError};
 use std::time::Duration;
 
@@ -24,6 +24,7 @@ use fairmesh::hierarchy::HierarchyError;
 use fairmesh::io::LoadReport;
 use fairmesh::TriMesh;
 
+use super::generation::GenerationId;
 use super::state::{KeptHierarchy, Measures};
 
 type Job = Box<dyn FnOnce() + Send + 'static>;
@@ -223,37 +224,6 @@ fn panic_message(payload: &(dyn std::any::Any + Send)) -> String {
         text.clone()
     } else {
         "no message".to_owned()
-    }
-}
-
-/// A generation counter shared between the UI and the jobs: latest wins. The UI bumps it for
-/// each new request (a file, a document change, a slider value); a job started under an older
-/// [`GenerationId`] stops, and its result is dropped.
-#[derive(Clone, Default)]
-pub struct Generation(Arc<AtomicU64>);
-
-/// One value of a [`Generation`]: what a job was started under, or what a result on screen came
-/// from. A later value compares greater; the default (0) is older than any bumped one.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, PartialOrd, Ord, Hash)]
-pub struct GenerationId(u64);
-
-impl GenerationId {
-    /// The number, for keys that outlive the app's types (the renderer's mesh keys).
-    pub fn get(self) -> u64 {
-        self.0
-    }
-}
-
-impl Generation {
-    /// Starts a new generation and returns it.
-    pub fn bump(&self) -> GenerationId {
-        GenerationId(self.0.fetch_add(1, Ordering::SeqCst) + 1)
-    }
-    pub fn current(&self) -> GenerationId {
-        GenerationId(self.0.load(Ordering::SeqCst))
-    }
-    pub fn is_current(&self, generation: GenerationId) -> bool {
-        self.current() == generation
     }
 }
 
@@ -506,14 +476,5 @@ mod tests {
         assert!(message.contains("the index is 7"), "{message}");
         assert_eq!(rx.recv_timeout(Duration::from_secs(5)).unwrap(), "ran");
         assert!(reports.recv_timeout(Duration::from_millis(200)).is_err());
-    }
-
-    #[test]
-    fn generations_mark_old_work_stale() {
-        let generation = Generation::default();
-        let first = generation.bump();
-        assert!(generation.is_current(first));
-        let second = generation.bump();
-        assert!(!generation.is_current(first) && generation.is_current(second));
     }
 }

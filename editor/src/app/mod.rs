@@ -49,6 +49,7 @@ mod confirm_replace;
 mod export_panel;
 mod fairing_panel;
 mod frame_stats;
+mod generation;
 mod held_views;
 mod hierarchy_panel;
 pub mod history;

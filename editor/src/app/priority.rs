@@ -28,6 +28,11 @@ pub fn lower_this_thread() {
     }
 }
 
+/// The editor's worker threads (io, compute, measure), whose jobs run in [`background_pool`]:
+/// `Workers::spawn` starts one of each.
+pub(in crate::app) const WORKER_NAMES: [&str; 3] =
+    ["fairmesh-io", "fairmesh-compute", "fairmesh-measure"];
+
 /// The rayon pool background jobs run in, each at background priority: one thread per core plus
 /// one per worker, because a job holds the pool thread it runs on (a long measure must not keep
 /// an export waiting for a free thread); the extra threads only run while there is work.
@@ -36,7 +41,7 @@ pub fn background_pool() -> Option<&'static rayon::ThreadPool> {
     static POOL: OnceLock<Option<rayon::ThreadPool>> = OnceLock::new();
     POOL.get_or_init(|| {
         rayon::ThreadPoolBuilder::new()
-            .num_threads(rayon::current_num_threads() + super::workers::Workers::NAMES.len())
+            .num_threads(rayon::current_num_threads() + WORKER_NAMES.len())
             .thread_name(|i| format!("fairmesh-background-{i}"))
             .start_handler(|_| lower_this_thread())
             .build()

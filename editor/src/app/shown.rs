@@ -2,7 +2,7 @@
 //! input, a level, a result) and with which colours ([`Shown`]), the record the view syncing
 //! ([`super::view_sync`]) and the meshes held on the GPU ([`super::held_views`]) both keep.
 
-use crate::app::jobs::GenerationId;
+use crate::app::generation::GenerationId;
 use crate::app::state::HeatReference;
 
 /// What a viewport has uploaded, to know when to upload again: one record per viewport, so

@@ -1,6 +1,6 @@
-//! The editor's workers: its named background threads, the count of jobs in flight and the
-//! channel their results come back on. [`Workers::NAMES`] is the one list of them: the
-//! background pool (`priority.rs`) is sized from it.
+//! The editor's workers: its named background threads (one of each of
+//! [`super::priority::WORKER_NAMES`], the list the background pool is sized from), the count of
+//! jobs in flight and the channel their results come back on.
 
 use std::sync::mpsc::{self, Receiver, Sender};
 use std::sync::Arc;
@@ -28,11 +28,6 @@ pub(in crate::app) struct Workers {
 }
 
 impl Workers {
-    /// The names of the worker threads, in the order [`Workers::spawn`] starts them: io,
-    /// compute, measure.
-    pub(in crate::app) const NAMES: [&'static str; 3] =
-        ["fairmesh-io", "fairmesh-compute", "fairmesh-measure"];
-
     /// Starts the editor's named threads and the measuring worker's one-thread pool. A job
     /// that panics comes back as [`JobResult::JobFailed`], and `ctx` repaints to show it.
     pub(in crate::app) fn spawn(ctx: &egui::Context) -> Self {
@@ -47,7 +42,7 @@ impl Workers {
             })
         };
         // Without threads the editor cannot work at all; failing to start one is fatal.
-        let [io, compute, measure] = Self::NAMES.map(|name| {
+        let [io, compute, measure] = super::priority::WORKER_NAMES.map(|name| {
             Worker::spawn(name, on_panic())
                 .unwrap_or_else(|error| panic!("cannot start the {name} thread: {error}"))
         });

@@ -7,8 +7,8 @@ use std::path::{Path, PathBuf};
 use std::sync::Arc;
 use std::time::Duration;
 
+use crate::app::generation::GenerationId;
 use crate::app::history::SizeInBytes;
-use crate::app::jobs::GenerationId;
 use crate::app::sharp_edges::SharpEdgeLines;
 use fairmesh::fairing::strength::CLEAN_NOISE;
 use fairmesh::fairing::{FairReport, Mask, Method};

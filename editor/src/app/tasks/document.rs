@@ -3,7 +3,8 @@
 
 use std::sync::Arc;
 
-use crate::app::jobs::{GenerationId, JobKind, JobResult};
+use crate::app::generation::GenerationId;
+use crate::app::jobs::{JobKind, JobResult};
 use crate::app::state::{Document, DocumentSnapshot, HierarchyState, Measures, MethodChoice};
 use crate::app::App;
 use fairmesh::TriMesh;

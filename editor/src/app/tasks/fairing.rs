@@ -4,7 +4,8 @@
 use std::sync::{Arc, Mutex, PoisonError};
 use std::time::{Duration, Instant};
 
-use crate::app::jobs::{Faired, GenerationId, JobKind, JobResult};
+use crate::app::generation::GenerationId;
+use crate::app::jobs::{Faired, JobKind, JobResult};
 use crate::app::state::{FairedResult, HierarchyState, ViewMode};
 use crate::app::tasks::measure::MeasureRequest;
 use crate::app::App;

@@ -5,7 +5,8 @@ use std::sync::atomic::Ordering;
 use std::sync::{Arc, PoisonError};
 use std::time::Instant;
 
-use crate::app::jobs::{GenerationId, JobKind, JobResult};
+use crate::app::generation::GenerationId;
+use crate::app::jobs::{JobKind, JobResult};
 use crate::app::sharp_edges::SharpEdgeLines;
 use crate::app::state::{DenoiseSummary, HierarchyState, KeptHierarchy};
 use crate::app::App;

@@ -4,7 +4,8 @@ use std::path::{Path, PathBuf};
 use std::sync::Arc;
 use std::time::{Duration, Instant};
 
-use crate::app::jobs::{DialogPurpose, GenerationId, JobKind, JobResult, LoadedMesh};
+use crate::app::generation::GenerationId;
+use crate::app::jobs::{DialogPurpose, JobKind, JobResult, LoadedMesh};
 use crate::app::state::{self, DocumentSnapshot};
 use crate::app::App;
 

@@ -5,7 +5,8 @@
 use std::sync::Arc;
 use std::time::{Duration, Instant};
 
-use crate::app::jobs::{GenerationId, JobKind, JobResult};
+use crate::app::generation::GenerationId;
+use crate::app::jobs::{JobKind, JobResult};
 use crate::app::state::{HierarchyState, Measures};
 use crate::app::App;
 use fairmesh::TriMesh;
