@@ -156,18 +156,16 @@ fn multires_on_noisy_bunny_keeps_volume_and_beats_single_level_fairing() {
             );
         }
     }
-    // Single-level constrained fairing with the same iterations (one round, the operator alone:
-    // no creases, no tangential relaxation), against multires from a middle level of the first
-    // third (the levels where the start level removes noise, not shape).
+    // Single-level fairing with the same operator (the paper's: one round, no creases, no
+    // tangential relaxation) run until it has converged, not cut short at the five iterations a
+    // level gets (measured: 8.20e-4 mean distance after 5 iterations, 8.22e-4 after 20 and after
+    // 40), against multires from a middle level of the first third (the levels where the start
+    // level removes noise, not shape: 6.27e-4 Improved, 6.32e-4 Paper).
     let mut single = noisy.clone();
     fair_constrained(
         &mut single,
         &Topology::build(&noisy),
-        &FairOptions::default()
-            .with_iterations(5)
-            .with_rounds(1)
-            .with_creases(None)
-            .with_tangential_relaxation(0.0),
+        &FairOptions::paper().with_iterations(40),
     );
     let single_distance = metrics::compare(&clean, &single).mean_surface_distance;
     for variant in [MultiresVariant::Improved, MultiresVariant::Paper] {
@@ -181,6 +179,12 @@ fn multires_on_noisy_bunny_keeps_volume_and_beats_single_level_fairing() {
             distance < single_distance,
             "{variant:?}: multires {distance} vs single-level {single_distance}"
         );
+        // The improved recipe's split placement gives each split back the volume it added in the
+        // original geometry (low-passed): without it the run ends 9 % farther from the clean
+        // bunny (6.83e-4 against 6.27e-4 measured), though the volume offsets keep its volume.
+        if variant == MultiresVariant::Improved {
+            assert!(distance < 6.5e-4, "improved from level 3: {distance}");
+        }
     }
 }
 
@@ -201,8 +205,9 @@ fn improved_variant_keeps_a_clean_elephant_from_shrinking() {
     let paper = change(MultiresVariant::Paper);
     let improved = change(MultiresVariant::Improved);
     assert!(paper < -10.0, "the paper's recipe loses {paper}%");
+    // (Measured: 2.3e-6 %.)
     assert!(
-        improved.abs() < 2.0,
+        improved.abs() < 0.01,
         "improved changes the volume by {improved}%"
     );
 }
@@ -227,7 +232,22 @@ fn multires_runs_again_with_the_same_result_and_can_be_cancelled() {
         &mut NoProgress,
     )
     .unwrap();
+    // That is the paper's fairing of M0 with the run's five iterations, run on its own.
+    let mut alone = mesh.clone();
+    fair_constrained(
+        &mut alone,
+        &Topology::build(&mesh),
+        &FairOptions::paper().with_iterations(5),
+    );
+    assert_ne!(alone.positions, mesh.positions);
     assert_eq!(single.len(), mesh.vertex_count());
+    let farthest = single
+        .iter()
+        .zip(&alone.positions)
+        .map(|(a, b)| glam::Vec3::from(*a).distance(glam::Vec3::from(*b)))
+        .fold(0.0, f32::max);
+    let edge = metrics::mean_edge_length(&mesh) as f32;
+    assert!(farthest < 1e-4 * edge, "{farthest} apart, edge {edge}");
 }
 
 #[test]
@@ -630,4 +650,83 @@ fn the_hierarchy_takes_its_own_zigzag_angle_when_none_is_given() {
         unset.len(),
         fairing.len()
     );
+}
+
+/// How many faces of `level` turned by more than 90 degrees against the surface of M0 under them:
+/// their normal against the sum of M0's area-weighted vertex normals at their three corners.
+fn faces_turned_against_m0(h: &Hierarchy, level: usize) -> usize {
+    let m0_normals = h.base_mesh().vertex_normals();
+    let m = h.level_mesh(level);
+    let (origin, _) = h.level_origins(level);
+    (0..m.face_count())
+        .filter(|&t| {
+            let under: glam::DVec3 = m.triangles[t]
+                .iter()
+                .map(|&v| m0_normals[origin[v as usize] as usize])
+                .sum();
+            m.face_normal(t).dot(under) < 0.0
+        })
+        .count()
+}
+
+/// How many edges of `mesh` fold its two faces over each other: their normals more than 150
+/// degrees apart.
+fn folded_edges(mesh: &TriMesh) -> usize {
+    let mut faces_of_edge = std::collections::HashMap::<[u32; 2], Vec<usize>>::new();
+    for (t, tri) in mesh.triangles.iter().enumerate() {
+        for k in 0..3 {
+            let (a, b) = (tri[k], tri[(k + 1) % 3]);
+            faces_of_edge
+                .entry([a.min(b), a.max(b)])
+                .or_default()
+                .push(t);
+        }
+    }
+    let normal = |t: usize| mesh.face_normal(t).normalize_or_zero();
+    faces_of_edge
+        .values()
+        .filter(|faces| {
+            faces.len() == 2 && normal(faces[0]).dot(normal(faces[1])) < 150f64.to_radians().cos()
+        })
+        .count()
+}
+
+/// Per level of `mesh`'s hierarchy: (faces turned against M0, edges folded), each beyond M0's own.
+fn flips_per_level(mesh: &TriMesh) -> Vec<(usize, usize)> {
+    let h = build(mesh);
+    let folded_in_m0 = folded_edges(h.base_mesh());
+    (0..h.level_count())
+        .map(|level| {
+            (
+                faces_turned_against_m0(&h, level),
+                folded_edges(&h.level_mesh(level)).saturating_sub(folded_in_m0),
+            )
+        })
+        .collect()
+}
+
+#[test]
+fn hierarchy_levels_of_a_cad_box_turn_no_face_against_m0_and_fold_no_edge() {
+    let mesh = fairmesh::mesh::shapes::cad_box_with_holes([2.0, 1.5, 1.0], 0.2, 0.3, 24);
+    let per_level = flips_per_level(&mesh);
+    assert!(per_level.len() > 1, "{} levels", per_level.len());
+    assert!(
+        per_level.iter().all(|&counts| counts == (0, 0)),
+        "{per_level:?}"
+    );
+}
+
+/// Scans: levels 1-11 of the elephant turn up to 13 faces against M0 and fold up to 6 edges;
+/// levels 2-10 of the npm bunny turn 1-4 and levels 6-10 fold 3-7 (none in M0 either). The decimation's flip check looks
+/// at each collapse's fan alone, against the level it collapses in, not against M0.
+#[test]
+#[ignore = "fails: coarse levels of the elephant and the npm bunny turn faces against M0"]
+fn hierarchy_levels_of_scans_turn_no_face_against_m0_and_fold_no_edge() {
+    for path in ["tests/data/bunny_npm.obj", "tests/data/elephant.obj"] {
+        let per_level = flips_per_level(&load(path));
+        assert!(
+            per_level.iter().all(|&counts| counts == (0, 0)),
+            "{path}: {per_level:?}"
+        );
+    }
 }

@@ -122,9 +122,22 @@ fn a_soft_edge_moves_the_band_less_than_the_inside() {
     assert!(band < 0.6 * inside, "band {band} inside {inside}");
 }
 
+/// Sum over the painted vertices of their squared distance to the surface of `clean`.
+fn painted_squared_distances(clean: &TriMesh, positions: &[[f32; 3]], mask: &Mask) -> f64 {
+    let surface = fairmesh::metrics::ClosestPointIndex::new(clean);
+    (0..positions.len())
+        .filter(|&v| mask.weight(v) > 0.0)
+        .map(|v| {
+            surface
+                .distance(glam::DVec3::from(positions[v].map(f64::from)))
+                .powi(2)
+        })
+        .sum()
+}
+
 #[test]
-fn multires_moves_only_the_painted_region() {
-    let (_, noisy, mask) = noisy_bunny_and_left_half();
+fn multires_moves_only_the_painted_region_and_removes_its_noise() {
+    let (clean, noisy, mask) = noisy_bunny_and_left_half();
     let hierarchy = build_hierarchy(&noisy, &HierarchyOptions::default(), &mut NoProgress).unwrap();
     let options = MultiresOptions::default()
         .with_start_level(6)
@@ -132,6 +145,11 @@ fn multires_moves_only_the_painted_region() {
     let mut workspace = MultiresWorkspace::default();
     let positions = fair_multires(&hierarchy, &options, &mut workspace, &mut NoProgress).unwrap();
     check_only_painted_moved(hierarchy.base_mesh(), &positions, &mask);
+    // The painted half came much closer to the clean bunny's surface: its squared distances
+    // summed fall to 22 % of the input's (measured).
+    let before = painted_squared_distances(&clean, &noisy.positions, &mask);
+    let after = painted_squared_distances(&clean, &positions, &mask);
+    assert!(after < 0.3 * before, "{after} against {before}");
 }
 
 #[test]

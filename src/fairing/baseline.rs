@@ -319,11 +319,107 @@ mod tests {
     }
 
     #[test]
-    fn hc_and_taubin_keep_a_plane_flat() {
-        let mut mesh = grid();
-        let topology = Topology::build(&mesh);
-        fair_hc(&mut mesh, &topology, &HcOptions::default());
-        fair_taubin(&mut mesh, &topology, &TaubinOptions::default());
-        assert!(mesh.positions.iter().all(|p| p[2] == 0.0));
+    fn hc_and_taubin_even_out_a_jittered_plane_and_keep_it_flat() {
+        // The interior vertices pushed off their grid points within the plane: both smoothers
+        // move them back towards the regular grid (doing nothing would not) and out of the plane
+        // not at all (every mean of points at z = 0 is at z = 0).
+        let regular = grid();
+        let mut jittered = regular.clone();
+        let topology = Topology::build(&regular);
+        for v in 0..25u32 {
+            if !topology.is_boundary_vertex(v) {
+                let sign = if v % 2 == 0 { 1.0 } else { -1.0 };
+                jittered.positions[v as usize][0] += 0.3 * sign;
+                jittered.positions[v as usize][1] -= 0.2 * sign;
+            }
+        }
+        let off_grid = |m: &TriMesh| -> f64 {
+            (0..25u32)
+                .filter(|&v| !topology.is_boundary_vertex(v))
+                .map(|v| m.point(v).distance(regular.point(v)))
+                .sum()
+        };
+        let mut hc = jittered.clone();
+        fair_hc(&mut hc, &topology, &HcOptions::default());
+        let mut taubin = jittered.clone();
+        fair_taubin(&mut taubin, &topology, &TaubinOptions::default());
+        for (name, mesh) in [("HC", &hc), ("Taubin", &taubin)] {
+            assert!(mesh.positions.iter().all(|p| p[2] == 0.0), "{name}");
+            assert!(
+                off_grid(mesh) < 0.5 * off_grid(&jittered),
+                "{name}: {} from the grid, jittered {}",
+                off_grid(mesh),
+                off_grid(&jittered)
+            );
+        }
+    }
+
+    /// A level-3 icosphere (642 vertices) with Gaussian noise along the normals of 0.3 mean edge
+    /// lengths.
+    fn noisy_sphere() -> TriMesh {
+        let mut mesh = crate::mesh::shapes::icosphere(3);
+        crate::noise::add_noise(
+            &mut mesh,
+            &crate::noise::NoiseOptions::default()
+                .with_sigma(0.3)
+                .with_seed(1)
+                .with_mode(crate::noise::NoiseMode::Normal),
+        );
+        mesh
+    }
+
+    /// Mean distance of the vertices from the unit sphere the noise was added to.
+    fn radius_error(mesh: &TriMesh) -> f64 {
+        (0..mesh.vertex_count() as u32)
+            .map(|v| (mesh.point(v).length() - 1.0).abs())
+            .sum::<f64>()
+            / mesh.vertex_count() as f64
+    }
+
+    /// Relative volume change of `after` against `before`, and its radius error over `before`'s.
+    fn volume_and_noise(before: &TriMesh, after: &TriMesh) -> (f64, f64) {
+        let volume = crate::metrics::signed_volume;
+        (
+            (volume(after) - volume(before)) / volume(before),
+            radius_error(after) / radius_error(before),
+        )
+    }
+
+    /// (volume change, radius error left) of the noisy sphere after `fair`.
+    fn on_the_noisy_sphere(fair: &dyn Fn(&mut TriMesh, &Topology)) -> (f64, f64) {
+        let noisy = noisy_sphere();
+        let topology = Topology::build(&noisy);
+        let mut mesh = noisy.clone();
+        fair(&mut mesh, &topology);
+        volume_and_noise(&noisy, &mesh)
+    }
+
+    // (volume change, radius error left) on the noisy sphere, measured: Laplacian (-15.7 %, 149 %:
+    // the sphere shrinks inside its noise), Taubin (+0.91 %, 40 %), HC (-0.21 %, 30 %). Taubin
+    // without its μ step is the Laplacian; HC without its correction step is the umbrella mean
+    // alone, a Laplacian of λ = 1.
+
+    #[test]
+    fn the_laplacian_shrinks_a_noisy_sphere() {
+        let laplacian = on_the_noisy_sphere(&|m, t| {
+            fair_laplacian(m, t, &LaplacianOptions::default());
+        });
+        assert!(laplacian.0 < -0.1, "{laplacian:?}");
+    }
+
+    #[test]
+    fn taubin_smooths_a_noisy_sphere_and_keeps_its_volume() {
+        let taubin = on_the_noisy_sphere(&|m, t| {
+            fair_taubin(m, t, &TaubinOptions::default());
+        });
+        assert!(taubin.0.abs() < 0.015 && taubin.1 < 0.5, "{taubin:?}");
+    }
+
+    #[test]
+    fn hc_smooths_a_noisy_sphere_and_keeps_its_volume() {
+        let hc = on_the_noisy_sphere(&|m, t| {
+            fair_hc(m, t, &HcOptions::default());
+        });
+        assert!(hc.0.abs() < 0.004 && hc.1 < 0.4, "{hc:?}");
     }
 }

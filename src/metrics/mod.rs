@@ -414,6 +414,28 @@ mod tests {
     }
 
     #[test]
+    fn normal_error_is_the_mean_turn_of_the_face_normals_in_degrees() {
+        // Two separate triangles in the z = 0 plane; in `other` each is hinged about its edge on
+        // the x axis, the first by 30 degrees and the second by 60: the mean turn is 45 degrees.
+        let tilted = |degrees: f32, x: f32| {
+            let (s, c) = degrees.to_radians().sin_cos();
+            [[x, 0.0, 0.0], [x + 1.0, 0.0, 0.0], [x, c, s]]
+        };
+        let triangles = vec![[0, 1, 2], [3, 4, 5]];
+        let reference = TriMesh::new(
+            [tilted(0.0, 0.0), tilted(0.0, 2.0)].concat(),
+            triangles.clone(),
+        );
+        let other = TriMesh::new([tilted(30.0, 0.0), tilted(60.0, 2.0)].concat(), triangles);
+        let v = compare_vertices(&reference, &other).unwrap();
+        assert!(
+            (v.normal_error_deg - 45.0).abs() < 1e-3,
+            "{}",
+            v.normal_error_deg
+        );
+    }
+
+    #[test]
     fn sliding_vertices_along_the_surface_changes_no_surface_distance() {
         // Same flat square, two triangulations with the shared vertex moved within the plane.
         let a = TriMesh::new(

@@ -370,4 +370,58 @@ mod tests {
         let parsed = parse(&bytes, Path::new("t.glb"), None).unwrap();
         assert_eq!(parsed.mesh, mesh);
     }
+
+    fn triangle_with_uvs() -> (TriMesh, VertexAttributes) {
+        let mesh = TriMesh::new(
+            vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]],
+            vec![[0, 1, 2]],
+        );
+        let extra = VertexAttributes {
+            uvs: Some(vec![[0.25, 0.0], [0.5, 0.25], [1.0, 0.75]]),
+            ..Default::default()
+        };
+        (mesh, extra)
+    }
+
+    /// TEXCOORD_0 of the file's one primitive, read with the `gltf` crate's document and decoded
+    /// by hand from the buffer: VEC2 of f32, little-endian, at the view's stride (8 when none).
+    fn texcoords(document: &::gltf::Document, buffer: &[u8]) -> Option<Vec<[f32; 2]>> {
+        let primitive = document.meshes().next()?.primitives().next()?;
+        let accessor = primitive.get(&::gltf::Semantic::TexCoords(0))?;
+        assert_eq!(accessor.data_type(), ::gltf::accessor::DataType::F32);
+        assert_eq!(accessor.dimensions(), ::gltf::accessor::Dimensions::Vec2);
+        let view = accessor.view()?;
+        let stride = view.stride().unwrap_or(8);
+        let start = view.offset() + accessor.offset();
+        let float = |at: usize| f32::from_le_bytes(buffer[at..at + 4].try_into().unwrap());
+        Some(
+            (0..accessor.count())
+                .map(|i| [float(start + i * stride), float(start + i * stride + 4)])
+                .collect(),
+        )
+    }
+
+    #[test]
+    fn glb_with_uvs_holds_them_as_texcoord_0() {
+        let (mesh, extra) = triangle_with_uvs();
+        let mut bytes = Vec::new();
+        write_glb_with(&mut bytes, &mesh, &extra).unwrap();
+        let glb = ::gltf::Gltf::from_slice(&bytes).unwrap();
+        let blob = glb.blob.as_deref().unwrap();
+        // glTF counts v from the top row, as the library does: written unchanged.
+        assert_eq!(texcoords(&glb.document, blob), extra.uvs);
+    }
+
+    #[test]
+    fn gltf_with_uvs_holds_them_as_texcoord_0_in_its_bin() {
+        let (mesh, extra) = triangle_with_uvs();
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("t.gltf");
+        write_gltf_with(&path, &mesh, &extra).unwrap();
+        let document = ::gltf::Gltf::from_slice(&std::fs::read(&path).unwrap())
+            .unwrap()
+            .document;
+        let bin = std::fs::read(dir.path().join("t.bin")).unwrap();
+        assert_eq!(texcoords(&document, &bin), extra.uvs);
+    }
 }

@@ -75,4 +75,32 @@ mod tests {
         assert_eq!(bits(&parsed.mesh), bits(&mesh));
         assert_eq!(parsed.mesh.triangles, mesh.triangles);
     }
+
+    #[test]
+    fn writes_each_vertexs_uv_as_a_vt_counted_from_the_bottom_row() {
+        let mesh = TriMesh::new(
+            vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]],
+            vec![[0, 1, 2]],
+        );
+        // The library's v runs down from the image's top row; OBJ's `vt` up from its bottom row.
+        let extra = VertexAttributes {
+            uvs: Some(vec![[0.25, 0.0], [0.5, 0.25], [1.0, 0.75]]),
+            ..Default::default()
+        };
+        let mut out = Vec::new();
+        write_with(&mut out, &mesh, &extra).unwrap();
+        let text = String::from_utf8(out).unwrap();
+        // Read by hand: every `vt` line, and each face corner's texture index.
+        let vts: Vec<[f32; 2]> = text
+            .lines()
+            .filter_map(|l| l.strip_prefix("vt "))
+            .map(|rest| {
+                let mut values = rest.split_whitespace().map(|x| x.parse::<f32>().unwrap());
+                [values.next().unwrap(), values.next().unwrap()]
+            })
+            .collect();
+        assert_eq!(vts, vec![[0.25, 1.0], [0.5, 0.75], [1.0, 0.25]], "{text}");
+        let faces: Vec<&str> = text.lines().filter(|l| l.starts_with("f ")).collect();
+        assert_eq!(faces, vec!["f 1/1 2/2 3/3"], "{text}");
+    }
 }
