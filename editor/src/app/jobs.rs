@@ -6,13 +6,14 @@
 //!   dragged queues at most one fairing run behind the one in flight. A job submitted with
 //!   [`Worker::submit_idle`] runs only when no other job waits: work for later (setting up the
 //!   hierarchy's levels) never delays what the user asked for by more than the idle job in hand.
-//! - [`Generation`](super::generation::Generation) is a shared counter. A job remembers the value it was started under; when the
-//!   UI bumps the counter (a new file, a newer slider value) the job's progress hook sees the
-//!   change and cancels, and the UI ignores a result whose generation is not the current one.
+//! - A `Generation` (`generation.rs`) is a shared counter. A job remembers the value it was
+//!   started under; when the UI bumps the counter (a new file, a newer slider value) the job's
+//!   progress hook sees the change and cancels, and the UI ignores a result whose generation is
+//!   not the current one.
 //! - Jobs send a [`JobResult`] over a channel and call `request_repaint`, so the UI wakes up even
 //!   when nothing else moves. A job that panics sends nothing; its worker survives it and tells
-//!   its [`PanicReport`] which kind of job it was ([`JobKind`]) and what the panic said,
-//!   so that the UI can say so and clear what the job held (see [`JobResult::JobFailed`]).
+//!   its [`PanicReport`] which kind of job it was ([`JobKind`]) and what the panic said, so that
+//!   the UI can say so and clear what the job held (see [`JobResult::JobFailed`]).
 
 use std::collections::VecDeque;
 use std::path::PathBuf;
