@@ -5,7 +5,8 @@
 # (rustdoc, the workspace's own crates); the library with no GUI dependency; no import cycle
 # between the files of a module
 # (scripts/import_cycles.py); every file the `fairmesh` binary writes on the repository's meshes byte-identical to
-# scripts/output_sums.txt (scripts/check_outputs.sh).
+# scripts/output_sums.txt (scripts/check_outputs.sh); the README and the guide short enough and with
+# no broken link (scripts/check_docs.py, offline).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 if cargo clippy --version >/dev/null 2>&1; then
@@ -20,6 +21,7 @@ else
 fi
 # Every intra-doc link resolves (the crates' own docs: a few seconds on the test build).
 RUSTDOCFLAGS="-D warnings" cargo doc --quiet --no-deps
+python3 scripts/check_docs.py
 for source in src editor/src cli/src; do
   python3 scripts/import_cycles.py "$source"
 done

@@ -177,10 +177,10 @@ fn the_words_say_what_is_on_screen() {
         let node = harness.get_by_label(name);
         assert_eq!(node.accesskit_node().description().as_deref(), Some(tip));
     }
-    // The export hint names the six formats the README lists.
+    // The export hint names the six formats the editor guide lists.
     harness.get_by_label(tips::EXPORT_FORMATS);
-    let readme = include_str!("../../README.md");
-    assert!(readme.contains("GLB, glTF, OBJ, PLY, STL or OFF by extension"));
+    let guide = include_str!("../../docs/editor.md");
+    assert!(guide.contains("GLB, glTF, OBJ, PLY, STL or OFF by extension"));
 
     // A message about this file's history is gone once another file is loaded.
     harness.key_press(egui::Key::P);

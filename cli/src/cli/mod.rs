@@ -2,7 +2,7 @@
 //! `convert` and `compare`; `fair.rs` `fair`; `hierarchy.rs` `hierarchy`; `multires.rs`
 //! `multires`; `bench.rs` `bench`. Beside them: `args.rs`, the argument types several commands share;
 //! `common.rs`, loading the input, saving the result and writing the report; `mask.rs`, `--mask`;
-//! `progress.rs`, the progress line of long steps.
+//! `progress.rs`, the progress line of long steps; `shell.rs`, `completions` and `man`.
 
 mod args;
 mod basic;
@@ -13,6 +13,7 @@ mod hierarchy;
 mod mask;
 mod multires;
 mod progress;
+mod shell;
 
 use clap::{Parser, Subcommand};
 use std::path::PathBuf;
@@ -70,6 +71,12 @@ pub enum Command {
     Multires(multires::MultiresArgs),
     /// Time the operations that matter on a mesh.
     Bench(bench::BenchArgs),
+    /// Print a completion script for bash, zsh, fish, elvish or PowerShell.
+    #[command(long_about = "Print a completion script for bash, zsh, fish, elvish or PowerShell to \
+standard output. For bash: `fairmesh completions bash > ~/.local/share/bash-completion/completions/fairmesh`.")]
+    Completions(shell::CompletionsArgs),
+    /// Write the manual pages (fairmesh.1 and one per command) into a folder.
+    Man(shell::ManArgs),
 }
 
 /// Runs a non-editor subcommand.
@@ -84,5 +91,7 @@ pub fn run(command: Command) -> anyhow::Result<()> {
         Command::Hierarchy(args) => hierarchy::run(args),
         Command::Multires(args) => multires::run(args),
         Command::Bench(args) => bench::run(args),
+        Command::Completions(args) => shell::completions(args),
+        Command::Man(args) => shell::man(args),
     }
 }

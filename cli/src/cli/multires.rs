@@ -52,6 +52,8 @@ pub struct MultiresArgs {
     /// Fairing rounds per level (each re-imposes the constraints).
     #[arg(long, default_value_t = 1)]
     pub rounds: usize,
+    /// How boundary vertices of open meshes move: `curve` smooths each boundary loop as a curve
+    /// (paper section 3.3), `fixed` keeps them where they are.
     #[arg(long, default_value = "curve", value_parser = BoundaryArg::names_only_parser())]
     pub boundary: BoundaryArg,
     /// Also fair M0 after the last refinement (`--fair-finest false`: not): a light pass that
@@ -77,6 +79,7 @@ pub struct MultiresArgs {
     /// --measure the distances, are then taken against the clean input).
     #[arg(long)]
     pub noise: Option<f64>,
+    /// Random seed of --noise: the same seed gives the same noise on every machine.
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
     /// Measure each result against the input (before any noise): two-way surface distance (mean

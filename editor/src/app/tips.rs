@@ -121,7 +121,7 @@ pub const NOISE_ROW: &str = "Mean distance of the input mesh from the clean mesh
 
 // The Export section.
 
-/// The formats Export writes, as the README lists them.
+/// The formats Export writes, as the editor guide (docs/editor.md) lists them.
 pub const EXPORT_FORMATS: &str = "GLB, glTF, OBJ, PLY, STL or OFF, by extension";
 pub const HELD_MESHES: &str = "The meshes the 3D view keeps on the graphics card: the one \
     shown, and those you switched away from (Faired, Level mesh, Input mesh), so that switching \
