@@ -12,6 +12,32 @@ REPOSITORY = Path(__file__).resolve().parents[2]
 BUNNY = REPOSITORY / "assets" / "bunny00.obj"
 
 
+# Skips are allowed only where a thing cannot be had on the machine, and then loudly: with
+# FAIRMESH_ALLOWED_SKIPS set (scripts/test_python.sh sets it), a skip whose reason contains none of
+# its comma-separated phrases fails the run.
+_skipped = []
+
+
+def pytest_runtest_logreport(report):
+    if report.skipped:
+        longrepr = report.longrepr
+        reason = longrepr[2] if isinstance(longrepr, tuple) else str(longrepr)
+        _skipped.append((report.nodeid, reason))
+
+
+def pytest_sessionfinish(session, exitstatus):
+    allowed = os.environ.get("FAIRMESH_ALLOWED_SKIPS")
+    if allowed is None:
+        return
+    phrases = [phrase for phrase in allowed.split(",") if phrase]
+    unexpected = [(test, reason) for test, reason in _skipped
+                  if not any(phrase in reason for phrase in phrases)]
+    if unexpected:
+        for test, reason in unexpected:
+            print(f"\nunexpected skip: {test}: {reason}")
+        session.exitstatus = pytest.ExitCode.TESTS_FAILED
+
+
 @pytest.fixture(scope="session")
 def bunny():
     return fairmesh.load(BUNNY)

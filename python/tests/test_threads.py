@@ -1,7 +1,6 @@
 """Long calls release the GIL, report progress, and stop on Ctrl+C or when asked."""
 
 import _thread
-import hashlib
 import signal
 import threading
 import time
@@ -66,50 +65,6 @@ def test_two_fairings_from_two_threads_run_at_the_same_time(bunny, noisy):
     assert overlap > 0.5 * shorter, f"fairings {spans} overlap by {overlap:.3f} s"
 
 
-def at_once(work, runs=3):
-    """Best wall time of `work` alone, and of two threads running it at once."""
-
-    def best(job):
-        times = []
-        for _ in range(runs):
-            started = time.perf_counter()
-            job()
-            times.append(time.perf_counter() - started)
-        return min(times)
-
-    def two():
-        threads = [threading.Thread(target=work) for _ in range(2)]
-        for t in threads:
-            t.start()
-        for t in threads:
-            t.join()
-
-    return best(work), best(two)
-
-
-def test_two_threads_fairing_at_once_take_less_than_twice_one(bunny, noisy):
-    # One core a call (`threads=1`): on the shared pool one call already keeps every core busy,
-    # and two calls would share them whatever the GIL does.
-    data = bytes(32 << 20)
-
-    def control():
-        # hashlib releases the GIL on large buffers: what two threads can gain here now.
-        for _ in range(4):
-            hashlib.sha256(data).digest()
-
-    alone, together = at_once(control)
-    if together > 1.6 * alone:
-        pytest.skip(f"two cores are not free now: two threads hashing at once took "
-                    f"{together / alone:.2f} times one")
-
-    def one():
-        fairmesh.fair(noisy, bunny.faces, rounds=15, threads=1)
-
-    single, double = at_once(one)
-    assert double < 1.9 * single, f"one: {single:.3f} s, two at once: {double:.3f} s " \
-        f"(hashing: {together / alone:.2f} times one)"
-
-
 def test_progress_is_reported_and_can_cancel(bunny, noisy):
     fractions = []
     fairmesh.hierarchy(noisy, bunny.faces, progress=fractions.append)
@@ -168,9 +123,9 @@ def _ctrl_c_stops_a_long_fair(bunny, noisy):
         fairmesh.fair(noisy, bunny.faces, rounds=2000)
     stopped = time.perf_counter() - started
     timer.join()
-    # 2000 rounds would take about 2000 * per_round; it stops within a few rounds of 0.3 s.
-    assert stopped < 0.3 + 20 * per_round + 1.0, f"{stopped:.2f} s ({per_round:.4f} s a round)"
-    assert stopped < 0.25 * 2000 * per_round
+    # 2000 rounds would take about 2000 * per_round; it stops soon after 0.3 s, long before. (A
+    # ratio of two times taken on the same machine, with a margin wide enough for its drift.)
+    assert stopped < 0.25 * 2000 * per_round, f"{stopped:.2f} s ({per_round:.4f} s a round)"
 
 
 def test_a_call_in_a_worker_thread_stops_when_the_main_thread_asks(bunny, noisy):
