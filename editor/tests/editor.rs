@@ -164,6 +164,9 @@ fn exports_and_reloads_the_result() {
     let mut harness = harness_sized(bunny(), egui::vec2(1200.0, 1400.0));
     settle(&mut harness);
     let loaded = harness.state().status();
+    let faired = harness.state().faired_positions().expect("a faired result");
+    let input = harness.state().document_mesh().expect("a document");
+    assert_ne!(*faired, input.positions, "fairing moved the bunny");
 
     // The default export name sits next to the input, in its format.
     let default_export = bunny().with_file_name("bunny00_faired.obj");
@@ -205,6 +208,11 @@ fn exports_and_reloads_the_result() {
     assert!(reloaded.error.is_none(), "{:?}", reloaded.error);
     assert_eq!(reloaded.view.shown_faces, loaded.view.shown_faces);
     assert_eq!(reloaded.view.shown_vertices, loaded.view.shown_vertices);
+    // What was exported, and is now the document, is the faired result, vertex for vertex, on
+    // the input's triangles: not the input, not another level's result.
+    let document = harness.state().document_mesh().expect("the reloaded document");
+    assert_eq!(document.positions, *faired);
+    assert_eq!(document.triangles, input.triangles);
 }
 
 #[test]

@@ -406,6 +406,15 @@ fn baselines_shrink_where_the_paper_method_does_not() {
         laplacian.abs() > 10.0 * paper.abs(),
         "the paper's method keeps the volume far better"
     );
+    // Taubin's inflating μ step and HC's correction step exist to undo Laplacian's shrinking: a
+    // Taubin without μ or an HC without its correction is a Laplacian smoothing, and shrinks as
+    // much.
+    for &(method, volume) in &shrinkage[1..] {
+        assert!(
+            volume.abs() < 0.2 * laplacian.abs(),
+            "{method} keeps the volume far better than Laplacian: {volume} % against {laplacian} %"
+        );
+    }
     // The Lambda slider is there for Laplacian and Taubin.
     choose_method(&mut harness, "Laplacian");
     harness.get_by_role_and_label(Role::Slider, "Lambda");
