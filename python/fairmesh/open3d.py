@@ -15,6 +15,10 @@ copies is read over the welded vertices). Texture coordinates stay as they are.
 Only ``open3d.geometry.TriangleMesh`` is taken; anything else (a ``PointCloud``, a tensor
 ``open3d.t.geometry.TriangleMesh``: convert it with ``.to_legacy()``) raises ``TypeError``.
 
+``from fairmesh import open3d`` takes the Open3D package's name, harmlessly: every name this module
+does not define is looked up in the Open3D package, so ``open3d.geometry`` and ``open3d.io`` go
+on meaning the package's own.
+
 Open3D is not a dependency of fairmesh: this module needs it installed. Keyword arguments are
 those of ``fairmesh.fair``.
 """
@@ -31,6 +35,15 @@ def arrays(mesh: "open3d.geometry.TriangleMesh") -> Tuple[np.ndarray, np.ndarray
     """``mesh``'s vertices (n, 3) float64 and triangles (m, 3) int32, as numpy arrays (views of
     Open3D's own buffers, not copies)."""
     return np.asarray(mesh.vertices), np.asarray(mesh.triangles)
+
+
+def __getattr__(name: str) -> Any:
+    # What `from fairmesh import open3d` hides: the Open3D package's own names (PEP 562).
+    if name.startswith("__"):
+        raise AttributeError(f"module 'fairmesh.open3d' has no attribute '{name}'")
+    import open3d
+
+    return getattr(open3d, name)
 
 
 def _checked(mesh: Any, call: str):

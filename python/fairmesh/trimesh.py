@@ -5,8 +5,10 @@ the smoothed vertices (the same faces, visuals and metadata), and the report.
     import fairmesh.trimesh
     smooth, report = fairmesh.trimesh.fair(trimesh.load("scan.ply"))
 
-Import it as ``import fairmesh.trimesh`` (and call ``fairmesh.trimesh.fair``): ``from fairmesh
-import trimesh`` would hide the trimesh package under the same name.
+Import it as ``import fairmesh.trimesh`` and call ``fairmesh.trimesh.fair``. ``from fairmesh import
+trimesh`` works too, though it takes the trimesh package's name: every name this module does not
+define is looked up in the trimesh package, so ``trimesh.load`` and ``trimesh.Trimesh`` go on
+meaning the package's own.
 
 Seams: ``trimesh.load`` gives a textured or normal-split mesh one vertex per side of each UV or
 normal seam. Those copies of a position are faired as one vertex, as ``fairmesh.load`` welds a
@@ -41,6 +43,13 @@ def _trimesh():
     import trimesh
 
     return trimesh
+
+
+def __getattr__(name: str) -> Any:
+    # What `from fairmesh import trimesh` hides: the trimesh package's own names (PEP 562).
+    if name.startswith("__"):
+        raise AttributeError(f"module 'fairmesh.trimesh' has no attribute '{name}'")
+    return getattr(_trimesh(), name)
 
 
 def _refuse(what: Any, call: str) -> TypeError:

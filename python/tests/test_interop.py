@@ -267,3 +267,25 @@ def test_open3d_meshes_split_at_seams_keep_their_seams_closed():
     with pytest.raises(TypeError, match="takes an open3d.geometry.TriangleMesh, not a "
                                         "open3d.*PointCloud"):
         fairmesh.open3d.fair(o3d.geometry.PointCloud())
+
+
+def test_from_fairmesh_import_trimesh_keeps_the_trimesh_package_usable(bunny):
+    real = pytest.importorskip("trimesh")
+    from fairmesh import trimesh
+
+    # The package's own names through the adapter, which takes its name.
+    assert trimesh.Trimesh is real.Trimesh and trimesh.load is real.load
+    assert trimesh.fair is fairmesh.trimesh.fair
+    mesh = trimesh.Trimesh(bunny.vertices, bunny.faces, process=False)
+    smooth, _ = trimesh.fair(mesh, rounds=1)
+    assert isinstance(smooth, real.Trimesh)
+    with pytest.raises(AttributeError):
+        trimesh.no_such_name_in_trimesh
+
+
+def test_from_fairmesh_import_open3d_keeps_the_open3d_package_usable():
+    real = open3d_or_skip()
+    from fairmesh import open3d
+
+    assert open3d.geometry is real.geometry and open3d.utility is real.utility
+    assert open3d.fair is fairmesh.open3d.fair
