@@ -108,7 +108,10 @@ fn guide_sections() -> BTreeMap<String, String> {
 #[test]
 fn the_guide_has_a_section_for_every_command_and_no_other() {
     let commands: BTreeSet<String> = commands().into_iter().collect();
-    assert!(commands.contains("fair") && commands.contains("multires"), "{commands:?}");
+    assert!(
+        commands.contains("fair") && commands.contains("multires"),
+        "{commands:?}"
+    );
     let sections: BTreeSet<String> = guide_sections().into_keys().collect();
     assert_eq!(
         sections, commands,
@@ -134,21 +137,37 @@ fn the_guide_names_exactly_the_options_of_each_command() {
             ));
         }
     }
-    assert!(wrong.is_empty(), "docs/cli.md and --help disagree:\n{}", wrong.join("\n"));
+    assert!(
+        wrong.is_empty(),
+        "docs/cli.md and --help disagree:\n{}",
+        wrong.join("\n")
+    );
 }
 
 #[test]
 fn the_option_reader_finds_what_help_lists() {
     // The comparison above is only as good as the reading of `--help`.
     let fair = options_in_help("fair");
-    for name in ["output", "rounds", "mask-falloff", "no-volume-correction", "json"] {
-        assert!(fair.contains(name), "{name} not read from fair --help: {fair:?}");
+    for name in [
+        "output",
+        "rounds",
+        "mask-falloff",
+        "no-volume-correction",
+        "json",
+    ] {
+        assert!(
+            fair.contains(name),
+            "{name} not read from fair --help: {fair:?}"
+        );
     }
     assert!(!fair.contains("help"));
     let named = options_named("`-o`, `--output OUT`; --mask-falloff 3, not a--b nor -- nor --X");
     assert_eq!(
         named,
-        ["mask-falloff", "output"].iter().map(|s| s.to_string()).collect()
+        ["mask-falloff", "output"]
+            .iter()
+            .map(|s| s.to_string())
+            .collect()
     );
 }
 
@@ -156,20 +175,30 @@ fn the_option_reader_finds_what_help_lists() {
 fn the_bash_completion_script_is_valid_bash_and_completes_the_commands() {
     let script = fairmesh(&["completions", "bash"]);
     for command in commands() {
-        assert!(script.contains(&command), "no {command} in the bash completions");
+        assert!(
+            script.contains(&command),
+            "no {command} in the bash completions"
+        );
     }
     assert!(script.contains("--mask-falloff"));
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("fairmesh.bash");
     std::fs::write(&path, &script).unwrap();
-    let check = Command::new("bash").arg("-n").arg(&path).output().expect("bash runs");
+    let check = Command::new("bash")
+        .arg("-n")
+        .arg(&path)
+        .output()
+        .expect("bash runs");
     assert!(
         check.status.success(),
         "bash -n rejects the completion script: {}",
         String::from_utf8_lossy(&check.stderr)
     );
     for shell in ["zsh", "fish", "powershell", "elvish"] {
-        assert!(fairmesh(&["completions", shell]).contains("multires"), "{shell}");
+        assert!(
+            fairmesh(&["completions", shell]).contains("multires"),
+            "{shell}"
+        );
     }
 }
 
@@ -184,15 +213,28 @@ fn man_writes_a_page_per_command_that_names_its_options() {
     expected.push("fairmesh.1".to_owned());
     for name in &expected {
         let path = dir.path().join(name);
-        assert!(printed.contains(&path.display().to_string()), "{name} not printed");
+        assert!(
+            printed.contains(&path.display().to_string()),
+            "{name} not printed"
+        );
         let page = std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("{name}: {e}"));
-        assert!(page.starts_with(".ie") || page.contains(".TH"), "{name} is no man page");
+        assert!(
+            page.starts_with(".ie") || page.contains(".TH"),
+            "{name} is no man page"
+        );
     }
     let fair = std::fs::read_to_string(dir.path().join("fairmesh-fair.1")).unwrap();
     // roff escapes the dashes of options: \-\-mask\-falloff.
-    assert!(fair.contains(r"\-\-mask\-falloff"), "fairmesh-fair.1 lacks --mask-falloff");
+    assert!(
+        fair.contains(r"\-\-mask\-falloff"),
+        "fairmesh-fair.1 lacks --mask-falloff"
+    );
     let files = std::fs::read_dir(dir.path()).unwrap().count();
-    assert_eq!(files, expected.len(), "no stray or temporary file is left behind");
+    assert_eq!(
+        files,
+        expected.len(),
+        "no stray or temporary file is left behind"
+    );
     // Rendered by man itself where it is installed.
     if let Ok(rendered) = Command::new("man")
         .arg("-l")

@@ -210,7 +210,10 @@ fn exports_and_reloads_the_result() {
     assert_eq!(reloaded.view.shown_vertices, loaded.view.shown_vertices);
     // What was exported, and is now the document, is the faired result, vertex for vertex, on
     // the input's triangles: not the input, not another level's result.
-    let document = harness.state().document_mesh().expect("the reloaded document");
+    let document = harness
+        .state()
+        .document_mesh()
+        .expect("the reloaded document");
     assert_eq!(document.positions, *faired);
     assert_eq!(document.triangles, input.triangles);
 }

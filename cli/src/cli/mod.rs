@@ -72,8 +72,10 @@ pub enum Command {
     /// Time the operations that matter on a mesh.
     Bench(bench::BenchArgs),
     /// Print a completion script for bash, zsh, fish, elvish or PowerShell.
-    #[command(long_about = "Print a completion script for bash, zsh, fish, elvish or PowerShell to \
-standard output. For bash: `fairmesh completions bash > ~/.local/share/bash-completion/completions/fairmesh`.")]
+    #[command(
+        long_about = "Print a completion script for bash, zsh, fish, elvish or PowerShell to \
+standard output. For bash: `fairmesh completions bash > ~/.local/share/bash-completion/completions/fairmesh`."
+    )]
     Completions(shell::CompletionsArgs),
     /// Write the manual pages (fairmesh.1 and one per command) into a folder.
     Man(shell::ManArgs),

@@ -46,9 +46,12 @@ pub(super) fn edges_changed(a: &[[u32; 2]], b: &[[u32; 2]]) -> usize {
     changed + (a.len() - i) + (b.len() - j)
 }
 
-/// Milliseconds since `start`.
-pub(super) fn milliseconds(start: std::time::Instant) -> f64 {
-    start.elapsed().as_secs_f64() * 1e3
+/// `work`'s value and the milliseconds it took (wall clock): the phase timer of the reports'
+/// `phases` and `detection_ms`, which keeps the clock out of the algorithm's lines.
+pub(super) fn timed<T>(work: impl FnOnce() -> T) -> (T, f64) {
+    let started = std::time::Instant::now();
+    let value = work();
+    (value, started.elapsed().as_secs_f64() * 1e3)
 }
 
 /// What the rounds of `fair_rounds` ([`super::rounds`]) work with, set up before the first.
@@ -98,56 +101,58 @@ impl RoundLoop<'_> {
         ) {
             let detection = (fans, crease_options, &mut self.face_rings);
             if self.tracked.detect_again(mesh, topology, detection, report) {
-                let started = std::time::Instant::now();
                 let creases = self.tracked.creases.as_ref();
                 let fairing = &mut self.fairing;
-                fairing.for_other_creases(mesh, topology, fans, creases, self.pinned);
-                report.phases.set_up += milliseconds(started);
+                let ((), ms) = timed(|| {
+                    fairing.for_other_creases(mesh, topology, fans, creases, self.pinned);
+                });
+                report.phases.set_up += ms;
             }
         }
         // Imposes the constraints on the positions this round starts from.
-        let started = std::time::Instant::now();
-        self.fairing.load(&mesh.positions);
-        let mut iterations_ms = milliseconds(started);
+        let ((), load_ms) = timed(|| self.fairing.load(&mesh.positions));
         let fans = self.fans.as_ref();
         let at = (&*mesh, topology);
-        let started = std::time::Instant::now();
-        self.relaxation
-            .before_round(&mut self.fairing, round, at, fans);
-        report.phases.relaxation += milliseconds(started);
-        let started = std::time::Instant::now();
-        let iterations = self.fairing.run_round(self.options, report);
+        let ((), ms) = timed(|| {
+            self.relaxation
+                .before_round(&mut self.fairing, round, at, fans);
+        });
+        report.phases.relaxation += ms;
         let step = self.step(round);
-        if step != 1.0 {
-            self.fairing.extrapolate(step);
-        }
-        self.fairing.store(&mut mesh.positions);
-        iterations_ms += milliseconds(started);
-        report.phases.iterations += iterations_ms;
-        let started = std::time::Instant::now();
+        let (iterations, ms) = timed(|| {
+            let iterations = self.fairing.run_round(self.options, report);
+            if step != 1.0 {
+                self.fairing.extrapolate(step);
+            }
+            self.fairing.store(&mut mesh.positions);
+            iterations
+        });
+        report.phases.iterations += load_ms + ms;
         let class = self.tracked.creases.as_ref().map(|c| c.class.as_slice());
         let class = class.unwrap_or(&[]);
         let held = |v: usize| class.get(v) == Some(&FeatureClass::Corner);
-        let offsets = self
-            .volume
-            .as_ref()
-            .map(|volume| volume.restore_with_normals(mesh, topology, held).1);
-        report.phases.volume += milliseconds(started);
+        let (offsets, ms) = timed(|| {
+            self.volume
+                .as_ref()
+                .map(|volume| volume.restore_with_normals(mesh, topology, held).1)
+        });
+        report.phases.volume += ms;
         let Some(judge) = &mut self.judge else {
             return false;
         };
-        let started = std::time::Instant::now();
-        judge.fair_copy(&mut self.fairing, iterations, step);
-        // The copy takes the mesh's volume offsets: what its own correction would give, but for a
-        // change of the distance that sums a part's volume change, of order 1/N per vertex
-        // against the local response the risk reads.
-        if let (Some(volume), Some(offsets)) = (&self.volume, offsets) {
-            volume.offset(&mut judge.copy, &offsets, held);
-            judge.normals = Some(offsets.normals);
-        }
-        let edges = self.tracked.creases.as_ref().map_or(0, |c| c.edges.len());
-        let stop = judge.stops_after(round, (mesh, topology), edges, report);
-        report.phases.risk += milliseconds(started);
+        let (stop, ms) = timed(|| {
+            judge.fair_copy(&mut self.fairing, iterations, step);
+            // The copy takes the mesh's volume offsets: what its own correction would give, but
+            // for a change of the distance that sums a part's volume change, of order 1/N per
+            // vertex against the local response the risk reads.
+            if let (Some(volume), Some(offsets)) = (&self.volume, offsets) {
+                volume.offset(&mut judge.copy, &offsets, held);
+                judge.normals = Some(offsets.normals);
+            }
+            let edges = self.tracked.creases.as_ref().map_or(0, |c| c.edges.len());
+            judge.stops_after(round, (mesh, topology), edges, report)
+        });
+        report.phases.risk += ms;
         stop
     }
 }
@@ -185,16 +190,17 @@ impl TrackedCreases {
         (fans, crease_options, face_rings): (&FanRings, &CreaseOptions, &mut FaceRingCache),
         report: &mut FairReport,
     ) -> bool {
-        let started = std::time::Instant::now();
-        let (noise, found) = detect_creases_with_estimate(
-            mesh,
-            topology,
-            fans,
-            crease_options,
-            face_rings,
-            !self.read_clean,
-        );
-        report.detection_ms += milliseconds(started);
+        let ((noise, found), ms) = timed(|| {
+            detect_creases_with_estimate(
+                mesh,
+                topology,
+                fans,
+                crease_options,
+                face_rings,
+                !self.read_clean,
+            )
+        });
+        report.detection_ms += ms;
         self.read_clean |= noise.is_some_and(|noise| normal_filtering_for(noise) == 0);
         let found = Some(found);
         fn edges(creases: &Option<Creases>) -> &[[u32; 2]] {

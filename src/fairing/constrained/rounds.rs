@@ -5,7 +5,7 @@
 //! it is needed, the volume given back and, with automatic strength, the risk read after every
 //! round and the rounds after the best one undone.
 
-use super::round_steps::{milliseconds, RelaxationPlan, RiskJudge, RoundLoop, TrackedCreases};
+use super::round_steps::{timed, RelaxationPlan, RiskJudge, RoundLoop, TrackedCreases};
 use super::ConstrainedFairing;
 use crate::fairing::creases::{
     detect_creases_cached, detect_creases_with_estimate, CreaseOptions, Creases, FaceRingCache,
@@ -64,46 +64,25 @@ pub fn fair_constrained_with_progress(
     options: &FairOptions,
     progress: &mut dyn Progress,
 ) -> Result<FairReport, Cancelled> {
-    let nothing_to_do = options.iterations == 0
-        || mesh.positions.is_empty()
-        || (options.strength == Strength::Fixed && options.rounds == 0)
-        // A mask that does not fit, or pins everything: nothing may move.
-        || options.mask.as_ref().is_some_and(|mask| {
-            mask.check_fits(mesh.positions.len()).is_err() || mask.painted_count() == 0
-        });
-    if nothing_to_do {
-        progress.check(1.0)?;
-        return Ok(FairReport::default());
+    match FairPlan::new(mesh, topology, options) {
+        Some(plan) => plan.run(mesh, topology, options, progress),
+        None => {
+            progress.check(1.0)?;
+            Ok(FairReport::default())
+        }
     }
-    if let Some(report) = fair_without_loose_triangles(mesh, topology, options, progress)? {
-        return Ok(report);
-    }
-    let original = options.mask.as_ref().map(|_| mesh.positions.clone());
-    let pinned = options
-        .mask
-        .as_ref()
-        .map(|mask| mask.pinned_flags())
-        .unwrap_or_default();
-    let report = if options.strength == Strength::Fixed && options.rounds >= LOCAL_ORDER_ROUNDS {
-        in_local_order(
-            mesh,
-            topology,
-            options,
-            &pinned,
-            |mesh, topology, options, pinned| {
-                decide_and_fair(mesh, topology, options, pinned, false, progress)
-            },
-        )
-    } else {
-        decide_and_fair(mesh, topology, options, &pinned, true, progress)
-    }?;
-    // The operator held the pinned vertices; the blend fades the rest by their weights (and
-    // puts back pinned boundary vertices, which the boundary curves may have moved).
-    if let (Some(mask), Some(original)) = (&options.mask, &original) {
-        mask.blend(original, &mut mesh.positions);
-    }
-    progress.check(1.0)?;
-    Ok(report)
+}
+
+/// What a run of [`fair_constrained`] does, decided once before anything is faired: the surface it
+/// fairs (the mesh, or the mesh without the triangles lying loose at its non-manifold edges), the
+/// vertices the mask holds, and the vertex order the work runs in. [`Self::run`] then follows it
+/// on one path.
+struct FairPlan {
+    /// The surface without its loose triangles, when it has some.
+    without_loose: Option<WithoutLoose>,
+    /// Vertices a mask pins (empty: no mask).
+    pinned: Vec<bool>,
+    order: RunOrder,
 }
 
 /// A non-manifold scan is faired as the surface it stands for: without the triangles its
@@ -111,39 +90,127 @@ pub fn fair_constrained_with_progress(
 /// would make their corners boundary vertices on chains no boundary curve runs through, and so
 /// hold them with their noise (`crate::mesh::loose_triangles`, `docs/measurements.md`). Same
 /// vertices, nothing renumbered; a corner only loose triangles use (a fin's tip) stays where it
-/// is. `Ok(None)` when the default variant has no loose triangles to leave out: the caller fairs
-/// the mesh as it is.
-fn fair_without_loose_triangles(
-    mesh: &mut TriMesh,
-    topology: &Topology,
-    options: &FairOptions,
-    progress: &mut dyn Progress,
-) -> Result<Option<FairReport>, Cancelled> {
-    if options.variant != FairVariant::NormalProjected || topology.non_manifold_edges.is_empty() {
-        return Ok(None);
+/// is. The normal-projected variant only: the paper's fairs the mesh as it is.
+struct WithoutLoose {
+    /// How many triangles are left out.
+    loose: usize,
+    kept: TriMesh,
+    topology: Topology,
+    /// The volume kept is the file's, loose triangles included: they follow their corners, and
+    /// their own (cone) volume changes with them; one more uniform offset takes that back.
+    volume: Option<VolumeKeeper>,
+}
+
+/// Where the work runs in the locality order ([`in_local_order`]), chosen in one place
+/// ([`RunOrder::for_options`]).
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum RunOrder {
+    /// In the mesh's own order: a fixed strength of a few rounds, which would not pay for
+    /// making the order.
+    Mesh,
+    /// All of it in the locality order, the first reading included: a fixed strength of
+    /// [`LOCAL_ORDER_ROUNDS`] rounds or more.
+    Local,
+    /// The first reading in the mesh's order, then, when the automatic strength finds the mesh
+    /// noisy (a clean one is left as it is, and costs no reordering), the rounds in the locality
+    /// order.
+    LocalOnceNoisy,
+}
+
+impl RunOrder {
+    fn for_options(options: &FairOptions) -> Self {
+        match options.strength {
+            Strength::Fixed if options.rounds >= LOCAL_ORDER_ROUNDS => RunOrder::Local,
+            Strength::Fixed => RunOrder::Mesh,
+            Strength::Auto => RunOrder::LocalOnceNoisy,
+        }
     }
-    let Some((loose, mut kept, kept_topology)) =
-        crate::mesh::without_loose_triangles(mesh, topology)
-    else {
-        return Ok(None);
-    };
-    // The volume kept is the file's, loose triangles included: they follow their corners, and
-    // their own (cone) volume changes with them; one more uniform offset takes that back.
-    let pinned = options
-        .mask
-        .as_ref()
-        .map(|mask| mask.pinned_flags())
-        .unwrap_or_default();
-    let volume = options
-        .keep_volume
-        .then(|| VolumeKeeper::new(mesh, topology, &pinned));
-    let mut report = fair_constrained_with_progress(&mut kept, &kept_topology, options, progress)?;
-    mesh.positions = kept.positions;
-    if let Some(volume) = volume.filter(|_| report.rounds_run > 0) {
-        volume.restore(mesh, topology, |v| pinned.get(v).copied().unwrap_or(false));
+}
+
+impl FairPlan {
+    /// The plan for `mesh`, or `None` when there is nothing to do: no iteration, no vertex, no
+    /// round asked for, or a mask that does not fit the mesh or pins everything.
+    fn new(mesh: &TriMesh, topology: &Topology, options: &FairOptions) -> Option<Self> {
+        let nothing_to_do = options.iterations == 0
+            || mesh.positions.is_empty()
+            || (options.strength == Strength::Fixed && options.rounds == 0)
+            || options.mask.as_ref().is_some_and(|mask| {
+                mask.check_fits(mesh.positions.len()).is_err() || mask.painted_count() == 0
+            });
+        if nothing_to_do {
+            return None;
+        }
+        let pinned = options
+            .mask
+            .as_ref()
+            .map(|mask| mask.pinned_flags())
+            .unwrap_or_default();
+        let without_loose = (options.variant == FairVariant::NormalProjected
+            && !topology.non_manifold_edges.is_empty())
+        .then(|| crate::mesh::without_loose_triangles(mesh, topology))
+        .flatten()
+        .map(|(loose, kept, kept_topology)| WithoutLoose {
+            loose: loose.len(),
+            kept,
+            topology: kept_topology,
+            volume: options
+                .keep_volume
+                .then(|| VolumeKeeper::new(mesh, topology, &pinned)),
+        });
+        Some(FairPlan {
+            without_loose,
+            pinned,
+            order: RunOrder::for_options(options),
+        })
     }
-    report.loose_triangles += loose.len();
-    Ok(Some(report))
+
+    /// Fairs the planned surface, puts the vertices the mask fades back in proportion, and for a
+    /// surface without its loose triangles, gives the whole mesh its positions and its volume.
+    fn run(
+        self,
+        mesh: &mut TriMesh,
+        topology: &Topology,
+        options: &FairOptions,
+        progress: &mut dyn Progress,
+    ) -> Result<FairReport, Cancelled> {
+        let FairPlan {
+            without_loose,
+            pinned,
+            order,
+        } = self;
+        let original = options.mask.as_ref().map(|_| mesh.positions.clone());
+        let mut without_loose = without_loose;
+        let (surface, surface_topology) = match &mut without_loose {
+            Some(without) => (&mut without.kept, &without.topology),
+            None => (&mut *mesh, topology),
+        };
+        let mut report = match order {
+            RunOrder::Local => in_local_order(
+                surface,
+                surface_topology,
+                options,
+                &pinned,
+                |mesh, topology, options, pinned| {
+                    decide_and_fair(mesh, topology, options, pinned, RunOrder::Local, progress)
+                },
+            ),
+            order => decide_and_fair(surface, surface_topology, options, &pinned, order, progress),
+        }?;
+        // The operator held the pinned vertices; the blend fades the rest by their weights (and
+        // puts back pinned boundary vertices, which the boundary curves may have moved).
+        if let (Some(mask), Some(original)) = (&options.mask, &original) {
+            mask.blend(original, &mut surface.positions);
+        }
+        if let Some(without) = without_loose {
+            mesh.positions = without.kept.positions;
+            if let Some(volume) = without.volume.filter(|_| report.rounds_run > 0) {
+                volume.restore(mesh, topology, |v| pinned.get(v).copied().unwrap_or(false));
+            }
+            report.loose_triangles += without.loose;
+        }
+        progress.check(1.0)?;
+        Ok(report)
+    }
 }
 
 /// Rounds from which a run in the locality order pays for making it (see [`in_local_order`]).
@@ -165,46 +232,16 @@ fn in_local_order(
     pinned: &[bool],
     fair: impl FnOnce(&mut TriMesh, &Topology, &FairOptions, &[bool]) -> Result<FairReport, Cancelled>,
 ) -> Result<FairReport, Cancelled> {
-    let started = std::time::Instant::now();
-    let (offsets, neighbors) = topology.neighbor_csr();
-    let order = breadth_first_order(offsets, neighbors);
-    let position = inverse_permutation(&order);
-    let positions: Vec<[f32; 3]> = order
-        .par_iter()
-        .map(|&v| mesh.positions[v as usize])
-        .collect();
-    // Faces relabelled (corners in their own order, so the winding stays), then placed by their
-    // lowest corner with a stable counting sort.
-    let relabelled: Vec<[u32; 3]> = mesh
-        .triangles
-        .par_iter()
-        .map(|t| t.map(|v| position[v as usize]))
-        .collect();
-    let lowest = |t: &[u32; 3]| t[0].min(t[1]).min(t[2]) as usize;
-    let mut start = vec![0u32; positions.len() + 1];
-    for t in &relabelled {
-        start[lowest(t) + 1] += 1;
-    }
-    for v in 0..positions.len() {
-        start[v + 1] += start[v];
-    }
-    let mut triangles = vec![[0u32; 3]; relabelled.len()];
-    for t in relabelled {
-        let slot = &mut start[lowest(&t)];
-        triangles[*slot as usize] = t;
-        *slot += 1;
-    }
-    let mut local = TriMesh::new(positions, triangles);
-    let local_topology = Topology::build(&local);
-    let set_up_ms = milliseconds(started);
+    let (mut local, set_up_ms) = timed(|| LocalCopy::of(mesh, topology));
     let local_pinned: Vec<bool> = if pinned.is_empty() {
         Vec::new()
     } else {
-        order.iter().map(|&v| pinned[v as usize]).collect()
+        local.order.iter().map(|&v| pinned[v as usize]).collect()
     };
     let mut local_options = options.clone();
     local_options.mask = None;
     if let Some(creases) = &mut local_options.creases {
+        let position = &local.position;
         let edges: Vec<[u32; 2]> = creases
             .file_edges
             .iter()
@@ -219,60 +256,126 @@ fn in_local_order(
             .collect();
         creases.file_edges = edges.into();
     }
-    let mut report = fair(&mut local, &local_topology, &local_options, &local_pinned)?;
-    let started = std::time::Instant::now();
-    for (&v, p) in order.iter().zip(&local.positions) {
-        mesh.positions[v as usize] = *p;
-    }
-    report.phases.set_up += set_up_ms + milliseconds(started);
+    let mut report = fair(
+        &mut local.mesh,
+        &local.topology,
+        &local_options,
+        &local_pinned,
+    )?;
+    let ((), back_ms) = timed(|| {
+        for (&v, p) in local.order.iter().zip(&local.mesh.positions) {
+            mesh.positions[v as usize] = *p;
+        }
+    });
+    report.phases.set_up += set_up_ms + back_ms;
     Ok(report)
 }
 
+/// A mesh renumbered in the locality order ([`in_local_order`]).
+struct LocalCopy {
+    /// Local vertex i is the mesh's vertex `order[i]`.
+    order: Vec<u32>,
+    /// The mesh's vertex v is local vertex `position[v]` (the inverse of `order`).
+    position: Vec<u32>,
+    mesh: TriMesh,
+    topology: Topology,
+}
+
+impl LocalCopy {
+    /// `mesh` with its vertices numbered breadth-first over the one-rings and its faces sorted by
+    /// their lowest corner.
+    fn of(mesh: &TriMesh, topology: &Topology) -> Self {
+        let (offsets, neighbors) = topology.neighbor_csr();
+        let order = breadth_first_order(offsets, neighbors);
+        let position = inverse_permutation(&order);
+        let positions: Vec<[f32; 3]> = order
+            .par_iter()
+            .map(|&v| mesh.positions[v as usize])
+            .collect();
+        // Faces relabelled (corners in their own order, so the winding stays), then placed by
+        // their lowest corner with a stable counting sort.
+        let relabelled: Vec<[u32; 3]> = mesh
+            .triangles
+            .par_iter()
+            .map(|t| t.map(|v| position[v as usize]))
+            .collect();
+        let lowest = |t: &[u32; 3]| t[0].min(t[1]).min(t[2]) as usize;
+        let mut start = vec![0u32; positions.len() + 1];
+        for t in &relabelled {
+            start[lowest(t) + 1] += 1;
+        }
+        for v in 0..positions.len() {
+            start[v + 1] += start[v];
+        }
+        let mut triangles = vec![[0u32; 3]; relabelled.len()];
+        for t in relabelled {
+            let slot = &mut start[lowest(&t)];
+            triangles[*slot as usize] = t;
+            *slot += 1;
+        }
+        let mesh = TriMesh::new(positions, triangles);
+        let topology = Topology::build(&mesh);
+        LocalCopy {
+            order,
+            position,
+            mesh,
+            topology,
+        }
+    }
+}
+
 /// The noise estimate, the decision to fair at all (automatic strength leaves a clean mesh as it
-/// is), the first creases, then the rounds. With `may_reorder`, automatic strength on a noisy
-/// mesh runs its rounds in the locality order ([`in_local_order`]). [`Cancelled`] when
+/// is), the first creases, then the rounds. `order` says where `mesh` stands: in the locality
+/// order already ([`RunOrder::Local`]: `mesh` is [`in_local_order`]'s copy), in its own order for
+/// good ([`RunOrder::Mesh`]), or in its own order until the automatic strength finds it noisy
+/// ([`RunOrder::LocalOnceNoisy`]), when the rounds move to the locality order. [`Cancelled`] when
 /// `progress` cancelled the run.
 fn decide_and_fair(
     mesh: &mut TriMesh,
     topology: &Topology,
     options: &FairOptions,
     pinned: &[bool],
-    may_reorder: bool,
+    order: RunOrder,
     progress: &mut dyn Progress,
 ) -> Result<FairReport, Cancelled> {
     // The fan-ordered one-rings the operator is built from serve the noise estimate and the
     // crease detection first (`read_noise`, `detect_creases_with_estimate`).
     let fans = FanRings::new(&mesh.triangles, topology);
-    // Without `may_reorder` the mesh is already the locality-ordered copy (`in_local_order`):
-    // the filter keeps its face order (the same normals bit for bit, its lists built faster).
-    let mut face_rings = if may_reorder {
-        FaceRingCache::default()
-    } else {
+    // In the locality-ordered copy the filter keeps its face order (the same normals bit for bit,
+    // its lists built faster).
+    let face_rings = if order == RunOrder::Local {
         FaceRingCache::in_mesh_order()
+    } else {
+        FaceRingCache::default()
     };
-    let started = std::time::Instant::now();
-    let (estimate, found, reading) = first_reading(mesh, topology, &fans, options, &mut face_rings);
-    let auto_noise = match options.strength {
-        Strength::Auto => match noisy(estimate, reading.as_ref(), topology) {
-            Some(noise) => Some(noise),
-            None => {
-                return Ok(FairReport {
-                    noise_estimate: estimate,
-                    detection_ms: milliseconds(started),
-                    ..FairReport::default()
-                })
-            }
-        },
-        _ => None,
-    };
-    drop(reading);
-    let decided_ms = milliseconds(started);
+    let ((reading, auto_noise), decided_ms) = timed(|| {
+        let reading = FirstReading::of(mesh, topology, &fans, options, face_rings);
+        let auto_noise = match options.strength {
+            Strength::Auto => noisy(reading.estimate, reading.noise.as_ref(), topology),
+            Strength::Fixed => None,
+        };
+        (reading, auto_noise)
+    });
+    if options.strength == Strength::Auto && auto_noise.is_none() {
+        return Ok(FairReport {
+            noise_estimate: reading.estimate,
+            detection_ms: decided_ms,
+            ..FairReport::default()
+        });
+    }
+    let FirstReading {
+        estimate,
+        creases,
+        face_rings,
+        noise,
+    } = reading;
+    drop(noise);
     let rounds = Rounds {
         estimate,
         auto_noise,
         pinned,
     };
-    let mut report = if may_reorder && auto_noise.is_some() {
+    let mut report = if order == RunOrder::LocalOnceNoisy {
         drop(fans);
         in_local_order(
             mesh,
@@ -281,11 +384,15 @@ fn decide_and_fair(
             pinned,
             |mesh, topology, options, pinned| {
                 let fans = FanRings::new(&mesh.triangles, topology);
+                let found = FoundCreases {
+                    creases: None,
+                    face_rings: FaceRingCache::in_mesh_order(),
+                };
                 fair_rounds(
                     mesh,
                     topology,
                     fans,
-                    (None, FaceRingCache::in_mesh_order()),
+                    found,
                     options,
                     Rounds { pinned, ..rounds },
                     progress,
@@ -293,54 +400,71 @@ fn decide_and_fair(
             },
         )
     } else {
-        fair_rounds(
-            mesh,
-            topology,
-            fans,
-            (found, face_rings),
-            options,
-            rounds,
-            progress,
-        )
+        let found = FoundCreases {
+            creases,
+            face_rings,
+        };
+        fair_rounds(mesh, topology, fans, found, options, rounds, progress)
     }?;
     report.detection_ms += decided_ms;
     Ok(report)
 }
 
-/// The first reading of the input: the noise estimate, which decides the strength (automatic)
-/// and how much the normals are filtered before creases are detected (raw normals of a noisy
-/// mesh make creases of the noise). A fixed strength finds the estimate and the creases in one
-/// gather (skipping the filter when the mesh is clean); automatic strength fairs only a noisy
-/// mesh, so its creases are always found later on filtered normals, and it reads in the same
-/// gather which vertices lie on sharp edges ([`read_noise`]).
-fn first_reading(
-    mesh: &TriMesh,
-    topology: &Topology,
-    fans: &FanRings,
-    options: &FairOptions,
-    face_rings: &mut FaceRingCache,
-) -> (Option<f64>, Option<Creases>, Option<NoiseReading>) {
-    match (&options.creases, options.strength) {
-        (Some(crease_options), Strength::Fixed) => {
-            let (estimate, creases) = detect_creases_with_estimate(
-                mesh,
-                topology,
-                fans,
-                crease_options,
-                face_rings,
-                true,
-            );
-            (estimate, Some(creases), None)
+/// The first reading of the input ([`FirstReading::of`]).
+struct FirstReading {
+    /// The noise estimate, in mean edge lengths (`None`: no reading was asked for).
+    estimate: Option<f64>,
+    /// The creases, when they were found in the same gather (a fixed strength).
+    creases: Option<Creases>,
+    /// The faces around each face, kept from the detection for the next.
+    face_rings: FaceRingCache,
+    /// Automatic strength: what the reading saw (which vertices lie on sharp edges, for
+    /// [`noisy`]).
+    noise: Option<NoiseReading>,
+}
+
+impl FirstReading {
+    /// The noise estimate, which decides the strength (automatic) and how much the normals are
+    /// filtered before creases are detected (raw normals of a noisy mesh make creases of the
+    /// noise). A fixed strength finds the estimate and the creases in one gather (skipping the
+    /// filter when the mesh is clean); automatic strength fairs only a noisy mesh, so its creases
+    /// are always found later on filtered normals, and it reads in the same gather which vertices
+    /// lie on sharp edges ([`read_noise`]).
+    fn of(
+        mesh: &TriMesh,
+        topology: &Topology,
+        fans: &FanRings,
+        options: &FairOptions,
+        mut face_rings: FaceRingCache,
+    ) -> Self {
+        let (estimate, creases, noise) = match (&options.creases, options.strength) {
+            (Some(crease_options), Strength::Fixed) => {
+                let (estimate, creases) = detect_creases_with_estimate(
+                    mesh,
+                    topology,
+                    fans,
+                    crease_options,
+                    &mut face_rings,
+                    true,
+                );
+                (estimate, Some(creases), None)
+            }
+            (_, Strength::Auto) => {
+                let angle = options
+                    .creases
+                    .as_ref()
+                    .map_or(CreaseOptions::default().angle_degrees, |c| c.angle_degrees);
+                let reading = read_noise(mesh, topology, fans, angle);
+                (reading.noise(topology), None, Some(reading))
+            }
+            (None, _) => (None, None, None),
+        };
+        FirstReading {
+            estimate,
+            creases,
+            face_rings,
+            noise,
         }
-        (_, Strength::Auto) => {
-            let angle = options
-                .creases
-                .as_ref()
-                .map_or(CreaseOptions::default().angle_degrees, |c| c.angle_degrees);
-            let reading = read_noise(mesh, topology, fans, angle);
-            (reading.noise(topology), None, Some(reading))
-        }
-        (None, _) => (None, None, None),
     }
 }
 
@@ -363,6 +487,13 @@ fn noisy(
         || reading.is_some_and(|reading| reading.clean_off_flat_edges(topology, CLEAN_NOISE));
     estimate
         .filter(|&noise| noise > CLEAN_NOISE && !clean_away_from_edges() && !clean_off_flat_edges())
+}
+
+/// The creases the first reading found (a fixed strength finds them with the noise estimate),
+/// with the faces around each face that detection kept, for the next.
+struct FoundCreases {
+    creases: Option<Creases>,
+    face_rings: FaceRingCache,
 }
 
 /// What [`fair_rounds`] takes from the decision to fair.
@@ -388,7 +519,7 @@ fn fair_rounds(
     mesh: &mut TriMesh,
     topology: &Topology,
     fans: FanRings,
-    (found, mut face_rings): (Option<Creases>, FaceRingCache),
+    found: FoundCreases,
     options: &FairOptions,
     rounds: Rounds,
     progress: &mut dyn Progress,
@@ -398,50 +529,54 @@ fn fair_rounds(
         auto_noise,
         pinned,
     } = rounds;
-    let started = std::time::Instant::now();
-    let creases =
-        found.or_else(|| first_creases(mesh, topology, options, estimate, &mut face_rings));
-    let first_detection_ms = milliseconds(started);
+    let FoundCreases {
+        creases,
+        mut face_rings,
+    } = found;
+    let (creases, first_detection_ms) = timed(|| {
+        creases.or_else(|| first_creases(mesh, topology, options, estimate, &mut face_rings))
+    });
     let max_rounds = match auto_noise {
         Some(_) => MAX_AUTO_ROUNDS,
         None => options.rounds,
     };
     let redetect = options.creases.is_some() && max_rounds > 1;
-    let started = std::time::Instant::now();
-    let mut fairing = ConstrainedFairing::with_fans(
-        mesh,
-        topology,
-        &fans,
-        options.variant,
-        options.boundary,
-        creases.as_ref(),
-        pinned,
-    );
-    fairing.set_tangential_relaxation(options.tangential_relaxation as f32);
-    let set_up_ms = milliseconds(started);
-    let started = std::time::Instant::now();
-    let relaxation = RelaxationPlan::read(mesh, topology, &fans, options, estimate);
-    let reading_ms = milliseconds(started);
+    let (fairing, set_up_ms) = timed(|| {
+        let mut fairing = ConstrainedFairing::with_fans(
+            mesh,
+            topology,
+            &fans,
+            options.variant,
+            options.boundary,
+            creases.as_ref(),
+            pinned,
+        );
+        fairing.set_tangential_relaxation(options.tangential_relaxation as f32);
+        fairing
+    });
+    let (relaxation, reading_ms) =
+        timed(|| RelaxationPlan::read(mesh, topology, &fans, options, estimate));
     // The fans serve the later rounds only to find the creases again (and estimate the noise
     // that sets the filtering for it) and to read the noise along the surface again while the
     // relaxation acts everywhere: otherwise they are freed before the iterations (the peak,
     // while the operator is set up from them, stays).
     let fans = (redetect || relaxation.everywhere.is_some_and(|share| share > 0.0)).then_some(fans);
-    let started = std::time::Instant::now();
-    let volume = options
-        .keep_volume
-        .then(|| VolumeKeeper::new(mesh, topology, pinned));
+    let (volume, volume_ms) = timed(|| {
+        options
+            .keep_volume
+            .then(|| VolumeKeeper::new(mesh, topology, pinned))
+    });
+    let (judge, risk_ms) =
+        timed(|| auto_noise.map(|noise| RiskJudge::new(mesh, topology, noise, creases.as_ref())));
     let mut report = FairReport {
         detection_ms: first_detection_ms,
         tangential_noise: relaxation.tangential_noise,
         ..FairReport::default()
     };
-    report.phases.volume = milliseconds(started);
     report.phases.set_up = set_up_ms;
     report.phases.relaxation = reading_ms;
-    let started = std::time::Instant::now();
-    let judge = auto_noise.map(|noise| RiskJudge::new(mesh, topology, noise, creases.as_ref()));
-    report.phases.risk = milliseconds(started);
+    report.phases.volume = volume_ms;
+    report.phases.risk = risk_ms;
     // A round ends once it has settled (`FairOptions::settled`) or at `options.tolerance`.
     let settled = match judge.as_ref() {
         Some(judge) => judge.edge,
