@@ -1,0 +1,35 @@
+#!/usr/bin/env bash
+# The Blender add-on's tests (tests/blender/test_*.py), run inside Blender itself: installs
+# Debian's blender and python3-numpy when missing, builds target/fairmesh_blender.zip
+# (scripts/build_blender_addon.sh, reusing python/dist/*.whl that scripts/test_python.sh left),
+# then runs each test script headless with the zip. Blender installs the add-on into a scratch
+# user folder, so the machine's own Blender settings are not touched. Exits non-zero when a test
+# fails. Run by .ci/run after scripts/test_python.sh.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+if ! command -v blender >/dev/null 2>&1 || ! python3 -c 'import numpy' >/dev/null 2>&1 \
+    && ! dpkg -s python3-numpy >/dev/null 2>&1; then
+  sudo_cmd=()
+  [ "$(id -u)" -ne 0 ] && sudo_cmd=(sudo)
+  echo "test_blender: installing blender and python3-numpy"
+  "${sudo_cmd[@]}" apt-get update -qq
+  DEBIAN_FRONTEND=noninteractive "${sudo_cmd[@]}" apt-get install -y -qq \
+    --no-install-recommends blender python3-numpy >/dev/null
+fi
+scripts/build_blender_addon.sh
+zip="$(realpath "${CARGO_TARGET_DIR:-target}/fairmesh_blender.zip")"
+scratch=$(mktemp -d)
+trap 'rm -rf "$scratch"' EXIT
+failed=0
+for script in tests/blender/test_*.py; do
+  echo "test_blender: $script"
+  if ! BLENDER_USER_SCRIPTS="$scratch/scripts" BLENDER_USER_CONFIG="$scratch/config" \
+      blender -b --factory-startup --python-exit-code 1 --python "$script" -- "$zip" \
+      2>&1 | grep -v -E '^(Read prefs|Blender quit|Color management)'; then
+    :
+  fi
+  if [ "${PIPESTATUS[0]}" -ne 0 ]; then
+    failed=1
+  fi
+done
+exit "$failed"
