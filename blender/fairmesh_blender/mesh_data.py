@@ -10,9 +10,22 @@ the result.
 
 from typing import List, Optional, Tuple
 
+import bpy
 import numpy as np
 
 from . import work
+
+#: The integer type Blender keeps indices in, which foreach_get then copies at once (any other
+#: type is converted one value at a time, several times slower): unsigned before Blender 3.6,
+#: which moved corners and edges into int attributes.
+INDEX = np.uint32 if bpy.app.version < (3, 6, 0) else np.int32
+
+
+def _indices(collection, name: str, count: int) -> np.ndarray:
+    """``collection``'s integer property ``name`` (``count`` values in all) as int64."""
+    values = np.empty(count, dtype=INDEX)
+    collection.foreach_get(name, values)
+    return values.astype(np.int64)
 
 
 class NotFairable(Exception):
@@ -36,20 +49,13 @@ def read(obj, only_selected: bool, vertex_group: str,
     vertices = vertices.reshape(n, 3)
     mesh.calc_loop_triangles()
     m = len(mesh.loop_triangles)
-    triangles = np.empty(m * 3, dtype=np.int32)
-    mesh.loop_triangles.foreach_get("vertices", triangles)
-    triangles = triangles.reshape(m, 3).astype(np.int64)
-    triangle_corners = np.empty(m * 3, dtype=np.int32)
-    mesh.loop_triangles.foreach_get("loops", triangle_corners)
-    triangle_corners = triangle_corners.reshape(m, 3)
+    corner_count = len(mesh.loops)
+    corner_vertex = _indices(mesh.loops, "vertex_index", corner_count)
+    triangle_corners = _indices(mesh.loop_triangles, "loops", m * 3).reshape(m, 3)
+    triangles = corner_vertex[triangle_corners]
 
     edge_count = len(mesh.edges)
-    edge_vertices = np.empty(edge_count * 2, dtype=np.int32)
-    mesh.edges.foreach_get("vertices", edge_vertices)
-    edge_vertices = edge_vertices.reshape(edge_count, 2)
-    corner_count = len(mesh.loops)
-    corner_edge = np.empty(corner_count, dtype=np.int32)
-    mesh.loops.foreach_get("edge_index", corner_edge)
+    corner_edge = _indices(mesh.loops, "edge_index", corner_count)
     faces_per_edge = np.bincount(corner_edge, minlength=edge_count)
     non_manifold = int((faces_per_edge > 2).sum())
     if non_manifold:
@@ -69,14 +75,15 @@ def read(obj, only_selected: bool, vertex_group: str,
             f"are")
 
     sharp = _sharp_edges(mesh, edge_count)
-    hard_edges = edge_vertices[sharp].astype(np.int64) if sharp is not None else None
+    hard_edges = None
+    if sharp is not None and sharp.any():
+        edge_vertices = _indices(mesh.edges, "vertices", edge_count * 2).reshape(edge_count, 2)
+        hard_edges = edge_vertices[sharp]
 
     mask = None
     if only_selected:
         mask = _mask(obj, mesh, n, vertex_group, in_edit_mode)
 
-    corner_vertex = np.empty(corner_count, dtype=np.int32)
-    mesh.loops.foreach_get("vertex_index", corner_vertex)
     uv_layers = []
     for layer in mesh.uv_layers:
         uvs = np.empty(corner_count * 2, dtype=np.float32)
@@ -198,10 +205,8 @@ def write(obj, before: np.ndarray, result: work.MeshResult) -> None:
     if custom:
         face_normals_after = _face_normals(mesh)
         face_of_corner = np.empty(len(mesh.loops), dtype=np.int32)
-        starts = np.empty(len(mesh.polygons), dtype=np.int32)
-        totals = np.empty(len(mesh.polygons), dtype=np.int32)
-        mesh.polygons.foreach_get("loop_start", starts)
-        mesh.polygons.foreach_get("loop_total", totals)
+        starts = _indices(mesh.polygons, "loop_start", len(mesh.polygons))
+        totals = _indices(mesh.polygons, "loop_total", len(mesh.polygons))
         face_of_corner[_corner_order(starts, totals)] = np.repeat(np.arange(len(starts)),
                                                                   totals)
         turned = _turned(corner_normals, face_normals_before[face_of_corner],
