@@ -37,7 +37,6 @@ def install():
 
 install()
 import fairmesh  # noqa: E402  (the add-on's copy, put on sys.path by the add-on)
-import fairmesh_blender  # noqa: E402
 from fairmesh_blender import operator as addon_operator, work  # noqa: E402
 
 
@@ -101,8 +100,7 @@ def diagonal(vertices):
 
 
 def fair(**options):
-    result = bpy.ops.object.fairmesh_fair(**options)
-    return result
+    return bpy.ops.object.fairmesh_fair(**options)
 
 
 # --- the tests -------------------------------------------------------------------------------
@@ -335,8 +333,6 @@ def shape_keys_keep_their_offsets_and_custom_normals_turn():
     face_normals = np.empty(len(mesh.polygons) * 3, dtype=np.float32)
     mesh.polygons.foreach_get("normal", face_normals)
     face_normals = face_normals.reshape(-1, 3)
-    starts = np.empty(len(mesh.polygons), dtype=np.int32)
-    mesh.polygons.foreach_get("loop_start", starts)
     corner_face = np.repeat(np.arange(len(mesh.polygons)), 3)  # all triangles
     mesh.normals_split_custom_set(face_normals[corner_face])
     assert mesh.has_custom_normals
