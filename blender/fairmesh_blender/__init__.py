@@ -28,7 +28,8 @@ bl_info = {
 }
 
 _vendor = os.path.join(os.path.dirname(os.path.abspath(__file__)), "vendor")
-if os.path.isdir(_vendor) and _vendor not in sys.path:
+_extension = __package__.startswith("bl_ext.")  # Blender 4.2+ installed the wheel itself
+if not _extension and os.path.isdir(_vendor) and _vendor not in sys.path:
     # The classic add-on carries the package; put its copy first so that this add-on's
     # version is the one used.
     sys.path.insert(0, _vendor)
