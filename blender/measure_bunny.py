@@ -26,7 +26,7 @@ import bpy
 import numpy as np
 
 ZIP = os.path.abspath(sys.argv[sys.argv.index("--") + 1])
-REPEATS = 3
+REPEATS = 5
 
 bpy.ops.preferences.addon_install(filepath=ZIP, overwrite=True)
 bpy.ops.preferences.addon_enable(module="fairmesh_blender")
