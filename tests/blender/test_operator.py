@@ -33,6 +33,9 @@ def install():
     assert hasattr(bpy.ops.object, "fairmesh_fair"), "the operator is not registered"
     import fairmesh
     assert os.path.join("fairmesh_blender", "vendor") in fairmesh.__file__, fairmesh.__file__
+    from fairmesh_blender import operator as entry
+    for menu in (bpy.types.VIEW3D_MT_object, bpy.types.VIEW3D_MT_edit_mesh):
+        assert entry.menu_entry in menu.draw._draw_funcs, f"not in {menu.__name__}"
 
 
 install()
@@ -361,6 +364,24 @@ def shape_keys_keep_their_offsets_and_custom_normals_turn():
     cosine = (corner_normals.reshape(-1, 3) * new_face[corner_face]).sum(axis=1)
     assert cosine.min() > 0.999, f"a custom normal is {math.degrees(math.acos(cosine.min())):.1f}" \
                                  " degrees off its face"
+
+
+@test
+def every_selected_mesh_is_faired_and_reported_by_name():
+    clear_scene()
+    first = noisy_sphere("First", subdivisions=3)
+    second = noisy_sphere("Second", subdivisions=3)
+    second.location.x = 3.0
+    before = {obj.name: positions(obj).copy() for obj in (first, second)}
+    for obj in (first, second):
+        obj.select_set(True)
+    assert fair() == {'FINISHED'}
+    for obj in (first, second):
+        expected, _ = fairmesh.fair(before[obj.name], triangles(obj))
+        error = np.abs(positions(obj) - expected).max() / diagonal(before[obj.name])
+        assert error <= 1e-6, f"{obj.name}: {error} of the diagonal from fairmesh.fair"
+    info = [m for level, m in addon_operator.last_reports if level == 'INFO']
+    assert info and "First: noise about" in info[0] and "Second: noise about" in info[0], info
 
 
 @test
