@@ -40,6 +40,9 @@ def read(obj, only_selected: bool, vertex_group: str,
     if obj.type != 'MESH':
         raise NotFairable(f"{obj.name} is not a mesh (it is a {obj.type.lower()}): skipped")
     mesh = obj.data
+    if mesh.library is not None or getattr(mesh, "override_library", None) is not None:
+        raise NotFairable(f"{obj.name}'s mesh is linked from another file: make it local "
+                          f"(Object > Relations > Make Local) to fair it")
     n = len(mesh.vertices)
     if n == 0 or len(mesh.polygons) == 0:
         raise NotFairable(f"{obj.name} is an empty mesh (no faces): nothing to fair")

@@ -132,12 +132,20 @@ class OBJECT_OT_fairmesh_fair(bpy.types.Operator):
             # The edit mesh written into the mesh data, UV maps included.
             bpy.ops.object.mode_set(mode='OBJECT')
         try:
+            seen = set()
             for obj in objects:
+                if obj.type == 'MESH':
+                    if obj.data.as_pointer() in seen:
+                        continue  # a linked duplicate: its mesh is faired once
+                    seen.add(obj.data.as_pointer())
                 try:
                     mesh, warnings = mesh_data.read(obj, self.only_selected, self.vertex_group,
                                                     in_edit_mode)
                 except mesh_data.NotFairable as reason:
                     self._say({'WARNING'}, str(reason))
+                    continue
+                except Exception as error:  # reported, never a traceback
+                    self._say({'WARNING'}, f"{obj.name} could not be read: {error}")
                     continue
                 jobs.append((obj, mesh, warnings))
         finally:
@@ -164,6 +172,8 @@ class OBJECT_OT_fairmesh_fair(bpy.types.Operator):
                 raise
             except (ValueError, TypeError) as error:
                 outcomes.append((None, f"{obj_name}: {error}"))
+            except Exception as error:  # reported, never a traceback
+                outcomes.append((None, f"{obj_name}: fairmesh failed: {error}"))
         return outcomes
 
     def _apply(self, context, jobs, outcomes):
@@ -243,7 +253,6 @@ class OBJECT_OT_fairmesh_fair(bpy.types.Operator):
         window_manager.progress_begin(0, 1000)
         self._timer = window_manager.event_timer_add(0.1, window=context.window)
         window_manager.modal_handler_add(self)
-        context.window.cursor_modal_set('WAIT')
         self._thread.start()
         return {'RUNNING_MODAL'}
 
@@ -259,7 +268,6 @@ class OBJECT_OT_fairmesh_fair(bpy.types.Operator):
         window_manager = context.window_manager
         window_manager.event_timer_remove(self._timer)
         window_manager.progress_end()
-        context.window.cursor_modal_restore()
         state, value = self._outcome or ("failed", "fairmesh stopped unexpectedly")
         if state == "cancelled":
             self._say({'WARNING'}, "Cancelled: nothing changed")

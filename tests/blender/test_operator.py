@@ -385,6 +385,24 @@ def every_selected_mesh_is_faired_and_reported_by_name():
 
 
 @test
+def a_mesh_shared_by_linked_duplicates_is_faired_once():
+    clear_scene()
+    first = noisy_sphere("First", subdivisions=3)
+    twin = bpy.data.objects.new("Twin", first.data)
+    bpy.context.scene.collection.objects.link(twin)
+    before = positions(first).copy()
+    twin.select_set(True)
+    # Rounds as asked: a second fairing would move it again (the automatic strength would
+    # leave the faired mesh as it is, and hide it).
+    assert fair(denoise='ROUNDS', rounds=3) == {'FINISHED'}
+    expected, _ = fairmesh.fair(before, triangles(first), rounds=3)
+    twice, _ = fairmesh.fair(expected, triangles(first), rounds=3)
+    assert np.abs(twice - expected).max() > 1e-4 * diagonal(before)
+    error = np.abs(positions(first) - expected).max() / diagonal(before)
+    assert error <= 1e-6, f"{error} of the diagonal from one fairmesh.fair"
+
+
+@test
 def a_non_mesh_object_and_an_empty_mesh_give_a_report():
     clear_scene()
     camera = bpy.data.objects.new("Camera", bpy.data.cameras.new("Camera"))
