@@ -1,20 +1,26 @@
 #!/usr/bin/env bash
 # The Blender add-on's tests (tests/blender/test_*.py), run inside Blender itself: installs
-# Debian's blender and python3-numpy when missing, builds target/fairmesh_blender.zip
+# Debian's blender and python3-numpy (and xvfb, xauth) when missing, builds target/fairmesh_blender.zip
 # (scripts/build_blender_addon.sh, reusing python/dist/*.whl that scripts/test_python.sh left),
 # then runs each test script headless with the zip. Blender installs the add-on into a scratch
 # user folder, so the machine's own Blender settings are not touched. Exits non-zero when a test
 # fails. Run by .ci/run after scripts/test_python.sh.
 set -euo pipefail
 cd "$(dirname "$0")/.."
-if ! command -v blender >/dev/null 2>&1 || ! python3 -c 'import numpy' >/dev/null 2>&1 \
-    && ! dpkg -s python3-numpy >/dev/null 2>&1; then
+# Debian's Blender runs the system Python, which finds numpy in Debian's python3-numpy; the
+# window test runs under xvfb-run, which needs xauth.
+missing=()
+for package in blender python3-numpy xvfb xauth; do
+  dpkg-query -W -f='${Status}' "$package" 2>/dev/null | grep -q "install ok installed" \
+    || missing+=("$package")
+done
+if [ "${#missing[@]}" -gt 0 ]; then
   sudo_cmd=()
   [ "$(id -u)" -ne 0 ] && sudo_cmd=(sudo)
-  echo "test_blender: installing blender and python3-numpy"
+  echo "test_blender: installing ${missing[*]}"
   "${sudo_cmd[@]}" apt-get update -qq
   DEBIAN_FRONTEND=noninteractive "${sudo_cmd[@]}" apt-get install -y -qq \
-    --no-install-recommends blender python3-numpy >/dev/null
+    --no-install-recommends "${missing[@]}" >/dev/null
 fi
 scripts/build_blender_addon.sh
 zip="$(realpath "${CARGO_TARGET_DIR:-target}/fairmesh_blender.zip")"

@@ -137,6 +137,25 @@ def start_level_is_the_hierarchys_multires():
 
 
 @test
+def rounds_and_off_are_fair_with_those_rounds_and_the_bare_hierarchy():
+    clear_scene()
+    obj = noisy_sphere()
+    before, faces = positions(obj).copy(), triangles(obj)
+    assert fair(denoise='ROUNDS', rounds=4, boundary='FIXED') == {'FINISHED'}
+    expected, _ = fairmesh.fair(before, faces, rounds=4, boundary="fixed")
+    assert np.abs(positions(obj) - expected).max() / diagonal(before) <= 1e-6
+    info = [m for level, m in addon_operator.last_reports if level == 'INFO']
+    assert info == ["4 rounds as asked, 0 sharp edges kept"], info
+    obj.data.vertices.foreach_set("co", before.reshape(-1))
+    obj.data.update()
+    assert fair(denoise='OFF', start_level=1, keep_sharp_edges=False) == {'FINISHED'}
+    expected = fairmesh.hierarchy(before, faces).multires(1)
+    assert np.abs(positions(obj) - expected).max() / diagonal(before) <= 1e-6
+    info = [m for level, m in addon_operator.last_reports if level == 'INFO']
+    assert info and info[0].startswith("no noise removed first; faired from level 1"), info
+
+
+@test
 def undo_restores_the_mesh_exactly_and_a_redo_keeps_the_hierarchy():
     clear_scene()
     obj = noisy_sphere(subdivisions=5)
