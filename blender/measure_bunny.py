@@ -7,11 +7,12 @@ doing the same work in the same process:
   ``Hierarchy.multires`` alone.
 
     scripts/build_blender_addon.sh
-    blender -b --factory-startup --python blender/measure_bunny.py -- target/fairmesh_blender.zip
+    BLENDER_USER_SCRIPTS=$(mktemp -d) blender -b --factory-startup \
+        --python blender/measure_bunny.py -- target/fairmesh_blender.zip
 
 The noisy bunny is ``fairmesh noise @bunny --sigma 0.3 --seed 1``'s. Each figure is the median
-of a few runs. The zip is installed into a scratch user folder (BLENDER_USER_SCRIPTS is set to
-one when not given).
+of a few runs. The zip is installed into BLENDER_USER_SCRIPTS (an empty folder above, so that
+your own add-ons are not touched).
 """
 
 import os
@@ -20,7 +21,7 @@ import sys
 import time
 
 if "BLENDER_USER_SCRIPTS" not in os.environ:
-    print("set BLENDER_USER_SCRIPTS to a scratch folder to keep your own add-ons untouched")
+    print("BLENDER_USER_SCRIPTS is not set: the add-on is installed among your own add-ons")
 
 import bpy
 import numpy as np
