@@ -15,6 +15,8 @@ array of vertex indices; results are new numpy arrays and the inputs are never c
 - ``noise``, ``compare``: seeded noise; distances and volume change between two meshes.
 - ``hierarchy``: the decimation hierarchy, whose ``multires(start_level)`` fairs from a coarse
   level and can be run again and again without building anything again.
+- ``follow_texture``: texture coordinates kept with the texture when vertices slide, for a
+  program that keeps its own (as ``Mesh.save`` does for files).
 - ``load`` / ``Mesh.save``: files kept as the command line keeps them (written back into
   their own format with only the positions changed); ``save`` writes a bare mesh.
 - ``fairmesh.trimesh`` and ``fairmesh.open3d``: the same on trimesh meshes and scenes and on
@@ -38,6 +40,7 @@ from ._fairmesh import (
     __version__,
     compare,
     fair,
+    follow_texture,
     hierarchy,
     load,
     noise,
@@ -59,6 +62,7 @@ __all__ = [
     "__version__",
     "compare",
     "fair",
+    "follow_texture",
     "hierarchy",
     "load",
     "noise",

@@ -293,6 +293,7 @@ def hierarchy(
     keep_boundary: bool = False,
     keep_creases: bool = False,
     crease_angle: Optional[float] = None,
+    hard_edges: Optional[npt.ArrayLike] = None,
     denoise: Union[None, Literal["auto", "off"], int] = None,
     progress: Optional[Progress] = None,
     threads: Optional[int] = None,
@@ -309,6 +310,7 @@ def hierarchy(
     keep_boundary: bool = False,
     keep_creases: bool = False,
     crease_angle: Optional[float] = None,
+    hard_edges: Optional[npt.ArrayLike] = None,
     denoise: Union[None, Literal["auto", "off"], int] = None,
     progress: Optional[Progress] = None,
     threads: Optional[int] = None,
@@ -330,11 +332,40 @@ def hierarchy(
     - ``keep_creases``: sharp creases (found at ``crease_angle``, 40 degrees unless given; the
       file's own sharp edges too for a loaded ``Mesh``) stay on every level: a crease vertex
       collapses only along its crease and corners never do. Giving ``crease_angle`` implies it.
+    - ``hard_edges``: (k, 2) vertex pairs kept sharp with the creases found, as ``fair``'s
+      (for a loaded ``Mesh``, instead of its file's sharp edges); giving them implies
+      ``keep_creases``.
     - ``denoise``: None or "off" (none), "auto" or a number of rounds: first denoise the mesh as
       ``fair`` does and build the levels on the result, as the editor and ``fairmesh multires``
       do (with ``keep_creases=True`` for their defaults): ``multires(0)`` is then ``fair``'s
       result and ``Hierarchy.denoise`` says what the denoise found.
     - ``progress``, ``threads``: as for ``fair``."""
+
+def follow_texture(
+    before: Vertices,
+    after: Vertices,
+    faces: Faces,
+    uvs: npt.ArrayLike,
+    uv_faces: Optional[Faces] = None,
+) -> npt.NDArray[np.float64]:
+    """Texture coordinates that follow the vertices' slide along the surface, as ``Mesh.save``
+    moves a file's: fairing moves vertices mostly across the surface and a little along it, and
+    a texture coordinate that stays with a vertex that slid drags the texture with it. Each
+    moved vertex's texture coordinates are moved to what the texture held, before the move,
+    where the vertex slid to (each side of a UV seam in its own chart).
+
+    - ``before``, ``after``: the (n, 3) vertices before and after the move (``fair``'s input
+      and result); ``faces``: the (m, 3) triangles.
+    - ``uvs``: (k, 2) texture coordinates; ``uv_faces``: (m, 3) indices into ``uvs``, the
+      coordinate of each corner of each triangle (None: ``uvs`` has one row per vertex and
+      ``faces`` indexes it). A program that keeps one coordinate per corner passes one index
+      per corner, or better the distinct (vertex, coordinate) pairs, so that corners of a vertex
+      in one chart move as one.
+
+    Returns the new (k, 2) float64 coordinates; those of vertices that did not move are kept
+    exactly. A coordinate several moved vertices share cannot follow them all: it is kept, and
+    a ``MeshWarning`` says how many. Raises ``ValueError`` or ``TypeError`` naming the argument
+    at fault."""
 
 def load(path: PathLike, *, weld: bool = True, progress: Optional[Progress] = None) -> Mesh:
     """Read a mesh file (.obj .gltf .glb .ply .stl .off; ``"@bunny"``: the bundled bunny),

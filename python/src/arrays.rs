@@ -295,6 +295,14 @@ pub fn triangles_array<'py>(py: Python<'py>, triangles: &[[u32; 3]]) -> Bound<'p
     owned_rows(py, flat, triangles.len())
 }
 
+/// Pairs (texture coordinates) as a new (k, 2) float64 array.
+pub fn pairs_array(py: Python<'_>, pairs: Vec<[f64; 2]>) -> Bound<'_, PyAny> {
+    let rows = pairs.len();
+    let flat: Vec<f64> = pairs.into_iter().flatten().collect();
+    let array = Array2::from_shape_vec((rows, 2), flat).expect("two values a row");
+    PyArray2::from_owned_array(py, array).into_any()
+}
+
 /// A (rows, 3) array that takes over `flat` (no copy).
 fn owned_rows<T: Element>(py: Python<'_>, flat: Vec<T>, rows: usize) -> Bound<'_, PyAny> {
     let array = Array2::from_shape_vec((rows, 3), flat).expect("three values a row");

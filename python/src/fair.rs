@@ -292,7 +292,7 @@ pub fn fair<'py>(
 }
 
 /// `hard_edges`: (k, 2) vertex pairs.
-fn read_edges(edges: &Bound<'_, PyAny>, vertex_count: usize) -> PyResult<Vec<[u32; 2]>> {
+pub(crate) fn read_edges(edges: &Bound<'_, PyAny>, vertex_count: usize) -> PyResult<Vec<[u32; 2]>> {
     let pairs: Vec<[i64; 2]> = edges.extract().map_err(|_| {
         PyTypeError::new_err("hard_edges must be a (k, 2) array of vertex index pairs")
     })?;

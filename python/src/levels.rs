@@ -175,8 +175,8 @@ impl Hierarchy {
 #[pyfunction]
 #[pyo3(signature = (
     vertices, faces=None, *, alpha=1.0, beta=0.01, min_vertices=100, max_levels=64,
-    keep_boundary=false, keep_creases=false, crease_angle=None, denoise=None, progress=None,
-    threads=None
+    keep_boundary=false, keep_creases=false, crease_angle=None, hard_edges=None, denoise=None,
+    progress=None, threads=None
 ), text_signature = None)]
 #[allow(clippy::too_many_arguments)]
 pub fn hierarchy(
@@ -190,6 +190,7 @@ pub fn hierarchy(
     keep_boundary: bool,
     keep_creases: bool,
     crease_angle: Option<f64>,
+    hard_edges: Option<&Bound<'_, PyAny>>,
     denoise: Option<&Bound<'_, PyAny>>,
     progress: Option<&Bound<'_, PyAny>>,
     threads: Option<i64>,
@@ -199,13 +200,14 @@ pub fn hierarchy(
     let crease_angle = crease_angle
         .map(|a| options::number_in("crease_angle", a, 0.0, 180.0))
         .transpose()?;
+    let hard_edges = hard_edges.filter(|e| !e.is_none());
     let mut options = HierarchyOptions::default()
         .with_alpha(options::finite("alpha", alpha)?)
         .with_beta(options::finite("beta", beta)?)
         .with_min_vertices(options::count("min_vertices", min_vertices)?)
         .with_max_levels(options::count("max_levels", max_levels)?)
         .with_keep_boundary(keep_boundary)
-        .with_creases((keep_creases || crease_angle.is_some()).then(|| {
+        .with_creases((keep_creases || crease_angle.is_some() || hard_edges.is_some()).then(|| {
             CreaseOptions::default()
                 .with_angle_degrees(crease_angle.unwrap_or(DEFAULT_CREASE_ANGLE))
         }));
@@ -217,7 +219,12 @@ pub fn hierarchy(
                 ));
             }
             let loaded = loaded.borrow();
-            let edges = loaded.file_hard_edges();
+            let edges = match hard_edges {
+                Some(edges) => {
+                    crate::fair::read_edges(edges, loaded.loaded.mesh.vertex_count())?
+                }
+                None => loaded.file_hard_edges(),
+            };
             let state = &loaded.loaded;
             (
                 state.mesh.clone(),
@@ -233,7 +240,11 @@ pub fn hierarchy(
                 ));
             };
             let (mesh, topology, precision) = from_arrays(vertices, faces)?;
-            (mesh, topology, precision, Vec::new())
+            let edges = match hard_edges {
+                Some(edges) => crate::fair::read_edges(edges, mesh.vertex_count())?,
+                None => Vec::new(),
+            };
+            (mesh, topology, precision, edges)
         }
     };
     if let Some(creases) = &mut options.creases {

@@ -7,6 +7,7 @@
 //! - `fair.rs`: `fair`, the command line's `fair` with its `--json` report as a dict.
 //! - `levels.rs`: `hierarchy` and its `Hierarchy` object, which runs `multires` again and again.
 //! - `measure.rs`: `noise` and `compare`.
+//! - `texture.rs`: `follow_texture`, texture coordinates that follow the vertices' slide.
 //! - `run.rs`: long calls without the GIL, with a progress callback and Ctrl+C.
 //! - `pool.rs`: the rayon pool every call runs in, one per process (so a forked child works).
 //! - `options.rs`, `errors.rs`: keyword arguments checked, the library's errors as exceptions.
@@ -20,6 +21,7 @@ mod mesh;
 mod options;
 mod pool;
 mod run;
+mod texture;
 
 use pyo3::prelude::*;
 
@@ -30,6 +32,7 @@ fn _fairmesh(module: &Bound<'_, PyModule>) -> PyResult<()> {
     module.add_function(wrap_pyfunction!(measure::noise, module)?)?;
     module.add_function(wrap_pyfunction!(measure::compare, module)?)?;
     module.add_function(wrap_pyfunction!(levels::hierarchy, module)?)?;
+    module.add_function(wrap_pyfunction!(texture::follow_texture, module)?)?;
     module.add_function(wrap_pyfunction!(mesh::load, module)?)?;
     module.add_function(wrap_pyfunction!(mesh::save, module)?)?;
     module.add_function(wrap_pyfunction!(mesh::load_pickled, module)?)?;

@@ -55,6 +55,7 @@ pub use save::{save, save_as, write_to};
 pub use save_source::{save_derived_with_source, save_with_source, Derivation};
 pub use source::Source;
 pub use uv_convention::TextureVOrigin;
+pub use uv_follow::{follow_texture_coordinates, FollowedTexture, TextureFollowError};
 pub use vertex_list::{loaded_vertices, parse_vertex_list, read_vertex_list, VertexListError};
 
 use crate::mesh::TriMesh;

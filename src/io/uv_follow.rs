@@ -103,6 +103,118 @@ pub(crate) fn follow(
     }
 }
 
+/// Why [`follow_texture_coordinates`] refused its arrays.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+pub enum TextureFollowError {
+    /// `before` and `after` hold different numbers of vertices.
+    #[error("the positions before ({before}) and after ({after}) the move differ in count")]
+    VertexCounts { before: usize, after: usize },
+    /// The vertex triangles and the texture triangles differ in count.
+    #[error("{triangles} triangles but {texture_triangles} triangles of texture coordinates")]
+    TriangleCounts {
+        triangles: usize,
+        texture_triangles: usize,
+    },
+    /// A corner names a vertex beyond the positions.
+    #[error("triangle {triangle} names vertex {vertex}, but there are {count} vertices")]
+    VertexBeyond {
+        triangle: usize,
+        vertex: u32,
+        count: usize,
+    },
+    /// A corner names a texture coordinate beyond the table.
+    #[error(
+        "triangle {triangle} names texture coordinate {coordinate}, but there are {count}"
+    )]
+    CoordinateBeyond {
+        triangle: usize,
+        coordinate: u32,
+        count: usize,
+    },
+    /// A texture coordinate or a position is NaN or infinite.
+    #[error("{what} {index} is not finite")]
+    NotFinite { what: &'static str, index: usize },
+}
+
+/// What [`follow_texture_coordinates`] gives.
+#[derive(Debug, Clone, PartialEq)]
+pub struct FollowedTexture {
+    /// Every texture coordinate: moved where its vertex slid, else as it was.
+    pub uvs: Vec<[f64; 2]>,
+    /// Texture coordinates left as they were because several moved vertices share them.
+    pub shared: usize,
+}
+
+/// Texture coordinates that follow their vertices' slide along the surface (see the module
+/// docs), for a front end that holds its own texture coordinates (the Python package, and
+/// through it an add-on): `triangles` over the vertices, moved from `before` to `after`;
+/// `texture_triangles[t][k]`, the index in `uvs` of corner `k` of triangle `t`. Arrays that do
+/// not fit together are refused, naming the first thing wrong.
+pub fn follow_texture_coordinates(
+    before: &[[f32; 3]],
+    after: &[[f32; 3]],
+    triangles: &[[u32; 3]],
+    texture_triangles: &[[u32; 3]],
+    uvs: &[[f64; 2]],
+) -> Result<FollowedTexture, TextureFollowError> {
+    if before.len() != after.len() {
+        return Err(TextureFollowError::VertexCounts {
+            before: before.len(),
+            after: after.len(),
+        });
+    }
+    if triangles.len() != texture_triangles.len() {
+        return Err(TextureFollowError::TriangleCounts {
+            triangles: triangles.len(),
+            texture_triangles: texture_triangles.len(),
+        });
+    }
+    for (what, points) in [("position before", before), ("position after", after)] {
+        if let Some(index) = points.iter().position(|p| !p.iter().all(|c| c.is_finite())) {
+            return Err(TextureFollowError::NotFinite { what, index });
+        }
+    }
+    if let Some(index) = uvs.iter().position(|p| !p.iter().all(|c| c.is_finite())) {
+        return Err(TextureFollowError::NotFinite {
+            what: "texture coordinate",
+            index,
+        });
+    }
+    let mut corners: Vec<UvTriangle> = Vec::with_capacity(triangles.len());
+    for (triangle, (vertices, coordinates)) in triangles.iter().zip(texture_triangles).enumerate() {
+        let mut corner = [[0u32; 2]; 3];
+        for k in 0..3 {
+            let (vertex, coordinate) = (vertices[k], coordinates[k]);
+            if vertex as usize >= before.len() {
+                return Err(TextureFollowError::VertexBeyond {
+                    triangle,
+                    vertex,
+                    count: before.len(),
+                });
+            }
+            if coordinate as usize >= uvs.len() {
+                return Err(TextureFollowError::CoordinateBeyond {
+                    triangle,
+                    coordinate,
+                    count: uvs.len(),
+                });
+            }
+            corner[k] = [vertex, coordinate];
+        }
+        corners.push(corner);
+    }
+    let followed = follow(before, after, &corners, uvs);
+    let moved = uvs
+        .iter()
+        .zip(followed.moved)
+        .map(|(&old, new)| new.unwrap_or(old))
+        .collect();
+    Ok(FollowedTexture {
+        uvs: moved,
+        shared: followed.shared,
+    })
+}
+
 /// A texture coordinate's vertex not seen yet.
 const NONE: u32 = u32::MAX;
 /// A texture coordinate several vertices use.
@@ -499,5 +611,37 @@ mod tests {
         let followed = follow(&before, &after, &triangles, &uvs);
         assert_eq!(followed.moved[copy[centre].unwrap()], None);
         assert_eq!(followed.shared, 1);
+    }
+
+    #[test]
+    fn the_public_entry_point_moves_what_follow_moves_and_refuses_what_does_not_fit() {
+        let (before, corners, uvs) = grid(5);
+        let triangles: Vec<[u32; 3]> = corners.iter().map(|t| t.map(|c| c[0])).collect();
+        let texture: Vec<[u32; 3]> = corners.iter().map(|t| t.map(|c| c[1])).collect();
+        let mut after = before.clone();
+        after[12] = [2.2, 1.9, 0.0];
+        let followed =
+            follow_texture_coordinates(&before, &after, &triangles, &texture, &uvs).unwrap();
+        let expected = affine(2.2, 1.9);
+        assert!((followed.uvs[12][0] - expected[0]).abs() < 1e-6);
+        assert!((followed.uvs[12][1] - expected[1]).abs() < 1e-6);
+        assert_eq!(followed.uvs[11], uvs[11]);
+        assert_eq!(followed.shared, 0);
+        let mut beyond = texture.clone();
+        beyond[3][1] = uvs.len() as u32;
+        assert!(matches!(
+            follow_texture_coordinates(&before, &after, &triangles, &beyond, &uvs),
+            Err(TextureFollowError::CoordinateBeyond { triangle: 3, .. })
+        ));
+        assert!(matches!(
+            follow_texture_coordinates(&before, &after[1..], &triangles, &texture, &uvs),
+            Err(TextureFollowError::VertexCounts { .. })
+        ));
+        let mut nan = uvs.clone();
+        nan[2][0] = f64::NAN;
+        assert!(matches!(
+            follow_texture_coordinates(&before, &after, &triangles, &texture, &nan),
+            Err(TextureFollowError::NotFinite { index: 2, .. })
+        ));
     }
 }
