@@ -10,7 +10,11 @@ them), and the report.
 Seams: a mesh read from a file with split normals or texture seams may hold one vertex per side
 of a seam. Those copies of a position are faired as one vertex, as ``fairmesh.load`` welds a
 file, and every copy gets the result, so no seam opens (a ``mask`` or ``hard_edges`` over the
-copies is read over the welded vertices). Texture coordinates stay as they are.
+copies is read over the welded vertices). Texture coordinates (Open3D keeps one per triangle
+corner) follow the vertices' slide along the surface, as ``Mesh.save`` makes them follow in
+files: each moves to what the texture held where its vertex slid to (``fairmesh.follow_texture``,
+the corners of a vertex that share a coordinate moved as one), so the texture stays where it was
+on the surface.
 
 Only ``open3d.geometry.TriangleMesh`` is taken; anything else (a ``PointCloud``, a tensor
 ``open3d.t.geometry.TriangleMesh``: convert it with ``.to_legacy()``) raises ``TypeError``.
@@ -71,10 +75,27 @@ def fair(
 ) -> Tuple["open3d.geometry.TriangleMesh", Dict[str, Any]]:
     """``fairmesh.fair`` on ``mesh``: a copy with the smoothed vertices, and the report; the
     copies of a position across seams are faired as one. ``mesh`` itself is not changed."""
-    _checked(mesh, "fair")
+    open3d = _checked(mesh, "fair")
     vertices, faces = arrays(mesh)
     smoothed, report = _welding.fair(vertices, faces, options)
-    return _with_vertices(mesh, smoothed), report
+    result = _with_vertices(mesh, smoothed)
+    corner_uvs = np.asarray(mesh.triangle_uvs)
+    if len(faces) and corner_uvs.shape == (3 * len(faces), 2):
+        followed = _follow_corners(vertices, smoothed, faces, corner_uvs)
+        result.triangle_uvs = open3d.utility.Vector2dVector(followed)
+    return result, report
+
+
+def _follow_corners(before: np.ndarray, after: np.ndarray, faces: np.ndarray,
+                    corner_uvs: np.ndarray) -> np.ndarray:
+    """Per-corner texture coordinates moved with the vertices' slide: the distinct (vertex,
+    coordinate) pairs move as one, each in its own chart."""
+    pairs = np.column_stack([faces.reshape(-1).astype(np.float64), corner_uvs])
+    distinct, inverse = np.unique(pairs, axis=0, return_inverse=True)
+    inverse = inverse.reshape(-1)
+    moved = fairmesh.follow_texture(before, after, faces, distinct[:, 1:],
+                                    uv_faces=inverse.reshape(-1, 3))
+    return moved[inverse]
 
 
 def noise(mesh: "open3d.geometry.TriangleMesh", **options: Any) -> "open3d.geometry.TriangleMesh":

@@ -36,7 +36,7 @@ from typing import Any, Dict, Tuple, Union
 import numpy as np
 
 import fairmesh
-from fairmesh import _texture, _welding
+from fairmesh import _welding
 
 
 def _trimesh():
@@ -81,7 +81,7 @@ def _move(geometry, vertices):
     visual = geometry.visual
     uv = getattr(visual, "uv", None) if getattr(visual, "kind", None) == "texture" else None
     if uv is not None and len(uv) == len(vertices):
-        visual.uv = _texture.follow(geometry.vertices, vertices, geometry.faces, uv)
+        visual.uv = fairmesh.follow_texture(geometry.vertices, vertices, geometry.faces, uv)
     geometry.vertices = vertices
 
 

@@ -269,6 +269,43 @@ def test_open3d_meshes_split_at_seams_keep_their_seams_closed():
         fairmesh.open3d.fair(o3d.geometry.PointCloud())
 
 
+def jittered_grid(k=30):
+    """A flat k x k grid jittered in its plane (z = 0), its faces, and its texture coordinates:
+    its own x and y over k - 1, so that wherever a vertex slides in the plane, the texture there
+    is its new x and y."""
+    x, y = np.meshgrid(np.arange(k, dtype=float), np.arange(k, dtype=float))
+    xy = np.stack([x.ravel(), y.ravel()], axis=1)
+    inside = (xy > 0).all(axis=1) & (xy < k - 1).all(axis=1)
+    xy[inside] += np.random.default_rng(1).uniform(-0.3, 0.3, (inside.sum(), 2))
+    xy = xy.astype(np.float32).astype(np.float64)  # what fairmesh computes in: kept exactly
+    corners = np.arange(k * k).reshape(k, k)[:-1, :-1].ravel()
+    faces = np.concatenate([np.stack([corners, corners + 1, corners + k + 1], axis=1),
+                            np.stack([corners, corners + k + 1, corners + k], axis=1)])
+    return np.column_stack([xy, np.zeros(len(xy))]), faces, xy / (k - 1)
+
+
+def test_open3d_texture_coordinates_follow_the_slide_corner_by_corner():
+    o3d = open3d_or_skip()
+    import fairmesh.open3d
+
+    k = 30
+    vertices, faces, uv = jittered_grid(k)
+    mesh = o3d.geometry.TriangleMesh(o3d.utility.Vector3dVector(vertices),
+                                     o3d.utility.Vector3iVector(faces.astype(np.int32)))
+    # One coordinate per corner, as Open3D keeps them.
+    mesh.triangle_uvs = o3d.utility.Vector2dVector(uv[faces].reshape(-1, 2))
+    left = vertices[:, 0] < k / 2
+    smooth, _ = fairmesh.open3d.fair(mesh, variant="paper", rounds=1, iterations=3,
+                                     boundary="fixed", mask=left)
+    after = np.asarray(smooth.vertices)
+    assert np.abs(after[:, 2]).max() == 0
+    assert np.abs(after[:, :2] - vertices[:, :2]).max() > 0.2  # a slide the texture would show
+    corners = np.asarray(smooth.triangle_uvs)
+    np.testing.assert_allclose(corners * (k - 1), after[faces].reshape(-1, 3)[:, :2], atol=1e-6)
+    # The input mesh is not changed.
+    np.testing.assert_array_equal(np.asarray(mesh.triangle_uvs), uv[faces].reshape(-1, 2))
+
+
 def test_from_fairmesh_import_trimesh_keeps_the_trimesh_package_usable(bunny):
     real = pytest.importorskip("trimesh")
     from fairmesh import trimesh
