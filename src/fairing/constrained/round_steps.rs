@@ -47,7 +47,7 @@ pub(super) fn edges_changed(a: &[[u32; 2]], b: &[[u32; 2]]) -> usize {
 }
 
 /// Milliseconds since `start`.
-pub(super) fn milliseconds(start: std::time::Instant) -> f64 {
+pub(super) fn milliseconds(start: crate::clock::Instant) -> f64 {
     start.elapsed().as_secs_f64() * 1e3
 }
 
@@ -98,7 +98,7 @@ impl RoundLoop<'_> {
         ) {
             let detection = (fans, crease_options, &mut self.face_rings);
             if self.tracked.detect_again(mesh, topology, detection, report) {
-                let started = std::time::Instant::now();
+                let started = crate::clock::Instant::now();
                 let creases = self.tracked.creases.as_ref();
                 let fairing = &mut self.fairing;
                 fairing.for_other_creases(mesh, topology, fans, creases, self.pinned);
@@ -106,16 +106,16 @@ impl RoundLoop<'_> {
             }
         }
         // Imposes the constraints on the positions this round starts from.
-        let started = std::time::Instant::now();
+        let started = crate::clock::Instant::now();
         self.fairing.load(&mesh.positions);
         let mut iterations_ms = milliseconds(started);
         let fans = self.fans.as_ref();
         let at = (&*mesh, topology);
-        let started = std::time::Instant::now();
+        let started = crate::clock::Instant::now();
         self.relaxation
             .before_round(&mut self.fairing, round, at, fans);
         report.phases.relaxation += milliseconds(started);
-        let started = std::time::Instant::now();
+        let started = crate::clock::Instant::now();
         let iterations = self.fairing.run_round(self.options, report);
         let step = self.step(round);
         if step != 1.0 {
@@ -124,7 +124,7 @@ impl RoundLoop<'_> {
         self.fairing.store(&mut mesh.positions);
         iterations_ms += milliseconds(started);
         report.phases.iterations += iterations_ms;
-        let started = std::time::Instant::now();
+        let started = crate::clock::Instant::now();
         let class = self.tracked.creases.as_ref().map(|c| c.class.as_slice());
         let class = class.unwrap_or(&[]);
         let held = |v: usize| class.get(v) == Some(&FeatureClass::Corner);
@@ -136,7 +136,7 @@ impl RoundLoop<'_> {
         let Some(judge) = &mut self.judge else {
             return false;
         };
-        let started = std::time::Instant::now();
+        let started = crate::clock::Instant::now();
         judge.fair_copy(&mut self.fairing, iterations, step);
         // The copy takes the mesh's volume offsets: what its own correction would give, but for a
         // change of the distance that sums a part's volume change, of order 1/N per vertex
@@ -185,7 +185,7 @@ impl TrackedCreases {
         (fans, crease_options, face_rings): (&FanRings, &CreaseOptions, &mut FaceRingCache),
         report: &mut FairReport,
     ) -> bool {
-        let started = std::time::Instant::now();
+        let started = crate::clock::Instant::now();
         let (noise, found) = detect_creases_with_estimate(
             mesh,
             topology,

@@ -165,7 +165,7 @@ fn in_local_order(
     pinned: &[bool],
     fair: impl FnOnce(&mut TriMesh, &Topology, &FairOptions, &[bool]) -> Result<FairReport, Cancelled>,
 ) -> Result<FairReport, Cancelled> {
-    let started = std::time::Instant::now();
+    let started = crate::clock::Instant::now();
     let (offsets, neighbors) = topology.neighbor_csr();
     let order = breadth_first_order(offsets, neighbors);
     let position = inverse_permutation(&order);
@@ -220,7 +220,7 @@ fn in_local_order(
         creases.file_edges = edges.into();
     }
     let mut report = fair(&mut local, &local_topology, &local_options, &local_pinned)?;
-    let started = std::time::Instant::now();
+    let started = crate::clock::Instant::now();
     for (&v, p) in order.iter().zip(&local.positions) {
         mesh.positions[v as usize] = *p;
     }
@@ -250,7 +250,7 @@ fn decide_and_fair(
     } else {
         FaceRingCache::in_mesh_order()
     };
-    let started = std::time::Instant::now();
+    let started = crate::clock::Instant::now();
     let (estimate, found, reading) = first_reading(mesh, topology, &fans, options, &mut face_rings);
     let auto_noise = match options.strength {
         Strength::Auto => match noisy(estimate, reading.as_ref(), topology) {
@@ -398,7 +398,7 @@ fn fair_rounds(
         auto_noise,
         pinned,
     } = rounds;
-    let started = std::time::Instant::now();
+    let started = crate::clock::Instant::now();
     let creases =
         found.or_else(|| first_creases(mesh, topology, options, estimate, &mut face_rings));
     let first_detection_ms = milliseconds(started);
@@ -407,7 +407,7 @@ fn fair_rounds(
         None => options.rounds,
     };
     let redetect = options.creases.is_some() && max_rounds > 1;
-    let started = std::time::Instant::now();
+    let started = crate::clock::Instant::now();
     let mut fairing = ConstrainedFairing::with_fans(
         mesh,
         topology,
@@ -419,7 +419,7 @@ fn fair_rounds(
     );
     fairing.set_tangential_relaxation(options.tangential_relaxation as f32);
     let set_up_ms = milliseconds(started);
-    let started = std::time::Instant::now();
+    let started = crate::clock::Instant::now();
     let relaxation = RelaxationPlan::read(mesh, topology, &fans, options, estimate);
     let reading_ms = milliseconds(started);
     // The fans serve the later rounds only to find the creases again (and estimate the noise
@@ -427,7 +427,7 @@ fn fair_rounds(
     // relaxation acts everywhere: otherwise they are freed before the iterations (the peak,
     // while the operator is set up from them, stays).
     let fans = (redetect || relaxation.everywhere.is_some_and(|share| share > 0.0)).then_some(fans);
-    let started = std::time::Instant::now();
+    let started = crate::clock::Instant::now();
     let volume = options
         .keep_volume
         .then(|| VolumeKeeper::new(mesh, topology, pinned));
@@ -439,7 +439,7 @@ fn fair_rounds(
     report.phases.volume = milliseconds(started);
     report.phases.set_up = set_up_ms;
     report.phases.relaxation = reading_ms;
-    let started = std::time::Instant::now();
+    let started = crate::clock::Instant::now();
     let judge = auto_noise.map(|noise| RiskJudge::new(mesh, topology, noise, creases.as_ref()));
     report.phases.risk = milliseconds(started);
     // A round ends once it has settled (`FairOptions::settled`) or at `options.tolerance`.
