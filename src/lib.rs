@@ -70,6 +70,7 @@ macro_rules! with_setters {
 }
 
 pub mod bundled;
+mod clock;
 pub mod fairing;
 pub mod hierarchy;
 pub mod io;

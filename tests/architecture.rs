@@ -1,5 +1,6 @@
 //! `docs/architecture.md` matches the tree: its "Source files" list names every Rust file of the
-//! library (`src/`), the editor (`editor/src/`) and the binary (`cli/src/`) by its path from the
+//! library (`src/`), the editor (`editor/src/`), the binary (`cli/src/`) and the web page's entry
+//! point (`web/src/`) by its path from the
 //! repository's root, and every path it names there exists.
 
 use std::collections::BTreeSet;
@@ -18,7 +19,7 @@ fn rust_files(dir: &Path, root: &Path, found: &mut BTreeSet<String>) {
 }
 
 /// The folders whose Rust files the page lists, from the repository's root.
-const SOURCE_FOLDERS: [&str; 3] = ["src/", "editor/src/", "cli/src/"];
+const SOURCE_FOLDERS: [&str; 4] = ["src/", "editor/src/", "cli/src/", "web/src/"];
 
 /// The `.rs` paths under [`SOURCE_FOLDERS`] named in the "Source files" section (between its
 /// heading and the next `## ` heading), each written as `` `FOLDER/PATH.rs` ``.
@@ -56,22 +57,33 @@ fn the_architecture_page_names_every_source_file_and_no_other() {
 }
 
 /// The library stands alone: none of the GUI stack is among its dependencies, direct or
-/// transitive (the editor is a crate of its own, `fairmesh-editor`, that uses the library). Reads
-/// `cargo tree` of the package offline, from `Cargo.lock`.
+/// transitive (the editor is a crate of its own, `fairmesh-editor`, that uses the library), on
+/// the machine's own target and on the web page's (`wasm32-unknown-unknown`). Reads `cargo tree`
+/// of the package offline, from `Cargo.lock`.
 #[test]
 fn the_library_depends_on_no_gui_crate() {
+    for target in ["", "wasm32-unknown-unknown"] {
+        library_depends_on_no_gui_crate(target);
+    }
+}
+
+/// [`the_library_depends_on_no_gui_crate`] on `target` (empty: the machine's own).
+fn library_depends_on_no_gui_crate(target: &str) {
     let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".to_string());
-    let output = std::process::Command::new(cargo)
-        .current_dir(env!("CARGO_MANIFEST_DIR"))
-        .args([
-            "tree",
-            "--offline",
-            "--locked",
-            "-p",
-            "fairmesh",
-            "-e",
-            "normal",
-        ])
+    let mut command = std::process::Command::new(cargo);
+    command.current_dir(env!("CARGO_MANIFEST_DIR")).args([
+        "tree",
+        "--offline",
+        "--locked",
+        "-p",
+        "fairmesh",
+        "-e",
+        "normal",
+    ]);
+    if !target.is_empty() {
+        command.args(["--target", target]);
+    }
+    let output = command
         .args(["--prefix", "none", "--format", "{p}"])
         .output()
         .expect("cargo runs");

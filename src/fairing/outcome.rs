@@ -7,7 +7,7 @@
 //!
 //! Not part of the paper: reporting only. The fairing itself is the method's own.
 
-use std::time::Instant;
+use crate::clock::Instant;
 
 use super::{FairReport, FairVariant, Mask, MethodOptions};
 use crate::mesh::{Topology, TriMesh};

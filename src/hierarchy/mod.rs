@@ -518,7 +518,7 @@ fn build(
     options: &HierarchyOptions,
     progress: &mut dyn Progress,
 ) -> Result<Hierarchy, HierarchyError> {
-    let started = std::time::Instant::now();
+    let started = crate::clock::Instant::now();
     check_supported(mesh)?;
     // A non-manifold scan is decimated without the triangles its reconstruction left lying loose
     // at its non-manifold edges (`crate::mesh::loose_triangles`, as the default fairing leaves

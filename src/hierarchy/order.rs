@@ -20,7 +20,7 @@ pub(super) fn in_level_order(
     creases: Option<Creases>,
     setup_ms: f64,
 ) -> Hierarchy {
-    let finishing = std::time::Instant::now();
+    let finishing = crate::clock::Instant::now();
     let passes = built.pass_ms.len();
 
     // Internal order: by pass of removal, latest (or never) first; ties by id.

@@ -6,6 +6,9 @@
 //! [`stage`] and [`Staged::commit`] split the two steps so that a pair of files (`.gltf` + `.bin`)
 //! is only renamed into place once both are complete; a staged file that is dropped uncommitted is
 //! removed.
+//!
+//! A target in an in-memory folder (`files.rs`) is written to memory the same way: the content is
+//! made whole first and stored only on commit.
 
 use super::IoError;
 use std::fs::File;
@@ -30,11 +33,18 @@ pub(crate) struct Staged {
     temp: PathBuf,
     target: PathBuf,
     committed: bool,
+    /// The content, for a target in an in-memory folder (no temporary file then).
+    in_memory: Option<Vec<u8>>,
 }
 
 impl Staged {
     /// Rename the temporary file over the target.
     pub(crate) fn commit(mut self) -> Result<(), IoError> {
+        if let Some(bytes) = self.in_memory.take() {
+            super::files::store(&self.target, bytes);
+            self.committed = true;
+            return Ok(());
+        }
         std::fs::rename(&self.temp, &self.target).map_err(|source| IoError::Write {
             path: self.target.clone(),
             source,
@@ -46,7 +56,7 @@ impl Staged {
 
 impl Drop for Staged {
     fn drop(&mut self) {
-        if !self.committed {
+        if !self.committed && self.in_memory.is_none() {
             let _ = std::fs::remove_file(&self.temp);
         }
     }
@@ -57,10 +67,24 @@ pub(crate) fn stage(
     path: &Path,
     fill: impl FnOnce(&mut dyn Write) -> std::io::Result<()>,
 ) -> Result<Staged, IoError> {
+    if super::files::in_memory(path) {
+        let mut bytes = Vec::new();
+        fill(&mut bytes).map_err(|source| IoError::Write {
+            path: path.to_owned(),
+            source,
+        })?;
+        return Ok(Staged {
+            temp: path.to_owned(),
+            target: path.to_owned(),
+            committed: false,
+            in_memory: Some(bytes),
+        });
+    }
     let staged = Staged {
         temp: temp_path(path),
         target: path.to_owned(),
         committed: false,
+        in_memory: None,
     };
     let result = (|| {
         let file = File::create(&staged.temp).map_err(|e| explain_create_error(e, path))?;
@@ -98,7 +122,7 @@ fn explain_create_error(error: std::io::Error, path: &Path) -> std::io::Error {
 
 /// Stage a copy of the file `from` at `to`.
 pub(crate) fn stage_copy(from: &Path, to: &Path) -> Result<Staged, IoError> {
-    let bytes = std::fs::read(from).map_err(|source| IoError::Read {
+    let bytes = super::files::read(from).map_err(|source| IoError::Read {
         path: from.to_owned(),
         source,
     })?;

@@ -29,7 +29,7 @@ pub fn load(path: impl AsRef<Path>) -> Result<Loaded, IoError> {
 pub fn load_with(path: impl AsRef<Path>, options: &LoadOptions) -> Result<Loaded, IoError> {
     let path = path.as_ref();
     let format = format_of(path)?;
-    let bytes = std::fs::read(path).map_err(|source| IoError::Read {
+    let bytes = super::files::read(path).map_err(|source| IoError::Read {
         path: path.to_owned(),
         source,
     })?;

@@ -24,6 +24,7 @@
 pub(crate) mod atomic;
 mod carry;
 mod error;
+pub(crate) mod files;
 mod finish;
 mod format;
 mod gltf;
@@ -47,6 +48,7 @@ mod vertex_list;
 pub use atomic::write as write_atomically;
 pub use carry::VertexAttributes;
 pub use error::{IoError, Location};
+pub use files::{exists, MemoryFolder};
 pub use finish::{finish, LoadOptions, Loaded};
 pub use format::Format;
 pub use load::{load, load_from_bytes, load_from_reader, load_with};

@@ -261,7 +261,7 @@ impl ImageData {
     /// The image file's bytes: read from its file, or borrowed from the input that stored it.
     pub fn bytes(&self) -> std::io::Result<std::borrow::Cow<'_, [u8]>> {
         match self {
-            ImageData::File(path) => std::fs::read(path).map(std::borrow::Cow::Owned),
+            ImageData::File(path) => super::files::read(path).map(std::borrow::Cow::Owned),
             ImageData::Bytes(bytes) => Ok(std::borrow::Cow::Borrowed(bytes)),
         }
     }
@@ -662,17 +662,14 @@ impl Scene {
     pub(crate) fn place_images(&self, output: &Path) -> Vec<Option<PlacedImage>> {
         let (out_dir, stem) = super::folder_and_stem(output);
         let same_dir = |file: &Path| {
-            file.parent()
-                .and_then(|d| {
-                    let d = if d.as_os_str().is_empty() {
-                        Path::new(".")
-                    } else {
-                        d
-                    };
-                    d.canonicalize().ok()
-                })
-                .zip(out_dir.canonicalize().ok())
-                .is_some_and(|(a, b)| a == b)
+            file.parent().is_some_and(|d| {
+                let d = if d.as_os_str().is_empty() {
+                    Path::new(".")
+                } else {
+                    d
+                };
+                super::files::same_file(d, &out_dir)
+            })
         };
         // (name used, what is there) so that two images of one name do not overwrite each other.
         let mut taken: Vec<(String, String)> = Vec::new();
@@ -705,8 +702,8 @@ impl Scene {
                 let clash = |name: &str, taken: &[(String, String)]| {
                     let target = out_dir.join(name);
                     taken.iter().any(|(n, _)| n == name)
-                        || (target.exists()
-                            && std::fs::read(&target).ok().as_deref()
+                        || (super::files::exists(&target)
+                            && super::files::read(&target).ok().as_deref()
                                 != image.data.bytes().ok().as_deref())
                 };
                 if clash(&name, &taken) {

@@ -75,7 +75,7 @@ pub enum PanelChange {
     PaintMode(bool),
     /// Draw the kept sharp edges over the mesh until then (their controls are pointed at or
     /// were just changed).
-    ShowSharpEdgesUntil(std::time::Instant),
+    ShowSharpEdgesUntil(web_time::Instant),
 }
 
 impl App {
@@ -183,7 +183,7 @@ impl App {
                 let shown = self
                     .view
                     .sharp_edges_shown_until
-                    .is_some_and(|shown| shown > std::time::Instant::now());
+                    .is_some_and(|shown| shown > web_time::Instant::now());
                 self.view.sharp_edges_shown_until = Some(until);
                 // Drawn from the next frame; one already drawing them repaints on its own.
                 !shown

@@ -23,6 +23,9 @@ pub(super) fn show(
     ui.add(egui::TextEdit::singleline(&mut export_path).desired_width(f32::INFINITY))
         .labelled_by(label.id);
     ui.small(super::tips::EXPORT_FORMATS);
+    if cfg!(target_arch = "wasm32") {
+        ui.small(super::tips::WEB_EXPORT);
+    }
     ui.horizontal(|ui| {
         if ui
             .button("Export")
@@ -31,7 +34,8 @@ pub(super) fn show(
         {
             commands.push(Command::Export(PathBuf::from(export_path.trim())));
         }
-        if ui.button("Export as…").clicked() {
+        // A page has no save dialog: the browser asks where a download goes.
+        if !cfg!(target_arch = "wasm32") && ui.button("Export as…").clicked() {
             commands.push(Command::ExportDialog);
         }
     });
@@ -39,6 +43,10 @@ pub(super) fn show(
         commands.push(Command::Panel(PanelChange::ExportPath(export_path)));
     }
 
+    // The level chain writes a folder of files: not in a web page.
+    if cfg!(target_arch = "wasm32") {
+        return;
+    }
     ui.add_space(4.0);
     ui.strong("Level chain (LOD)");
     let placeholder = view

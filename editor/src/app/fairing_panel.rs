@@ -312,7 +312,7 @@ pub(super) fn sharp_edge_controls(
         .text("Sharp edge angle"),
     );
     let angle = explain(angle, tips::SHARP_EDGE_ANGLE, not_for_baseline.as_deref());
-    let now = std::time::Instant::now();
+    let now = web_time::Instant::now();
     let pointed_at = keep.hovered() || angle.hovered() || angle.dragged();
     // The hierarchy is built again when the angle is let go (not at every step of a drag).
     let settled = !angle.dragged();
@@ -355,7 +355,7 @@ pub(super) fn sharp_edge_overlay(
     let Some(until) = view.sharp_edges_shown_until else {
         return 0;
     };
-    let now = std::time::Instant::now();
+    let now = web_time::Instant::now();
     if now > until || settings.view_mode == ViewMode::Level {
         return 0;
     }

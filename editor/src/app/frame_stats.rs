@@ -1,7 +1,8 @@
 //! CPU time the UI thread spends per frame, for the Performance section and `--log-frames`.
 
 use std::collections::VecDeque;
-use std::time::{Duration, Instant};
+use std::time::Duration;
+use web_time::Instant;
 
 /// CPU time the UI thread spent per frame, for the performance readout.
 #[derive(Default)]

@@ -7,9 +7,13 @@ use crate::render::Shading;
 
 impl App {
     pub(super) fn handle_global_input(&mut self, ctx: &egui::Context) {
+        #[cfg(not(target_arch = "wasm32"))]
         if let Some(path) = dropped_file(ctx) {
             self.commands.push(Command::Open(path));
         }
+        // A page gets the dropped files' bytes, not their paths.
+        #[cfg(target_arch = "wasm32")]
+        self.open_dropped_files(ctx);
         // Shortcuts work unless a text field has the keyboard (it has its own undo, and typing
         // an F or a W must not fit the view or toggle the wireframe).
         let text_focus = ctx.text_edit_focused();
@@ -110,6 +114,7 @@ impl App {
 }
 
 /// The first file dropped on the window in this frame.
+#[cfg(not(target_arch = "wasm32"))]
 fn dropped_file(ctx: &egui::Context) -> Option<PathBuf> {
     let dropped: Vec<PathBuf> = ctx.input(|i| {
         i.raw

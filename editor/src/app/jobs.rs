@@ -14,6 +14,8 @@
 //!   when nothing else moves. A job that panics sends nothing; its worker survives it and tells
 //!   its [`PanicReport`] which kind of job it was ([`JobKind`]) and what the panic said, so that
 //!   the UI can say so and clear what the job held (see [`JobResult::JobFailed`]).
+//! - In a web page (`wasm32`, no threads) a worker is its queue alone: the UI thread runs one
+//!   waiting job between two frames ([`Worker::run_next`]), in the same order a thread would.
 
 use std::collections::VecDeque;
 use std::path::PathBuf;
@@ -109,6 +111,7 @@ pub struct Worker {
 
 impl Worker {
     /// Starts the thread `name`; a job that panics is reported to `on_panic`.
+    #[cfg(not(target_arch = "wasm32"))]
     pub fn spawn(name: &str, on_panic: PanicReport) -> std::io::Result<Self> {
         let shared = Arc::new(Shared {
             queue: Mutex::new(Queue::default()),
@@ -119,6 +122,39 @@ impl Worker {
             .name(name.to_owned())
             .spawn(move || worker_loop(&thread_shared, &on_panic))?;
         Ok(Self { shared })
+    }
+
+    /// The queue alone: a page has no threads, so [`Worker::run_next`] runs the jobs (a panic
+    /// aborts the page's module there, so `on_panic` is never called).
+    #[cfg(target_arch = "wasm32")]
+    pub fn spawn(_name: &str, _on_panic: PanicReport) -> std::io::Result<Self> {
+        Ok(Self {
+            shared: Arc::new(Shared {
+                queue: Mutex::new(Queue::default()),
+                wake: Condvar::new(),
+            }),
+        })
+    }
+
+    /// Runs the job a worker thread would take next, on the calling thread; false when none
+    /// waits.
+    #[cfg(target_arch = "wasm32")]
+    pub fn run_next(&self) -> bool {
+        let next = {
+            let mut queue = self.lock();
+            let next = queue.jobs.iter().position(|queued| !queued.idle);
+            let next = queue.jobs.remove(next.unwrap_or(0));
+            if next.is_some() {
+                queue.running += 1;
+            }
+            next
+        };
+        let Some(Queued { job, .. }) = next else {
+            return false;
+        };
+        job();
+        self.lock().running -= 1;
+        true
     }
 
     fn lock(&self) -> std::sync::MutexGuard<'_, Queue> {
@@ -178,6 +214,7 @@ impl Drop for Worker {
     }
 }
 
+#[cfg_attr(target_arch = "wasm32", allow(dead_code))]
 fn worker_loop(shared: &Shared, on_panic: &PanicReport) {
     // The window comes first: jobs run at background priority (see `priority`).
     super::priority::lower_this_thread();
@@ -218,6 +255,7 @@ fn worker_loop(shared: &Shared, on_panic: &PanicReport) {
 }
 
 /// What a panic said (its payload, when it is text).
+#[cfg_attr(target_arch = "wasm32", allow(dead_code))]
 fn panic_message(payload: &(dyn std::any::Any + Send)) -> String {
     if let Some(text) = payload.downcast_ref::<&str>() {
         (*text).to_owned()

@@ -15,6 +15,7 @@ use super::workers::Workers;
 use super::{App, FrameStats};
 
 /// Opens the editor window on `options.file`, or on the bundled bunny.
+#[cfg(not(target_arch = "wasm32"))]
 pub fn run(options: AppOptions) -> anyhow::Result<()> {
     let app_options = AppOptions {
         persistence: true,
@@ -41,7 +42,7 @@ pub fn run(options: AppOptions) -> anyhow::Result<()> {
 /// eframe's wgpu set-up, asking for the largest buffers the adapter allows: wgpu's default
 /// limit (256 MiB per buffer) caps the wireframe at about 11M faces and the mesh at 22M, below
 /// what big scans have; real GPUs allow far more.
-fn wgpu_configuration() -> egui_wgpu::WgpuConfiguration {
+pub fn wgpu_configuration() -> egui_wgpu::WgpuConfiguration {
     let mut configuration = egui_wgpu::WgpuConfiguration::default();
     if let egui_wgpu::WgpuSetup::CreateNew(setup) = &mut configuration.wgpu_setup {
         let base = setup.device_descriptor.clone();

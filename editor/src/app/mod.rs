@@ -79,18 +79,23 @@ pub mod view_panel;
 mod view_state;
 mod view_sync;
 mod viewport_panel;
+#[cfg(target_arch = "wasm32")]
+pub mod web;
 mod widgets;
 mod workers;
 
 pub use command::{Command, PanelChange};
 pub use frame_stats::FrameStats;
-pub use launch::{run, AppOptions};
+#[cfg(not(target_arch = "wasm32"))]
+pub use launch::run;
+pub use launch::{wgpu_configuration, AppOptions};
 pub use shown::Slot;
 pub use status::{AppStatus, ViewStatus};
 pub use viewport_panel::COMPUTING;
 
 use std::path::PathBuf;
-use std::time::{Duration, Instant};
+use std::time::Duration;
+use web_time::Instant;
 
 use crate::render::Viewport3d;
 
@@ -236,6 +241,12 @@ impl eframe::App for App {
         self.frame_stats.record_start(started, had_input);
         // Busy at the start counts too: the frame that applies the last result is a working one.
         let busy_before = self.busy();
+        // A page has no threads: one waiting job runs here, between two frames.
+        #[cfg(target_arch = "wasm32")]
+        {
+            self.poll_web();
+            self.run_one_job();
+        }
         self.poll_results();
         self.start_waiting_measure();
         self.handle_global_input(&ctx);
@@ -272,6 +283,8 @@ impl eframe::App for App {
         self.frame_stats
             .record(started.elapsed(), parts, render, busy || busy_before);
         self.exit_if_settled(&ctx, busy);
+        #[cfg(target_arch = "wasm32")]
+        self.publish_status();
     }
 
     fn save(&mut self, storage: &mut dyn eframe::Storage) {

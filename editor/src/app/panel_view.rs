@@ -9,7 +9,7 @@
 //! the area reports back ([`ViewportDrawn`]).
 
 use std::path::{Path, PathBuf};
-use std::time::Instant;
+use web_time::Instant;
 
 use super::camera::OrbitCamera;
 use super::history::History;

@@ -15,6 +15,7 @@ use std::sync::OnceLock;
 /// weights a thread at 5 gets about a third of the share of a normal thread that wants the same
 /// core (10 and 15 answered input a little better but made results wait twice as long:
 /// `docs/measurements.md`).
+#[cfg_attr(not(target_os = "linux"), allow(dead_code))]
 pub const BACKGROUND_NICE: i32 = 5;
 
 /// Lowers the calling thread's scheduling priority to [`BACKGROUND_NICE`] (Linux only; a

@@ -34,7 +34,7 @@ pub(super) fn menu(ui: &mut egui::Ui, settings: &Settings, commands: &mut Comman
 impl App {
     /// Opens a file from the Recent menu; one that is gone is named and dropped from the menu.
     pub(super) fn open_recent(&mut self, path: PathBuf) {
-        if !fairmesh::bundled::is_bunny_pseudo_path(&path) && !path.exists() {
+        if !fairmesh::bundled::is_bunny_pseudo_path(&path) && !fairmesh::io::exists(&path) {
             self.settings.forget_recent(&path);
             self.error = Some(format!(
                 "Cannot open {}: the file is no longer there (removed from Recent)",

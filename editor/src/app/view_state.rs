@@ -40,7 +40,7 @@ pub(in crate::app) struct ViewState {
     pub(in crate::app) viewport_rect: Option<egui::Rect>,
     /// Draw the kept sharp edges over the mesh until then (their controls are hovered or were
     /// just changed).
-    pub(in crate::app) sharp_edges_shown_until: Option<std::time::Instant>,
+    pub(in crate::app) sharp_edges_shown_until: Option<web_time::Instant>,
     pub(in crate::app) sharp_edges_drawn: usize,
     /// "Save image" was asked for: the next frame is drawn without the mouse hints and captured.
     pub(in crate::app) capture_next_frame: bool,

@@ -775,7 +775,7 @@ impl MeshRenderer {
             None => *params,
         };
         self.wireframe = params.wireframe;
-        let started = std::time::Instant::now();
+        let started = web_time::Instant::now();
         self.ensure_materials(device, queue);
         let (materials, colours, uvs) = self.mesh.as_ref().map_or((false, false, false), |m| {
             let look = m.appearance.as_deref();
@@ -838,7 +838,7 @@ impl MeshRenderer {
         encoder: &mut wgpu::CommandEncoder,
         params: DrawParams,
         (faces, total): (u32, usize),
-        started: std::time::Instant,
+        started: web_time::Instant,
     ) -> PartDrawn {
         let Some((size, samples)) = self.target.as_ref().map(|t| (t.size, t.samples)) else {
             return PartDrawn::NoTarget;

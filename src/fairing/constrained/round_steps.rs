@@ -49,7 +49,7 @@ pub(super) fn edges_changed(a: &[[u32; 2]], b: &[[u32; 2]]) -> usize {
 /// `work`'s value and the milliseconds it took (wall clock): the phase timer of the reports'
 /// `phases` and `detection_ms`, which keeps the clock out of the algorithm's lines.
 pub(super) fn timed<T>(work: impl FnOnce() -> T) -> (T, f64) {
-    let started = std::time::Instant::now();
+    let started = crate::clock::Instant::now();
     let value = work();
     (value, started.elapsed().as_secs_f64() * 1e3)
 }

@@ -122,7 +122,7 @@ use sort::{
     bucket_sort, digit_sort, running_starts, sort_by_first, split_by_lengths, SortedBuckets,
 };
 use std::sync::atomic::{AtomicU32, AtomicU64, Ordering::Relaxed};
-use std::time::Instant;
+use crate::clock::Instant;
 
 pub(super) const NEVER: u32 = u32::MAX;
 

@@ -33,7 +33,7 @@ pub(super) fn external_images(
         };
         let file = percent_decode(uri).map(|relative| base.join(relative));
         match file {
-            Some(file) if file.is_file() => found.push((i, file)),
+            Some(file) if crate::io::files::is_file(&file) => found.push((i, file)),
             _ => report.warnings.push(format!(
                 "image {i} refers to {uri:?}, which is not beside the input: the reference is kept as it was"
             )),
@@ -51,7 +51,7 @@ pub(super) fn embed_images(
     report: &mut SaveReport,
 ) {
     for (i, file) in images {
-        let bytes = match std::fs::read(&file) {
+        let bytes = match crate::io::files::read(&file) {
             Ok(bytes) => bytes,
             Err(e) => {
                 report.warnings.push(format!(
@@ -98,10 +98,7 @@ pub(super) fn place_image_files(
     output: &Path,
 ) -> Vec<(PathBuf, PathBuf)> {
     let (out_dir, stem) = crate::io::folder_and_stem(output);
-    let same = |a: &Path, b: &Path| match (a.canonicalize(), b.canonicalize()) {
-        (Ok(a), Ok(b)) => a == b,
-        _ => false,
-    };
+    let same = crate::io::files::same_file;
     let mut copies: Vec<(PathBuf, PathBuf)> = Vec::new();
     for (i, file) in images {
         if file.parent().is_some_and(|dir| same(dir, &out_dir)) {
@@ -116,7 +113,8 @@ pub(super) fn place_image_files(
             copies
                 .iter()
                 .any(|(from, to)| to == target && *from != file)
-                || (target.exists() && std::fs::read(target).ok() != std::fs::read(&file).ok())
+                || (crate::io::files::exists(target)
+                    && crate::io::files::read(target).ok() != crate::io::files::read(&file).ok())
         };
         if taken(&target) {
             target = out_dir.join(format!("{stem}_{name}"));

@@ -123,7 +123,7 @@ fn load_buffers<'a>(
                     };
                     let file = dir.join(&relative);
                     Cow::Owned(
-                        std::fs::read(&file)
+                        crate::io::files::read(&file)
                             .map_err(|e| at(format!("cannot read {}: {e}", file.display())))?,
                     )
                 }

@@ -303,7 +303,7 @@ impl GltfSource {
             };
             let file = percent_decode(uri).map(|relative| base.join(relative));
             return match file {
-                Some(file) if file.is_file() => Some(Image {
+                Some(file) if crate::io::files::is_file(&file) => Some(Image {
                     name: image_file_name(
                         &file.file_name().map_or_else(
                             || own_name.to_string(),

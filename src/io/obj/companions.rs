@@ -54,7 +54,7 @@ pub(crate) fn companion_copies(
         let Some(file) = copies.plan(base, library, "material library") else {
             continue;
         };
-        let Ok(text) = std::fs::read(&file) else {
+        let Ok(text) = crate::io::files::read(&file) else {
             continue;
         };
         let library_dir = Path::new(library).parent().unwrap_or(Path::new(""));
@@ -76,7 +76,11 @@ pub(crate) fn stage_copies(
     copies
         .iter()
         .map(|(from, to)| {
-            if let Some(folder) = to.parent().filter(|f| *f != out_dir && out_dir.is_dir()) {
+            let in_memory = crate::io::files::in_memory(to);
+            if let Some(folder) = to
+                .parent()
+                .filter(|f| !in_memory && *f != out_dir && out_dir.is_dir())
+            {
                 std::fs::create_dir_all(folder).map_err(|source| IoError::Write {
                     path: to.clone(),
                     source,
@@ -133,10 +137,7 @@ fn images_named(text: &[u8]) -> Vec<String> {
 
 /// Whether two folders are one (both resolved; a folder that cannot be resolved is another).
 fn same_folder(a: &Path, b: &Path) -> bool {
-    match (a.canonicalize(), b.canonicalize()) {
-        (Ok(a), Ok(b)) => a == b,
-        _ => false,
-    }
+    crate::io::files::same_file(a, b)
 }
 
 /// The copies planned so far and the warnings for those that cannot be made.
@@ -158,7 +159,7 @@ impl Copies<'_> {
             return None;
         }
         let file = base.join(relative);
-        if !file.is_file() {
+        if !crate::io::files::is_file(&file) {
             self.warn(what, name, "it is not beside the input");
             return None;
         }
@@ -173,8 +174,8 @@ impl Copies<'_> {
         if self.planned.iter().any(|(_, to)| *to == target) {
             return Some(file);
         }
-        if target.exists() {
-            if std::fs::read(&target).ok() != std::fs::read(&file).ok() {
+        if crate::io::files::exists(&target) {
+            if crate::io::files::read(&target).ok() != crate::io::files::read(&file).ok() {
                 self.warn(
                     what,
                     name,

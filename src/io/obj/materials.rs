@@ -69,7 +69,7 @@ fn read_library(library: &str, origin: &Origin) -> Result<(Vec<u8>, PathBuf), St
         return Err("the input was read from memory, so it cannot be found".into());
     };
     let file = base.join(library);
-    match std::fs::read(&file) {
+    match crate::io::files::read(&file) {
         Ok(text) => Ok((text, file)),
         Err(e) if e.kind() == std::io::ErrorKind::NotFound => {
             let obj = origin.path.file_name().unwrap_or_default();
@@ -133,7 +133,7 @@ impl MtlRead<'_> {
                         continue;
                     };
                     let image = folder.join(name.replace('\\', "/"));
-                    if image.is_file() {
+                    if crate::io::files::is_file(&image) {
                         material.texture = Some(Image {
                             name: image_file_name(
                                 &image.file_name().map_or_else(

@@ -349,7 +349,12 @@ pub fn default_export_path(input: &Path) -> PathBuf {
     // The input's own format, so that the export keeps everything the file holds (materials,
     // UVs, colours, the scene); GLB for a name with no known format.
     let extension = fairmesh::io::Format::from_path(input).map_or("glb", |f| f.extension());
-    input.with_file_name(format!("{stem}_faired.{extension}"))
+    let name = format!("{stem}_faired.{extension}");
+    // A web page downloads its exports: the name is all there is to choose.
+    if cfg!(target_arch = "wasm32") {
+        return PathBuf::from(name);
+    }
+    input.with_file_name(name)
 }
 
 /// Axis-aligned bounds of `positions` (zeros when empty).

@@ -1,7 +1,8 @@
 //! Exporting the result and the level chain (on the io worker): launch and result.
 
 use std::path::PathBuf;
-use std::time::{Duration, Instant};
+use std::time::Duration;
+use web_time::Instant;
 
 use crate::app::jobs::{JobKind, JobResult};
 use crate::app::state::HierarchyState;
@@ -15,6 +16,8 @@ impl App {
         if self.export_refused(&path) {
             return;
         }
+        // A page downloads the export (the browser asks where to keep it): nothing to replace.
+        #[cfg(not(target_arch = "wasm32"))]
         if path.exists() {
             self.confirm_replace = Some(path);
             return;
@@ -44,6 +47,8 @@ impl App {
         let Some(document) = &self.document else {
             return;
         };
+        #[cfg(target_arch = "wasm32")]
+        let path = Self::web_export_path(&path);
         // The faired positions go with M0's triangles (the hierarchy's base mesh).
         let file_source = document.source.clone();
         let (positions, triangles_source) = match (&document.faired, &document.hierarchy) {
@@ -181,6 +186,12 @@ impl App {
     ) {
         match result {
             Ok(warnings) => {
+                #[cfg(target_arch = "wasm32")]
+                let path = match self.download_export(&path) {
+                    Some(download) => PathBuf::from(format!("a download, {download}")),
+                    None => return,
+                };
+                #[cfg(not(target_arch = "wasm32"))]
                 if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
                     self.settings.last_dir = Some(dir.to_path_buf());
                 }

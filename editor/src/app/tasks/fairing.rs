@@ -2,7 +2,8 @@
 //! the level view, on the compute worker: launch and result.
 
 use std::sync::{Arc, Mutex, PoisonError};
-use std::time::{Duration, Instant};
+use std::time::Duration;
+use web_time::Instant;
 
 use crate::app::generation::GenerationId;
 use crate::app::jobs::{Faired, JobKind, JobResult};

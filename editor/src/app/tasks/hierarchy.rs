@@ -3,7 +3,7 @@
 
 use std::sync::atomic::Ordering;
 use std::sync::{Arc, PoisonError};
-use std::time::Instant;
+use web_time::Instant;
 
 use crate::app::generation::GenerationId;
 use crate::app::jobs::{JobKind, JobResult};

@@ -1,8 +1,9 @@
 //! Loading a file (on the io worker) and the file dialogs: launch and result.
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::sync::Arc;
-use std::time::{Duration, Instant};
+use std::time::Duration;
+use web_time::Instant;
 
 use crate::app::generation::GenerationId;
 use crate::app::jobs::{DialogPurpose, JobKind, JobResult, LoadedMesh};
@@ -12,9 +13,20 @@ use crate::app::App;
 impl App {
     /// Starts loading `path` on the io worker; the current mesh stays until it arrives.
     pub(in crate::app) fn open(&mut self, path: PathBuf) {
+        // In a page, a typed path that is no file given to the page is a URL to fetch.
+        #[cfg(target_arch = "wasm32")]
+        if !fairmesh::bundled::is_bunny_pseudo_path(&path) && !fairmesh::io::exists(&path) {
+            crate::app::web::open_url(path.display().to_string());
+            return;
+        }
         let generation = self.work.load_generation.bump();
         self.work.loading = Some(path.clone());
         self.open_path = path.display().to_string();
+        // A page's files sit in an in-memory folder whose name means nothing to the user.
+        #[cfg(target_arch = "wasm32")]
+        if let Some(name) = path.file_name().filter(|_| fairmesh::io::exists(&path)) {
+            self.open_path = name.to_string_lossy().into_owned();
+        }
         let (tx, ctx, ticket) = (
             self.workers.results_tx.clone(),
             self.ctx.clone(),
@@ -55,6 +67,24 @@ impl App {
         });
     }
 
+    /// A page has no system dialogs: Open… clicks the page's file input, and Export as… exports
+    /// to the typed name (the browser asks where to keep the download).
+    #[cfg(target_arch = "wasm32")]
+    pub(in crate::app) fn open_dialog(&mut self, purpose: DialogPurpose) {
+        match purpose {
+            DialogPurpose::Open => self.open_file_input(),
+            DialogPurpose::Export => {
+                let path = self
+                    .document
+                    .as_ref()
+                    .map(|d| PathBuf::from(&d.export_path))
+                    .unwrap_or_default();
+                self.export(path);
+            }
+        }
+    }
+
+    #[cfg(not(target_arch = "wasm32"))]
     pub(in crate::app) fn open_dialog(&mut self, purpose: DialogPurpose) {
         if self.dialog_open {
             return;
@@ -62,7 +92,7 @@ impl App {
         let start_dir = self.settings.last_dir.clone().or_else(|| {
             self.document
                 .as_ref()
-                .and_then(|d| d.path.parent().map(Path::to_path_buf))
+                .and_then(|d| d.path.parent().map(std::path::Path::to_path_buf))
         });
         let default_name = self.document.as_ref().and_then(|d| {
             PathBuf::from(&d.export_path)

@@ -3,7 +3,8 @@
 //! and result.
 
 use std::sync::Arc;
-use std::time::{Duration, Instant};
+use std::time::Duration;
+use web_time::Instant;
 
 use crate::app::generation::GenerationId;
 use crate::app::jobs::{JobKind, JobResult};

@@ -75,6 +75,9 @@ impl App {
         );
         self.workers.io.submit(JobKind::ViewImage, move || {
             let path = free_image_path(&beside);
+            // A page downloads the image (written into the export folder first).
+            #[cfg(target_arch = "wasm32")]
+            let path = Self::web_export_path(&path);
             let result = write_png(&path, &crop(&image, rect, pixels_per_point))
                 .map(|()| path)
                 .map_err(|error| error.to_string());
@@ -84,7 +87,14 @@ impl App {
 
     pub(in crate::app) fn on_view_image_saved(&mut self, result: Result<PathBuf, String>) {
         match result {
-            Ok(path) => self.message = Some(format!("Saved the view to {}", path.display())),
+            Ok(path) => {
+                #[cfg(target_arch = "wasm32")]
+                let path = match self.download_export(&path) {
+                    Some(download) => PathBuf::from(format!("a download, {download}")),
+                    None => return,
+                };
+                self.message = Some(format!("Saved the view to {}", path.display()));
+            }
             Err(error) => {
                 self.message = None;
                 self.error = Some(format!("Save image failed: {error}"));

@@ -1,0 +1,81 @@
+#!/usr/bin/env bash
+# The editor as a web page: a folder of static files any static host serves (docs/web.md).
+#
+#   scripts/web.sh build [--dev] [OUT]   build the page into OUT (default target/web): index.html,
+#                                        fairmesh_web.js and fairmesh_web_bg.wasm. The release
+#                                        build (what is published) is the default; --dev builds
+#                                        the quicker, larger debug build the browser test uses.
+#   scripts/web.sh serve [PORT] [DIR]    serve DIR (default target/web) on 127.0.0.1:PORT (8000)
+#   scripts/web.sh tools                 install what `build` needs and say what is missing
+#
+# Needs: rustup's wasm32-unknown-unknown target and wasm-bindgen-cli at exactly the version of
+# wasm-bindgen in Cargo.lock (`tools` installs both); wasm-opt (Debian's binaryen) shrinks the
+# release build when it is there.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+
+# The wasm-bindgen version the lock file pins: the command-line tool must be the same.
+bindgen_version() {
+  awk '/^name = "wasm-bindgen"$/ { getline; gsub(/version = |"/, ""); print; exit }' Cargo.lock
+}
+
+tools() {
+  rustup target list --installed 2>/dev/null | grep -qx wasm32-unknown-unknown ||
+    rustup target add wasm32-unknown-unknown
+  local want
+  want="$(bindgen_version)"
+  if [ "$(wasm-bindgen --version 2>/dev/null | awk '{print $2}')" != "$want" ]; then
+    echo "web.sh: installing wasm-bindgen-cli $want (cargo install, a few minutes)"
+    # The wasm-bindgen binary alone, without TLS (its test runner's downloads need it): quicker.
+    cargo install --quiet wasm-bindgen-cli --version "$want" --no-default-features --bin wasm-bindgen
+  fi
+  command -v wasm-opt >/dev/null 2>&1 ||
+    echo "web.sh: wasm-opt not found (apt-get install binaryen): the release .wasm is not shrunk" >&2
+}
+
+build() {
+  local profile=release out=target/web
+  if [ "${1:-}" = "--dev" ]; then
+    profile=dev
+    shift
+  fi
+  out="${1:-$out}"
+  tools
+  local flags=(--target wasm32-unknown-unknown -p fairmesh-web --lib)
+  local built
+  if [ "$profile" = release ]; then
+    cargo build --profile wasm-release "${flags[@]}"
+    built=target/wasm32-unknown-unknown/wasm-release/fairmesh_web.wasm
+  else
+    cargo build "${flags[@]}"
+    built=target/wasm32-unknown-unknown/debug/fairmesh_web.wasm
+  fi
+  mkdir -p "$out"
+  rm -f "$out"/fairmesh_web*
+  wasm-bindgen --target web --no-typescript --out-dir "$out" "$built"
+  if [ "$profile" = release ] && command -v wasm-opt >/dev/null 2>&1; then
+    # -O2 for speed; the features wasm-bindgen's output and rustc's default target use.
+    wasm-opt -O2 --enable-bulk-memory --enable-nontrapping-float-to-int --enable-sign-ext \
+      --enable-mutable-globals --enable-reference-types --enable-multivalue \
+      "$out/fairmesh_web_bg.wasm" -o "$out/fairmesh_web_bg.wasm"
+  fi
+  cp web/index.html "$out/index.html"
+  local raw gz
+  raw=$(stat -c %s "$out/fairmesh_web_bg.wasm")
+  gz=$(gzip -9 -c "$out/fairmesh_web_bg.wasm" | wc -c)
+  echo "web.sh: built $out ($profile): fairmesh_web_bg.wasm $raw bytes, $gz gzipped"
+}
+
+serve() {
+  local port="${1:-8000}" dir="${2:-target/web}"
+  [ -f "$dir/index.html" ] || { echo "web.sh: no $dir/index.html: run scripts/web.sh build first" >&2; exit 1; }
+  echo "web.sh: serving $dir at http://127.0.0.1:$port/ (Ctrl+C stops)"
+  exec python3 -m http.server --bind 127.0.0.1 --directory "$dir" "$port"
+}
+
+case "${1:-}" in
+  build) shift; build "$@" ;;
+  serve) shift; serve "$@" ;;
+  tools) tools ;;
+  *) sed -n '2,14p' "$0" | sed 's/^# \{0,1\}//'; exit 2 ;;
+esac

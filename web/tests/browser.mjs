@@ -1,0 +1,208 @@
+// The page in a real browser (Debian's chromium through playwright-core), against the page
+// served on 127.0.0.1 (scripts/test_web.sh builds, serves and calls this). Each check prints
+// "ok" or "FAILED" with what it saw; the last line counts them ("N passed, N failed").
+//
+// Environment: FAIRMESH_WEB_URL (the page, ending in /), FAIRMESH_WEB_OUT (a folder for the
+// screenshots, downloads and figures), FAIRMESH_WEB_BACKEND ("webgl2" asks the page for WebGL2
+// alone; empty: WebGPU where the browser has it), CHROMIUM (the browser, /usr/bin/chromium).
+// The served folder holds the test files under data/ (scene.gltf with scene.bin and
+// checker.png, textured.obj with textured.mtl and textured.png, broken.obj).
+
+import { chromium } from "playwright-core";
+import fs from "node:fs";
+import path from "node:path";
+
+const base = process.env.FAIRMESH_WEB_URL;
+const out = process.env.FAIRMESH_WEB_OUT;
+const backend = process.env.FAIRMESH_WEB_BACKEND || "";
+const dataDir = process.env.FAIRMESH_WEB_DATA;
+const tag = backend || "default";
+fs.mkdirSync(out, { recursive: true });
+
+let passed = 0;
+let failed = 0;
+const figures = {};
+function check(name, ok, detail) {
+  if (ok) passed++;
+  else failed++;
+  console.log(`${ok ? "ok" : "FAILED"} [${tag}] ${name}${detail ? ": " + detail : ""}`);
+}
+
+const browser = await chromium.launch({
+  executablePath: process.env.CHROMIUM || "/usr/bin/chromium",
+  args: [
+    "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
+    "--disable-background-networking", "--disable-component-update", "--disable-sync",
+    "--enable-unsafe-swiftshader",
+  ],
+});
+const context = await browser.newContext({
+  viewport: { width: 1280, height: 800 },
+  acceptDownloads: true,
+});
+const page = await context.newPage();
+const consoleErrors = [];
+page.on("console", (message) => {
+  if (message.type() === "error") consoleErrors.push(message.text());
+});
+page.on("pageerror", (error) => consoleErrors.push(String(error)));
+
+const query = (extra) => {
+  const params = new URLSearchParams(extra || {});
+  if (backend) params.set("backend", backend);
+  const text = params.toString();
+  return base + (text ? "?" + text : "");
+};
+
+async function status() {
+  return page.evaluate(() => {
+    if (!window.fairmesh) return null;
+    const text = window.fairmesh.status();
+    return text ? JSON.parse(text) : null;
+  });
+}
+
+// Waits until `wanted(status)` holds (and nothing is in flight, unless `unsettled`).
+async function waitFor(what, wanted, timeoutMs = 120000, unsettled = false) {
+  const started = Date.now();
+  let last = null;
+  while (Date.now() - started < timeoutMs) {
+    last = await status();
+    if (last && (unsettled || last.settled) && wanted(last)) return last;
+    await page.waitForTimeout(100);
+  }
+  throw new Error(`timed out waiting for ${what}; last status: ${JSON.stringify(last)}`);
+}
+
+// The screenshot's pixels, counted in the page: how many differ from the 3D view's background
+// (the colour at its corner) within the view, and how many of those are coloured (not grey).
+async function shoot(name) {
+  const file = path.join(out, `${tag}-${name}.png`);
+  const png = await page.screenshot({ path: file });
+  const stats = await page.evaluate(async (b64) => {
+    const image = new Image();
+    image.src = "data:image/png;base64," + b64;
+    await image.decode();
+    const canvas = document.createElement("canvas");
+    canvas.width = image.width;
+    canvas.height = image.height;
+    const ctx = canvas.getContext("2d");
+    ctx.drawImage(image, 0, 0);
+    const { data, width, height } = ctx.getImageData(0, 0, image.width, image.height);
+    // The 3D view fills the window left of the side panel (on the right): its middle.
+    const x0 = Math.floor(width * 0.08), x1 = Math.floor(width * 0.6);
+    const y0 = Math.floor(height * 0.15), y1 = Math.floor(height * 0.85);
+    const at = (x, y) => { const i = (y * width + x) * 4; return [data[i], data[i + 1], data[i + 2]]; };
+    // The background: the commonest colour of the region's border.
+    const counts = new Map();
+    for (let x = x0; x < x1; x += 4) {
+      for (const y of [y0, y1 - 1]) {
+        const key = at(x, y).join(",");
+        counts.set(key, (counts.get(key) || 0) + 1);
+      }
+    }
+    const background = [...counts.entries()].sort((a, b) => b[1] - a[1])[0][0].split(",").map(Number);
+    let mesh = 0, coloured = 0, total = 0;
+    const pixels = [];
+    for (let y = y0; y < y1; y += 2) {
+      for (let x = x0; x < x1; x += 2) {
+        const [r, g, b] = at(x, y);
+        total++;
+        pixels.push(r, g, b);
+        const d = Math.abs(r - background[0]) + Math.abs(g - background[1]) + Math.abs(b - background[2]);
+        if (d > 24) {
+          mesh++;
+          if (Math.max(r, g, b) - Math.min(r, g, b) > 40) coloured++;
+        }
+      }
+    }
+    return { mesh: mesh / total, coloured: coloured / total, background, pixels };
+  }, png.toString("base64"));
+  return stats;
+}
+
+function difference(a, b) {
+  let changed = 0;
+  for (let i = 0; i < a.pixels.length; i += 3) {
+    const d = Math.abs(a.pixels[i] - b.pixels[i]) + Math.abs(a.pixels[i + 1] - b.pixels[i + 1]) +
+      Math.abs(a.pixels[i + 2] - b.pixels[i + 2]);
+    if (d > 24) changed++;
+  }
+  return changed / (a.pixels.length / 3);
+}
+
+async function command(name, value) {
+  await page.evaluate(([n, v]) => window.fairmesh.command(n, v), [name, String(value)]);
+}
+
+try {
+  // 1. The bunny on start, shaded.
+  const loadStarted = Date.now();
+  await page.goto(query());
+  await waitFor("the first picture", (s) => s.document && s.images_drawn > 0, 60000, true);
+  figures.first_picture_ms = Date.now() - loadStarted;
+  let s = await waitFor("the bunny's hierarchy", (s) => s.hierarchy_ready && s.shown_serial !== null);
+  figures.bunny_ready_ms = Date.now() - loadStarted;
+  const bunny = await shoot("bunny");
+  check("the bunny is shown", s.document.endsWith("bunny00.obj") && bunny.mesh > 0.05,
+    `${s.document}, ${(bunny.mesh * 100).toFixed(1)}% of the view is mesh, first picture after ${figures.first_picture_ms} ms`);
+
+  // 2. A slider step changes the picture.
+  const level = Math.min(2, s.level_count - 1);
+  const before = await shoot("bunny-level-before");
+  await command("level", level);
+  s = await waitFor(`level ${level}`, (s) => s.faired_level === level && s.shown_serial === s.faired_serial);
+  const after = await shoot(`bunny-level-${level}`);
+  const changed = difference(before, after);
+  check("a slider step changes the picture", s.level === level && changed > 0.002,
+    `level ${s.level}, ${(changed * 100).toFixed(2)}% of the view's pixels changed`);
+
+  // 3. A glTF through ?open= with its .bin and texture beside it, in its own colours.
+  await page.goto(query({ open: "data/scene.gltf" }));
+  s = await waitFor("scene.gltf", (s) => s.document && s.document.endsWith("scene.gltf") && s.hierarchy_ready);
+  const scene = await shoot("scene-gltf");
+  check("?open= shows a glTF in its colours", scene.mesh > 0.02 && scene.coloured > 0.01 && !s.error,
+    `${(scene.mesh * 100).toFixed(1)}% mesh, ${(scene.coloured * 100).toFixed(1)}% coloured, warnings ${JSON.stringify(s.warnings)}, error ${s.error}`);
+
+  // 4. An OBJ with its .mtl and texture through the file input, then a slider step and Export.
+  await page.setInputFiles("#fairmesh-file-input", ["textured.obj", "textured.mtl", "textured.png"].map((f) => path.join(dataDir, f)));
+  s = await waitFor("textured.obj", (s) => s.document && s.document.endsWith("textured.obj") && s.hierarchy_ready);
+  const textured = await shoot("textured-obj");
+  check("the file input shows an OBJ in its texture", textured.mesh > 0.02 && textured.coloured > 0.01 && !s.error,
+    `${(textured.mesh * 100).toFixed(1)}% mesh, ${(textured.coloured * 100).toFixed(1)}% coloured, error ${s.error}`);
+  const exportLevel = Math.min(2, s.level_count - 1);
+  await command("level", exportLevel);
+  s = await waitFor(`level ${exportLevel} of textured.obj`, (s) => s.faired_level === exportLevel && s.shown_serial === s.faired_serial);
+  const download = page.waitForEvent("download", { timeout: 60000 });
+  await command("export", "textured_faired.obj");
+  const file = await download;
+  const saved = path.join(out, `${tag}-${file.suggestedFilename()}`);
+  await file.saveAs(saved);
+  fs.writeFileSync(path.join(out, `${tag}-export.json`), JSON.stringify({ file: saved, level: exportLevel }));
+  check("Export downloads the OBJ with its .mtl and texture as a .zip", file.suggestedFilename() === "textured_faired.zip",
+    `${file.suggestedFilename()} (${fs.statSync(saved).size} bytes); compared with the CLI by test_web.sh`);
+
+  // 5. A broken file: the same error as native, and the page goes on.
+  await page.setInputFiles("#fairmesh-file-input", [path.join(dataDir, "broken.obj")]);
+  s = await waitFor("the broken file's error", (s) => s.error !== null);
+  fs.writeFileSync(path.join(out, `${tag}-broken-error.txt`), s.error);
+  await shoot("broken");
+  const stillThere = s.document && s.document.endsWith("textured.obj");
+  await command("level", 0);
+  s = await waitFor("level 0 after the error", (s) => s.faired_level === 0 && s.shown_serial === s.faired_serial);
+  check("a broken file shows its error and the page goes on", stillThere && s.level === 0,
+    `error "${fs.readFileSync(path.join(out, `${tag}-broken-error.txt`), "utf8")}"`);
+
+  // 6. Settings are remembered in the browser's storage.
+  const stored = await page.evaluate(() => Object.keys(window.localStorage));
+  check("settings are kept in the browser's storage", stored.length > 0, JSON.stringify(stored));
+} catch (error) {
+  check("the run", false, String(error && error.stack || error));
+  await page.screenshot({ path: path.join(out, `${tag}-failure.png`) }).catch(() => {});
+}
+
+check("the console has no error or panic", consoleErrors.length === 0, consoleErrors.slice(0, 5).join(" | "));
+fs.writeFileSync(path.join(out, `${tag}-figures.json`), JSON.stringify(figures));
+await browser.close();
+console.log(`${passed} passed, ${failed} failed`);
+process.exit(failed === 0 ? 0 : 1);
