@@ -106,8 +106,9 @@ pub struct MultiresOptions {
     /// Also fair M0 after the last refinement.
     pub fair_finest: bool,
     /// After a run from a coarser level, unfold the edges it left folded where M0 is not (the
-    /// `unfold` step; on by default). Off, the result is the levels' fairing and placements
-    /// alone.
+    /// `unfold` step; on by default). An addition of [`MultiresVariant::Improved`]: the paper's
+    /// variant never unfolds, so that it is the paper's recipe to the letter. Off, the result is
+    /// the levels' fairing and placements alone.
     pub unfold: bool,
     pub variant: MultiresVariant,
     /// Where to fair ([`crate::fairing::mask`]), one weight per M0 vertex in the base mesh's
@@ -462,9 +463,9 @@ fn fair_multires_on_worker(
         fair_level(workspace, 0, &fair_options);
         progress.check(1.0)?;
     }
-    if start > 0 && options.unfold {
-        let keep_volume = options.variant == MultiresVariant::Improved;
-        unfold_new_folds(hierarchy, workspace, keep_volume);
+    // The paper's variant is the paper's recipe alone: no unfolding.
+    if start > 0 && options.unfold && options.variant == MultiresVariant::Improved {
+        unfold_new_folds(hierarchy, workspace, true);
     }
     if release {
         workspace.levels[0] = None;
