@@ -772,3 +772,35 @@ fn the_paper_variant_matches_an_independent_implementation() {
         .fold(0.0, f32::max);
     assert!(moved > 1e-3 * diagonal, "moved {moved}");
 }
+
+#[test]
+fn multires_from_every_level_turns_no_face_against_m0() {
+    // Refining from a coarse level places split vertices from their coarse neighbours; without
+    // the unfolding the noisy npm bunny and elephant turn faces over against M0 (the mesh the
+    // hierarchy was built on) from their middle and coarse levels. With it, none at any level.
+    for path in ["tests/data/bunny_npm.obj", "tests/data/elephant.obj"] {
+        let mut mesh = load(path);
+        add_noise(&mut mesh, &NoiseOptions::default());
+        let h = build(&mesh);
+        let mut workspace = MultiresWorkspace::new();
+        let turned = |positions: Vec<[f32; 3]>| {
+            let result = TriMesh::new(positions, mesh.triangles.clone());
+            (0..mesh.face_count())
+                .filter(|&t| result.face_normal(t).dot(mesh.face_normal(t)) < 0.0)
+                .count()
+        };
+        let mut without = 0;
+        for start in 1..h.level_count() {
+            let options = MultiresOptions::default().with_start_level(start);
+            let positions = fair_multires(&h, &options, &mut workspace, &mut NoProgress).unwrap();
+            assert_eq!(turned(positions), 0, "{path} from level {start}");
+            let options = options.with_unfold(false);
+            without +=
+                turned(fair_multires(&h, &options, &mut workspace, &mut NoProgress).unwrap());
+        }
+        assert!(
+            without > 0,
+            "{path}: nothing to unfold, the test proves nothing"
+        );
+    }
+}
