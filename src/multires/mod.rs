@@ -61,8 +61,8 @@
 //!   automatic default of constrained fairing, once; the hierarchy is built on its result).
 //! - `refine`: the steps between two levels (the shrinkage taken back, the split vertices
 //!   placed).
-//! - `unfold`: the last step of a run from a coarser level: the edges it left folded where M0 is
-//!   not, unfolded.
+//! - `unfold`: the last step of a run from a coarser level: the faces it left turned against M0
+//!   and the edges it left folded where M0 is not, unfolded.
 
 pub mod denoise;
 mod refine;
@@ -105,9 +105,10 @@ pub struct MultiresOptions {
     pub boundary: BoundaryMode,
     /// Also fair M0 after the last refinement.
     pub fair_finest: bool,
-    /// After a run from a coarser level, unfold the edges it left folded where M0 is not (the
-    /// `unfold` step; on by default). Off, the result is the levels' fairing and placements
-    /// alone.
+    /// After a run from a coarser level, unfold the faces it left turned by more than 90° against
+    /// M0 and the edges it left folded where M0 is not (the `unfold` step; on by default). An addition of [`MultiresVariant::Improved`]: the paper's
+    /// variant never unfolds, so that it is the paper's recipe to the letter. Off, the result is
+    /// the levels' fairing and placements alone.
     pub unfold: bool,
     pub variant: MultiresVariant,
     /// Where to fair ([`crate::fairing::mask`]), one weight per M0 vertex in the base mesh's
@@ -171,9 +172,9 @@ struct LevelData {
     /// The precomputed fairing operator of this connectivity, for the variant and boundary mode
     /// it was made with.
     fairing: Option<ConstrainedFairing>,
-    /// M0 only, once a run from a coarser level needed them: its edges with two faces and which
-    /// of them bend to a right angle or beyond on M0 itself ([`unfold`]).
-    folds: Option<(Vec<[u32; 4]>, Vec<bool>)>,
+    /// M0 only, once a run from a coarser level needed them: its face normals, its edges with
+    /// two faces and which of them bend to a right angle or beyond on M0 itself ([`unfold`]).
+    folds: Option<unfold::FoldEdges>,
 }
 
 /// Buffers reused between runs (the editor runs this on every slider move).
@@ -462,9 +463,9 @@ fn fair_multires_on_worker(
         fair_level(workspace, 0, &fair_options);
         progress.check(1.0)?;
     }
-    if start > 0 && options.unfold {
-        let keep_volume = options.variant == MultiresVariant::Improved;
-        unfold_new_folds(hierarchy, workspace, keep_volume);
+    // The paper's variant is the paper's recipe alone: no unfolding.
+    if start > 0 && options.unfold && options.variant == MultiresVariant::Improved {
+        unfold_new_folds(hierarchy, workspace);
     }
     if release {
         workspace.levels[0] = None;
@@ -478,9 +479,9 @@ fn fair_multires_on_worker(
     Ok(result)
 }
 
-/// The last step of a run from a coarser level ([`unfold`]): the edges it left folded where M0
-/// was not are unfolded.
-fn unfold_new_folds(hierarchy: &Hierarchy, workspace: &mut MultiresWorkspace, keep_volume: bool) {
+/// The last step of a run from a coarser level ([`unfold`]): the faces it left turned against
+/// M0 and the edges it left folded where M0 was not are unfolded.
+fn unfold_new_folds(hierarchy: &Hierarchy, workspace: &mut MultiresWorkspace) {
     let level = workspace.levels[0].get_or_insert_with(|| LevelData::build(hierarchy, 0));
     let LevelData {
         mesh,
@@ -490,19 +491,15 @@ fn unfold_new_folds(hierarchy: &Hierarchy, workspace: &mut MultiresWorkspace, ke
         loop_neighbors,
         ..
     } = level;
-    let (edges, reference) = folds.get_or_insert_with(|| {
-        let edges = crate::mesh::two_face_edges(&mesh.triangles);
-        let reference = unfold::bent_to_right_angle(&mesh.positions, mesh, &edges);
-        (edges, reference)
-    });
+    let folds = folds.get_or_insert_with(|| unfold::FoldEdges::new(mesh));
     let level = unfold::Level {
         mesh,
         topology,
         creases: creases.as_ref(),
         loop_neighbors,
-        keep_volume,
+        keep_volume: true,
     };
-    unfold::unfold(&mut workspace.positions, &level, edges, reference);
+    unfold::unfold(&mut workspace.positions, &level, folds);
 }
 
 /// Sets `workspace` up for a run from level `start`: the levels it needs now (all it touches, or

@@ -1,36 +1,42 @@
-//! Not in the paper: the edges a multiresolution run leaves folded. Refining from a coarse level
+//! Not in the paper: the folds a multiresolution run leaves. Refining from a coarse level
 //! places each split vertex from its coarse neighbours, and where a coarse level's fairing bent
 //! a thin part or a sharp edge, a few of those placements fall on the wrong side of their
-//! neighbours: two triangles then fold over their shared edge by more than a right angle (the
-//! noisy bunny from its opening level 9: 18 such edges of 113k). The M0 pass that follows
-//! ([`super::MultiresOptions::fair_finest`]) unfolds most, as constrained fairing does on M0,
-//! but not all. So, last, every edge folded beyond 90° where M0 itself (the mesh the hierarchy
-//! was built on) was not bent to within 5° of a right angle (a box's edges are features):
+//! neighbours: a triangle then faces away from the surface of M0 under it, and two triangles
+//! fold over their shared edge by more than a right angle (the noisy 1.2M-face bunny from level
+//! 14: 78 faces turned against the clean mesh). So, last, every face of the result turned by more
+//! than 90° against the same face of M0 (the mesh the hierarchy was built on, `fair`'s result in
+//! the editor), and every edge folded beyond 90° where M0 was not bent to within 5° of a right
+//! angle (a box's edges are features):
 //!
-//! 1. gets its two corners and the third corners of its two faces moved to the mean of their
-//!    neighbours (Jacobi, a few sweeps), and those of edges still folded join them, until none
-//!    is left or [`UNFOLD_PASSES`] have run. A crease vertex moves along its crease (to the mean
-//!    of its two neighbours on it); corners and boundary vertices stay.
+//! 1. gets its corners (an edge: its two ends and its faces' third corners) moved to the mean of
+//!    their neighbours (Jacobi, a few sweeps), and those of faces and edges still turned or
+//!    folded join them, until none is left or [`UNFOLD_PASSES`] have run. A crease vertex moves
+//!    along its crease (to the mean of its two neighbours on it); corners and boundary vertices
+//!    stay.
 //! 2. What that cannot undo (a fold between crease corners, which stay, or one pressed in too
-//!    deep: on the coarsely sampled noisy elephant, most of them) has the same four corners put
-//!    back where M0 has them, where the edge was not folded, corners of creases included but not
-//!    boundary vertices; they stay there, the passes of 1. run again around them, and this
-//!    repeats up to [`FALLBACK_PASSES`] times.
-//! 3. With the improved variant, M0's volume is given back before 1. and again after 2., as
-//!    constrained fairing gives it back after a round: every vertex offset along its normal, one
-//!    distance per connected part. (The paper's variant shows the paper's recipe, shrinkage
-//!    and all.)
+//!    deep: on the coarsely sampled noisy elephant, most of them) has the same corners put back
+//!    where M0 has them, boundary vertices aside; they stay there, the passes of 1. run again
+//!    around them, and this repeats up to [`FALLBACK_PASSES`] times.
+//! 3. Whatever is still turned or folded then has its corners, boundary vertices included, put
+//!    back where M0 has them, again until none is: a face whose corners are all M0's is M0's
+//!    face, so this ends, at the latest with the whole mesh back to M0, and no result has a
+//!    face turned or an edge folded that M0 does not have.
 //!
-//! A run with no such fold (most runs) changes nothing and pays one pass over the edges. Noisy
-//! elephant from levels 3 / 5 / 7, edges folded that `fair`'s result does not fold: 31 / 72 /
-//! 112 with 1. alone, 4 / 5 / 5 with 2. and 3. (`docs/measurements.md`, "Multiresolution
-//! fairing").
+//! The faces and edges are looked at once whole (a pass over the faces and one over the
+//! edges); after that only those around the vertices that moved, so a run pays for its folds,
+//! not for M0's size. A run with no fold changes nothing.
+//!
+//! With the improved variant, M0's volume is given back before 1. and after 3. (every vertex
+//! offset along its normal, one distance per connected part), on every run from a coarser
+//! level: two passes over M0 of four reads each, the larger part of what this step costs.
+//! That offset can turn a face again on a thin part, so 3. runs once more after it.
 
 use super::NONE;
 use crate::fairing::creases::Creases;
 use crate::fairing::volume::VolumeKeeper;
 use crate::mesh::{Topology, TriMesh};
 use glam::Vec3A;
+use rayon::prelude::*;
 
 /// What [`unfold`] reads of M0: its connectivity, its creases and, per vertex, its two
 /// neighbours along its crease or boundary loop (`NONE` for others; empty when M0 has neither).
@@ -39,82 +45,258 @@ pub(super) struct Level<'a> {
     pub(super) topology: &'a Topology,
     pub(super) creases: Option<&'a Creases>,
     pub(super) loop_neighbors: &'a [[u32; 2]],
-    /// Give M0's volume back (step 3 of the module docs): the improved variant, whose promise
-    /// it is; the paper's variant shows the paper's recipe, shrinkage and all.
+    /// Give M0's volume back first (the improved variant's promise).
     pub(super) keep_volume: bool,
 }
 
-/// At most this many rounds of finding the folded edges and smoothing their corners.
+/// At most this many rounds of finding the folds and smoothing their corners.
 pub const UNFOLD_PASSES: usize = 8;
 
-/// At most this many times the corners of the folds left (and their neighbours) go back to M0.
+/// At most this many times the corners of the folds left (and their neighbours) go back to M0
+/// before the passes stop and only putting back remains.
 const FALLBACK_PASSES: usize = 4;
 
-/// Umbrella sweeps over the folded edges' corners in each pass.
+/// At most this many times the volume is given back after the unfolding (each time holding the
+/// vertices put back to M0, and putting back what it turned again).
+const VOLUME_PASSES: usize = 3;
+
+/// Umbrella sweeps over the folds' corners in each pass.
 const SWEEPS: usize = 3;
 
-/// Whether each of `edges` folds beyond 90° with `positions` (its faces' normals more than a
-/// right angle apart; a face with no area folds nothing).
-pub(super) fn folded(positions: &[[f32; 3]], mesh: &TriMesh, edges: &[[u32; 4]]) -> Vec<bool> {
-    bent_beyond(positions, mesh, edges, 0.0)
-}
-
-/// Whether each of `edges` bends to within [`RIGHT_ANGLE_MARGIN_DEGREES`] of a right angle or
-/// beyond with `positions`: on M0, such an edge is a feature (a box's edges bend by exactly
-/// 90°), which the unfolding leaves alone even when the levels bend it a little further.
-pub(super) fn bent_to_right_angle(
-    positions: &[[f32; 3]],
-    mesh: &TriMesh,
-    edges: &[[u32; 4]],
-) -> Vec<bool> {
-    let cosine = RIGHT_ANGLE_MARGIN_DEGREES.to_radians().sin();
-    bent_beyond(positions, mesh, edges, cosine)
-}
-
-/// How close to a right angle an edge of M0 may bend and still be a feature ([`bent_to_right_angle`]).
+/// How close to a right angle an edge of M0 may bend and still be a feature
+/// ([`FoldEdges::new`]).
 pub const RIGHT_ANGLE_MARGIN_DEGREES: f32 = 5.0;
 
-/// Whether the faces of each of `edges` have normals whose angle's cosine is below `cosine`.
-fn bent_beyond(
-    positions: &[[f32; 3]],
-    mesh: &TriMesh,
-    edges: &[[u32; 4]],
-    cosine: f32,
-) -> Vec<bool> {
-    let normal = |f: u32| {
-        let [a, b, c] =
-            mesh.triangles[f as usize].map(|v| Vec3A::from_array(positions[v as usize]));
-        (b - a).cross(c - a)
-    };
-    edges
-        .iter()
-        .map(|&[_, _, f, g]| {
-            let (n, m) = (normal(f), normal(g));
-            n.dot(m) < cosine * (n.length() * m.length())
+/// Area normal of face `f` with `positions`.
+#[inline]
+fn face_normal(positions: &[[f32; 3]], triangles: &[[u32; 3]], f: u32) -> Vec3A {
+    let [a, b, c] = triangles[f as usize].map(|v| Vec3A::from_array(positions[v as usize]));
+    (b - a).cross(c - a)
+}
+
+/// Every face's area normal with `positions`, into `normals`.
+fn face_normals(positions: &[[f32; 3]], triangles: &[[u32; 3]], normals: &mut Vec<Vec3A>) {
+    triangles
+        .par_iter()
+        .with_min_len(super::PARALLEL_GRAIN)
+        .map(|t| {
+            let [a, b, c] = t.map(|v| Vec3A::from_array(positions[v as usize]));
+            (b - a).cross(c - a)
         })
-        .collect()
+        .collect_into_vec(normals);
 }
 
-/// The corners of a folded edge that move: its two ends and its two faces' third corners (the
-/// ones that move when the edge itself lies on a crease).
-fn fold_corners(mesh: &TriMesh, &[a, b, f, g]: &[u32; 4]) -> [u32; 4] {
-    let third = |face: u32| {
-        let t = mesh.triangles[face as usize];
-        t[0] ^ t[1] ^ t[2] ^ a ^ b
-    };
-    [a, b, third(f), third(g)]
+/// What [`unfold`] keeps of M0 from run to run: its faces' normals, its edges with two faces,
+/// which of them bend to within [`RIGHT_ANGLE_MARGIN_DEGREES`] of a right angle or beyond on M0
+/// itself (features, left alone even when the levels bend them a little further), and each
+/// face's edges among them.
+pub(super) struct FoldEdges {
+    edges: Vec<[u32; 4]>,
+    reference: Vec<bool>,
+    /// Per face, the indices in `edges` of its edges (`NONE` for an edge without two faces).
+    face_edges: Vec<[u32; 3]>,
+    /// M0's face normals (area-weighted).
+    m0_normals: Vec<Vec3A>,
+    /// The result's face normals, kept up to date while a run unfolds.
+    normals: Vec<Vec3A>,
+    /// M0's volumes, and a mesh to offset (built by the first run that gives the volume back).
+    volume: Option<(VolumeKeeper, TriMesh)>,
 }
 
-/// Moves the corners of the edges of `edges` folded in `positions` but not in `reference` (one
-/// flag per edge, [`bent_to_right_angle`] of M0) to the mean of their neighbours, as the module
-/// docs say.
-/// Returns how many vertices moved.
-pub(super) fn unfold(
-    positions: &mut [[f32; 3]],
-    level: &Level,
-    edges: &[[u32; 4]],
-    reference: &[bool],
-) -> usize {
+impl FoldEdges {
+    pub(super) fn new(mesh: &TriMesh) -> Self {
+        let edges = crate::mesh::two_face_edges(&mesh.triangles);
+        let mut m0_normals = Vec::new();
+        face_normals(&mesh.positions, &mesh.triangles, &mut m0_normals);
+        let cosine = RIGHT_ANGLE_MARGIN_DEGREES.to_radians().sin();
+        let reference = edges
+            .par_iter()
+            .with_min_len(super::PARALLEL_GRAIN)
+            .map(|&[_, _, f, g]| {
+                let (n, m) = (m0_normals[f as usize], m0_normals[g as usize]);
+                n.dot(m) < cosine * (n.length() * m.length())
+            })
+            .collect();
+        Self::with_reference(mesh, edges, reference, m0_normals)
+    }
+
+    /// [`Self::new`] with the edges and the reference flags given.
+    fn with_reference(
+        mesh: &TriMesh,
+        edges: Vec<[u32; 4]>,
+        reference: Vec<bool>,
+        m0_normals: Vec<Vec3A>,
+    ) -> Self {
+        let mut face_edges = vec![[NONE; 3]; mesh.face_count()];
+        for (e, &[a, b, f, g]) in edges.iter().enumerate() {
+            for face in [f, g] {
+                let t = mesh.triangles[face as usize];
+                let slot = (0..3)
+                    .find(|&k| {
+                        let (x, y) = (t[k], t[(k + 1) % 3]);
+                        (x == a && y == b) || (x == b && y == a)
+                    })
+                    .expect("an edge's face has the edge");
+                face_edges[face as usize][slot] = e as u32;
+            }
+        }
+        Self {
+            edges,
+            reference,
+            face_edges,
+            m0_normals,
+            normals: Vec::new(),
+            volume: None,
+        }
+    }
+}
+
+/// Which faces are turned against M0 and which edges newly folded, kept up to date as vertices
+/// move: after one pass over everything, only the faces around moved vertices and their edges
+/// are looked at again.
+struct FoldState<'a> {
+    triangles: &'a [[u32; 3]],
+    topology: &'a Topology,
+    folds: &'a mut FoldEdges,
+    turned: Vec<bool>,
+    folded: Vec<bool>,
+    /// The faces and edges that may be turned or folded now: all that were at the full pass and
+    /// every one looked at since (`watched_*` flag them).
+    faces: Vec<u32>,
+    edges: Vec<u32>,
+    watched_faces: Vec<bool>,
+    watched_edges: Vec<bool>,
+}
+
+impl<'a> FoldState<'a> {
+    /// Every face and edge looked at.
+    fn new(
+        positions: &[[f32; 3]],
+        triangles: &'a [[u32; 3]],
+        topology: &'a Topology,
+        folds: &'a mut FoldEdges,
+    ) -> Self {
+        face_normals(positions, triangles, &mut folds.normals);
+        let (normals, m0) = (&folds.normals, &folds.m0_normals);
+        let turned: Vec<bool> = normals
+            .par_iter()
+            .zip(m0.par_iter())
+            .with_min_len(super::PARALLEL_GRAIN)
+            .map(|(n, m)| n.dot(*m) < 0.0)
+            .collect();
+        let folded: Vec<bool> = folds
+            .edges
+            .par_iter()
+            .zip(folds.reference.par_iter())
+            .with_min_len(super::PARALLEL_GRAIN)
+            .map(|(&[_, _, f, g], &was)| !was && normals[f as usize].dot(normals[g as usize]) < 0.0)
+            .collect();
+        let flagged = |flags: &[bool]| -> Vec<u32> {
+            (0..flags.len() as u32)
+                .filter(|&i| flags[i as usize])
+                .collect()
+        };
+        let (faces, edges) = (flagged(&turned), flagged(&folded));
+        let mut watched_faces = vec![false; turned.len()];
+        let mut watched_edges = vec![false; folded.len()];
+        for &f in &faces {
+            watched_faces[f as usize] = true;
+        }
+        for &e in &edges {
+            watched_edges[e as usize] = true;
+        }
+        Self {
+            triangles,
+            topology,
+            folds,
+            turned,
+            folded,
+            faces,
+            edges,
+            watched_faces,
+            watched_edges,
+        }
+    }
+
+    /// The faces around `moved` and their edges looked at again.
+    fn moved(&mut self, positions: &[[f32; 3]], moved: &[u32]) {
+        for &v in moved {
+            for &f in self.topology.faces_of(v) {
+                let n = face_normal(positions, self.triangles, f);
+                self.folds.normals[f as usize] = n;
+                self.turned[f as usize] = n.dot(self.folds.m0_normals[f as usize]) < 0.0;
+                if !self.watched_faces[f as usize] {
+                    self.watched_faces[f as usize] = true;
+                    self.faces.push(f);
+                }
+            }
+        }
+        for &v in moved {
+            for &f in self.topology.faces_of(v) {
+                for e in self.folds.face_edges[f as usize] {
+                    if e == NONE {
+                        continue;
+                    }
+                    let [_, _, f, g] = self.folds.edges[e as usize];
+                    let normals = &self.folds.normals;
+                    self.folded[e as usize] = !self.folds.reference[e as usize]
+                        && normals[f as usize].dot(normals[g as usize]) < 0.0;
+                    if !self.watched_edges[e as usize] {
+                        self.watched_edges[e as usize] = true;
+                        self.edges.push(e);
+                    }
+                }
+            }
+        }
+    }
+
+    /// The corners of every face turned and every edge folded now (repeats possible); empty
+    /// when there is none.
+    fn corners(&self) -> Vec<u32> {
+        let mut corners = Vec::new();
+        for &f in &self.faces {
+            if self.turned[f as usize] {
+                corners.extend(self.triangles[f as usize]);
+            }
+        }
+        for &e in &self.edges {
+            if self.folded[e as usize] {
+                let [a, b, f, g] = self.folds.edges[e as usize];
+                let third = |face: u32| {
+                    let t = self.triangles[face as usize];
+                    t[0] ^ t[1] ^ t[2] ^ a ^ b
+                };
+                corners.extend([a, b, third(f), third(g)]);
+            }
+        }
+        corners
+    }
+}
+
+/// Puts the corners of what `state` finds turned or folded back where M0 has them, until
+/// nothing is (marking them in `back`).
+fn put_back(positions: &mut [[f32; 3]], mesh: &TriMesh, state: &mut FoldState, back: &mut [bool]) {
+    loop {
+        let still: Vec<u32> = state
+            .corners()
+            .into_iter()
+            .filter(|&v| positions[v as usize] != mesh.positions[v as usize])
+            .collect();
+        if still.is_empty() {
+            return;
+        }
+        for &v in &still {
+            positions[v as usize] = mesh.positions[v as usize];
+            back[v as usize] = true;
+        }
+        state.moved(positions, &still);
+    }
+}
+
+/// Moves the corners of the faces turned against M0 and the edges folded where M0 is not
+/// (`folds`, made by [`FoldEdges::new`] from M0) as the module docs say. Returns how many
+/// vertices moved.
+pub(super) fn unfold(positions: &mut [[f32; 3]], level: &Level, folds: &mut FoldEdges) -> usize {
     let Level {
         mesh,
         topology,
@@ -122,6 +304,36 @@ pub(super) fn unfold(
         loop_neighbors,
         keep_volume,
     } = *level;
+    // M0's volume given back before and after the unfolding (the improved variant), as
+    // constrained fairing gives it back after a round: every vertex offset along its normal, one
+    // distance per connected part. Before, for the levels' own drift (a coarse level's result can
+    // hold a percent or two more); after, for what the means and the vertices put back to M0
+    // changed (clean elephant from its coarsest level: +1.9 % without it).
+    if keep_volume && folds.volume.is_none() {
+        folds.volume = Some((
+            VolumeKeeper::new(mesh, topology, &[]),
+            TriMesh::new(Vec::new(), mesh.triangles.clone()),
+        ));
+    }
+    let mut volume = folds.volume.take().filter(|_| keep_volume);
+    // The vertices `held` (put back to M0) stay where they are.
+    let restore = |positions: &mut [[f32; 3]],
+                   volume: &mut Option<(VolumeKeeper, TriMesh)>,
+                   held: &[bool]| {
+        if let Some((keeper, result)) = volume {
+            result.positions.clear();
+            result.positions.extend_from_slice(positions);
+            keeper.restore(result, topology, |v| held.get(v).copied().unwrap_or(false));
+            positions.copy_from_slice(&result.positions);
+        }
+    };
+    restore(positions, &mut volume, &[]);
+    let mut state = FoldState::new(positions, &mesh.triangles, topology, folds);
+    if state.faces.is_empty() && state.edges.is_empty() {
+        drop(state);
+        folds.volume = volume;
+        return 0;
+    }
     // A crease vertex moves along its crease (to the mean of its two neighbours on it); a corner
     // and a boundary vertex stay.
     let on_crease = |v: u32| {
@@ -134,94 +346,59 @@ pub(super) fn unfold(
         topology.is_boundary_vertex(v)
             || (creases.is_some_and(|c| c.is_feature(v)) && on_crease(v).is_none())
     };
-    // Only when there is a fold to undo (most runs have none and pay one pass over the edges).
-    if !folded(positions, mesh, edges)
-        .iter()
-        .zip(reference)
-        .any(|(&now, &was)| now && !was)
-    {
-        return 0;
-    }
-    // M0's volume, given back before and after the unfolding as constrained fairing gives it
-    // back after a round: every vertex offset along its normal, one distance per connected part.
-    // Before, so that the levels' own drift (a coarse level's result can hold a percent more)
-    // is not taken for folds and the offset after is small: one offset after alone folded a
-    // third as many edges again on the noisy elephant. After, for what the means and the
-    // vertices put back to M0 changed. (The improved variant only.)
-    let mut keep = keep_volume.then(|| {
-        (
-            VolumeKeeper::new(mesh, topology, &[]),
-            TriMesh::new(Vec::new(), mesh.triangles.clone()),
-        )
-    });
-    let restore = |positions: &mut [[f32; 3]], keep: &mut Option<(VolumeKeeper, TriMesh)>| {
-        if let Some((keeper, result)) = keep {
-            result.positions = positions.to_vec();
-            keeper.restore(result, topology, |_| false);
-            positions.copy_from_slice(&result.positions);
-        }
-    };
-    restore(positions, &mut keep);
     let mut moving = vec![false; positions.len()];
     let mut region: Vec<u32> = Vec::new();
     // The vertices put back to M0 (below), which stay there.
     let mut back = vec![false; positions.len()];
-    let passes =
-        |positions: &mut [[f32; 3]], region: &mut Vec<u32>, moving: &mut [bool], back: &[bool]| {
-            for _ in 0..UNFOLD_PASSES {
-                let now = folded(positions, mesh, edges);
-                let mut grew = false;
-                for ((edge, &folded), &was) in edges.iter().zip(&now).zip(reference) {
-                    if !folded || was {
-                        continue;
-                    }
-                    for v in fold_corners(mesh, edge) {
-                        if !moving[v as usize] && !stays(v) {
-                            moving[v as usize] = true;
-                            region.push(v);
-                            grew = true;
-                        }
-                    }
-                }
-                if !grew && !now.iter().zip(reference).any(|(&n, &r)| n && !r) {
-                    return;
-                }
-                for _ in 0..SWEEPS {
-                    let means: Vec<[f32; 3]> = region
-                        .iter()
-                        .map(|&v| {
-                            if back[v as usize] {
-                                return positions[v as usize];
-                            }
-                            if let Some([p, n]) = on_crease(v) {
-                                let [p, n] =
-                                    [p, n].map(|u| Vec3A::from_array(positions[u as usize]));
-                                return ((p + n) * 0.5).to_array();
-                            }
-                            let ring = topology.neighbors(v);
-                            let sum = ring.iter().fold(Vec3A::ZERO, |sum, &u| {
-                                sum + Vec3A::from_array(positions[u as usize])
-                            });
-                            (sum / ring.len().max(1) as f32).to_array()
-                        })
-                        .collect();
-                    for (&v, mean) in region.iter().zip(means) {
-                        positions[v as usize] = mean;
-                    }
+    let passes = |positions: &mut [[f32; 3]],
+                  state: &mut FoldState,
+                  region: &mut Vec<u32>,
+                  moving: &mut [bool],
+                  back: &[bool]| {
+        for _ in 0..UNFOLD_PASSES {
+            let corners = state.corners();
+            if corners.is_empty() {
+                return;
+            }
+            for v in corners {
+                if !moving[v as usize] && !stays(v) {
+                    moving[v as usize] = true;
+                    region.push(v);
                 }
             }
-        };
-    passes(positions, &mut region, &mut moving, &back);
+            for _ in 0..SWEEPS {
+                let means: Vec<[f32; 3]> = region
+                    .iter()
+                    .map(|&v| {
+                        if back[v as usize] {
+                            return positions[v as usize];
+                        }
+                        if let Some([p, n]) = on_crease(v) {
+                            let [p, n] = [p, n].map(|u| Vec3A::from_array(positions[u as usize]));
+                            return ((p + n) * 0.5).to_array();
+                        }
+                        let ring = topology.neighbors(v);
+                        let sum = ring.iter().fold(Vec3A::ZERO, |sum, &u| {
+                            sum + Vec3A::from_array(positions[u as usize])
+                        });
+                        (sum / ring.len().max(1) as f32).to_array()
+                    })
+                    .collect();
+                for (&v, mean) in region.iter().zip(means) {
+                    positions[v as usize] = mean;
+                }
+            }
+            state.moved(positions, region);
+        }
+    };
+    passes(positions, &mut state, &mut region, &mut moving, &back);
     // What the neighbours' means cannot undo (a fold whose corners all stay, or one the levels
     // pressed in too deep): its corners, corners of creases among them, go back to where M0 has
-    // them, where the edge was not folded, and the passes run again around them.
+    // them, and the passes run again around them.
     for _ in 0..FALLBACK_PASSES {
-        let still: Vec<u32> = folded(positions, mesh, edges)
-            .iter()
-            .zip(reference)
-            .zip(edges)
-            .filter(|((&now, &was), _)| now && !was)
-            .flat_map(|(_, edge)| fold_corners(mesh, edge))
+        let still: Vec<u32> = state
+            .corners()
+            .into_iter()
             .filter(|&v| !topology.is_boundary_vertex(v))
             .collect();
         if still.is_empty() {
@@ -231,9 +408,31 @@ pub(super) fn unfold(
             positions[v as usize] = mesh.positions[v as usize];
             back[v as usize] = true;
         }
-        passes(positions, &mut region, &mut moving, &back);
+        state.moved(positions, &still);
+        passes(positions, &mut state, &mut region, &mut moving, &back);
     }
-    restore(positions, &mut keep);
+    // Whatever is left goes back to M0, corner by corner, until nothing is turned or folded (a
+    // face whose corners are all M0's is M0's face, so this ends); again after the volume's
+    // offset, which moves every vertex.
+    put_back(positions, mesh, &mut state, &mut back);
+    drop(state);
+    // The offset holds the vertices put back; what it turns again goes back too, and the
+    // offset is made again without them, a few times at most.
+    for _ in 0..VOLUME_PASSES {
+        if volume.is_none() {
+            break;
+        }
+        restore(positions, &mut volume, &back);
+        let mut state = FoldState::new(positions, &mesh.triangles, topology, folds);
+        let before = back.iter().filter(|&&b| b).count();
+        put_back(positions, mesh, &mut state, &mut back);
+        if back.iter().filter(|&&b| b).count() == before {
+            break;
+        }
+    }
+    if keep_volume {
+        folds.volume = volume;
+    }
     let moved = |v: usize| moving[v] || back[v];
     (0..positions.len()).filter(|&v| moved(v)).count()
 }
@@ -244,13 +443,29 @@ mod tests {
     use crate::mesh::fixtures::grid;
     use crate::mesh::two_face_edges;
 
+    fn fold_edges(mesh: &TriMesh, edges: &[[u32; 4]], reference: &[bool]) -> FoldEdges {
+        let mut m0_normals = Vec::new();
+        face_normals(&mesh.positions, &mesh.triangles, &mut m0_normals);
+        FoldEdges::with_reference(mesh, edges.to_vec(), reference.to_vec(), m0_normals)
+    }
+
+    /// Whether each of `edges` folds beyond 90° with `positions`.
+    fn folded(positions: &[[f32; 3]], mesh: &TriMesh, edges: &[[u32; 4]]) -> Vec<bool> {
+        let mut normals = Vec::new();
+        face_normals(positions, &mesh.triangles, &mut normals);
+        edges
+            .iter()
+            .map(|&[_, _, f, g]| normals[f as usize].dot(normals[g as usize]) < 0.0)
+            .collect()
+    }
+
     fn level<'a>(mesh: &'a TriMesh, topology: &'a Topology) -> Level<'a> {
         Level {
             mesh,
             topology,
             creases: None,
             loop_neighbors: &[],
-            keep_volume: true,
+            keep_volume: false,
         }
     }
 
@@ -268,7 +483,11 @@ mod tests {
         positions[v][0] += 1.6;
         let flipped = folded(&positions, &mesh, &edges);
         assert!(flipped.iter().any(|&f| f), "the push folds edges");
-        let moved = unfold(&mut positions, &level(&mesh, &topology), &edges, &reference);
+        let moved = unfold(
+            &mut positions,
+            &level(&mesh, &topology),
+            &mut fold_edges(&mesh, &edges, &reference),
+        );
         assert!(folded(&positions, &mesh, &edges).iter().all(|&f| !f));
         assert!((1..=8).contains(&moved), "{moved} vertices moved");
         // The vertex is back near its place, the vertices away from the fold did not move.
@@ -282,13 +501,13 @@ mod tests {
     fn a_fold_between_corners_that_stay_goes_back_to_m0() {
         // A cube's corner (a crease corner: it stays in the passes) pushed through the cube,
         // past the centre: the neighbours' means cannot unfold its edges, so its corners go back
-        // to M0; nothing stays folded, the corner is where M0 has it (but for the volume's
-        // offsets), and the volume is M0's.
+        // to M0; nothing stays folded, the corner is where M0 has it.
         let mesh = crate::mesh::shapes::cuboid([1.0, 1.0, 1.0], 0.25);
         let topology = Topology::build(&mesh);
         let creases = crate::fairing::detect_creases(&mesh, &topology, &Default::default());
         let edges = two_face_edges(&mesh.triangles);
-        let reference = bent_to_right_angle(&mesh.positions, &mesh, &edges);
+        let mut folds = FoldEdges::new(&mesh);
+        let reference = folds.reference.clone();
         let sum = |p: &[f32; 3]| p[0] + p[1] + p[2];
         let corner = (0..mesh.positions.len())
             .max_by(|&a, &b| sum(&mesh.positions[a]).total_cmp(&sum(&mesh.positions[b])))
@@ -313,37 +532,38 @@ mod tests {
             topology: &topology,
             creases: Some(&creases),
             loop_neighbors: &[],
-            keep_volume: true,
+            keep_volume: false,
         };
-        let moved = unfold(&mut positions, &level, &edges, &reference);
+        let moved = unfold(&mut positions, &level, &mut folds);
         assert!(moved >= 1);
         assert_eq!(new_folds(&positions), 0);
-        // Back to M0 but for the volume's offsets (within a hundredth of the diagonal, where the
-        // push moved it 1.3 diagonals).
-        let off = (0..3).map(|i| (positions[corner][i] - mesh.positions[corner][i]).powi(2));
-        assert!(
-            off.sum::<f32>().sqrt() < 0.01 * 3f32.sqrt(),
-            "{:?}",
-            positions[corner]
-        );
-        let volume = |positions: &[[f32; 3]]| {
-            crate::metrics::signed_volume(&TriMesh::new(positions.to_vec(), mesh.triangles.clone()))
-        };
-        assert!((volume(&positions) - volume(&mesh.positions)).abs() < 1e-5);
+        // Back where M0 has it, and no face turned against M0.
+        assert_eq!(positions[corner], mesh.positions[corner]);
+        let result = TriMesh::new(positions.clone(), mesh.triangles.clone());
+        for t in 0..mesh.face_count() {
+            assert!(
+                result.face_normal(t).dot(mesh.face_normal(t)) >= 0.0,
+                "face {t}"
+            );
+        }
     }
 
     #[test]
     fn folds_the_reference_has_are_kept() {
-        // The same push, but taken as the reference: nothing is new, nothing moves.
-        let mesh = grid(6);
+        // The same push, but in M0 itself: nothing is new, nothing moves.
+        let mut mesh = grid(6);
+        mesh.positions[3 * 7 + 3][0] += 1.6;
         let topology = Topology::build(&mesh);
         let edges = two_face_edges(&mesh.triangles);
         let mut positions = mesh.positions.clone();
-        positions[3 * 7 + 3][0] += 1.6;
         let reference = folded(&positions, &mesh, &edges);
         let before = positions.clone();
         assert_eq!(
-            unfold(&mut positions, &level(&mesh, &topology), &edges, &reference),
+            unfold(
+                &mut positions,
+                &level(&mesh, &topology),
+                &mut fold_edges(&mesh, &edges, &reference)
+            ),
             0
         );
         assert_eq!(positions, before);

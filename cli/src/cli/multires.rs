@@ -28,9 +28,12 @@ use super::hierarchy::{build_with, check_crease_angle, levels_phrase, print_note
 
 #[derive(Clone, Copy, Debug, ValueEnum, PartialEq, Eq)]
 pub enum VariantArg {
-    /// The paper's placement of split vertices (1-ring mean plus one Kobbelt step).
+    /// The paper's section 4.2 and nothing else: split vertices at their 1-ring mean plus one
+    /// Kobbelt step, no unfolding. With --denoise off --no-creases --fair-finest false it is the
+    /// paper's recipe exactly.
     Paper,
-    /// Kobbelt placement plus a low-passed volume restoration (see the multires module docs).
+    /// Kobbelt placement plus a low-passed volume restoration, each level's shrinkage taken back,
+    /// and the edges a run leaves folded unfolded (see the multires module docs).
     Improved,
 }
 
@@ -61,7 +64,8 @@ pub struct MultiresArgs {
     #[arg(long, default_value_t = true, num_args = 0..=1, default_missing_value = "true",
           action = clap::ArgAction::Set, value_name = "BOOL")]
     pub fair_finest: bool,
-    /// Placement of split vertices; several, comma separated, run one after another.
+    /// The recipe (`paper`: the paper's section 4 exactly when run with --denoise off
+    /// --no-creases --fair-finest false); several, comma separated, run one after another.
     #[arg(long, value_enum, value_delimiter = ',', default_value = "improved")]
     pub variant: Vec<VariantArg>,
     /// Denoise the mesh first, once, as `fairmesh fair` does by default, and build the hierarchy
