@@ -158,7 +158,17 @@ fn start_level_slider(
     if explain(slider, tips::START_LEVEL, level_off.as_deref()).changed() {
         commands.push(Command::SetLevel(level));
     }
+    ui.add_enabled(
+        level_off.is_none(),
+        egui::Label::new(egui::RichText::new(START_LEVEL_WORDS).small()),
+    )
+    .on_hover_text(tips::START_LEVEL)
+    .on_disabled_hover_text(tips::START_LEVEL);
 }
+
+/// What moving the start level does, under the slider.
+const START_LEVEL_WORDS: &str =
+    "0 keeps all the detail; each step right takes more away     (coarser start, smoother result).";
 
 /// The method and the options of `method` (the one chosen when the frame began): iterations and
 /// rounds over the hierarchy, or a baseline's iterations and step.

@@ -18,10 +18,10 @@ pub const SHARP_EDGE_ANGLE: &str = "How sharply the surface must fold at an edge
     to be kept sharp. Lower: more edges are kept (gentle folds too). Higher: only the sharpest. \
     The kept edges are drawn over the mesh while you point here.";
 pub const START_LEVEL: &str = "How coarse a version of the mesh the smoothing starts from. \
-    M0: the mesh with its noise removed (the same result as the command line's `fair`). \
-    Higher: smoother, bigger bumps and fine detail go too. Lower: more of the detail stays. \
-    Raise it until the surface is as plain as you want; lower it if wanted features melt \
-    away.";
+    0 (where a file opens): the mesh with its noise removed and all its detail kept (the \
+    same result as the command line's `fair`). Moving it right takes detail away: each level \
+    is coarser, so bigger bumps and fine detail go too and the result is smoother. Raise it \
+    until the surface is as plain as you want; lower it if wanted features melt away.";
 pub const REMOVE_NOISE: &str = "Remove the mesh's noise before anything else, once: the \
     smoother measures how noisy the mesh is and smooths until the result stops getting \
     better (a clean mesh is left as it is). The levels are built on the result, so the \

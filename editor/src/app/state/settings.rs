@@ -256,17 +256,16 @@ impl Settings {
     }
 
     /// The start level to open `path` at, with `level_count` levels: the one last chosen for
-    /// it, or a middle level (level 0 would show the input unchanged as the result), or level 0
-    /// for a `cad_part` (a clean CAD part, whose rims and slivers a coarse level's smoothing
-    /// wrecks: it opens as it is, and a coarser level is the user's choice).
-    pub fn start_level_for(&self, path: &Path, level_count: usize, cad_part: bool) -> usize {
+    /// it, else level 0, `fair`'s result (the noise removed, the detail kept: a coarser level
+    /// takes detail away, and how much is the user's choice; a middle level of a scan lay
+    /// farther from its clean surface than the noisy input).
+    pub fn start_level_for(&self, path: &Path, level_count: usize) -> usize {
         let top = level_count.saturating_sub(1);
-        let first = if cad_part { 0 } else { top / 2 };
         self.start_levels
             .iter()
             .rev()
             .find(|(remembered, _)| remembered == path)
-            .map_or(first, |&(_, level)| level)
+            .map_or(0, |&(_, level)| level)
             .min(top)
     }
 
@@ -528,19 +527,17 @@ mod tests {
     }
 
     #[test]
-    fn start_level_is_the_files_last_choice_or_a_middle_one_or_0_for_a_cad_part() {
+    fn start_level_is_the_files_last_choice_or_0() {
         let mut settings = Settings::default();
         let (bunny, scan) = (Path::new("/a/bunny.obj"), Path::new("/b/scan.ply"));
-        assert_eq!(settings.start_level_for(bunny, 20, false), 9);
-        assert_eq!(settings.start_level_for(bunny, 20, true), 0);
-        assert_eq!(settings.start_level_for(bunny, 1, false), 0);
+        assert_eq!(settings.start_level_for(bunny, 20), 0);
+        assert_eq!(settings.start_level_for(bunny, 1), 0);
         settings.remember_start_level(bunny, 3);
         settings.remember_start_level(scan, 12);
         settings.remember_start_level(bunny, 5);
-        assert_eq!(settings.start_level_for(bunny, 20, false), 5);
-        assert_eq!(settings.start_level_for(bunny, 20, true), 5);
+        assert_eq!(settings.start_level_for(bunny, 20), 5);
         assert_eq!(
-            settings.start_level_for(scan, 8, false),
+            settings.start_level_for(scan, 8),
             7,
             "clamped to the levels there are"
         );
@@ -549,8 +546,8 @@ mod tests {
         }
         assert_eq!(settings.start_levels.len(), Settings::REMEMBERED_FILES);
         assert_eq!(
-            settings.start_level_for(bunny, 20, false),
-            9,
+            settings.start_level_for(bunny, 20),
+            0,
             "the oldest are forgotten"
         );
     }

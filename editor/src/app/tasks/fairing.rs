@@ -53,6 +53,7 @@ impl App {
             return;
         };
         let document_generation = self.work.document_generation.clone();
+        let view_generation = self.work.view_generation.clone();
         let progress_out = self.work.fair_progress.clone();
         let workspace = self.work.workspace.clone();
         let (tx, ctx, ticket) = (
@@ -67,11 +68,13 @@ impl App {
             if !document_generation.is_current(document) {
                 return;
             }
-            // A newer slider value does not cancel this run: while dragging, finished runs are
-            // what keeps the view moving. Only a new document makes it pointless.
+            // A newer request (another slider value, a changed option, a new document) makes
+            // this run stale: it stops at its next level and gives no result, so that a drag
+            // computes the level it rests on, not every level it crossed, and the view keeps the
+            // last finished result until then.
             let progress = |fraction: f32| {
                 progress_out.set(fraction);
-                document_generation.is_current(document)
+                document_generation.is_current(document) && view_generation.is_current(view)
             };
             let result = job.run(&workspace, progress);
             let message = JobResult::Faired {

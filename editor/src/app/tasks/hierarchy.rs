@@ -166,10 +166,7 @@ impl App {
                     .collect::<Vec<_>>();
                 current.level = if current.pick_start_level {
                     current.pick_start_level = false;
-                    let cad_part =
-                        (kept.denoise.as_ref()).is_some_and(|denoise| denoise.reads_as_cad_part());
-                    self.settings
-                        .start_level_for(&current.path, levels.len(), cad_part)
+                    self.settings.start_level_for(&current.path, levels.len())
                 } else {
                     current.level.min(levels.len().saturating_sub(1))
                 };
