@@ -104,10 +104,11 @@ fn level_slider_refairs_and_updates_the_numbers() {
     }
 }
 
-/// Switching to the level view while a fairing runs: the fairing still finishes (its spinner
-/// goes), and the result it brings is measured once it has been on screen a moment.
+/// Switching to the level view while a fairing runs: the fairing, whose result the level view
+/// does not show, is abandoned (its spinner goes); back on the faired view, the result for the
+/// level the slider rests on comes and is measured.
 #[test]
-fn level_view_during_a_fairing_still_finishes_and_measures_it() {
+fn level_view_during_a_fairing_abandons_it_and_the_faired_view_brings_it_back() {
     let mut harness = harness_for(bunny());
     settle(&mut harness);
     let before = harness.state().status();
@@ -115,13 +116,18 @@ fn level_view_during_a_fairing_still_finishes_and_measures_it() {
     harness.step();
     harness.get_by_label("Level mesh").click();
     settle(&mut harness);
-    let after = harness.state().status();
-    assert!(after.faired_serial > before.faired_serial);
     assert!(
         harness.query_by_label_contains("fairing …").is_none(),
         "the fairing spinner is gone"
     );
     assert!(harness.query_by_label("running…").is_none());
+    let level = harness.state().status().level;
+    assert_eq!(level, before.level + 1);
+    harness.get_by_label("Faired").click();
+    settle(&mut harness);
+    let after = harness.state().status();
+    assert!(after.faired_serial > before.faired_serial);
+    assert_eq!(after.faired_level, Some(level));
     let (against_document, _) = harness.state().faired_measures();
     assert!(against_document.is_some());
 }
@@ -163,7 +169,13 @@ fn exports_and_reloads_the_result() {
     // Tall enough that the Export section sits in the side panel's view.
     let mut harness = harness_sized(bunny(), egui::vec2(1200.0, 1400.0));
     settle(&mut harness);
+    // The clean bunny at level 0 is left as it is; a coarser start level smooths it.
+    harness
+        .state_mut()
+        .push_command(fairmesh_editor::app::Command::SetLevel(3));
+    settle(&mut harness);
     let loaded = harness.state().status();
+    assert_eq!(loaded.faired_level, Some(3));
     let faired = harness.state().faired_positions().expect("a faired result");
     let input = harness.state().document_mesh().expect("a document");
     assert_ne!(*faired, input.positions, "fairing moved the bunny");
@@ -229,6 +241,12 @@ fn export_writes_an_artists_file_back_with_its_materials_groups_and_uvs() {
     std::fs::copy(data.join("textured.obj"), &input).unwrap();
     let mut harness = harness_for(input.clone());
     settle(&mut harness);
+    // The clean file at level 0 is left as it is; a coarser start level smooths it.
+    harness
+        .state_mut()
+        .push_command(fairmesh_editor::app::Command::SetLevel(1));
+    settle(&mut harness);
+    assert_eq!(harness.state().status().faired_level, Some(1));
     // The default export (Ctrl+E) keeps the input's format; nothing is lost, so no note.
     harness.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::E);
     settle(&mut harness);
@@ -798,16 +816,16 @@ fn fairing_controls_explain_themselves_and_say_why_they_are_off() {
     assert!(harness.query_by_label_contains("from M").is_none());
 }
 
-/// A file opens at a middle start level (level 0 would show the input as the result), and at
-/// the level last chosen for it when it is opened again.
+/// A file opens at start level 0 (`fair`'s result: all the detail kept), and at the level last
+/// chosen for it when it is opened again.
 #[test]
-fn a_file_opens_at_a_middle_level_then_at_the_last_one_chosen() {
+fn a_file_opens_at_level_0_then_at_the_last_one_chosen() {
     let mut harness = harness_for(bunny());
     settle(&mut harness);
     let status = harness.state().status();
     assert!(status.level_count >= 3);
-    assert_eq!(status.level, (status.level_count - 1) / 2);
-    assert_eq!(status.faired_level, Some(status.level));
+    assert_eq!(status.level, 0);
+    assert_eq!(status.faired_level, Some(0));
 
     harness
         .state_mut()
@@ -899,7 +917,7 @@ fn responsiveness() {
     );
     // The first slider steps right after the hierarchy is ready: the levels' set-up job runs
     // then, and a step's fairing waits behind it on the compute worker.
-    // The file opens at a middle level; each step goes one level coarser.
+    // Each step goes one level coarser than the opening level.
     let start = harness.state().status().level;
     for level in start + 1..=start + 3 {
         let (frames, elapsed) = slider_step_to_result(&mut harness, level);
@@ -1064,21 +1082,23 @@ fn with_no_control_touched_the_editor_fairs_as_fair_does_and_coarser_levels_star
 
     let mut harness = harness_for(noisy.clone().into());
     settle(&mut harness);
-    let opening_level = harness.state().status().level;
-    assert!(opening_level > 0, "a file opens at a middle level");
+    assert_eq!(harness.state().status().level, 0, "a file opens at level 0");
     let mesh = harness.state().document_mesh().unwrap();
-    let opening = harness.state().faired_positions().unwrap();
+    let at_m0 = harness.state().faired_positions().unwrap();
     // The panel says what the denoise found.
     harness.get_by_label_contains("Noise about");
-    harness
-        .state_mut()
-        .push_command(fairmesh_editor::app::Command::SetLevel(0));
-    settle(&mut harness);
-    let at_m0 = harness.state().faired_positions().unwrap();
     // Byte for byte `fair`'s result.
     assert!(at_m0.as_slice() == by_fair.positions.as_slice());
-    // The opening level removes detail on top of it, and leaves no edge folded that `fair`
+    // A middle level removes detail on top of it, and leaves no edge folded that `fair`
     // unfolded (the paper's multires alone left a fifth of the noise's folds on this mesh).
+    let middle = (harness.state().status().level_count - 1) / 2;
+    assert!(middle > 0);
+    harness
+        .state_mut()
+        .push_command(fairmesh_editor::app::Command::SetLevel(middle));
+    settle(&mut harness);
+    assert_eq!(harness.state().status().faired_level, Some(middle));
+    let opening = harness.state().faired_positions().unwrap();
     assert!(opening.as_slice() != at_m0.as_slice());
     let folded =
         |positions: &[[f32; 3]]| edges_folded_beyond_90_degrees(positions, &mesh.triangles);
@@ -1092,7 +1112,7 @@ fn with_no_control_touched_the_editor_fairs_as_fair_does_and_coarser_levels_star
     let new_folds: Vec<_> = opening_folds.difference(&by_fair_folds).collect();
     assert!(
         new_folds.is_empty(),
-        "edges folded at the opening level that fair unfolded: {new_folds:?} ({} folded there, \
+        "edges folded at the middle level that fair unfolded: {new_folds:?} ({} folded there, \
          {} after fair, {noisy_folds} in the noisy mesh)",
         opening_folds.len(),
         by_fair_folds.len()
@@ -1100,14 +1120,20 @@ fn with_no_control_touched_the_editor_fairs_as_fair_does_and_coarser_levels_star
 }
 
 #[test]
-fn a_box_keeps_its_corners_at_the_opening_level() {
+fn a_box_keeps_its_corners_at_a_middle_level() {
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("box.obj");
     let cuboid = fairmesh::mesh::shapes::cuboid([2.0, 1.0, 0.5], 0.05);
     fairmesh::io::save(&path, &cuboid).unwrap();
     let mut harness = harness_for(path);
     settle(&mut harness);
-    assert!(harness.state().status().level > 0, "a middle level");
+    let middle = (harness.state().status().level_count - 1) / 2;
+    assert!(middle > 0, "a middle level");
+    harness
+        .state_mut()
+        .push_command(fairmesh_editor::app::Command::SetLevel(middle));
+    settle(&mut harness);
+    assert_eq!(harness.state().status().faired_level, Some(middle));
     let faired = harness.state().faired_positions().unwrap();
     let diagonal = (2.0f32 * 2.0 + 1.0 + 0.25).sqrt();
     let (low, high) = fairmesh_editor::app::state::bounds_of(&cuboid.positions);
