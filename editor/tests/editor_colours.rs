@@ -47,9 +47,10 @@ fn snapshot(image: &image::RgbaImage, name: &str) {
     );
 }
 
+/// `name` opened, faired from a middle level (the pictures are of a smoothed result).
 fn loaded(name: &str) -> Harness {
     let mut harness = harness_for(asset(name));
-    settle(&mut harness);
+    editor_common::at_middle_level(&mut harness);
     harness
 }
 

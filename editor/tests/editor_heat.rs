@@ -16,7 +16,7 @@ type Harness = egui_kittest::Harness<'static, App>;
 /// Tall enough that the whole side panel (Clear mask, the Numbers) is on screen.
 fn tall_bunny() -> Harness {
     let mut harness = harness_sized(bunny(), egui::vec2(1200.0, 1600.0));
-    settle(&mut harness);
+    editor_common::at_middle_level(&mut harness);
     harness
 }
 

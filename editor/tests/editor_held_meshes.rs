@@ -100,7 +100,7 @@ fn gpu_shows_the_newest_result(harness: &Harness) {
 /// Once the editor has settled, shows the faired mesh, then the input mesh, each drawn whole:
 /// both are then held. Their images, in that order.
 fn faired_then_input(harness: &mut Harness) -> (image::RgbaImage, image::RgbaImage) {
-    settle(harness);
+    editor_common::at_middle_level(harness);
     show(harness, "Faired");
     let faired = viewport_image(harness);
     show(harness, "Input mesh");

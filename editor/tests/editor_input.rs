@@ -184,7 +184,7 @@ fn numbers_and_paint_are_reachable_in_a_1280x800_window() {
 fn the_start_level_keeps_its_value_while_the_hierarchy_rebuilds() {
     use egui_kittest::kittest::NodeT as _;
     let mut harness = bunny_1280x800();
-    let level = harness.state().status().level;
+    let level = editor_common::at_middle_level(&mut harness);
     assert!(level > 0);
     harness.get_by_label("Keep sharp edges").click();
     harness.step();

@@ -48,7 +48,7 @@ fn moved_by_mask(harness: &Harness) -> (usize, usize, usize) {
 #[test]
 fn painting_a_disc_fairs_only_inside_it_and_undo_removes_the_mask() {
     let mut harness = harness_for(bunny());
-    settle(&mut harness);
+    editor_common::at_middle_level(&mut harness);
     assert!(harness.state().mask().is_none());
     assert_eq!(
         orange_pixels(&mut harness),

@@ -70,6 +70,21 @@ pub fn settle(harness: &mut Harness<'_, App>) {
     panic!("the editor did not settle: {:?}", harness.state().status());
 }
 
+/// Sets the start level to the hierarchy's middle one and waits for its result. A file opens at
+/// level 0, `fair`'s result, which leaves a clean mesh (the bundled bunny) as it is; the tests
+/// that need a smoothed result to look at start from here.
+pub fn at_middle_level(harness: &mut Harness<'_, App>) -> usize {
+    settle(harness);
+    let middle = (harness.state().status().level_count - 1) / 2;
+    assert!(middle > 0, "a hierarchy of more than two levels");
+    harness
+        .state_mut()
+        .push_command(fairmesh_editor::app::Command::SetLevel(middle));
+    settle(harness);
+    assert_eq!(harness.state().status().faired_level, Some(middle));
+    middle
+}
+
 /// The viewport's pixels out of a full-window render (the harness is 1200 points wide).
 /// An image drawn over several frames (a big mesh on the software test renderer) is rendered
 /// to its end first: the pixels are those of the complete image.
