@@ -42,13 +42,14 @@ build() {
   out="${1:-$out}"
   tools
   local flags=(--target wasm32-unknown-unknown -p fairmesh-web --lib)
+  local target_dir="${CARGO_TARGET_DIR:-target}"
   local built
   if [ "$profile" = release ]; then
     cargo build --profile wasm-release "${flags[@]}"
-    built=target/wasm32-unknown-unknown/wasm-release/fairmesh_web.wasm
+    built=$target_dir/wasm32-unknown-unknown/wasm-release/fairmesh_web.wasm
   else
     cargo build "${flags[@]}"
-    built=target/wasm32-unknown-unknown/debug/fairmesh_web.wasm
+    built=$target_dir/wasm32-unknown-unknown/debug/fairmesh_web.wasm
   fi
   mkdir -p "$out"
   rm -f "$out"/fairmesh_web*
