@@ -1,4 +1,4 @@
-//! The fairmesh editor in a web page: [`start`] runs on the page's load (wasm-bindgen's start
+//! The fairmesh editor in a web page: `start` runs on the page's load (wasm-bindgen's start
 //! function) and starts the editor (`fairmesh-editor`) on the canvas `fairmesh-canvas` of
 //! `web/index.html`, with eframe's web runner and wgpu (WebGPU where the browser has it,
 //! WebGL2 otherwise; `?backend=webgl2` asks for WebGL2 alone).

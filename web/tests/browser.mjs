@@ -146,6 +146,13 @@ try {
   const bunny = await shoot("bunny");
   check("the bunny is shown", s.document.endsWith("bunny00.obj") && bunny.mesh > 0.05,
     `${s.document}, ${(bunny.mesh * 100).toFixed(1)}% of the view is mesh, first picture after ${figures.first_picture_ms} ms`);
+  figures.adapter = s.adapter;
+  const webgpu = await page.evaluate(() => !!navigator.gpu);
+  if (backend === "webgl2") {
+    check("WebGL2 alone draws it", /gl/i.test(s.adapter || ""), `adapter: ${s.adapter}`);
+  } else {
+    console.log(`[${tag}] navigator.gpu ${webgpu ? "present" : "absent"}; adapter: ${s.adapter}`);
+  }
 
   // 2. A slider step changes the picture.
   const level = Math.min(2, s.level_count - 1);
@@ -193,7 +200,34 @@ try {
   check("a broken file shows its error and the page goes on", stillThere && s.level === 0,
     `error "${fs.readFileSync(path.join(out, `${tag}-broken-error.txt`), "utf8")}"`);
 
-  // 6. Settings are remembered in the browser's storage.
+  // 6. Figures: the default fair of the noisy bunny (the denoise before the hierarchy), and the
+  // longest the page went without a frame meanwhile (work runs between frames).
+  await page.goto(query());
+  s = await waitFor("the bunny again", (s) => s.document && s.document.endsWith("bunny00.obj") && s.hierarchy_ready);
+  await page.evaluate(() => {
+    window.fairmeshLongestFrameGap = 0;
+    let last = performance.now();
+    const tick = (now) => {
+      window.fairmeshLongestFrameGap = Math.max(window.fairmeshLongestFrameGap, now - last);
+      last = now;
+      window.fairmeshFrames = requestAnimationFrame(tick);
+    };
+    window.fairmeshFrames = requestAnimationFrame(tick);
+  });
+  const clean = s;
+  const noiseStarted = Date.now();
+  await command("noise", "");
+  s = await waitFor("the noisy bunny's denoise and hierarchy",
+    (s) => s.hierarchy_ready && s.denoise_ms !== null && s.denoise_ms !== clean.denoise_ms &&
+      s.faired_serial !== clean.faired_serial && s.shown_serial === s.faired_serial);
+  figures.noisy_bunny_default_fair_ms = s.denoise_ms;
+  figures.noisy_bunny_hierarchy_ms = s.hierarchy_ms;
+  figures.noisy_bunny_to_result_ms = Date.now() - noiseStarted;
+  figures.longest_frame_gap_ms = await page.evaluate(() => window.fairmeshLongestFrameGap);
+  await shoot("noisy-bunny-faired");
+  console.log(`figures [${tag}]: ${JSON.stringify(figures)}`);
+
+  // 7. Settings are remembered in the browser's storage.
   const stored = await page.evaluate(() => Object.keys(window.localStorage));
   check("settings are kept in the browser's storage", stored.length > 0, JSON.stringify(stored));
 } catch (error) {

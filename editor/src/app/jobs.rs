@@ -15,7 +15,7 @@
 //!   its [`PanicReport`] which kind of job it was ([`JobKind`]) and what the panic said, so that
 //!   the UI can say so and clear what the job held (see [`JobResult::JobFailed`]).
 //! - In a web page (`wasm32`, no threads) a worker is its queue alone: the UI thread runs one
-//!   waiting job between two frames (`Worker::run_next`, web builds only), in the same order a thread would.
+//!   waiting job between two frames (`Worker::run_next`), in the same order a thread would.
 
 use std::collections::VecDeque;
 use std::path::PathBuf;

@@ -181,6 +181,7 @@ impl App {
             "message": status.message,
             "warnings": self.appearance_warnings(),
             "export_path": self.document.as_ref().map(|d| d.export_path.clone()),
+            "adapter": self.view.viewport.as_ref().map(|v| v.adapter_description()),
         });
         events::STATUS.with(|kept| *kept.borrow_mut() = json.to_string());
     }
