@@ -26,7 +26,10 @@ fn files_on_disk(dir: &Path) -> BTreeMap<PathBuf, Vec<u8>> {
 fn memory_copy(root: &str, names: &[&str]) -> MemoryFolder {
     let folder = MemoryFolder::new(root);
     for name in names {
-        folder.insert(name, std::fs::read(Path::new(ROUNDTRIP).join(name)).unwrap());
+        folder.insert(
+            name,
+            std::fs::read(Path::new(ROUNDTRIP).join(name)).unwrap(),
+        );
     }
     folder
 }
@@ -47,9 +50,11 @@ fn same_as_on_disk(tag: &str, names: &[&str], main: &str, out_name: &str) {
         p[1] += 0.01 * p[0];
     }
     let dir = tempfile::tempdir().unwrap();
-    let disk_report = io::save_with_source(dir.path().join(out_name), &moved, &from_disk.source).unwrap();
+    let disk_report =
+        io::save_with_source(dir.path().join(out_name), &moved, &from_disk.source).unwrap();
     let output = MemoryFolder::new(format!("/fairmesh-test-io-memory/{tag}/out"));
-    let memory_report = io::save_with_source(output.path(out_name), &moved, &from_memory.source).unwrap();
+    let memory_report =
+        io::save_with_source(output.path(out_name), &moved, &from_memory.source).unwrap();
     assert_eq!(memory_report.warnings, disk_report.warnings);
     let written: BTreeMap<PathBuf, Vec<u8>> = output.files().into_iter().collect();
     let on_disk = files_on_disk(dir.path());
@@ -57,7 +62,10 @@ fn same_as_on_disk(tag: &str, names: &[&str], main: &str, out_name: &str) {
         written.keys().collect::<Vec<_>>(),
         on_disk.keys().collect::<Vec<_>>()
     );
-    assert!(written == on_disk, "{tag}: a file differs between memory and disk");
+    assert!(
+        written == on_disk,
+        "{tag}: a file differs between memory and disk"
+    );
     // The write-back read back from memory is the moved mesh.
     let again = io::load(output.path(out_name)).unwrap();
     assert_eq!(again.mesh.triangles.len(), moved.triangles.len());
@@ -97,13 +105,22 @@ fn a_missing_companion_is_named_as_on_disk() {
     let input = memory_copy("/fairmesh-test-io-memory/missing/in", &["textured.obj"]);
     let loaded = io::load(input.path("textured.obj")).unwrap();
     let output = MemoryFolder::new("/fairmesh-test-io-memory/missing/out");
-    let report = io::save_with_source(output.path("out.obj"), &loaded.mesh, &loaded.source).unwrap();
+    let report =
+        io::save_with_source(output.path("out.obj"), &loaded.mesh, &loaded.source).unwrap();
     let alone = tempfile::tempdir().unwrap();
-    std::fs::copy(Path::new(ROUNDTRIP).join("textured.obj"), alone.path().join("textured.obj")).unwrap();
+    std::fs::copy(
+        Path::new(ROUNDTRIP).join("textured.obj"),
+        alone.path().join("textured.obj"),
+    )
+    .unwrap();
     let on_disk = io::load(alone.path().join("textured.obj")).unwrap();
     let out_dir = tempfile::tempdir().unwrap();
-    let disk_report =
-        io::save_with_source(out_dir.path().join("out.obj"), &on_disk.mesh, &on_disk.source).unwrap();
+    let disk_report = io::save_with_source(
+        out_dir.path().join("out.obj"),
+        &on_disk.mesh,
+        &on_disk.source,
+    )
+    .unwrap();
     let warnings = report.warnings.join("\n");
     assert!(warnings.contains("textured.mtl"), "{warnings}");
     // The same words, the folders apart.
@@ -128,7 +145,9 @@ fn a_missing_companion_is_named_as_on_disk() {
 #[test]
 fn a_failed_save_into_memory_leaves_nothing() {
     let output = MemoryFolder::new("/fairmesh-test-io-memory/failed/out");
-    let mut mesh = io::load(Path::new(ROUNDTRIP).join("textured.obj")).unwrap().mesh;
+    let mut mesh = io::load(Path::new(ROUNDTRIP).join("textured.obj"))
+        .unwrap()
+        .mesh;
     mesh.positions[0][0] = f32::NAN;
     assert!(io::save(output.path("bad.obj"), &mesh).is_err());
     assert!(output.files().is_empty());

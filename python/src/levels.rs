@@ -207,10 +207,12 @@ pub fn hierarchy(
         .with_min_vertices(options::count("min_vertices", min_vertices)?)
         .with_max_levels(options::count("max_levels", max_levels)?)
         .with_keep_boundary(keep_boundary)
-        .with_creases((keep_creases || crease_angle.is_some() || hard_edges.is_some()).then(|| {
-            CreaseOptions::default()
-                .with_angle_degrees(crease_angle.unwrap_or(DEFAULT_CREASE_ANGLE))
-        }));
+        .with_creases(
+            (keep_creases || crease_angle.is_some() || hard_edges.is_some()).then(|| {
+                CreaseOptions::default()
+                    .with_angle_degrees(crease_angle.unwrap_or(DEFAULT_CREASE_ANGLE))
+            }),
+        );
     let (mesh, topology, precision, file_edges) = match vertices.cast::<Mesh>() {
         Ok(loaded) => {
             if faces.is_some_and(|f| !f.is_none()) {
@@ -220,9 +222,7 @@ pub fn hierarchy(
             }
             let loaded = loaded.borrow();
             let edges = match hard_edges {
-                Some(edges) => {
-                    crate::fair::read_edges(edges, loaded.loaded.mesh.vertex_count())?
-                }
+                Some(edges) => crate::fair::read_edges(edges, loaded.loaded.mesh.vertex_count())?,
                 None => loaded.file_hard_edges(),
             };
             let state = &loaded.loaded;

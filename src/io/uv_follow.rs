@@ -123,9 +123,7 @@ pub enum TextureFollowError {
         count: usize,
     },
     /// A corner names a texture coordinate beyond the table.
-    #[error(
-        "triangle {triangle} names texture coordinate {coordinate}, but there are {count}"
-    )]
+    #[error("triangle {triangle} names texture coordinate {coordinate}, but there are {count}")]
     CoordinateBeyond {
         triangle: usize,
         coordinate: u32,

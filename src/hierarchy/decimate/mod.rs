@@ -111,6 +111,7 @@ mod levels;
 mod sort;
 
 use super::{HierarchyError, HierarchyOptions};
+use crate::clock::Instant;
 use crate::fairing::creases::{Creases, FeatureClass};
 use crate::mesh::TriMesh;
 use crate::Progress;
@@ -122,7 +123,6 @@ use sort::{
     bucket_sort, digit_sort, running_starts, sort_by_first, split_by_lengths, SortedBuckets,
 };
 use std::sync::atomic::{AtomicU32, AtomicU64, Ordering::Relaxed};
-use crate::clock::Instant;
 
 pub(super) const NEVER: u32 = u32::MAX;
 

@@ -14,14 +14,17 @@ thread_local! {
 
 /// Offers `bytes` for download as `name`.
 pub(super) fn offer(name: &str, bytes: &[u8]) -> Result<(), String> {
-    let failed = |error: wasm_bindgen::JsValue| format!("{name}: the download failed ({})", describe(&error));
+    let failed = |error: wasm_bindgen::JsValue| {
+        format!("{name}: the download failed ({})", describe(&error))
+    };
     let document = web_sys::window()
         .and_then(|w| w.document())
         .ok_or_else(|| format!("{name}: no page to download from"))?;
     let parts = js_sys::Array::of1(&js_sys::Uint8Array::from(bytes));
     let options = web_sys::BlobPropertyBag::new();
     options.set_type("application/octet-stream");
-    let blob = web_sys::Blob::new_with_u8_array_sequence_and_options(&parts, &options).map_err(failed)?;
+    let blob =
+        web_sys::Blob::new_with_u8_array_sequence_and_options(&parts, &options).map_err(failed)?;
     let url = web_sys::Url::create_object_url_with_blob(&blob).map_err(failed)?;
     let link: web_sys::HtmlAnchorElement = document
         .create_element("a")

@@ -62,7 +62,11 @@ fn named_after(text: &[u8], keywords: &[&str]) -> Vec<String> {
     for line in text.lines() {
         let mut words = line.split_whitespace();
         let Some(first) = words.next() else { continue };
-        if !keywords.contains(&first) && !keywords.iter().any(|k| k.ends_with('_') && first.starts_with(k)) {
+        if !keywords.contains(&first)
+            && !keywords
+                .iter()
+                .any(|k| k.ends_with('_') && first.starts_with(k))
+        {
             continue;
         }
         // `mtllib` names the rest of the line; a map line's options come first, the file last.
