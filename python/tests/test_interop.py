@@ -112,21 +112,13 @@ def test_texture_coordinates_follow_the_slide_along_the_surface():
     trimesh = pytest.importorskip("trimesh")
     import fairmesh.trimesh
 
-    # A flat grid, jittered in its plane, textured by its own x and y: wherever a vertex slides
-    # in the plane, the texture there is its new x and y.
+    # A flat grid, jittered in its plane, textured by its own x and y (`jittered_grid`).
     k = 30
-    x, y = np.meshgrid(np.arange(k, dtype=float), np.arange(k, dtype=float))
-    xy = np.stack([x.ravel(), y.ravel()], axis=1)
-    inside = (xy > 0).all(axis=1) & (xy < k - 1).all(axis=1)
-    xy[inside] += np.random.default_rng(1).uniform(-0.3, 0.3, (inside.sum(), 2))
-    xy = xy.astype(np.float32).astype(np.float64)  # what fairmesh computes in: kept exactly
-    corners = np.arange(k * k).reshape(k, k)[:-1, :-1].ravel()
-    faces = np.concatenate([np.stack([corners, corners + 1, corners + k + 1], axis=1),
-                            np.stack([corners, corners + k + 1, corners + k], axis=1)])
-    visual = trimesh.visual.TextureVisuals(uv=xy / (k - 1),
+    vertices, faces, uv = jittered_grid(k)
+    xy = vertices[:, :2]
+    visual = trimesh.visual.TextureVisuals(uv=uv,
                                            material=trimesh.visual.material.PBRMaterial())
-    mesh = trimesh.Trimesh(np.column_stack([xy, np.zeros(len(xy))]), faces, visual=visual,
-                           process=False)
+    mesh = trimesh.Trimesh(vertices, faces, visual=visual, process=False)
     left = xy[:, 0] < k / 2
     # The paper's operator slides vertices along the surface (here, in the plane).
     smooth, _ = fairmesh.trimesh.fair(mesh, variant="paper", rounds=1, iterations=3,
