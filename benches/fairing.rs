@@ -26,7 +26,7 @@ fn fairing_iteration(c: &mut Criterion) {
     group.sample_size(20);
     for (name, mesh) in meshes() {
         let topology = Topology::build(&mesh);
-        for variant in [FairVariant::Paper, FairVariant::NormalProjected] {
+        for variant in [FairVariant::Paper, FairVariant::Improved] {
             let mut fairing =
                 ConstrainedFairing::new(&mesh, &topology, variant, BoundaryMode::Curve);
             let positions = mesh.positions.clone();
@@ -35,7 +35,7 @@ fn fairing_iteration(c: &mut Criterion) {
                 BenchmarkId::new(format!("constrained_{}", variant.name()), name),
                 |b| b.iter(|| black_box(fairing.step())),
             );
-            if variant == FairVariant::NormalProjected {
+            if variant == FairVariant::Improved {
                 // The shares of the default's later rounds: the relaxation only at thin
                 // triangles (every one, as with creases).
                 fairing.load(&positions);

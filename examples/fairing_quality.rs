@@ -141,7 +141,7 @@ fn main() {
         );
         println!("\nNoise-free input, one run of 10 iterations:\n");
         println!("| variant | mean vertex move (edges) | max move (edges) | volume change % |\n|---|---:|---:|---:|");
-        for variant in [FairVariant::Paper, FairVariant::NormalProjected] {
+        for variant in [FairVariant::Paper, FairVariant::Improved] {
             let mut faired = clean.clone();
             fair(
                 &mut faired,
@@ -187,7 +187,7 @@ fn main() {
         println!("\nNoise 0.3 mean edge lengths along normals (seed 1):\n");
         println!("| method | setting | surf mean | hausdorff | rms | normal ° | vol % |\n|---|---|---:|---:|---:|---:|---:|");
         row("noisy input", "-", &quality(&clean, &noisy, &noisy, edge));
-        for variant in [FairVariant::Paper, FairVariant::NormalProjected] {
+        for variant in [FairVariant::Paper, FairVariant::Improved] {
             for rounds in [1, 2, 3, 5, 10, 20, 30, 40, 60] {
                 let mut faired = noisy.clone();
                 fair(

@@ -82,7 +82,7 @@ fn main() {
         } else {
             300
         };
-        for variant in [FairVariant::Paper, FairVariant::NormalProjected] {
+        for variant in [FairVariant::Paper, FairVariant::Improved] {
             let start = Instant::now();
             let mut fairing =
                 ConstrainedFairing::new(mesh, &topology, variant, BoundaryMode::Curve);

@@ -11,7 +11,7 @@ use fairmesh::metrics::{mean_edge_length, signed_volume};
 use fairmesh::noise::{add_noise, NoiseMode, NoiseOptions};
 use fairmesh::{Topology, TriMesh};
 
-const VARIANTS: [FairVariant; 2] = [FairVariant::Paper, FairVariant::NormalProjected];
+const VARIANTS: [FairVariant; 2] = [FairVariant::Paper, FairVariant::Improved];
 
 /// The part of the icosphere whose triangles have their centroid above z = 0.1, reindexed, with
 /// the boundary vertices snapped onto one horizontal circle of the sphere (so that the clean
@@ -377,7 +377,7 @@ fn noise_free_plane_stays_exactly_flat() {
                     faired.positions.iter().all(|p| p[2] == 0.0),
                     "{variant:?} {boundary:?} tangential {tangential}"
                 );
-                if variant == FairVariant::NormalProjected && tangential == 0.0 {
+                if variant == FairVariant::Improved && tangential == 0.0 {
                     // Only normal motion: nothing in the plane moves.
                     let interior_moved = (0..mesh.positions.len())
                         .filter(|&v| !topology.is_boundary_vertex(v as u32))
@@ -587,7 +587,7 @@ fn normal_projection_stops_sliding_on_the_clean_bunny() {
         (mean_move, relative_volume_change(&mesh, &faired))
     };
     let (paper_move, paper_volume) = measure(FairVariant::Paper);
-    let (projected_move, projected_volume) = measure(FairVariant::NormalProjected);
+    let (projected_move, projected_volume) = measure(FairVariant::Improved);
     eprintln!(
         "clean bunny00: paper moves {paper_move:.4} edges, volume {:.4}%; normal-projected \
          {projected_move:.4} edges, volume {:.4}%",

@@ -619,6 +619,26 @@ fn fair_leaves_a_clean_mesh_alone_and_says_how_noisy_the_input_was() {
     ]);
     assert_eq!(paper["rounds_run"], 1, "{paper}");
     assert_eq!(paper["crease_edges"], 0, "{paper}");
+    assert_eq!(paper["variant"], "paper", "{paper}");
+    // The default is the improved variant, named as multires names its own; its former name
+    // still chooses it, and writes the same file.
+    assert_eq!(two["variant"], "improved", "{two}");
+    let old = json_of(&[
+        "fair",
+        &path("noisy.obj"),
+        "-o",
+        &path("2old.obj"),
+        "--json",
+        "--rounds",
+        "2",
+        "--variant",
+        "normal-projected",
+    ]);
+    assert_eq!(old["variant"], "improved", "{old}");
+    assert_eq!(
+        std::fs::read(path("2old.obj")).unwrap(),
+        std::fs::read(path("2.obj")).unwrap()
+    );
 }
 
 #[test]

@@ -163,7 +163,7 @@ def fair(
     no_volume_correction: bool = False,
     tolerance: Optional[float] = None,
     boundary: Literal["curve", "fixed"] = "curve",
-    variant: Literal["projected", "paper", "normal-projected"] = "projected",
+    variant: Literal["improved", "paper", "normal-projected", "projected"] = "improved",
     lambda_: Optional[float] = None,
     mu: Optional[float] = None,
     alpha: Optional[float] = None,
@@ -189,7 +189,7 @@ def fair(
     no_volume_correction: bool = False,
     tolerance: Optional[float] = None,
     boundary: Literal["curve", "fixed"] = "curve",
-    variant: Literal["projected", "paper", "normal-projected"] = "projected",
+    variant: Literal["improved", "paper", "normal-projected", "projected"] = "improved",
     lambda_: Optional[float] = None,
     mu: Optional[float] = None,
     alpha: Optional[float] = None,
@@ -226,10 +226,10 @@ def fair(
     - ``tolerance``: stop a round once no vertex moves more than this many mean edge lengths
       (None: once it has settled, 0.001; 0: run every iteration).
     - ``boundary``: "curve" (boundary loops smoothed as curves) or "fixed".
-    - ``variant``: "projected" (default: the paper's update kept along the normal, so vertices
-      do not slide along the surface) or "paper" (the paper's operator exactly). The old name
-      "normal-projected" is accepted; the report names the variant as ``fairmesh fair --json``
-      does ("normal-projected" or "paper").
+    - ``variant``: "improved" (default: the paper's update kept along the normal, so vertices
+      do not slide along the surface) or "paper" (the paper's operator exactly), the words
+      ``multires`` and ``fairmesh fair --variant`` use. The old names "normal-projected" and
+      "projected" are accepted; the report names the variant "improved" or "paper".
     - ``lambda_``, ``mu``: the Laplacian and Taubin steps; ``alpha``, ``beta`` (0 to 1): HC's
       weight of the input in the pull back, and of a vertex's own correction against its
       neighbours' (``hierarchy``'s ``alpha`` and ``beta`` are something else).

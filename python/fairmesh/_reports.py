@@ -18,7 +18,7 @@ class FairPhases(TypedDict):
 
 class _FairReportFields(TypedDict):
     method: Literal["constrained", "laplacian", "taubin", "hc"]
-    variant: Optional[Literal["normal-projected", "paper"]]
+    variant: Optional[Literal["improved", "paper"]]
     input: Optional[str]
     output: None
     vertices: int
@@ -45,7 +45,7 @@ class FairReport(_FairReportFields, total=False):
     """What ``fair`` did: the fields of ``fairmesh fair --json``.
 
     - ``method``; ``variant``: the constrained operator as ``fairmesh fair --json`` names it
-      ("normal-projected" for ``variant="projected"``, or "paper"), None for a baseline.
+      ("improved" or "paper"), None for a baseline.
     - ``input``: the loaded file's path (``fair(mesh)``), else None; ``output``: None.
     - ``vertices``, ``faces``, ``closed``: the mesh faired.
     - ``iterations_run``, ``rounds_run``: what ran; ``risk_by_round``: the estimated error

@@ -132,7 +132,7 @@ fn json_to_python<'py>(py: Python<'py>, value: &serde_json::Value) -> PyResult<B
 #[pyo3(signature = (
     vertices, faces=None, *, method="constrained", iterations=10, rounds=None,
     crease_angle=DEFAULT_CREASE_ANGLE, no_creases=false, tangential=None,
-    no_volume_correction=false, tolerance=None, boundary="curve", variant="projected",
+    no_volume_correction=false, tolerance=None, boundary="curve", variant="improved",
     lambda_=None, mu=None, alpha=None, beta=None, mask=None, mask_falloff=0, hard_edges=None,
     measure=false, progress=None, threads=None
 ), text_signature = None)]
@@ -190,8 +190,8 @@ pub fn fair<'py>(
         paper_variant: options::choice_or_old_name(
             "variant",
             variant,
-            &["projected", "paper"],
-            &[("normal-projected", 0)],
+            &["improved", "paper"],
+            &[("normal-projected", 0), ("projected", 0)],
         )? == 1,
         lambda: lambda_.map(|v| options::finite("lambda_", v)).transpose()?,
         mu: mu.map(|v| options::finite("mu", v)).transpose()?,

@@ -135,12 +135,14 @@ def test_a_mask_is_unambiguous(bunny):
 
 def test_old_variant_names_are_accepted_and_numbers_read_plainly(bunny):
     v, f = bunny.vertices, bunny.faces
-    new, report = fairmesh.fair(v, f, rounds=1, variant="projected")
-    for old in ("normal-projected", "normal_projected"):
+    new, report = fairmesh.fair(v, f, rounds=1, variant="improved")
+    paper, _ = fairmesh.fair(v, f, rounds=1, variant="paper")
+    assert not np.array_equal(paper, new)  # so the names below choose something
+    for old in ("normal-projected", "normal_projected", "projected", "Improved"):
         result, _ = fairmesh.fair(v, f, rounds=1, variant=old)
         np.testing.assert_array_equal(result, new)
-    assert report["variant"] == "normal-projected"  # as `fairmesh fair --json` names it
-    with pytest.raises(ValueError, match=r'variant must be one of "projected", "paper", not '
+    assert report["variant"] == "improved"  # as `fairmesh fair --json` names it
+    with pytest.raises(ValueError, match=r'variant must be one of "improved", "paper", not '
                                          r'"exact"$'):
         fairmesh.fair(v, f, variant="exact")
     with pytest.raises(ValueError, match=r"sigma must be a finite number of 0 or more, not -1$"):

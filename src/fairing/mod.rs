@@ -15,7 +15,7 @@
 //! irregular mesh a vertex is pulled towards the centroid of its neighbours even where the surface
 //! is already smooth, so vertices slide along the surface.
 //!
-//! [`FairVariant::NormalProjected`] (the default) computes exactly the paper's update x̃ (all
+//! [`FairVariant::Improved`] (the default; it was called "normal-projected") computes exactly the paper's update x̃ (all
 //! vertices, Jacobi) and keeps only the component of each move x̃_v − x_v along the normal of v's
 //! fan taken at the midpoints between the positions and their umbrella means; boundary vertices
 //! keep the part of the curve update orthogonal to the loop's tangent. Noise lies across the
@@ -106,18 +106,26 @@ impl BoundaryMode {
 pub enum FairVariant {
     /// The paper's operator exactly (uniform umbrella weights, eq 7, plain average).
     Paper,
-    /// The paper's update with only its component along the normal of the midpoint fan kept
-    /// (boundary vertices: the component orthogonal to the loop tangent), so vertices no longer
-    /// slide along the surface. The default; see the module docs for why.
+    /// The improved variant (the default): the paper's update with only its component along the
+    /// normal of the midpoint fan kept (boundary vertices: the component orthogonal to the loop
+    /// tangent), so vertices no longer slide along the surface; see the module docs for why.
+    /// "Improved" is also what [`crate::multires::MultiresVariant`] calls its own change of the
+    /// paper's recipe: every variant of fairmesh is either the paper's or the improved one.
     #[default]
-    NormalProjected,
+    Improved,
 }
 
 impl FairVariant {
+    /// The improved variant's former name (the paper's update projected on the normal).
+    #[deprecated(note = "renamed FairVariant::Improved, the word the CLI and Python use")]
+    #[allow(non_upper_case_globals)]
+    pub const NormalProjected: FairVariant = FairVariant::Improved;
+
+    /// The variant's name as `--variant`, Python's `variant=` and the JSON report spell it.
     pub fn name(self) -> &'static str {
         match self {
             FairVariant::Paper => "paper",
-            FairVariant::NormalProjected => "normal-projected",
+            FairVariant::Improved => "improved",
         }
     }
 }
@@ -208,7 +216,7 @@ impl Default for FairOptions {
             rounds: 1,
             strength: Strength::Auto,
             boundary: BoundaryMode::Curve,
-            variant: FairVariant::NormalProjected,
+            variant: FairVariant::Improved,
             creases: Some(CreaseOptions::default()),
             tangential_relaxation: DEFAULT_TANGENTIAL_RELAXATION,
             relaxation: Relaxation::WhereNeeded,

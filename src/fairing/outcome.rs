@@ -42,7 +42,7 @@ pub fn fair_measured(
     let edge = metrics::mean_edge_length(mesh);
     let volume_before = metrics::signed_volume(mesh);
     let slides = matches!(options, MethodOptions::Constrained(o) if o.tangential_relaxation > 0.0
-        && o.variant == FairVariant::NormalProjected);
+        && o.variant == FairVariant::Improved);
     let textured_input = (slides && textured).then(|| mesh.positions.clone());
     let started = Instant::now();
     let report = super::fair_with_progress(mesh, topology, options, mask, progress)?;
@@ -194,7 +194,7 @@ mod tests {
         };
         let json = outcome.to_json(&options, &mesh, &context);
         assert_eq!(json["method"], "constrained");
-        assert_eq!(json["variant"], "normal-projected");
+        assert_eq!(json["variant"], "improved");
         assert_eq!(json["input"], "in.obj");
         assert!(json["output"].is_null());
         assert_eq!(json["vertices"], mesh.vertex_count());

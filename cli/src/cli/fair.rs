@@ -34,8 +34,10 @@ pub enum MethodArg {
 pub enum VariantArg {
     /// The paper's operator exactly (vertices may slide along the surface).
     Paper,
-    /// The paper's update projected on the vertex normal (no sliding; the default).
-    NormalProjected,
+    /// The paper's update projected on the vertex normal, so vertices do not slide (the
+    /// default; "normal-projected" is its former name, still accepted).
+    #[value(alias = "normal-projected", alias = "projected")]
+    Improved,
 }
 
 #[derive(Args, Debug)]
@@ -65,16 +67,16 @@ pub struct FairArgs {
     /// error of the result falls; the last round that lowered it clearly is kept.
     #[arg(long)]
     pub rounds: Option<usize>,
-    /// Constrained normal-projected only: edges where the surface folds by more than this many
+    /// Constrained, improved variant only: edges where the surface folds by more than this many
     /// degrees are kept sharp (faired along the crease; corners stay).
     #[arg(long, default_value_t = fairmesh::fairing::creases::DEFAULT_CREASE_ANGLE,
           conflicts_with = "no_creases")]
     pub crease_angle: f64,
-    /// Constrained normal-projected only: fair across sharp edges too, as the paper does (for
+    /// Constrained, improved variant only: fair across sharp edges too, as the paper does (for
     /// smooth shapes: thin triangles are then relaxed only where they fold, not along bends).
     #[arg(long)]
     pub no_creases: bool,
-    /// Constrained normal-projected only: how much each iteration also evens out the triangles
+    /// Constrained, improved variant only: how much each iteration also evens out the triangles
     /// along the surface, at every vertex (0 to 1; 0 moves vertices only along their normals).
     /// Without it, 0.1 where needed: everywhere when the noise moved vertices along the surface
     /// too (it reads how much: `tangential_noise` in --json), until the mesh reads even, and
@@ -83,7 +85,7 @@ pub struct FairArgs {
     /// curves.
     #[arg(long)]
     pub tangential: Option<f64>,
-    /// Constrained normal-projected only: do not give each part back its volume after every
+    /// Constrained, improved variant only: do not give each part back its volume after every
     /// round (by default a uniform offset along the normals undoes the little each round loses).
     #[arg(long)]
     pub no_volume_correction: bool,
@@ -96,7 +98,7 @@ pub struct FairArgs {
     #[arg(long, value_enum, default_value_t = BoundaryArg::Curve)]
     pub boundary: BoundaryArg,
     /// Constrained only: the operator variant.
-    #[arg(long, value_enum, default_value_t = VariantArg::NormalProjected)]
+    #[arg(long, value_enum, default_value_t = VariantArg::Improved)]
     pub variant: VariantArg,
     /// Laplacian and Taubin: the (shrinking) step size λ [default: 0.5].
     #[arg(long)]
@@ -406,12 +408,12 @@ pub fn bench_rows(mesh: &TriMesh, topology: &Topology) -> Vec<(String, f64)> {
         std::hint::black_box(ConstrainedFairing::new(
             mesh,
             topology,
-            FairVariant::NormalProjected,
+            FairVariant::Improved,
             BoundaryMode::Curve,
         ));
     });
     rows.push(("fair: constrained precomputation".to_string(), precompute));
-    for variant in [FairVariant::Paper, FairVariant::NormalProjected] {
+    for variant in [FairVariant::Paper, FairVariant::Improved] {
         let mut fairing = ConstrainedFairing::new(mesh, topology, variant, BoundaryMode::Curve);
         let positions = mesh.positions.clone();
         fairing.load(&positions);

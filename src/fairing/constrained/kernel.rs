@@ -152,7 +152,7 @@ impl ConstrainedFairing {
         // means (and, projected, the fan flags); writes the new positions.
         let flags = match self.variant {
             FairVariant::Paper => 0,
-            FairVariant::NormalProjected => vertices,
+            FairVariant::Improved => vertices,
         };
         let pass2 = offsets + (4 + index) * entries + 12 * vertices + flags + 3 * point + 2 * point;
         pass1 + pass2
@@ -247,7 +247,7 @@ impl ConstrainedFairing {
     /// [`Self::reanchor`]). Returns the largest vertex move, the tangential relaxation's part of
     /// a move counted at a tenth of its length (what a round's settling reads).
     pub fn step(&mut self) -> f64 {
-        let project = self.variant == FairVariant::NormalProjected;
+        let project = self.variant == FairVariant::Improved;
         self.buffers();
         let ws = &mut self.workspace;
         let offsets = &self.ring_offsets;
@@ -584,7 +584,7 @@ mod tests {
         let mut fairing = ConstrainedFairing::with_creases(
             &noisy,
             &topology,
-            FairVariant::NormalProjected,
+            FairVariant::Improved,
             BoundaryMode::Curve,
             &creases,
         );
@@ -630,7 +630,7 @@ mod tests {
         let mut fairing = ConstrainedFairing::new(
             &mesh,
             &topology,
-            FairVariant::NormalProjected,
+            FairVariant::Improved,
             BoundaryMode::Fixed,
         );
         fairing.set_tangential_relaxation(1.0);
@@ -664,7 +664,7 @@ mod tests {
                 [p[0] + bump, p[1] - 0.5 * bump, p[2] + 0.3 * bump]
             })
             .collect();
-        for variant in [FairVariant::Paper, FairVariant::NormalProjected] {
+        for variant in [FairVariant::Paper, FairVariant::Improved] {
             let options = FairOptions {
                 iterations: 4,
                 rounds: 2,

@@ -244,7 +244,7 @@ impl RelaxationPlan {
         options: &FairOptions,
         estimate: Option<f64>,
     ) -> RelaxationPlan {
-        let tangential_noise = (options.variant == FairVariant::NormalProjected
+        let tangential_noise = (options.variant == FairVariant::Improved
             && options.tangential_relaxation > 0.0
             && options.relaxation == Relaxation::WhereNeeded)
             .then(|| read_tangential_noise(mesh, topology, fans));

@@ -145,7 +145,7 @@ impl FairPlan {
             .as_ref()
             .map(|mask| mask.pinned_flags())
             .unwrap_or_default();
-        let without_loose = (options.variant == FairVariant::NormalProjected
+        let without_loose = (options.variant == FairVariant::Improved
             && !topology.non_manifold_edges.is_empty())
         .then(|| crate::mesh::without_loose_triangles(mesh, topology))
         .flatten()
@@ -673,7 +673,7 @@ mod tests {
         let triangles = (0..6u32).map(|i| [0, 1 + i, 1 + (i + 1) % 6]).collect();
         let mut mesh = TriMesh::new(positions, triangles);
         let topology = Topology::build(&mesh);
-        for variant in [FairVariant::Paper, FairVariant::NormalProjected] {
+        for variant in [FairVariant::Paper, FairVariant::Improved] {
             let before = mesh.positions.clone();
             fair_constrained(
                 &mut mesh,

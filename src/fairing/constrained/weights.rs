@@ -696,14 +696,14 @@ mod tests {
         let mut fairing = ConstrainedFairing::with_creases(
             &mesh,
             &topology,
-            FairVariant::NormalProjected,
+            FairVariant::Improved,
             BoundaryMode::Fixed,
             &creases,
         );
         let options = FairOptions {
             iterations: 10,
             rounds: 5,
-            variant: FairVariant::NormalProjected,
+            variant: FairVariant::Improved,
             ..Default::default()
         };
         fairing.run(&mut positions, &options);
@@ -735,7 +735,7 @@ mod tests {
                 [p[0] + bump, p[1] - bump, p[2] + 0.5 * bump]
             })
             .collect();
-        for variant in [FairVariant::Paper, FairVariant::NormalProjected] {
+        for variant in [FairVariant::Paper, FairVariant::Improved] {
             let run_options = FairOptions {
                 iterations: 3,
                 rounds: 1,
