@@ -627,12 +627,8 @@ mod tests {
         }
         assert!(mesh.positions.iter().all(|p| p[2] == 0.0), "a flat grid");
         let topology = Topology::build(&mesh);
-        let mut fairing = ConstrainedFairing::new(
-            &mesh,
-            &topology,
-            FairVariant::Improved,
-            BoundaryMode::Fixed,
-        );
+        let mut fairing =
+            ConstrainedFairing::new(&mesh, &topology, FairVariant::Improved, BoundaryMode::Fixed);
         fairing.set_tangential_relaxation(1.0);
         fairing.load(&mesh.positions);
         let reported = fairing.step();
