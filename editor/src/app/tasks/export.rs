@@ -88,7 +88,7 @@ impl App {
 
     /// The folder the level chain goes to: the typed one, or `<stem>_levels` next to the file.
     pub fn levels_folder(&self) -> Option<PathBuf> {
-        let typed = self.settings.levels_folder.trim();
+        let typed = self.settings.level_chain.folder.trim();
         if !typed.is_empty() {
             return Some(PathBuf::from(typed));
         }
@@ -114,8 +114,8 @@ impl App {
         let hierarchy = hierarchy.clone();
         let file_source = document.source.clone();
         let top = hierarchy.level_count().saturating_sub(1);
-        let to = self.settings.levels_to.min(top);
-        let from = self.settings.levels_from.min(to);
+        let to = self.settings.level_chain.to.min(top);
+        let from = self.settings.level_chain.from.min(to);
         let stem = document
             .path
             .file_stem()
@@ -193,7 +193,7 @@ impl App {
                 };
                 #[cfg(not(target_arch = "wasm32"))]
                 if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
-                    self.settings.last_dir = Some(dir.to_path_buf());
+                    self.settings.files.last_dir = Some(dir.to_path_buf());
                 }
                 self.message = Some(format!(
                     "Exported to {} ({:.2} s){}",

@@ -89,7 +89,7 @@ impl App {
         if self.dialog_open {
             return;
         }
-        let start_dir = self.settings.last_dir.clone().or_else(|| {
+        let start_dir = self.settings.files.last_dir.clone().or_else(|| {
             self.document
                 .as_ref()
                 .and_then(|d| d.path.parent().map(std::path::Path::to_path_buf))
@@ -156,10 +156,10 @@ impl App {
                     } else {
                         std::path::absolute(&requested).unwrap_or(requested)
                     };
-                    self.settings.remember_recent(&requested);
+                    self.settings.files.remember_recent(&requested);
                 }
                 if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
-                    self.settings.last_dir = Some(dir.to_path_buf());
+                    self.settings.files.last_dir = Some(dir.to_path_buf());
                 }
                 let loaded = *loaded;
                 let name = path
