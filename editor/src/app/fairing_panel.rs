@@ -182,19 +182,24 @@ fn method_controls(settings: &mut Settings, ui: &mut egui::Ui, method: Method) {
         });
     explain(combo.response, tips::METHOD, None);
     if method.uses_hierarchy() {
-        let iterations = ui
-            .add(egui::Slider::new(&mut settings.fairing.iterations, 1..=50).text("Iterations per level"));
+        let iterations = ui.add(
+            egui::Slider::new(&mut settings.fairing.iterations, 1..=50)
+                .text("Iterations per level"),
+        );
         explain(iterations, tips::ITERATIONS_PER_LEVEL, None);
         let rounds = ui.add(egui::Slider::new(&mut settings.fairing.rounds, 1..=10).text("Rounds"));
         explain(rounds, tips::ROUNDS, None);
     } else {
         ui.small("A baseline smooths the mesh itself (no hierarchy): watch the volume change.");
-        let iterations = ui
-            .add(egui::Slider::new(&mut settings.fairing.baseline_iterations, 1..=200).text("Iterations"));
+        let iterations = ui.add(
+            egui::Slider::new(&mut settings.fairing.baseline_iterations, 1..=200)
+                .text("Iterations"),
+        );
         explain(iterations, tips::BASELINE_ITERATIONS, None);
         if matches!(method, Method::Laplacian | Method::Taubin) {
-            let lambda =
-                ui.add(egui::Slider::new(&mut settings.fairing.baseline_lambda, 0.05..=1.0).text("Lambda"));
+            let lambda = ui.add(
+                egui::Slider::new(&mut settings.fairing.baseline_lambda, 0.05..=1.0).text("Lambda"),
+            );
             explain(lambda, tips::LAMBDA, None);
         }
     }
@@ -234,8 +239,16 @@ fn boundary_and_variant(
                 MultiresVariant::Improved => "Improved",
             })
             .show_ui(ui, |ui| {
-                ui.selectable_value(&mut settings.fairing.variant, MultiresVariant::Paper, "Paper");
-                ui.selectable_value(&mut settings.fairing.variant, MultiresVariant::Improved, "Improved");
+                ui.selectable_value(
+                    &mut settings.fairing.variant,
+                    MultiresVariant::Paper,
+                    "Paper",
+                );
+                ui.selectable_value(
+                    &mut settings.fairing.variant,
+                    MultiresVariant::Improved,
+                    "Improved",
+                );
             })
             .response
     });

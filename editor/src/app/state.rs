@@ -19,6 +19,6 @@ pub use measures::Measures;
 pub use settings::{
     CompareView, FairingKey, FairingSettings, FileSettings, HeatReference, HierarchyKey,
     HierarchySettings, LevelChainSettings, MethodChoice, NoiseSettings, Settings, ViewMode,
-    ViewSettings, MAX_DENOISE_ROUNDS, MAX_SHARP_EDGE_ANGLE, MIN_SHARP_EDGE_ANGLE,
-    SETTINGS_VERSION, UNVERSIONED,
+    ViewSettings, MAX_DENOISE_ROUNDS, MAX_SHARP_EDGE_ANGLE, MIN_SHARP_EDGE_ANGLE, SETTINGS_VERSION,
+    UNVERSIONED,
 };

@@ -725,7 +725,10 @@ mod tests {
     #[test]
     fn settings_stored_before_the_parts_load_into_the_same_values_and_are_stored_the_same() {
         let expected = stored_before_the_parts();
-        assert_eq!(load_from_eframe(STORED_BEFORE_THE_PARTS), Some(expected.clone()));
+        assert_eq!(
+            load_from_eframe(STORED_BEFORE_THE_PARTS),
+            Some(expected.clone())
+        );
         let from_json: Settings = serde_json::from_str(STORED_BEFORE_THE_PARTS_JSON).unwrap();
         assert_eq!(from_json, expected);
         // Stored now, they read as before (an older editor loads them too).

@@ -166,7 +166,9 @@ impl App {
                     .collect::<Vec<_>>();
                 current.level = if current.pick_start_level {
                     current.pick_start_level = false;
-                    self.settings.files.start_level_for(&current.path, levels.len())
+                    self.settings
+                        .files
+                        .start_level_for(&current.path, levels.len())
                 } else {
                     current.level.min(levels.len().saturating_sub(1))
                 };

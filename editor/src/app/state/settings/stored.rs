@@ -219,6 +219,8 @@ impl Visitor<'_> for FieldNameVisitor {
         let name = usize::try_from(index)
             .ok()
             .and_then(|index| STORED_FIELDS.get(index));
-        Ok(FieldName(name.map_or_else(String::new, |&name| name.to_owned())))
+        Ok(FieldName(
+            name.map_or_else(String::new, |&name| name.to_owned()),
+        ))
     }
 }
