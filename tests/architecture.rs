@@ -246,9 +246,8 @@ fn named_fields(code: &[char], open: usize) -> (usize, usize) {
             }
             _ => {}
         }
-        if depth == 1 && c != '{' {
-            segment.push(c);
-        } else if depth > 1 {
+        // Everything inside the body but its opening brace.
+        if depth > 1 || c != '{' {
             segment.push(c);
         }
     }

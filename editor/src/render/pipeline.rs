@@ -131,10 +131,10 @@ enum PartDrawn {
 
 /// Owns the pipelines, the mesh buffers and the offscreen target. Knows nothing of fairing.
 ///
-/// Its state in parts: the device and what is made on it once ([`DeviceKit`]), the uploads in
-/// flight ([`InFlight`], `pipeline/upload.rs`), the image drawn over several frames
-/// ([`PartDrawing`]), the held meshes' kept images ([`kept::KeptImages`]) and what was drawn
-/// and written so far ([`ImageCounts`], [`UploadCounts`]).
+/// Its state in parts: the device and what is made on it once (`DeviceKit`), the uploads in
+/// flight (`InFlight`, `pipeline/upload.rs`), the image drawn over several frames
+/// (`PartDrawing`), the held meshes' kept images (`KeptImages`, `pipeline/kept.rs`) and what
+/// was drawn and written so far ([`ImageCounts`], [`UploadCounts`]).
 pub struct MeshRenderer {
     /// The device, the pipelines and the materials' layout.
     gpu: DeviceKit,
