@@ -117,3 +117,244 @@ fn library_depends_on_no_gui_crate(target: &str) {
         );
     }
 }
+
+/// The most named fields a struct of the editor or the web page may have: a bigger one is state
+/// that any task can change, which the editor keeps in owned parts instead.
+const MAX_STRUCT_FIELDS: usize = 20;
+
+/// The folders whose structs [`MAX_STRUCT_FIELDS`] bounds.
+const PARTED_FOLDERS: [&str; 2] = ["editor/src/", "web/src/"];
+
+#[test]
+fn no_struct_of_the_editor_or_the_web_page_has_more_than_20_fields() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let mut files = BTreeSet::new();
+    for folder in PARTED_FOLDERS {
+        rust_files(&root.join(folder), root, &mut files);
+    }
+    let mut structs = 0;
+    let mut too_big = Vec::new();
+    for file in &files {
+        let source = std::fs::read_to_string(root.join(file)).expect("a source file is readable");
+        for (name, fields) in struct_field_counts(&source) {
+            structs += 1;
+            if fields > MAX_STRUCT_FIELDS {
+                too_big.push(format!("{file}: {name} has {fields} fields"));
+            }
+        }
+    }
+    assert!(
+        too_big.is_empty(),
+        "structs of more than {MAX_STRUCT_FIELDS} fields (split them into owned parts): {too_big:#?}"
+    );
+    assert!(
+        structs > 50,
+        "found only {structs} structs with named fields"
+    );
+}
+
+#[test]
+fn the_field_count_sees_past_comments_strings_attributes_and_nested_types() {
+    let fields: String = (0..21)
+        .map(|i| {
+            format!(
+                "    /// Field {i}, a: b.\n    #[serde(default)]\n    pub f{i}: Vec<(u32, u8)>,\n"
+            )
+        })
+        .collect();
+    let source = format!(
+        "// struct Commented {{ a: u8, b: u8 }}\nconst S: &str = \"struct Quoted {{ a: u8 }}\";\n\
+         pub struct Big<'a, T: Copy> where T: Send {{\n{fields}    call: fn(u8) -> Option<u8>,\n    \
+         path: std::path::PathBuf,\n    tag: &'a T, /* c: u8, */\n}}\n\
+         struct Tuple(u8, u8);\nstruct Unit;\nmacro_rules! m {{ () => {{ struct $name {{ a: u8 }} }} }}\n\
+         struct Small {{ c: char, q: [u8; 2], }}\nconst C: char = '{{';\n"
+    );
+    assert_eq!(
+        struct_field_counts(&source),
+        vec![("Big".to_string(), 24), ("Small".to_string(), 2)]
+    );
+}
+
+/// Each struct with named fields in `source` (a Rust file) and how many fields it has.
+fn struct_field_counts(source: &str) -> Vec<(String, usize)> {
+    let code: Vec<char> = code_only(source).chars().collect();
+    let is_ident = |c: char| c.is_alphanumeric() || c == '_';
+    let mut found = Vec::new();
+    let mut at = 0;
+    while at + 6 <= code.len() {
+        let keyword = code[at..at + 6].iter().collect::<String>() == "struct"
+            && (at == 0 || !is_ident(code[at - 1]) && code[at - 1] != '$')
+            && code.get(at + 6).is_some_and(|c| c.is_whitespace());
+        if !keyword {
+            at += 1;
+            continue;
+        }
+        at += 6;
+        while code.get(at).is_some_and(|c| c.is_whitespace()) {
+            at += 1;
+        }
+        let name_start = at;
+        while code.get(at).is_some_and(|&c| is_ident(c)) {
+            at += 1;
+        }
+        let name: String = code[name_start..at].iter().collect();
+        if name.is_empty() || name.starts_with(|c: char| c.is_ascii_digit()) {
+            continue;
+        }
+        // Past the generics and the where clause to the body: `{` (named fields), else a tuple
+        // or unit struct.
+        let mut angle = 0usize;
+        while let Some(&c) = code.get(at) {
+            match c {
+                '<' => angle += 1,
+                '>' if code[at - 1] != '-' => angle = angle.saturating_sub(1),
+                '{' | ';' | '(' if angle == 0 => break,
+                _ => {}
+            }
+            at += 1;
+        }
+        if code.get(at) != Some(&'{') {
+            continue;
+        }
+        let (fields, end) = named_fields(&code, at);
+        found.push((name, fields));
+        at = end;
+    }
+    found
+}
+
+/// The named fields of the struct body opening at `open` (a `{`), and where the body ends.
+fn named_fields(code: &[char], open: usize) -> (usize, usize) {
+    let mut depth = 0usize;
+    let mut segments = Vec::new();
+    let mut segment = String::new();
+    let mut at = open;
+    while let Some(&c) = code.get(at) {
+        at += 1;
+        match c {
+            '{' | '(' | '[' | '<' => depth += 1,
+            '>' if code[at - 2] == '-' => {}
+            '}' | ')' | ']' | '>' => {
+                depth -= 1;
+                if depth == 0 {
+                    break;
+                }
+            }
+            ',' if depth == 1 => {
+                segments.push(std::mem::take(&mut segment));
+                continue;
+            }
+            _ => {}
+        }
+        // Everything inside the body but its opening brace.
+        if depth > 1 || c != '{' {
+            segment.push(c);
+        }
+    }
+    segments.push(segment);
+    let named = segments
+        .iter()
+        .filter(|segment| {
+            let mut rest = segment.trim();
+            // Attributes, then the visibility.
+            while let Some(attribute) = rest.strip_prefix("#[") {
+                let close = attribute.find(']').map_or(attribute.len(), |i| i + 1);
+                rest = attribute[close..].trim_start();
+            }
+            if let Some(public) = rest.strip_prefix("pub") {
+                rest = public.trim_start();
+                if rest.starts_with('(') {
+                    rest = rest[rest.find(')').map_or(rest.len(), |i| i + 1)..].trim_start();
+                }
+            }
+            let name_end = rest
+                .find(|c: char| !(c.is_alphanumeric() || c == '_' || c == '#'))
+                .unwrap_or(rest.len());
+            let after = rest[name_end..].trim_start();
+            name_end > 0
+                && !rest.starts_with(|c: char| c.is_ascii_digit())
+                && after.starts_with(':')
+                && !after.starts_with("::")
+        })
+        .count();
+    (named, at)
+}
+
+/// `source` with its comments, strings and character literals blanked out (lifetimes kept).
+fn code_only(source: &str) -> String {
+    let chars: Vec<char> = source.chars().collect();
+    let mut code = String::with_capacity(source.len());
+    let mut at = 0;
+    while at < chars.len() {
+        let c = chars[at];
+        let next = chars.get(at + 1).copied();
+        if c == '/' && next == Some('/') {
+            while at < chars.len() && chars[at] != '\n' {
+                at += 1;
+            }
+        } else if c == '/' && next == Some('*') {
+            let mut depth = 0;
+            while at < chars.len() {
+                if chars[at] == '/' && chars.get(at + 1) == Some(&'*') {
+                    depth += 1;
+                    at += 2;
+                } else if chars[at] == '*' && chars.get(at + 1) == Some(&'/') {
+                    depth -= 1;
+                    at += 2;
+                    if depth == 0 {
+                        break;
+                    }
+                } else {
+                    at += 1;
+                }
+            }
+            code.push(' ');
+        } else if c == 'r' && (next == Some('"') || next == Some('#') && raw_string_at(&chars, at))
+        {
+            // A raw string: r"…", r#"…"#, …
+            at += 1;
+            let mut hashes = 0;
+            while chars.get(at) == Some(&'#') {
+                hashes += 1;
+                at += 1;
+            }
+            at += 1;
+            while at < chars.len() {
+                if chars[at] == '"' && (1..=hashes).all(|i| chars.get(at + i) == Some(&'#')) {
+                    at += 1 + hashes;
+                    break;
+                }
+                at += 1;
+            }
+            code.push_str("\"\"");
+        } else if c == '"' {
+            at += 1;
+            while at < chars.len() && chars[at] != '"' {
+                at += if chars[at] == '\\' { 2 } else { 1 };
+            }
+            at += 1;
+            code.push_str("\"\"");
+        } else if c == '\'' && (next == Some('\\') || chars.get(at + 2) == Some(&'\'')) {
+            // A character literal ('x', '\n', '\u{..}'); otherwise a lifetime.
+            at += 1;
+            while at < chars.len() && chars[at] != '\'' {
+                at += if chars[at] == '\\' { 2 } else { 1 };
+            }
+            at += 1;
+            code.push_str("' '");
+        } else {
+            code.push(c);
+            at += 1;
+        }
+    }
+    code
+}
+
+/// Whether `r#` at `at` opens a raw string (`r#"`), not a raw identifier (`r#type`).
+fn raw_string_at(chars: &[char], at: usize) -> bool {
+    let mut after = at + 1;
+    while chars.get(after) == Some(&'#') {
+        after += 1;
+    }
+    chars.get(after) == Some(&'"')
+}

@@ -432,10 +432,10 @@ fn camera_orbits_pans_zooms_and_fits() {
     assert!((refitted.distance - fitted.distance).abs() < 1e-4 * fitted.distance);
     assert_eq!(refitted.target, fitted.target);
 
-    assert!(!harness.state().settings().wireframe);
+    assert!(!harness.state().settings().view.wireframe);
     harness.key_press(egui::Key::W);
     harness.step();
-    assert!(harness.state().settings().wireframe);
+    assert!(harness.state().settings().view.wireframe);
 }
 
 #[test]
@@ -1004,7 +1004,7 @@ fn keep_sharp_edges_keeps_a_boxs_edges_in_the_hierarchy_and_draws_them_while_poi
     let status = harness.state().status();
     assert!(status.hierarchy_ready, "the hierarchy was built again");
     assert_eq!(status.sharp_edges_kept, 0);
-    assert!(!harness.state().settings().keep_sharp_edges);
+    assert!(!harness.state().settings().hierarchy.keep_sharp_edges);
     assert!(status.faired_serial.is_some(), "and the view fairs with it");
     assert!(
         levels_with >= status.level_count,

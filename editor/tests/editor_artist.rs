@@ -166,7 +166,7 @@ fn recent_files_reopen_and_a_missing_one_is_named_and_dropped() {
     harness.get_by_role_and_label(Role::Button, "Load").click();
     settle(&mut harness);
     assert_eq!(
-        harness.state().settings().recent_files,
+        harness.state().settings().files.recent_files,
         vec![other.clone(), input.clone()],
         "newest first"
     );
@@ -181,7 +181,7 @@ fn recent_files_reopen_and_a_missing_one_is_named_and_dropped() {
     assert_eq!(status.document.as_deref(), Some(input.as_path()));
     assert!(status.error.is_none(), "{:?}", status.error);
     assert_eq!(
-        harness.state().settings().recent_files,
+        harness.state().settings().files.recent_files,
         vec![input.clone(), other.clone()]
     );
 
@@ -197,7 +197,7 @@ fn recent_files_reopen_and_a_missing_one_is_named_and_dropped() {
     assert!(error.contains(&other.display().to_string()), "{error}");
     assert!(error.contains("no longer there"), "{error}");
     assert_eq!(status.document.as_deref(), Some(input.as_path()));
-    assert_eq!(harness.state().settings().recent_files, vec![input]);
+    assert_eq!(harness.state().settings().files.recent_files, vec![input]);
 }
 
 fn open_recent_menu(harness: &mut egui_kittest::Harness<'_, fairmesh_editor::app::App>) {

@@ -62,7 +62,7 @@ fn a_scene_shows_its_texture_and_base_colours_and_clay_hides_them() {
         node.accesskit_node().description().as_deref(),
         Some(tips::CLAY)
     );
-    assert!(!harness.state().settings().clay);
+    assert!(!harness.state().settings().view.clay);
     let coloured = viewport_image(&mut harness);
     let (blue, red) = (blue_pixels(&coloured), red_pixels(&coloured));
     assert!(blue > 1500, "the checker texture on the ball: {blue} px");
@@ -72,7 +72,7 @@ fn a_scene_shows_its_texture_and_base_colours_and_clay_hides_them() {
     harness.key_press(egui::Key::C);
     harness.step();
     settle(&mut harness);
-    assert!(harness.state().settings().clay);
+    assert!(harness.state().settings().view.clay);
     assert!(harness.state().main_draw_params().unwrap().clay);
     let clay = viewport_image(&mut harness);
     assert_eq!(blue_pixels(&clay), 0, "clay: no texture");
@@ -81,7 +81,7 @@ fn a_scene_shows_its_texture_and_base_colours_and_clay_hides_them() {
 
     harness.get_by_label(CLAY).click();
     settle(&mut harness);
-    assert!(!harness.state().settings().clay);
+    assert!(!harness.state().settings().view.clay);
     let again = viewport_image(&mut harness);
     assert!(blue_pixels(&again) > 1500);
 }

@@ -21,7 +21,7 @@ use editor_common::{
 fn noisy_bunny_faired_from_the_middle() -> Harness<'static, App> {
     let mut harness = harness_for(bunny());
     settle(&mut harness);
-    assert_eq!(harness.state().settings().noise_seed, 1);
+    assert_eq!(harness.state().settings().noise.seed, 1);
     harness
         .get_by_role_and_label(Role::Button, "Add noise")
         .click();
@@ -264,7 +264,7 @@ fn heat_map_colours_by_distance_and_shows_a_legend() {
     harness.step();
     harness.get_by_label("clean mesh").click();
     settle(&mut harness);
-    assert!(harness.state().settings().heat_map);
+    assert!(harness.state().settings().view.heat_map);
     let top = harness
         .state()
         .heat_map_top()
@@ -353,7 +353,7 @@ fn before_after_toggle_split_and_side_by_side_render() {
     let start = rect.center();
     let target_x = rect.left() + rect.width() / 3.0;
     drag(&mut harness, start, egui::pos2(target_x, start.y), 4);
-    let split_at = harness.state().settings().split;
+    let split_at = harness.state().settings().view.split;
     assert!((split_at - 1.0 / 3.0).abs() < 0.03, "divider at {split_at}");
     assert_eq!(
         harness.state().camera().yaw,
@@ -480,7 +480,7 @@ fn shortcuts_export_and_persisted_settings_round_trip() {
     // F and W work again once no text field has the keyboard; tooltips name the keys.
     harness.key_press(egui::Key::W);
     harness.step();
-    assert!(harness.state().settings().wireframe);
+    assert!(harness.state().settings().view.wireframe);
     harness.get_by_label("Fit view (F)").hover();
     for _ in 0..60 {
         harness.step();
@@ -489,7 +489,7 @@ fn shortcuts_export_and_persisted_settings_round_trip() {
 
     // What persists: the settings, including the last folder, survive a JSON round trip.
     let settings = harness.state().settings().clone();
-    assert_eq!(settings.last_dir.as_deref(), Some(dir.path()));
+    assert_eq!(settings.files.last_dir.as_deref(), Some(dir.path()));
     let json = serde_json::to_string(&settings).unwrap();
     let back: fairmesh_editor::app::state::Settings = serde_json::from_str(&json).unwrap();
     assert_eq!(back, settings);

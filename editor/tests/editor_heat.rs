@@ -110,7 +110,7 @@ fn heat_map_mask_and_shape_come_from_one_result_through_the_mask_steps() {
         harness.state().status().view.mask_shown,
         "the mask is shown"
     );
-    assert!(harness.state().settings().heat_map);
+    assert!(harness.state().settings().view.heat_map);
     let masked = heat_map_of_the_result_on_screen(&mut harness, "after a stroke");
     assert!(masked != whole, "the masked result's map is its own");
     snapshot(&mut harness, "heat_mask_1_stroke");

@@ -52,7 +52,7 @@ fn shading_and_lighting_explain_themselves_and_change_what_is_drawn() {
     // An artist's default: smooth, in the studio.
     let settings = harness.state().settings();
     assert_eq!(
-        (settings.shading, settings.lighting),
+        (settings.view.shading, settings.view.lighting),
         (Shading::Smooth, Lighting::Studio)
     );
     let params = harness.state().main_draw_params().expect("a viewport");
@@ -70,7 +70,7 @@ fn shading_and_lighting_explain_themselves_and_change_what_is_drawn() {
     );
 
     click_and_settle(&mut harness, "Flat");
-    assert_eq!(harness.state().settings().shading, Shading::Flat);
+    assert_eq!(harness.state().settings().view.shading, Shading::Flat);
     let params = harness.state().main_draw_params().unwrap();
     assert_eq!(params.shading, Shading::Flat);
     let flat_studio = viewport_image(&mut harness);
@@ -78,7 +78,7 @@ fn shading_and_lighting_explain_themselves_and_change_what_is_drawn() {
     assert!(changed > 20_000, "flat differs from smooth ({changed} px)");
 
     click_and_settle(&mut harness, STUDIO_LIGHTING);
-    assert_eq!(harness.state().settings().lighting, Lighting::Simple);
+    assert_eq!(harness.state().settings().view.lighting, Lighting::Simple);
     assert_eq!(
         harness.state().main_draw_params().unwrap().lighting,
         Lighting::Simple
@@ -93,7 +93,7 @@ fn shading_and_lighting_explain_themselves_and_change_what_is_drawn() {
     // And back: the same choices draw the same image again.
     click_and_settle(&mut harness, "Smooth");
     click_and_settle(&mut harness, STUDIO_LIGHTING);
-    assert_eq!(harness.state().settings().lighting, Lighting::Studio);
+    assert_eq!(harness.state().settings().view.lighting, Lighting::Studio);
     let again = viewport_image(&mut harness);
     assert!(differing_pixels(&smooth_studio, &again) < 200);
 }
@@ -149,7 +149,7 @@ fn smooth_shading_keeps_a_cad_parts_edges_crisp() {
     let mut harness = harness_for(path);
     settle(&mut harness);
     click_and_settle(&mut harness, "Input mesh");
-    assert_eq!(harness.state().settings().shading, Shading::Smooth);
+    assert_eq!(harness.state().settings().view.shading, Shading::Smooth);
     let angle = format!("more than {}°", SHARP_EDGE_ANGLE);
     assert!(tips::SMOOTH.contains(&angle), "the tip names the angle");
 
@@ -239,7 +239,7 @@ fn the_heat_map_is_lit_in_the_before_view() {
             click_and_settle(&mut harness, STUDIO_LIGHTING);
         }
         assert_eq!(
-            harness.state().settings().lighting == Lighting::Studio,
+            harness.state().settings().view.lighting == Lighting::Studio,
             studio
         );
         let spread = brightness_spread(&viewport_image(&mut harness));
@@ -255,17 +255,17 @@ fn the_heat_map_is_lit_in_the_before_view() {
 #[test]
 fn the_s_key_switches_between_flat_and_smooth() {
     let mut harness = bunny_input_mesh();
-    assert_eq!(harness.state().settings().shading, Shading::Smooth);
+    assert_eq!(harness.state().settings().view.shading, Shading::Smooth);
     harness.key_press(egui::Key::S);
     settle(&mut harness);
-    assert_eq!(harness.state().settings().shading, Shading::Flat);
+    assert_eq!(harness.state().settings().view.shading, Shading::Flat);
     assert_eq!(
         harness.state().main_draw_params().unwrap().shading,
         Shading::Flat
     );
     harness.key_press(egui::Key::S);
     settle(&mut harness);
-    assert_eq!(harness.state().settings().shading, Shading::Smooth);
+    assert_eq!(harness.state().settings().view.shading, Shading::Smooth);
 
     harness
         .get_by_role_and_label(egui::accesskit::Role::TextInput, "Path:")
@@ -274,7 +274,7 @@ fn the_s_key_switches_between_flat_and_smooth() {
     harness.key_press(egui::Key::S);
     settle(&mut harness);
     assert_eq!(
-        harness.state().settings().shading,
+        harness.state().settings().view.shading,
         Shading::Smooth,
         "an S typed into the path field is text, not a shortcut"
     );

@@ -327,7 +327,7 @@ fn an_image_drawn_over_several_frames_is_the_image_drawn_at_once() {
     // In parts of 1000 faces or edges: 6400 + 19200 take 26 frames; meanwhile the target keeps
     // the previous image and no image counts as drawn.
     renderer.set_faces_per_frame(1000);
-    let drawn_before = renderer.images_drawn;
+    let drawn_before = renderer.image_counts().drawn;
     for frame in 0..26 {
         assert!(
             render_once(&mut renderer, &device, &queue, &near),
@@ -335,7 +335,7 @@ fn an_image_drawn_over_several_frames_is_the_image_drawn_at_once() {
         );
         if frame < 25 {
             assert!(renderer.drawing(), "frame {frame}");
-            assert_eq!(renderer.images_drawn, drawn_before);
+            assert_eq!(renderer.image_counts().drawn, drawn_before);
             // Set once the first part was drawn: which image is shown must not change meanwhile.
             if frame % 9 == 0 {
                 let shown = renderer.read_back_image(&device, &queue).unwrap();
@@ -344,7 +344,7 @@ fn an_image_drawn_over_several_frames_is_the_image_drawn_at_once() {
         }
     }
     assert!(!renderer.drawing());
-    assert_eq!(renderer.images_drawn, drawn_before + 1);
+    assert_eq!(renderer.image_counts().drawn, drawn_before + 1);
     assert!(renderer.read_back_image(&device, &queue).unwrap() == near_image);
     assert!(
         !render_once(&mut renderer, &device, &queue, &near),
@@ -368,7 +368,7 @@ fn an_image_drawn_over_several_frames_is_the_image_drawn_at_once() {
     // A resized target has no image to show meanwhile: its first image is drawn at once.
     let smaller = [80, 64];
     renderer.ensure_target(&device, smaller);
-    let drawn_before = renderer.images_drawn;
+    let drawn_before = renderer.image_counts().drawn;
     assert!(render_once(
         &mut renderer,
         &device,
@@ -376,7 +376,7 @@ fn an_image_drawn_over_several_frames_is_the_image_drawn_at_once() {
         &params(smaller, 3.0, true)
     ));
     assert!(!renderer.drawing());
-    assert_eq!(renderer.images_drawn, drawn_before + 1);
+    assert_eq!(renderer.image_counts().drawn, drawn_before + 1);
     assert!(render_once(
         &mut renderer,
         &device,

@@ -105,6 +105,7 @@ impl App {
                     document.level = level.min(top);
                     document.applied = false;
                     self.settings
+                        .files
                         .remember_start_level(&document.path, document.level);
                 }
                 self.refresh_view();
@@ -116,7 +117,7 @@ impl App {
                 self.refresh_view();
             }
             Command::SetViewMode(mode) => {
-                let previous = std::mem::replace(&mut self.settings.view_mode, mode);
+                let previous = std::mem::replace(&mut self.settings.view.view_mode, mode);
                 // The input mesh and the result are both shown from the fairing asked for
                 // whenever a setting changed: switching between them asks for nothing new.
                 let fairs = |mode| matches!(mode, ViewMode::Faired | ViewMode::Original);

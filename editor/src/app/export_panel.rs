@@ -55,25 +55,25 @@ pub(super) fn show(
         .map_or_else(String::new, |p| p.display().to_string());
     let label = ui.label("Levels folder:");
     ui.add(
-        egui::TextEdit::singleline(&mut settings.levels_folder)
+        egui::TextEdit::singleline(&mut settings.level_chain.folder)
             .hint_text(placeholder)
             .desired_width(f32::INFINITY),
     )
     .labelled_by(label.id);
     let top = document.level_count().unwrap_or(1).saturating_sub(1);
     // Edit copies: the stored range may reach past this mesh's levels (its end "to the top").
-    let mut to = settings.levels_to.min(top);
-    let mut from = settings.levels_from.min(to);
+    let mut to = settings.level_chain.to.min(top);
+    let mut from = settings.level_chain.from.min(to);
     ui.horizontal(|ui| {
         ui.label("Levels");
         let a = ui.add(egui::DragValue::new(&mut from).range(0..=top).prefix("M"));
         ui.label("to");
         let b = ui.add(egui::DragValue::new(&mut to).range(0..=top).prefix("M"));
         if a.changed() {
-            settings.levels_from = from;
+            settings.level_chain.from = from;
         }
         if b.changed() {
-            settings.levels_to = if to == top { usize::MAX } else { to };
+            settings.level_chain.to = if to == top { usize::MAX } else { to };
         }
     });
     if ui

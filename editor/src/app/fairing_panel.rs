@@ -34,7 +34,7 @@ pub(super) fn fairing_controls(
         document.level,
         document.applied,
     );
-    let method = settings.method;
+    let method = settings.fairing.method;
     let not_for_baseline = (!method.uses_hierarchy()).then(|| {
         format!(
             "Not used by {}: it smooths the whole input mesh at once, without the hierarchy.",
@@ -47,7 +47,7 @@ pub(super) fn fairing_controls(
     let before = settings.clone();
     method_controls(settings, ui, method);
     boundary_and_variant(settings, ui, not_for_baseline);
-    if settings.fairing_key() != before.fairing_key() {
+    if settings.fairing.key() != before.fairing.key() {
         commands.push(Command::Refair);
     }
     progress_and_apply(ui, view, commands, applied);
@@ -71,9 +71,9 @@ fn denoise_controls(
     ui.horizontal(|ui| {
         let combo = ui.add_enabled_ui(enabled, |ui| {
             egui::ComboBox::from_label("Remove noise first")
-                .selected_text(label(settings.denoise))
+                .selected_text(label(settings.hierarchy.denoise))
                 .show_ui(ui, |ui| {
-                    let rounds = match settings.denoise {
+                    let rounds = match settings.hierarchy.denoise {
                         Denoise::Rounds(rounds) => rounds,
                         _ => denoised_rounds(document).unwrap_or(10),
                     };
@@ -82,7 +82,7 @@ fn denoise_controls(
                         (Denoise::Rounds(rounds), tips::DENOISE_ROUNDS),
                         (Denoise::Off, tips::DENOISE_OFF),
                     ] {
-                        let chosen = std::mem::discriminant(&settings.denoise)
+                        let chosen = std::mem::discriminant(&settings.hierarchy.denoise)
                             == std::mem::discriminant(&choice);
                         if ui
                             .selectable_label(chosen, label(choice))
@@ -90,14 +90,14 @@ fn denoise_controls(
                             .clicked()
                             && !chosen
                         {
-                            settings.denoise = choice;
+                            settings.hierarchy.denoise = choice;
                         }
                     }
                 })
                 .response
         });
         explain(combo.inner, tips::REMOVE_NOISE, not_for_baseline);
-        if let Denoise::Rounds(count) = &mut settings.denoise {
+        if let Denoise::Rounds(count) = &mut settings.hierarchy.denoise {
             let value = ui.add_enabled(
                 enabled,
                 egui::DragValue::new(count).range(1..=MAX_DENOISE_ROUNDS),
@@ -119,7 +119,7 @@ fn denoise_controls(
         HierarchyState::Ready { denoise: None, .. } => {
             ui.small("The levels are built on the mesh as it is");
         }
-        HierarchyState::Building if settings.denoise != Denoise::Off => {
+        HierarchyState::Building if settings.hierarchy.denoise != Denoise::Off => {
             ui.small("Measuring the noise…");
         }
         _ => {}
@@ -174,27 +174,32 @@ const START_LEVEL_WORDS: &str =
 /// rounds over the hierarchy, or a baseline's iterations and step.
 fn method_controls(settings: &mut Settings, ui: &mut egui::Ui, method: Method) {
     let combo = egui::ComboBox::from_label("Method")
-        .selected_text(settings.method.label())
+        .selected_text(settings.fairing.method.label())
         .show_ui(ui, |ui| {
             for method in Method::ALL {
-                ui.selectable_value(&mut settings.method, method, method.label());
+                ui.selectable_value(&mut settings.fairing.method, method, method.label());
             }
         });
     explain(combo.response, tips::METHOD, None);
     if method.uses_hierarchy() {
-        let iterations = ui
-            .add(egui::Slider::new(&mut settings.iterations, 1..=50).text("Iterations per level"));
+        let iterations = ui.add(
+            egui::Slider::new(&mut settings.fairing.iterations, 1..=50)
+                .text("Iterations per level"),
+        );
         explain(iterations, tips::ITERATIONS_PER_LEVEL, None);
-        let rounds = ui.add(egui::Slider::new(&mut settings.rounds, 1..=10).text("Rounds"));
+        let rounds = ui.add(egui::Slider::new(&mut settings.fairing.rounds, 1..=10).text("Rounds"));
         explain(rounds, tips::ROUNDS, None);
     } else {
         ui.small("A baseline smooths the mesh itself (no hierarchy): watch the volume change.");
-        let iterations = ui
-            .add(egui::Slider::new(&mut settings.baseline_iterations, 1..=200).text("Iterations"));
+        let iterations = ui.add(
+            egui::Slider::new(&mut settings.fairing.baseline_iterations, 1..=200)
+                .text("Iterations"),
+        );
         explain(iterations, tips::BASELINE_ITERATIONS, None);
         if matches!(method, Method::Laplacian | Method::Taubin) {
-            let lambda =
-                ui.add(egui::Slider::new(&mut settings.baseline_lambda, 0.05..=1.0).text("Lambda"));
+            let lambda = ui.add(
+                egui::Slider::new(&mut settings.fairing.baseline_lambda, 0.05..=1.0).text("Lambda"),
+            );
             explain(lambda, tips::LAMBDA, None);
         }
     }
@@ -208,34 +213,42 @@ fn boundary_and_variant(
     not_for_baseline: Option<&str>,
 ) {
     let boundary = egui::ComboBox::from_label("Boundary")
-        .selected_text(match settings.boundary {
+        .selected_text(match settings.fairing.boundary {
             BoundaryMode::Curve => "Smooth as curve",
             BoundaryMode::Fixed => "Fixed",
         })
         .show_ui(ui, |ui| {
             ui.selectable_value(
-                &mut settings.boundary,
+                &mut settings.fairing.boundary,
                 BoundaryMode::Curve,
                 "Smooth as curve",
             );
-            ui.selectable_value(&mut settings.boundary, BoundaryMode::Fixed, "Fixed");
+            ui.selectable_value(&mut settings.fairing.boundary, BoundaryMode::Fixed, "Fixed");
         });
     explain(boundary.response, tips::BOUNDARY, None);
     let hierarchy_only = not_for_baseline.is_none();
     let fair_finest = ui.add_enabled(
         hierarchy_only,
-        egui::Checkbox::new(&mut settings.fair_finest, "Fair M0 too"),
+        egui::Checkbox::new(&mut settings.fairing.fair_finest, "Fair M0 too"),
     );
     explain(fair_finest, tips::FAIR_FINEST, not_for_baseline);
     let variant = ui.add_enabled_ui(hierarchy_only, |ui| {
         egui::ComboBox::from_label("Variant")
-            .selected_text(match settings.variant {
+            .selected_text(match settings.fairing.variant {
                 MultiresVariant::Paper => "Paper",
                 MultiresVariant::Improved => "Improved",
             })
             .show_ui(ui, |ui| {
-                ui.selectable_value(&mut settings.variant, MultiresVariant::Paper, "Paper");
-                ui.selectable_value(&mut settings.variant, MultiresVariant::Improved, "Improved");
+                ui.selectable_value(
+                    &mut settings.fairing.variant,
+                    MultiresVariant::Paper,
+                    "Paper",
+                );
+                ui.selectable_value(
+                    &mut settings.fairing.variant,
+                    MultiresVariant::Improved,
+                    "Improved",
+                );
             })
             .response
     });
@@ -295,10 +308,10 @@ pub(super) fn sharp_edge_controls(
     let Some(document) = view.document else {
         return;
     };
-    let not_for_baseline = (!settings.method.uses_hierarchy()).then(|| {
+    let not_for_baseline = (!settings.fairing.method.uses_hierarchy()).then(|| {
         format!(
             "Not used by {}: it smooths the whole mesh at once, across sharp edges too.",
-            settings.method.label()
+            settings.fairing.method.label()
         )
     });
     let kept = match &document.hierarchy {
@@ -308,13 +321,13 @@ pub(super) fn sharp_edge_controls(
     let enabled = not_for_baseline.is_none();
     let keep = ui.add_enabled(
         enabled,
-        egui::Checkbox::new(&mut settings.keep_sharp_edges, "Keep sharp edges"),
+        egui::Checkbox::new(&mut settings.hierarchy.keep_sharp_edges, "Keep sharp edges"),
     );
     let keep = explain(keep, tips::KEEP_SHARP_EDGES, not_for_baseline.as_deref());
     let angle = ui.add_enabled(
-        enabled && settings.keep_sharp_edges,
+        enabled && settings.hierarchy.keep_sharp_edges,
         egui::Slider::new(
-            &mut settings.sharp_edge_angle,
+            &mut settings.hierarchy.sharp_edge_angle,
             MIN_SHARP_EDGE_ANGLE..=MAX_SHARP_EDGE_ANGLE,
         )
         .suffix("°")
@@ -340,7 +353,7 @@ pub(super) fn sharp_edge_controls(
     if rebuild {
         commands.push(Command::RebuildHierarchy);
     }
-    if settings.keep_sharp_edges && enabled {
+    if settings.hierarchy.keep_sharp_edges && enabled {
         match kept {
             Some(0) => ui.small("No sharp edges found at this angle"),
             Some(edges) => ui.small(format!(
@@ -366,7 +379,7 @@ pub(super) fn sharp_edge_overlay(
         return 0;
     };
     let now = web_time::Instant::now();
-    if now > until || settings.view_mode == ViewMode::Level {
+    if now > until || settings.view.view_mode == ViewMode::Level {
         return 0;
     }
     ui.ctx().request_repaint_after(until - now);
@@ -376,7 +389,7 @@ pub(super) fn sharp_edge_overlay(
     let HierarchyState::Ready { sharp_edges, .. } = &document.hierarchy else {
         return 0;
     };
-    let shows_before = view.show_before && settings.compare == CompareView::Single;
+    let shows_before = view.show_before && settings.view.compare == CompareView::Single;
     let positions: &[[f32; 3]] = match (&document.faired, shows_before) {
         (Some(faired), false) => &faired.positions,
         _ => &document.original.positions,

@@ -84,7 +84,7 @@ impl App {
             )
         });
         if clay {
-            self.settings.clay = !self.settings.clay;
+            self.settings.view.clay = !self.settings.view.clay;
         }
         if paint {
             self.painting.paint_mode = !self.painting.paint_mode;
@@ -96,16 +96,16 @@ impl App {
             self.commands.push(Command::FitView);
         }
         if wire {
-            self.settings.wireframe = !self.settings.wireframe;
+            self.settings.view.wireframe = !self.settings.view.wireframe;
         }
         if before {
             self.view.show_before = !self.view.show_before;
         }
         if heat {
-            self.settings.heat_map = !self.settings.heat_map;
+            self.settings.view.heat_map = !self.settings.view.heat_map;
         }
         if shading {
-            self.settings.shading = match self.settings.shading {
+            self.settings.view.shading = match self.settings.view.shading {
                 Shading::Flat => Shading::Smooth,
                 Shading::Smooth => Shading::Flat,
             };

@@ -24,7 +24,7 @@ use std::sync::{Arc, Condvar, Mutex, PoisonError};
 use std::time::Duration;
 
 use fairmesh::hierarchy::HierarchyError;
-use fairmesh::io::LoadReport;
+use fairmesh::io::{IoError, LoadReport};
 use fairmesh::TriMesh;
 
 use super::generation::GenerationId;
@@ -320,7 +320,7 @@ pub enum JobResult {
     Loaded {
         load_generation: GenerationId,
         path: PathBuf,
-        result: Result<Box<LoadedMesh>, String>,
+        result: Result<Box<LoadedMesh>, IoError>,
         elapsed: Duration,
     },
     Hierarchy {
@@ -370,14 +370,14 @@ pub enum JobResult {
     /// The export was written; `Ok` holds what the output could not keep of the input.
     Exported {
         path: PathBuf,
-        result: Result<Vec<String>, String>,
+        result: Result<Vec<String>, IoError>,
         elapsed: Duration,
     },
     /// The level chain was written, one GLB per level; `Ok` holds the files and what they could
     /// not keep of the input.
     LevelsExported {
         folder: PathBuf,
-        result: Result<(Vec<PathBuf>, Vec<String>), String>,
+        result: Result<(Vec<PathBuf>, Vec<String>), LevelChainError>,
         elapsed: Duration,
     },
     /// A job panicked (a bug): `kind` says which, `message` what the panic said. Whatever the
@@ -393,12 +393,24 @@ pub enum JobResult {
         beside: PathBuf,
     },
     /// The PNG of the view was written (its path) or not (why).
-    ViewImageSaved { result: Result<PathBuf, String> },
+    ViewImageSaved { result: Result<PathBuf, IoError> },
     /// A file dialog closed; `None` when it was cancelled or no dialog could be shown.
     DialogPicked {
         purpose: DialogPurpose,
         path: Option<PathBuf>,
     },
+}
+
+/// Why the level chain was not written (the export task words it for the status bar).
+#[derive(Debug)]
+pub enum LevelChainError {
+    /// The folder could not be made.
+    CreateFolder {
+        folder: PathBuf,
+        source: std::io::Error,
+    },
+    /// A level's file could not be written (the files written before it stay).
+    Save(IoError),
 }
 
 impl JobResult {

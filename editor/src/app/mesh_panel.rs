@@ -57,24 +57,24 @@ pub(super) fn mesh_section(ui: &mut egui::Ui, view: &PanelView) {
 
 /// Sigma, seed and direction of the noise, and the button that adds it.
 pub(super) fn noise_section(ui: &mut egui::Ui, settings: &mut Settings, commands: &mut Commands) {
-    let sigma = &mut settings.noise_sigma;
+    let sigma = &mut settings.noise.sigma;
     super::widgets::slider(ui, true, sigma, 0.0..=2.0, "Sigma (× mean edge)")
         .on_hover_text(tips::NOISE_SIGMA);
     ui.horizontal(|ui| {
         let label = ui.label("Seed").on_hover_text(tips::NOISE_SEED);
-        ui.add(egui::DragValue::new(&mut settings.noise_seed))
+        ui.add(egui::DragValue::new(&mut settings.noise.seed))
             .labelled_by(label.id)
             .on_hover_text(tips::NOISE_SEED);
     });
     egui::ComboBox::from_label("Noise direction")
-        .selected_text(noise_mode_name(settings.noise_mode))
+        .selected_text(noise_mode_name(settings.noise.mode))
         .show_ui(ui, |ui| {
             for mode in [
                 NoiseMode::Normal,
                 NoiseMode::Direction,
                 NoiseMode::Isotropic,
             ] {
-                ui.selectable_value(&mut settings.noise_mode, mode, noise_mode_name(mode));
+                ui.selectable_value(&mut settings.noise.mode, mode, noise_mode_name(mode));
             }
         })
         .response

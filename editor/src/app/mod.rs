@@ -182,7 +182,7 @@ impl App {
             self.apply(command);
         }
         let side_by_side = |view| view == CompareView::SideBySide;
-        if side_by_side(self.settings.compare) != side_by_side(compare)
+        if side_by_side(self.settings.view.compare) != side_by_side(compare)
             && self.view.fitted_camera == Some(self.view.camera)
         {
             self.fit_view();
@@ -254,7 +254,7 @@ impl eframe::App for App {
         // Upload before drawing, so the viewport draws what the panels describe.
         self.sync_viewport();
         let upload_done = Instant::now();
-        let compare = self.settings.compare;
+        let compare = self.settings.view.compare;
         // A saved view waits for an image being drawn over several frames to be complete.
         self.view.capturing_view = self.view.capture_next_frame && !self.drawing();
         self.view.capture_next_frame &= !self.view.capturing_view;

@@ -16,7 +16,7 @@ pub(super) fn section(
     settings: &mut Settings,
     commands: &mut Commands,
 ) {
-    let level_view = settings.view_mode == ViewMode::Level;
+    let level_view = settings.view.view_mode == ViewMode::Level;
     let mut paint_mode = view.paint_mode;
     let paint = ui
         .add_enabled(
@@ -100,7 +100,7 @@ pub(super) fn viewport_brush(
     settings: &Settings,
     commands: &mut Commands,
 ) -> bool {
-    if !view.paint_mode || settings.view_mode == ViewMode::Level {
+    if !view.paint_mode || settings.view.view_mode == ViewMode::Level {
         if view.stroking {
             commands.push(Command::EndStroke);
         }
@@ -150,7 +150,7 @@ pub(super) fn viewport_brush(
 /// The image the brush paints on: the result's, the right half side by side, the whole view
 /// otherwise.
 pub(super) fn painted_image(settings: &Settings, rect: egui::Rect) -> egui::Rect {
-    match settings.compare {
+    match settings.view.compare {
         CompareView::SideBySide => rect.split_left_right_at_fraction(0.5).1,
         CompareView::Single | CompareView::Split => rect,
     }
@@ -164,7 +164,7 @@ pub(super) fn brush_outline(
     settings: &Settings,
     rect: egui::Rect,
 ) {
-    if !view.paint_mode || settings.view_mode == ViewMode::Level {
+    if !view.paint_mode || settings.view.view_mode == ViewMode::Level {
         return;
     }
     let (shift, hover) = ui.input(|i| (i.modifiers.shift, i.pointer.hover_pos()));

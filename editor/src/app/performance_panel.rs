@@ -19,7 +19,7 @@ pub(super) fn show(
 ) {
     ui.separator();
     let response = egui::CollapsingHeader::new("Performance")
-        .default_open(settings.show_performance)
+        .default_open(settings.view.show_performance)
         .show(ui, |ui| {
             let stats = view.frame_stats;
             egui::Grid::new("fairmesh-performance")
@@ -79,7 +79,7 @@ pub(super) fn show(
                 commands.push(Command::Panel(PanelChange::ResetBusyMax));
             }
         });
-    settings.show_performance = response.fully_open();
+    settings.view.show_performance = response.fully_open();
 }
 
 /// The meshes held on the GPU, each with its bytes and its kept image's, and their sum.

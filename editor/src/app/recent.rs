@@ -8,7 +8,7 @@ use crate::app::{App, Command};
 
 /// The toolbar's Recent menu.
 pub(super) fn menu(ui: &mut egui::Ui, settings: &Settings, commands: &mut Commands) {
-    let recent = settings.recent_files.clone();
+    let recent = settings.files.recent_files.clone();
     ui.add_enabled_ui(!recent.is_empty(), |ui| {
         let response = ui
             .menu_button("Recent", |ui| {
@@ -35,7 +35,7 @@ impl App {
     /// Opens a file from the Recent menu; one that is gone is named and dropped from the menu.
     pub(super) fn open_recent(&mut self, path: PathBuf) {
         if !fairmesh::bundled::is_bunny_pseudo_path(&path) && !fairmesh::io::exists(&path) {
-            self.settings.forget_recent(&path);
+            self.settings.files.forget_recent(&path);
             self.error = Some(format!(
                 "Cannot open {}: the file is no longer there (removed from Recent)",
                 path.display()

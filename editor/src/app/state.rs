@@ -17,6 +17,8 @@ pub use document::{
 };
 pub use measures::Measures;
 pub use settings::{
-    CompareView, FairingKey, HeatReference, HierarchyKey, MethodChoice, Settings, ViewMode,
-    MAX_DENOISE_ROUNDS, MAX_SHARP_EDGE_ANGLE, MIN_SHARP_EDGE_ANGLE, SETTINGS_VERSION,
+    CompareView, FairingKey, FairingSettings, FileSettings, HeatReference, HierarchyKey,
+    HierarchySettings, LevelChainSettings, MethodChoice, NoiseSettings, Settings, ViewMode,
+    ViewSettings, MAX_DENOISE_ROUNDS, MAX_SHARP_EDGE_ANGLE, MIN_SHARP_EDGE_ANGLE, SETTINGS_VERSION,
+    UNVERSIONED,
 };

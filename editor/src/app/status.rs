@@ -185,7 +185,7 @@ impl App {
                 mask_shown: self.view.shown.is_some_and(|s| s.mask.is_some()),
                 view_behind: self.main_view_behind(),
                 caption: super::viewport_panel::main_caption(
-                    self.settings.view_mode,
+                    self.settings.view.view_mode,
                     self.main_view_behind(),
                 ),
                 sharp_edges_drawn: self.view.sharp_edges_drawn,

@@ -84,17 +84,17 @@ fn view_controls(
         commands.push(Command::FitView);
     }
     super::tasks::view_image::button(ui, view, commands);
-    ui.checkbox(&mut settings.wireframe, "Wireframe (W)")
+    ui.checkbox(&mut settings.view.wireframe, "Wireframe (W)")
         .on_hover_text("Draw the edges over the faces (W)");
     ui.separator();
-    let mut mode = settings.view_mode;
+    let mut mode = settings.view.view_mode;
     ui.selectable_value(&mut mode, ViewMode::Faired, "Faired")
         .on_hover_text("Show the result of the fairing");
     ui.selectable_value(&mut mode, ViewMode::Level, "Level mesh")
         .on_hover_text("Show the coarse mesh of the start level, where the fairing begins");
     ui.selectable_value(&mut mode, ViewMode::Original, "Input mesh")
         .on_hover_text("Show the input mesh: as loaded, or as Add noise or Apply result left it");
-    if mode != settings.view_mode {
+    if mode != settings.view.view_mode {
         commands.push(Command::SetViewMode(mode));
     }
 }

@@ -47,14 +47,14 @@ pub(super) fn show(
 fn compare_row(ui: &mut egui::Ui, settings: &mut Settings) {
     ui.horizontal(|ui| {
         ui.label("Compare:");
-        let mut compare = settings.compare;
+        let mut compare = settings.view.compare;
         ui.selectable_value(&mut compare, CompareView::Single, "Single")
             .on_hover_text("One view; B toggles before and after");
         ui.selectable_value(&mut compare, CompareView::Split, "Split")
             .on_hover_text("Before left of the divider, after right of it (drag the divider)");
         ui.selectable_value(&mut compare, CompareView::SideBySide, "Side by side")
             .on_hover_text("Before and after next to each other, one camera");
-        settings.compare = compare;
+        settings.view.compare = compare;
     });
 }
 
@@ -66,29 +66,29 @@ fn heat_rows(
 ) {
     ui.horizontal(|ui| {
         ui.add_enabled(
-            settings.compare == CompareView::Single,
+            settings.view.compare == CompareView::Single,
             egui::Button::selectable(view.show_before, "Before (B)"),
         )
         .on_hover_text("Show the input mesh instead of the result (B)")
         .on_disabled_hover_text("Split and Side by side show before and after already")
         .clicked()
         .then(|| commands.push(Command::Panel(PanelChange::ToggleBefore)));
-        ui.checkbox(&mut settings.heat_map, "Heat map (H)")
+        ui.checkbox(&mut settings.view.heat_map, "Heat map (H)")
             .on_hover_text("Colour each vertex by its distance from the reference mesh (H)");
         // On the heat map's row (it colours the surface too), so the panel keeps its width.
-        ui.checkbox(&mut settings.clay, CLAY)
+        ui.checkbox(&mut settings.view.clay, CLAY)
             .on_hover_text(tips::CLAY);
     });
     // The reference only while the heat map is on: the panel below stays a row higher, so
     // Export fits an 800-point-high window.
-    if !settings.heat_map {
+    if !settings.view.heat_map {
         return;
     }
     ui.horizontal(|ui| {
         let has_clean = view.document.is_some_and(|d| d.clean.is_some());
         ui.label("against");
         ui.selectable_value(
-            &mut settings.heat_reference,
+            &mut settings.view.heat_reference,
             HeatReference::Document,
             "input mesh",
         )
@@ -96,14 +96,14 @@ fn heat_rows(
         ui.add_enabled(
             has_clean,
             egui::Button::selectable(
-                settings.heat_reference == HeatReference::Clean,
+                settings.view.heat_reference == HeatReference::Clean,
                 "clean mesh",
             ),
         )
         .on_hover_text(tips::HEAT_CLEAN)
         .on_disabled_hover_text("Add noise first: the mesh before it becomes the clean one")
         .clicked()
-        .then(|| settings.heat_reference = HeatReference::Clean);
+        .then(|| settings.view.heat_reference = HeatReference::Clean);
     });
 }
 
@@ -117,16 +117,16 @@ fn look_rows(ui: &mut egui::Ui, settings: &mut Settings) {
                 Shading::Flat => tips::FLAT,
                 Shading::Smooth => tips::SMOOTH,
             };
-            ui.selectable_value(&mut settings.shading, shading, shading.label())
+            ui.selectable_value(&mut settings.view.shading, shading, shading.label())
                 .on_hover_text(tip);
         }
-        let mut studio = settings.lighting == Lighting::Studio;
+        let mut studio = settings.view.lighting == Lighting::Studio;
         if ui
             .checkbox(&mut studio, STUDIO_LIGHTING)
             .on_hover_text(tips::STUDIO)
             .changed()
         {
-            settings.lighting = match studio {
+            settings.view.lighting = match studio {
                 true => Lighting::Studio,
                 false => Lighting::Simple,
             };

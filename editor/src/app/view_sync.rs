@@ -39,12 +39,12 @@ impl SlotLook {
             light_dir: camera.light_dir().to_array(),
             fill_dir: camera.fill_dir().to_array(),
             up: camera.basis().1.to_array(),
-            shading: settings.shading,
-            lighting: settings.lighting,
-            wireframe: settings.wireframe,
+            shading: settings.view.shading,
+            lighting: settings.view.lighting,
+            wireframe: settings.view.wireframe,
             scalar_range: self.scalar_range,
             mask_tint: self.mask_tint,
-            clay: settings.clay,
+            clay: settings.view.clay,
             size: [0, 0],
         }
     }
@@ -151,11 +151,11 @@ impl MeshSource for ViewMesh {
 impl App {
     /// The heat map's reference now: `None` when it is off; the clean mesh only when there is one.
     pub(super) fn heat_reference(&self) -> Option<HeatReference> {
-        if !self.settings.heat_map {
+        if !self.settings.view.heat_map {
             return None;
         }
         let has_clean = self.document.as_ref().is_some_and(|d| d.clean.is_some());
-        Some(match self.settings.heat_reference {
+        Some(match self.settings.view.heat_reference {
             HeatReference::Clean if has_clean => HeatReference::Clean,
             _ => HeatReference::Document,
         })
@@ -163,7 +163,7 @@ impl App {
 
     /// Whether the before viewport is on screen.
     pub(super) fn before_needed(&self) -> bool {
-        self.settings.compare != CompareView::Single || self.view.show_before
+        self.settings.view.compare != CompareView::Single || self.view.show_before
     }
 
     /// What a viewport should show now: for the main one the view mode's mesh when it exists,
@@ -213,7 +213,7 @@ impl App {
     /// The mesh the main view's mode asks for, as far as it is computed: the newest result, the
     /// level mesh (or `previous` until one exists), the input mesh.
     fn newest_mesh(&self, document: &Document, previous: Option<ShownMesh>) -> ShownMesh {
-        match self.settings.view_mode {
+        match self.settings.view.view_mode {
             ViewMode::Original => ShownMesh::Original,
             ViewMode::Faired => match &document.faired {
                 Some(faired) => ShownMesh::Faired {
@@ -239,7 +239,7 @@ impl App {
             .view
             .shown
             .filter(|s| s.document == document.generation);
-        match self.settings.view_mode {
+        match self.settings.view.view_mode {
             ViewMode::Original => shown.is_none_or(|s| s.what != ShownMesh::Original),
             ViewMode::Level => {
                 matches!(document.hierarchy, HierarchyState::Building)
@@ -504,13 +504,13 @@ impl App {
         let Some(document) = &self.document else {
             return;
         };
-        let (lo, hi) = match (self.settings.view_mode, &document.level_mesh) {
+        let (lo, hi) = match (self.settings.view.view_mode, &document.level_mesh) {
             (ViewMode::Level, Some((_, mesh))) => state::bounds_of(&mesh.positions),
             _ => document.bounds,
         };
         // Each side-by-side half is half the view's width.
         let aspect = self.view.viewport_rect.map_or(1.0, |rect| {
-            let width = match self.settings.compare {
+            let width = match self.settings.view.compare {
                 CompareView::SideBySide => rect.width() * 0.5,
                 CompareView::Single | CompareView::Split => rect.width(),
             };

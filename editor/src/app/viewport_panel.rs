@@ -21,7 +21,7 @@ pub fn show(
 ) -> ViewportDrawn {
     let rect = ui.available_rect_before_wrap();
     let response = ui.allocate_rect(rect, egui::Sense::click_and_drag());
-    let divider_x = rect.left() + rect.width() * settings.split.clamp(0.0, 1.0);
+    let divider_x = rect.left() + rect.width() * settings.view.split.clamp(0.0, 1.0);
     let divider_dragged = split_divider(ui, settings, rect, divider_x);
     let painting = !divider_dragged
         && super::paint_panel::viewport_brush(ui, &response, rect, view, state, settings, commands);
@@ -54,7 +54,7 @@ fn split_divider(
     rect: egui::Rect,
     divider_x: f32,
 ) -> bool {
-    if settings.compare != CompareView::Split {
+    if settings.view.compare != CompareView::Split {
         return false;
     }
     let handle = egui::Rect::from_x_y_ranges(divider_x - 6.0..=divider_x + 6.0, rect.y_range());
@@ -72,7 +72,7 @@ fn split_divider(
     let x = divider
         .interact_pointer_pos()
         .map_or(divider_x + divider.drag_delta().x, |p| p.x);
-    settings.split = ((x - rect.left()) / rect.width().max(1.0)).clamp(0.02, 0.98);
+    settings.view.split = ((x - rect.left()) / rect.width().max(1.0)).clamp(0.02, 0.98);
     true
 }
 
@@ -141,12 +141,12 @@ fn draw_views(
     rect: egui::Rect,
     divider_x: f32,
 ) {
-    let after_name = &main_caption(settings.view_mode, view.main_behind);
+    let after_name = &main_caption(settings.view.view_mode, view.main_behind);
     let top_left = |r: egui::Rect| r.left_top() + egui::vec2(10.0, 8.0);
     let params = |state: &ViewportState, rect: egui::Rect, slot: Slot| {
         view.looks[slot as usize].draw_params(state.camera, settings, rect)
     };
-    match settings.compare {
+    match settings.view.compare {
         CompareView::Single => {
             let slot = match view.show_before {
                 true => Slot::Before,
@@ -254,7 +254,7 @@ fn overlays(
         .viewports
         .iter()
         .flatten()
-        .find_map(|viewport| viewport.problem(settings.wireframe));
+        .find_map(|viewport| viewport.problem(settings.view.wireframe));
     if let Some(problem) = problem {
         let text = egui::RichText::new(format!("Not drawn: {problem}"))
             .size(14.0)

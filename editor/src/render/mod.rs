@@ -199,7 +199,7 @@ impl Viewport3d {
 
     /// Offscreen images drawn so far.
     pub fn images_drawn(&self) -> u64 {
-        self.with_renderer(|r| r.images_drawn).unwrap_or(0)
+        self.with_renderer(|r| r.image_counts().drawn).unwrap_or(0)
     }
 
     /// Images drawn, parts of images drawn over several frames, and images shown again from a

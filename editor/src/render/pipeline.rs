@@ -36,9 +36,9 @@ use std::time::Duration;
 use super::appearance::Appearance;
 use super::shading::{Lighting, Shading};
 use buffers::MeshBuffers;
-use kept::KeptImage;
+use kept::KeptImages;
 use passes::{MaterialKit, Part, Pipelines, Target, Uniforms};
-use upload::{MoveJob, Moved, PendingMesh, UploadJob, Uploaded, Uploader};
+use upload::{InFlight, MoveJob, Moved, PendingMesh, UploadJob, Uploaded, Uploader};
 
 /// Format of the image the mesh is drawn into (and that egui then samples).
 pub const COLOR_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8UnormSrgb;
@@ -130,7 +130,54 @@ enum PartDrawn {
 }
 
 /// Owns the pipelines, the mesh buffers and the offscreen target. Knows nothing of fairing.
+///
+/// Its state in parts: the device and what is made on it once (`DeviceKit`), the uploads in
+/// flight (`InFlight`, `pipeline/upload.rs`), the image drawn over several frames
+/// (`PartDrawing`), the held meshes' kept images (`KeptImages`, `pipeline/kept.rs`) and what
+/// was drawn and written so far ([`ImageCounts`], [`UploadCounts`]).
 pub struct MeshRenderer {
+    /// The device, the pipelines and the materials' layout.
+    gpu: DeviceKit,
+    /// Faces of the mesh last given to [`Self::set_mesh`], uploaded or not: the target gets that
+    /// mesh's sampling before its upload lands, so its first image is drawn once.
+    newest_faces: usize,
+    mesh: Option<MeshBuffers>,
+    /// Meshes kept on the GPU besides the one on screen, to show again without uploading
+    /// (see [`Self::show_held`]); at most [`MAX_HELD_MESHES`] with `mesh`.
+    held: Vec<MeshBuffers>,
+    /// What was written to the GPU so far (tests and the performance readout).
+    pub uploads: UploadCounts,
+    /// Uploads and moves on the upload thread, and what waits for them.
+    in_flight: InFlight,
+    target: Option<Target>,
+    /// Parameters of the image now in the target; `None` forces a redraw.
+    drawn: Option<DrawParams>,
+    /// An image too big for one frame, drawn in parts.
+    parts: PartDrawing,
+    /// The target holds a complete image (it has since it was made): only then is a new image
+    /// drawn over several frames, the old one staying on screen meanwhile. A new target (the
+    /// view was resized) gets its first image at once rather than a blank view for a while.
+    target_has_image: bool,
+    /// Asks the UI for another frame (an image drawn over several frames needs them).
+    repaint: Arc<dyn Fn() + Send + Sync>,
+    /// Images drawn, parts drawn and images restored so far ([`Self::image_counts`]).
+    counts: ImageCounts,
+    /// The last complete image of each held mesh (and of the one on screen, when it has one).
+    kept: KeptImages,
+    /// Whether the last image had the wireframe (a big upload then builds its edges too).
+    wireframe: bool,
+    /// Why the last mesh set is not drawn (a buffer would exceed the device's `max_buffer_size`,
+    /// or its upload failed).
+    problem: Option<String>,
+    /// Building the current mesh's wireframe failed (not tried again for this mesh).
+    lines_failed: bool,
+    /// CPU time of the last [`Self::render`] that drew (recording commands, building the
+    /// wireframe's edges on first use).
+    pub last_draw_time: Duration,
+}
+
+/// The device the renderer draws with and what it makes there once.
+struct DeviceKit {
     /// The device the buffers are made on (a move may need new ones).
     device: wgpu::Device,
     /// The materials' bind group layout (shared by both samplings' pipelines) and the group of
@@ -141,70 +188,18 @@ pub struct MeshRenderer {
     single_sample: Option<Pipelines>,
     /// The adapter is a CPU (a software renderer): big meshes are drawn with one sample.
     software: bool,
-    /// Faces of the mesh last given to [`Self::set_mesh`], uploaded or not: the target gets that
-    /// mesh's sampling before its upload lands, so its first image is drawn once.
-    newest_faces: usize,
-    mesh: Option<MeshBuffers>,
-    /// Meshes kept on the GPU besides the one on screen, to show again without uploading
-    /// (see [`Self::show_held`]); at most [`MAX_HELD_MESHES`] with `mesh`.
-    held: Vec<MeshBuffers>,
-    /// What was written to the GPU so far (tests and the performance readout).
-    pub uploads: UploadCounts,
-    target: Option<Target>,
-    /// Parameters of the image now in the target; `None` forces a redraw.
-    drawn: Option<DrawParams>,
+    /// The biggest buffer the renderer makes (the device's limit, or less: tests).
+    max_buffer_size: u64,
+}
+
+/// An image too big for one frame, drawn in parts into a second target.
+struct PartDrawing {
     /// Faces (or edges) a new image draws per frame at most; more take several frames.
     faces_per_frame: usize,
     /// The image being drawn over several frames, if one is.
     progress: Option<Progress>,
-    /// The target holds a complete image (it has since it was made): only then is a new image
-    /// drawn over several frames, the old one staying on screen meanwhile. A new target (the
-    /// view was resized) gets its first image at once rather than a blank view for a while.
-    target_has_image: bool,
     /// Where that image is drawn (the target's size and sampling; kept between images).
     work: Option<Target>,
-    /// Asks the UI for another frame (an image drawn over several frames needs them).
-    repaint: Arc<dyn Fn() + Send + Sync>,
-    /// Offscreen images drawn so far (for tests and the performance readout).
-    pub images_drawn: u64,
-    /// Parts drawn of images drawn over several frames (see [`Self::set_faces_per_frame`]).
-    pub parts_drawn: u64,
-    /// Images shown again from a held mesh's kept image instead of drawn (`pipeline/kept.rs`).
-    pub images_restored: u64,
-    /// The last complete image of each held mesh (and of the one on screen, when it has one).
-    kept: Vec<KeptImage>,
-    /// A mesh that left the screen (its generation) whose complete image, drawn with these
-    /// parameters, is still in the target: the next render copies it into its kept image.
-    keep_request: Option<(u64, DrawParams)>,
-    uploader: Option<Uploader>,
-    /// Counts [`Self::set_mesh`] calls; an upload that lands for an older one is dropped.
-    generation: u64,
-    /// The upload in flight on the upload thread (the previous mesh stays on screen meanwhile).
-    pending: Option<PendingMesh>,
-    /// Generation of the mesh whose wireframe edges the upload thread is building.
-    lines_requested: Option<u64>,
-    /// Counts [`Self::set_positions`] calls; normals that land for an older one are dropped.
-    move_serial: u64,
-    /// The newest positions whose normals the upload thread is computing (the mesh on screen
-    /// keeps its positions until they land, so positions and normals always match).
-    pending_move: Option<u64>,
-    /// Scalars and mask weights set while those positions are on their way: they belong to
-    /// the new positions (a heat map of the new result), so they are written with them.
-    move_scalars: Option<Vec<f32>>,
-    move_mask: Option<Vec<f32>>,
-    /// Whether the last image had the wireframe (a big upload then builds its edges too).
-    wireframe: bool,
-    /// Meshes of at least this many bytes (positions + triangles) upload on the upload thread.
-    async_upload_bytes: usize,
-    /// Why the last mesh set is not drawn (a buffer would exceed the device's `max_buffer_size`,
-    /// or its upload failed).
-    problem: Option<String>,
-    /// Building the current mesh's wireframe failed (not tried again for this mesh).
-    lines_failed: bool,
-    max_buffer_size: u64,
-    /// CPU time of the last [`Self::render`] that drew (recording commands, building the
-    /// wireframe's edges on first use).
-    pub last_draw_time: Duration,
 }
 
 impl MeshRenderer {
@@ -213,49 +208,42 @@ impl MeshRenderer {
     pub fn new(device: &wgpu::Device, on_upload_done: Arc<dyn Fn() + Send + Sync>) -> Self {
         let materials = MaterialKit::new(device);
         Self {
-            device: device.clone(),
-            pipelines: Pipelines::new(device, SAMPLE_COUNT, &materials),
-            materials,
-            single_sample: None,
-            software: false,
+            gpu: DeviceKit {
+                device: device.clone(),
+                pipelines: Pipelines::new(device, SAMPLE_COUNT, &materials),
+                materials,
+                single_sample: None,
+                software: false,
+                max_buffer_size: device.limits().max_buffer_size,
+            },
             newest_faces: 0,
             mesh: None,
             held: Vec::new(),
             uploads: UploadCounts::default(),
+            // Without the thread (it failed to start) every upload happens in the calling frame.
+            in_flight: InFlight::new(Uploader::spawn(device.clone(), on_upload_done.clone())),
             target: None,
             drawn: None,
-            faces_per_frame: usize::MAX,
-            progress: None,
+            parts: PartDrawing {
+                faces_per_frame: usize::MAX,
+                progress: None,
+                work: None,
+            },
             target_has_image: false,
-            work: None,
-            repaint: on_upload_done.clone(),
-            images_drawn: 0,
-            parts_drawn: 0,
-            images_restored: 0,
-            kept: Vec::new(),
-            keep_request: None,
+            repaint: on_upload_done,
+            counts: ImageCounts::default(),
+            kept: KeptImages::default(),
             last_draw_time: Duration::ZERO,
-            // Without the thread (it failed to start) every upload happens in the calling frame.
-            uploader: Uploader::spawn(device.clone(), on_upload_done),
-            generation: 0,
-            pending: None,
-            lines_requested: None,
-            move_serial: 0,
-            pending_move: None,
-            move_scalars: None,
-            move_mask: None,
             wireframe: false,
-            async_upload_bytes: DEFAULT_ASYNC_UPLOAD_BYTES,
             problem: None,
             lines_failed: false,
-            max_buffer_size: device.limits().max_buffer_size,
         }
     }
 
     /// Uses at most `bytes` per buffer, or the device's limit if that is lower (to see what a
     /// smaller GPU would do; tests).
     pub fn cap_buffer_size(&mut self, device: &wgpu::Device, bytes: u64) {
-        self.max_buffer_size = bytes.min(device.limits().max_buffer_size);
+        self.gpu.max_buffer_size = bytes.min(device.limits().max_buffer_size);
     }
 
     /// Why the mesh, or its wireframe when `wireframe` is on, is not shown (too big for the
@@ -284,11 +272,11 @@ impl MeshRenderer {
                 format!("{mb:.0} MB")
             }
         };
-        (bytes as u64 > self.max_buffer_size).then(|| {
+        (bytes as u64 > self.gpu.max_buffer_size).then(|| {
             format!(
                 "{what} of {faces} faces needs a {} buffer; this GPU allows {}",
                 megabytes(bytes as u64),
-                megabytes(self.max_buffer_size)
+                megabytes(self.gpu.max_buffer_size)
             )
         })
     }
@@ -296,7 +284,7 @@ impl MeshRenderer {
     /// Meshes of at least `bytes` (positions + triangles) upload on the upload thread; 0 sends
     /// every mesh there, `usize::MAX` none.
     pub fn set_async_upload_bytes(&mut self, bytes: usize) {
-        self.async_upload_bytes = bytes;
+        self.in_flight.async_upload_bytes = bytes;
     }
 
     /// Shows a mesh with new connectivity (its scalars zero until [`Self::set_scalars`]).
@@ -317,12 +305,7 @@ impl MeshRenderer {
         key: Option<MeshKey>,
     ) {
         self.drop_family(key);
-        self.generation += 1;
-        self.pending = None;
-        self.pending_move = None;
-        self.move_scalars = None;
-        self.move_mask = None;
-        self.lines_requested = None;
+        self.in_flight.next_mesh();
         self.lines_failed = false;
         let (vertex_count, face_count) = (source.positions().len(), source.triangles().len());
         self.newest_faces = face_count;
@@ -334,18 +317,19 @@ impl MeshRenderer {
             return;
         }
         self.uploads.count_mesh(vertex_count, face_count);
-        let generation = self.generation;
+        let generation = self.in_flight.generation;
         let mut source = source;
-        if (vertex_count + face_count) * 12 >= self.async_upload_bytes {
-            if let Some(uploader) = &self.uploader {
+        if (vertex_count + face_count) * 12 >= self.in_flight.async_upload_bytes {
+            if let Some(uploader) = &self.in_flight.uploader {
                 let job = UploadJob::Mesh {
                     generation,
                     source,
-                    with_lines: self.wireframe && face_count as u64 * 24 <= self.max_buffer_size,
+                    with_lines: self.wireframe
+                        && face_count as u64 * 24 <= self.gpu.max_buffer_size,
                 };
                 match uploader.send(job) {
                     Ok(()) => {
-                        self.pending = Some(PendingMesh {
+                        self.in_flight.pending = Some(PendingMesh {
                             generation,
                             key,
                             vertex_count,
@@ -371,7 +355,7 @@ impl MeshRenderer {
 
     /// Takes in the uploads that landed since the last call (a stale one is dropped).
     fn poll_uploads(&mut self, queue: &wgpu::Queue) {
-        let Some(uploader) = &self.uploader else {
+        let Some(uploader) = &self.in_flight.uploader else {
             return;
         };
         let landed: Vec<Uploaded> = match uploader.done.lock() {
@@ -382,11 +366,12 @@ impl MeshRenderer {
             match uploaded {
                 Uploaded::Mesh(mut buffers) => {
                     if self
+                        .in_flight
                         .pending
                         .as_ref()
                         .is_some_and(|p| p.generation == buffers.generation)
                     {
-                        if let Some(pending) = self.pending.take() {
+                        if let Some(pending) = self.in_flight.pending.take() {
                             buffers.key = pending.key;
                             if let Some(scalars) = pending.scalars {
                                 buffers.write_per_vertex(queue, &scalars, false);
@@ -400,17 +385,18 @@ impl MeshRenderer {
                 }
                 Uploaded::Failed { generation } => {
                     if self
+                        .in_flight
                         .pending
                         .as_ref()
                         .is_some_and(|p| p.generation == generation)
                     {
-                        self.pending = None;
+                        self.in_flight.pending = None;
                         self.mesh = None;
                         self.redraw();
                         self.problem = Some("the GPU could not take the mesh's buffers".into());
                     }
-                    if self.lines_requested == Some(generation) {
-                        self.lines_requested = None;
+                    if self.in_flight.lines_requested == Some(generation) {
+                        self.in_flight.lines_requested = None;
                         self.lines_failed = true;
                         self.redraw();
                     }
@@ -420,7 +406,7 @@ impl MeshRenderer {
                         .is_some_and(|m| m.generation == generation)
                     {
                         // A move's normals failed: the mesh keeps its last positions.
-                        self.pending_move = None;
+                        self.in_flight.pending_move = None;
                         self.write_move_tints(queue);
                     }
                 }
@@ -430,10 +416,10 @@ impl MeshRenderer {
                     source,
                     moved,
                 } => {
-                    if self.pending_move != Some(serial) {
+                    if self.in_flight.pending_move != Some(serial) {
                         continue;
                     }
-                    self.pending_move = None;
+                    self.in_flight.pending_move = None;
                     if self
                         .mesh
                         .as_ref()
@@ -448,8 +434,8 @@ impl MeshRenderer {
                     look,
                     lines,
                 } => {
-                    if self.lines_requested == Some(generation) {
-                        self.lines_requested = None;
+                    if self.in_flight.lines_requested == Some(generation) {
+                        self.in_flight.lines_requested = None;
                     }
                     let same_look = |m: &&mut MeshBuffers| match (&m.appearance, &look) {
                         (Some(a), Some(b)) => Arc::ptr_eq(a, b),
@@ -470,7 +456,7 @@ impl MeshRenderer {
     /// Whether an upload is still in flight (takes in those that landed first).
     pub fn upload_pending(&mut self, queue: &wgpu::Queue) -> bool {
         self.poll_uploads(queue);
-        self.pending.is_some() || self.lines_requested.is_some() || self.pending_move.is_some()
+        self.in_flight.any()
     }
 
     /// Moves the vertices of the current mesh to `source`'s positions (its triangles must be the
@@ -480,7 +466,7 @@ impl MeshRenderer {
     /// moves once they land.
     pub fn set_positions(&mut self, queue: &wgpu::Queue, source: Arc<dyn MeshSource>) -> bool {
         self.poll_uploads(queue);
-        if self.pending.is_some() {
+        if self.in_flight.pending.is_some() {
             return false;
         }
         let Some(mesh) = self.mesh.as_mut() else {
@@ -490,24 +476,24 @@ impl MeshRenderer {
         if mesh.vertex_count != vertex_count {
             return false;
         }
-        self.move_serial += 1;
+        self.in_flight.move_serial += 1;
         self.uploads.count_positions(vertex_count);
         // The mesh is about to move: its kept image shows where it was.
-        kept::forget_image(&mut self.kept, mesh.generation);
+        kept::forget_image(&mut self.kept.images, mesh.generation);
         let faces = mesh.index_count as usize / 3;
         let job = MoveJob {
             generation: mesh.generation,
-            serial: self.move_serial,
+            serial: self.in_flight.move_serial,
             source: source.clone(),
             corners: mesh.corners.clone(),
             layout: mesh.layout.clone(),
         };
         let mut job = Box::new(job);
-        if (vertex_count + faces) * 12 >= self.async_upload_bytes {
-            if let Some(uploader) = &self.uploader {
+        if (vertex_count + faces) * 12 >= self.in_flight.async_upload_bytes {
+            if let Some(uploader) = &self.in_flight.uploader {
                 match uploader.send(UploadJob::Move(job)) {
                     Ok(()) => {
-                        self.pending_move = Some(self.move_serial);
+                        self.in_flight.pending_move = Some(self.in_flight.move_serial);
                         return true;
                     }
                     // The thread is gone: the move is made here.
@@ -516,8 +502,8 @@ impl MeshRenderer {
                 }
             }
         }
-        self.pending_move = None;
-        let moved = job.run(&self.device);
+        self.in_flight.pending_move = None;
+        let moved = job.run(&self.gpu.device);
         self.apply_move(queue, source, moved);
         self.write_move_tints(queue);
         true
@@ -535,7 +521,7 @@ impl MeshRenderer {
             Moved::Rebuilt(mut buffers) => {
                 buffers.take_place_of(queue, mesh);
                 *mesh = *buffers;
-                self.lines_requested = None;
+                self.in_flight.lines_requested = None;
                 self.lines_failed = false;
             }
         }
@@ -544,7 +530,10 @@ impl MeshRenderer {
 
     /// Writes the scalars and mask weights that waited for a move's positions.
     fn write_move_tints(&mut self, queue: &wgpu::Queue) {
-        let (scalars, mask) = (self.move_scalars.take(), self.move_mask.take());
+        let (scalars, mask) = (
+            self.in_flight.move_scalars.take(),
+            self.in_flight.move_mask.take(),
+        );
         if let Some(mesh) = &mut self.mesh {
             if let Some(scalars) = scalars.filter(|s| s.len() == mesh.vertex_count) {
                 mesh.write_per_vertex(queue, &scalars, false);
@@ -628,7 +617,7 @@ impl MeshRenderer {
 
     fn set_per_vertex(&mut self, queue: &wgpu::Queue, values: &[f32], mask: bool) -> bool {
         self.poll_uploads(queue);
-        if let Some(pending) = &mut self.pending {
+        if let Some(pending) = &mut self.in_flight.pending {
             if pending.vertex_count != values.len() {
                 return false;
             }
@@ -646,10 +635,10 @@ impl MeshRenderer {
         else {
             return false;
         };
-        if self.pending_move.is_some() {
+        if self.in_flight.pending_move.is_some() {
             match mask {
-                true => self.move_mask = Some(values.to_vec()),
-                false => self.move_scalars = Some(values.to_vec()),
+                true => self.in_flight.move_mask = Some(values.to_vec()),
+                false => self.in_flight.move_scalars = Some(values.to_vec()),
             }
             self.uploads.count_per_vertex(values.len());
             return true;
@@ -667,7 +656,7 @@ impl MeshRenderer {
     /// Tells the renderer that its device is a software renderer (a CPU adapter): meshes over
     /// [`SOFTWARE_SINGLE_SAMPLE_FACES`] faces are then drawn without multisampling.
     pub fn set_software_adapter(&mut self, software: bool) {
-        self.software = software;
+        self.gpu.software = software;
         self.set_faces_per_frame(if software {
             SOFTWARE_FACES_PER_FRAME
         } else {
@@ -680,28 +669,28 @@ impl MeshRenderer {
     /// the new one is complete. Software renderers get [`SOFTWARE_FACES_PER_FRAME`]; GPUs draw
     /// every image at once.
     pub fn set_faces_per_frame(&mut self, faces: usize) {
-        self.faces_per_frame = faces.max(1);
+        self.parts.faces_per_frame = faces.max(1);
         self.redraw();
     }
 
     /// Whether an image is being drawn over several frames (the target still shows the one
     /// before it).
     pub fn drawing(&self) -> bool {
-        self.progress.is_some()
+        self.parts.progress.is_some()
     }
 
     /// The image in the target no longer shows the mesh as it is: draw it again, drop an
     /// image half drawn from the old buffers, and forget the mesh's kept image.
     fn redraw(&mut self) {
         self.drawn = None;
-        self.progress = None;
+        self.parts.progress = None;
         self.forget_current_image();
     }
 
     /// Samples per pixel the newest mesh is drawn with (4, or 1 for a big mesh on a software
     /// renderer).
     pub fn samples(&self) -> u32 {
-        if self.software && self.newest_faces > SOFTWARE_SINGLE_SAMPLE_FACES {
+        if self.gpu.software && self.newest_faces > SOFTWARE_SINGLE_SAMPLE_FACES {
             1
         } else {
             SAMPLE_COUNT
@@ -721,16 +710,16 @@ impl MeshRenderer {
         {
             return false;
         }
-        if samples != SAMPLE_COUNT && self.single_sample.is_none() {
-            self.single_sample = Some(Pipelines::new(device, samples, &self.materials));
+        if samples != SAMPLE_COUNT && self.gpu.single_sample.is_none() {
+            self.gpu.single_sample = Some(Pipelines::new(device, samples, &self.gpu.materials));
         }
         self.target = Some(Target::new(device, size, samples));
         self.target_has_image = false;
         // The image in the old target is gone (the meshes and their kept images are as they
         // were: a kept image of this size is shown again).
         self.drawn = None;
-        self.progress = None;
-        self.keep_request = None;
+        self.parts.progress = None;
+        self.kept.request = None;
         true
     }
 
@@ -762,7 +751,7 @@ impl MeshRenderer {
         // The image of the mesh that just left the screen, before anything is drawn over it.
         self.keep_outgoing_image(device, encoder);
         self.prune_images();
-        if self.progress.is_none() && self.drawn.as_ref() == Some(params) {
+        if self.parts.progress.is_none() && self.drawn.as_ref() == Some(params) {
             return false;
         }
         // The mesh's kept image, when it shows exactly this (an image half drawn with older
@@ -770,7 +759,7 @@ impl MeshRenderer {
         if self.drawn.as_ref() != Some(params) && self.restore_kept_image(encoder, params) {
             return true;
         }
-        let params = match &self.progress {
+        let params = match &self.parts.progress {
             Some(progress) => progress.params,
             None => *params,
         };
@@ -800,9 +789,9 @@ impl MeshRenderer {
         let whole = Part::whole(mesh, params.wireframe);
         let (faces, edges) = (whole.faces.end, whole.edges.end);
         let total = faces as usize + edges as usize;
-        let at_once = total <= self.faces_per_frame || !self.target_has_image;
+        let at_once = total <= self.parts.faces_per_frame || !self.target_has_image;
         if at_once {
-            let plain = self.materials.plain.as_ref();
+            let plain = self.gpu.materials.plain.as_ref();
             pipelines.draw(encoder, target, (mesh, plain), params.wireframe);
             self.last_draw_time = started.elapsed();
         } else {
@@ -814,7 +803,7 @@ impl MeshRenderer {
         }
         self.target_has_image = true;
         self.drawn = Some(params);
-        self.images_drawn += 1;
+        self.counts.drawn += 1;
         true
     }
 
@@ -822,8 +811,8 @@ impl MeshRenderer {
     /// target was made: it is made again in the next frame's `ensure_target`); `None` without a
     /// target, or without the single-sample pipelines it needs.
     fn pipelines(&self) -> Option<&Pipelines> {
-        match (&self.target, &self.single_sample) {
-            (Some(target), _) if target.samples == SAMPLE_COUNT => Some(&self.pipelines),
+        match (&self.target, &self.gpu.single_sample) {
+            (Some(target), _) if target.samples == SAMPLE_COUNT => Some(&self.gpu.pipelines),
             (Some(_), Some(single)) => Some(single),
             _ => None,
         }
@@ -844,19 +833,20 @@ impl MeshRenderer {
             return PartDrawn::NoTarget;
         };
         if self
+            .parts
             .work
             .as_ref()
             .is_none_or(|w| w.size != size || w.samples != samples)
         {
-            self.work = Some(Target::new(device, size, samples));
+            self.parts.work = Some(Target::new(device, size, samples));
         }
         let (Some(pipelines), Some(target), Some(work)) =
-            (self.pipelines(), &self.target, &self.work)
+            (self.pipelines(), &self.target, &self.parts.work)
         else {
             return PartDrawn::NoTarget;
         };
-        let start = self.progress.as_ref().map_or(0, |p| p.done);
-        let end = (start as usize + self.faces_per_frame).min(total) as u32;
+        let start = self.parts.progress.as_ref().map_or(0, |p| p.done);
+        let end = (start as usize + self.parts.faces_per_frame).min(total) as u32;
         let part = Part {
             faces: start.min(faces)..end.min(faces),
             edges: start.saturating_sub(faces)..end.saturating_sub(faces),
@@ -866,19 +856,20 @@ impl MeshRenderer {
         pipelines.draw_part(
             encoder,
             work,
-            (self.mesh.as_ref(), self.materials.plain.as_ref()),
+            (self.mesh.as_ref(), self.gpu.materials.plain.as_ref()),
             params.wireframe,
             &part,
             last,
         );
-        self.parts_drawn += 1;
+        self.counts.parts += 1;
         let recording = self
+            .parts
             .progress
             .as_ref()
             .map_or(Duration::ZERO, |p| p.recording)
             + started.elapsed();
         if !last {
-            self.progress = Some(Progress {
+            self.parts.progress = Some(Progress {
                 params,
                 done: end,
                 recording,
@@ -887,7 +878,7 @@ impl MeshRenderer {
             return PartDrawn::MoreToDraw;
         }
         work.copy_image_to(encoder, target);
-        self.progress = None;
+        self.parts.progress = None;
         self.last_draw_time = recording;
         PartDrawn::Complete
     }

@@ -64,7 +64,7 @@ impl App {
             self.error = Some("Nothing to add noise to: no mesh is loaded".into());
             return;
         };
-        let options = self.settings.noise_options();
+        let options = self.settings.noise.options();
         if options.sigma <= 0.0 {
             self.error = Some("Noise: sigma must be above 0".into());
             return;

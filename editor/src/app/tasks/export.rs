@@ -4,10 +4,11 @@ use std::path::PathBuf;
 use std::time::Duration;
 use web_time::Instant;
 
-use crate::app::jobs::{JobKind, JobResult};
+use crate::app::jobs::{JobKind, JobResult, LevelChainError};
 use crate::app::state::HierarchyState;
 use crate::app::view_sync::SharedMesh;
 use crate::app::App;
+use fairmesh::io::IoError;
 use fairmesh::TriMesh;
 
 impl App {
@@ -75,8 +76,7 @@ impl App {
                 _ => source.clone(),
             };
             let result = fairmesh::io::save_with_source(&path, &mesh, &file_source)
-                .map(|report| report.warnings)
-                .map_err(|error| error.to_string());
+                .map(|report| report.warnings);
             let message = JobResult::Exported {
                 path,
                 result,
@@ -88,7 +88,7 @@ impl App {
 
     /// The folder the level chain goes to: the typed one, or `<stem>_levels` next to the file.
     pub fn levels_folder(&self) -> Option<PathBuf> {
-        let typed = self.settings.levels_folder.trim();
+        let typed = self.settings.level_chain.folder.trim();
         if !typed.is_empty() {
             return Some(PathBuf::from(typed));
         }
@@ -114,8 +114,8 @@ impl App {
         let hierarchy = hierarchy.clone();
         let file_source = document.source.clone();
         let top = hierarchy.level_count().saturating_sub(1);
-        let to = self.settings.levels_to.min(top);
-        let from = self.settings.levels_from.min(to);
+        let to = self.settings.level_chain.to.min(top);
+        let from = self.settings.level_chain.from.min(to);
         let stem = document
             .path
             .file_stem()
@@ -132,7 +132,10 @@ impl App {
         self.workers.io.submit(JobKind::LevelChain, move || {
             let started = Instant::now();
             let result = std::fs::create_dir_all(&folder)
-                .map_err(|error| format!("cannot create {}: {error}", folder.display()))
+                .map_err(|source| LevelChainError::CreateFolder {
+                    folder: folder.clone(),
+                    source,
+                })
                 .and_then(|()| {
                     (from..=to)
                         .map(|level| {
@@ -151,7 +154,7 @@ impl App {
                                 &file_source,
                             )
                             .map(|report| (path, report.warnings))
-                            .map_err(|error| error.to_string())
+                            .map_err(LevelChainError::Save)
                         })
                         .collect::<Result<Vec<_>, _>>()
                 })
@@ -181,7 +184,7 @@ impl App {
     pub(in crate::app) fn on_exported(
         &mut self,
         path: PathBuf,
-        result: Result<Vec<String>, String>,
+        result: Result<Vec<String>, IoError>,
         elapsed: Duration,
     ) {
         match result {
@@ -193,7 +196,7 @@ impl App {
                 };
                 #[cfg(not(target_arch = "wasm32"))]
                 if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
-                    self.settings.last_dir = Some(dir.to_path_buf());
+                    self.settings.files.last_dir = Some(dir.to_path_buf());
                 }
                 self.message = Some(format!(
                     "Exported to {} ({:.2} s){}",
@@ -213,7 +216,7 @@ impl App {
     pub(in crate::app) fn on_levels_exported(
         &mut self,
         folder: PathBuf,
-        result: Result<(Vec<PathBuf>, Vec<String>), String>,
+        result: Result<(Vec<PathBuf>, Vec<String>), LevelChainError>,
         elapsed: Duration,
     ) {
         match result {
@@ -228,9 +231,22 @@ impl App {
             }
             Err(error) => {
                 self.message = None;
-                self.error = Some(format!("Level export failed: {error}"));
+                self.error = Some(format!(
+                    "Level export failed: {}",
+                    level_chain_failure(&error)
+                ));
             }
         }
+    }
+}
+
+/// Why the level chain was not written, in the words after "Level export failed: ".
+fn level_chain_failure(error: &LevelChainError) -> String {
+    match error {
+        LevelChainError::CreateFolder { folder, source } => {
+            format!("cannot create {}: {source}", folder.display())
+        }
+        LevelChainError::Save(error) => error.to_string(),
     }
 }
 
@@ -240,5 +256,36 @@ fn notes(warnings: &[String]) -> String {
         String::new()
     } else {
         format!(". Note: {}", warnings.join(". "))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_level_chain_failure_names_the_folder_or_the_file() {
+        let folder = PathBuf::from("/read-only/bunny_levels");
+        let create = LevelChainError::CreateFolder {
+            folder: folder.clone(),
+            source: std::io::Error::from(std::io::ErrorKind::PermissionDenied),
+        };
+        assert_eq!(
+            level_chain_failure(&create),
+            format!(
+                "cannot create /read-only/bunny_levels: {}",
+                std::io::Error::from(std::io::ErrorKind::PermissionDenied)
+            )
+        );
+        let path = folder.join("bunny_L03.glb");
+        let save = LevelChainError::Save(IoError::Write {
+            path: path.clone(),
+            source: std::io::Error::from(std::io::ErrorKind::StorageFull),
+        });
+        assert!(
+            level_chain_failure(&save).starts_with("/read-only/bunny_levels/bunny_L03.glb: "),
+            "{}",
+            level_chain_failure(&save)
+        );
     }
 }

@@ -31,7 +31,7 @@ impl App {
         let document_generation = document.generation;
         let applied = document.applied;
         let view = self.work.view_generation.bump();
-        match self.settings.view_mode {
+        match self.settings.view.view_mode {
             ViewMode::Level => self.request_level_mesh(hierarchy, document_generation, level, view),
             // An applied result is shown as it is until a setting changes.
             ViewMode::Faired | ViewMode::Original if applied => {}
@@ -104,9 +104,9 @@ impl App {
             denoised,
             mask: document.mask.clone(),
             topology: document.topology.clone(),
-            options: self.settings.multires_options(level),
-            baseline: self.settings.baseline_options(),
-            method: self.settings.method,
+            options: self.settings.fairing.multires_options(level),
+            baseline: self.settings.fairing.baseline_options(),
+            method: self.settings.fairing.method,
         })
     }
 

@@ -50,7 +50,7 @@ impl App {
         self.work.hierarchy_progress.set(0.0);
         let mesh = document.original.clone();
         let topology = document.topology.clone();
-        let mut options = self.settings.hierarchy_options();
+        let mut options = self.settings.hierarchy.options();
         let mut denoise_options = self.settings.denoise_options();
         let source = document.source.clone();
         let document_generation = document.generation;
@@ -126,7 +126,7 @@ impl App {
         document: GenerationId,
     ) {
         for level in 1..hierarchy.level_count() {
-            let options = self.settings.multires_options(level);
+            let options = self.settings.fairing.multires_options(level);
             let document_generation = self.work.document_generation.clone();
             let workspace = self.work.workspace.clone();
             let hierarchy = hierarchy.clone();
@@ -166,7 +166,9 @@ impl App {
                     .collect::<Vec<_>>();
                 current.level = if current.pick_start_level {
                     current.pick_start_level = false;
-                    self.settings.start_level_for(&current.path, levels.len())
+                    self.settings
+                        .files
+                        .start_level_for(&current.path, levels.len())
                 } else {
                     current.level.min(levels.len().saturating_sub(1))
                 };

@@ -9,6 +9,7 @@ use crate::app::generation::GenerationId;
 use crate::app::jobs::{DialogPurpose, JobKind, JobResult, LoadedMesh};
 use crate::app::state::{self, DocumentSnapshot};
 use crate::app::App;
+use fairmesh::io::IoError;
 
 impl App {
     /// Starts loading `path` on the io worker; the current mesh stays until it arrives.
@@ -43,20 +44,18 @@ impl App {
                 let loaded = fairmesh::io::load(&path);
                 (path, loaded)
             };
-            let result = loaded
-                .map_err(|error| error.to_string())
-                .and_then(|loaded| {
-                    if loaded.mesh.triangles.is_empty() {
-                        Err(format!("{}: the file holds no triangles", path.display()))
-                    } else {
-                        Ok(Box::new(LoadedMesh {
-                            mesh: loaded.mesh,
-                            topology: Arc::new(loaded.topology),
-                            report: loaded.report,
-                            source: loaded.source,
-                        }))
-                    }
-                });
+            let result = loaded.and_then(|loaded| {
+                if loaded.mesh.triangles.is_empty() {
+                    Err(no_triangles(&path))
+                } else {
+                    Ok(Box::new(LoadedMesh {
+                        mesh: loaded.mesh,
+                        topology: Arc::new(loaded.topology),
+                        report: loaded.report,
+                        source: loaded.source,
+                    }))
+                }
+            });
             let message = JobResult::Loaded {
                 load_generation: generation,
                 path,
@@ -89,7 +88,7 @@ impl App {
         if self.dialog_open {
             return;
         }
-        let start_dir = self.settings.last_dir.clone().or_else(|| {
+        let start_dir = self.settings.files.last_dir.clone().or_else(|| {
             self.document
                 .as_ref()
                 .and_then(|d| d.path.parent().map(std::path::Path::to_path_buf))
@@ -140,7 +139,7 @@ impl App {
         &mut self,
         load_generation: GenerationId,
         path: PathBuf,
-        result: Result<Box<LoadedMesh>, String>,
+        result: Result<Box<LoadedMesh>, IoError>,
         elapsed: Duration,
     ) {
         if !self.work.load_generation.is_current(load_generation) {
@@ -156,10 +155,10 @@ impl App {
                     } else {
                         std::path::absolute(&requested).unwrap_or(requested)
                     };
-                    self.settings.remember_recent(&requested);
+                    self.settings.files.remember_recent(&requested);
                 }
                 if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
-                    self.settings.last_dir = Some(dir.to_path_buf());
+                    self.settings.files.last_dir = Some(dir.to_path_buf());
                 }
                 let loaded = *loaded;
                 let name = path
@@ -223,5 +222,27 @@ impl App {
                     Some("No file chosen (if no dialog appeared, type a path instead)".into());
             }
         }
+    }
+}
+
+/// The error of a file that loads but holds no triangles: nothing to fair.
+fn no_triangles(path: &std::path::Path) -> IoError {
+    IoError::Invalid {
+        path: path.to_path_buf(),
+        message: "the file holds no triangles".into(),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_file_without_triangles_is_named_with_what_is_wrong() {
+        let error = no_triangles(std::path::Path::new("/scans/points.ply"));
+        assert_eq!(
+            error.to_string(),
+            "/scans/points.ply: the file holds no triangles"
+        );
     }
 }

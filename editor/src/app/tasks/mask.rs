@@ -28,7 +28,7 @@ impl App {
         let Some(document) = &self.document else {
             return;
         };
-        if self.settings.view_mode == ViewMode::Level {
+        if self.settings.view.view_mode == ViewMode::Level {
             self.message = Some("Painting needs the full mesh: switch the view to Faired".into());
             return;
         }
@@ -36,7 +36,7 @@ impl App {
         // Pick on what is on screen: the result when it has the document's vertices.
         let positions = match &document.faired {
             Some(faired)
-                if self.settings.view_mode == ViewMode::Faired
+                if self.settings.view.view_mode == ViewMode::Faired
                     && faired.positions.len() == mesh.positions.len() =>
             {
                 faired.positions.as_slice()

@@ -78,14 +78,15 @@ impl App {
             // A page downloads the image (written into the export folder first).
             #[cfg(target_arch = "wasm32")]
             let path = Self::web_export_path(&path);
-            let result = write_png(&path, &crop(&image, rect, pixels_per_point))
-                .map(|()| path)
-                .map_err(|error| error.to_string());
+            let result = write_png(&path, &crop(&image, rect, pixels_per_point)).map(|()| path);
             Self::send_result(&tx, &ctx, JobResult::ViewImageSaved { result }, ticket);
         });
     }
 
-    pub(in crate::app) fn on_view_image_saved(&mut self, result: Result<PathBuf, String>) {
+    pub(in crate::app) fn on_view_image_saved(
+        &mut self,
+        result: Result<PathBuf, fairmesh::io::IoError>,
+    ) {
         match result {
             Ok(path) => {
                 #[cfg(target_arch = "wasm32")]

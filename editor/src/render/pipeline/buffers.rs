@@ -386,8 +386,8 @@ impl super::MeshRenderer {
     /// Uploads the textures and uniforms of the mesh's materials, and the "no material" group,
     /// when they are not on the GPU yet.
     pub(super) fn ensure_materials(&mut self, device: &wgpu::Device, queue: &wgpu::Queue) {
-        if self.materials.plain.is_none() {
-            self.materials.plain = Some(self.materials.group(device, queue, None));
+        if self.gpu.materials.plain.is_none() {
+            self.gpu.materials.plain = Some(self.gpu.materials.group(device, queue, None));
         }
         if let Some(mesh) = &mut self.mesh {
             if mesh.materials.is_none() {
@@ -399,7 +399,7 @@ impl super::MeshRenderer {
                     looks
                         .iter()
                         .map(|look| MaterialGroup {
-                            bind_group: self.materials.group(device, queue, Some(look)),
+                            bind_group: self.gpu.materials.group(device, queue, Some(look)),
                         })
                         .collect(),
                 );

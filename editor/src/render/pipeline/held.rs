@@ -74,20 +74,25 @@ impl MeshRenderer {
     /// [`Self::set_positions_keyed`].
     pub fn show_held(&mut self, queue: &wgpu::Queue, key: MeshKey) -> bool {
         self.poll_uploads(queue);
-        if self.pending.as_ref().is_some_and(|p| p.key == Some(key)) {
+        if self
+            .in_flight
+            .pending
+            .as_ref()
+            .is_some_and(|p| p.key == Some(key))
+        {
             return true;
         }
         let on_screen = self.mesh.as_ref().is_some_and(|m| m.key == Some(key));
-        if on_screen && self.pending_move.is_none() {
+        if on_screen && self.in_flight.pending_move.is_none() {
             // A mesh on its way would replace it when it lands: it is no longer wanted.
-            self.pending = None;
+            self.in_flight.pending = None;
             return true;
         }
         let Some(index) = self.held.iter().position(|m| m.key == Some(key)) else {
             return false;
         };
         // The mesh on its way is no longer wanted (its upload is dropped when it lands).
-        self.pending = None;
+        self.in_flight.pending = None;
         let mesh = self.held.remove(index);
         self.replace_current(mesh);
         true
@@ -103,7 +108,7 @@ impl MeshRenderer {
         key: MeshKey,
     ) -> bool {
         self.poll_uploads(queue);
-        if self.pending.is_some() {
+        if self.in_flight.pending.is_some() {
             return false;
         }
         let vertices = source.positions().len();
@@ -160,16 +165,13 @@ impl MeshRenderer {
     /// its key's version yet). A held mesh keeps the complete image of it the target holds
     /// (`kept.rs`); `mesh`'s own kept image, if any, is shown again when the view is unchanged.
     pub(super) fn replace_current(&mut self, mesh: MeshBuffers) {
-        let moving = self.pending_move.take().is_some();
-        self.move_scalars = None;
-        self.move_mask = None;
-        self.lines_requested = None;
+        let moving = self.in_flight.screen_replaced();
         self.lines_failed = false;
         self.problem = None;
         self.newest_faces = mesh.index_count as usize / 3;
         // The target's complete image shows the mesh leaving (an image half drawn is dropped).
         let image = self.drawn.take();
-        self.progress = None;
+        self.parts.progress = None;
         let family = mesh.key.map(|k| k.family);
         let generation = mesh.generation;
         if let Some(old) = self.mesh.replace(mesh) {
@@ -193,7 +195,7 @@ impl MeshRenderer {
     pub(super) fn drop_family(&mut self, key: Option<MeshKey>) {
         // The mesh on screen is about to be replaced: if its new positions are still on their
         // way, its buffers are not its key's version, so it is not kept.
-        if self.pending_move.is_some() {
+        if self.in_flight.pending_move.is_some() {
             if let Some(mesh) = &mut self.mesh {
                 mesh.key = None;
             }

@@ -15,6 +15,15 @@
 
 use super::{DrawParams, MeshRenderer};
 
+/// The held meshes' kept images, and the image of a mesh that left the screen still to copy.
+#[derive(Default)]
+pub(super) struct KeptImages {
+    pub(super) images: Vec<KeptImage>,
+    /// A mesh that left the screen (its generation) whose complete image, drawn with these
+    /// parameters, is still in the target: the next render copies it into its kept image.
+    pub(super) request: Option<(u64, DrawParams)>,
+}
+
 /// A held mesh's last complete image.
 pub(super) struct KeptImage {
     /// The mesh's `MeshBuffers::generation` (which `set_mesh` call made its buffers).
@@ -45,26 +54,22 @@ pub struct ImageCounts {
 
 impl MeshRenderer {
     pub fn image_counts(&self) -> ImageCounts {
-        ImageCounts {
-            drawn: self.images_drawn,
-            parts: self.parts_drawn,
-            restored: self.images_restored,
-        }
+        self.counts
     }
 
     /// The mesh of `generation` leaves the screen, the target holding its complete image drawn
     /// with `params`: keep that image (copied by the next `render`, unless the mesh's kept
     /// image is that one already).
     pub(super) fn keep_image_of(&mut self, generation: u64, params: DrawParams) {
-        self.keep_request = Some((generation, params));
+        self.kept.request = Some((generation, params));
     }
 
     /// `generation`'s mesh comes back on screen before the target was drawn into since it left:
     /// the target still holds its image (returns the parameters it was drawn with).
     pub(super) fn image_still_in_target(&mut self, generation: u64) -> Option<DrawParams> {
-        let (requested, params) = self.keep_request?;
+        let (requested, params) = self.kept.request?;
         (requested == generation).then(|| {
-            self.keep_request = None;
+            self.kept.request = None;
             params
         })
     }
@@ -76,7 +81,7 @@ impl MeshRenderer {
         device: &wgpu::Device,
         encoder: &mut wgpu::CommandEncoder,
     ) {
-        let Some((generation, params)) = self.keep_request.take() else {
+        let Some((generation, params)) = self.kept.request.take() else {
             return;
         };
         let Some(target) = self.target.as_ref().filter(|t| t.size == params.size) else {
@@ -85,19 +90,24 @@ impl MeshRenderer {
         if !self.held.iter().any(|m| m.generation == generation) {
             return;
         }
-        let index = match self.kept.iter().position(|k| k.generation == generation) {
-            Some(index) if self.kept[index].params == Some(params) => return,
+        let index = match self
+            .kept
+            .images
+            .iter()
+            .position(|k| k.generation == generation)
+        {
+            Some(index) if self.kept.images[index].params == Some(params) => return,
             Some(index) => index,
             None => {
-                self.kept.push(KeptImage {
+                self.kept.images.push(KeptImage {
                     generation,
                     texture: target.image_texture(device),
                     params: None,
                 });
-                self.kept.len() - 1
+                self.kept.images.len() - 1
             }
         };
-        let kept = &mut self.kept[index];
+        let kept = &mut self.kept.images[index];
         let size = kept.texture.size();
         if [size.width, size.height] != target.size {
             kept.texture = target.image_texture(device);
@@ -118,6 +128,7 @@ impl MeshRenderer {
         };
         let Some(kept) = self
             .kept
+            .images
             .iter()
             .find(|k| k.generation == mesh.generation && k.params.as_ref() == Some(params))
         else {
@@ -125,10 +136,10 @@ impl MeshRenderer {
         };
         target.copy_image_from(encoder, &kept.texture);
         self.drawn = Some(*params);
-        self.progress = None;
+        self.parts.progress = None;
         self.wireframe = params.wireframe;
         self.target_has_image = true;
-        self.images_restored += 1;
+        self.counts.restored += 1;
         // The frame after shows (and logs) the image, as it does after a drawn one.
         (self.repaint)();
         true
@@ -137,7 +148,7 @@ impl MeshRenderer {
     /// The mesh on screen changed: its kept image no longer shows it.
     pub(super) fn forget_current_image(&mut self) {
         if let Some(mesh) = &self.mesh {
-            forget_image(&mut self.kept, mesh.generation);
+            forget_image(&mut self.kept.images, mesh.generation);
         }
     }
 
@@ -145,19 +156,20 @@ impl MeshRenderer {
     pub(super) fn prune_images(&mut self) {
         let on_screen = self.mesh.as_ref().map(|m| m.generation);
         let held = &self.held;
-        self.kept.retain(|k| {
+        self.kept.images.retain(|k| {
             on_screen == Some(k.generation) || held.iter().any(|m| m.generation == k.generation)
         });
     }
 
     /// Bytes of GPU memory the kept images take.
     pub fn image_bytes(&self) -> u64 {
-        self.kept.iter().map(KeptImage::bytes).sum()
+        self.kept.images.iter().map(KeptImage::bytes).sum()
     }
 
     /// Bytes of the kept image of the mesh of `generation` (0 without one).
     pub(super) fn image_bytes_of(&self, generation: u64) -> u64 {
         self.kept
+            .images
             .iter()
             .filter(|k| k.generation == generation)
             .map(KeptImage::bytes)

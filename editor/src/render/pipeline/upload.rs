@@ -203,6 +203,73 @@ pub(super) struct PendingMesh {
     pub(super) mask: Option<Vec<f32>>,
 }
 
+/// What the renderer has on the upload thread, and what waits for it to land.
+pub(super) struct InFlight {
+    /// The upload thread (`None`: it failed to start; every upload happens in the calling
+    /// frame).
+    pub(super) uploader: Option<Uploader>,
+    /// Counts `MeshRenderer::set_mesh` calls; an upload that lands for an older one is dropped.
+    pub(super) generation: u64,
+    /// The upload in flight on the upload thread (the previous mesh stays on screen meanwhile).
+    pub(super) pending: Option<PendingMesh>,
+    /// Generation of the mesh whose wireframe edges the upload thread is building.
+    pub(super) lines_requested: Option<u64>,
+    /// Counts `MeshRenderer::set_positions` calls; normals that land for an older one are
+    /// dropped.
+    pub(super) move_serial: u64,
+    /// The newest positions whose normals the upload thread is computing (the mesh on screen
+    /// keeps its positions until they land, so positions and normals always match).
+    pub(super) pending_move: Option<u64>,
+    /// Scalars and mask weights set while those positions are on their way: they belong to
+    /// the new positions (a heat map of the new result), so they are written with them.
+    pub(super) move_scalars: Option<Vec<f32>>,
+    pub(super) move_mask: Option<Vec<f32>>,
+    /// Meshes of at least this many bytes (positions + triangles) upload on the upload thread.
+    pub(super) async_upload_bytes: usize,
+}
+
+impl InFlight {
+    pub(super) fn new(uploader: Option<Uploader>) -> Self {
+        Self {
+            uploader,
+            generation: 0,
+            pending: None,
+            lines_requested: None,
+            move_serial: 0,
+            pending_move: None,
+            move_scalars: None,
+            move_mask: None,
+            async_upload_bytes: super::DEFAULT_ASYNC_UPLOAD_BYTES,
+        }
+    }
+
+    /// A new mesh is set (its generation counted): whatever was on its way for the one before
+    /// is no longer wanted.
+    pub(super) fn next_mesh(&mut self) {
+        self.generation += 1;
+        self.pending = None;
+        self.pending_move = None;
+        self.move_scalars = None;
+        self.move_mask = None;
+        self.lines_requested = None;
+    }
+
+    /// The mesh on screen is replaced: new positions on their way for it and its wireframe's
+    /// edges no longer apply. Returns whether positions were on their way.
+    pub(super) fn screen_replaced(&mut self) -> bool {
+        let moving = self.pending_move.take().is_some();
+        self.move_scalars = None;
+        self.move_mask = None;
+        self.lines_requested = None;
+        moving
+    }
+
+    /// Whether anything is still on its way.
+    pub(super) fn any(&self) -> bool {
+        self.pending.is_some() || self.lines_requested.is_some() || self.pending_move.is_some()
+    }
+}
+
 /// The wireframe's edges, made when first drawn.
 impl super::MeshRenderer {
     /// Builds the wireframe's edges of the mesh on screen when they are missing and fit: a big
@@ -211,11 +278,11 @@ impl super::MeshRenderer {
     pub(super) fn ensure_lines(&mut self, device: &wgpu::Device) {
         if let Some(mesh) = &mut self.mesh {
             let faces = mesh.index_count as usize / 3;
-            let fits = faces as u64 * 24 <= self.max_buffer_size;
+            let fits = faces as u64 * 24 <= self.gpu.max_buffer_size;
             if fits
                 && !self.lines_failed
                 && mesh.lines.is_none()
-                && self.lines_requested != Some(mesh.generation)
+                && self.in_flight.lines_requested != Some(mesh.generation)
             {
                 // A big mesh's edges are built on the upload thread (the image shows the
                 // mesh without them meanwhile); a small one's here.
@@ -225,14 +292,14 @@ impl super::MeshRenderer {
                     source: mesh.source.clone(),
                     look: mesh.appearance.clone(),
                 };
-                let sent = match &self.uploader {
-                    Some(uploader) if bytes >= self.async_upload_bytes => {
+                let sent = match &self.in_flight.uploader {
+                    Some(uploader) if bytes >= self.in_flight.async_upload_bytes => {
                         uploader.send(job).is_ok()
                     }
                     _ => false,
                 };
                 if sent {
-                    self.lines_requested = Some(mesh.generation);
+                    self.in_flight.lines_requested = Some(mesh.generation);
                 } else {
                     let triangles =
                         draw_triangles(mesh.source.as_ref(), mesh.appearance.as_deref());
