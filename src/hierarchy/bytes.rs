@@ -37,14 +37,19 @@ impl Reader<'_> {
         Ok(head)
     }
 
-    /// A list of `width` words per item (its item count first).
+    /// A list of words (its word count first), `width` words per item.
     fn words(&mut self, width: usize, what: &str) -> Result<Vec<u32>, HierarchyBytesError> {
         let count = u64::from_le_bytes(self.take(8, what)?.try_into().unwrap_or_default());
-        let items = usize::try_from(count)
+        let words = usize::try_from(count)
             .ok()
-            .filter(|&n| n.checked_mul(width * 4).is_some_and(|b| b <= self.bytes.len()))
+            .filter(|&n| n.checked_mul(4).is_some_and(|b| b <= self.bytes.len()))
             .ok_or_else(|| HierarchyBytesError(format!("{what}: the bytes end early")))?;
-        let raw = self.take(items * width * 4, what)?;
+        if words % width != 0 {
+            return Err(HierarchyBytesError(format!(
+                "{what}: {words} numbers do not make items of {width}"
+            )));
+        }
+        let raw = self.take(words * 4, what)?;
         Ok(raw
             .chunks_exact(4)
             .map(|w| u32::from_le_bytes([w[0], w[1], w[2], w[3]]))
