@@ -44,7 +44,7 @@ impl Reader<'_> {
             .ok()
             .filter(|&n| n.checked_mul(4).is_some_and(|b| b <= self.bytes.len()))
             .ok_or_else(|| HierarchyBytesError(format!("{what}: the bytes end early")))?;
-        if words % width != 0 {
+        if !words.is_multiple_of(width) {
             return Err(HierarchyBytesError(format!(
                 "{what}: {words} numbers do not make items of {width}"
             )));
