@@ -60,6 +60,9 @@ build() {
       "$out/fairmesh_web_bg.wasm" -o "$out/fairmesh_web_bg.wasm"
   fi
   cp web/index.html "$out/index.html"
+  cp web/fairmesh_worker.js "$out/fairmesh_worker.js"
+  # The bunny the page opens on start (the module does not carry it).
+  cp assets/bunny00.obj "$out/bunny00.obj"
   local raw gz
   raw=$(stat -c %s "$out/fairmesh_web_bg.wasm")
   gz=$(gzip -9 -c "$out/fairmesh_web_bg.wasm" | wc -c)

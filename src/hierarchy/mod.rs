@@ -45,6 +45,7 @@
 //! - `order`: M0 numbered by level from the passes' output.
 
 mod decimate;
+mod bytes;
 mod order;
 
 use crate::fairing::creases::{
@@ -55,6 +56,7 @@ use crate::mesh::{FanRings, Topology, TriMesh};
 use crate::Progress;
 use decimate::NEVER;
 use order::in_level_order;
+pub use bytes::HierarchyBytesError;
 use std::borrow::Cow;
 use std::sync::atomic::AtomicU64;
 

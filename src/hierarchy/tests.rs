@@ -357,3 +357,32 @@ fn creases_survive_every_level_visited_in_regions() {
         }
     }
 }
+
+#[test]
+fn a_hierarchy_read_back_from_its_bytes_is_the_same_hierarchy() {
+    let mesh = crate::bundled::load_bunny(&crate::io::LoadOptions::default())
+        .unwrap()
+        .mesh;
+    let built = build_hierarchy(&mesh, &HierarchyOptions::default(), &mut NoProgress).unwrap();
+    let bytes = built.to_bytes();
+    let back = Hierarchy::from_bytes(&bytes).unwrap();
+    assert_ne!(back.id, built.id);
+    assert_eq!(back.to_bytes(), bytes);
+    assert_eq!(back.level_count(), built.level_count());
+    let coarsest = built.coarsest_level();
+    assert_eq!(back.level_mesh(coarsest), built.level_mesh(coarsest));
+    assert_eq!(back.base_mesh(), built.base_mesh());
+    // Cut short, another layout, or an id out of range: an error, never a panic.
+    for cut in [0, 7, 8, 100, bytes.len() / 2, bytes.len() - 1] {
+        assert!(Hierarchy::from_bytes(&bytes[..cut]).is_err(), "cut at {cut}");
+    }
+    let mut other = bytes.clone();
+    other[7] = b'9';
+    assert!(Hierarchy::from_bytes(&other).is_err());
+    let mut bad = bytes;
+    // The first triangle's first corner of M0 (after the header, the positions and the count).
+    let at = 8 + 8 + mesh.positions.len() * 12 + 8;
+    bad[at..at + 4].copy_from_slice(&u32::MAX.to_le_bytes());
+    let error = Hierarchy::from_bytes(&bad).unwrap_err().to_string();
+    assert!(error.contains("out of range"), "{error}");
+}

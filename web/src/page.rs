@@ -25,7 +25,8 @@ fn show_failure(message: &str) {
     }
 }
 
-/// Runs when the page loads the module: starts the editor on the canvas.
+/// Runs when the page loads the module: starts the editor on the canvas (in the engine's
+/// worker, which has no page, it only sets the panic hook).
 #[wasm_bindgen(start)]
 pub fn start() {
     // Panics and the editor's log go to the browser's console.
@@ -34,6 +35,9 @@ pub fn start() {
         web_sys::console::error_1(&message.clone().into());
         show_failure(&message);
     }));
+    if web_sys::window().is_none() {
+        return;
+    }
     let Some(canvas) = web_sys::window()
         .and_then(|w| w.document())
         .and_then(|d| d.get_element_by_id(CANVAS_ID))
@@ -103,4 +107,12 @@ pub fn status() -> String {
 #[wasm_bindgen]
 pub fn command(name: &str, value: &str) -> Result<(), JsValue> {
     web::command(name, value).map_err(|error| JsValue::from_str(&error))
+}
+
+/// The engine's answer to one request from the page: `fairmesh_worker.js`, the Web Worker that
+/// runs this module beside the page, calls it for each message (the hierarchy and fairing run
+/// there, so that the page goes on answering).
+#[wasm_bindgen]
+pub fn engine_handle(message: JsValue) {
+    web::engine::handle(message);
 }

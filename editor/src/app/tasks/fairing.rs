@@ -65,6 +65,27 @@ impl App {
         self.work.fair_in_flight = true;
         self.work.fair_view = view;
         self.work.fair_progress.set(0.0);
+        // In a page the fairing runs in the engine's worker, which holds the hierarchy.
+        #[cfg(target_arch = "wasm32")]
+        let (tx, ctx, ticket) = {
+            use crate::app::web::engine::{post_fair, FairPost, Sending};
+            let post = FairPost {
+                settings: self.settings.clone(),
+                hierarchy: job.hierarchy.clone(),
+                original: job.original.clone(),
+                denoised: job.denoised,
+                mask: job.mask.clone(),
+                level,
+                document,
+                document_generation: document_generation.clone(),
+                view,
+                progress: progress_out.clone(),
+            };
+            match post_fair(post, Sending { tx, ctx, ticket }) {
+                Ok(()) => return,
+                Err(back) => (back.tx, back.ctx, back.ticket),
+            }
+        };
         self.workers.compute.submit_latest(JobKind::Fair, move || {
             if !document_generation.is_current(document) {
                 return;
@@ -98,16 +119,15 @@ impl App {
                 ..
             }
         );
-        Some(FairJob {
+        Some(FairJob::new(
             hierarchy,
-            original: document.original.clone(),
+            document.original.clone(),
             denoised,
-            mask: document.mask.clone(),
-            topology: document.topology.clone(),
-            options: self.settings.fairing.multires_options(level),
-            baseline: self.settings.fairing.baseline_options(),
-            method: self.settings.fairing.method,
-        })
+            document.mask.clone(),
+            document.topology.clone(),
+            &self.settings,
+            level,
+        ))
     }
 
     pub(in crate::app) fn request_level_mesh(
@@ -209,7 +229,7 @@ impl App {
 
 /// One fairing of the document, as the compute worker runs it: taken from the app when it is
 /// asked for, so that the worker reads nothing of the app.
-struct FairJob {
+pub(in crate::app) struct FairJob {
     /// Built on the denoised mesh when `denoised`, else on the document's mesh.
     hierarchy: Arc<hierarchy::Hierarchy>,
     /// The document's mesh: what a baseline smooths, what a mask fades the result into, what
@@ -229,9 +249,31 @@ struct FairJob {
 }
 
 impl FairJob {
+    /// Fairing `original` from `level` of `hierarchy` with `settings`' options.
+    pub(in crate::app) fn new(
+        hierarchy: Arc<hierarchy::Hierarchy>,
+        original: Arc<TriMesh>,
+        denoised: bool,
+        mask: Option<Mask>,
+        topology: Arc<Topology>,
+        settings: &crate::app::state::Settings,
+        level: usize,
+    ) -> Self {
+        FairJob {
+            hierarchy,
+            original,
+            denoised,
+            mask,
+            topology,
+            options: settings.fairing.multires_options(level),
+            baseline: settings.fairing.baseline_options(),
+            method: settings.fairing.method,
+        }
+    }
+
     /// Fairs, reporting to `progress` (which returns false to cancel): the result, or `None`
     /// when cancelled.
-    fn run(
+    pub(in crate::app) fn run(
         self,
         workspace: &Mutex<MultiresWorkspace>,
         mut progress: impl FnMut(f32) -> bool + Send,

@@ -35,6 +35,52 @@ fn build_on(
     Ok((Arc::new(built), matches, Arc::new(sharp_edges)))
 }
 
+/// Denoises `mesh` (as `denoise_options` ask) and builds the hierarchy on the result, keeping the
+/// file's own sharp edges (`source`'s) when sharp edges are kept, as `fairmesh fair` keeps them.
+/// Both stages report to `progress` (false cancels); `denoised` is told when the denoise is done.
+pub(in crate::app) fn denoise_and_build(
+    mesh: &TriMesh,
+    topology: &Topology,
+    mut options: HierarchyOptions,
+    mut denoise_options: fairmesh::multires::DenoiseOptions,
+    file_edges: &dyn Fn(&TriMesh) -> Vec<[u32; 2]>,
+    progress: &mut dyn fairmesh::Progress,
+    denoised_done: &mut dyn FnMut(),
+) -> Result<KeptHierarchy, HierarchyError> {
+    let started = Instant::now();
+    let file_edges = if options.creases.is_some() {
+        file_edges(mesh)
+    } else {
+        Vec::new()
+    };
+    if let Some(creases) = &mut options.creases {
+        *creases = creases.clone().with_file_edges(file_edges.clone());
+    }
+    if let Some(creases) = &mut denoise_options.creases {
+        *creases = creases.clone().with_file_edges(file_edges);
+    }
+    match denoise(mesh, topology, &denoise_options, progress) {
+        Err(fairmesh::Cancelled) => Err(HierarchyError::Cancelled),
+        Ok(denoised) => {
+            let denoise = denoised.as_ref().map(|d| DenoiseSummary {
+                report: d.report.clone(),
+                time: started.elapsed(),
+            });
+            denoised_done();
+            let built_on = denoised.as_ref().map_or(mesh, |d| &d.mesh);
+            build_on(built_on, mesh, topology, &options, progress).map(
+                |(hierarchy, base_matches_original, sharp_edges)| KeptHierarchy {
+                    hierarchy,
+                    build_time: started.elapsed(),
+                    base_matches_original,
+                    sharp_edges,
+                    denoise,
+                },
+            )
+        }
+    }
+}
+
 impl App {
     /// Denoises the document's mesh ([`fairmesh::multires::denoise`], as the settings ask) and
     /// builds the hierarchy on the result, on the compute worker; both report to the
@@ -50,8 +96,8 @@ impl App {
         self.work.hierarchy_progress.set(0.0);
         let mesh = document.original.clone();
         let topology = document.topology.clone();
-        let mut options = self.settings.hierarchy.options();
-        let mut denoise_options = self.settings.denoise_options();
+        let options = self.settings.hierarchy.options();
+        let denoise_options = self.settings.denoise_options();
         let source = document.source.clone();
         let document_generation = document.generation;
         let hierarchy_generation = self.work.hierarchy_generation.clone();
@@ -63,49 +109,52 @@ impl App {
             self.ctx.clone(),
             self.workers.jobs.start(),
         );
-        self.workers.compute.submit(JobKind::Hierarchy, move || {
-            if !hierarchy_generation.is_current(generation) {
-                return;
-            }
-            let started = Instant::now();
-            let mut progress = |fraction: f32| {
-                progress_out.set(fraction);
-                hierarchy_generation.is_current(generation)
-            };
-            // The file's own sharp edges (split normals, material boundaries) are kept
-            // too when sharp edges are, as `fairmesh fair` keeps them.
+        // In a page the job runs in the engine's worker, so that the page goes on answering.
+        #[cfg(target_arch = "wasm32")]
+        let (tx, ctx, ticket) = {
+            use crate::app::web::engine::{post_hierarchy, HierarchyPost, Sending};
             let file_edges = if options.creases.is_some() {
                 source.hard_edges(&mesh)
             } else {
                 Vec::new()
             };
-            if let Some(creases) = &mut options.creases {
-                *creases = creases.clone().with_file_edges(file_edges.clone());
-            }
-            if let Some(creases) = &mut denoise_options.creases {
-                *creases = creases.clone().with_file_edges(file_edges);
-            }
-            let result = match denoise(&mesh, &topology, &denoise_options, &mut progress) {
-                Err(fairmesh::Cancelled) => Err(HierarchyError::Cancelled),
-                Ok(denoised) => {
-                    let denoise = denoised.as_ref().map(|d| DenoiseSummary {
-                        report: d.report.clone(),
-                        time: started.elapsed(),
-                    });
-                    denoising.store(false, Ordering::Relaxed);
-                    progress_out.set(0.0);
-                    let built_on = denoised.as_ref().map_or(mesh.as_ref(), |d| &d.mesh);
-                    build_on(built_on, &mesh, &topology, &options, &mut progress).map(
-                        |(hierarchy, base_matches_original, sharp_edges)| KeptHierarchy {
-                            hierarchy,
-                            build_time: started.elapsed(),
-                            base_matches_original,
-                            sharp_edges,
-                            denoise,
-                        },
-                    )
-                }
+            let post = HierarchyPost {
+                settings: self.settings.clone(),
+                mesh: mesh.clone(),
+                file_edges,
+                document: document_generation,
+                document_generation: self.work.document_generation.clone(),
+                generation,
+                hierarchy_generation: hierarchy_generation.clone(),
+                progress: progress_out.clone(),
+                denoising: denoising.clone(),
             };
+            match post_hierarchy(post, Sending { tx, ctx, ticket }) {
+                Ok(()) => return,
+                Err(back) => (back.tx, back.ctx, back.ticket),
+            }
+        };
+        self.workers.compute.submit(JobKind::Hierarchy, move || {
+            if !hierarchy_generation.is_current(generation) {
+                return;
+            }
+            let mut progress = |fraction: f32| {
+                progress_out.set(fraction);
+                hierarchy_generation.is_current(generation)
+            };
+            let mut denoised = || {
+                denoising.store(false, Ordering::Relaxed);
+                progress_out.set(0.0);
+            };
+            let result = denoise_and_build(
+                &mesh,
+                &topology,
+                options,
+                denoise_options,
+                &|m: &TriMesh| source.hard_edges(m),
+                &mut progress,
+                &mut denoised,
+            );
             let message = JobResult::Hierarchy {
                 document: document_generation,
                 hierarchy: generation,
@@ -125,6 +174,28 @@ impl App {
         hierarchy: Arc<hierarchy::Hierarchy>,
         document: GenerationId,
     ) {
+        // In a page the levels are set up in the engine's worker, which fairs them.
+        #[cfg(target_arch = "wasm32")]
+        if let Some(current) = self.document.as_ref().filter(|d| d.generation == document) {
+            use crate::app::web::engine::{post_prepare, Sending};
+            let denoised = matches!(
+                current.hierarchy,
+                HierarchyState::Ready {
+                    denoise: Some(_),
+                    ..
+                }
+            );
+            let sending = Sending {
+                tx: self.workers.results_tx.clone(),
+                ctx: self.ctx.clone(),
+                ticket: self.workers.jobs.start(),
+            };
+            let state = (hierarchy.clone(), current.original.clone(), denoised);
+            let generation = self.work.document_generation.clone();
+            if post_prepare(&self.settings, state, document, generation, sending).is_ok() {
+                return;
+            }
+        }
         for level in 1..hierarchy.level_count() {
             let options = self.settings.fairing.multires_options(level);
             let document_generation = self.work.document_generation.clone();

@@ -11,12 +11,34 @@ use crate::app::state::{self, DocumentSnapshot};
 use crate::app::App;
 use fairmesh::io::IoError;
 
+/// The bundled bunny when `path` names it (`@bunny`).
+#[cfg(not(target_arch = "wasm32"))]
+fn load_bundled(
+    path: &std::path::Path,
+) -> Option<Result<fairmesh::io::Loaded, fairmesh::io::IoError>> {
+    fairmesh::bundled::is_bunny_pseudo_path(path)
+        .then(|| fairmesh::bundled::load_bunny(&fairmesh::io::LoadOptions::default()))
+}
+
+/// A page fetches the bunny as the file beside it (`App::open`), so nothing is bundled here.
+#[cfg(target_arch = "wasm32")]
+fn load_bundled(
+    _path: &std::path::Path,
+) -> Option<Result<fairmesh::io::Loaded, fairmesh::io::IoError>> {
+    None
+}
+
 impl App {
     /// Starts loading `path` on the io worker; the current mesh stays until it arrives.
     pub(in crate::app) fn open(&mut self, path: PathBuf) {
-        // In a page, a typed path that is no file given to the page is a URL to fetch.
+        // In a page, a typed path that is no file given to the page is a URL to fetch; the
+        // bunny is the file `bunny00.obj` beside the page (the module does not carry it: it
+        // would be a sixth of its download).
         #[cfg(target_arch = "wasm32")]
-        if !fairmesh::bundled::is_bunny_pseudo_path(&path) && !fairmesh::io::exists(&path) {
+        if fairmesh::bundled::is_bunny_pseudo_path(&path) {
+            crate::app::web::open_url(fairmesh::bundled::BUNNY_FILE_NAME.to_owned());
+            return;
+        } else if !fairmesh::io::exists(&path) {
             crate::app::web::open_url(path.display().to_string());
             return;
         }
@@ -37,12 +59,12 @@ impl App {
             let started = Instant::now();
             // The bundled bunny comes from the binary itself; it is named by its file name, so
             // its default export is `bunny00_faired.glb` in the working directory.
-            let (path, loaded) = if fairmesh::bundled::is_bunny_pseudo_path(&path) {
-                let loaded = fairmesh::bundled::load_bunny(&fairmesh::io::LoadOptions::default());
-                (PathBuf::from(fairmesh::bundled::BUNNY_FILE_NAME), loaded)
-            } else {
-                let loaded = fairmesh::io::load(&path);
-                (path, loaded)
+            let (path, loaded) = match load_bundled(&path) {
+                Some(loaded) => (PathBuf::from(fairmesh::bundled::BUNNY_FILE_NAME), loaded),
+                None => {
+                    let loaded = fairmesh::io::load(&path);
+                    (path, loaded)
+                }
             };
             let result = loaded.and_then(|loaded| {
                 if loaded.mesh.triangles.is_empty() {

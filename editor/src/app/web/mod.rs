@@ -14,6 +14,7 @@
 //! `events.rs` until the next frame's [`App::poll_web`] opens the file or shows the error.
 
 mod download;
+pub mod engine;
 mod events;
 mod fetch;
 mod zip;
@@ -169,6 +170,11 @@ impl App {
             "loading": status.loading,
             "settled": self.is_settled(),
             "hierarchy_ready": status.hierarchy_ready,
+            "hierarchy_building": matches!(
+                document.map(|d| &d.hierarchy),
+                Some(crate::app::state::HierarchyState::Building)
+            ),
+            "hierarchy_progress": self.work.hierarchy_progress.get(),
             "level_count": status.level_count,
             "level": status.level,
             "faired_serial": status.faired_serial,
@@ -186,9 +192,12 @@ impl App {
         events::STATUS.with(|kept| *kept.borrow_mut() = json.to_string());
     }
 
-    /// Runs one waiting background job (the page has no threads): loading or exporting first,
-    /// then the hierarchy and fairing, then the measures. True when one ran.
+    /// Hands the engine's worker what waits for it (`engine.rs`: the hierarchy and fairing run
+    /// there), then runs one waiting background job on the page (it has no threads): loading
+    /// or exporting first, then the hierarchy or fairing left to the page, then the measures.
+    /// True when one ran.
     pub(in crate::app) fn run_one_job(&mut self) -> bool {
+        engine::tick();
         let workers = &self.workers;
         workers.io.run_next() || workers.compute.run_next() || workers.measure.run_next()
     }
