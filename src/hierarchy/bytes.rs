@@ -160,7 +160,9 @@ impl Hierarchy {
                 0 => Ok(FeatureClass::Smooth),
                 1 => Ok(FeatureClass::Crease),
                 2 => Ok(FeatureClass::Corner),
-                _ => Err(HierarchyBytesError(format!("crease class {class} is unknown"))),
+                _ => Err(HierarchyBytesError(format!(
+                    "crease class {class} is unknown"
+                ))),
             })
             .collect::<Result<Vec<_>, _>>()?;
         let crease_edges = reader
@@ -171,7 +173,10 @@ impl Hierarchy {
         let non_manifold = reader.words(1, "the non-manifold vertices")?;
         let loose = reader.words(1, "the loose faces")?;
         let ms_count = u64::from_le_bytes(
-            reader.take(8, "the level times")?.try_into().unwrap_or_default(),
+            reader
+                .take(8, "the level times")?
+                .try_into()
+                .unwrap_or_default(),
         );
         let ms_bytes = usize::try_from(ms_count)
             .ok()
@@ -190,7 +195,12 @@ impl Hierarchy {
         // Every face of M0, those left out of the levels included.
         let faces = base_triangles.len();
         let six_split_volume: Vec<f32> = six_split_volume;
-        let same = [order.len(), rank.len(), target.len(), six_split_volume.len()];
+        let same = [
+            order.len(),
+            rank.len(),
+            target.len(),
+            six_split_volume.len(),
+        ];
         if base_positions.len() != vertices
             || triangles.len() > faces
             || face_order.len() != faces
@@ -202,17 +212,44 @@ impl Hierarchy {
         }
         check_ids(order.iter().copied(), vertices, None, "the order")?;
         check_ids(rank.iter().copied(), vertices, None, "the ranks")?;
-        check_ids(target.iter().copied(), vertices, Some(NEVER), "the collapse targets")?;
-        check_ids(triangles.iter().flatten().copied(), vertices, None, "the triangles")?;
-        check_ids(base_triangles.iter().flatten().copied(), vertices, None, "the base triangles")?;
+        check_ids(
+            target.iter().copied(),
+            vertices,
+            Some(NEVER),
+            "the collapse targets",
+        )?;
+        check_ids(
+            triangles.iter().flatten().copied(),
+            vertices,
+            None,
+            "the triangles",
+        )?;
+        check_ids(
+            base_triangles.iter().flatten().copied(),
+            vertices,
+            None,
+            "the base triangles",
+        )?;
         check_ids(face_order.iter().copied(), faces, None, "the face order")?;
-        check_ids(crease_edges.iter().flatten().copied(), vertices, None, "the crease edges")?;
-        check_ids(non_manifold.iter().copied(), vertices, None, "the non-manifold vertices")?;
+        check_ids(
+            crease_edges.iter().flatten().copied(),
+            vertices,
+            None,
+            "the crease edges",
+        )?;
+        check_ids(
+            non_manifold.iter().copied(),
+            vertices,
+            None,
+            "the non-manifold vertices",
+        )?;
         check_ids(loose.iter().copied(), faces, None, "the loose faces")?;
         if level_vertices.iter().any(|&n| n as usize > vertices)
             || level_faces.iter().any(|&n| n as usize > faces)
         {
-            return Err(HierarchyBytesError("a level is larger than the mesh".into()));
+            return Err(HierarchyBytesError(
+                "a level is larger than the mesh".into(),
+            ));
         }
         Ok(Hierarchy {
             base: TriMesh::new(base_positions, base_triangles),

@@ -44,8 +44,8 @@
 //! - `decimate`: the passes that remove the vertices, level by level.
 //! - `order`: M0 numbered by level from the passes' output.
 
-mod decimate;
 mod bytes;
+mod decimate;
 mod order;
 
 use crate::fairing::creases::{
@@ -54,9 +54,9 @@ use crate::fairing::creases::{
 };
 use crate::mesh::{FanRings, Topology, TriMesh};
 use crate::Progress;
+pub use bytes::HierarchyBytesError;
 use decimate::NEVER;
 use order::in_level_order;
-pub use bytes::HierarchyBytesError;
 use std::borrow::Cow;
 use std::sync::atomic::AtomicU64;
 

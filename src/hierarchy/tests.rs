@@ -374,7 +374,10 @@ fn a_hierarchy_read_back_from_its_bytes_is_the_same_hierarchy() {
     assert_eq!(back.base_mesh(), built.base_mesh());
     // Cut short, another layout, or an id out of range: an error, never a panic.
     for cut in [0, 7, 8, 100, bytes.len() / 2, bytes.len() - 1] {
-        assert!(Hierarchy::from_bytes(&bytes[..cut]).is_err(), "cut at {cut}");
+        assert!(
+            Hierarchy::from_bytes(&bytes[..cut]).is_err(),
+            "cut at {cut}"
+        );
     }
     let mut other = bytes.clone();
     other[7] = b'9';

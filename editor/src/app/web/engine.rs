@@ -392,7 +392,12 @@ fn report_from_json(json: &serde_json::Value) -> FairReport {
         },
         risk_by_round: json["risk_by_round"]
             .as_array()
-            .map(|values| values.iter().filter_map(serde_json::Value::as_f64).collect())
+            .map(|values| {
+                values
+                    .iter()
+                    .filter_map(serde_json::Value::as_f64)
+                    .collect()
+            })
             .unwrap_or_default(),
     }
 }
@@ -581,7 +586,8 @@ impl Engine {
         } else {
             if matches!(request.reply, Reply::Fair { .. }) {
                 // A newer fairing replaces the one still waiting (its ticket ends with it).
-                self.waiting.retain(|r| !matches!(r.reply, Reply::Fair { .. }));
+                self.waiting
+                    .retain(|r| !matches!(r.reply, Reply::Fair { .. }));
             }
             self.waiting.push_back(request);
         }
@@ -601,7 +607,11 @@ impl Engine {
         if !self.ensure_worker() {
             // The worker could not be started again: the request is lost, and says so.
             let kind = request.kind();
-            fail(request, kind, "no worker could be started for the job".into());
+            fail(
+                request,
+                kind,
+                "no worker could be started for the job".into(),
+            );
             return;
         }
         if let Some(state) = &request.state {
@@ -631,7 +641,11 @@ impl Engine {
             Some(Ok(())) => self.in_flight = Some(request),
             Some(Err(error)) => {
                 let kind = request.kind();
-                fail(request, kind, format!("could not post the job ({})", describe(&error)));
+                fail(
+                    request,
+                    kind,
+                    format!("could not post the job ({})", describe(&error)),
+                );
                 self.end_worker();
             }
             None => {}
