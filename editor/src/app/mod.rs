@@ -45,6 +45,7 @@
 mod appearance;
 pub mod camera;
 mod command;
+mod compute;
 mod confirm_replace;
 mod export_panel;
 mod fairing_panel;

@@ -1,21 +1,17 @@
 //! Fairing the document from the start level (or a baseline method), and the level meshes of
 //! the level view, on the compute worker: launch and result.
 
-use std::sync::{Arc, Mutex, PoisonError};
+use std::sync::Arc;
 use std::time::Duration;
 use web_time::Instant;
 
+use crate::app::compute::FairJob;
 use crate::app::generation::GenerationId;
 use crate::app::jobs::{Faired, JobKind, JobResult};
 use crate::app::state::{FairedResult, HierarchyState, ViewMode};
 use crate::app::tasks::measure::MeasureRequest;
 use crate::app::App;
-use fairmesh::fairing::{Mask, Method, MethodOptions};
-use fairmesh::multires::{self, MultiresOptions, MultiresWorkspace};
-use fairmesh::{hierarchy, metrics, Topology, TriMesh};
-
-/// Rings of vertices over which a painted mask always fades out at its edge.
-const MASK_EDGE_RINGS: usize = 3;
+use fairmesh::{hierarchy, TriMesh};
 
 impl App {
     /// Asks for what the current view mode needs at the current level and options.
@@ -224,103 +220,5 @@ impl App {
         }
         self.work.applied_level_view = view;
         current.level_mesh = Some((level, mesh));
-    }
-}
-
-/// One fairing of the document, as the compute worker runs it: taken from the app when it is
-/// asked for, so that the worker reads nothing of the app.
-pub(in crate::app) struct FairJob {
-    /// Built on the denoised mesh when `denoised`, else on the document's mesh.
-    hierarchy: Arc<hierarchy::Hierarchy>,
-    /// The document's mesh: what a baseline smooths, what a mask fades the result into, what
-    /// the result is measured against.
-    original: Arc<TriMesh>,
-    /// The hierarchy's M0 is the denoised mesh ("Remove noise first"): start level 0 is that
-    /// mesh as it is.
-    denoised: bool,
-    /// The painted mask, if any (its edge fades out over [`MASK_EDGE_RINGS`] when the job runs).
-    mask: Option<Mask>,
-    /// The document's connectivity.
-    topology: Arc<Topology>,
-    options: MultiresOptions,
-    /// The baseline method's options; `None` for the paper's method.
-    baseline: Option<MethodOptions>,
-    method: Method,
-}
-
-impl FairJob {
-    /// Fairing `original` from `level` of `hierarchy` with `settings`' options.
-    pub(in crate::app) fn new(
-        hierarchy: Arc<hierarchy::Hierarchy>,
-        original: Arc<TriMesh>,
-        denoised: bool,
-        mask: Option<Mask>,
-        topology: Arc<Topology>,
-        settings: &crate::app::state::Settings,
-        level: usize,
-    ) -> Self {
-        FairJob {
-            hierarchy,
-            original,
-            denoised,
-            mask,
-            topology,
-            options: settings.fairing.multires_options(level),
-            baseline: settings.fairing.baseline_options(),
-            method: settings.fairing.method,
-        }
-    }
-
-    /// Fairs, reporting to `progress` (which returns false to cancel): the result, or `None`
-    /// when cancelled.
-    pub(in crate::app) fn run(
-        self,
-        workspace: &Mutex<MultiresWorkspace>,
-        mut progress: impl FnMut(f32) -> bool + Send,
-    ) -> Option<Faired> {
-        let started = Instant::now();
-        let FairJob {
-            hierarchy,
-            original,
-            denoised,
-            mask,
-            topology,
-            options,
-            baseline,
-            method,
-        } = self;
-        // A few rings of fade inside the painted region's edge, whatever the brush left: where
-        // the brush stopped at a silhouette the mask drops from 1 to 0 at once, and the
-        // result would show a step there.
-        let mask = mask.map(|mask| mask.with_falloff(&topology, MASK_EDGE_RINGS));
-        let mut positions = match &baseline {
-            // A baseline smooths the document's mesh itself; the level does not apply.
-            Some(method) => {
-                let mut mesh = original.as_ref().clone();
-                fairmesh::fairing::fair(&mut mesh, &topology, method);
-                progress(1.0).then_some(mesh.positions)?
-            }
-            // Start level 0 of a hierarchy built on the denoised mesh: that mesh.
-            None if denoised && options.start_level == 0 => {
-                progress(1.0).then(|| hierarchy.base_mesh().positions.clone())?
-            }
-            None => {
-                let mut workspace = workspace.lock().unwrap_or_else(PoisonError::into_inner);
-                multires::fair_multires(&hierarchy, &options, &mut workspace, &mut progress).ok()?
-            }
-        };
-        // The mask fades the result into the document's mesh (not into the denoised one the
-        // levels start from): unpainted vertices keep their positions exactly.
-        if let Some(mask) = mask.filter(|mask| mask.check_fits(positions.len()).is_ok()) {
-            mask.blend(&original.positions, &mut positions);
-        }
-        let (volume_change, rms_displacement) = metrics::change_of_positions(&original, &positions);
-        Some(Faired {
-            positions,
-            volume_change,
-            rms_displacement,
-            elapsed: started.elapsed(),
-            method,
-        })
     }
 }

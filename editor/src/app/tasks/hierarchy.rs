@@ -3,83 +3,14 @@
 
 use std::sync::atomic::Ordering;
 use std::sync::{Arc, PoisonError};
-use web_time::Instant;
 
+use crate::app::compute::denoise_and_build;
 use crate::app::generation::GenerationId;
 use crate::app::jobs::{JobKind, JobResult};
-use crate::app::sharp_edges::SharpEdgeLines;
-use crate::app::state::{DenoiseSummary, HierarchyState, KeptHierarchy};
+use crate::app::state::{HierarchyState, KeptHierarchy};
 use crate::app::App;
-use fairmesh::hierarchy::{self, HierarchyError, HierarchyOptions};
-use fairmesh::multires::denoise;
-use fairmesh::{Topology, TriMesh};
-
-/// Builds the hierarchy on `built_on` (the denoised mesh, or the document's own `mesh`), whose
-/// triangles and `topology` are `mesh`'s: the hierarchy, whether its M0 has `mesh`'s triangles,
-/// and its sharp edges as lines to draw.
-fn build_on(
-    built_on: &TriMesh,
-    mesh: &TriMesh,
-    topology: &Topology,
-    options: &HierarchyOptions,
-    progress: &mut dyn fairmesh::Progress,
-) -> Result<(Arc<hierarchy::Hierarchy>, bool, Arc<SharpEdgeLines>), HierarchyError> {
-    let built = hierarchy::build_hierarchy_with_topology(built_on, topology, options, progress)?;
-    // Compared here, not on the UI thread (millions of triangles).
-    let matches = built.base_mesh().triangles == mesh.triangles;
-    let sharp_edges = if matches {
-        SharpEdgeLines::new(mesh, built.crease_edges())
-    } else {
-        SharpEdgeLines::default()
-    };
-    Ok((Arc::new(built), matches, Arc::new(sharp_edges)))
-}
-
-/// Denoises `mesh` (as `denoise_options` ask) and builds the hierarchy on the result, keeping the
-/// file's own sharp edges (`source`'s) when sharp edges are kept, as `fairmesh fair` keeps them.
-/// Both stages report to `progress` (false cancels); `denoised` is told when the denoise is done.
-pub(in crate::app) fn denoise_and_build(
-    mesh: &TriMesh,
-    topology: &Topology,
-    mut options: HierarchyOptions,
-    mut denoise_options: fairmesh::multires::DenoiseOptions,
-    file_edges: &dyn Fn(&TriMesh) -> Vec<[u32; 2]>,
-    progress: &mut dyn fairmesh::Progress,
-    denoised_done: &mut dyn FnMut(),
-) -> Result<KeptHierarchy, HierarchyError> {
-    let started = Instant::now();
-    let file_edges = if options.creases.is_some() {
-        file_edges(mesh)
-    } else {
-        Vec::new()
-    };
-    if let Some(creases) = &mut options.creases {
-        *creases = creases.clone().with_file_edges(file_edges.clone());
-    }
-    if let Some(creases) = &mut denoise_options.creases {
-        *creases = creases.clone().with_file_edges(file_edges);
-    }
-    match denoise(mesh, topology, &denoise_options, progress) {
-        Err(fairmesh::Cancelled) => Err(HierarchyError::Cancelled),
-        Ok(denoised) => {
-            let denoise = denoised.as_ref().map(|d| DenoiseSummary {
-                report: d.report.clone(),
-                time: started.elapsed(),
-            });
-            denoised_done();
-            let built_on = denoised.as_ref().map_or(mesh, |d| &d.mesh);
-            build_on(built_on, mesh, topology, &options, progress).map(
-                |(hierarchy, base_matches_original, sharp_edges)| KeptHierarchy {
-                    hierarchy,
-                    build_time: started.elapsed(),
-                    base_matches_original,
-                    sharp_edges,
-                    denoise,
-                },
-            )
-        }
-    }
-}
+use fairmesh::hierarchy::{self, HierarchyError};
+use fairmesh::TriMesh;
 
 impl App {
     /// Denoises the document's mesh ([`fairmesh::multires::denoise`], as the settings ask) and

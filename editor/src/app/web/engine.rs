@@ -34,12 +34,12 @@ use wasm_bindgen::closure::Closure;
 use wasm_bindgen::prelude::*;
 use wasm_bindgen::JsCast;
 
+use crate::app::compute::denoise_and_build;
+use crate::app::compute::FairJob;
 use crate::app::generation::{Generation, GenerationId};
 use crate::app::jobs::{Faired, JobKind, JobResult, JobTicket, SharedProgress};
 use crate::app::sharp_edges::SharpEdgeLines;
 use crate::app::state::{DenoiseSummary, KeptHierarchy, Settings};
-use crate::app::tasks::fairing::FairJob;
-use crate::app::tasks::hierarchy::denoise_and_build;
 
 /// The engine's script, beside the page (`web/fairmesh_worker.js`).
 const WORKER_SCRIPT: &str = "./fairmesh_worker.js";
