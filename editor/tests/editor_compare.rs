@@ -297,6 +297,21 @@ fn heat_map_colours_by_distance_and_shows_a_legend() {
     let [pr, _, pb] = mesh_colour(&plain, 0, plain.width());
     assert!(pr > pb && b > r, "plain {pr}/{pb}, heat {r}/{b}");
 
+    // The input mesh against itself: every distance is 0, and the legend says so instead of
+    // drawing a scale up to the least positive float.
+    harness.get_by_label("Input mesh").click();
+    harness.step();
+    harness.get_by_label("input mesh").click();
+    settle(&mut harness);
+    assert_eq!(harness.state().heat_map_top(), Some(f32::MIN_POSITIVE));
+    harness.get_by_label("Distance to the input mesh (model units)");
+    harness.get_by_label("0 everywhere: the two meshes are the same");
+    assert!(harness.query_by_label("0").is_none(), "no ticks");
+    harness.get_by_label("Faired").click();
+    harness.step();
+    harness.get_by_label("clean mesh").click();
+    settle(&mut harness);
+
     // H switches it off again.
     harness.key_press(egui::Key::H);
     harness.step();

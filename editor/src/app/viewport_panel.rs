@@ -290,6 +290,16 @@ fn heat_legend(ui: &mut egui::Ui, viewport: egui::Rect, top: f32, reference: Hea
                         .small()
                         .color(egui::Color32::WHITE),
                 );
+                // Every distance is zero (the top is clamped to the least positive float): a
+                // scale of 1e-38 would read as a measurement.
+                if top <= f32::MIN_POSITIVE {
+                    ui.label(
+                        egui::RichText::new("0 everywhere: the two meshes are the same")
+                            .small()
+                            .color(egui::Color32::WHITE),
+                    );
+                    return;
+                }
                 let (strip, _) =
                     ui.allocate_exact_size(egui::vec2(WIDTH, 14.0), egui::Sense::hover());
                 let colours = viridis_strip(64);
