@@ -497,6 +497,16 @@ thread_local! {
     static ENGINE: RefCell<Engine> = RefCell::new(Engine::default());
 }
 
+/// A job's message to the worker: its kind and the settings as JSON; `None` when the settings
+/// do not come back from JSON exactly (the job then runs on the page).
+fn job_message(kind: &str, settings: &Settings) -> Option<js_sys::Object> {
+    let settings = settings_json(settings)?;
+    let message = js_sys::Object::new();
+    set(&message, "kind", kind);
+    set(&message, "settings", settings);
+    Some(message)
+}
+
 /// The settings as JSON, if they come back from it exactly (else the job runs on the page).
 fn settings_json(settings: &Settings) -> Option<String> {
     let json = serde_json::to_string(settings).ok()?;
@@ -822,15 +832,13 @@ pub(in crate::app) struct HierarchyPost {
     pub(in crate::app) denoising: Arc<AtomicBool>,
 }
 
-/// Denoises and builds the hierarchy in the worker; false (nothing sent, `sending` given back)
-/// when there is no worker, and the caller runs the job on the page.
+/// Denoises and builds the hierarchy in the worker; `Err` (nothing sent, `sending` given back)
+/// when there is no worker or the settings cannot go to it, and the caller runs the job on the
+/// page.
 pub(in crate::app) fn post_hierarchy(post: HierarchyPost, sending: Sending) -> Result<(), Sending> {
-    let Some(settings) = settings_json(&post.settings) else {
+    let Some(message) = job_message("hierarchy", &post.settings) else {
         return Err(sending);
     };
-    let message = js_sys::Object::new();
-    set(&message, "kind", "hierarchy");
-    set(&message, "settings", settings);
     let positions = flat_positions(&post.mesh.positions);
     let triangles = flat_triangles(&post.mesh.triangles);
     let edges: Vec<u32> = post.file_edges.iter().flatten().copied().collect();
@@ -874,12 +882,9 @@ pub(in crate::app) struct FairPost {
 
 /// Fairs from a level in the worker (see [`post_hierarchy`] for the error).
 pub(in crate::app) fn post_fair(post: FairPost, sending: Sending) -> Result<(), Sending> {
-    let Some(settings) = settings_json(&post.settings) else {
+    let Some(message) = job_message("fair", &post.settings) else {
         return Err(sending);
     };
-    let message = js_sys::Object::new();
-    set(&message, "kind", "fair");
-    set(&message, "settings", settings);
     set(&message, "level", post.level as f64);
     let transfer = js_sys::Array::new();
     if let Some(mask) = &post.mask {
