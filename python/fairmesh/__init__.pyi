@@ -291,6 +291,7 @@ def hierarchy(
     min_vertices: int = 100,
     max_levels: int = 64,
     keep_boundary: bool = False,
+    keep_orientation: bool = True,
     keep_creases: bool = False,
     crease_angle: Optional[float] = None,
     hard_edges: Optional[npt.ArrayLike] = None,
@@ -308,6 +309,7 @@ def hierarchy(
     min_vertices: int = 100,
     max_levels: int = 64,
     keep_boundary: bool = False,
+    keep_orientation: bool = True,
     keep_creases: bool = False,
     crease_angle: Optional[float] = None,
     hard_edges: Optional[npt.ArrayLike] = None,
@@ -329,6 +331,11 @@ def hierarchy(
     - ``max_levels`` (64): at most this many levels above level 0.
     - ``keep_boundary``: boundary vertices never collapse (the outline stays exact on every
       level).
+    - ``keep_orientation`` (True): no collapse may leave a face pointing away from the input
+      surface it stands for, or two faces folded over each other; False builds the paper's
+      hierarchy, whose check looks only at the level being collapsed (with
+      ``multires(level, variant="paper", fair_finest=False)`` on an undenoised hierarchy without
+      creases, the paper's recipe exactly).
     - ``keep_creases``: sharp creases (found at ``crease_angle``, 40 degrees unless given; the
       file's own sharp edges too for a loaded ``Mesh``) stay on every level: a crease vertex
       collapses only along its crease and corners never do. Giving ``crease_angle`` implies it.

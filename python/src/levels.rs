@@ -175,8 +175,8 @@ impl Hierarchy {
 #[pyfunction]
 #[pyo3(signature = (
     vertices, faces=None, *, alpha=1.0, beta=0.01, min_vertices=100, max_levels=64,
-    keep_boundary=false, keep_creases=false, crease_angle=None, hard_edges=None, denoise=None,
-    progress=None, threads=None
+    keep_boundary=false, keep_orientation=true, keep_creases=false, crease_angle=None,
+    hard_edges=None, denoise=None, progress=None, threads=None
 ), text_signature = None)]
 #[allow(clippy::too_many_arguments)]
 pub fn hierarchy(
@@ -188,6 +188,7 @@ pub fn hierarchy(
     min_vertices: i64,
     max_levels: i64,
     keep_boundary: bool,
+    keep_orientation: bool,
     keep_creases: bool,
     crease_angle: Option<f64>,
     hard_edges: Option<&Bound<'_, PyAny>>,
@@ -207,6 +208,7 @@ pub fn hierarchy(
         .with_min_vertices(options::count("min_vertices", min_vertices)?)
         .with_max_levels(options::count("max_levels", max_levels)?)
         .with_keep_boundary(keep_boundary)
+        .with_keep_orientation(keep_orientation)
         .with_creases(
             (keep_creases || crease_angle.is_some() || hard_edges.is_some()).then(|| {
                 CreaseOptions::default()

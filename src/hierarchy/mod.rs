@@ -85,6 +85,12 @@ pub struct HierarchyOptions {
     /// leaves them out; they stay in M0 ([`Hierarchy::loose_triangles`]). Otherwise their
     /// corners, being non-manifold, stay in every level with their neighbours.
     pub leave_out_loose_triangles: bool,
+    /// Refuse a collapse that would turn a face of the coarser level against M0: a face whose
+    /// normal points away from the sum of M0's vertex normals at its corners, or that folds over
+    /// a neighbouring face of the collapse's fan (their normals more than 150° apart). Not in the
+    /// paper, whose check looks only at the level being collapsed; off, the hierarchy is the
+    /// paper's (the multiresolution recipe to the letter needs it off).
+    pub keep_orientation: bool,
     /// How a level is cut into regions visited in parallel (tests make them small).
     regions: decimate::RegionSize,
 }
@@ -97,6 +103,7 @@ with_setters!(HierarchyOptions {
     with_keep_boundary => keep_boundary: bool,
     with_creases => creases: Option<CreaseOptions>,
     with_leave_out_loose_triangles => leave_out_loose_triangles: bool,
+    with_keep_orientation => keep_orientation: bool,
 });
 
 impl Default for HierarchyOptions {
@@ -109,6 +116,7 @@ impl Default for HierarchyOptions {
             keep_boundary: false,
             creases: None,
             leave_out_loose_triangles: true,
+            keep_orientation: true,
             regions: decimate::RegionSize::DEFAULT,
         }
     }

@@ -28,9 +28,10 @@ use super::hierarchy::{build_with, check_crease_angle, levels_phrase, print_note
 
 #[derive(Clone, Copy, Debug, ValueEnum, PartialEq, Eq)]
 pub enum VariantArg {
-    /// The paper's section 4.2 and nothing else: split vertices at their 1-ring mean plus one
-    /// Kobbelt step, no unfolding. With --denoise off --no-creases --fair-finest false it is the
-    /// paper's recipe exactly.
+    /// The paper's section 4 and nothing else: its hierarchy (each collapse checked against its
+    /// own level only, unless the improved variant is asked for too), split vertices at their
+    /// 1-ring mean plus one Kobbelt step, no unfolding. With --denoise off --no-creases
+    /// --fair-finest false it is the paper's recipe exactly.
     Paper,
     /// Kobbelt placement plus a low-passed volume restoration, each level's shrinkage taken back,
     /// and the edges a run leaves folded unfolded (see the multires module docs).
@@ -119,9 +120,11 @@ fn parse_denoise(text: &str) -> Result<Denoise, String> {
 
 impl MultiresArgs {
     /// The hierarchy's options: those of `fairmesh hierarchy`, with sharp edges kept unless
-    /// --no-creases.
+    /// --no-creases, and the paper's hierarchy (no check of collapses against M0) when only the
+    /// paper's variant is asked for.
     fn hierarchy_options(&self) -> HierarchyOptions {
-        let options = self.build.options();
+        let paper_only = self.variant.iter().all(|&v| v == VariantArg::Paper);
+        let options = self.build.options().with_keep_orientation(!paper_only);
         if self.no_creases || options.creases.is_some() {
             return options;
         }

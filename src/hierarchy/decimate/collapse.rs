@@ -74,6 +74,8 @@ pub(super) struct PassView<'a> {
     open: &'a [bool],
     /// Per M0 id, empty when nothing is pinned.
     pinned: &'a [bool],
+    /// M0's vertex normals by M0 id; empty when collapses may turn faces against them.
+    m0_normals: &'a [[f32; 3]],
     keep_boundary: bool,
     mark: &'a [AtomicU32],
     absorbed_head: &'a [AtomicU32],
@@ -86,6 +88,7 @@ impl<'a> PassView<'a> {
         level: &'a Level,
         state: &'a PassState,
         pinned: &'a [bool],
+        m0_normals: &'a [[f32; 3]],
         keep_boundary: bool,
     ) -> Self {
         PassView {
@@ -95,6 +98,7 @@ impl<'a> PassView<'a> {
             fans: &state.fans,
             open: &state.open,
             pinned,
+            m0_normals,
             keep_boundary,
             mark: &state.mark,
             absorbed_head: &state.absorbed_head,
@@ -153,6 +157,10 @@ pub(super) struct Scratch {
     positions: Vec<[DVec3; 2]>,
     /// The normal (x_a - x_v) x (x_b - x_v) of each of those faces.
     normals: Vec<DVec3>,
+    /// The faces `(k, a, b)` a candidate collapse leaves, with their normals.
+    after: Vec<([u32; 2], DVec3)>,
+    /// Those and `k`'s other faces: `k`'s one-ring after the collapse.
+    ring: Vec<([u32; 2], DVec3)>,
     /// `(|cone|, k, signed cone)`.
     candidates: Vec<(f64, u32, f64)>,
     /// Scratch space of `in_cost_order`.
@@ -238,6 +246,7 @@ pub(super) fn choose_collapse(
         let xk = p(k) - xv;
         // No surviving face may flip or degenerate.
         let mut opposite = [NEVER; 2];
+        scratch.after.clear();
         for ((&[a, b], &[xa, xb]), &old) in fan.iter().zip(&scratch.positions).zip(&scratch.normals)
         {
             if a == k {
@@ -252,6 +261,12 @@ pub(super) fn choose_collapse(
             if old.dot(new) <= 0.0 {
                 continue 'candidate;
             }
+            scratch.after.push(([a, b], new));
+        }
+        if !view.m0_normals.is_empty()
+            && turns_against_m0(v, k, &scratch.after, &mut scratch.ring, view)
+        {
+            continue;
         }
         // Link condition: apart from the opposite vertices, no neighbour of v may be one of k.
         let neighbors = &scratch.neighbors;
@@ -287,4 +302,61 @@ pub(super) fn choose_collapse(
         return Some((k, cone));
     }
     None
+}
+
+/// Whether one of the faces `(k, a, b)` a collapse `v -> k` leaves (`after`, with their
+/// normals) turns against M0, its normal pointing away from the sum of M0's vertex normals at
+/// its three corners, or folds over a neighbour (normals more than 150° apart): across `k-a` and
+/// `k-b`, another face of `after` or one of `k`'s own; across `a-b`, the face there, which the
+/// collapse does not change. The orientation test, which is cheap, goes first for every face.
+fn turns_against_m0(
+    v: u32,
+    k: u32,
+    after: &[([u32; 2], DVec3)],
+    ring: &mut Vec<([u32; 2], DVec3)>,
+    view: &PassView,
+) -> bool {
+    let m0 = |c: u32| {
+        let n = view.m0_normals[view.vertex_id[c as usize] as usize];
+        DVec3::new(n[0] as f64, n[1] as f64, n[2] as f64)
+    };
+    let p = |c: u32| point(view.points, c);
+    let (xk, at_k) = (p(k), m0(k));
+    if after
+        .iter()
+        .any(|&([a, b], new)| new.dot(at_k + m0(a) + m0(b)) <= 0.0)
+    {
+        return true;
+    }
+    // cos 150°: two faces whose unit normals' dot product is below this fold over each other.
+    const FOLD_COS: f64 = -0.866_025_403_784_438_6;
+    let folds = |x: DVec3, y: DVec3| x.dot(y) < FOLD_COS * x.length() * y.length();
+    // k's one-ring after the collapse: `after`, and k's own faces but those with `v`, which go.
+    ring.clear();
+    ring.extend_from_slice(after);
+    view.for_each_face_of(k, |x, y| {
+        if x != v && y != v {
+            ring.push(([x, y], (p(x) - xk).cross(p(y) - xk)));
+        }
+    });
+    after.iter().any(|&([a, b], new)| {
+        // Across k-a a face (k, x, a), across k-b a face (k, b, y).
+        if ring
+            .iter()
+            .any(|&([x, y], normal)| (y == a || x == b) && folds(new, normal))
+        {
+            return true;
+        }
+        // The face across a-b is (a, c, b) as a face of `a`.
+        let mut across = NEVER;
+        view.for_each_face_of(a, |x, y| {
+            if y == b {
+                across = x;
+            }
+        });
+        across != NEVER && {
+            let xa = p(a);
+            folds(new, (p(across) - xa).cross(p(b) - xa))
+        }
+    })
 }

@@ -273,6 +273,15 @@ fn passes(
     let start_vertices = level.points.len() as f64;
     let goal = (start_vertices - options.min_vertices as f64).max(1.0);
     let mut vertex_count = n;
+    // M0's area-weighted vertex normals by M0 id, when no collapse may turn a face against them.
+    let m0_normals: Vec<[f32; 3]> = if options.keep_orientation {
+        mesh.vertex_normals()
+            .iter()
+            .map(|n| n.as_vec3().to_array())
+            .collect()
+    } else {
+        Vec::new()
+    };
 
     for pass in 0..options.max_levels.max(1) as u32 {
         // Pass 0 always builds its fans, to check the input.
@@ -320,6 +329,7 @@ fn passes(
             &mut level,
             &mut state,
             &pinned,
+            &m0_normals,
             options,
             budget,
             &mut |removed| {
@@ -457,6 +467,7 @@ fn visit_level(
     level: &mut Level,
     state: &mut PassState,
     pinned: &[bool],
+    m0_normals: &[[f32; 3]],
     options: &HierarchyOptions,
     budget: usize,
     report: &mut dyn FnMut(usize) -> bool,
@@ -472,7 +483,7 @@ fn visit_level(
     if let Some(size) = options.regions.for_level(n) {
         two_ring_reach(state);
         for offset in [0, size / 2] {
-            let view = PassView::new(level, state, pinned, options.keep_boundary);
+            let view = PassView::new(level, state, pinned, m0_normals, options.keep_boundary);
             let region_count = (n + offset).div_ceil(size);
             let range =
                 |r: usize| (r * size).saturating_sub(offset)..((r + 1) * size - offset).min(n);
@@ -520,7 +531,7 @@ fn visit_level(
     let mut order = Vec::new();
     let rest = (0..n).filter(|&v| !state.visited[v]);
     in_cost_order(rest, state, level, &mut order, &mut Vec::new());
-    let view = PassView::new(level, state, pinned, options.keep_boundary);
+    let view = PassView::new(level, state, pinned, m0_normals, options.keep_boundary);
     let mut scratch = Scratch::default();
     for (visits, &v) in order.iter().enumerate() {
         if visits % REPORT_EVERY == REPORT_EVERY - 1 && !report(removals.len()) {
