@@ -160,12 +160,19 @@ struct FoldState<'a> {
     folds: &'a mut FoldEdges,
     turned: Vec<bool>,
     folded: Vec<bool>,
-    /// The faces and edges that may be turned or folded now: all that were at the full pass and
-    /// every one looked at since (`watched_*` flag them).
+    /// The faces and edges that may be turned or folded now: those that were at the full pass or
+    /// at the last [`Self::corners`], and every one looked at since (`watched_*` flag them).
     faces: Vec<u32>,
     edges: Vec<u32>,
     watched_faces: Vec<bool>,
     watched_edges: Vec<bool>,
+    /// [`Self::moved`]'s marks of the faces and edges it has looked at in this call (`stamp`),
+    /// and its buffers of those faces and their normals.
+    face_stamps: Vec<u32>,
+    edge_stamps: Vec<u32>,
+    stamp: u32,
+    touched: Vec<u32>,
+    touched_normals: Vec<Vec3A>,
 }
 
 impl<'a> FoldState<'a> {
@@ -213,61 +220,99 @@ impl<'a> FoldState<'a> {
             folded,
             faces,
             edges,
+            face_stamps: vec![0; watched_faces.len()],
+            edge_stamps: vec![0; watched_edges.len()],
+            stamp: 0,
+            touched: Vec::new(),
+            touched_normals: Vec::new(),
             watched_faces,
             watched_edges,
         }
     }
 
-    /// The faces around `moved` and their edges looked at again.
+    /// The faces around `moved` and their edges looked at again, each once however many of its
+    /// corners moved (a face has three, an edge is on two faces): the normals in parallel.
     fn moved(&mut self, positions: &[[f32; 3]], moved: &[u32]) {
+        self.stamp = self.stamp.wrapping_add(1);
+        if self.stamp == 0 {
+            self.face_stamps.fill(0);
+            self.edge_stamps.fill(0);
+            self.stamp = 1;
+        }
+        let stamp = self.stamp;
+        let mut faces = std::mem::take(&mut self.touched);
+        faces.clear();
         for &v in moved {
             for &f in self.topology.faces_of(v) {
-                let n = face_normal(positions, self.triangles, f);
-                self.folds.normals[f as usize] = n;
-                self.turned[f as usize] = n.dot(self.folds.m0_normals[f as usize]) < 0.0;
-                if !self.watched_faces[f as usize] {
-                    self.watched_faces[f as usize] = true;
-                    self.faces.push(f);
+                if self.face_stamps[f as usize] != stamp {
+                    self.face_stamps[f as usize] = stamp;
+                    faces.push(f);
                 }
             }
         }
-        for &v in moved {
-            for &f in self.topology.faces_of(v) {
-                for e in self.folds.face_edges[f as usize] {
-                    if e == NONE {
-                        continue;
-                    }
-                    let [_, _, f, g] = self.folds.edges[e as usize];
-                    let normals = &self.folds.normals;
-                    self.folded[e as usize] = !self.folds.reference[e as usize]
-                        && normals[f as usize].dot(normals[g as usize]) < 0.0;
-                    if !self.watched_edges[e as usize] {
-                        self.watched_edges[e as usize] = true;
-                        self.edges.push(e);
-                    }
+        let triangles = self.triangles;
+        let mut normals = std::mem::take(&mut self.touched_normals);
+        faces
+            .par_iter()
+            .with_min_len(super::PARALLEL_GRAIN)
+            .map(|&f| face_normal(positions, triangles, f))
+            .collect_into_vec(&mut normals);
+        for (&f, &n) in faces.iter().zip(&normals) {
+            self.folds.normals[f as usize] = n;
+            self.turned[f as usize] = n.dot(self.folds.m0_normals[f as usize]) < 0.0;
+            if !self.watched_faces[f as usize] {
+                self.watched_faces[f as usize] = true;
+                self.faces.push(f);
+            }
+        }
+        for &f in &faces {
+            for e in self.folds.face_edges[f as usize] {
+                if e == NONE || self.edge_stamps[e as usize] == stamp {
+                    continue;
+                }
+                self.edge_stamps[e as usize] = stamp;
+                let [_, _, f, g] = self.folds.edges[e as usize];
+                let normals = &self.folds.normals;
+                self.folded[e as usize] = !self.folds.reference[e as usize]
+                    && normals[f as usize].dot(normals[g as usize]) < 0.0;
+                if !self.watched_edges[e as usize] {
+                    self.watched_edges[e as usize] = true;
+                    self.edges.push(e);
                 }
             }
         }
+        self.touched = faces;
+        self.touched_normals = normals;
     }
 
     /// The corners of every face turned and every edge folded now (repeats possible); empty
-    /// when there is none.
-    fn corners(&self) -> Vec<u32> {
+    /// when there is none. The faces and edges no longer turned or folded leave the watched
+    /// lists (only a move of one of their corners can turn them again, and [`Self::moved`]
+    /// watches them then), so that the repeated calls of a run cost what is still folded.
+    fn corners(&mut self) -> Vec<u32> {
         let mut corners = Vec::new();
+        let (turned, watched_faces) = (&self.turned, &mut self.watched_faces);
+        self.faces.retain(|&f| {
+            let keep = turned[f as usize];
+            watched_faces[f as usize] = keep;
+            keep
+        });
         for &f in &self.faces {
-            if self.turned[f as usize] {
-                corners.extend(self.triangles[f as usize]);
-            }
+            corners.extend(self.triangles[f as usize]);
         }
+        let (folded, watched_edges) = (&self.folded, &mut self.watched_edges);
+        self.edges.retain(|&e| {
+            let keep = folded[e as usize];
+            watched_edges[e as usize] = keep;
+            keep
+        });
         for &e in &self.edges {
-            if self.folded[e as usize] {
-                let [a, b, f, g] = self.folds.edges[e as usize];
-                let third = |face: u32| {
-                    let t = self.triangles[face as usize];
-                    t[0] ^ t[1] ^ t[2] ^ a ^ b
-                };
-                corners.extend([a, b, third(f), third(g)]);
-            }
+            let [a, b, f, g] = self.folds.edges[e as usize];
+            let third = |face: u32| {
+                let t = self.triangles[face as usize];
+                t[0] ^ t[1] ^ t[2] ^ a ^ b
+            };
+            corners.extend([a, b, third(f), third(g)]);
         }
         corners
     }
@@ -368,7 +413,8 @@ pub(super) fn unfold(positions: &mut [[f32; 3]], level: &Level, folds: &mut Fold
             }
             for _ in 0..SWEEPS {
                 let means: Vec<[f32; 3]> = region
-                    .iter()
+                    .par_iter()
+                    .with_min_len(super::PARALLEL_GRAIN)
                     .map(|&v| {
                         if back[v as usize] {
                             return positions[v as usize];
