@@ -94,7 +94,10 @@ fn local_name(uri: &str) -> String {
 pub fn open_url(url: String) {
     wasm_bindgen_futures::spawn_local(async move {
         match fetch_with_companions(&url).await {
-            Ok(files) => open_files(files, "the fetched files"),
+            Ok(files) => {
+                super::mark("fairmesh_fetched");
+                open_files(files, "the fetched files");
+            }
             Err(error) => push(WebEvent::Failed(error)),
         }
     });
