@@ -63,6 +63,7 @@ pub fn start() {
                 canvas,
                 options,
                 Box::new(move |cc| {
+                    web::mark("fairmesh_runner_ready");
                     web::listen_to_file_input();
                     let app = App::with_options(
                         cc,

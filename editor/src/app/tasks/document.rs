@@ -1,5 +1,6 @@
 //! Changes of the document as a whole, each undoable: installing a snapshot (a loaded file, undo,
-//! redo), adding noise (on the io worker) and applying a result.
+//! redo), adding noise (on the io worker; in a page, in the engine's worker) and applying a
+//! result.
 
 use std::sync::Arc;
 
@@ -83,6 +84,24 @@ impl App {
             self.ctx.clone(),
             self.workers.jobs.start(),
         );
+        // In a page the noise is added (and measured) in the engine's worker, so that the page
+        // goes on answering.
+        #[cfg(target_arch = "wasm32")]
+        let (tx, ctx, ticket, label) = {
+            use crate::app::web::engine::{post_noise, NoisePost, Sending};
+            let post = NoisePost {
+                settings: self.settings.clone(),
+                label: label.clone(),
+                mesh: mesh.clone(),
+                clean: clean.clone(),
+                document,
+                document_generation: document_generation.clone(),
+            };
+            match post_noise(post, Sending { tx, ctx, ticket }) {
+                Ok(()) => return,
+                Err(back) => (back.tx, back.ctx, back.ticket, label),
+            }
+        };
         self.workers.io.submit(JobKind::Noise, move || {
             if !document_generation.is_current(document) {
                 return;

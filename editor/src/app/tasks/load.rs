@@ -168,6 +168,8 @@ impl App {
             return;
         }
         let requested = self.work.loading.take();
+        #[cfg(target_arch = "wasm32")]
+        crate::app::web::mark("fairmesh_loaded");
         match result {
             Ok(loaded) => {
                 if let Some(requested) = requested {

@@ -1,6 +1,6 @@
 //! Measuring a faired result against the input and clean meshes (surface distances, on the
-//! measuring worker and its own one-thread pool), once the result has rested on screen: launch
-//! and result.
+//! measuring worker and its own one-thread pool; in a page, in the engine's worker), once the
+//! result has rested on screen: launch and result.
 
 use std::sync::Arc;
 use std::time::Duration;
@@ -79,6 +79,24 @@ impl App {
             self.ctx.clone(),
             self.workers.jobs.start(),
         );
+        // In a page the measuring runs in the engine's worker, so that the page goes on
+        // answering.
+        #[cfg(target_arch = "wasm32")]
+        let (tx, ctx, ticket) = {
+            use crate::app::web::engine::{post_measure, MeasurePost, Sending};
+            let post = MeasurePost {
+                document,
+                document_generation: document_generation.clone(),
+                serial,
+                positions: positions.clone(),
+                base: base.clone(),
+                clean: clean.clone(),
+            };
+            match post_measure(post, Sending { tx, ctx, ticket }) {
+                Ok(()) => return,
+                Err(back) => (back.tx, back.ctx, back.ticket),
+            }
+        };
         self.workers
             .measure
             .submit_latest(JobKind::Measure, move || {

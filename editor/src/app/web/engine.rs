@@ -2,10 +2,12 @@
 //! an engine that keeps the document's mesh, the hierarchy it built and the fairing workspace,
 //! so that the page answers while the hierarchy is built or a level is faired.
 //!
-//! - The page side ([`post_hierarchy`], [`post_fair`], [`post_prepare`], [`tick`]) sends one
-//!   request at a time, as a message of typed arrays (positions, triangles, a mask) and the
-//!   settings as JSON; the others wait in order (a fairing replaces the fairing still waiting, as
-//!   on the desktop's compute thread; setting up the levels waits for everything else). Answers
+//! - The page side ([`post_hierarchy`], [`post_fair`], [`post_prepare`], [`post_noise`],
+//!   [`post_measure`], [`tick`]) sends one request at a time, as a message of typed arrays
+//!   (positions, triangles, a mask) and the settings as JSON; the others wait in order (a fairing
+//!   replaces the fairing still waiting, as on the desktop's compute thread, and a measuring the
+//!   measuring still waiting, as on its measuring thread; a measuring lets the other requests go
+//!   first, and setting up the levels waits for everything else). Answers
 //!   come back with their arrays transferred, not copied, and become the same [`JobResult`]s the
 //!   desktop's threads send, with the same progress.
 //! - The engine keeps what it built: a slider step sends the level and the settings only. When
@@ -39,7 +41,7 @@ use crate::app::compute::FairJob;
 use crate::app::generation::{Generation, GenerationId};
 use crate::app::jobs::{Faired, JobKind, JobResult, JobTicket, SharedProgress};
 use crate::app::sharp_edges::SharpEdgeLines;
-use crate::app::state::{DenoiseSummary, KeptHierarchy, Settings};
+use crate::app::state::{DenoiseSummary, KeptHierarchy, Measures, Settings};
 
 /// The engine's script, beside the page (`web/fairmesh_worker.js`).
 const WORKER_SCRIPT: &str = "./fairmesh_worker.js";
@@ -108,6 +110,66 @@ fn words_from(value: &JsValue) -> Vec<u32> {
         .dyn_ref::<js_sys::Uint32Array>()
         .map(js_sys::Uint32Array::to_vec)
         .unwrap_or_default()
+}
+
+/// The mesh of a request's `{prefix}positions` and `{prefix}triangles`, if it has them.
+fn mesh_from(message: &JsValue, prefix: &str) -> Option<TriMesh> {
+    let positions = get(message, &format!("{prefix}positions"));
+    if positions.is_undefined() {
+        return None;
+    }
+    let triangles = words_from(&get(message, &format!("{prefix}triangles")))
+        .chunks_exact(3)
+        .map(|t| [t[0], t[1], t[2]])
+        .collect();
+    Some(TriMesh::new(positions_from(&positions), triangles))
+}
+
+/// Sets `{prefix}positions` and `{prefix}triangles` on `message` to `mesh`'s, transferred.
+fn set_mesh(message: &js_sys::Object, transfer: &js_sys::Array, prefix: &str, mesh: &TriMesh) {
+    let positions = flat_positions(&mesh.positions);
+    let triangles = flat_triangles(&mesh.triangles);
+    transfer.push(&positions.buffer());
+    transfer.push(&triangles.buffer());
+    set(message, &format!("{prefix}positions"), positions);
+    set(message, &format!("{prefix}triangles"), triangles);
+}
+
+/// A result's measures as a message's object (the heat map's distances transferred).
+fn measures_to_js(measures: &Measures, transfer: &js_sys::Array) -> js_sys::Object {
+    let object = js_sys::Object::new();
+    let optional = |value: Option<f64>| value.map_or(JsValue::UNDEFINED, JsValue::from);
+    set(
+        &object,
+        "volume_change_percent",
+        optional(measures.volume_change_percent),
+    );
+    set(&object, "mean_distance", measures.mean_distance);
+    set(&object, "max_distance", measures.max_distance);
+    set(&object, "vertex_rms", optional(measures.vertex_rms));
+    set(&object, "barycenter_drift", optional(measures.barycenter_drift));
+    let distances = js_sys::Float32Array::from(measures.vertex_distances.as_slice());
+    transfer.push(&distances.buffer());
+    set(&object, "vertex_distances", distances);
+    object
+}
+
+/// The measures [`measures_to_js`] sent, if `value` holds them for `vertices` vertices.
+fn measures_from_js(value: &JsValue, vertices: usize) -> Option<Measures> {
+    let distances = get(value, "vertex_distances")
+        .dyn_ref::<js_sys::Float32Array>()?
+        .to_vec();
+    if distances.len() != vertices {
+        return None;
+    }
+    Some(Measures {
+        volume_change_percent: get(value, "volume_change_percent").as_f64(),
+        mean_distance: get(value, "mean_distance").as_f64()?,
+        max_distance: get(value, "max_distance").as_f64()?,
+        vertex_rms: get(value, "vertex_rms").as_f64(),
+        barycenter_drift: get(value, "barycenter_drift").as_f64(),
+        vertex_distances: Arc::new(distances),
+    })
 }
 
 fn describe(error: &JsValue) -> String {
@@ -198,6 +260,8 @@ pub fn handle(message: JsValue) {
         "hierarchy" => build_hierarchy(&message),
         "fair" => take_state(&message).and_then(|()| fair(&message)),
         "prepare" => take_state(&message).and_then(|()| prepare(&message)),
+        "noise" => noise(&message),
+        "measure" => measure(&message),
         _ => Err(format!("unknown request {kind:?}")),
     };
     if let Err(error) = outcome {
@@ -353,6 +417,63 @@ fn prepare(message: &JsValue) -> Result<(), String> {
     Ok(())
 }
 
+/// Adds noise to a copy of the request's mesh and measures it against the clean mesh (the
+/// request's `clean_` mesh, else its mesh), as the desktop's io thread does.
+fn noise(message: &JsValue) -> Result<(), String> {
+    let settings = settings_from(message)?;
+    let mesh = mesh_from(message, "").ok_or("the request has no mesh")?;
+    let clean = mesh_from(message, "clean_");
+    let mut noisy = mesh.clone();
+    fairmesh::noise::add_noise(&mut noisy, &settings.noise.options());
+    let against_clean = Measures::of(clean.as_ref().unwrap_or(&mesh), &noisy);
+    let transfer = js_sys::Array::new();
+    let positions = flat_positions(&noisy.positions);
+    transfer.push(&positions.buffer());
+    let measures = measures_to_js(&against_clean, &transfer);
+    answer(
+        "noised",
+        |m| {
+            set(m, "positions", positions);
+            set(m, "against_clean", measures);
+        },
+        &transfer,
+    );
+    Ok(())
+}
+
+/// Measures a faired result (the request's `positions` on its `base_` mesh's triangles) against
+/// the document's mesh (`base_`) and the clean one (`clean_`, if any), as the desktop's measuring
+/// thread does.
+fn measure(message: &JsValue) -> Result<(), String> {
+    let started = web_time::Instant::now();
+    let base = mesh_from(message, "base_").ok_or("the request has no mesh")?;
+    let faired = TriMesh {
+        positions: positions_from(&get(message, "positions")),
+        triangles: base.triangles.clone(),
+    };
+    if faired.positions.len() != base.positions.len() {
+        return Err("the result to measure does not fit the mesh".into());
+    }
+    let against_document = Measures::of(&base, &faired);
+    let against_clean = mesh_from(message, "clean_").map(|clean| Measures::of(&clean, &faired));
+    let transfer = js_sys::Array::new();
+    let against_document = measures_to_js(&against_document, &transfer);
+    let against_clean = against_clean.map(|m| measures_to_js(&m, &transfer));
+    let elapsed = started.elapsed();
+    answer(
+        "measured",
+        |m| {
+            set(m, "against_document", against_document);
+            if let Some(against_clean) = against_clean {
+                set(m, "against_clean", against_clean);
+            }
+            set(m, "measure_ms", elapsed.as_secs_f64() * 1e3);
+        },
+        &transfer,
+    );
+    Ok(())
+}
+
 /// The fairing report's fields as JSON (the page shows them).
 fn report_json(report: &FairReport) -> serde_json::Value {
     serde_json::json!({
@@ -434,6 +555,19 @@ enum Reply {
         method: Method,
     },
     Prepare,
+    Noise {
+        document: GenerationId,
+        label: String,
+        /// The document's mesh: the noisy one has its triangles.
+        mesh: Arc<TriMesh>,
+        clean: Arc<TriMesh>,
+    },
+    Measure {
+        document: GenerationId,
+        serial: u64,
+        /// How many vertices the measured result has.
+        vertices: usize,
+    },
 }
 
 struct Request {
@@ -454,6 +588,8 @@ impl Request {
             Reply::Hierarchy { .. } => JobKind::Hierarchy,
             Reply::Fair { .. } => JobKind::Fair,
             Reply::Prepare => JobKind::LevelSetUp,
+            Reply::Noise { .. } => JobKind::Noise,
+            Reply::Measure { .. } => JobKind::Measure,
         }
     }
 
@@ -599,6 +735,11 @@ impl Engine {
                 self.waiting
                     .retain(|r| !matches!(r.reply, Reply::Fair { .. }));
             }
+            if matches!(request.reply, Reply::Measure { .. }) {
+                // So does a newer measuring.
+                self.waiting
+                    .retain(|r| !matches!(r.reply, Reply::Measure { .. }));
+            }
             self.waiting.push_back(request);
         }
         self.send_next();
@@ -611,7 +752,17 @@ impl Engine {
         }
         self.waiting.retain(|r| !r.is_stale());
         self.idle.retain(|r| !r.is_stale());
-        let Some(request) = self.waiting.pop_front().or_else(|| self.idle.pop_front()) else {
+        // A measuring lets the other waiting requests go first (a fairing the user waits for).
+        let next = self
+            .waiting
+            .iter()
+            .position(|r| !matches!(r.reply, Reply::Measure { .. }))
+            .unwrap_or(0);
+        let Some(request) = self
+            .waiting
+            .remove(next)
+            .or_else(|| self.idle.pop_front())
+        else {
             return;
         };
         if !self.ensure_worker() {
@@ -693,6 +844,8 @@ impl Engine {
                 }
             }
             "faired" => on_faired(request, data),
+            "noised" => on_noised(request, data),
+            "measured" => on_measured(request, data),
             _ => drop(request),
         }
         self.send_next();
@@ -817,6 +970,73 @@ fn on_faired(request: Request, data: &JsValue) {
             result,
         },
     );
+}
+
+/// The noisy mesh and its measures against the clean one, sent on as the desktop's io thread
+/// sends them.
+fn on_noised(request: Request, data: &JsValue) {
+    let Reply::Noise {
+        document,
+        label,
+        mesh,
+        clean,
+    } = &request.reply
+    else {
+        return;
+    };
+    let positions = positions_from(&get(data, "positions"));
+    let vertices = mesh.positions.len();
+    let against_clean = measures_from_js(&get(data, "against_clean"), vertices);
+    let (Some(against_clean), true) = (against_clean, positions.len() == vertices) else {
+        fail(
+            request,
+            JobKind::Noise,
+            "the noisy mesh came back incomplete".into(),
+        );
+        return;
+    };
+    let result = JobResult::Noised {
+        document: *document,
+        label: label.clone(),
+        noisy: Arc::new(TriMesh {
+            positions,
+            triangles: mesh.triangles.clone(),
+        }),
+        clean: clean.clone(),
+        against_clean: Box::new(against_clean),
+    };
+    send(request.sending, result);
+}
+
+/// A result's measures, sent on as the desktop's measuring thread sends them.
+fn on_measured(request: Request, data: &JsValue) {
+    let Reply::Measure {
+        document,
+        serial,
+        vertices,
+    } = request.reply
+    else {
+        return;
+    };
+    let against_document = measures_from_js(&get(data, "against_document"), vertices);
+    let clean = get(data, "against_clean");
+    let against_clean = measures_from_js(&clean, vertices);
+    if against_document.is_none() || (!clean.is_undefined() && against_clean.is_none()) {
+        fail(
+            request,
+            JobKind::Measure,
+            "the measures came back incomplete".into(),
+        );
+        return;
+    }
+    let result = JobResult::Measured {
+        document,
+        serial,
+        against_document,
+        against_clean,
+        measure_time: Duration::from_secs_f64(number(data, "measure_ms").max(0.0) / 1e3),
+    };
+    send(request.sending, result);
 }
 
 /// What [`post_hierarchy`] needs.
@@ -944,6 +1164,89 @@ pub(in crate::app) fn post_prepare(
         sending,
     };
     queue(request, true)
+}
+
+/// What [`post_noise`] needs.
+pub(in crate::app) struct NoisePost {
+    pub(in crate::app) settings: Settings,
+    pub(in crate::app) label: String,
+    pub(in crate::app) mesh: Arc<TriMesh>,
+    /// The mesh before any noise: `mesh` itself when it has none.
+    pub(in crate::app) clean: Arc<TriMesh>,
+    pub(in crate::app) document: GenerationId,
+    pub(in crate::app) document_generation: Generation,
+}
+
+/// Adds noise to the document's mesh in the worker and measures it against the clean mesh
+/// (see [`post_hierarchy`] for the error).
+pub(in crate::app) fn post_noise(post: NoisePost, sending: Sending) -> Result<(), Sending> {
+    let Some(message) = job_message("noise", &post.settings) else {
+        return Err(sending);
+    };
+    let transfer = js_sys::Array::new();
+    set_mesh(&message, &transfer, "", &post.mesh);
+    if !Arc::ptr_eq(&post.clean, &post.mesh) {
+        set_mesh(&message, &transfer, "clean_", &post.clean);
+    }
+    let request = Request {
+        message,
+        transfer,
+        state: None,
+        reply: Reply::Noise {
+            document: post.document,
+            label: post.label,
+            mesh: post.mesh,
+            clean: post.clean,
+        },
+        document: post.document,
+        document_generation: post.document_generation,
+        progress: SharedProgress::default(),
+        sending,
+    };
+    queue(request, false)
+}
+
+/// What [`post_measure`] needs.
+pub(in crate::app) struct MeasurePost {
+    pub(in crate::app) document: GenerationId,
+    pub(in crate::app) document_generation: Generation,
+    pub(in crate::app) serial: u64,
+    /// The faired result, on `base`'s triangles.
+    pub(in crate::app) positions: Arc<Vec<[f32; 3]>>,
+    /// The document's mesh.
+    pub(in crate::app) base: Arc<TriMesh>,
+    pub(in crate::app) clean: Option<Arc<TriMesh>>,
+}
+
+/// Measures a faired result in the worker against the document's mesh and the clean one (see
+/// [`post_hierarchy`] for the error). It runs to its end even when the view has moved on
+/// meanwhile (a worker cannot be told to stop): the result is measured once, whenever asked.
+pub(in crate::app) fn post_measure(post: MeasurePost, sending: Sending) -> Result<(), Sending> {
+    let message = js_sys::Object::new();
+    set(&message, "kind", "measure");
+    let transfer = js_sys::Array::new();
+    let positions = flat_positions(&post.positions);
+    transfer.push(&positions.buffer());
+    set(&message, "positions", positions);
+    set_mesh(&message, &transfer, "base_", &post.base);
+    if let Some(clean) = &post.clean {
+        set_mesh(&message, &transfer, "clean_", clean);
+    }
+    let request = Request {
+        message,
+        transfer,
+        state: None,
+        reply: Reply::Measure {
+            document: post.document,
+            serial: post.serial,
+            vertices: post.positions.len(),
+        },
+        document: post.document,
+        document_generation: post.document_generation,
+        progress: SharedProgress::default(),
+        sending,
+    };
+    queue(request, false)
 }
 
 fn queue(request: Request, idle: bool) -> Result<(), Sending> {

@@ -15,8 +15,32 @@ fn resolve(relative: &str, base: &str) -> Result<String, String> {
         .map_err(|error| format!("{relative}: not a valid URL ({})", describe(&error)))
 }
 
+/// The body the page fetched ahead for `url` (`index.html` fetches the bunny while the module
+/// compiles: `window.fairmeshPrefetch = {url, body}`, `body` a promise of an `ArrayBuffer`), if
+/// it did and the fetch went well; taken once.
+async fn prefetched(url: &str) -> Option<Vec<u8>> {
+    let window = web_sys::window()?;
+    let key = wasm_bindgen::JsValue::from_str("fairmeshPrefetch");
+    let ahead = js_sys::Reflect::get(&window, &key).ok()?;
+    let ahead_url = js_sys::Reflect::get(&ahead, &"url".into()).ok()?.as_string()?;
+    if ahead_url != url {
+        return None;
+    }
+    let _ = js_sys::Reflect::delete_property(&window, &key);
+    let body = js_sys::Reflect::get(&ahead, &"body".into()).ok()?;
+    let body = JsFuture::from(body.dyn_into::<js_sys::Promise>().ok()?)
+        .await
+        .ok()?;
+    body.is_instance_of::<js_sys::ArrayBuffer>()
+        .then(|| js_sys::Uint8Array::new(&body).to_vec())
+}
+
 /// The body of `url`, or why not.
 async fn fetch_bytes(url: &str) -> Result<Vec<u8>, String> {
+    // A fetch the page made ahead that failed is made again here, to say why.
+    if let Some(bytes) = prefetched(url).await {
+        return Ok(bytes);
+    }
     let window = web_sys::window().ok_or("no browser window")?;
     let response = JsFuture::from(window.fetch_with_str(url))
         .await
@@ -94,7 +118,10 @@ fn local_name(uri: &str) -> String {
 pub fn open_url(url: String) {
     wasm_bindgen_futures::spawn_local(async move {
         match fetch_with_companions(&url).await {
-            Ok(files) => open_files(files, "the fetched files"),
+            Ok(files) => {
+                super::mark("fairmesh_fetched");
+                open_files(files, "the fetched files");
+            }
             Err(error) => push(WebEvent::Failed(error)),
         }
     });

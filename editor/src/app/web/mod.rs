@@ -42,6 +42,17 @@ thread_local! {
     static EXPORT: MemoryFolder = MemoryFolder::new(EXPORT_ROOT);
 }
 
+/// Sets the page's performance mark `name` (`performance.mark`): where the time to the first
+/// picture goes, read by the browser test. Nothing happens where there is no such clock.
+pub fn mark(name: &str) {
+    let performance = js_sys::Reflect::get(&js_sys::global(), &"performance".into());
+    let Ok(performance) = performance else { return };
+    let mark = js_sys::Reflect::get(&performance, &"mark".into());
+    if let Ok(mark) = mark.and_then(JsCast::dyn_into::<js_sys::Function>) {
+        let _ = mark.call1(&performance, &name.into());
+    }
+}
+
 /// What the app showed at the end of its last frame, as JSON: the document, whether work is in
 /// flight (`settled`), the hierarchy's levels, the level and result on screen, the error and
 /// the status message (the page's scripting hook; the browser test reads it).
@@ -166,6 +177,7 @@ impl App {
             "denoise_ms": denoise_ms,
             "hierarchy_ms": build_ms,
             "fair_ms": fair_ms,
+            "load_ms": self.document.as_ref().map(|d| d.load_time.as_secs_f64() * 1e3),
             "document": status.document.map(|p| p.display().to_string()),
             "loading": status.loading,
             "settled": self.is_settled(),
