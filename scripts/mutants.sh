@@ -14,9 +14,14 @@
 #                                           one file, optionally with fewer tests
 #
 # Arguments go to cargo mutants (`cargo mutants --help`); what follows `--` goes to cargo test.
+# What follows `--` reaches only the tests (the build still compiles every example); `-C --lib
+# -C --test=fairing ...` limits both. `--in-place` saves copying the tree: stop such a run only
+# between mutants, or move target/debug/incremental/fairmesh-* away after, as a run stopped
+# mid-build left a stale incremental cache that kept the mutant in later builds.
+# `npm ci` first: tests/io_keep.rs validates its glTF files with the Khronos validator.
 # Installs cargo-mutants when missing. Results: target/mutants/mutants.out/ (caught.txt,
-# missed.txt, timeout.txt, unviable.txt, outcomes.json); docs/measurements.md has the figures of
-# the last whole runs, per module, and the missed mutants judged equivalent, with the reason.
+# missed.txt, timeout.txt, unviable.txt, outcomes.json); docs/mutants.md has the figures of
+# the runs, per module, and the missed mutants judged equivalent, with the reason.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 command -v cargo-mutants >/dev/null 2>&1 || cargo install --locked cargo-mutants

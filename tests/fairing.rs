@@ -1245,3 +1245,14 @@ fn the_tangential_relaxation_keeps_to_where_it_is_needed() {
         "normal error {kept}°; with the relaxation everywhere {spread}°, with none {none}°"
     );
 }
+
+#[test]
+fn each_choice_is_named_as_the_cli_and_python_spell_it() {
+    // The words `--boundary`, `--variant` and `--method` take, and Python's keywords.
+    assert_eq!(BoundaryMode::Curve.name(), "curve");
+    assert_eq!(BoundaryMode::Fixed.name(), "fixed");
+    assert_eq!(FairVariant::Paper.name(), "paper");
+    assert_eq!(FairVariant::Improved.name(), "improved");
+    let methods = fairmesh::fairing::Method::ALL.map(fairmesh::fairing::Method::name);
+    assert_eq!(methods, ["constrained", "laplacian", "taubin", "hc"]);
+}

@@ -296,6 +296,30 @@ mod tests {
     }
 
     #[test]
+    fn a_laplacian_step_moves_a_bump_by_lambda_times_its_height_and_reports_that_move() {
+        // The grid's centre lifted by 1 above its six flat neighbours: one step of λ = 0.5 moves
+        // it down by 0.5 (its neighbours' mean is straight below it), each of its
+        // neighbours up by 0.5 / 6 (one of their six neighbours is the bump), the rest not at
+        // all; the largest move reported is the centre's.
+        let mut mesh = grid();
+        mesh.positions[12][2] = 1.0;
+        let topology = Topology::build(&mesh);
+        let options = LaplacianOptions {
+            iterations: 1,
+            lambda: 0.5,
+            boundary: BoundaryMode::Fixed,
+        };
+        let report = fair_laplacian(&mut mesh, &topology, &options);
+        assert!((report.max_move - 0.5).abs() < 1e-6, "{}", report.max_move);
+        assert!((mesh.positions[12][2] - 0.5).abs() < 1e-6);
+        // Its neighbours along the grid's diagonals (v ± 6) and edges (v ± 1, v ± 5).
+        for v in [6, 7, 11, 13, 17, 18] {
+            assert!((mesh.positions[v][2] - 0.5 / 6.0).abs() < 1e-6, "{v}");
+        }
+        assert_eq!((mesh.positions[8][2], mesh.positions[16][2]), (0.0, 0.0));
+    }
+
+    #[test]
     fn fixed_boundary_stays_and_bump_flattens() {
         let mut mesh = grid();
         mesh.positions[12][2] = 1.0;

@@ -116,3 +116,53 @@ fn is_feature(na: Vec3A, nb: Vec3A, threshold: f32) -> bool {
     let (la, lb) = (na.length(), nb.length());
     la > 0.0 && lb > 0.0 && (la * lb).is_finite() && na.dot(nb) < threshold * la * lb
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A closed fan of `n` faces around vertex 0 at the origin, folded by a right angle along
+    /// the x axis: ring vertex k + 1 at the angle 2πk/n, the ring's first half in the plane
+    /// z = 0 (y ≥ 0), its second half in the plane y = 0 (z < 0). Vertex 1 is (1, 0, 0) and
+    /// vertex n/2 + 1 is (−1, 0, 0).
+    fn folded_fan(n: usize) -> TriMesh {
+        let mut positions = vec![[0.0f32; 3]];
+        for k in 0..n {
+            let (s, c) = (k as f32 / n as f32 * std::f32::consts::TAU).sin_cos();
+            positions.push(if k <= n / 2 {
+                [c, s.max(0.0), 0.0]
+            } else {
+                [c, 0.0, s]
+            });
+        }
+        let triangles = (0..n as u32)
+            .map(|k| [0, 1 + k, 1 + (k + 1) % n as u32])
+            .collect();
+        TriMesh::new(positions, triangles)
+    }
+
+    #[test]
+    fn a_folded_fan_has_its_two_fold_edges_for_feature_edges_with_few_faces_or_many() {
+        // The faces of the half in z = 0 face +z, those of the other half −y: the two edges
+        // along the fold turn by 90°, every other edge joins two faces of one plane. 8 faces are
+        // read from the stack buffer, 40 from the heap.
+        for n in [8, 40] {
+            let mesh = folded_fan(n);
+            let topology = Topology::build(&mesh);
+            let normal = |f: u32| {
+                let [a, b, c] =
+                    mesh.triangles[f as usize].map(|v| Vec3A::from(mesh.positions[v as usize]));
+                (b - a).cross(c - a)
+            };
+            let mut edges = Vec::new();
+            let threshold = 30f32.to_radians().cos();
+            vertex_feature_edges(&mesh, &topology, 0, normal, threshold, &mut edges);
+            let found: Vec<[u32; 2]> = edges.iter().map(|e| e.0).collect();
+            assert_eq!(found, [[0, 1], [0, n as u32 / 2 + 1]], "{n} faces");
+            // The crease direction is the fold's, the x axis (the normals' cross product).
+            for (_, direction) in &edges {
+                assert!((direction.x.abs() - 1.0).abs() < 1e-5, "{direction}");
+            }
+        }
+    }
+}

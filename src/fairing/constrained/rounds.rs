@@ -801,9 +801,24 @@ mod tests {
         let mut noisy = irregular_sphere();
         crate::noise::add_noise(&mut noisy, &crate::noise::NoiseOptions::default());
         let topology = Topology::build(&noisy);
-        let report = fair_constrained(&mut noisy, &topology, &FairOptions::default());
-        assert!(report.rounds_run > 0, "the noisy sphere is faired");
-        assert!(report.phases.relaxation > 0.0, "{:?}", report.phases);
+        // A fixed strength runs the rounds asked for, none doubled and none rolled back.
+        let rounds = 4;
+        let options = FairOptions::default().with_rounds(rounds);
+        // On the ticking clock a timed stretch (two readings; no stretch of a run reads the
+        // clock inside another) lasts one step, so each phase is its stretches times the step.
+        const STEP: u64 = 3;
+        let _ticking = crate::clock::Ticking::start(STEP);
+        let report = fair_constrained(&mut noisy, &topology, &options);
+        assert_eq!(report.rounds_run, rounds);
+        let phases = report.phases;
+        let ms = |stretches: usize| (stretches as u64 * STEP) as f64;
+        // The relaxation: reading the noise along the surface once, then its pass before every
+        // round.
+        assert_eq!(phases.relaxation, ms(1 + rounds), "{phases:?}");
+        // The iterations: loading the positions and running the round, every round.
+        assert_eq!(phases.iterations, ms(2 * rounds), "{phases:?}");
+        // The volume: setting the correction up once, then giving the volume back every round.
+        assert_eq!(phases.volume, ms(1 + rounds), "{phases:?}");
     }
 
     #[test]
