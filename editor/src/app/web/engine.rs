@@ -147,7 +147,11 @@ fn measures_to_js(measures: &Measures, transfer: &js_sys::Array) -> js_sys::Obje
     set(&object, "mean_distance", measures.mean_distance);
     set(&object, "max_distance", measures.max_distance);
     set(&object, "vertex_rms", optional(measures.vertex_rms));
-    set(&object, "barycenter_drift", optional(measures.barycenter_drift));
+    set(
+        &object,
+        "barycenter_drift",
+        optional(measures.barycenter_drift),
+    );
     let distances = js_sys::Float32Array::from(measures.vertex_distances.as_slice());
     transfer.push(&distances.buffer());
     set(&object, "vertex_distances", distances);
@@ -758,11 +762,7 @@ impl Engine {
             .iter()
             .position(|r| !matches!(r.reply, Reply::Measure { .. }))
             .unwrap_or(0);
-        let Some(request) = self
-            .waiting
-            .remove(next)
-            .or_else(|| self.idle.pop_front())
-        else {
+        let Some(request) = self.waiting.remove(next).or_else(|| self.idle.pop_front()) else {
             return;
         };
         if !self.ensure_worker() {

@@ -22,7 +22,9 @@ async fn prefetched(url: &str) -> Option<Vec<u8>> {
     let window = web_sys::window()?;
     let key = wasm_bindgen::JsValue::from_str("fairmeshPrefetch");
     let ahead = js_sys::Reflect::get(&window, &key).ok()?;
-    let ahead_url = js_sys::Reflect::get(&ahead, &"url".into()).ok()?.as_string()?;
+    let ahead_url = js_sys::Reflect::get(&ahead, &"url".into())
+        .ok()?
+        .as_string()?;
     if ahead_url != url {
         return None;
     }
