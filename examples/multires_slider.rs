@@ -18,7 +18,9 @@
 //! and one pass over each level's split vertices, in M0 iterations: the levels' vertex counts
 //! over M0's); and the faces of each result turned by more than 90 degrees against the same face
 //! of M0 (`fair`'s result) and, with noise, against the clean mesh, beyond those the noisy
-//! input itself has.
+//! input itself has; and the share of the first run's vertices that the unfolding put back
+//! where M0 has them (its last resort, `multires::unfold`): what share of that result is
+//! `fair`'s result rather than a smoother one.
 
 use fairmesh::fairing::creases::{CreaseOptions, DEFAULT_CREASE_ANGLE};
 use fairmesh::fairing::{BoundaryMode, ConstrainedFairing, FairOptions, FairVariant, Strength};
@@ -129,9 +131,9 @@ fn main() {
     };
     println!(
         "\n| K | first ms (CPU) | = M0 its | step to K-1 ms (CPU) | = M0 its | floor its | \
-         turned vs M0 (K, K-1) | vs clean |"
+         turned vs M0 (K, K-1) | vs clean | at M0 |"
     );
-    println!("|---:|---:|---:|---:|---:|---:|---:|---:|");
+    println!("|---:|---:|---:|---:|---:|---:|---:|---:|---:|");
     let base = hierarchy.base_mesh();
     let input_turned = turned_faces(&noisy.positions, base, &clean);
     for k in levels {
@@ -164,12 +166,19 @@ fn main() {
         } else {
             "-".to_string()
         };
+        let at_m0 = first
+            .iter()
+            .zip(&base.positions)
+            .filter(|(p, q)| p == q)
+            .count() as f64
+            / first.len().max(1) as f64;
         println!(
             "| {k} | {first_wall:.0} ({first_cpu:.0}) | {:.0} | {step_wall:.0} ({step_cpu:.0}) | \
-             {:.0} | {floor:.0} | {} | {clean_column} |",
+             {:.0} | {floor:.0} | {} | {clean_column} | {:.1} % |",
             first_cpu / iteration_cpu,
             step_cpu / iteration_cpu,
             against(base),
+            100.0 * at_m0,
         );
     }
 }
