@@ -236,13 +236,7 @@ fn take_state(message: &JsValue) -> Result<(), String> {
         return Ok(());
     };
     let hierarchy = Hierarchy::from_bytes(&bytes.to_vec()).map_err(|e| e.to_string())?;
-    let original = TriMesh::new(
-        positions_from(&get(message, "positions")),
-        words_from(&get(message, "triangles"))
-            .chunks_exact(3)
-            .map(|t| [t[0], t[1], t[2]])
-            .collect(),
-    );
+    let original = mesh_from(message, "").ok_or("the request has no mesh")?;
     let topology = Topology::build(&original);
     HELD.with(|held| {
         *held.borrow_mut() = Some(Held {
@@ -279,13 +273,7 @@ pub fn handle(message: JsValue) {
 
 fn build_hierarchy(message: &JsValue) -> Result<(), String> {
     let settings = settings_from(message)?;
-    let mesh = Arc::new(TriMesh::new(
-        positions_from(&get(message, "positions")),
-        words_from(&get(message, "triangles"))
-            .chunks_exact(3)
-            .map(|t| [t[0], t[1], t[2]])
-            .collect(),
-    ));
+    let mesh = Arc::new(mesh_from(message, "").ok_or("the request has no mesh")?);
     let file_edges: Vec<[u32; 2]> = words_from(&get(message, "file_edges"))
         .chunks_exact(2)
         .map(|e| [e[0], e[1]])
@@ -782,14 +770,9 @@ impl Engine {
                 .is_some_and(|held| Arc::ptr_eq(held, &state.hierarchy));
             if !holds {
                 let bytes = js_sys::Uint8Array::from(state.hierarchy.to_bytes().as_slice());
-                let positions = flat_positions(&state.original.positions);
-                let triangles = flat_triangles(&state.original.triangles);
                 request.transfer.push(&bytes.buffer());
-                request.transfer.push(&positions.buffer());
-                request.transfer.push(&triangles.buffer());
                 set(&request.message, "hierarchy", bytes);
-                set(&request.message, "positions", positions);
-                set(&request.message, "triangles", triangles);
+                set_mesh(&request.message, &request.transfer, "", &state.original);
                 set(&request.message, "denoised", state.denoised);
                 self.held = Some(state.hierarchy.clone());
             }
@@ -1059,13 +1042,11 @@ pub(in crate::app) fn post_hierarchy(post: HierarchyPost, sending: Sending) -> R
     let Some(message) = job_message("hierarchy", &post.settings) else {
         return Err(sending);
     };
-    let positions = flat_positions(&post.mesh.positions);
-    let triangles = flat_triangles(&post.mesh.triangles);
+    let transfer = js_sys::Array::new();
+    set_mesh(&message, &transfer, "", &post.mesh);
     let edges: Vec<u32> = post.file_edges.iter().flatten().copied().collect();
     let edges = js_sys::Uint32Array::from(edges.as_slice());
-    let transfer = js_sys::Array::of3(&positions.buffer(), &triangles.buffer(), &edges.buffer());
-    set(&message, "positions", positions);
-    set(&message, "triangles", triangles);
+    transfer.push(&edges.buffer());
     set(&message, "file_edges", edges);
     let request = Request {
         message,
@@ -1142,12 +1123,9 @@ pub(in crate::app) fn post_prepare(
     document_generation: Generation,
     sending: Sending,
 ) -> Result<(), Sending> {
-    let Some(json) = settings_json(settings) else {
+    let Some(message) = job_message("prepare", settings) else {
         return Err(sending);
     };
-    let message = js_sys::Object::new();
-    set(&message, "kind", "prepare");
-    set(&message, "settings", json);
     let (hierarchy, original, denoised) = state;
     let request = Request {
         message,
