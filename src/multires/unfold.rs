@@ -6,30 +6,43 @@
 //! 14: 78 faces turned against the clean mesh). So, last, every face of the result turned by more
 //! than 90° against the same face of M0 (the mesh the hierarchy was built on, `fair`'s result in
 //! the editor), and every edge folded beyond 90° where M0 was not bent to within 5° of a right
-//! angle (a box's edges are features):
+//! angle (a box's edges are features), is undone in steps, each for what the one before left:
 //!
-//! 1. gets its corners (an edge: its two ends and its faces' third corners) moved to the mean of
-//!    their neighbours (Jacobi, a few sweeps), and those of faces and edges still turned or
-//!    folded join them, until none is left or [`UNFOLD_PASSES`] have run. A crease vertex moves
-//!    along its crease (to the mean of its two neighbours on it); corners and boundary vertices
-//!    stay.
-//! 2. What that cannot undo (a fold between crease corners, which stay, or one pressed in too
-//!    deep: on the coarsely sampled noisy elephant, most of them) has the same corners put back
-//!    where M0 has them, boundary vertices aside; they stay there, the passes of 1. run again
-//!    around them, and this repeats up to [`FALLBACK_PASSES`] times.
-//! 3. Whatever is still turned or folded then has its corners, boundary vertices included, put
-//!    back where M0 has them, again until none is: a face whose corners are all M0's is M0's
-//!    face, so this ends, at the latest with the whole mesh back to M0, and no result has a
-//!    face turned or an edge folded that M0 does not have.
+//! 1. **Tangential relaxation** around the folds ([`TANGENT_RINGS`] rings, [`TANGENT_SWEEPS`]
+//!    sweeps): every vertex moves towards the mean of its neighbours, less the part along its
+//!    normal. Most folds of a
+//!    coarse run are triangles squeezed past each other on a surface that is smooth, and this
+//!    spreads them out again without changing the shape. Crease and boundary vertices stay.
+//! 2. The corners of what is left (an edge: its two ends and its faces' third corners) move to
+//!    the mean of their neighbours (Jacobi, a few sweeps), and those of faces and edges still
+//!    turned or folded join them, until none is left or [`UNFOLD_PASSES`] have run. A crease
+//!    vertex moves along its crease (to the mean of its two neighbours on it).
+//! 3. **The displacement from M0 smoothed** around what is still left: the corners that lie far
+//!    from M0 (more than half their edge length there, [`FAR_FROM_M0`]) and the vertices up to k
+//!    rings around them get the mean of their neighbours' displacements, the vertices outside
+//!    held; k grows round by round ([`DISPLACEMENT_RINGS`]). A face whose corners are displaced
+//!    alike is M0's face moved, neither turned nor folded. Corners nearer M0 are left to 4.: put
+//!    back, they fold little, and smoothing M0's displacement would bring M0's noise back where
+//!    the hierarchy was built on a noisy mesh (`--denoise off`).
+//! 4. What that cannot undo has its corners put back where M0 has them and held there, and the
+//!    displacement around them smoothed again, so that it ramps from zero at those corners to
+//!    the result's a few rings out ([`RAMP_ROUNDS`] times). Putting a corner back alone would
+//!    make a spike as high as the coarse result lies from M0 (several edge lengths on the coarse
+//!    half of the slider), fold its neighbours and spread over most of the mesh: the bundled
+//!    bunny from level 16 ended 87 % `fair`'s result, a patchwork with seams.
+//! 5. Whatever is still turned or folded then has its corners, boundary vertices included, put
+//!    back where M0 has them, until none is: a face whose corners are all M0's is M0's face, so
+//!    this ends, at the latest with the whole mesh back to M0, and no result has a face turned
+//!    or an edge folded that M0 does not have.
 //!
-//! The faces and edges are looked at once whole (a pass over the faces and one over the
-//! edges); after that only those around the vertices that moved, so a run pays for its folds,
-//! not for M0's size. A run with no fold changes nothing.
+//! The faces and edges are looked at once whole (a pass over the faces and one over the edges);
+//! after that only those around the vertices that moved, so that a run pays for its folds, not
+//! for M0's size. A run with no fold changes nothing.
 //!
-//! With the improved variant, M0's volume is given back before 1. and after 3. (every vertex
+//! With the improved variant, M0's volume is given back before 1. and after 5. (every vertex
 //! offset along its normal, one distance per connected part), on every run from a coarser
-//! level: two passes over M0 of four reads each, the larger part of what this step costs.
-//! That offset can turn a face again on a thin part, so 3. runs once more after it.
+//! level: two passes over M0 of four reads each. That offset can turn a face again on a thin
+//! part, so 3.-5. run once more after it, holding the vertices put back.
 
 use super::NONE;
 use crate::fairing::creases::Creases;
@@ -52,9 +65,27 @@ pub(super) struct Level<'a> {
 /// At most this many rounds of finding the folds and smoothing their corners.
 pub const UNFOLD_PASSES: usize = 8;
 
-/// At most this many times the corners of the folds left (and their neighbours) go back to M0
-/// before the passes stop and only putting back remains.
-const FALLBACK_PASSES: usize = 4;
+/// Sweeps of the tangential relaxation (step 1 of the module docs).
+pub const TANGENT_SWEEPS: usize = 10;
+
+/// How far around the folds the tangential relaxation reaches, in rings.
+const TANGENT_RINGS: usize = 16;
+
+/// Ring counts of the rounds of smoothing the displacement from M0 (step 3); a round runs
+/// [`DISPLACEMENT_SWEEPS_PER_RING`] sweeps per ring.
+const DISPLACEMENT_RINGS: [usize; 8] = [1, 2, 3, 4, 6, 8, 12, 16];
+
+/// Jacobi sweeps per ring of a round of smoothing the displacement: a harmonic ramp over k rings
+/// settles in about k² sweeps; the rounds before it have done part of the work.
+const DISPLACEMENT_SWEEPS_PER_RING: usize = 16;
+
+/// How far from M0, in its edge lengths there, a vertex must lie for the displacement around it
+/// to be smoothed (steps 3 and 4): one put back from nearer folds little around it.
+const FAR_FROM_M0: f32 = 0.5;
+
+/// At most this many times the corners of what is left go back to M0 with the displacement
+/// ramped around them (step 4) before only putting back remains.
+const RAMP_ROUNDS: usize = 8;
 
 /// At most this many times the volume is given back after the unfolding (each time holding the
 /// vertices put back to M0, and putting back what it turned again).
@@ -318,6 +349,169 @@ impl<'a> FoldState<'a> {
     }
 }
 
+/// The vertices up to `rings` rings around `seeds` (each once, `seeds` first), leaving out those
+/// `skip` names. `mark` is all false on entry and again on return.
+fn grow(
+    seeds: impl IntoIterator<Item = u32>,
+    rings: usize,
+    topology: &Topology,
+    mark: &mut [bool],
+    skip: impl Fn(u32) -> bool,
+) -> Vec<u32> {
+    let mut reached = Vec::new();
+    for v in seeds {
+        if !mark[v as usize] && !skip(v) {
+            mark[v as usize] = true;
+            reached.push(v);
+        }
+    }
+    let mut start = 0;
+    for _ in 0..rings {
+        let end = reached.len();
+        for i in start..end {
+            for &u in topology.neighbors(reached[i]) {
+                if !mark[u as usize] && !skip(u) {
+                    mark[u as usize] = true;
+                    reached.push(u);
+                }
+            }
+        }
+        start = end;
+    }
+    for &v in &reached {
+        mark[v as usize] = false;
+    }
+    reached
+}
+
+/// Step 1 of the module docs: the vertices up to [`TANGENT_RINGS`] rings around what `state`
+/// finds turned or folded, but those `stays` names, moved [`TANGENT_SWEEPS`] times towards the
+/// mean of their neighbours, less the part along their normal (Jacobi: each sweep reads the
+/// last one's positions).
+fn relax_tangentially(
+    positions: &mut [[f32; 3]],
+    triangles: &[[u32; 3]],
+    topology: &Topology,
+    state: &mut FoldState,
+    stays: impl Fn(u32) -> bool,
+) {
+    let mut mark = vec![false; positions.len()];
+    let region = grow(state.corners(), TANGENT_RINGS, topology, &mut mark, stays);
+    let mut moved = Vec::new();
+    for _ in 0..TANGENT_SWEEPS {
+        let positions_now: &[[f32; 3]] = positions;
+        region
+            .par_iter()
+            .with_min_len(super::PARALLEL_GRAIN)
+            .map(|&v| {
+                let p = Vec3A::from_array(positions_now[v as usize]);
+                let normal = topology
+                    .faces_of(v)
+                    .iter()
+                    .fold(Vec3A::ZERO, |n, &f| {
+                        n + face_normal(positions_now, triangles, f)
+                    })
+                    .normalize_or_zero();
+                let ring = topology.neighbors(v);
+                let sum = ring.iter().fold(Vec3A::ZERO, |sum, &u| {
+                    sum + Vec3A::from_array(positions_now[u as usize])
+                });
+                let step = sum / ring.len().max(1) as f32 - p;
+                (p + step - normal * step.dot(normal)).to_array()
+            })
+            .collect_into_vec(&mut moved);
+        for (&v, &p) in region.iter().zip(&moved) {
+            positions[v as usize] = p;
+        }
+    }
+    state.moved(positions, &region);
+}
+
+/// Steps 3 and 4 of the module docs: the displacement from M0 smoothed around what `state`
+/// finds turned or folded, over the rings `rings` names round by round. The vertices `back`
+/// (put back to M0) and boundary vertices are held.
+fn smooth_displacement(
+    positions: &mut [[f32; 3]],
+    mesh: &TriMesh,
+    topology: &Topology,
+    state: &mut FoldState,
+    back: &[bool],
+    rings: &[usize],
+) {
+    let mut mark = vec![false; positions.len()];
+    let mut means = Vec::new();
+    for &rings in rings {
+        let corners = state.corners();
+        if corners.is_empty() {
+            return;
+        }
+        let held = |v: u32| back[v as usize] || topology.is_boundary_vertex(v);
+        let far = |v: &u32| far_from_m0(positions, mesh, topology, *v);
+        let seeds: Vec<u32> = corners.into_iter().filter(far).collect();
+        if seeds.is_empty() {
+            return;
+        }
+        let region = grow(seeds, rings, topology, &mut mark, held);
+        for _ in 0..DISPLACEMENT_SWEEPS_PER_RING * rings {
+            let positions_now: &[[f32; 3]] = positions;
+            region
+                .par_iter()
+                .with_min_len(super::PARALLEL_GRAIN)
+                .map(|&v| {
+                    let m0 = |u: u32| Vec3A::from_array(mesh.positions[u as usize]);
+                    let ring = topology.neighbors(v);
+                    let sum = ring.iter().fold(Vec3A::ZERO, |sum, &u| {
+                        sum + Vec3A::from_array(positions_now[u as usize]) - m0(u)
+                    });
+                    (m0(v) + sum / ring.len().max(1) as f32).to_array()
+                })
+                .collect_into_vec(&mut means);
+            for (&v, &p) in region.iter().zip(&means) {
+                positions[v as usize] = p;
+            }
+        }
+        state.moved(positions, &region);
+    }
+}
+
+/// Whether vertex `v` lies farther from where M0 has it than [`FAR_FROM_M0`] times the mean
+/// length of its edges on M0: put back alone, it would fold its neighbours.
+fn far_from_m0(positions: &[[f32; 3]], mesh: &TriMesh, topology: &Topology, v: u32) -> bool {
+    let m0 = |u: u32| Vec3A::from_array(mesh.positions[u as usize]);
+    let ring = topology.neighbors(v);
+    let length =
+        ring.iter().map(|&u| m0(u).distance(m0(v))).sum::<f32>() / ring.len().max(1) as f32;
+    m0(v).distance(Vec3A::from_array(positions[v as usize])) > FAR_FROM_M0 * length
+}
+
+/// Steps 3-5 of the module docs, for what `state` finds turned or folded.
+fn undo_what_is_left(
+    positions: &mut [[f32; 3]],
+    mesh: &TriMesh,
+    topology: &Topology,
+    state: &mut FoldState,
+    back: &mut [bool],
+) {
+    smooth_displacement(positions, mesh, topology, state, back, &DISPLACEMENT_RINGS);
+    for _ in 0..RAMP_ROUNDS {
+        let still: Vec<u32> = state
+            .corners()
+            .into_iter()
+            .filter(|&v| !topology.is_boundary_vertex(v) && !back[v as usize])
+            .collect();
+        if still.is_empty() {
+            break;
+        }
+        for &v in &still {
+            positions[v as usize] = mesh.positions[v as usize];
+            back[v as usize] = true;
+        }
+        state.moved(positions, &still);
+        smooth_displacement(positions, mesh, topology, state, back, &DISPLACEMENT_RINGS);
+    }
+    put_back(positions, mesh, state, back);
+}
+
 /// Puts the corners of what `state` finds turned or folded back where M0 has them, until
 /// nothing is (marking them in `back`).
 fn put_back(positions: &mut [[f32; 3]], mesh: &TriMesh, state: &mut FoldState, back: &mut [bool]) {
@@ -391,6 +585,14 @@ pub(super) fn unfold(positions: &mut [[f32; 3]], level: &Level, folds: &mut Fold
         topology.is_boundary_vertex(v)
             || (creases.is_some_and(|c| c.is_feature(v)) && on_crease(v).is_none())
     };
+    // Crease vertices too stay in the relaxation: moved along their faces' mean plane they would
+    // leave the crease.
+    let at_rest = positions.to_vec();
+    relax_tangentially(positions, &mesh.triangles, topology, &mut state, |v| {
+        topology.is_boundary_vertex(v)
+            || topology.neighbors(v).is_empty()
+            || creases.is_some_and(|c| c.is_feature(v))
+    });
     let mut moving = vec![false; positions.len()];
     let mut region: Vec<u32> = Vec::new();
     // The vertices put back to M0 (below), which stay there.
@@ -439,28 +641,8 @@ pub(super) fn unfold(positions: &mut [[f32; 3]], level: &Level, folds: &mut Fold
     };
     passes(positions, &mut state, &mut region, &mut moving, &back);
     // What the neighbours' means cannot undo (a fold whose corners all stay, or one the levels
-    // pressed in too deep): its corners, corners of creases among them, go back to where M0 has
-    // them, and the passes run again around them.
-    for _ in 0..FALLBACK_PASSES {
-        let still: Vec<u32> = state
-            .corners()
-            .into_iter()
-            .filter(|&v| !topology.is_boundary_vertex(v))
-            .collect();
-        if still.is_empty() {
-            break;
-        }
-        for &v in &still {
-            positions[v as usize] = mesh.positions[v as usize];
-            back[v as usize] = true;
-        }
-        state.moved(positions, &still);
-        passes(positions, &mut state, &mut region, &mut moving, &back);
-    }
-    // Whatever is left goes back to M0, corner by corner, until nothing is turned or folded (a
-    // face whose corners are all M0's is M0's face, so this ends); again after the volume's
-    // offset, which moves every vertex.
-    put_back(positions, mesh, &mut state, &mut back);
+    // pressed in too deep), with the displacement from M0; last, what is left goes back to M0.
+    undo_what_is_left(positions, mesh, topology, &mut state, &mut back);
     drop(state);
     // The offset holds the vertices put back; what it turns again goes back too, and the
     // offset is made again without them, a few times at most.
@@ -471,7 +653,7 @@ pub(super) fn unfold(positions: &mut [[f32; 3]], level: &Level, folds: &mut Fold
         restore(positions, &mut volume, &back);
         let mut state = FoldState::new(positions, &mesh.triangles, topology, folds);
         let before = back.iter().filter(|&&b| b).count();
-        put_back(positions, mesh, &mut state, &mut back);
+        undo_what_is_left(positions, mesh, topology, &mut state, &mut back);
         if back.iter().filter(|&&b| b).count() == before {
             break;
         }
@@ -479,8 +661,11 @@ pub(super) fn unfold(positions: &mut [[f32; 3]], level: &Level, folds: &mut Fold
     if keep_volume {
         folds.volume = volume;
     }
-    let moved = |v: usize| moving[v] || back[v];
-    (0..positions.len()).filter(|&v| moved(v)).count()
+    positions
+        .iter()
+        .zip(&at_rest)
+        .filter(|(now, was)| now != was)
+        .count()
 }
 
 #[cfg(test)]
@@ -519,12 +704,14 @@ mod tests {
     fn a_vertex_pushed_through_its_neighbours_is_put_back_and_the_rest_stays() {
         // A flat grid (no fold) with one inner vertex moved far across its neighbours, in the
         // plane: its triangles flip over their edges.
-        let mesh = grid(6);
+        let n = 24;
+        let mesh = grid(n);
         let topology = Topology::build(&mesh);
         let edges = two_face_edges(&mesh.triangles);
         let reference = folded(&mesh.positions, &mesh, &edges);
         assert!(reference.iter().all(|&f| !f), "the flat grid folds nothing");
-        let v = 3 * 7 + 3;
+        let (row, column) = (n / 2, n / 2);
+        let v = row * (n + 1) + column;
         let mut positions = mesh.positions.clone();
         positions[v][0] += 1.6;
         let flipped = folded(&positions, &mesh, &edges);
@@ -535,19 +722,32 @@ mod tests {
             &mut fold_edges(&mesh, &edges, &reference),
         );
         assert!(folded(&positions, &mesh, &edges).iter().all(|&f| !f));
-        assert!((1..=8).contains(&moved), "{moved} vertices moved");
-        // The vertex is back near its place, the vertices away from the fold did not move.
+        // The vertex is back near its place. Every sweep of the relaxation reaches one ring
+        // further (on a regular grid a vertex is the mean of its neighbours, so only the push
+        // moves anything), and nothing else ran: the vertices more than TANGENT_SWEEPS rings
+        // away did not move, and those that did stayed in the plane.
         assert!((positions[v][0] - mesh.positions[v][0]).abs() < 0.5);
-        for u in [0, 6, 42, 48] {
-            assert_eq!(positions[u], mesh.positions[u], "corner {u}");
+        let mut near = 0;
+        for (u, (now, was)) in positions.iter().zip(&mesh.positions).enumerate() {
+            let rings = (u / (n + 1))
+                .abs_diff(row)
+                .max((u % (n + 1)).abs_diff(column));
+            if rings > TANGENT_SWEEPS {
+                assert_eq!(now, was, "vertex {u}, {rings} rings away");
+            } else {
+                near += 1;
+            }
+            assert_eq!(now[2], was[2], "vertex {u} left the plane");
         }
+        assert!((1..=near).contains(&moved), "{moved} vertices moved");
     }
 
     #[test]
-    fn a_fold_between_corners_that_stay_goes_back_to_m0() {
-        // A cube's corner (a crease corner: it stays in the passes) pushed through the cube,
-        // past the centre: the neighbours' means cannot unfold its edges, so its corners go back
-        // to M0; nothing stays folded, the corner is where M0 has it.
+    fn a_fold_between_corners_that_stay_is_undone_next_to_m0() {
+        // A cube's corner (a crease corner: it stays in the relaxation and the passes) pushed
+        // through the cube, past the centre: the neighbours' means cannot unfold its edges, the
+        // displacement from M0 smoothed around it can: nothing stays folded, and the corner is
+        // next to where M0 has it, displaced as its neighbours are.
         let mesh = crate::mesh::shapes::cuboid([1.0, 1.0, 1.0], 0.25);
         let topology = Topology::build(&mesh);
         let creases = crate::fairing::detect_creases(&mesh, &topology, &Default::default());
@@ -583,8 +783,11 @@ mod tests {
         let moved = unfold(&mut positions, &level, &mut folds);
         assert!(moved >= 1);
         assert_eq!(new_folds(&positions), 0);
-        // Back where M0 has it, and no face turned against M0.
-        assert_eq!(positions[corner], mesh.positions[corner]);
+        // Next to where M0 has it (the side is 1, the push moved it by 1.1), and no face
+        // turned against M0.
+        let off = Vec3A::from_array(positions[corner])
+            .distance(Vec3A::from_array(mesh.positions[corner]));
+        assert!(off < 0.05, "{off} from M0");
         let result = TriMesh::new(positions.clone(), mesh.triangles.clone());
         for t in 0..mesh.face_count() {
             assert!(
