@@ -54,8 +54,9 @@ pub fn mark(name: &str) {
 }
 
 /// What the app showed at the end of its last frame, as JSON: the document, whether work is in
-/// flight (`settled`), the hierarchy's levels, the level and result on screen, the error and
-/// the status message (the page's scripting hook; the browser test reads it).
+/// flight (`settled`), the hierarchy's levels, the level and result on screen, whether it is
+/// being measured, the error, the status message and the frame's number (the page's scripting
+/// hook; the browser test reads it).
 pub fn status() -> String {
     events::STATUS.with(|kept| kept.borrow().clone())
 }
@@ -187,6 +188,10 @@ impl App {
                 Some(crate::app::state::HierarchyState::Building)
             ),
             "hierarchy_progress": self.work.hierarchy_progress.get(),
+            // The result on screen is being measured (its numbers and heat map are on the way).
+            "measuring": status.measuring,
+            // Which frame published this: the page drew that many frames since it started.
+            "frame": self.ctx.cumulative_frame_nr(),
             "level_count": status.level_count,
             "level": status.level,
             "faired_serial": status.faired_serial,
