@@ -193,9 +193,19 @@ try {
   const file = await download;
   const saved = path.join(out, `${tag}-${file.suggestedFilename()}`);
   await file.saveAs(saved);
-  fs.writeFileSync(path.join(out, `${tag}-export.json`), JSON.stringify({ file: saved, level: exportLevel }));
   check("Export downloads the OBJ with its .mtl and texture as a .zip", file.suggestedFilename() === "textured_faired.zip",
     `${file.suggestedFilename()} (${fs.statSync(saved).size} bytes); compared with the CLI by test_web.sh`);
+  // Export levels: the level chain, every level as a GLB, in one .zip (compared with the CLI's
+  // `hierarchy --write-levels` by check_downloads.py).
+  const levelsDownload = page.waitForEvent("download", { timeout: 60000 });
+  await command("export_levels", "");
+  const levelsFile = await levelsDownload;
+  const levelsSaved = path.join(out, `${tag}-${levelsFile.suggestedFilename()}`);
+  await levelsFile.saveAs(levelsSaved);
+  s = await waitFor("the level chain's message", (s) => s.message && s.message.startsWith("Exported"));
+  fs.writeFileSync(path.join(out, `${tag}-export.json`), JSON.stringify({ file: saved, level: exportLevel, levels: levelsSaved, level_count: s.level_count }));
+  check("Export levels downloads every level as a GLB in one .zip", levelsFile.suggestedFilename() === "textured_levels.zip" && !s.error,
+    `${levelsFile.suggestedFilename()} (${fs.statSync(levelsSaved).size} bytes), "${s.message}"`);
 
   // 5. A broken file: the same error as native, and the page goes on.
   await page.setInputFiles("#fairmesh-file-input", [path.join(dataDir, "broken.obj")]);

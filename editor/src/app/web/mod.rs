@@ -63,7 +63,8 @@ pub fn status() -> String {
 
 /// Asks the app for something as its widgets would (the page's scripting hook, for automation
 /// and the browser test): `level` N (the start level slider), `export` NAME (Export, the
-/// download named NAME), `open` URL (as `?open=`), `noise`, `undo`, `redo`, `fit`.
+/// download named NAME), `export_levels` (Export levels: the level chain as one `.zip`), `open`
+/// URL (as `?open=`), `noise`, `undo`, `redo`, `fit`.
 pub fn command(name: &str, value: &str) -> Result<(), String> {
     use crate::app::Command;
     let command = match name {
@@ -73,6 +74,7 @@ pub fn command(name: &str, value: &str) -> Result<(), String> {
                 .map_err(|_| format!("level: {value:?} is not a level number"))?,
         ),
         "export" => Command::Export(PathBuf::from(value)),
+        "export_levels" => Command::ExportLevels,
         "open" => {
             open_url(value.to_owned());
             return Ok(());
@@ -270,12 +272,16 @@ impl App {
     }
 
     /// The export was written into the export folder: hands it to the browser as a download
-    /// and returns the download's name (`None`: it failed, and the error says why).
+    /// and returns the download's name (`None`: it failed, and the error says why). Several
+    /// files go as one `.zip` named after `path` (a file's companions beside it, or the level
+    /// chain's folder with the levels in it).
     pub(in crate::app) fn download_export(&mut self, path: &Path) -> Option<String> {
         let files = EXPORT.with(MemoryFolder::files);
         let result = match files.as_slice() {
             [] => Err(format!("{}: the export wrote nothing", path.display())),
             [(name, bytes)] => {
+                // A file in a folder (one level of the level chain) downloads under its own name.
+                let name = name.file_name().unwrap_or(name.as_os_str());
                 let name = name.to_string_lossy().into_owned();
                 download::offer(&name, bytes).map(|()| name)
             }
