@@ -695,6 +695,8 @@ struct Engine {
     held: Option<Arc<Hierarchy>>,
     /// The meshes the measuring worker holds.
     held_against: Option<AgainstMeshes>,
+    /// Messages the worker sent (progress and answers), counted since the page started.
+    heard: u64,
     /// The handlers of ended workers.
     retired: Vec<(Handler, Handler)>,
 }
@@ -732,6 +734,7 @@ impl Engine {
             idle: VecDeque::new(),
             held: None,
             held_against: None,
+            heard: 0,
             retired: Vec::new(),
         }
     }
@@ -912,6 +915,7 @@ impl Engine {
     }
 
     fn on_message(&mut self, data: &JsValue) {
+        self.heard += 1;
         let kind = text(data, "kind").unwrap_or_default();
         if kind == "progress" {
             if let Some(request) = &self.in_flight {
@@ -1396,6 +1400,13 @@ fn queue_on(role: Role, request: Request, idle: bool) -> Result<(), Sending> {
             Err(request.sending)
         }
     })
+}
+
+/// Whether the engine's worker (not the measuring one) runs a job now, and how many messages
+/// the page has had from its workers so far: the page's status, which shows that the page
+/// answers while a job runs (the count moves on between two of its frames).
+pub(in crate::app) fn engine_activity() -> (bool, u64) {
+    Role::Engine.with(|engine| (engine.in_flight.is_some(), engine.heard))
 }
 
 /// Once a frame: ends a worker when the job it runs is no longer wanted (Cancel, another

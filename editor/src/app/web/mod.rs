@@ -55,8 +55,8 @@ pub fn mark(name: &str) {
 
 /// What the app showed at the end of its last frame, as JSON: the document, whether work is in
 /// flight (`settled`), the hierarchy's levels, the level and result on screen, whether it is
-/// being measured, the error, the status message and the frame's number (the page's scripting
-/// hook; the browser test reads it).
+/// being measured, the error, the status message, the frame's number and the engine's worker's
+/// activity (the page's scripting hook; the browser test reads it).
 pub fn status() -> String {
     events::STATUS.with(|kept| kept.borrow().clone())
 }
@@ -173,6 +173,7 @@ impl App {
             ),
             _ => (None, None),
         };
+        let engine_activity = engine::engine_activity();
         let fair_ms = document
             .and_then(|d| d.faired.as_ref())
             .map(|f| milliseconds(f.elapsed));
@@ -194,6 +195,9 @@ impl App {
             "measuring": status.measuring,
             // Which frame published this: the page drew that many frames since it started.
             "frame": self.ctx.cumulative_frame_nr(),
+            // The engine's worker runs a job, and the messages had from it so far.
+            "engine_busy": engine_activity.0,
+            "engine_heard": engine_activity.1,
             "level_count": status.level_count,
             "level": status.level,
             "faired_serial": status.faired_serial,
