@@ -1,6 +1,7 @@
-// The engine's worker: runs the same module as the page (fairmesh_web.js) beside it, so that
-// denoising, building the hierarchy and fairing leave the page free to answer. The page posts
-// requests; the module answers each with postMessage (editor: app/web/engine.rs).
+// The page's workers (the engine, and the measuring worker beside it): each runs the same module
+// as the page (fairmesh_web.js), so that denoising, building the hierarchy, fairing and measuring
+// leave the page free to answer. The page posts requests; the module answers each with
+// postMessage (editor: app/web/engine.rs).
 import init, { engine_handle } from "./fairmesh_web.js";
 
 let ready = null;

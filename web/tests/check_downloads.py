@@ -3,8 +3,11 @@
 For each run (`<tag>-export.json` in the results folder): the exported .zip holds the OBJ, its
 .mtl and its texture; the OBJ's positions equal `fairmesh multires --level N` of the same file
 within 1e-5 of the bounding box's diagonal, its other lines (mtllib, usemtl, vt, f) are the
-CLI's, and the .mtl and texture are the input's bytes. The broken file's error in the page ends
-with the error `fairmesh info` prints for it. Prints one line per check and the count.
+CLI's, and the .mtl and texture are the input's bytes. The level chain's .zip holds one GLB per
+level, each byte for byte the file `fairmesh hierarchy --write-levels --format glb
+--keep-creases` writes (the editor keeps sharp edges by default, as `--keep-creases` asks). The
+broken file's error in the page ends with the error `fairmesh info` prints for it. Prints one
+line per check and the count.
 """
 
 import json
@@ -57,6 +60,18 @@ for export in sorted(results.glob("*-export.json")):
         check(f"[{tag}] the export keeps the OBJ's other lines (mtllib, usemtl, vt, f)", rest(web_obj) == rest(cli_obj))
         for companion in ("textured.mtl", "textured.png"):
             check(f"[{tag}] {companion} is the input's", got.get(companion) == (data / companion).read_bytes())
+        if "levels" in run:
+            subprocess.run([str(fairmesh), "hierarchy", str(data / "textured.obj"), "--write-levels", str(tmp / "levels"),
+                            "--format", "glb", "--keep-creases"], check=True, capture_output=True)
+            cli_levels = sorted((tmp / "levels").glob("level_*.glb"))
+            with zipfile.ZipFile(run["levels"]) as archive:
+                names = sorted(archive.namelist())
+                wanted = [f"textured_levels/textured_L{n:02}.glb" for n in range(len(cli_levels))]
+                check(f"[{tag}] the level chain's zip holds every level as a GLB", names == wanted and len(names) == run["level_count"],
+                      f"{len(names)} files in the zip, {len(cli_levels)} levels from the CLI, {run['level_count']} in the page")
+                differ = [name for name, cli in zip(wanted, cli_levels) if name not in names or archive.read(name) != cli.read_bytes()]
+            check(f"[{tag}] each level equals fairmesh hierarchy --write-levels --format glb, byte for byte", not differ and names == wanted,
+                  f"differing: {differ}" if differ else f"{len(wanted)} levels")
 
 cli = subprocess.run([str(fairmesh), "info", str(data / "broken.obj")], capture_output=True, text=True)
 cli_error = cli.stderr.strip().split("broken.obj", 1)[-1]

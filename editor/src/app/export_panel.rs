@@ -1,5 +1,6 @@
 //! The side panel's Export section: the export path with Export and Export as…, and the level
-//! chain (one GLB per level of the hierarchy, for LOD) with its folder and range.
+//! chain (one GLB per level of the hierarchy, for LOD) with its folder and range (in a page,
+//! without a folder: the levels download as one `.zip`).
 
 use std::path::PathBuf;
 
@@ -43,32 +44,35 @@ pub(super) fn show(
         commands.push(Command::Panel(PanelChange::ExportPath(export_path)));
     }
 
-    // The level chain writes a folder of files: not in a web page.
-    if cfg!(target_arch = "wasm32") {
-        return;
-    }
     ui.add_space(4.0);
     ui.strong("Level chain (LOD)");
-    let placeholder = view
-        .levels_folder
-        .as_ref()
-        .map_or_else(String::new, |p| p.display().to_string());
-    let label = ui.label("Levels folder:");
-    ui.add(
-        egui::TextEdit::singleline(&mut settings.level_chain.folder)
-            .hint_text(placeholder)
-            .desired_width(f32::INFINITY),
-    )
-    .labelled_by(label.id);
+    // A page has no folders: the levels download together, as one `.zip`.
+    if !cfg!(target_arch = "wasm32") {
+        let placeholder = view
+            .levels_folder
+            .as_ref()
+            .map_or_else(String::new, |p| p.display().to_string());
+        let label = ui.label("Levels folder:");
+        ui.add(
+            egui::TextEdit::singleline(&mut settings.level_chain.folder)
+                .hint_text(placeholder)
+                .desired_width(f32::INFINITY),
+        )
+        .labelled_by(label.id);
+    }
     let top = document.level_count().unwrap_or(1).saturating_sub(1);
     // Edit copies: the stored range may reach past this mesh's levels (its end "to the top").
     let mut to = settings.level_chain.to.min(top);
     let mut from = settings.level_chain.from.min(to);
     ui.horizontal(|ui| {
         ui.label("Levels");
-        let a = ui.add(egui::DragValue::new(&mut from).range(0..=top).prefix("M"));
+        let a = ui
+            .add(egui::DragValue::new(&mut from).range(0..=top).prefix("M"))
+            .on_hover_text("The first level written (M0: the full mesh)");
         ui.label("to");
-        let b = ui.add(egui::DragValue::new(&mut to).range(0..=top).prefix("M"));
+        let b = ui
+            .add(egui::DragValue::new(&mut to).range(0..=top).prefix("M"))
+            .on_hover_text("The last level written (the coarsest is the top)");
         if a.changed() {
             settings.level_chain.from = from;
         }
@@ -81,7 +85,11 @@ pub(super) fn show(
             document.level_count().is_some(),
             egui::Button::new("Export levels"),
         )
-        .on_hover_text("One GLB per level of the hierarchy, for LOD")
+        .on_hover_text(if cfg!(target_arch = "wasm32") {
+            "One GLB per level of the hierarchy, for LOD, downloaded together as one .zip"
+        } else {
+            "One GLB per level of the hierarchy, for LOD"
+        })
         .clicked()
     {
         commands.push(Command::ExportLevels);

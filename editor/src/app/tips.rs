@@ -126,7 +126,8 @@ pub const EXPORT_FORMATS: &str = "GLB, glTF, OBJ, PLY, STL or OFF, by extension"
 /// What Export does in the web page (shown under the export path there).
 pub const WEB_EXPORT: &str = "In the browser, Export downloads the file. A file that needs \
     others beside it (an OBJ with its .mtl and images, a .gltf with its .bin and images) comes \
-    as one .zip; name the export .glb for a single file with everything in it.";
+    as one .zip; name the export .glb for a single file with everything in it. Export levels \
+    downloads the level chain as one .zip of GLB files.";
 pub const HELD_MESHES: &str = "The meshes the 3D view keeps on the graphics card: the one \
     shown, and those you switched away from (Faired, Level mesh, Input mesh), so that switching \
     back uploads nothing. A new result or level takes the place of the old one; the Before \

@@ -97,7 +97,8 @@ impl App {
         Some(path.with_file_name(format!("{stem}_levels")))
     }
 
-    /// Writes levels `levels_from..=levels_to` as `<stem>_L<level>.glb` on the io worker.
+    /// Writes levels `levels_from..=levels_to` as `<stem>_L<level>.glb` on the io worker (in a
+    /// page, into a folder `<stem>_levels` that is downloaded as one `.zip`).
     pub(in crate::app) fn export_levels(&mut self) {
         let Some(document) = &self.document else {
             self.error = Some("Nothing to export: no mesh is loaded".into());
@@ -105,10 +106,6 @@ impl App {
         };
         let HierarchyState::Ready { hierarchy, .. } = &document.hierarchy else {
             self.error = Some("Export levels: the hierarchy is not built yet".into());
-            return;
-        };
-        let Some(folder) = self.levels_folder() else {
-            self.error = Some("Export levels: type a folder first".into());
             return;
         };
         let hierarchy = hierarchy.clone();
@@ -120,6 +117,14 @@ impl App {
             .path
             .file_stem()
             .map_or_else(|| "mesh".to_owned(), |s| s.to_string_lossy().into_owned());
+        // A page writes the levels into its export folder and downloads them as one `.zip`.
+        #[cfg(target_arch = "wasm32")]
+        let folder = Self::web_export_path(std::path::Path::new(&format!("{stem}_levels")));
+        #[cfg(not(target_arch = "wasm32"))]
+        let Some(folder) = self.levels_folder() else {
+            self.error = Some("Export levels: type a folder first".into());
+            return;
+        };
         self.message = Some(format!(
             "Exporting levels M{from} … M{to} to {} …",
             folder.display()
@@ -131,7 +136,12 @@ impl App {
         );
         self.workers.io.submit(JobKind::LevelChain, move || {
             let started = Instant::now();
-            let result = std::fs::create_dir_all(&folder)
+            // A page's export folder is in memory: nothing to create.
+            #[cfg(target_arch = "wasm32")]
+            let created = Ok(());
+            #[cfg(not(target_arch = "wasm32"))]
+            let created = std::fs::create_dir_all(&folder);
+            let result = created
                 .map_err(|source| LevelChainError::CreateFolder {
                     folder: folder.clone(),
                     source,
@@ -221,6 +231,11 @@ impl App {
     ) {
         match result {
             Ok((paths, warnings)) => {
+                #[cfg(target_arch = "wasm32")]
+                let folder = match self.download_export(&folder) {
+                    Some(download) => PathBuf::from(format!("a download, {download}")),
+                    None => return,
+                };
                 self.message = Some(format!(
                     "Exported {} levels to {} ({:.2} s){}",
                     paths.len(),

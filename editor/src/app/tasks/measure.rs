@@ -1,6 +1,6 @@
 //! Measuring a faired result against the input and clean meshes (surface distances, on the
-//! measuring worker and its own one-thread pool; in a page, in the engine's worker), once the
-//! result has rested on screen: launch and result.
+//! measuring worker and its own one-thread pool; in a page, in the page's measuring worker), once
+//! the result has rested on screen: launch and result.
 
 use std::sync::Arc;
 use std::time::Duration;
@@ -79,8 +79,8 @@ impl App {
             self.ctx.clone(),
             self.workers.jobs.start(),
         );
-        // In a page the measuring runs in the engine's worker, so that the page goes on
-        // answering.
+        // In a page the measuring runs in a worker of its own, so that the page goes on
+        // answering and a fairing does not wait for it.
         #[cfg(target_arch = "wasm32")]
         let (tx, ctx, ticket) = {
             use crate::app::web::engine::{post_measure, MeasurePost, Sending};
@@ -91,6 +91,8 @@ impl App {
                 positions: positions.clone(),
                 base: base.clone(),
                 clean: clean.clone(),
+                view_generation: view_generation.clone(),
+                view,
             };
             match post_measure(post, Sending { tx, ctx, ticket }) {
                 Ok(()) => return,

@@ -1,15 +1,20 @@
 //! Long work off the page's thread: a Web Worker (`fairmesh_worker.js`) runs this same module as
 //! an engine that keeps the document's mesh, the hierarchy it built and the fairing workspace,
-//! so that the page answers while the hierarchy is built or a level is faired.
+//! so that the page answers while the hierarchy is built or a level is faired. A second worker,
+//! the measuring worker, measures each faired result (the numbers and the heat map), so that a
+//! fairing never waits behind a measuring.
 //!
 //! - The page side ([`post_hierarchy`], [`post_fair`], [`post_prepare`], [`post_noise`],
-//!   [`post_measure`], [`tick`]) sends one request at a time, as a message of typed arrays
-//!   (positions, triangles, a mask) and the settings as JSON; the others wait in order (a fairing
-//!   replaces the fairing still waiting, as on the desktop's compute thread, and a measuring the
-//!   measuring still waiting, as on its measuring thread; a measuring lets the other requests go
-//!   first, and setting up the levels waits for everything else). Answers
-//!   come back with their arrays transferred, not copied, and become the same [`JobResult`]s the
-//!   desktop's threads send, with the same progress.
+//!   [`post_measure`], [`tick`]) sends one request at a time to each worker, as a message of
+//!   typed arrays (positions, triangles, a mask) and the settings as JSON; the others wait in
+//!   order (a fairing replaces the fairing still waiting, as on the desktop's compute thread, and
+//!   setting up the levels waits for everything else). Answers come back with their arrays
+//!   transferred, not copied, and become the same [`JobResult`]s the desktop's threads send, with
+//!   the same progress.
+//! - The measuring worker keeps the meshes it measures against (the document's and the clean
+//!   one): a request sends the result only. A newer measuring, or the view moving on, ends it, as
+//!   the desktop's measuring stops half way; a fresh one starts with the next request, which
+//!   carries the meshes again.
 //! - The engine keeps what it built: a slider step sends the level and the settings only. When
 //!   it does not hold the hierarchy a request is for (it was started afresh, or an undo brought
 //!   back an older one), the request carries the mesh and the hierarchy as bytes
@@ -196,8 +201,16 @@ struct Held {
     workspace: Arc<Mutex<MultiresWorkspace>>,
 }
 
+/// What the measuring worker measures each result against: the document's mesh and the clean
+/// mesh (the one before the noise), if there is one.
+struct Against {
+    base: TriMesh,
+    clean: Option<TriMesh>,
+}
+
 thread_local! {
     static HELD: RefCell<Option<Held>> = const { RefCell::new(None) };
+    static AGAINST: RefCell<Option<Arc<Against>>> = const { RefCell::new(None) };
 }
 
 /// Posts `fields` to the page as `{kind, ...fields}`, transferring `transfer`'s buffers.
@@ -433,12 +446,21 @@ fn noise(message: &JsValue) -> Result<(), String> {
     Ok(())
 }
 
-/// Measures a faired result (the request's `positions` on its `base_` mesh's triangles) against
-/// the document's mesh (`base_`) and the clean one (`clean_`, if any), as the desktop's measuring
-/// thread does.
+/// Measures a faired result (the request's `positions` on the document mesh's triangles) against
+/// the document's mesh and the clean one (if any), as the desktop's measuring thread does. A
+/// request that carries `meshes` brings those two (`base_` and `clean_`), and the measuring
+/// worker keeps them for the requests after it.
 fn measure(message: &JsValue) -> Result<(), String> {
     let started = web_time::Instant::now();
-    let base = mesh_from(message, "base_").ok_or("the request has no mesh")?;
+    if get(message, "meshes").is_truthy() {
+        let base = mesh_from(message, "base_").ok_or("the request has no mesh")?;
+        let clean = mesh_from(message, "clean_");
+        AGAINST.with(|held| *held.borrow_mut() = Some(Arc::new(Against { base, clean })));
+    }
+    let against = AGAINST
+        .with(|held| held.borrow().clone())
+        .ok_or("the measuring worker holds no mesh")?;
+    let base = &against.base;
     let faired = TriMesh {
         positions: positions_from(&get(message, "positions")),
         triangles: base.triangles.clone(),
@@ -446,8 +468,8 @@ fn measure(message: &JsValue) -> Result<(), String> {
     if faired.positions.len() != base.positions.len() {
         return Err("the result to measure does not fit the mesh".into());
     }
-    let against_document = Measures::of(&base, &faired);
-    let against_clean = mesh_from(message, "clean_").map(|clean| Measures::of(&clean, &faired));
+    let against_document = Measures::of(base, &faired);
+    let against_clean = against.clean.as_ref().map(|clean| Measures::of(clean, &faired));
     let transfer = js_sys::Array::new();
     let against_document = measures_to_js(&against_document, &transfer);
     let against_clean = against_clean.map(|m| measures_to_js(&m, &transfer));
@@ -557,15 +579,38 @@ enum Reply {
     Measure {
         document: GenerationId,
         serial: u64,
-        /// How many vertices the measured result has.
-        vertices: usize,
+        /// The result being measured (given back when the measuring stops).
+        positions: Arc<Vec<[f32; 3]>>,
+        view_generation: Generation,
+        /// The view the result was measured for: the measuring stops when it moves on.
+        view: GenerationId,
     },
+}
+
+/// The meshes a measuring is against (the document's and the clean one), sent along unless the
+/// measuring worker holds them already.
+#[derive(Clone)]
+struct AgainstMeshes {
+    base: Arc<TriMesh>,
+    clean: Option<Arc<TriMesh>>,
+}
+
+impl AgainstMeshes {
+    fn same(&self, other: &Self) -> bool {
+        Arc::ptr_eq(&self.base, &other.base)
+            && match (&self.clean, &other.clean) {
+                (Some(a), Some(b)) => Arc::ptr_eq(a, b),
+                (None, None) => true,
+                _ => false,
+            }
+    }
 }
 
 struct Request {
     message: js_sys::Object,
     transfer: js_sys::Array,
     state: Option<State>,
+    against: Option<AgainstMeshes>,
     reply: Reply,
     /// The document the request is for.
     document: GenerationId,
@@ -599,14 +644,45 @@ impl Request {
             _ => false,
         }
     }
+
+    /// A measuring whose result the view no longer shows, or soon will not (the slider moved,
+    /// an option changed): it stops, as on the desktop, to leave the cores to the next fairing.
+    fn moved_on(&self) -> bool {
+        match &self.reply {
+            Reply::Measure {
+                view_generation,
+                view,
+                ..
+            } => !view_generation.is_current(*view),
+            _ => false,
+        }
+    }
+}
+
+/// The page's two workers: the engine (the hierarchy, fairing, noise) and the measuring worker,
+/// so that a fairing never waits for a measuring.
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum Role {
+    Engine,
+    Measurer,
+}
+
+impl Role {
+    fn with<T>(self, f: impl FnOnce(&mut Engine) -> T) -> T {
+        let cell = match self {
+            Role::Engine => &ENGINE,
+            Role::Measurer => &MEASURER,
+        };
+        cell.with(|engine| f(&mut engine.borrow_mut()))
+    }
 }
 
 /// A handler of the worker's events.
 type Handler = Closure<dyn FnMut(JsValue)>;
 
-/// The worker and its requests.
-#[derive(Default)]
+/// A worker and its requests.
 struct Engine {
+    role: Role,
     /// The worker, with its message and error handlers.
     worker: Option<(js::Worker, Handler, Handler)>,
     /// No worker could be started: jobs run on the page.
@@ -617,12 +693,17 @@ struct Engine {
     idle: VecDeque<Request>,
     /// The hierarchy the engine holds (the page's copy of it).
     held: Option<Arc<Hierarchy>>,
+    /// The meshes the measuring worker holds.
+    held_against: Option<AgainstMeshes>,
+    /// Messages the worker sent (progress and answers), counted since the page started.
+    heard: u64,
     /// The handlers of ended workers.
     retired: Vec<(Handler, Handler)>,
 }
 
 thread_local! {
-    static ENGINE: RefCell<Engine> = RefCell::new(Engine::default());
+    static ENGINE: RefCell<Engine> = RefCell::new(Engine::new(Role::Engine));
+    static MEASURER: RefCell<Engine> = RefCell::new(Engine::new(Role::Measurer));
 }
 
 /// A job's message to the worker: its kind and the settings as JSON; `None` when the settings
@@ -643,6 +724,21 @@ fn settings_json(settings: &Settings) -> Option<String> {
 }
 
 impl Engine {
+    fn new(role: Role) -> Self {
+        Self {
+            role,
+            worker: None,
+            unavailable: false,
+            in_flight: None,
+            waiting: VecDeque::new(),
+            idle: VecDeque::new(),
+            held: None,
+            held_against: None,
+            heard: 0,
+            retired: Vec::new(),
+        }
+    }
+
     fn ensure_worker(&mut self) -> bool {
         if self.worker.is_some() {
             return true;
@@ -677,16 +773,17 @@ impl Engine {
                 return false;
             }
         };
-        let on_message = Handler::new(|event: JsValue| {
+        let role = self.role;
+        let on_message = Handler::new(move |event: JsValue| {
             let data = get(&event, "data");
-            ENGINE.with(|engine| engine.borrow_mut().on_message(&data));
+            role.with(|engine| engine.on_message(&data));
         });
-        let on_error = Handler::new(|event: JsValue| {
+        let on_error = Handler::new(move |event: JsValue| {
             let message = text(&event, "message").unwrap_or_else(|| "the worker failed".into());
             let data = js_sys::Object::new();
             set(&data, "kind", "failed");
             set(&data, "message", message);
-            ENGINE.with(|engine| engine.borrow_mut().on_message(&data));
+            role.with(|engine| engine.on_message(&data));
         });
         worker.set_onmessage(on_message.as_ref().unchecked_ref());
         worker.set_onerror(on_error.as_ref().unchecked_ref());
@@ -712,6 +809,7 @@ impl Engine {
             self.retired.push((on_message, on_error));
         }
         self.held = None;
+        self.held_against = None;
         self.in_flight = None;
     }
 
@@ -728,9 +826,17 @@ impl Engine {
                     .retain(|r| !matches!(r.reply, Reply::Fair { .. }));
             }
             if matches!(request.reply, Reply::Measure { .. }) {
-                // So does a newer measuring.
+                // So does a newer measuring, and it ends the one in flight: that one's result
+                // is no longer on screen. The measuring worker starts again with the meshes.
                 self.waiting
                     .retain(|r| !matches!(r.reply, Reply::Measure { .. }));
+                if self
+                    .in_flight
+                    .as_ref()
+                    .is_some_and(|r| matches!(r.reply, Reply::Measure { .. }))
+                {
+                    self.end_worker();
+                }
             }
             self.waiting.push_back(request);
         }
@@ -744,13 +850,11 @@ impl Engine {
         }
         self.waiting.retain(|r| !r.is_stale());
         self.idle.retain(|r| !r.is_stale());
-        // A measuring lets the other waiting requests go first (a fairing the user waits for).
-        let next = self
+        let Some(request) = self
             .waiting
-            .iter()
-            .position(|r| !matches!(r.reply, Reply::Measure { .. }))
-            .unwrap_or(0);
-        let Some(request) = self.waiting.remove(next).or_else(|| self.idle.pop_front()) else {
+            .pop_front()
+            .or_else(|| self.idle.pop_front())
+        else {
             return;
         };
         if !self.ensure_worker() {
@@ -777,6 +881,20 @@ impl Engine {
                 self.held = Some(state.hierarchy.clone());
             }
         }
+        if let Some(against) = &request.against {
+            let holds = self
+                .held_against
+                .as_ref()
+                .is_some_and(|held| held.same(against));
+            if !holds {
+                set(&request.message, "meshes", true);
+                set_mesh(&request.message, &request.transfer, "base_", &against.base);
+                if let Some(clean) = &against.clean {
+                    set_mesh(&request.message, &request.transfer, "clean_", clean);
+                }
+                self.held_against = Some(against.clone());
+            }
+        }
         let sent = self
             .worker
             .as_ref()
@@ -797,6 +915,7 @@ impl Engine {
     }
 
     fn on_message(&mut self, data: &JsValue) {
+        self.heard += 1;
         let kind = text(data, "kind").unwrap_or_default();
         if kind == "progress" {
             if let Some(request) = &self.in_flight {
@@ -835,10 +954,18 @@ impl Engine {
     }
 
     /// Ends the worker if the request it runs is no longer wanted, and drops such waiting ones.
+    /// A measuring whose view moved on is ended too, and said to have stopped (the app
+    /// measures the result again if it is still shown when the view rests).
     fn tick(&mut self) {
         self.retired.clear();
         if self.in_flight.as_ref().is_some_and(Request::is_stale) {
             self.end_worker();
+        } else if self.in_flight.as_ref().is_some_and(Request::moved_on) {
+            let request = self.in_flight.take();
+            self.end_worker();
+            if let Some(request) = request {
+                on_measure_stopped(request);
+            }
         }
         self.send_next();
     }
@@ -991,16 +1118,37 @@ fn on_noised(request: Request, data: &JsValue) {
     send(request.sending, result);
 }
 
+/// A measuring ended because its view moved on, said as the desktop's measuring thread says it.
+fn on_measure_stopped(request: Request) {
+    let Reply::Measure {
+        document,
+        serial,
+        positions,
+        ..
+    } = request.reply
+    else {
+        return;
+    };
+    let result = JobResult::MeasureStopped {
+        document,
+        serial,
+        positions,
+    };
+    send(request.sending, result);
+}
+
 /// A result's measures, sent on as the desktop's measuring thread sends them.
 fn on_measured(request: Request, data: &JsValue) {
     let Reply::Measure {
         document,
         serial,
-        vertices,
+        ref positions,
+        ..
     } = request.reply
     else {
         return;
     };
+    let vertices = positions.len();
     let against_document = measures_from_js(&get(data, "against_document"), vertices);
     let clean = get(data, "against_clean");
     let against_clean = measures_from_js(&clean, vertices);
@@ -1052,6 +1200,7 @@ pub(in crate::app) fn post_hierarchy(post: HierarchyPost, sending: Sending) -> R
         message,
         transfer,
         state: None,
+        against: None,
         reply: Reply::Hierarchy {
             document: post.document,
             generation: post.generation,
@@ -1101,6 +1250,7 @@ pub(in crate::app) fn post_fair(post: FairPost, sending: Sending) -> Result<(), 
             original: post.original,
             denoised: post.denoised,
         }),
+        against: None,
         reply: Reply::Fair {
             document: post.document,
             view: post.view,
@@ -1135,6 +1285,7 @@ pub(in crate::app) fn post_prepare(
             original,
             denoised,
         }),
+        against: None,
         reply: Reply::Prepare,
         document,
         document_generation,
@@ -1170,6 +1321,7 @@ pub(in crate::app) fn post_noise(post: NoisePost, sending: Sending) -> Result<()
         message,
         transfer,
         state: None,
+        against: None,
         reply: Reply::Noise {
             document: post.document,
             label: post.label,
@@ -1194,11 +1346,17 @@ pub(in crate::app) struct MeasurePost {
     /// The document's mesh.
     pub(in crate::app) base: Arc<TriMesh>,
     pub(in crate::app) clean: Option<Arc<TriMesh>>,
+    pub(in crate::app) view_generation: Generation,
+    /// The view the result is measured for.
+    pub(in crate::app) view: GenerationId,
 }
 
-/// Measures a faired result in the worker against the document's mesh and the clean one (see
-/// [`post_hierarchy`] for the error). It runs to its end even when the view has moved on
-/// meanwhile (a worker cannot be told to stop): the result is measured once, whenever asked.
+/// Measures a faired result against the document's mesh and the clean one in the measuring
+/// worker, a worker of its own beside the engine's, so that a fairing never waits for a
+/// measuring (see [`post_hierarchy`] for the error). The worker keeps the two meshes: a request
+/// sends the result only. A newer measuring, or the view moving on (the slider, an option),
+/// ends the worker, as the desktop stops its measuring half way; the next one starts afresh
+/// and is sent the meshes again.
 pub(in crate::app) fn post_measure(post: MeasurePost, sending: Sending) -> Result<(), Sending> {
     let message = js_sys::Object::new();
     set(&message, "kind", "measure");
@@ -1206,30 +1364,35 @@ pub(in crate::app) fn post_measure(post: MeasurePost, sending: Sending) -> Resul
     let positions = flat_positions(&post.positions);
     transfer.push(&positions.buffer());
     set(&message, "positions", positions);
-    set_mesh(&message, &transfer, "base_", &post.base);
-    if let Some(clean) = &post.clean {
-        set_mesh(&message, &transfer, "clean_", clean);
-    }
     let request = Request {
         message,
         transfer,
         state: None,
+        against: Some(AgainstMeshes {
+            base: post.base,
+            clean: post.clean,
+        }),
         reply: Reply::Measure {
             document: post.document,
             serial: post.serial,
-            vertices: post.positions.len(),
+            positions: post.positions,
+            view_generation: post.view_generation,
+            view: post.view,
         },
         document: post.document,
         document_generation: post.document_generation,
         progress: SharedProgress::default(),
         sending,
     };
-    queue(request, false)
+    queue_on(Role::Measurer, request, false)
 }
 
 fn queue(request: Request, idle: bool) -> Result<(), Sending> {
-    ENGINE.with(|engine| {
-        let mut engine = engine.borrow_mut();
+    queue_on(Role::Engine, request, idle)
+}
+
+fn queue_on(role: Role, request: Request, idle: bool) -> Result<(), Sending> {
+    role.with(|engine| {
         if engine.ensure_worker() {
             engine.queue(request, idle);
             Ok(())
@@ -1239,8 +1402,16 @@ fn queue(request: Request, idle: bool) -> Result<(), Sending> {
     })
 }
 
-/// Once a frame: ends the worker when the job it runs is no longer wanted (Cancel, another
-/// file), and sends what waits.
+/// Whether the engine's worker (not the measuring one) runs a job now, and how many messages
+/// the page has had from its workers so far: the page's status, which shows that the page
+/// answers while a job runs (the count moves on between two of its frames).
+pub(in crate::app) fn engine_activity() -> (bool, u64) {
+    Role::Engine.with(|engine| (engine.in_flight.is_some(), engine.heard))
+}
+
+/// Once a frame: ends a worker when the job it runs is no longer wanted (Cancel, another
+/// file, a measuring whose view moved on), and sends what waits.
 pub(in crate::app) fn tick() {
-    ENGINE.with(|engine| engine.borrow_mut().tick());
+    Role::Engine.with(Engine::tick);
+    Role::Measurer.with(Engine::tick);
 }

@@ -54,15 +54,17 @@ pub fn mark(name: &str) {
 }
 
 /// What the app showed at the end of its last frame, as JSON: the document, whether work is in
-/// flight (`settled`), the hierarchy's levels, the level and result on screen, the error and
-/// the status message (the page's scripting hook; the browser test reads it).
+/// flight (`settled`), the hierarchy's levels, the level and result on screen, whether it is
+/// being measured, the error, the status message, the frame's number and the engine's worker's
+/// activity (the page's scripting hook; the browser test reads it).
 pub fn status() -> String {
     events::STATUS.with(|kept| kept.borrow().clone())
 }
 
 /// Asks the app for something as its widgets would (the page's scripting hook, for automation
 /// and the browser test): `level` N (the start level slider), `export` NAME (Export, the
-/// download named NAME), `open` URL (as `?open=`), `noise`, `undo`, `redo`, `fit`.
+/// download named NAME), `export_levels` (Export levels: the level chain as one `.zip`), `open`
+/// URL (as `?open=`), `noise`, `undo`, `redo`, `fit`.
 pub fn command(name: &str, value: &str) -> Result<(), String> {
     use crate::app::Command;
     let command = match name {
@@ -72,6 +74,7 @@ pub fn command(name: &str, value: &str) -> Result<(), String> {
                 .map_err(|_| format!("level: {value:?} is not a level number"))?,
         ),
         "export" => Command::Export(PathBuf::from(value)),
+        "export_levels" => Command::ExportLevels,
         "open" => {
             open_url(value.to_owned());
             return Ok(());
@@ -170,6 +173,7 @@ impl App {
             ),
             _ => (None, None),
         };
+        let engine_activity = engine::engine_activity();
         let fair_ms = document
             .and_then(|d| d.faired.as_ref())
             .map(|f| milliseconds(f.elapsed));
@@ -187,6 +191,13 @@ impl App {
                 Some(crate::app::state::HierarchyState::Building)
             ),
             "hierarchy_progress": self.work.hierarchy_progress.get(),
+            // The result on screen is being measured (its numbers and heat map are on the way).
+            "measuring": status.measuring,
+            // Which frame published this: the page drew that many frames since it started.
+            "frame": self.ctx.cumulative_frame_nr(),
+            // The engine's worker runs a job, and the messages had from it so far.
+            "engine_busy": engine_activity.0,
+            "engine_heard": engine_activity.1,
             "level_count": status.level_count,
             "level": status.level,
             "faired_serial": status.faired_serial,
@@ -265,12 +276,16 @@ impl App {
     }
 
     /// The export was written into the export folder: hands it to the browser as a download
-    /// and returns the download's name (`None`: it failed, and the error says why).
+    /// and returns the download's name (`None`: it failed, and the error says why). Several
+    /// files go as one `.zip` named after `path` (a file's companions beside it, or the level
+    /// chain's folder with the levels in it).
     pub(in crate::app) fn download_export(&mut self, path: &Path) -> Option<String> {
         let files = EXPORT.with(MemoryFolder::files);
         let result = match files.as_slice() {
             [] => Err(format!("{}: the export wrote nothing", path.display())),
             [(name, bytes)] => {
+                // A file in a folder (one level of the level chain) downloads under its own name.
+                let name = name.file_name().unwrap_or(name.as_os_str());
                 let name = name.to_string_lossy().into_owned();
                 download::offer(&name, bytes).map(|()| name)
             }
