@@ -8,15 +8,16 @@
 //! the editor), and every edge folded beyond 90° where M0 was not bent to within 5° of a right
 //! angle (a box's edges are features), is undone in steps, each for what the one before left:
 //!
-//! 1. **Tangential relaxation** around the folds ([`TANGENT_RINGS`] rings, [`TANGENT_SWEEPS`]
-//!    sweeps): every vertex moves towards the mean of its neighbours, less the part along its
-//!    normal. Most folds of a
-//!    coarse run are triangles squeezed past each other on a surface that is smooth, and this
-//!    spreads them out again without changing the shape. Crease and boundary vertices stay.
-//! 2. The corners of what is left (an edge: its two ends and its faces' third corners) move to
-//!    the mean of their neighbours (Jacobi, a few sweeps), and those of faces and edges still
-//!    turned or folded join them, until none is left or [`UNFOLD_PASSES`] have run. A crease
-//!    vertex moves along its crease (to the mean of its two neighbours on it).
+//! 1. The corners of each (an edge: its two ends and its faces' third corners) move to the mean
+//!    of their neighbours (Jacobi, a few sweeps), and those of faces and edges still turned or
+//!    folded join them, until none is left or [`UNFOLD_PASSES`] have run. A crease vertex moves
+//!    along its crease (to the mean of its two neighbours on it); corners of creases and
+//!    boundary vertices stay. From the middle levels down this is all most runs need.
+//! 2. **Tangential relaxation** around what is left ([`TANGENT_RINGS`] rings,
+//!    [`TANGENT_SWEEPS`] sweeps): every vertex moves towards the mean of its neighbours, less the
+//!    part along its normal, and 1. runs again. Most folds of a coarse run are triangles squeezed
+//!    past each other on a surface that is smooth, and this spreads them out again without
+//!    changing the shape. Crease and boundary vertices stay.
 //! 3. **The displacement from M0 smoothed** around what is still left: the corners that lie far
 //!    from M0 (more than half their edge length there, [`FAR_FROM_M0`]) and the vertices up to k
 //!    rings around them get the mean of their neighbours' displacements, the vertices outside
@@ -88,7 +89,7 @@ const FAR_FROM_M0: f32 = 0.5;
 const RAMP_ROUNDS: usize = 8;
 
 /// At most this many times the volume is given back after the unfolding (each time holding the
-/// vertices put back to M0, and putting back what it turned again).
+/// vertices put back to M0, and undoing what it turned again).
 const VOLUME_PASSES: usize = 3;
 
 /// Umbrella sweeps over the folds' corners in each pass.
@@ -585,14 +586,7 @@ pub(super) fn unfold(positions: &mut [[f32; 3]], level: &Level, folds: &mut Fold
         topology.is_boundary_vertex(v)
             || (creases.is_some_and(|c| c.is_feature(v)) && on_crease(v).is_none())
     };
-    // Crease vertices too stay in the relaxation: moved along their faces' mean plane they would
-    // leave the crease.
     let at_rest = positions.to_vec();
-    relax_tangentially(positions, &mesh.triangles, topology, &mut state, |v| {
-        topology.is_boundary_vertex(v)
-            || topology.neighbors(v).is_empty()
-            || creases.is_some_and(|c| c.is_feature(v))
-    });
     let mut moving = vec![false; positions.len()];
     let mut region: Vec<u32> = Vec::new();
     // The vertices put back to M0 (below), which stay there.
@@ -640,23 +634,34 @@ pub(super) fn unfold(positions: &mut [[f32; 3]], level: &Level, folds: &mut Fold
         }
     };
     passes(positions, &mut state, &mut region, &mut moving, &back);
+    // What the means leave, relaxed along the surface around it and passed over again. Crease
+    // vertices too stay in the relaxation: moved along their faces' mean plane they would leave
+    // the crease.
+    if !state.corners().is_empty() {
+        relax_tangentially(positions, &mesh.triangles, topology, &mut state, |v| {
+            topology.is_boundary_vertex(v)
+                || topology.neighbors(v).is_empty()
+                || creases.is_some_and(|c| c.is_feature(v))
+        });
+        passes(positions, &mut state, &mut region, &mut moving, &back);
+    }
     // What the neighbours' means cannot undo (a fold whose corners all stay, or one the levels
     // pressed in too deep), with the displacement from M0; last, what is left goes back to M0.
     undo_what_is_left(positions, mesh, topology, &mut state, &mut back);
     drop(state);
-    // The offset holds the vertices put back; what it turns again goes back too, and the
-    // offset is made again without them, a few times at most.
+    // The offset holds the vertices put back; what it turns again is undone as above, and the
+    // offset made again, until it turns nothing (a few times at most: after the last, the
+    // volume is off by what that undoing moved).
     for _ in 0..VOLUME_PASSES {
         if volume.is_none() {
             break;
         }
         restore(positions, &mut volume, &back);
         let mut state = FoldState::new(positions, &mesh.triangles, topology, folds);
-        let before = back.iter().filter(|&&b| b).count();
-        undo_what_is_left(positions, mesh, topology, &mut state, &mut back);
-        if back.iter().filter(|&&b| b).count() == before {
+        if state.faces.is_empty() && state.edges.is_empty() {
             break;
         }
+        undo_what_is_left(positions, mesh, topology, &mut state, &mut back);
     }
     if keep_volume {
         folds.volume = volume;
@@ -722,10 +727,11 @@ mod tests {
             &mut fold_edges(&mesh, &edges, &reference),
         );
         assert!(folded(&positions, &mesh, &edges).iter().all(|&f| !f));
-        // The vertex is back near its place. Every sweep of the relaxation reaches one ring
-        // further (on a regular grid a vertex is the mean of its neighbours, so only the push
-        // moves anything), and nothing else ran: the vertices more than TANGENT_SWEEPS rings
-        // away did not move, and those that did stayed in the plane.
+        // The vertex is back near its place. The passes move the folds' corners only, and every
+        // sweep of the relaxation, if it runs, reaches one ring further (on a regular grid a
+        // vertex is the mean of its neighbours, so only the push moves anything): the vertices
+        // more than TANGENT_SWEEPS rings away did not move, and those that did stayed in the
+        // plane.
         assert!((positions[v][0] - mesh.positions[v][0]).abs() < 0.5);
         let mut near = 0;
         for (u, (now, was)) in positions.iter().zip(&mesh.positions).enumerate() {

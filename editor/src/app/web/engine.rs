@@ -469,7 +469,10 @@ fn measure(message: &JsValue) -> Result<(), String> {
         return Err("the result to measure does not fit the mesh".into());
     }
     let against_document = Measures::of(base, &faired);
-    let against_clean = against.clean.as_ref().map(|clean| Measures::of(clean, &faired));
+    let against_clean = against
+        .clean
+        .as_ref()
+        .map(|clean| Measures::of(clean, &faired));
     let transfer = js_sys::Array::new();
     let against_document = measures_to_js(&against_document, &transfer);
     let against_clean = against_clean.map(|m| measures_to_js(&m, &transfer));
@@ -850,11 +853,7 @@ impl Engine {
         }
         self.waiting.retain(|r| !r.is_stale());
         self.idle.retain(|r| !r.is_stale());
-        let Some(request) = self
-            .waiting
-            .pop_front()
-            .or_else(|| self.idle.pop_front())
-        else {
+        let Some(request) = self.waiting.pop_front().or_else(|| self.idle.pop_front()) else {
             return;
         };
         if !self.ensure_worker() {
