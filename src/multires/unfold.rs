@@ -503,11 +503,7 @@ fn undo_what_is_left(
         if still.is_empty() {
             break;
         }
-        for &v in &still {
-            positions[v as usize] = mesh.positions[v as usize];
-            back[v as usize] = true;
-        }
-        state.moved(positions, &still);
+        put_at_m0(positions, mesh, state, back, &still);
         smooth_displacement(positions, mesh, topology, state, back, &DISPLACEMENT_RINGS);
     }
     put_back(positions, mesh, state, back);
@@ -525,12 +521,23 @@ fn put_back(positions: &mut [[f32; 3]], mesh: &TriMesh, state: &mut FoldState, b
         if still.is_empty() {
             return;
         }
-        for &v in &still {
-            positions[v as usize] = mesh.positions[v as usize];
-            back[v as usize] = true;
-        }
-        state.moved(positions, &still);
+        put_at_m0(positions, mesh, state, back, &still);
     }
+}
+
+/// Puts `vertices` where M0 has them, marks them in `back` and tells `state` they moved.
+fn put_at_m0(
+    positions: &mut [[f32; 3]],
+    mesh: &TriMesh,
+    state: &mut FoldState,
+    back: &mut [bool],
+    vertices: &[u32],
+) {
+    for &v in vertices {
+        positions[v as usize] = mesh.positions[v as usize];
+        back[v as usize] = true;
+    }
+    state.moved(positions, vertices);
 }
 
 /// Moves the corners of the faces turned against M0 and the edges folded where M0 is not
