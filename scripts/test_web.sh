@@ -2,8 +2,9 @@
 # The editor's web page tested in a real browser (CI runs it as a step of its own; docs/web.md):
 # installs what it needs (Debian's chromium, the wasm32 target, wasm-bindgen-cli, npm's
 # playwright-core), builds the page (the quicker debug build: scripts/web.sh build --dev), serves
-# it on 127.0.0.1 with the test files beside it, and runs web/tests/browser.mjs twice: with the
-# renderer the browser picks (WebGPU where it has it) and with WebGL2 alone. Then it checks the
+# it on 127.0.0.1 with the test files beside it, and runs web/tests/browser.mjs three times: with
+# the renderer the browser picks (WebGL2: headless with --disable-gpu it has no WebGPU adapter),
+# with WebGL2 alone, and with the browser's software WebGPU (the page must draw through WebGPU). Then it checks the
 # downloads against the command-line tool: the exported OBJ's positions equal `fairmesh multires`
 # at the same level within 1e-5 of the bounding box's diagonal, with the same .mtl and texture,
 # and the broken file's error is the one `fairmesh info` gives. Screenshots, downloads and the
@@ -44,7 +45,7 @@ for _ in $(seq 50); do
 done
 
 status=0
-for backend in "" webgl2; do
+for backend in "" webgl2 webgpu; do
   FAIRMESH_WEB_URL="http://127.0.0.1:$port/" FAIRMESH_WEB_OUT="$results" \
     FAIRMESH_WEB_BACKEND="$backend" FAIRMESH_WEB_DATA="$site/data" \
     node web/tests/browser.mjs || status=1

@@ -123,7 +123,7 @@ fn wait_for_uploads(renderer: &mut MeshRenderer, queue: &wgpu::Queue) {
 #[test]
 fn the_newest_mesh_wins_over_uploads_in_flight() {
     let (device, queue) = device();
-    let mut renderer = MeshRenderer::new(&device, Arc::new(|| {}));
+    let mut renderer = MeshRenderer::new(&device, &queue, Arc::new(|| {}));
     renderer.set_async_upload_bytes(0);
     let sizes = [120, 80, 7];
     for n in sizes {
@@ -151,7 +151,7 @@ fn the_newest_mesh_wins_over_uploads_in_flight() {
 #[test]
 fn a_failed_upload_leaves_a_notice_and_a_working_renderer() {
     let (device, queue) = device();
-    let mut renderer = MeshRenderer::new(&device, Arc::new(|| {}));
+    let mut renderer = MeshRenderer::new(&device, &queue, Arc::new(|| {}));
     renderer.set_async_upload_bytes(0);
     // Call 1 is `set_mesh` counting faces on this thread; call 2 is on the upload thread.
     let mut failing = Grid::new(20);
@@ -177,7 +177,7 @@ fn a_failed_upload_leaves_a_notice_and_a_working_renderer() {
 #[test]
 fn uploaded_normals_follow_the_positions_on_screen() {
     let (device, queue) = device();
-    let mut renderer = MeshRenderer::new(&device, Arc::new(|| {}));
+    let mut renderer = MeshRenderer::new(&device, &queue, Arc::new(|| {}));
     let n = 12;
     let count = ((n + 1) * (n + 1)) as usize;
     for async_bytes in [usize::MAX, 0] {
@@ -213,7 +213,7 @@ fn uploaded_normals_follow_the_positions_on_screen() {
 #[test]
 fn a_move_that_folds_the_mesh_splits_its_shading_at_the_fold() {
     let (device, queue) = device();
-    let mut renderer = MeshRenderer::new(&device, Arc::new(|| {}));
+    let mut renderer = MeshRenderer::new(&device, &queue, Arc::new(|| {}));
     let n = 8;
     let count = ((n + 1) * (n + 1)) as usize;
     for async_bytes in [usize::MAX, 0] {
@@ -307,7 +307,7 @@ fn render_once(
 #[test]
 fn an_image_drawn_over_several_frames_is_the_image_drawn_at_once() {
     let (device, queue) = device();
-    let mut renderer = MeshRenderer::new(&device, Arc::new(|| {}));
+    let mut renderer = MeshRenderer::new(&device, &queue, Arc::new(|| {}));
     renderer.set_async_upload_bytes(usize::MAX);
     // A dome over a plane, 2 × 2 × 40² = 6400 faces (and 19200 wireframe edges), into a 4×
     // multisampled target: the plane's faces, drawn in later parts, are hidden by the depth the
@@ -389,7 +389,7 @@ fn an_image_drawn_over_several_frames_is_the_image_drawn_at_once() {
 #[test]
 fn a_software_renderer_draws_big_meshes_with_one_sample_and_small_ones_with_four() {
     let (device, queue) = device();
-    let mut renderer = MeshRenderer::new(&device, Arc::new(|| {}));
+    let mut renderer = MeshRenderer::new(&device, &queue, Arc::new(|| {}));
     renderer.set_async_upload_bytes(0);
     renderer.set_software_adapter(true);
     // 460² quads: 423k faces, over the threshold.
@@ -430,7 +430,7 @@ fn finish_image(
 fn a_held_mesh_shows_its_kept_image_again_only_while_nothing_changed() {
     use fairmesh_editor::render::{ImageCounts, MeshKey};
     let (device, queue) = device();
-    let mut renderer = MeshRenderer::new(&device, Arc::new(|| {}));
+    let mut renderer = MeshRenderer::new(&device, &queue, Arc::new(|| {}));
     renderer.set_async_upload_bytes(usize::MAX);
     let size = [96, 80];
     renderer.ensure_target(&device, size);

@@ -57,7 +57,13 @@ pub fn start() {
         ..Default::default()
     };
     let open = query_parameter("open");
+    let webgl2 = query_parameter("backend").as_deref() == Some("webgl2");
     wasm_bindgen_futures::spawn_local(async move {
+        // index.html asks the browser's WebGPU adapter whether it is a software renderer while
+        // the module compiles (wgpu's adapter info does not say): answered by now.
+        if !webgl2 {
+            fairmesh_editor::render::page::set_software_webgpu(software_webgpu().await);
+        }
         let started = eframe::WebRunner::new()
             .start(
                 canvas,
@@ -91,6 +97,24 @@ pub fn start() {
             Err(error) => show_failure(&format!("The editor could not start: {error:?}")),
         }
     });
+}
+
+/// Whether `window.fairmeshSoftwareWebGpu` (index.html: a promise of whether the browser's
+/// WebGPU adapter is a software renderer, SwiftShader or the fallback adapter) says so.
+async fn software_webgpu() -> bool {
+    let Some(window) = web_sys::window() else {
+        return false;
+    };
+    let Ok(answer) = js_sys::Reflect::get(&window, &JsValue::from_str("fairmeshSoftwareWebGpu"))
+    else {
+        return false;
+    };
+    let Ok(promise) = answer.dyn_into::<js_sys::Promise>() else {
+        return false;
+    };
+    wasm_bindgen_futures::JsFuture::from(promise)
+        .await
+        .is_ok_and(|software| software.as_bool() == Some(true))
 }
 
 /// What the editor showed at the end of its last frame, as JSON (`window.fairmesh.status()`:

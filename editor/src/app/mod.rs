@@ -245,6 +245,7 @@ impl eframe::App for App {
         // A page has no threads: one waiting job runs here, between two frames.
         #[cfg(target_arch = "wasm32")]
         {
+            self.mark_first_picture();
             self.poll_web();
             self.run_one_job();
         }

@@ -25,6 +25,30 @@ pub use shading::{Lighting, Shading};
 use egui_wgpu::wgpu;
 use std::sync::Arc;
 
+/// What the web page tells the renderer about the browser's GPU.
+#[cfg(target_arch = "wasm32")]
+pub mod page {
+    use std::sync::atomic::{AtomicBool, Ordering};
+
+    static SOFTWARE_WEBGPU: AtomicBool = AtomicBool::new(false);
+
+    /// The page found that the browser's WebGPU adapter is a software renderer (its
+    /// architecture is SwiftShader, or it is the browser's fallback adapter), which wgpu's
+    /// adapter info does not say. Call before the renderer is made.
+    pub fn set_software_webgpu(software: bool) {
+        SOFTWARE_WEBGPU.store(software, Ordering::Relaxed);
+    }
+
+    /// Whether `info`'s adapter draws on the CPU: a CPU device, SwiftShader under WebGL2 (its
+    /// name), or a WebGPU adapter the page found to be one.
+    pub(super) fn software_renderer(info: &super::wgpu::AdapterInfo) -> bool {
+        info.device_type == super::wgpu::DeviceType::Cpu
+            || info.name.to_lowercase().contains("swiftshader")
+            || (info.backend == super::wgpu::Backend::BrowserWebGpu
+                && SOFTWARE_WEBGPU.load(Ordering::Relaxed))
+    }
+}
+
 /// Every viewport's renderer, in egui_wgpu's callback resources (one entry per type, so the
 /// renderers of several viewports share one list; a viewport knows its slot).
 #[derive(Default)]
@@ -43,10 +67,18 @@ impl Viewport3d {
     /// device; `ctx` repaints when a background upload lands.
     pub fn new(state: &egui_wgpu::RenderState, ctx: &egui::Context) -> Self {
         let ctx = ctx.clone();
-        let mut renderer =
-            MeshRenderer::new(&state.device, Arc::new(move || ctx.request_repaint()));
-        renderer
-            .set_software_adapter(state.adapter.get_info().device_type == wgpu::DeviceType::Cpu);
+        let mut renderer = MeshRenderer::new(
+            &state.device,
+            &state.queue,
+            Arc::new(move || ctx.request_repaint()),
+        );
+        let info = state.adapter.get_info();
+        renderer.set_software_adapter(info.device_type == wgpu::DeviceType::Cpu);
+        // In the page, a software renderer draws every mesh with one sample (docs/web.md).
+        #[cfg(target_arch = "wasm32")]
+        if page::software_renderer(&info) {
+            renderer.set_single_sampled();
+        }
         let mut egui_renderer = state.renderer.write();
         let resources = &mut egui_renderer.callback_resources;
         if resources.get::<MeshRenderers>().is_none() {
@@ -217,6 +249,12 @@ impl Viewport3d {
     /// costs tens of milliseconds of the same cores the background work runs on.
     pub fn software(&self) -> bool {
         self.state.adapter.get_info().device_type == wgpu::DeviceType::Cpu
+    }
+
+    /// Samples per pixel the mesh on screen is drawn with (4, or 1 on a software renderer for a
+    /// big mesh, or in the web page for every mesh).
+    pub fn samples(&self) -> u32 {
+        self.with_renderer(|r| r.samples()).unwrap_or(0)
     }
 
     /// Adapter name and backend, for the performance readout.

@@ -178,8 +178,10 @@ pub struct MeshRenderer {
 
 /// The device the renderer draws with and what it makes there once.
 struct DeviceKit {
-    /// The device the buffers are made on (a move may need new ones).
+    /// The device the buffers are made on (a move may need new ones), and the queue that
+    /// fills them.
     device: wgpu::Device,
+    queue: wgpu::Queue,
     /// The materials' bind group layout (shared by both samplings' pipelines) and the group of
     /// "no material".
     materials: MaterialKit,
@@ -188,6 +190,9 @@ struct DeviceKit {
     single_sample: Option<Pipelines>,
     /// The adapter is a CPU (a software renderer): big meshes are drawn with one sample.
     software: bool,
+    /// On a software renderer, meshes with more faces than this are drawn with one sample
+    /// ([`SOFTWARE_SINGLE_SAMPLE_FACES`], or 0 in the web page: every mesh).
+    single_sample_faces: usize,
     /// The biggest buffer the renderer makes (the device's limit, or less: tests).
     max_buffer_size: u64,
 }
@@ -203,17 +208,24 @@ struct PartDrawing {
 }
 
 impl MeshRenderer {
-    /// Pipelines on `device`, and an upload thread for big meshes that calls `on_upload_done`
-    /// (from that thread) whenever an upload lands, so the UI can repaint.
-    pub fn new(device: &wgpu::Device, on_upload_done: Arc<dyn Fn() + Send + Sync>) -> Self {
+    /// Pipelines on `device` (buffers filled through `queue`), and an upload thread for big
+    /// meshes that calls `on_upload_done` (from that thread) whenever an upload lands, so the
+    /// UI can repaint.
+    pub fn new(
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        on_upload_done: Arc<dyn Fn() + Send + Sync>,
+    ) -> Self {
         let materials = MaterialKit::new(device);
         Self {
             gpu: DeviceKit {
                 device: device.clone(),
+                queue: queue.clone(),
                 pipelines: Pipelines::new(device, SAMPLE_COUNT, &materials),
                 materials,
                 single_sample: None,
                 software: false,
+                single_sample_faces: SOFTWARE_SINGLE_SAMPLE_FACES,
                 max_buffer_size: device.limits().max_buffer_size,
             },
             newest_faces: 0,
@@ -221,7 +233,11 @@ impl MeshRenderer {
             held: Vec::new(),
             uploads: UploadCounts::default(),
             // Without the thread (it failed to start) every upload happens in the calling frame.
-            in_flight: InFlight::new(Uploader::spawn(device.clone(), on_upload_done.clone())),
+            in_flight: InFlight::new(Uploader::spawn(
+                device.clone(),
+                queue.clone(),
+                on_upload_done.clone(),
+            )),
             target: None,
             drawn: None,
             parts: PartDrawing {
@@ -348,7 +364,7 @@ impl MeshRenderer {
                 }
             }
         }
-        let mut buffers = MeshBuffers::create(device, source, false, generation);
+        let mut buffers = MeshBuffers::create(device, &self.gpu.queue, source, false, generation);
         buffers.key = key;
         self.replace_current(buffers);
     }
@@ -503,7 +519,7 @@ impl MeshRenderer {
             }
         }
         self.in_flight.pending_move = None;
-        let moved = job.run(&self.gpu.device);
+        let moved = job.run(&self.gpu.device, queue);
         self.apply_move(queue, source, moved);
         self.write_move_tints(queue);
         true
@@ -664,6 +680,16 @@ impl MeshRenderer {
         });
     }
 
+    /// Marks the device as a software renderer whose meshes are all drawn with one sample (no
+    /// anti-aliasing), whatever their size: the web page on a software renderer (SwiftShader),
+    /// where the four samples' drawing and resolving is most of a frame's time. Unlike
+    /// [`Self::set_software_adapter`], images are still drawn whole in one frame.
+    pub fn set_single_sampled(&mut self) {
+        self.gpu.software = true;
+        self.gpu.single_sample_faces = 0;
+        self.redraw();
+    }
+
     /// A new image draws at most `faces` faces (or wireframe edges) per [`Self::render`]; a
     /// bigger mesh's image takes several calls, the previous image staying in the target until
     /// the new one is complete. Software renderers get [`SOFTWARE_FACES_PER_FRAME`]; GPUs draw
@@ -688,9 +714,9 @@ impl MeshRenderer {
     }
 
     /// Samples per pixel the newest mesh is drawn with (4, or 1 for a big mesh on a software
-    /// renderer).
+    /// renderer, or for every mesh after [`Self::set_single_sampled`]).
     pub fn samples(&self) -> u32 {
-        if self.gpu.software && self.newest_faces > SOFTWARE_SINGLE_SAMPLE_FACES {
+        if self.gpu.software && self.newest_faces > self.gpu.single_sample_faces {
             1
         } else {
             SAMPLE_COUNT
@@ -776,7 +802,7 @@ impl MeshRenderer {
         });
         let uniforms = Uniforms::of(&params, materials, colours, uvs);
         if params.wireframe {
-            self.ensure_lines(device);
+            self.ensure_lines(device, queue);
         }
         let Some(pipelines) = self.pipelines() else {
             return false;

@@ -157,6 +157,22 @@ impl App {
         }
     }
 
+    /// Sets the mark `fairmesh_first_picture` at the start of the first frame after the one
+    /// that drew the first image of a mesh: the browser showed that image when its frame ended,
+    /// just before this one (a `status()` only says so after this frame's end).
+    pub(in crate::app) fn mark_first_picture(&self) {
+        thread_local! {
+            static MARKED: std::cell::Cell<bool> = const { std::cell::Cell::new(false) };
+        }
+        if MARKED.get() {
+            return;
+        }
+        if self.viewports().any(|v| v.images_drawn() > 0) {
+            MARKED.set(true);
+            mark("fairmesh_first_picture");
+        }
+    }
+
     /// Keeps what the frame showed for [`status`], as JSON.
     pub(in crate::app) fn publish_status(&self) {
         let status = self.status();
@@ -211,6 +227,7 @@ impl App {
             "warnings": self.appearance_warnings(),
             "export_path": self.document.as_ref().map(|d| d.export_path.clone()),
             "adapter": self.view.viewport.as_ref().map(|v| v.adapter_description()),
+            "samples": self.view.viewport.as_ref().map(|v| v.samples()),
         });
         events::STATUS.with(|kept| *kept.borrow_mut() = json.to_string());
     }

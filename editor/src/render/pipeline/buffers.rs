@@ -6,8 +6,6 @@
 
 use std::sync::Arc;
 
-use wgpu::util::DeviceExt;
-
 use super::MeshSource;
 use crate::render::appearance::Appearance;
 use crate::render::normals::{
@@ -223,6 +221,7 @@ impl MeshBuffers {
     /// `MeshRenderer::set_mesh` call `generation`.
     pub(super) fn create(
         device: &wgpu::Device,
+        queue: &wgpu::Queue,
         source: Arc<dyn MeshSource>,
         with_lines: bool,
         generation: u64,
@@ -231,13 +230,16 @@ impl MeshBuffers {
         let corners = Arc::new(CornerTable::new(source.positions().len(), &welded));
         drop(welded);
         let drawn = draw_normals(source.as_ref(), &corners, None);
-        Self::create_with(device, source, corners, drawn, with_lines, generation)
+        Self::create_with(
+            device, queue, source, corners, drawn, with_lines, generation,
+        )
     }
 
     /// [`Self::create`] with the corner table and the draw normals already made (a move that
     /// changed the draw vertices).
     pub(super) fn create_with(
         device: &wgpu::Device,
+        queue: &wgpu::Queue,
         source: Arc<dyn MeshSource>,
         corners: Arc<CornerTable>,
         drawn: DrawNormals,
@@ -253,19 +255,21 @@ impl MeshBuffers {
         };
         let draw_count = draw_positions.as_ref().map_or(positions.len(), Vec::len);
         let triangles = draw_triangles(source.as_ref(), appearance.as_deref());
-        let positions_buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-            label: Some("fairmesh positions"),
-            contents: bytemuck::cast_slice(draw_positions.as_deref().unwrap_or(positions)),
-            usage: wgpu::BufferUsages::VERTEX | wgpu::BufferUsages::COPY_DST,
-        });
-        let normals_buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-            label: Some("fairmesh normals"),
-            contents: bytemuck::cast_slice(&normals),
+        let positions_buffer = filled_buffer(
+            device,
+            queue,
+            "fairmesh positions",
+            bytemuck::cast_slice(draw_positions.as_deref().unwrap_or(positions)),
+            wgpu::BufferUsages::VERTEX,
+        );
+        let normals_buffer = filled_buffer(
+            device,
+            queue,
+            "fairmesh normals",
+            bytemuck::cast_slice(&normals),
             // COPY_SRC: tests read back what was uploaded.
-            usage: wgpu::BufferUsages::VERTEX
-                | wgpu::BufferUsages::COPY_DST
-                | wgpu::BufferUsages::COPY_SRC,
-        });
+            wgpu::BufferUsages::VERTEX | wgpu::BufferUsages::COPY_SRC,
+        );
         // Scalars and mask weights come later through `set_scalars` and `set_mask`; wgpu
         // zero-fills a buffer that is not mapped at creation.
         let per_vertex = |label, bytes: usize| {
@@ -280,11 +284,7 @@ impl MeshBuffers {
         let mask_buffer = per_vertex("fairmesh mask", 4);
         let filled = |label, contents: &[u8], bytes: usize| match contents.is_empty() {
             true => per_vertex(label, bytes),
-            false => device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                label: Some(label),
-                contents,
-                usage: wgpu::BufferUsages::VERTEX,
-            }),
+            false => filled_buffer(device, queue, label, contents, wgpu::BufferUsages::VERTEX),
         };
         let look = appearance.as_deref();
         let uvs = look
@@ -299,12 +299,14 @@ impl MeshBuffers {
             bytemuck::cast_slice(colours.unwrap_or(&[])),
             16,
         );
-        let triangles_buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-            label: Some("fairmesh triangles"),
-            contents: bytemuck::cast_slice(triangles),
-            usage: wgpu::BufferUsages::INDEX,
-        });
-        let lines = with_lines.then(|| line_buffer(device, triangles));
+        let triangles_buffer = filled_buffer(
+            device,
+            queue,
+            "fairmesh triangles",
+            bytemuck::cast_slice(triangles),
+            wgpu::BufferUsages::INDEX,
+        );
+        let lines = with_lines.then(|| line_buffer(device, queue, triangles));
         Self {
             positions: positions_buffer,
             normals: normals_buffer,
@@ -345,39 +347,66 @@ impl MeshBuffers {
     }
 }
 
+/// A buffer holding `contents` (whose length is a multiple of 4 bytes, as for `f32` and `u32`
+/// data), written through `queue` rather than mapped at creation: a browser's WebGPU may refuse
+/// the memory of a mapping at creation (Chromium throws a RangeError, "too large for the
+/// implementation", for a buffer of a few hundred kB), while a queue write is sent in chunks.
+/// The buffer also gets `COPY_DST` (a queue write needs it).
+pub(super) fn filled_buffer(
+    device: &wgpu::Device,
+    queue: &wgpu::Queue,
+    label: &str,
+    contents: &[u8],
+    usage: wgpu::BufferUsages,
+) -> wgpu::Buffer {
+    let buffer = device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some(label),
+        size: contents.len() as u64,
+        usage: usage | wgpu::BufferUsages::COPY_DST,
+        mapped_at_creation: false,
+    });
+    if !contents.is_empty() {
+        queue.write_buffer(&buffer, 0, contents);
+    }
+    buffer
+}
+
 /// The wireframe's index buffer: each triangle's three edges as line segments (an edge shared by
 /// two triangles is drawn twice, which looks the same and needs no edge map).
-pub(super) fn line_buffer(device: &wgpu::Device, triangles: &[[u32; 3]]) -> (wgpu::Buffer, u32) {
+pub(super) fn line_buffer(
+    device: &wgpu::Device,
+    queue: &wgpu::Queue,
+    triangles: &[[u32; 3]],
+) -> (wgpu::Buffer, u32) {
     const BLOCK: usize = 4096;
     let count = triangles.len() * 6;
     let buffer = device.create_buffer(&wgpu::BufferDescriptor {
         label: Some("fairmesh wireframe edges"),
         size: (count * 4) as u64,
-        usage: wgpu::BufferUsages::INDEX,
-        mapped_at_creation: true,
+        usage: wgpu::BufferUsages::INDEX | wgpu::BufferUsages::COPY_DST,
+        mapped_at_creation: false,
     });
-    // The mapping is write-only (it may be write-combining memory): edges are built a block of
-    // triangles at a time in a small scratch array and copied in, with no full-size temporary.
+    // Written through the queue's staging memory (not mapped at creation: see
+    // `filled_buffer`), which is write-only (it may be write-combining memory): edges are built a
+    // block of triangles at a time in a small scratch array and copied in, with no full-size
+    // temporary. No staging memory (or no edges): the wireframe is just not drawn.
+    let Some(mut view) = wgpu::BufferSize::new(buffer.size())
+        .and_then(|size| queue.write_buffer_with(&buffer, 0, size))
+    else {
+        return (buffer, 0);
+    };
     let mut scratch = vec![0u32; BLOCK * 6];
-    match buffer.slice(..).get_mapped_range_mut() {
-        Ok(mut view) => {
-            for (block_index, block) in triangles.chunks(BLOCK).enumerate() {
-                let edges = &mut scratch[..block.len() * 6];
-                for (edge, &[a, b, c]) in edges.chunks_exact_mut(6).zip(block) {
-                    edge.copy_from_slice(&[a, b, b, c, c, a]);
-                }
-                let start = block_index * BLOCK * 6 * 4;
-                view.slice(start..start + edges.len() * 4)
-                    .copy_from_slice(bytemuck::cast_slice(edges));
-            }
+    for (block_index, block) in triangles.chunks(BLOCK).enumerate() {
+        let edges = &mut scratch[..block.len() * 6];
+        for (edge, &[a, b, c]) in edges.chunks_exact_mut(6).zip(block) {
+            edge.copy_from_slice(&[a, b, b, c, c, a]);
         }
-        // Cannot happen for a buffer mapped at creation; the wireframe is then just not drawn.
-        Err(_) => {
-            buffer.unmap();
-            return (buffer, 0);
-        }
+        let start = block_index * BLOCK * 6 * 4;
+        view.slice(start..start + edges.len() * 4)
+            .copy_from_slice(bytemuck::cast_slice(edges));
     }
-    buffer.unmap();
+    // Dropping the view queues the write.
+    drop(view);
     (buffer, count as u32)
 }
 

@@ -332,7 +332,6 @@ impl MaterialKit {
         queue: &wgpu::Queue,
         material: Option<&MaterialLook>,
     ) -> wgpu::BindGroup {
-        use wgpu::util::DeviceExt;
         let white = TextureImage {
             width: 1,
             height: 1,
@@ -348,11 +347,13 @@ impl MaterialKit {
             uv_u: [uv_u[0], uv_u[1], uv_u[2], 0.0],
             uv_v: [uv_v[0], uv_v[1], uv_v[2], 0.0],
         };
-        let buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-            label: Some("fairmesh material"),
-            contents: bytemuck::bytes_of(&uniform),
-            usage: wgpu::BufferUsages::UNIFORM,
-        });
+        let buffer = super::buffers::filled_buffer(
+            device,
+            queue,
+            "fairmesh material",
+            bytemuck::bytes_of(&uniform),
+            wgpu::BufferUsages::UNIFORM,
+        );
         let sampling = image.sampling;
         let levels = texture_levels(image, device.limits().max_texture_dimension_2d);
         let texture = device.create_texture(&wgpu::TextureDescriptor {

@@ -46,13 +46,14 @@ pub(super) enum Moved {
 
 impl MoveJob {
     /// The move's normals, or new buffers (made on `device`) when its draw vertices changed.
-    pub(super) fn run(&self, device: &wgpu::Device) -> Moved {
+    pub(super) fn run(&self, device: &wgpu::Device, queue: &wgpu::Queue) -> Moved {
         let drawn = draw_normals(self.source.as_ref(), &self.corners, Some(&self.layout));
         if Arc::ptr_eq(&drawn.layout, &self.layout) {
             return Moved::Normals(drawn.normals);
         }
         Moved::Rebuilt(Box::new(MeshBuffers::create_with(
             device,
+            queue,
             self.source.clone(),
             self.corners.clone(),
             drawn,
@@ -70,14 +71,14 @@ impl UploadJob {
         }
     }
 
-    fn run(self, device: &wgpu::Device) -> Uploaded {
+    fn run(self, device: &wgpu::Device, queue: &wgpu::Queue) -> Uploaded {
         match self {
             UploadJob::Mesh {
                 generation,
                 source,
                 with_lines,
             } => Uploaded::Mesh(Box::new(MeshBuffers::create(
-                device, source, with_lines, generation,
+                device, queue, source, with_lines, generation,
             ))),
             UploadJob::Lines {
                 generation,
@@ -85,13 +86,17 @@ impl UploadJob {
                 look,
             } => Uploaded::Lines {
                 generation,
-                lines: line_buffer(device, draw_triangles(source.as_ref(), look.as_deref())),
+                lines: line_buffer(
+                    device,
+                    queue,
+                    draw_triangles(source.as_ref(), look.as_deref()),
+                ),
                 look,
             },
             UploadJob::Move(job) => Uploaded::Moved {
                 generation: job.generation,
                 serial: job.serial,
-                moved: job.run(device),
+                moved: job.run(device, queue),
                 source: job.source,
             },
         }
@@ -130,6 +135,7 @@ pub(super) struct Uploader {
 impl Uploader {
     pub(super) fn spawn(
         device: wgpu::Device,
+        queue: wgpu::Queue,
         on_done: Arc<dyn Fn() + Send + Sync>,
     ) -> Option<Self> {
         let (jobs_tx, jobs_rx) = mpsc::channel::<UploadJob>();
@@ -152,7 +158,7 @@ impl Uploader {
                             continue;
                         }
                         let generation = job.generation();
-                        let upload = std::panic::AssertUnwindSafe(|| job.run(&device));
+                        let upload = std::panic::AssertUnwindSafe(|| job.run(&device, &queue));
                         // wgpu reports an error it cannot return (out of memory, say) by
                         // panicking: the upload fails, the thread and the app go on.
                         let uploaded = std::panic::catch_unwind(upload)
@@ -275,7 +281,7 @@ impl super::MeshRenderer {
     /// Builds the wireframe's edges of the mesh on screen when they are missing and fit: a big
     /// mesh's on the upload thread (the image shows the mesh without them meanwhile), a small
     /// one's here.
-    pub(super) fn ensure_lines(&mut self, device: &wgpu::Device) {
+    pub(super) fn ensure_lines(&mut self, device: &wgpu::Device, queue: &wgpu::Queue) {
         if let Some(mesh) = &mut self.mesh {
             let faces = mesh.index_count as usize / 3;
             let fits = faces as u64 * 24 <= self.gpu.max_buffer_size;
@@ -303,7 +309,7 @@ impl super::MeshRenderer {
                 } else {
                     let triangles =
                         draw_triangles(mesh.source.as_ref(), mesh.appearance.as_deref());
-                    mesh.lines = Some(line_buffer(device, triangles));
+                    mesh.lines = Some(line_buffer(device, queue, triangles));
                 }
             }
         }
