@@ -392,8 +392,8 @@ fn grow(
     reached
 }
 
-/// Step 2 of the module docs: the vertices up to `rings` rings around what `state` finds
-/// turned or folded, but those `stays` names, moved `sweeps` times towards the
+/// Step 2 of the module docs: the vertices up to `rings` rings around `seeds` (the corners of
+/// what is turned or folded), but those `stays` names, moved `sweeps` times towards the
 /// mean of their neighbours, less the part along their normal (Jacobi: each sweep reads the
 /// last one's positions).
 fn relax_tangentially(
@@ -402,10 +402,11 @@ fn relax_tangentially(
     topology: &Topology,
     state: &mut FoldState,
     stays: impl Fn(u32) -> bool,
+    seeds: Vec<u32>,
     [rings, sweeps]: [usize; 2],
 ) {
     let mut mark = vec![false; positions.len()];
-    let region = grow(state.corners(), rings, topology, &mut mark, stays);
+    let region = grow(seeds, rings, topology, &mut mark, stays);
     let mut moved = Vec::new();
     for _ in 0..sweeps {
         let positions_now: &[[f32; 3]] = positions;
@@ -663,7 +664,8 @@ pub(super) fn unfold(positions: &mut [[f32; 3]], level: &Level, folds: &mut Fold
     let mut all_steps = |positions: &mut [[f32; 3]], state: &mut FoldState, back: &mut [bool]| {
         passes(positions, state, &mut region, &mut moving, back);
         for reach in TANGENT_REACH {
-            if state.corners().is_empty() {
+            let seeds = state.corners();
+            if seeds.is_empty() {
                 break;
             }
             relax_tangentially(
@@ -672,6 +674,7 @@ pub(super) fn unfold(positions: &mut [[f32; 3]], level: &Level, folds: &mut Fold
                 topology,
                 state,
                 relax_stays,
+                seeds,
                 reach,
             );
             passes(positions, state, &mut region, &mut moving, back);
