@@ -34,5 +34,7 @@ core=(
 for arg in "$@"; do
   case "$arg" in -f | --file | -D | --in-diff | --file=* | --in-diff=*) core=() ;; esac
 done
+# cargo-mutants makes target/mutants but not target/ itself (a fresh clone has none).
+mkdir -p target
 exec cargo mutants --package fairmesh --output target/mutants --timeout-multiplier 3 \
   "${core[@]}" "$@"

@@ -315,6 +315,8 @@ fn multires_json_times_one_run_and_measures_only_when_asked() {
     assert!(plain["time_ms"].as_f64().unwrap() > 0.0);
     assert!(plain["hierarchy_ms"].as_f64().unwrap() > 0.0);
     assert_eq!(plain["level"], 3);
+    // Every fold the run made undone (only the coarsest levels of a large mesh leave some).
+    assert_eq!(plain["folds_left"], 0, "{plain}");
     let volume = plain["volume_change_percent"].as_f64().unwrap();
     assert!(volume.abs() < 1.0, "volume change {volume}%");
     // One run: no second, separately timed run, and no distances nobody asked for.

@@ -140,17 +140,29 @@ impl Hierarchy {
         let hierarchy = &self.hierarchy;
         let workspace = &self.workspace;
         let denoised_level_0 = self.denoised.is_some() && start_level == 0;
-        let mut positions = run_detached(py, progress, threads, |hook| {
+        let (mut positions, folds_left) = run_detached(py, progress, threads, |hook| {
             if denoised_level_0 {
                 // Level 0 is the denoised mesh itself, `fair`'s result.
-                return Some(hierarchy.base_mesh().positions.clone());
+                return Some((hierarchy.base_mesh().positions.clone(), 0));
             }
             // A run cancelled half way leaves the workspace fit for the next one.
             let mut workspace = workspace
                 .lock()
                 .unwrap_or_else(std::sync::PoisonError::into_inner);
-            fair_multires(hierarchy, &options, &mut workspace, hook).ok()
+            let positions = fair_multires(hierarchy, &options, &mut workspace, hook).ok()?;
+            Some((positions, workspace.folds_left()))
         })?;
+        if folds_left > 0 {
+            crate::mesh::warn(
+                py,
+                &format!(
+                    "from level {}, {folds_left} faces turned or edges folded against level 0 \
+                     are left: undoing them would have brought level 0's detail back over much \
+                     of the result; a finer level leaves none",
+                    start_level.min(hierarchy.coarsest_level())
+                ),
+            )?;
+        }
         if let Some((mask, input)) = fade_into {
             mask.blend(input, &mut positions);
         }

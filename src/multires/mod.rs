@@ -69,6 +69,7 @@ mod refine;
 mod unfold;
 
 pub use denoise::{denoise, Denoise, DenoiseOptions, Denoised};
+pub use unfold::{PUT_BACK_BUDGET, PUT_BACK_FAR};
 
 use crate::fairing::{BoundaryMode, ConstrainedFairing, Creases, FairOptions, FairVariant, Mask};
 use crate::hierarchy::Hierarchy;
@@ -202,6 +203,8 @@ pub struct MultiresWorkspace {
     normals: Vec<Vec3A>,
     normal_moves: Vec<[f32; 2]>,
     smoothed_moves: Vec<[f32; 2]>,
+    /// What the last run's unfolding left ([`Self::folds_left`]).
+    folds_left: usize,
 }
 
 impl MultiresWorkspace {
@@ -237,6 +240,14 @@ impl MultiresWorkspace {
         self.before_fairing = Vec::new();
         self.normal_moves = Vec::new();
         self.smoothed_moves = Vec::new();
+    }
+
+    /// How many faces turned against M0 (by more than 90°) and edges folded where M0 is not the
+    /// last run left: none, but from the coarsest levels of a large mesh, where undoing them would
+    /// have put more than [`PUT_BACK_BUDGET`] of the mesh back where M0 has it (see the
+    /// `unfold` step). Callers should say so, and that a finer start level has none.
+    pub fn folds_left(&self) -> usize {
+        self.folds_left
     }
 
     /// How many levels' connectivity the workspace holds now.
@@ -419,6 +430,7 @@ pub fn fair_multires(
     let original = &hierarchy.base_mesh().positions;
     if let Some(mask) = &options.mask {
         if mask.check_fits(original.len()).is_err() || mask.painted_count() == 0 {
+            workspace.folds_left = 0;
             progress.check(1.0)?;
             return Ok(original.clone());
         }
@@ -443,6 +455,7 @@ fn fair_multires_on_worker(
     let fair_options = level_fair_options(options);
     let operator = (fair_options.variant, fair_options.boundary);
     let release = workspace.release_levels;
+    workspace.folds_left = 0;
     let fixed = start_run(hierarchy, options, workspace, start);
     // Progress weights: a level costs about its vertex count.
     let total: f64 = (0..=start)
@@ -498,8 +511,9 @@ fn unfold_new_folds(hierarchy: &Hierarchy, workspace: &mut MultiresWorkspace) {
         creases: creases.as_ref(),
         loop_neighbors,
         keep_volume: true,
+        put_back_budget: unfold::PUT_BACK_BUDGET,
     };
-    unfold::unfold(&mut workspace.positions, &level, folds);
+    workspace.folds_left = unfold::unfold(&mut workspace.positions, &level, folds).left;
 }
 
 /// Sets `workspace` up for a run from level `start`: the levels it needs now (all it touches, or

@@ -37,8 +37,18 @@
 //!    bunny from level 16 ended 87 % `fair`'s result, a patchwork with seams.
 //! 5. Whatever is still turned or folded then has its corners, boundary vertices included, put
 //!    back where M0 has them, until none is: a face whose corners are all M0's is M0's face, so
-//!    this ends, at the latest with the whole mesh back to M0, and no result has a face turned
-//!    or an edge folded that M0 does not have.
+//!    this ends, at the latest with the whole mesh back to M0.
+//!
+//! **The budget.** From the coarsest levels of a large mesh (a 150k-face bunny from level 22 of
+//! 24), steps 4 and 5 cascade: a corner put back from many edge lengths away folds its
+//! neighbours, they go back in turn, and the result becomes a patchwork of the smooth result
+//! and M0 with seams between them (a third of the mesh at M0), far worse to look at than the
+//! specks it undoes. So when steps 4 and 5 have put back more than [`PUT_BACK_BUDGET`] of the
+//! vertices from farther than [`PUT_BACK_FAR`] edge lengths, steps 3-5 are taken back whole:
+//! the result is what steps 1 and 2 left, and the faces and edges still turned or folded are
+//! counted ([`Unfolded::left`]) for the caller to say so. Within the budget (every level of
+//! the quality set's meshes), no result has a face turned or an edge folded that M0 does not
+//! have.
 //!
 //! The faces and edges are looked at once whole (a pass over the faces and one over the edges);
 //! after that only those around the vertices that moved, so that a run pays for its folds, not
@@ -66,6 +76,9 @@ pub(super) struct Level<'a> {
     pub(super) loop_neighbors: &'a [[u32; 2]],
     /// Give M0's volume back first (the improved variant's promise).
     pub(super) keep_volume: bool,
+    /// The share of the vertices steps 4 and 5 may put back from far from M0
+    /// ([`PUT_BACK_BUDGET`]).
+    pub(super) put_back_budget: f32,
 }
 
 /// At most this many rounds of finding the folds and smoothing their corners.
@@ -98,6 +111,19 @@ const RAMP_ROUNDS: usize = 8;
 /// At most this many times the volume is given back after the unfolding (each time holding the
 /// vertices put back to M0, and undoing what it turned again).
 const VOLUME_PASSES: usize = 3;
+
+/// How far from M0 (in its edge lengths there) a vertex put back by steps 4 and 5 counts
+/// against [`PUT_BACK_BUDGET`]: put back, it leaves a step at least that tall in the result.
+pub const PUT_BACK_FAR: f32 = 4.0;
+
+/// The share of M0's vertices steps 4 and 5 may put back from farther than [`PUT_BACK_FAR`].
+/// Beyond it the putting back has become a cascade (each corner put back from far away folds
+/// its neighbours, which go back in turn), and the result a patchwork of the smooth result and
+/// M0 with seams between them, worse to look at than the specks it undoes: steps 3-5 are then
+/// taken back whole, and the folds they were undoing are left (and counted). A 150k-face noisy
+/// bunny put back 0.24 % of its vertices from that far from level 20 of 24, and 19 % from
+/// level 22; the tests' noisy box and elephant 0.14 % and none.
+pub const PUT_BACK_BUDGET: f32 = 0.02;
 
 /// Umbrella sweeps over the folds' corners in each pass.
 const SWEEPS: usize = 3;
@@ -487,40 +513,78 @@ fn smooth_displacement(
 /// Whether vertex `v` lies farther from where M0 has it than [`FAR_FROM_M0`] times the mean
 /// length of its edges on M0: put back alone, it would fold its neighbours.
 fn far_from_m0(positions: &[[f32; 3]], mesh: &TriMesh, topology: &Topology, v: u32) -> bool {
+    distance_from_m0(positions, mesh, topology, v) > FAR_FROM_M0
+}
+
+/// How far vertex `v` lies from where M0 has it, in the mean length of its edges on M0.
+fn distance_from_m0(positions: &[[f32; 3]], mesh: &TriMesh, topology: &Topology, v: u32) -> f32 {
     let m0 = |u: u32| Vec3A::from_array(mesh.positions[u as usize]);
     let ring = topology.neighbors(v);
     let length =
         ring.iter().map(|&u| m0(u).distance(m0(v))).sum::<f32>() / ring.len().max(1) as f32;
-    m0(v).distance(Vec3A::from_array(positions[v as usize])) > FAR_FROM_M0 * length
+    m0(v).distance(Vec3A::from_array(positions[v as usize])) / length.max(f32::MIN_POSITIVE)
 }
 
-/// Steps 3-5 of the module docs, for what `state` finds turned or folded.
+/// Steps 3-5 of the module docs, for what `state` finds turned or folded. Where they would put
+/// more than `budget` vertices back from farther than [`PUT_BACK_FAR`], they are taken back
+/// whole (the vertices `back` too): the result is what steps 1 and 2 left, and false is
+/// returned. True when they undid everything within the budget.
 fn undo_what_is_left(
     positions: &mut [[f32; 3]],
     mesh: &TriMesh,
     topology: &Topology,
     state: &mut FoldState,
     back: &mut [bool],
-) {
-    smooth_displacement(positions, mesh, topology, state, back, &DISPLACEMENT_RINGS);
-    for _ in 0..RAMP_ROUNDS {
-        let still: Vec<u32> = state
-            .corners()
-            .into_iter()
-            .filter(|&v| !topology.is_boundary_vertex(v) && !back[v as usize])
-            .collect();
-        if still.is_empty() {
-            break;
-        }
-        put_at_m0(positions, mesh, state, back, &still);
-        smooth_displacement(positions, mesh, topology, state, back, &DISPLACEMENT_RINGS);
+    budget: usize,
+) -> bool {
+    if state.corners().is_empty() {
+        return true;
     }
-    put_back(positions, mesh, state, back);
+    let before = positions.to_vec();
+    let back_before = back.to_vec();
+    let mut far = 0;
+    let mut undone = 'steps: {
+        smooth_displacement(positions, mesh, topology, state, back, &DISPLACEMENT_RINGS);
+        for _ in 0..RAMP_ROUNDS {
+            let still: Vec<u32> = state
+                .corners()
+                .into_iter()
+                .filter(|&v| !topology.is_boundary_vertex(v) && !back[v as usize])
+                .collect();
+            if still.is_empty() {
+                break;
+            }
+            far += put_at_m0(positions, mesh, state, back, &still);
+            if far > budget {
+                break 'steps false;
+            }
+            smooth_displacement(positions, mesh, topology, state, back, &DISPLACEMENT_RINGS);
+        }
+        put_back(positions, mesh, state, back, budget - far)
+    };
+    if !undone {
+        let changed: Vec<u32> = (0..positions.len() as u32)
+            .filter(|&v| positions[v as usize] != before[v as usize])
+            .collect();
+        positions.copy_from_slice(&before);
+        back.copy_from_slice(&back_before);
+        state.moved(positions, &changed);
+        undone = state.corners().is_empty();
+    }
+    undone
 }
 
 /// Puts the corners of what `state` finds turned or folded back where M0 has them, until
-/// nothing is (marking them in `back`).
-fn put_back(positions: &mut [[f32; 3]], mesh: &TriMesh, state: &mut FoldState, back: &mut [bool]) {
+/// nothing is (marking them in `back`; true), or until more than `budget` of them lay farther
+/// than [`PUT_BACK_FAR`] from M0 (false).
+fn put_back(
+    positions: &mut [[f32; 3]],
+    mesh: &TriMesh,
+    state: &mut FoldState,
+    back: &mut [bool],
+    budget: usize,
+) -> bool {
+    let mut far = 0;
     loop {
         let still: Vec<u32> = state
             .corners()
@@ -528,38 +592,59 @@ fn put_back(positions: &mut [[f32; 3]], mesh: &TriMesh, state: &mut FoldState, b
             .filter(|&v| positions[v as usize] != mesh.positions[v as usize])
             .collect();
         if still.is_empty() {
-            return;
+            return true;
         }
-        put_at_m0(positions, mesh, state, back, &still);
+        far += put_at_m0(positions, mesh, state, back, &still);
+        if far > budget {
+            return false;
+        }
     }
 }
 
 /// Puts `vertices` where M0 has them, marks them in `back` and tells `state` they moved.
+/// Returns how many of them lay farther than [`PUT_BACK_FAR`] from M0.
 fn put_at_m0(
     positions: &mut [[f32; 3]],
     mesh: &TriMesh,
     state: &mut FoldState,
     back: &mut [bool],
     vertices: &[u32],
-) {
+) -> usize {
+    let mut far = 0;
     for &v in vertices {
+        if distance_from_m0(positions, mesh, state.topology, v) > PUT_BACK_FAR {
+            far += 1;
+        }
         positions[v as usize] = mesh.positions[v as usize];
         back[v as usize] = true;
     }
     state.moved(positions, vertices);
+    far
+}
+
+/// What [`unfold`] did.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub(super) struct Unfolded {
+    /// How many vertices moved.
+    pub(super) moved: usize,
+    /// How many faces it left turned against M0 and edges folded where M0 is not: none, but
+    /// where undoing them would have put more than [`PUT_BACK_BUDGET`] of the vertices back
+    /// from far from M0.
+    pub(super) left: usize,
 }
 
 /// Moves the corners of the faces turned against M0 and the edges folded where M0 is not
-/// (`folds`, made by [`FoldEdges::new`] from M0) as the module docs say. Returns how many
-/// vertices moved.
-pub(super) fn unfold(positions: &mut [[f32; 3]], level: &Level, folds: &mut FoldEdges) -> usize {
+/// (`folds`, made by [`FoldEdges::new`] from M0) as the module docs say.
+pub(super) fn unfold(positions: &mut [[f32; 3]], level: &Level, folds: &mut FoldEdges) -> Unfolded {
     let Level {
         mesh,
         topology,
         creases,
         loop_neighbors,
         keep_volume,
+        put_back_budget,
     } = *level;
+    let budget = (put_back_budget * positions.len() as f32) as usize;
     // M0's volume given back before and after the unfolding (the improved variant), as
     // constrained fairing gives it back after a round: every vertex offset along its normal, one
     // distance per connected part. Before, for the levels' own drift (a coarse level's result can
@@ -588,7 +673,7 @@ pub(super) fn unfold(positions: &mut [[f32; 3]], level: &Level, folds: &mut Fold
     if state.faces.is_empty() && state.edges.is_empty() {
         drop(state);
         folds.volume = volume;
-        return 0;
+        return Unfolded::default();
     }
     // A crease vertex moves along its crease (to the mean of its two neighbours on it); a corner
     // and a boundary vertex stay.
@@ -661,6 +746,7 @@ pub(super) fn unfold(positions: &mut [[f32; 3]], level: &Level, folds: &mut Fold
             || topology.neighbors(v).is_empty()
             || creases.is_some_and(|c| c.is_feature(v))
     };
+    let gave_up = std::cell::Cell::new(false);
     let mut all_steps = |positions: &mut [[f32; 3]], state: &mut FoldState, back: &mut [bool]| {
         passes(positions, state, &mut region, &mut moving, back);
         for reach in TANGENT_REACH {
@@ -679,9 +765,16 @@ pub(super) fn unfold(positions: &mut [[f32; 3]], level: &Level, folds: &mut Fold
             );
             passes(positions, state, &mut region, &mut moving, back);
         }
-        undo_what_is_left(positions, mesh, topology, state, back);
+        // Once steps 3-5 went over the budget, the volume passes leave them out: they would go
+        // over it again.
+        if gave_up.get() {
+            return state.corners().is_empty();
+        }
+        let undone = undo_what_is_left(positions, mesh, topology, state, back, budget);
+        gave_up.set(!undone);
+        undone
     };
-    all_steps(positions, &mut state, &mut back);
+    let mut undone = all_steps(positions, &mut state, &mut back);
     drop(state);
     // The offset holds the vertices put back; what it turns again is undone as above, and the
     // offset made again, until it turns nothing (a few times at most: after the last, the
@@ -691,20 +784,35 @@ pub(super) fn unfold(positions: &mut [[f32; 3]], level: &Level, folds: &mut Fold
             break;
         }
         restore(positions, &mut volume, &back);
-        let mut state = FoldState::new(positions, &mesh.triangles, topology, folds);
-        if state.faces.is_empty() && state.edges.is_empty() {
+        if gave_up.get() {
+            // Steps 1 and 2 would only run again around the folds left (and what the offset
+            // turned, a few faces, is counted with them).
             break;
         }
-        all_steps(positions, &mut state, &mut back);
+        let mut state = FoldState::new(positions, &mesh.triangles, topology, folds);
+        if state.faces.is_empty() && state.edges.is_empty() {
+            undone = true;
+            break;
+        }
+        undone = all_steps(positions, &mut state, &mut back);
     }
     if keep_volume {
         folds.volume = volume;
     }
-    positions
-        .iter()
-        .zip(&at_rest)
-        .filter(|(now, was)| now != was)
-        .count()
+    let left = if undone {
+        0
+    } else {
+        let state = FoldState::new(positions, &mesh.triangles, topology, folds);
+        state.faces.len() + state.edges.len()
+    };
+    Unfolded {
+        moved: positions
+            .iter()
+            .zip(&at_rest)
+            .filter(|(now, was)| now != was)
+            .count(),
+        left,
+    }
 }
 
 #[cfg(test)]
@@ -736,6 +844,7 @@ mod tests {
             creases: None,
             loop_neighbors: &[],
             keep_volume: false,
+            put_back_budget: 1.0,
         }
     }
 
@@ -759,7 +868,8 @@ mod tests {
             &mut positions,
             &level(&mesh, &topology),
             &mut fold_edges(&mesh, &edges, &reference),
-        );
+        )
+        .moved;
         assert!(folded(&positions, &mesh, &edges).iter().all(|&f| !f));
         // The vertex is back near its place. The passes move the folds' corners only, and every
         // sweep of the relaxation's first round, if it runs, reaches one ring further (on a
@@ -819,8 +929,9 @@ mod tests {
             creases: Some(&creases),
             loop_neighbors: &[],
             keep_volume: false,
+            put_back_budget: 1.0,
         };
-        let moved = unfold(&mut positions, &level, &mut folds);
+        let moved = unfold(&mut positions, &level, &mut folds).moved;
         assert!(moved >= 1);
         assert_eq!(new_folds(&positions), 0);
         // Next to where M0 has it (the side is 1, the push moved it by 1.1), and no face
@@ -835,6 +946,58 @@ mod tests {
                 "face {t}"
             );
         }
+    }
+
+    #[test]
+    fn a_fold_only_putting_back_undoes_is_left_and_counted_when_that_is_over_budget() {
+        // A boundary vertex of a flat grid pushed six rows into it (farther than PUT_BACK_FAR):
+        // its faces turn over. A boundary vertex stays in the means, the relaxation and the
+        // displacement's smoothing, so only putting it back where M0 has it undoes them.
+        let n = 12;
+        let mesh = grid(n);
+        let topology = Topology::build(&mesh);
+        let edges = two_face_edges(&mesh.triangles);
+        let reference = folded(&mesh.positions, &mesh, &edges);
+        let v = n / 2;
+        let mut pushed = mesh.positions.clone();
+        pushed[v][1] += 6.0;
+        let turned = |positions: &[[f32; 3]]| {
+            let result = TriMesh::new(positions.to_vec(), mesh.triangles.clone());
+            (0..mesh.face_count())
+                .filter(|&t| result.face_normal(t).dot(mesh.face_normal(t)) < 0.0)
+                .count()
+        };
+        assert!(turned(&pushed) > 0, "the push turns faces");
+        let run = |budget: f32| {
+            let mut positions = pushed.clone();
+            let level = Level {
+                put_back_budget: budget,
+                ..level(&mesh, &topology)
+            };
+            let done = unfold(
+                &mut positions,
+                &level,
+                &mut fold_edges(&mesh, &edges, &reference),
+            );
+            (positions, done)
+        };
+        // Within the budget (the whole mesh may go back), it goes back and nothing is left.
+        let (positions, done) = run(1.0);
+        assert_eq!(positions[v], mesh.positions[v]);
+        assert_eq!(turned(&positions), 0);
+        assert_eq!(done.left, 0);
+        // With none, it stays where it was pushed and what is left is counted: the faces turned
+        // against M0 and the edges folded (each counted once).
+        let (positions, done) = run(0.0);
+        assert_eq!(positions[v], pushed[v]);
+        let left_turned = turned(&positions);
+        let left_folded = folded(&positions, &mesh, &edges)
+            .iter()
+            .zip(&reference)
+            .filter(|(&now, &was)| now && !was)
+            .count();
+        assert!(left_turned > 0);
+        assert_eq!(done.left, left_turned + left_folded);
     }
 
     #[test]
@@ -853,7 +1016,7 @@ mod tests {
                 &level(&mesh, &topology),
                 &mut fold_edges(&mesh, &edges, &reference)
             ),
-            0
+            Unfolded::default()
         );
         assert_eq!(positions, before);
     }

@@ -395,12 +395,13 @@ impl Runs<'_> {
         let mut step =
             super::progress::Step::start(format!("multiresolution fairing from level {start}"));
         let started = Instant::now();
-        let mut positions = if self.denoise.is_some() && start == 0 {
+        let (mut positions, folds_left) = if self.denoise.is_some() && start == 0 {
             // Level 0 is the denoised mesh itself (M0 keeps the input's numbering).
-            hierarchy.base_mesh().positions.clone()
+            (hierarchy.base_mesh().positions.clone(), 0)
         } else {
-            fair_multires(hierarchy, options, workspace, &mut step)
-                .context("multires fairing was cancelled")?
+            let positions = fair_multires(hierarchy, options, workspace, &mut step)
+                .context("multires fairing was cancelled")?;
+            (positions, workspace.folds_left())
         };
         if let (Some(mask), Some(unmasked), Some(_)) = (&self.mask, &self.unmasked, &self.denoise) {
             if mask.check_fits(unmasked.len()).is_ok() {
@@ -409,6 +410,14 @@ impl Runs<'_> {
         }
         let time_ms = started.elapsed().as_secs_f64() * 1e3;
         drop(step);
+        if folds_left > 0 {
+            eprintln!(
+                "warning: from level {start}, {folds_left} faces turned or edges folded against \
+                 level 0 are left: undoing them would have brought level 0's detail back over \
+                 more than {:.0} % of the result; a finer level leaves none",
+                100.0 * fairmesh::multires::PUT_BACK_BUDGET
+            );
+        }
         let result = TriMesh::new(positions, hierarchy.base_mesh().triangles.clone());
         let clean_volume = self.clean_volume;
         let volume_change_percent = (clean_volume != 0.0)
@@ -420,6 +429,7 @@ impl Runs<'_> {
             "time_ms": time_ms,
             "hierarchy_ms": self.hierarchy_ms,
             "loose_triangles": hierarchy.loose_triangles().len(),
+            "folds_left": folds_left,
             "volume_change_percent": volume_change_percent,
             "denoise": self.denoise.as_ref().map(|(report, time_ms)| json!({
                 "rounds_run": report.rounds_run,

@@ -150,6 +150,7 @@ impl FairJob {
         // the brush stopped at a silhouette the mask drops from 1 to 0 at once, and the
         // result would show a step there.
         let mask = mask.map(|mask| mask.with_falloff(&topology, MASK_EDGE_RINGS));
+        let mut folds_left = 0;
         let mut positions = match &baseline {
             // A baseline smooths the document's mesh itself; the level does not apply.
             Some(method) => {
@@ -163,7 +164,11 @@ impl FairJob {
             }
             None => {
                 let mut workspace = workspace.lock().unwrap_or_else(PoisonError::into_inner);
-                multires::fair_multires(&hierarchy, &options, &mut workspace, &mut progress).ok()?
+                let positions =
+                    multires::fair_multires(&hierarchy, &options, &mut workspace, &mut progress)
+                        .ok()?;
+                folds_left = workspace.folds_left();
+                positions
             }
         };
         // The mask fades the result into the document's mesh (not into the denoised one the
@@ -178,6 +183,7 @@ impl FairJob {
             rms_displacement,
             elapsed: started.elapsed(),
             method,
+            folds_left,
         })
     }
 }

@@ -44,6 +44,7 @@ pub(super) fn fairing_controls(
     let not_for_baseline = not_for_baseline.as_deref();
     denoise_controls(ui, document, settings, not_for_baseline);
     start_level_slider(commands, ui, (level, top_level), ready, not_for_baseline);
+    folds_left_note(ui, document);
     let before = settings.clone();
     method_controls(settings, ui, method);
     boundary_and_variant(settings, ui, not_for_baseline);
@@ -164,6 +165,27 @@ fn start_level_slider(
     )
     .on_hover_text(tips::START_LEVEL)
     .on_disabled_hover_text(tips::START_LEVEL);
+}
+
+/// Under the slider, when the result of the level it rests on left faces turned over (from the
+/// coarsest levels of a large mesh only).
+fn folds_left_note(ui: &mut egui::Ui, document: &super::state::Document) {
+    let Some(faired) = document
+        .faired
+        .as_ref()
+        .filter(|f| f.folds_left > 0 && f.level == document.level)
+    else {
+        return;
+    };
+    ui.label(
+        egui::RichText::new(format!(
+            "{} faces left turned over at this level (point here for why)",
+            faired.folds_left
+        ))
+        .small()
+        .color(ui.visuals().warn_fg_color),
+    )
+    .on_hover_text(tips::FOLDS_LEFT);
 }
 
 /// What moving the start level does, under the slider.

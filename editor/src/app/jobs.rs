@@ -313,6 +313,8 @@ pub struct Faired {
     pub elapsed: Duration,
     /// The method that made it (a baseline ignores the start level).
     pub method: fairmesh::fairing::Method,
+    /// Faces left turned over against level 0 ([`fairmesh::multires::MultiresWorkspace::folds_left`]).
+    pub folds_left: usize,
 }
 
 /// A job's answer to the UI. Each carries the generation it was started under.

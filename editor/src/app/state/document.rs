@@ -111,6 +111,8 @@ pub struct FairedResult {
     pub method: Method,
     pub volume_change: f64,
     pub rms_displacement: f64,
+    /// Faces left turned over against level 0 (from the coarsest levels of a large mesh only).
+    pub folds_left: usize,
     pub elapsed: Duration,
     /// Distinguishes results, so the viewport knows when to upload.
     pub serial: u64,

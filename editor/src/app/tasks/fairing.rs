@@ -188,6 +188,7 @@ impl App {
                 method: faired.method,
                 volume_change: faired.volume_change,
                 rms_displacement: faired.rms_displacement,
+                folds_left: faired.folds_left,
                 elapsed: faired.elapsed,
                 serial: self.work.next_serial,
                 against_document: previous.as_ref().and_then(|p| p.against_document.clone()),

@@ -400,6 +400,7 @@ fn fair(message: &JsValue) -> Result<(), String> {
                     set(m, "positions", positions);
                     set(m, "volume_change", faired.volume_change);
                     set(m, "rms_displacement", faired.rms_displacement);
+                    set(m, "folds_left", faired.folds_left as f64);
                     set(m, "elapsed_ms", faired.elapsed.as_secs_f64() * 1e3);
                 },
                 &transfer,
@@ -1069,6 +1070,7 @@ fn on_faired(request: Request, data: &JsValue) {
         rms_displacement: number(data, "rms_displacement"),
         elapsed: Duration::from_secs_f64(number(data, "elapsed_ms").max(0.0) / 1e3),
         method,
+        folds_left: number(data, "folds_left").max(0.0) as usize,
     });
     send(
         request.sending,
