@@ -156,9 +156,9 @@ impl Hierarchy {
             crate::mesh::warn(
                 py,
                 &format!(
-                    "from level {}, {folds_left} faces turned or edges folded against level 0 \
-                     are left: undoing them would have brought level 0's detail back over much \
-                     of the result; a finer level leaves none",
+                    "from level {}, {folds_left} faces turned over or edges folded against \
+                     level 0 are left: undoing them would have put level 0's detail back in \
+                     patches with seams; a finer level leaves none",
                     start_level.min(hierarchy.coarsest_level())
                 ),
             )?;

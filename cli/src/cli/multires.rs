@@ -412,10 +412,12 @@ impl Runs<'_> {
         drop(step);
         if folds_left > 0 {
             eprintln!(
-                "warning: from level {start}, {folds_left} faces turned or edges folded against \
-                 level 0 are left: undoing them would have brought level 0's detail back over \
-                 more than {:.0} % of the result; a finer level leaves none",
-                100.0 * fairmesh::multires::PUT_BACK_BUDGET
+                "warning: from level {start}, {folds_left} faces turned over or edges folded \
+                 against level 0 are left: undoing them would have put level 0's detail back \
+                 in patches with seams (over {:.0} % of the vertices from more than {} edge \
+                 lengths away); a finer level leaves none",
+                100.0 * fairmesh::multires::PUT_BACK_BUDGET,
+                fairmesh::multires::PUT_BACK_FAR
             );
         }
         let result = TriMesh::new(positions, hierarchy.base_mesh().triangles.clone());
