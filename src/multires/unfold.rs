@@ -950,26 +950,32 @@ mod tests {
 
     #[test]
     fn a_fold_only_putting_back_undoes_is_left_and_counted_when_that_is_over_budget() {
-        // A boundary vertex of a flat grid pushed six rows into it (farther than PUT_BACK_FAR):
-        // its faces turn over. A boundary vertex stays in the means, the relaxation and the
-        // displacement's smoothing, so only putting it back where M0 has it undoes them.
+        // A boundary vertex of a flat grid of squares of side 0.25 pushed into it: its faces
+        // turn over. A boundary vertex stays in the means, the relaxation and the
+        // displacement's smoothing, so only putting it back where M0 has it undoes them. The
+        // budget counts only what goes back from farther than PUT_BACK_FAR edge lengths (not
+        // model units: the side is not 1).
         let n = 12;
-        let mesh = grid(n);
+        let side = 0.25;
+        let mut mesh = grid(n);
+        for p in &mut mesh.positions {
+            *p = p.map(|x| x * side);
+        }
         let topology = Topology::build(&mesh);
         let edges = two_face_edges(&mesh.triangles);
         let reference = folded(&mesh.positions, &mesh, &edges);
         let v = n / 2;
-        let mut pushed = mesh.positions.clone();
-        pushed[v][1] += 6.0;
         let turned = |positions: &[[f32; 3]]| {
             let result = TriMesh::new(positions.to_vec(), mesh.triangles.clone());
             (0..mesh.face_count())
                 .filter(|&t| result.face_normal(t).dot(mesh.face_normal(t)) < 0.0)
                 .count()
         };
-        assert!(turned(&pushed) > 0, "the push turns faces");
-        let run = |budget: f32| {
-            let mut positions = pushed.clone();
+        let run = |rows: f32, budget: f32| {
+            let mut positions = mesh.positions.clone();
+            positions[v][1] += rows * side;
+            assert!(turned(&positions) > 0, "the push turns faces");
+            let pushed = positions[v];
             let level = Level {
                 put_back_budget: budget,
                 ..level(&mesh, &topology)
@@ -979,17 +985,18 @@ mod tests {
                 &level,
                 &mut fold_edges(&mesh, &edges, &reference),
             );
-            (positions, done)
+            (positions, pushed, done)
         };
-        // Within the budget (the whole mesh may go back), it goes back and nothing is left.
-        let (positions, done) = run(1.0);
+        // Pushed six rows (six edge lengths): within the budget (the whole mesh may go back), it
+        // goes back and nothing is left.
+        let (positions, _, done) = run(6.0, 1.0);
         assert_eq!(positions[v], mesh.positions[v]);
         assert_eq!(turned(&positions), 0);
         assert_eq!(done.left, 0);
-        // With none, it stays where it was pushed and what is left is counted: the faces turned
-        // against M0 and the edges folded (each counted once).
-        let (positions, done) = run(0.0);
-        assert_eq!(positions[v], pushed[v]);
+        // With no budget, it stays where it was pushed, and what is left is counted: the faces
+        // turned against M0 and the edges folded (each once).
+        let (positions, pushed, done) = run(6.0, 0.0);
+        assert_eq!(positions[v], pushed);
         let left_turned = turned(&positions);
         let left_folded = folded(&positions, &mesh, &edges)
             .iter()
@@ -998,6 +1005,11 @@ mod tests {
             .count();
         assert!(left_turned > 0);
         assert_eq!(done.left, left_turned + left_folded);
+        // Pushed two rows, nearer than PUT_BACK_FAR: it goes back even with no budget.
+        let (positions, _, done) = run(2.0, 0.0);
+        assert_eq!(positions[v], mesh.positions[v]);
+        assert_eq!(turned(&positions), 0);
+        assert_eq!(done.left, 0);
     }
 
     #[test]
