@@ -9,7 +9,8 @@ use crate::run::run_detached;
 use fairmesh::fairing::{creases::DEFAULT_CREASE_ANGLE, CreaseOptions, FairReport};
 use fairmesh::hierarchy::{build_hierarchy_with_topology, HierarchyError, HierarchyOptions};
 use fairmesh::multires::{
-    fair_multires, Denoise, DenoiseOptions, MultiresOptions, MultiresVariant, MultiresWorkspace,
+    fair_multires, folds_left_warning, Denoise, DenoiseOptions, MultiresOptions, MultiresVariant,
+    MultiresWorkspace,
 };
 use fairmesh::Topology;
 use pyo3::exceptions::{PyTypeError, PyValueError};
@@ -153,15 +154,8 @@ impl Hierarchy {
             Some((positions, workspace.folds_left()))
         })?;
         if folds_left > 0 {
-            crate::mesh::warn(
-                py,
-                &format!(
-                    "from level {}, {folds_left} faces turned over or edges folded against \
-                     level 0 are left: undoing them would have put level 0's detail back in \
-                     patches with seams; a finer level leaves none",
-                    start_level.min(hierarchy.coarsest_level())
-                ),
-            )?;
+            let start = start_level.min(hierarchy.coarsest_level());
+            crate::mesh::warn(py, &folds_left_warning(start, folds_left))?;
         }
         if let Some((mask, input)) = fade_into {
             mask.blend(input, &mut positions);

@@ -244,8 +244,9 @@ impl MultiresWorkspace {
 
     /// How many faces turned against M0 (by more than 90°) and edges folded where M0 is not the
     /// last run left: none, but from the coarsest levels of a large mesh, where undoing them would
-    /// have put more than [`PUT_BACK_BUDGET`] of the mesh back where M0 has it (see the
-    /// `unfold` step). Callers should say so, and that a finer start level has none.
+    /// have put more than [`PUT_BACK_BUDGET`] of the vertices back from farther than
+    /// [`PUT_BACK_FAR`] edge lengths (see the `unfold` step). Callers should say so
+    /// ([`folds_left_warning`]).
     pub fn folds_left(&self) -> usize {
         self.folds_left
     }
@@ -428,9 +429,9 @@ pub fn fair_multires(
     // is handed to a worker and waited for (a futex round trip); from a worker they run in place
     // or are stolen, so the whole run goes to the pool once.
     let original = &hierarchy.base_mesh().positions;
+    workspace.folds_left = 0;
     if let Some(mask) = &options.mask {
         if mask.check_fits(original.len()).is_err() || mask.painted_count() == 0 {
-            workspace.folds_left = 0;
             progress.check(1.0)?;
             return Ok(original.clone());
         }
@@ -455,7 +456,6 @@ fn fair_multires_on_worker(
     let fair_options = level_fair_options(options);
     let operator = (fair_options.variant, fair_options.boundary);
     let release = workspace.release_levels;
-    workspace.folds_left = 0;
     let fixed = start_run(hierarchy, options, workspace, start);
     // Progress weights: a level costs about its vertex count.
     let total: f64 = (0..=start)
@@ -490,6 +490,18 @@ fn fair_multires_on_worker(
         result[hierarchy.original_vertex(v as u32) as usize] = *p;
     }
     Ok(result)
+}
+
+/// What to tell a user whose run from `start_level` left `folds_left` faces turned or edges
+/// folded ([`MultiresWorkspace::folds_left`]): the command line prints it, Python warns with it.
+pub fn folds_left_warning(start_level: usize, folds_left: usize) -> String {
+    format!(
+        "from level {start_level}, {folds_left} faces turned over or edges folded against level \
+         0 are left: undoing them would have put level 0's detail back in patches with seams \
+         (over {:.0} % of the vertices from more than {PUT_BACK_FAR} edge lengths away); a finer \
+         level leaves none",
+        100.0 * PUT_BACK_BUDGET
+    )
 }
 
 /// The last step of a run from a coarser level ([`unfold`]): the faces it left turned against

@@ -746,7 +746,6 @@ pub(super) fn unfold(positions: &mut [[f32; 3]], level: &Level, folds: &mut Fold
             || topology.neighbors(v).is_empty()
             || creases.is_some_and(|c| c.is_feature(v))
     };
-    let gave_up = std::cell::Cell::new(false);
     let mut all_steps = |positions: &mut [[f32; 3]], state: &mut FoldState, back: &mut [bool]| {
         passes(positions, state, &mut region, &mut moving, back);
         for reach in TANGENT_REACH {
@@ -765,14 +764,7 @@ pub(super) fn unfold(positions: &mut [[f32; 3]], level: &Level, folds: &mut Fold
             );
             passes(positions, state, &mut region, &mut moving, back);
         }
-        // Once steps 3-5 went over the budget, the volume passes leave them out: they would go
-        // over it again.
-        if gave_up.get() {
-            return state.corners().is_empty();
-        }
-        let undone = undo_what_is_left(positions, mesh, topology, state, back, budget);
-        gave_up.set(!undone);
-        undone
+        undo_what_is_left(positions, mesh, topology, state, back, budget)
     };
     let mut undone = all_steps(positions, &mut state, &mut back);
     drop(state);
@@ -784,9 +776,10 @@ pub(super) fn unfold(positions: &mut [[f32; 3]], level: &Level, folds: &mut Fold
             break;
         }
         restore(positions, &mut volume, &back);
-        if gave_up.get() {
-            // Steps 1 and 2 would only run again around the folds left (and what the offset
-            // turned, a few faces, is counted with them).
+        if !undone {
+            // Steps 3-5 went over the budget (only then is something left): steps 1 and 2 would
+            // only run again around the folds left, and what the offset turned, a few faces, is
+            // counted with them.
             break;
         }
         let mut state = FoldState::new(positions, &mesh.triangles, topology, folds);

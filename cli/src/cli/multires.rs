@@ -412,12 +412,8 @@ impl Runs<'_> {
         drop(step);
         if folds_left > 0 {
             eprintln!(
-                "warning: from level {start}, {folds_left} faces turned over or edges folded \
-                 against level 0 are left: undoing them would have put level 0's detail back \
-                 in patches with seams (over {:.0} % of the vertices from more than {} edge \
-                 lengths away); a finer level leaves none",
-                100.0 * fairmesh::multires::PUT_BACK_BUDGET,
-                fairmesh::multires::PUT_BACK_FAR
+                "warning: {}",
+                fairmesh::multires::folds_left_warning(start, folds_left)
             );
         }
         let result = TriMesh::new(positions, hierarchy.base_mesh().triangles.clone());

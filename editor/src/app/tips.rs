@@ -23,10 +23,10 @@ pub const START_LEVEL: &str = "How coarse a version of the mesh the smoothing st
     is coarser, so bigger bumps and fine detail go too and the result is smoother. Raise it \
     until the surface is as plain as you want; lower it if wanted features melt away.";
 pub const FOLDS_LEFT: &str = "Coming back from a very coarse level to full detail, a few \
-    triangles ended turned over (in flat shading they can show as dark specks). Elsewhere they are undone by \
-    putting their corners back where level 0 has them, but here the smooth result lies so far \
-    from level 0 that doing so would bring level 0's detail back in patches with seams over \
-    much of the mesh, so they are left. A lower start level has none.";
+    triangles ended turned over (in flat shading they can show as dark specks). Elsewhere \
+    they are undone by putting their corners back where level 0 has them, but here the smooth \
+    result lies so far from level 0 that doing so would bring level 0's detail back in \
+    patches with seams over much of the mesh, so they are left. A lower start level has none.";
 pub const REMOVE_NOISE: &str = "Remove the mesh's noise before anything else, once: the \
     smoother measures how noisy the mesh is and smooths until the result stops getting \
     better (a clean mesh is left as it is). The levels are built on the result, so the \
