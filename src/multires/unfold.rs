@@ -383,8 +383,10 @@ impl<'a> FoldState<'a> {
     }
 }
 
-/// The vertices up to `rings` rings around `seeds` (each once, `seeds` first), leaving out those
-/// `skip` names. `mark` is all false on entry and again on return.
+/// The vertices up to `rings` rings around `seeds`, each once and in the mesh's vertex order,
+/// leaving out those `skip` names. `mark` is all false on entry and again on return. The order
+/// is for the sweeps over them: in the order the rings reach them, their neighbours lie all over
+/// memory, and a sweep of the wide relaxation took 2-3 times as long.
 fn grow(
     seeds: impl IntoIterator<Item = u32>,
     rings: usize,
@@ -415,6 +417,7 @@ fn grow(
     for &v in &reached {
         mark[v as usize] = false;
     }
+    reached.sort_unstable();
     reached
 }
 
