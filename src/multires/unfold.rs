@@ -238,6 +238,9 @@ struct FoldState<'a> {
     stamp: u32,
     touched: Vec<u32>,
     touched_normals: Vec<Vec3A>,
+    /// [`relax_tangentially`]'s face normals, by face (only those around its region are
+    /// current).
+    relax_normals: Vec<Vec3A>,
 }
 
 impl<'a> FoldState<'a> {
@@ -290,6 +293,7 @@ impl<'a> FoldState<'a> {
             stamp: 0,
             touched: Vec::new(),
             touched_normals: Vec::new(),
+            relax_normals: Vec::new(),
             watched_faces,
             watched_edges,
         }
@@ -436,9 +440,35 @@ fn relax_tangentially(
 ) {
     let mut mark = vec![false; positions.len()];
     let region = grow(seeds, rings, topology, &mut mark, stays);
+    // The faces around the region, whose normals a sweep reads: each computed once a sweep (not
+    // once for each of its corners in the region), into a buffer indexed by face.
+    let mut faces = Vec::new();
+    let mut seen = vec![false; triangles.len()];
+    for &v in &region {
+        for &f in topology.faces_of(v) {
+            if !seen[f as usize] {
+                seen[f as usize] = true;
+                faces.push(f);
+            }
+        }
+    }
+    drop(seen);
+    faces.sort_unstable();
+    let mut normals = std::mem::take(&mut state.relax_normals);
+    normals.resize(triangles.len(), Vec3A::ZERO);
+    let mut computed = Vec::new();
     let mut moved = Vec::new();
     for _ in 0..sweeps {
         let positions_now: &[[f32; 3]] = positions;
+        faces
+            .par_iter()
+            .with_min_len(super::PARALLEL_GRAIN)
+            .map(|&f| face_normal(positions_now, triangles, f))
+            .collect_into_vec(&mut computed);
+        for (&f, &n) in faces.iter().zip(&computed) {
+            normals[f as usize] = n;
+        }
+        let normals: &[Vec3A] = &normals;
         region
             .par_iter()
             .with_min_len(super::PARALLEL_GRAIN)
@@ -447,9 +477,7 @@ fn relax_tangentially(
                 let normal = topology
                     .faces_of(v)
                     .iter()
-                    .fold(Vec3A::ZERO, |n, &f| {
-                        n + face_normal(positions_now, triangles, f)
-                    })
+                    .fold(Vec3A::ZERO, |n, &f| n + normals[f as usize])
                     .normalize_or_zero();
                 let ring = topology.neighbors(v);
                 let sum = ring.iter().fold(Vec3A::ZERO, |sum, &u| {
@@ -463,6 +491,7 @@ fn relax_tangentially(
             positions[v as usize] = p;
         }
     }
+    state.relax_normals = normals;
     state.moved(positions, &region);
 }
 
