@@ -205,6 +205,9 @@ pub struct MultiresWorkspace {
     smoothed_moves: Vec<[f32; 2]>,
     /// What the last run's unfolding left ([`Self::folds_left`]).
     folds_left: usize,
+    /// The unfolding's budget when not [`PUT_BACK_BUDGET`]: the tests lower it to reach, on a
+    /// small mesh, what only the coarsest levels of a large one reach.
+    put_back_budget: Option<f32>,
 }
 
 impl MultiresWorkspace {
@@ -523,7 +526,7 @@ fn unfold_new_folds(hierarchy: &Hierarchy, workspace: &mut MultiresWorkspace) {
         creases: creases.as_ref(),
         loop_neighbors,
         keep_volume: true,
-        put_back_budget: unfold::PUT_BACK_BUDGET,
+        put_back_budget: workspace.put_back_budget.unwrap_or(unfold::PUT_BACK_BUDGET),
     };
     workspace.folds_left = unfold::unfold(&mut workspace.positions, &level, folds).left;
 }
@@ -649,6 +652,49 @@ fn fair_level(workspace: &mut MultiresWorkspace, level: usize, options: &FairOpt
 mod tests {
     use super::*;
     use crate::hierarchy::{build_hierarchy, HierarchyOptions};
+
+    #[test]
+    fn what_the_unfolding_leaves_is_counted_and_every_run_counts_again() {
+        let mesh = crate::bundled::load_bunny(&Default::default())
+            .unwrap()
+            .mesh;
+        let hierarchy =
+            build_hierarchy(&mesh, &HierarchyOptions::default(), &mut crate::NoProgress).unwrap();
+        let base = hierarchy.base_mesh();
+        // Faces of a result turned by more than 90 degrees against the same face of M0.
+        let turned = |positions: &[[f32; 3]]| {
+            let result = TriMesh::new(positions.to_vec(), base.triangles.clone());
+            (0..base.face_count())
+                .filter(|&f| result.face_normal(f).dot(base.face_normal(f)) < 0.0)
+                .count()
+        };
+        let options = MultiresOptions::default().with_start_level(hierarchy.coarsest_level());
+        let run = |workspace: &mut MultiresWorkspace| {
+            let result = fair_multires(&hierarchy, &options, workspace, &mut crate::NoProgress);
+            turned(&result.unwrap())
+        };
+        // With no budget the first corner put back from far away gives the last steps up, and
+        // what they were undoing is left: every face turned is counted (edges folded count too).
+        let mut workspace = MultiresWorkspace {
+            put_back_budget: Some(0.0),
+            ..Default::default()
+        };
+        let left_turned = run(&mut workspace);
+        assert!(
+            left_turned > 0,
+            "nothing left turned: the test needs another level"
+        );
+        assert!(
+            workspace.folds_left() >= left_turned,
+            "{} counted, {left_turned} faces turned",
+            workspace.folds_left()
+        );
+        // Within the budget nothing is left, and the same workspace no longer reports the last
+        // run's count.
+        workspace.put_back_budget = None;
+        assert_eq!(run(&mut workspace), 0);
+        assert_eq!(workspace.folds_left(), 0);
+    }
 
     #[test]
     fn a_split_over_a_shrunken_ring_rises_no_more_than_twice_its_longest_edge() {
