@@ -653,13 +653,17 @@ mod tests {
     use super::*;
     use crate::hierarchy::{build_hierarchy, HierarchyOptions};
 
-    #[test]
-    fn what_the_unfolding_leaves_is_counted_and_every_run_counts_again() {
+    /// The bundled bunny's hierarchy, with the default options.
+    fn bunny_hierarchy() -> Hierarchy {
         let mesh = crate::bundled::load_bunny(&Default::default())
             .unwrap()
             .mesh;
-        let hierarchy =
-            build_hierarchy(&mesh, &HierarchyOptions::default(), &mut crate::NoProgress).unwrap();
+        build_hierarchy(&mesh, &HierarchyOptions::default(), &mut crate::NoProgress).unwrap()
+    }
+
+    #[test]
+    fn what_the_unfolding_leaves_is_counted_and_every_run_counts_again() {
+        let hierarchy = bunny_hierarchy();
         let base = hierarchy.base_mesh();
         // Faces of a result turned by more than 90 degrees against the same face of M0.
         let turned = |positions: &[[f32; 3]]| {
@@ -702,11 +706,7 @@ mod tests {
         // noisy scan); the volume the split adds back, spread over that sliver, asks for a
         // tower. Stand-in: level 1 shrunk a thousandfold about its centre, then refined.
         // Without the bound the splits went 500 times the level's size out.
-        let mesh = crate::bundled::load_bunny(&Default::default())
-            .unwrap()
-            .mesh;
-        let hierarchy =
-            build_hierarchy(&mesh, &HierarchyOptions::default(), &mut crate::NoProgress).unwrap();
+        let hierarchy = bunny_hierarchy();
         let mut workspace = MultiresWorkspace::default();
         workspace.prepare_levels(&hierarchy, 0..=1, |_| None);
         let coarse = hierarchy.level_positions(1);

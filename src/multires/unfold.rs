@@ -238,9 +238,6 @@ struct FoldState<'a> {
     stamp: u32,
     touched: Vec<u32>,
     touched_normals: Vec<Vec3A>,
-    /// [`relax_tangentially`]'s face normals, by face (only those around its region are
-    /// current).
-    relax_normals: Vec<Vec3A>,
 }
 
 impl<'a> FoldState<'a> {
@@ -293,15 +290,14 @@ impl<'a> FoldState<'a> {
             stamp: 0,
             touched: Vec::new(),
             touched_normals: Vec::new(),
-            relax_normals: Vec::new(),
             watched_faces,
             watched_edges,
         }
     }
 
-    /// The faces around `moved` and their edges looked at again, each once however many of its
-    /// corners moved (a face has three, an edge is on two faces): the normals in parallel.
-    fn moved(&mut self, positions: &[[f32; 3]], moved: &[u32]) {
+    /// The faces around `vertices`, each once, into `faces` (cleared first), under a new
+    /// stamp: [`Self::moved`] marks their edges with the same one.
+    fn faces_around(&mut self, vertices: &[u32], faces: &mut Vec<u32>) {
         self.stamp = self.stamp.wrapping_add(1);
         if self.stamp == 0 {
             self.face_stamps.fill(0);
@@ -309,9 +305,8 @@ impl<'a> FoldState<'a> {
             self.stamp = 1;
         }
         let stamp = self.stamp;
-        let mut faces = std::mem::take(&mut self.touched);
         faces.clear();
-        for &v in moved {
+        for &v in vertices {
             for &f in self.topology.faces_of(v) {
                 if self.face_stamps[f as usize] != stamp {
                     self.face_stamps[f as usize] = stamp;
@@ -319,6 +314,14 @@ impl<'a> FoldState<'a> {
                 }
             }
         }
+    }
+
+    /// The faces around `moved` and their edges looked at again, each once however many of its
+    /// corners moved (a face has three, an edge is on two faces): the normals in parallel.
+    fn moved(&mut self, positions: &[[f32; 3]], moved: &[u32]) {
+        let mut faces = std::mem::take(&mut self.touched);
+        self.faces_around(moved, &mut faces);
+        let stamp = self.stamp;
         let triangles = self.triangles;
         let mut normals = std::mem::take(&mut self.touched_normals);
         faces
@@ -441,21 +444,11 @@ fn relax_tangentially(
     let mut mark = vec![false; positions.len()];
     let region = grow(seeds, rings, topology, &mut mark, stays);
     // The faces around the region, whose normals a sweep reads: each computed once a sweep (not
-    // once for each of its corners in the region), into a buffer indexed by face.
+    // once for each of its corners in the region), into the state's normals by face. Those are
+    // the faces `state.moved` looks at again last, so it leaves them current.
     let mut faces = Vec::new();
-    let mut seen = vec![false; triangles.len()];
-    for &v in &region {
-        for &f in topology.faces_of(v) {
-            if !seen[f as usize] {
-                seen[f as usize] = true;
-                faces.push(f);
-            }
-        }
-    }
-    drop(seen);
+    state.faces_around(&region, &mut faces);
     faces.sort_unstable();
-    let mut normals = std::mem::take(&mut state.relax_normals);
-    normals.resize(triangles.len(), Vec3A::ZERO);
     let mut computed = Vec::new();
     let mut moved = Vec::new();
     for _ in 0..sweeps {
@@ -466,9 +459,9 @@ fn relax_tangentially(
             .map(|&f| face_normal(positions_now, triangles, f))
             .collect_into_vec(&mut computed);
         for (&f, &n) in faces.iter().zip(&computed) {
-            normals[f as usize] = n;
+            state.folds.normals[f as usize] = n;
         }
-        let normals: &[Vec3A] = &normals;
+        let normals: &[Vec3A] = &state.folds.normals;
         region
             .par_iter()
             .with_min_len(super::PARALLEL_GRAIN)
@@ -491,7 +484,6 @@ fn relax_tangentially(
             positions[v as usize] = p;
         }
     }
-    state.relax_normals = normals;
     state.moved(positions, &region);
 }
 
