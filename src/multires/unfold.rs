@@ -523,7 +523,6 @@ fn smooth_displacement(
             mesh,
             topology,
             &region,
-            &mut mark,
             DISPLACEMENT_ITERATIONS_PER_RING * rings,
         );
         state.moved(positions, &region);
@@ -545,21 +544,16 @@ fn ordered_sum(terms: impl IndexedParallelIterator<Item = Vec3A>) -> Vec3A {
 /// Conjugate gradients on the graph Laplacian restricted to the region, one system a coordinate,
 /// from the displacement the region has, until each residual is down to
 /// [`HARMONIC_TOLERANCE`] of where it started or `limit` iterations have run. An isolated
-/// vertex's displacement becomes zero (the mean of none). `scratch` is all false on entry and
-/// again on return.
+/// vertex's displacement becomes zero (the mean of none).
 fn make_harmonic(
     positions: &mut [[f32; 3]],
     mesh: &TriMesh,
     topology: &Topology,
     region: &[u32],
-    scratch: &mut [bool],
     limit: usize,
 ) {
     let m0 = |u: u32| Vec3A::from_array(mesh.positions[u as usize]);
     let displacement = |u: u32| Vec3A::from_array(positions[u as usize]) - m0(u);
-    for &v in region {
-        scratch[v as usize] = true;
-    }
     // The system, row by row: each vertex's valence, its neighbours inside the region (by rank
     // in it) and the sum of the held displacements of those outside.
     let mut offsets = Vec::with_capacity(region.len() + 1);
@@ -571,21 +565,14 @@ fn make_harmonic(
         let ring = topology.neighbors(v);
         let mut sum = Vec3A::ZERO;
         for &u in ring {
-            if scratch[u as usize] {
-                let rank = region
-                    .binary_search(&u)
-                    .expect("a marked vertex is in the region");
-                inside.push(rank as u32);
-            } else {
-                sum += displacement(u);
+            match region.binary_search(&u) {
+                Ok(rank) => inside.push(rank as u32),
+                Err(_) => sum += displacement(u),
             }
         }
         offsets.push(inside.len() as u32);
         held.push(sum);
         valence.push(ring.len().max(1) as f32);
-    }
-    for &v in region {
-        scratch[v as usize] = false;
     }
     let apply = |x: &[Vec3A], out: &mut Vec<Vec3A>| {
         (0..x.len())
@@ -1001,16 +988,7 @@ mod tests {
             })
             .collect();
         let outside_before: Vec<[f32; 3]> = positions.clone();
-        let mut scratch = vec![false; positions.len()];
-        make_harmonic(
-            &mut positions,
-            &mesh,
-            &topology,
-            &region,
-            &mut scratch,
-            1000,
-        );
-        assert!(scratch.iter().all(|&s| !s), "the scratch marks are cleared");
+        make_harmonic(&mut positions, &mesh, &topology, &region, 1000);
         let mut largest = 0.0f32;
         for (v, (now, &m0)) in positions.iter().zip(&mesh.positions).enumerate() {
             if inside(v) {
