@@ -1113,6 +1113,23 @@ fn with_no_control_touched_the_editor_fairs_as_fair_does_and_coarser_levels_star
     );
 
     let mut harness = harness_for(noisy.clone().into());
+    // Level 0's result is `fair`'s, the denoise's own: it is shown as soon as the denoise ends,
+    // while the levels are still being built on it (the hierarchy's result comes after it on
+    // the same worker, and building it takes far longer than a frame here).
+    let deadline = Instant::now() + Duration::from_secs(300);
+    while harness.state().status().faired_serial.is_none() {
+        harness.step();
+        assert!(Instant::now() < deadline, "no faired result");
+        std::thread::sleep(Duration::from_millis(2));
+    }
+    let first = harness.state().status();
+    assert!(
+        !first.hierarchy_ready,
+        "the first faired picture waited for the levels"
+    );
+    assert_eq!(first.faired_level, Some(0));
+    let before_levels = harness.state().faired_positions().unwrap();
+    assert!(before_levels.as_slice() == by_fair.positions.as_slice());
     settle(&mut harness);
     assert_eq!(harness.state().status().level, 0, "a file opens at level 0");
     let mesh = harness.state().document_mesh().unwrap();

@@ -40,7 +40,9 @@ fn build_on(
 
 /// Denoises `mesh` (as `denoise_options` ask) and builds the hierarchy on the result, keeping the
 /// file's own sharp edges (`source`'s) when sharp edges are kept, as `fairmesh fair` keeps them.
-/// Both stages report to `progress` (false cancels); `denoised` is told when the denoise is done.
+/// Both stages report to `progress` (false cancels); `denoised` is told when the denoise is
+/// done, with the denoised mesh (`fair`'s result, which is start level 0's result) when the
+/// denoise ran.
 pub(in crate::app) fn denoise_and_build(
     mesh: &TriMesh,
     topology: &Topology,
@@ -48,7 +50,7 @@ pub(in crate::app) fn denoise_and_build(
     mut denoise_options: fairmesh::multires::DenoiseOptions,
     file_edges: &dyn Fn(&TriMesh) -> Vec<[u32; 2]>,
     progress: &mut dyn fairmesh::Progress,
-    denoised_done: &mut dyn FnMut(),
+    denoised_done: &mut dyn FnMut(Option<&TriMesh>),
 ) -> Result<KeptHierarchy, HierarchyError> {
     let started = Instant::now();
     let file_edges = if options.creases.is_some() {
@@ -69,7 +71,7 @@ pub(in crate::app) fn denoise_and_build(
                 report: d.report.clone(),
                 time: started.elapsed(),
             });
-            denoised_done();
+            denoised_done(denoised.as_ref().map(|d| &d.mesh));
             let built_on = denoised.as_ref().map_or(mesh, |d| &d.mesh);
             build_on(built_on, mesh, topology, &options, progress).map(
                 |(hierarchy, base_matches_original, sharp_edges)| KeptHierarchy {

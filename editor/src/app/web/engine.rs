@@ -295,7 +295,7 @@ fn build_hierarchy(message: &JsValue) -> Result<(), String> {
     // Whatever the engine held is for another hierarchy now.
     HELD.with(|held| held.borrow_mut().take());
     let mut progress = progress_to_page();
-    let mut denoised = || {
+    let mut denoised = |_: Option<&TriMesh>| {
         answer(
             "progress",
             |m| {
