@@ -42,7 +42,8 @@ pub(super) fn fairing_controls(
         )
     });
     let not_for_baseline = not_for_baseline.as_deref();
-    denoise_controls(ui, document, settings, not_for_baseline);
+    let denoising = view.progress.hierarchy_denoising;
+    denoise_controls(ui, document, settings, not_for_baseline, denoising);
     start_level_slider(commands, ui, (level, top_level), ready, not_for_baseline);
     folds_left_note(ui, document);
     let before = settings.clone();
@@ -62,6 +63,7 @@ fn denoise_controls(
     document: &super::state::Document,
     settings: &mut Settings,
     not_for_baseline: Option<&str>,
+    denoising: bool,
 ) {
     let enabled = not_for_baseline.is_none();
     let label = |denoise: Denoise| match denoise {
@@ -121,7 +123,13 @@ fn denoise_controls(
             ui.small("The levels are built on the mesh as it is");
         }
         HierarchyState::Building if settings.hierarchy.denoise != Denoise::Off => {
-            ui.small("Measuring the noise…");
+            // Once the noise is removed, the view shows the result (start level 0) while the
+            // levels are built on it.
+            ui.small(if denoising {
+                "Measuring the noise…"
+            } else {
+                "Noise removed; building the levels on the result…"
+            });
         }
         _ => {}
     }
