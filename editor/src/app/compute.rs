@@ -12,7 +12,7 @@ use crate::app::state::{DenoiseSummary, KeptHierarchy};
 use fairmesh::fairing::{Mask, Method, MethodOptions};
 use fairmesh::hierarchy::{self, HierarchyError, HierarchyOptions};
 use fairmesh::multires::{self, denoise, MultiresOptions, MultiresWorkspace};
-use fairmesh::{metrics, Topology, TriMesh};
+use fairmesh::{Topology, TriMesh};
 
 /// Rings of vertices over which a painted mask always fades out at its edge.
 const MASK_EDGE_RINGS: usize = 3;
@@ -178,14 +178,12 @@ impl FairJob {
         if let Some(mask) = mask.filter(|mask| mask.check_fits(positions.len()).is_ok()) {
             mask.blend(&original.positions, &mut positions);
         }
-        let (volume_change, rms_displacement) = metrics::change_of_positions(&original, &positions);
-        Some(Faired {
+        Some(Faired::measured(
+            &original,
             positions,
-            volume_change,
-            rms_displacement,
-            elapsed: started.elapsed(),
+            started.elapsed(),
             method,
             folds_left,
-        })
+        ))
     }
 }

@@ -317,6 +317,29 @@ pub struct Faired {
     pub folds_left: usize,
 }
 
+impl Faired {
+    /// `positions` of `original`'s vertices as a result, with their volume change and RMS
+    /// displacement against `original` measured.
+    pub(in crate::app) fn measured(
+        original: &fairmesh::TriMesh,
+        positions: Vec<[f32; 3]>,
+        elapsed: Duration,
+        method: fairmesh::fairing::Method,
+        folds_left: usize,
+    ) -> Self {
+        let (volume_change, rms_displacement) =
+            fairmesh::metrics::change_of_positions(original, &positions);
+        Faired {
+            positions,
+            volume_change,
+            rms_displacement,
+            elapsed,
+            method,
+            folds_left,
+        }
+    }
+}
+
 /// A job's answer to the UI. Each carries the generation it was started under.
 pub enum JobResult {
     Loaded {

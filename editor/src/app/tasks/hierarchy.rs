@@ -10,7 +10,7 @@ use crate::app::jobs::{Faired, JobKind, JobResult, JobTicket};
 use crate::app::state::{HierarchyState, KeptHierarchy, ViewMode};
 use crate::app::App;
 use fairmesh::hierarchy::{self, HierarchyError};
-use fairmesh::{metrics, TriMesh};
+use fairmesh::TriMesh;
 use web_time::Instant;
 
 /// Start level 0's result sent when the denoise ends ([`App::start_hierarchy`]): the view it is
@@ -119,21 +119,18 @@ impl App {
                 if !hierarchy_generation.is_current(generation) {
                     return;
                 }
-                let positions = denoised.positions.clone();
-                let (volume_change, rms_displacement) =
-                    metrics::change_of_positions(&mesh, &positions);
+                let result = Faired::measured(
+                    &mesh,
+                    denoised.positions.clone(),
+                    started.elapsed(),
+                    early.method,
+                    0,
+                );
                 let message = JobResult::Faired {
                     document: document_generation,
                     view: early.view,
                     level: 0,
-                    result: Some(Faired {
-                        positions,
-                        volume_change,
-                        rms_displacement,
-                        elapsed: started.elapsed(),
-                        method: early.method,
-                        folds_left: 0,
-                    }),
+                    result: Some(result),
                 };
                 Self::send_result(&tx, &ctx, message, early.ticket);
             };
