@@ -439,6 +439,13 @@ fn grow(
 /// what is turned or folded), but those `stays` names, moved `sweeps` times towards the
 /// mean of their neighbours, less the part along their normal (Jacobi: each sweep reads the
 /// last one's positions).
+///
+/// The sweeps run on a copy of the region ([`Patch`]): its vertices, their neighbours and the
+/// faces around it, numbered anew, so that a sweep reads a few megabytes that stay in cache
+/// instead of gathering its neighbours' positions and its faces' normals from all over M0's
+/// arrays (a 1.2M-face scan's level 16: a region of 71k vertices, 40 sweeps in 70 ms instead
+/// of about 900). The sums run in the same order as over M0's arrays, so the positions are the
+/// same to the bit.
 fn relax_tangentially(
     positions: &mut [[f32; 3]],
     triangles: &[[u32; 3]],
@@ -450,48 +457,127 @@ fn relax_tangentially(
 ) {
     let mut mark = vec![false; positions.len()];
     let region = grow(seeds, rings, topology, &mut mark, stays);
-    // The faces around the region, whose normals a sweep reads: each computed once a sweep (not
-    // once for each of its corners in the region), into the state's normals by face. Those are
-    // the faces `state.moved` looks at again last, so it leaves them current.
     let mut faces = Vec::new();
     state.faces_around(&region, &mut faces);
     faces.sort_unstable();
-    let mut computed = Vec::new();
-    let mut moved = Vec::new();
-    for _ in 0..sweeps {
-        let positions_now: &[[f32; 3]] = positions;
-        faces
-            .par_iter()
-            .with_min_len(super::PARALLEL_GRAIN)
-            .map(|&f| face_normal(positions_now, triangles, f))
-            .collect_into_vec(&mut computed);
-        for (&f, &n) in faces.iter().zip(&computed) {
-            state.folds.normals[f as usize] = n;
+    let mut patch = Patch::new(positions, triangles, topology, &region, &faces);
+    patch.relax(sweeps);
+    for (&v, p) in region.iter().zip(&patch.points) {
+        positions[v as usize] = p.to_array();
+    }
+    // The faces around the region get their normals from the positions the sweeps left.
+    state.moved(positions, &region);
+}
+
+/// A region of the mesh copied out for [`relax_tangentially`]'s sweeps: the region's vertices
+/// first (in the region's order), then the other corners of the faces around it, each with its
+/// position; those faces by their local corners; and per region vertex its neighbours and its
+/// faces by local index, in the topology's order.
+struct Patch {
+    /// The region's vertices, then the corners outside it (held).
+    points: Vec<Vec3A>,
+    /// How many of `points` move (the region's vertices).
+    moving: usize,
+    triangles: Vec<[u32; 3]>,
+    /// Per moving vertex i, its neighbours are `neighbors[neighbor_start[i]..neighbor_start[i
+    /// + 1]]` and its faces `faces_of[face_start[i]..face_start[i + 1]]`, by local index.
+    neighbor_start: Vec<u32>,
+    neighbors: Vec<u32>,
+    face_start: Vec<u32>,
+    faces_of: Vec<u32>,
+}
+
+impl Patch {
+    fn new(
+        positions: &[[f32; 3]],
+        triangles: &[[u32; 3]],
+        topology: &Topology,
+        region: &[u32],
+        faces: &[u32],
+    ) -> Self {
+        // Local index by M0's (NONE: not in the patch yet).
+        let mut local = vec![NONE; positions.len()];
+        let mut points = Vec::with_capacity(region.len() * 2);
+        let mut index = |v: u32, points: &mut Vec<Vec3A>| -> u32 {
+            let slot = &mut local[v as usize];
+            if *slot == NONE {
+                *slot = points.len() as u32;
+                points.push(Vec3A::from_array(positions[v as usize]));
+            }
+            *slot
+        };
+        for &v in region {
+            index(v, &mut points);
         }
-        let normals: &[Vec3A] = &state.folds.normals;
-        region
-            .par_iter()
-            .with_min_len(super::PARALLEL_GRAIN)
-            .map(|&v| {
-                let p = Vec3A::from_array(positions_now[v as usize]);
-                let normal = topology
-                    .faces_of(v)
-                    .iter()
-                    .fold(Vec3A::ZERO, |n, &f| n + normals[f as usize])
-                    .normalize_or_zero();
-                let ring = topology.neighbors(v);
-                let sum = ring.iter().fold(Vec3A::ZERO, |sum, &u| {
-                    sum + Vec3A::from_array(positions_now[u as usize])
-                });
-                let step = sum / ring.len().max(1) as f32 - p;
-                (p + step - normal * step.dot(normal)).to_array()
-            })
-            .collect_into_vec(&mut moved);
-        for (&v, &p) in region.iter().zip(&moved) {
-            positions[v as usize] = p;
+        let mut face_index = vec![NONE; triangles.len()];
+        for (i, &f) in faces.iter().enumerate() {
+            face_index[f as usize] = i as u32;
+        }
+        let local_triangles = faces
+            .iter()
+            .map(|&f| triangles[f as usize].map(|v| index(v, &mut points)))
+            .collect();
+        let (mut neighbor_start, mut neighbors) = (vec![0], Vec::new());
+        let (mut face_start, mut faces_of) = (vec![0], Vec::new());
+        for &v in region {
+            for &u in topology.neighbors(v) {
+                neighbors.push(index(u, &mut points));
+            }
+            neighbor_start.push(neighbors.len() as u32);
+            faces_of.extend(topology.faces_of(v).iter().map(|&f| face_index[f as usize]));
+            face_start.push(faces_of.len() as u32);
+        }
+        Self {
+            points,
+            moving: region.len(),
+            triangles: local_triangles,
+            neighbor_start,
+            neighbors,
+            face_start,
+            faces_of,
         }
     }
-    state.moved(positions, &region);
+
+    /// `sweeps` Jacobi sweeps of the tangential step over the moving vertices: each face's
+    /// area normal once a sweep, then each vertex moved by the step to its neighbours' mean less
+    /// the step's part along the sum of its faces' normals.
+    fn relax(&mut self, sweeps: usize) {
+        let mut normals = Vec::new();
+        let mut moved = Vec::new();
+        for _ in 0..sweeps {
+            let points: &[Vec3A] = &self.points;
+            self.triangles
+                .par_iter()
+                .with_min_len(super::PARALLEL_GRAIN)
+                .map(|t| {
+                    let [a, b, c] = t.map(|v| points[v as usize]);
+                    (b - a).cross(c - a)
+                })
+                .collect_into_vec(&mut normals);
+            let normals: &[Vec3A] = &normals;
+            (0..self.moving)
+                .into_par_iter()
+                .with_min_len(super::PARALLEL_GRAIN)
+                .map(|i| {
+                    let p = points[i];
+                    let faces = &self.faces_of
+                        [self.face_start[i] as usize..self.face_start[i + 1] as usize];
+                    let normal = faces
+                        .iter()
+                        .fold(Vec3A::ZERO, |n, &f| n + normals[f as usize])
+                        .normalize_or_zero();
+                    let ring = &self.neighbors
+                        [self.neighbor_start[i] as usize..self.neighbor_start[i + 1] as usize];
+                    let sum = ring
+                        .iter()
+                        .fold(Vec3A::ZERO, |sum, &u| sum + points[u as usize]);
+                    let step = sum / ring.len().max(1) as f32 - p;
+                    p + step - normal * step.dot(normal)
+                })
+                .collect_into_vec(&mut moved);
+            self.points[..self.moving].copy_from_slice(&moved);
+        }
+    }
 }
 
 /// Steps 3 and 4 of the module docs: the displacement from M0 smoothed around what `state`
