@@ -158,13 +158,29 @@ fn face_normals(positions: &[[f32; 3]], triangles: &[[u32; 3]], normals: &mut Ve
         .collect_into_vec(normals);
 }
 
+/// An edge with two faces, and what a run ([`FoldState`]) marks on it, together: a run that
+/// looks at the edges around what moved reads one record per edge, not five arrays (on a
+/// 1.2M-face scan those looks were most of an unfolding pass).
+#[derive(Clone, Copy, Debug)]
+struct Edge {
+    /// Its two ends and its two faces.
+    ends: [u32; 4],
+    /// [`FoldState::moved`]'s stamp of the last call that looked at it.
+    stamp: u32,
+    /// It bends to within [`RIGHT_ANGLE_MARGIN_DEGREES`] of a right angle or beyond on M0.
+    reference: bool,
+    /// Folded now (beyond a right angle, and not `reference`).
+    folded: bool,
+    /// On the run's list of edges that may be folded ([`FoldState`]'s `edges`).
+    watched: bool,
+}
+
 /// What [`unfold`] keeps of M0 from run to run: its faces' normals, its edges with two faces,
 /// which of them bend to within [`RIGHT_ANGLE_MARGIN_DEGREES`] of a right angle or beyond on M0
 /// itself (features, left alone even when the levels bend them a little further), and each
 /// face's edges among them.
 pub(super) struct FoldEdges {
-    edges: Vec<[u32; 4]>,
-    reference: Vec<bool>,
+    edges: Vec<Edge>,
     /// Per face, the indices in `edges` of its edges (`NONE` for an edge without two faces).
     face_edges: Vec<[u32; 3]>,
     /// M0's face normals (area-weighted).
@@ -192,15 +208,21 @@ impl FoldEdges {
         Self::with_reference(mesh, edges, reference, m0_normals)
     }
 
+    /// Whether each edge bends on M0 itself as [`Self::new`] reads it (a feature).
+    #[cfg(test)]
+    fn reference(&self) -> Vec<bool> {
+        self.edges.iter().map(|e| e.reference).collect()
+    }
+
     /// [`Self::new`] with the edges and the reference flags given.
     fn with_reference(
         mesh: &TriMesh,
-        edges: Vec<[u32; 4]>,
+        ends: Vec<[u32; 4]>,
         reference: Vec<bool>,
         m0_normals: Vec<Vec3A>,
     ) -> Self {
         let mut face_edges = vec![[NONE; 3]; mesh.face_count()];
-        for (e, &[a, b, f, g]) in edges.iter().enumerate() {
+        for (e, &[a, b, f, g]) in ends.iter().enumerate() {
             for face in [f, g] {
                 let t = mesh.triangles[face as usize];
                 let slot = (0..3)
@@ -212,9 +234,19 @@ impl FoldEdges {
                 face_edges[face as usize][slot] = e as u32;
             }
         }
+        let edges = ends
+            .into_iter()
+            .zip(reference)
+            .map(|(ends, reference)| Edge {
+                ends,
+                stamp: 0,
+                reference,
+                folded: false,
+                watched: false,
+            })
+            .collect();
         Self {
             edges,
-            reference,
             face_edges,
             m0_normals,
             normals: Vec::new(),
@@ -231,17 +263,14 @@ struct FoldState<'a> {
     topology: &'a Topology,
     folds: &'a mut FoldEdges,
     turned: Vec<bool>,
-    folded: Vec<bool>,
     /// The faces and edges that may be turned or folded now: those that were at the full pass or
     /// at the last [`Self::corners`], and every one looked at since (`watched_*` flag them).
     faces: Vec<u32>,
     edges: Vec<u32>,
     watched_faces: Vec<bool>,
-    watched_edges: Vec<bool>,
     /// [`Self::moved`]'s marks of the faces and edges it has looked at in this call (`stamp`),
     /// and its buffers of those faces and their normals.
     face_stamps: Vec<u32>,
-    edge_stamps: Vec<u32>,
     stamp: u32,
     touched: Vec<u32>,
     touched_normals: Vec<Vec3A>,
@@ -263,42 +292,41 @@ impl<'a> FoldState<'a> {
             .with_min_len(super::PARALLEL_GRAIN)
             .map(|(n, m)| n.dot(*m) < 0.0)
             .collect();
-        let folded: Vec<bool> = folds
+        folds
             .edges
-            .par_iter()
-            .zip(folds.reference.par_iter())
+            .par_iter_mut()
             .with_min_len(super::PARALLEL_GRAIN)
-            .map(|(&[_, _, f, g], &was)| !was && normals[f as usize].dot(normals[g as usize]) < 0.0)
-            .collect();
+            .for_each(|edge| {
+                let [_, _, f, g] = edge.ends;
+                edge.folded = !edge.reference && normals[f as usize].dot(normals[g as usize]) < 0.0;
+                edge.watched = edge.folded;
+                edge.stamp = 0;
+            });
         let flagged = |flags: &[bool]| -> Vec<u32> {
             (0..flags.len() as u32)
                 .filter(|&i| flags[i as usize])
                 .collect()
         };
-        let (faces, edges) = (flagged(&turned), flagged(&folded));
+        let faces = flagged(&turned);
+        let edges: Vec<u32> = (0..folds.edges.len() as u32)
+            .filter(|&e| folds.edges[e as usize].folded)
+            .collect();
         let mut watched_faces = vec![false; turned.len()];
-        let mut watched_edges = vec![false; folded.len()];
         for &f in &faces {
             watched_faces[f as usize] = true;
-        }
-        for &e in &edges {
-            watched_edges[e as usize] = true;
         }
         Self {
             triangles,
             topology,
             folds,
             turned,
-            folded,
             faces,
             edges,
             face_stamps: vec![0; watched_faces.len()],
-            edge_stamps: vec![0; watched_edges.len()],
             stamp: 0,
             touched: Vec::new(),
             touched_normals: Vec::new(),
             watched_faces,
-            watched_edges,
         }
     }
 
@@ -308,7 +336,9 @@ impl<'a> FoldState<'a> {
         self.stamp = self.stamp.wrapping_add(1);
         if self.stamp == 0 {
             self.face_stamps.fill(0);
-            self.edge_stamps.fill(0);
+            for edge in &mut self.folds.edges {
+                edge.stamp = 0;
+            }
             self.stamp = 1;
         }
         let stamp = self.stamp;
@@ -346,16 +376,19 @@ impl<'a> FoldState<'a> {
         }
         for &f in &faces {
             for e in self.folds.face_edges[f as usize] {
-                if e == NONE || self.edge_stamps[e as usize] == stamp {
+                if e == NONE {
                     continue;
                 }
-                self.edge_stamps[e as usize] = stamp;
-                let [_, _, f, g] = self.folds.edges[e as usize];
+                let edge = &mut self.folds.edges[e as usize];
+                if edge.stamp == stamp {
+                    continue;
+                }
+                edge.stamp = stamp;
+                let [_, _, f, g] = edge.ends;
                 let normals = &self.folds.normals;
-                self.folded[e as usize] = !self.folds.reference[e as usize]
-                    && normals[f as usize].dot(normals[g as usize]) < 0.0;
-                if !self.watched_edges[e as usize] {
-                    self.watched_edges[e as usize] = true;
+                edge.folded = !edge.reference && normals[f as usize].dot(normals[g as usize]) < 0.0;
+                if !edge.watched {
+                    edge.watched = true;
                     self.edges.push(e);
                 }
             }
@@ -379,14 +412,14 @@ impl<'a> FoldState<'a> {
         for &f in &self.faces {
             corners.extend(self.triangles[f as usize]);
         }
-        let (folded, watched_edges) = (&self.folded, &mut self.watched_edges);
+        let edges = &mut self.folds.edges;
         self.edges.retain(|&e| {
-            let keep = folded[e as usize];
-            watched_edges[e as usize] = keep;
-            keep
+            let edge = &mut edges[e as usize];
+            edge.watched = edge.folded;
+            edge.folded
         });
         for &e in &self.edges {
-            let [a, b, f, g] = self.folds.edges[e as usize];
+            let [a, b, f, g] = self.folds.edges[e as usize].ends;
             let third = |face: u32| {
                 let t = self.triangles[face as usize];
                 t[0] ^ t[1] ^ t[2] ^ a ^ b
@@ -1146,7 +1179,7 @@ mod tests {
         let creases = crate::fairing::detect_creases(&mesh, &topology, &Default::default());
         let edges = two_face_edges(&mesh.triangles);
         let mut folds = FoldEdges::new(&mesh);
-        let reference = folds.reference.clone();
+        let reference = folds.reference();
         let sum = |p: &[f32; 3]| p[0] + p[1] + p[2];
         let corner = (0..mesh.positions.len())
             .max_by(|&a, &b| sum(&mesh.positions[a]).total_cmp(&sum(&mesh.positions[b])))
