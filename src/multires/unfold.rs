@@ -208,6 +208,23 @@ impl FoldEdges {
         Self::with_reference(mesh, edges, reference, m0_normals)
     }
 
+    /// M0's volumes, to give them back ([`unfold`] with `keep_volume`), and a mesh to offset:
+    /// made by the first call, kept for the next runs.
+    pub(super) fn keep_volume_of(&mut self, mesh: &TriMesh, topology: &Topology) {
+        if self.volume.is_none() {
+            self.volume = Some((
+                VolumeKeeper::new(mesh, topology, &[]),
+                TriMesh::new(Vec::new(), mesh.triangles.clone()),
+            ));
+        }
+    }
+
+    /// Whether M0's volumes are made ([`Self::keep_volume_of`]).
+    #[cfg(test)]
+    pub(super) fn has_volume(&self) -> bool {
+        self.volume.is_some()
+    }
+
     /// Whether each edge bends on M0 itself as [`Self::new`] reads it (a feature).
     #[cfg(test)]
     fn reference(&self) -> Vec<bool> {
@@ -885,11 +902,8 @@ pub(super) fn unfold(positions: &mut [[f32; 3]], level: &Level, folds: &mut Fold
     // distance per connected part. Before, for the levels' own drift (a coarse level's result can
     // hold a percent or two more); after, for what the means and the vertices put back to M0
     // changed (clean elephant from its coarsest level: +1.9 % without it).
-    if keep_volume && folds.volume.is_none() {
-        folds.volume = Some((
-            VolumeKeeper::new(mesh, topology, &[]),
-            TriMesh::new(Vec::new(), mesh.triangles.clone()),
-        ));
+    if keep_volume {
+        folds.keep_volume_of(mesh, topology);
     }
     let mut volume = folds.volume.take().filter(|_| keep_volume);
     // The vertices `held` (put back to M0) stay where they are.
