@@ -270,7 +270,7 @@ impl MultiresWorkspace {
         let operator = (fair_options.variant, fair_options.boundary);
         let faired = move |level: usize| (level >= 1 || fair_last).then_some(operator);
         self.prepare_levels(hierarchy, 0..=start, faired);
-        if start > 0 && options.unfold && options.variant == MultiresVariant::Improved {
+        if unfolds(options, start) {
             self.prepare_unfolding(hierarchy);
         }
     }
@@ -494,8 +494,7 @@ fn fair_multires_on_worker(
         fair_level(workspace, 0, &fair_options);
         progress.check(1.0)?;
     }
-    // The paper's variant is the paper's recipe alone: no unfolding.
-    if start > 0 && options.unfold && options.variant == MultiresVariant::Improved {
+    if unfolds(options, start) {
         unfold_new_folds(hierarchy, workspace);
     }
     if release {
@@ -520,6 +519,13 @@ pub fn folds_left_warning(start_level: usize, folds_left: usize) -> String {
          level leaves none",
         100.0 * PUT_BACK_BUDGET
     )
+}
+
+/// Whether a run from `start` with `options` ends by unfolding ([`unfold_new_folds`]): the
+/// improved variant from a coarser level, with the unfolding on. The paper's variant is the
+/// paper's recipe alone: no unfolding.
+fn unfolds(options: &MultiresOptions, start: usize) -> bool {
+    start > 0 && options.unfold && options.variant == MultiresVariant::Improved
 }
 
 /// The last step of a run from a coarser level ([`unfold`]): the faces it left turned against

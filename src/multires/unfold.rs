@@ -320,12 +320,9 @@ impl<'a> FoldState<'a> {
                 edge.watched = edge.folded;
                 edge.stamp = 0;
             });
-        let flagged = |flags: &[bool]| -> Vec<u32> {
-            (0..flags.len() as u32)
-                .filter(|&i| flags[i as usize])
-                .collect()
-        };
-        let faces = flagged(&turned);
+        let faces: Vec<u32> = (0..turned.len() as u32)
+            .filter(|&f| turned[f as usize])
+            .collect();
         let edges: Vec<u32> = (0..folds.edges.len() as u32)
             .filter(|&e| folds.edges[e as usize].folded)
             .collect();
@@ -513,8 +510,8 @@ fn relax_tangentially(
     faces.sort_unstable();
     let mut patch = Patch::new(positions, triangles, topology, &region, &faces);
     patch.relax(sweeps);
-    for (&v, p) in region.iter().zip(&patch.points) {
-        positions[v as usize] = p.to_array();
+    for (&v, &p) in region.iter().zip(&patch.points) {
+        positions[v as usize] = p;
     }
     // The faces around the region get their normals from the positions the sweeps left.
     state.moved(positions, &region);
@@ -526,7 +523,7 @@ fn relax_tangentially(
 /// faces by local index, in the topology's order.
 struct Patch {
     /// The region's vertices, then the corners outside it (held).
-    points: Vec<Vec3A>,
+    points: Vec<[f32; 3]>,
     /// How many of `points` move (the region's vertices).
     moving: usize,
     triangles: Vec<[u32; 3]>,
@@ -549,11 +546,11 @@ impl Patch {
         // Local index by M0's (NONE: not in the patch yet).
         let mut local = vec![NONE; positions.len()];
         let mut points = Vec::with_capacity(region.len() * 2);
-        let mut index = |v: u32, points: &mut Vec<Vec3A>| -> u32 {
+        let mut index = |v: u32, points: &mut Vec<[f32; 3]>| -> u32 {
             let slot = &mut local[v as usize];
             if *slot == NONE {
                 *slot = points.len() as u32;
-                points.push(Vec3A::from_array(positions[v as usize]));
+                points.push(positions[v as usize]);
             }
             *slot
         };
@@ -596,21 +593,13 @@ impl Patch {
         let mut normals = Vec::new();
         let mut moved = Vec::new();
         for _ in 0..sweeps {
-            let points: &[Vec3A] = &self.points;
-            self.triangles
-                .par_iter()
-                .with_min_len(super::PARALLEL_GRAIN)
-                .map(|t| {
-                    let [a, b, c] = t.map(|v| points[v as usize]);
-                    (b - a).cross(c - a)
-                })
-                .collect_into_vec(&mut normals);
-            let normals: &[Vec3A] = &normals;
+            face_normals(&self.points, &self.triangles, &mut normals);
+            let (points, normals): (&[[f32; 3]], &[Vec3A]) = (&self.points, &normals);
             (0..self.moving)
                 .into_par_iter()
                 .with_min_len(super::PARALLEL_GRAIN)
                 .map(|i| {
-                    let p = points[i];
+                    let p = Vec3A::from_array(points[i]);
                     let faces = &self.faces_of
                         [self.face_start[i] as usize..self.face_start[i + 1] as usize];
                     let normal = faces
@@ -619,11 +608,11 @@ impl Patch {
                         .normalize_or_zero();
                     let ring = &self.neighbors
                         [self.neighbor_start[i] as usize..self.neighbor_start[i + 1] as usize];
-                    let sum = ring
-                        .iter()
-                        .fold(Vec3A::ZERO, |sum, &u| sum + points[u as usize]);
+                    let sum = ring.iter().fold(Vec3A::ZERO, |sum, &u| {
+                        sum + Vec3A::from_array(points[u as usize])
+                    });
                     let step = sum / ring.len().max(1) as f32 - p;
-                    p + step - normal * step.dot(normal)
+                    (p + step - normal * step.dot(normal)).to_array()
                 })
                 .collect_into_vec(&mut moved);
             self.points[..self.moving].copy_from_slice(&moved);
