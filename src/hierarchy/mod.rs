@@ -7,8 +7,11 @@
 //! - Vertices are renumbered ("internal" ids) by the level at which they disappear, those that
 //!   survive to the coarsest level first, those removed by the first pass last. The vertices of
 //!   level `i` are then exactly the internal ids `0..V_i`, so the positions of level `i` are a
-//!   prefix of one array and refining by a level appends the split vertices.
-//! - Faces are renumbered the same way, so the faces of level `i` are the first `F_i` faces.
+//!   prefix of one array and refining by a level appends the split vertices. Within a level's
+//!   share they are in Morton order of their positions (as the decimation visits M0), so that
+//!   every level's passes find a vertex's neighbours near it in memory.
+//! - Faces are renumbered the same way, so the faces of level `i` are the first `F_i` faces
+//!   (within a level's share, by their first corner in that Morton order).
 //! - The collapse record of a removed vertex `v` is its target `k = target[v]` (an internal id
 //!   of the next coarser level, so always smaller than `v`'s), the signed cone volume of the
 //!   collapse, and (implicitly, through the face order) the faces it removed. The faces it

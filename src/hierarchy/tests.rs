@@ -75,6 +75,54 @@ fn check_levels(mesh: &TriMesh, options: &HierarchyOptions) -> Hierarchy {
     h
 }
 
+/// Within each level's share of the internal order (the vertices and faces one pass removed,
+/// or those no pass removed), vertices follow the Morton order of their M0 positions and faces
+/// that of their first corner (ties by M0 id), as the decimation's first level has them: every
+/// level's arrays then keep a vertex's neighbours near it in memory. Ties by M0 id alone, the
+/// subdivided sphere's split vertices come before the corners near them.
+#[test]
+fn each_level_keeps_its_vertices_and_faces_in_morton_order() {
+    let mut mesh = sphere(3);
+    // An isolated vertex is in no face: it comes last of those no pass removed.
+    mesh.positions.push([0.0, 0.0, 0.0]);
+    let h = build_hierarchy(&mesh, &HierarchyOptions::default(), &mut NoProgress).unwrap();
+    let (lo, hi) = crate::metrics::bounding_box(&mesh).unwrap();
+    let extent = (hi - lo).max_element();
+    let key = |v: u32| {
+        let p = mesh.positions[v as usize].map(f64::from);
+        (crate::mesh::morton_code(p.into(), lo, extent), v)
+    };
+    let shares = |sizes: &[u32]| -> Vec<std::ops::Range<usize>> {
+        // The survivors' share, then each pass's, coarsest first.
+        let coarsest = std::iter::once(0..sizes[sizes.len() - 1] as usize);
+        let passes = (0..sizes.len() - 1)
+            .rev()
+            .map(|level| sizes[level + 1] as usize..sizes[level] as usize);
+        coarsest.chain(passes).collect()
+    };
+    let isolated = mesh.vertex_count() as u32 - 1;
+    let survivors = h.level_vertices[h.level_vertices.len() - 1] as usize;
+    assert_eq!(h.order[survivors - 1], isolated);
+    let mut ordered_shares = 0;
+    for share in shares(&h.level_vertices) {
+        let ids: Vec<u32> = h.order[share]
+            .iter()
+            .copied()
+            .filter(|&v| v != isolated)
+            .collect();
+        assert!(ids.windows(2).all(|w| key(w[0]) < key(w[1])), "{ids:?}");
+        ordered_shares += usize::from(ids.len() > 1);
+    }
+    for share in shares(&h.level_faces) {
+        let firsts: Vec<(u64, u32)> = h.face_order[share]
+            .iter()
+            .map(|&f| key(mesh.triangles[f as usize][0]))
+            .collect();
+        assert!(firsts.windows(2).all(|w| w[0] <= w[1]), "{firsts:?}");
+    }
+    assert!(ordered_shares > 2, "{ordered_shares}");
+}
+
 #[test]
 fn closed_sphere_levels_stay_manifold_and_coarsen() {
     let mesh = sphere(3);

@@ -141,6 +141,11 @@ pub(super) struct BuildOutput {
     /// M0 ids of the vertices whose faces are not one oriented fan (ascending): they and their
     /// neighbours stay in every level.
     pub non_manifold: Vec<u32>,
+    /// M0's vertices that some face uses, and its faces, in the first level's order (Morton
+    /// order of the positions; faces by their first corner): the order the hierarchy keeps
+    /// within each level's share, so that neighbours lie near each other in memory.
+    pub vertex_sequence: Vec<u32>,
+    pub face_sequence: Vec<u32>,
 }
 
 /// A pass that removes fewer than one vertex in this many ends the build, without its level.
@@ -256,6 +261,8 @@ fn passes(
         face_removed_in_pass: Vec::new(),
         pass_ms: Vec::new(),
         non_manifold: Vec::new(),
+        vertex_sequence: level.vertex_id.clone(),
+        face_sequence: level.face_id.clone(),
     };
     // Written by the removals of a pass at once (each vertex is removed once), then moved into
     // `out`; the six split volumes as f32 bits.
