@@ -246,11 +246,38 @@ impl Hierarchy {
         )
     }
     /// A level as a file should hold it: [`Hierarchy::level_mesh`] without the vertices none of
-    /// its faces uses (the tips of fins left out as loose triangles, which never collapse), and
-    /// [`Hierarchy::level_origins`] to match (per vertex its M0 vertex, per face its M0 face).
+    /// its faces uses (the tips of fins left out as loose triangles, which never collapse), its
+    /// vertices and faces in M0's order (so level 0 is M0 as it came in, less loose triangles,
+    /// and a file does not depend on the internal order), and [`Hierarchy::level_origins`] to
+    /// match (per vertex its M0 vertex, per face its M0 face).
     pub fn level_for_export(&self, level: usize) -> (TriMesh, Vec<u32>, Vec<u32>) {
-        let mut mesh = self.level_mesh(level);
+        let internal = self.level_mesh(level);
         let (vertex_origin, face_origin) = self.level_origins(level);
+        let by_origin = |origin: &[u32]| {
+            let mut ids: Vec<u32> = (0..origin.len() as u32).collect();
+            ids.sort_unstable_by_key(|&i| origin[i as usize]);
+            ids
+        };
+        let (vertices, faces) = (by_origin(&vertex_origin), by_origin(&face_origin));
+        let mut place = vec![0u32; vertices.len()];
+        for (i, &v) in vertices.iter().enumerate() {
+            place[v as usize] = i as u32;
+        }
+        let mut mesh = TriMesh::new(
+            vertices
+                .iter()
+                .map(|&v| internal.positions[v as usize])
+                .collect(),
+            faces
+                .iter()
+                .map(|&f| internal.triangles[f as usize].map(|c| place[c as usize]))
+                .collect(),
+        );
+        let vertex_origin: Vec<u32> = vertices
+            .iter()
+            .map(|&v| vertex_origin[v as usize])
+            .collect();
+        let face_origin: Vec<u32> = faces.iter().map(|&f| face_origin[f as usize]).collect();
         let faces = mesh.face_count();
         // A level has no face that repeats a vertex, so only vertices go.
         let (_, map) = crate::mesh::clean_with_map_but_repeats(&mut mesh);

@@ -123,6 +123,50 @@ fn each_level_keeps_its_vertices_and_faces_in_morton_order() {
     assert!(ordered_shares > 2, "{ordered_shares}");
 }
 
+/// A level for a file lists its vertices and faces in M0's order, whatever the internal order:
+/// level 0 is M0 as it came in, and every level's origins ascend.
+#[test]
+fn levels_for_files_keep_m0s_order_and_level_0_is_m0() {
+    let mesh = sphere(3);
+    let h = build_hierarchy(&mesh, &HierarchyOptions::default(), &mut NoProgress).unwrap();
+    let (level_0, vertex_origin, face_origin) = h.level_for_export(0);
+    assert_eq!(level_0.positions, mesh.positions);
+    assert_eq!(level_0.triangles, mesh.triangles);
+    assert!(vertex_origin
+        .iter()
+        .copied()
+        .eq(0..mesh.vertex_count() as u32));
+    assert!(face_origin.iter().copied().eq(0..mesh.face_count() as u32));
+    for level in 1..h.level_count() {
+        let (coarse, vertex_origin, face_origin) = h.level_for_export(level);
+        assert!(
+            vertex_origin.windows(2).all(|w| w[0] < w[1]),
+            "level {level}"
+        );
+        assert!(face_origin.windows(2).all(|w| w[0] < w[1]), "level {level}");
+        for (p, &v) in coarse.positions.iter().zip(&vertex_origin) {
+            assert_eq!(*p, mesh.positions[v as usize], "level {level}");
+        }
+        // The same faces as the level in internal order, corner for corner, by M0 ids.
+        let internal = h.level_mesh(level);
+        let (internal_vertices, internal_faces) = h.level_origins(level);
+        let mut expected: Vec<(u32, [u32; 3])> = internal
+            .triangles
+            .iter()
+            .zip(&internal_faces)
+            .map(|(t, &f)| (f, t.map(|c| internal_vertices[c as usize])))
+            .collect();
+        expected.sort_unstable();
+        let written: Vec<(u32, [u32; 3])> = coarse
+            .triangles
+            .iter()
+            .zip(&face_origin)
+            .map(|(t, &f)| (f, t.map(|c| vertex_origin[c as usize])))
+            .collect();
+        assert_eq!(written, expected, "level {level}");
+    }
+}
+
 #[test]
 fn closed_sphere_levels_stay_manifold_and_coarsen() {
     let mesh = sphere(3);
