@@ -248,8 +248,9 @@ impl Hierarchy {
     /// A level as a file should hold it: [`Hierarchy::level_mesh`] without the vertices none of
     /// its faces uses (the tips of fins left out as loose triangles, which never collapse), its
     /// vertices and faces in M0's order (so level 0 is M0 as it came in, less loose triangles,
-    /// and a file does not depend on the internal order), and [`Hierarchy::level_origins`] to
-    /// match (per vertex its M0 vertex, per face its M0 face).
+    /// and a file does not depend on the internal order), and its origins to match: per vertex
+    /// its M0 vertex and per face its M0 face, both ascending ([`Hierarchy::level_origins`] in
+    /// that order).
     pub fn level_for_export(&self, level: usize) -> (TriMesh, Vec<u32>, Vec<u32>) {
         let internal = self.level_mesh(level);
         let (vertex_origin, face_origin) = self.level_origins(level);
