@@ -260,10 +260,7 @@ impl Hierarchy {
             ids
         };
         let (vertices, faces) = (by_origin(&vertex_origin), by_origin(&face_origin));
-        let mut place = vec![0u32; vertices.len()];
-        for (i, &v) in vertices.iter().enumerate() {
-            place[v as usize] = i as u32;
-        }
+        let place = crate::mesh::inverse_permutation(&vertices);
         let mut mesh = TriMesh::new(
             vertices
                 .iter()
