@@ -554,11 +554,20 @@ fn loose_triangles_at_non_manifold_edges_stay_in_m0_and_out_of_the_levels() {
     );
     assert_eq!(file.vertex_count(), h.level_info(top).vertices - tips);
     assert_eq!(file.face_count(), h.level_info(top).faces);
+    // The file lists them in M0's order, whatever the level's own order.
     let (_, level_faces) = h.level_origins(top);
-    assert_eq!(face_origin, level_faces);
-    for (t, level_face) in file.triangles.iter().zip(h.level_triangles(top)) {
-        let m0 = t.map(|c| vertex_origin[c as usize]);
-        assert_eq!(m0, level_face.map(|c| h.original_vertex(c)));
+    let mut level_faces: Vec<(u32, [u32; 3])> = level_faces
+        .into_iter()
+        .zip(h.level_triangles(top))
+        .map(|(f, t)| (f, t.map(|c| h.original_vertex(c))))
+        .collect();
+    level_faces.sort_unstable_by_key(|&(f, _)| f);
+    assert!(
+        face_origin == level_faces.iter().map(|&(f, _)| f).collect::<Vec<_>>(),
+        "a level file's faces are not the level's faces in M0's order"
+    );
+    for (t, (_, level_face)) in file.triangles.iter().zip(&level_faces) {
+        assert_eq!(t.map(|c| vertex_origin[c as usize]), *level_face);
     }
     // Kept in the levels, they hold their corners with their neighbours.
     let pinned = build_hierarchy(
