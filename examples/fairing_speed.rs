@@ -1,7 +1,10 @@
 //! Speed of one fairing iteration against the memory floor, on `assets/bunny00.obj` and on it
 //! Loop-subdivided twice (about 1.2M faces) with noise.
 //!
-//! Run: `cargo run --release --example fairing_speed`
+//! Run: `cargo run --release --example fairing_speed [-- MESH...]`
+//!
+//! Each MESH file given is measured too, as it is (no noise added): for instance the levels
+//! `fairmesh hierarchy IN --write-levels DIR` writes, which are irregular meshes of every size.
 //!
 //! For each mesh and operator: median wall time per iteration (rayon's default pool), the
 //! process CPU time per iteration (from /proc/self/stat, robust when other processes share the
@@ -71,8 +74,18 @@ fn main() {
         big_bandwidth / 1e9
     );
     // The operator renumbers vertices for locality itself (breadth-first, valence-sorted
-    // blocks), so the input order does not matter: the subdivision's order is as fast.
-    let meshes: [(&str, TriMesh); 2] = [("bunny00", bunny), ("bunny00 x16", big)];
+    // blocks on small meshes), so the input order does not matter: the subdivision's order is as
+    // fast.
+    let mut meshes: Vec<(String, TriMesh)> = vec![
+        ("bunny00".to_string(), bunny),
+        ("bunny00 x16".to_string(), big),
+    ];
+    for path in std::env::args().skip(1) {
+        let mesh = fairmesh::io::load(std::path::Path::new(&path))
+            .unwrap_or_else(|e| panic!("{path}: {e}"))
+            .mesh;
+        meshes.push((path, mesh));
+    }
     println!("\n| mesh | operation | wall ms (median) | CPU ms / iteration | MB streamed | floor ms | wall / floor |");
     println!("|---|---|---:|---:|---:|---:|---:|");
     for (name, mesh) in &meshes {

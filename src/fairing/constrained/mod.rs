@@ -54,7 +54,9 @@
 //!
 //! # Speed
 //! - Locality: vertices are renumbered breadth-first over the one-rings (neighbours close in
-//!   memory), then sorted by valence within blocks (the gather loops' exits become predictable);
+//!   memory), then, on meshes small enough for the cache, sorted by valence within blocks (the
+//!   gather loops' exits become predictable; on larger ones the sort would hide the gathers'
+//!   ascending order from the hardware prefetcher);
 //!   [`ConstrainedFairing::load`] and [`ConstrainedFairing::store`] map between the mesh's
 //!   numbering and this one.
 //! - Bytes: weight rows are deduplicated (a mesh has a few hundred distinct rows) and each entry

@@ -25,6 +25,13 @@ const TABLE_VALENCE: usize = 32;
 /// 40% less CPU time per iteration on a mesh of mixed valences; blocks of 64 to 512 measured
 /// alike, see `docs/measurements.md`). Neighbours stay within a block of each other.
 const VALENCE_SORTED_BLOCK: usize = 256;
+/// Meshes with more vertices than this keep the plain breadth-first order. The sort pays while an
+/// iteration's arrays (about 240 bytes a vertex) stay in the cache; beyond it, each pass streams
+/// them from memory, and the gathers only keep up while consecutive vertices' neighbours lie in
+/// ascending order, which the hardware prefetcher follows and the sort scrambles: an irregular
+/// 450k-vertex mesh iterates twice as fast unsorted, an 83k one a quarter slower
+/// (`docs/measurements.md`).
+const VALENCE_SORT_MAX_VERTICES: usize = 100_000;
 
 /// What an operator's set-up computes from the connectivity alone: the locality order (internal
 /// vertex i is the mesh's vertex `order[i]`; `internal` is its inverse) and the one-rings in it
@@ -38,12 +45,15 @@ struct Layout {
 
 impl Layout {
     /// From the one-rings in the mesh's numbering (`ring_offsets`, `ring`): a breadth-first
-    /// order, its blocks sorted by valence.
+    /// order, its blocks sorted by valence unless the mesh is large
+    /// ([`VALENCE_SORT_MAX_VERTICES`]).
     fn new(ring_offsets: &[u32], ring: &[u32]) -> Layout {
         let vertex_count = ring_offsets.len() - 1;
         let mut order = breadth_first_order(ring_offsets, ring);
-        for block in order.chunks_mut(VALENCE_SORTED_BLOCK) {
-            block.sort_by_key(|&v| ring_offsets[v as usize + 1] - ring_offsets[v as usize]);
+        if vertex_count <= VALENCE_SORT_MAX_VERTICES {
+            for block in order.chunks_mut(VALENCE_SORTED_BLOCK) {
+                block.sort_by_key(|&v| ring_offsets[v as usize + 1] - ring_offsets[v as usize]);
+            }
         }
         let internal = inverse_permutation(&order);
         let mut offsets = Vec::with_capacity(vertex_count + 1);
