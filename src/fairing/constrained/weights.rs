@@ -29,7 +29,7 @@ const VALENCE_SORTED_BLOCK: usize = 256;
 /// iteration's arrays (about 240 bytes a vertex) stay in the cache; beyond it, each pass streams
 /// them from memory, and the gathers only keep up while consecutive vertices' neighbours lie in
 /// ascending order, which the hardware prefetcher follows and the sort scrambles: an irregular
-/// 450k-vertex mesh iterates twice as fast unsorted, an 83k one a quarter slower
+/// 450k-vertex mesh iterates twice as fast unsorted, an 83k one a quarter faster sorted
 /// (`docs/measurements.md`).
 const VALENCE_SORT_MAX_VERTICES: usize = 100_000;
 
