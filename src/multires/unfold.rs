@@ -139,10 +139,10 @@ const SWEEPS: usize = 3;
 /// ([`FoldEdges::new`]).
 pub const RIGHT_ANGLE_MARGIN_DEGREES: f32 = 5.0;
 
-/// Area normal of face `f` with `positions`.
+/// Area normal of the triangle `corners` with `positions`.
 #[inline]
-fn face_normal(positions: &[[f32; 3]], triangles: &[[u32; 3]], f: u32) -> Vec3A {
-    let [a, b, c] = triangles[f as usize].map(|v| Vec3A::from_array(positions[v as usize]));
+fn area_normal(positions: &[[f32; 3]], corners: [u32; 3]) -> Vec3A {
+    let [a, b, c] = corners.map(|v| Vec3A::from_array(positions[v as usize]));
     (b - a).cross(c - a)
 }
 
@@ -151,10 +151,7 @@ fn face_normals(positions: &[[f32; 3]], triangles: &[[u32; 3]], normals: &mut Ve
     triangles
         .par_iter()
         .with_min_len(super::PARALLEL_GRAIN)
-        .map(|t| {
-            let [a, b, c] = t.map(|v| Vec3A::from_array(positions[v as usize]));
-            (b - a).cross(c - a)
-        })
+        .map(|&t| area_normal(positions, t))
         .collect_into_vec(normals);
 }
 
@@ -176,14 +173,34 @@ struct Edge {
     watched: bool,
 }
 
-/// What [`unfold`] keeps of M0 from run to run: its faces' normals, its edges with two faces,
-/// which of them bend to within [`RIGHT_ANGLE_MARGIN_DEGREES`] of a right angle or beyond on M0
-/// itself (features, left alone even when the levels bend them a little further), and each
-/// face's edges among them.
+/// A face of M0 and what a run ([`FoldState`]) marks on it, together in half a cache line: the
+/// look at the faces around what moved reads one record a face and its two normals, where five
+/// arrays (corners, edges, stamp and two flags) were each a cache miss on a large mesh, whose
+/// faces around a vertex lie apart in memory. The normals stay in arrays of their own: the look
+/// at every edge after a full pass reads two of them an edge, and a 16-byte array of them stays
+/// in the cache where 64-byte records with them did not (that pass took half as long again).
+#[derive(Clone, Copy, Debug)]
+#[repr(C, align(32))]
+struct Face {
+    corners: [u32; 3],
+    /// The indices in [`FoldEdges`]' `edges` of its edges (`NONE` for an edge without two
+    /// faces).
+    edges: [u32; 3],
+    /// [`FoldState::faces_around`]'s stamp of the last call that reached it.
+    stamp: u32,
+    /// Turned by more than 90° against M0 now.
+    turned: bool,
+    /// On the run's list of faces that may be turned ([`FoldState`]'s `faces`).
+    watched: bool,
+}
+
+/// What [`unfold`] keeps of M0 from run to run: its faces with their edges and normals, its edges
+/// with two faces, and which of those bend to within [`RIGHT_ANGLE_MARGIN_DEGREES`] of a right
+/// angle or beyond on M0 itself (features, left alone even when the levels bend them a little
+/// further).
 pub(super) struct FoldEdges {
     edges: Vec<Edge>,
-    /// Per face, the indices in `edges` of its edges (`NONE` for an edge without two faces).
-    face_edges: Vec<[u32; 3]>,
+    faces: Vec<Face>,
     /// M0's face normals (area-weighted).
     m0_normals: Vec<Vec3A>,
     /// The result's face normals, kept up to date while a run unfolds.
@@ -239,17 +256,28 @@ impl FoldEdges {
         reference: Vec<bool>,
         m0_normals: Vec<Vec3A>,
     ) -> Self {
-        let mut face_edges = vec![[NONE; 3]; mesh.face_count()];
+        let mut faces: Vec<Face> = mesh
+            .triangles
+            .iter()
+            .map(|&corners| Face {
+                corners,
+                edges: [NONE; 3],
+                stamp: 0,
+                turned: false,
+                watched: false,
+            })
+            .collect();
         for (e, &[a, b, f, g]) in ends.iter().enumerate() {
             for face in [f, g] {
-                let t = mesh.triangles[face as usize];
+                let face = &mut faces[face as usize];
+                let t = face.corners;
                 let slot = (0..3)
                     .find(|&k| {
                         let (x, y) = (t[k], t[(k + 1) % 3]);
                         (x == a && y == b) || (x == b && y == a)
                     })
                     .expect("an edge's face has the edge");
-                face_edges[face as usize][slot] = e as u32;
+                face.edges[slot] = e as u32;
             }
         }
         let edges = ends
@@ -265,7 +293,7 @@ impl FoldEdges {
             .collect();
         Self {
             edges,
-            face_edges,
+            faces,
             m0_normals,
             normals: Vec::new(),
             volume: None,
@@ -277,18 +305,14 @@ impl FoldEdges {
 /// move: after one pass over everything, only the faces around moved vertices and their edges
 /// are looked at again.
 struct FoldState<'a> {
-    triangles: &'a [[u32; 3]],
     topology: &'a Topology,
     folds: &'a mut FoldEdges,
-    turned: Vec<bool>,
     /// The faces and edges that may be turned or folded now: those that were at the full pass or
-    /// at the last [`Self::corners`], and every one looked at since (`watched_*` flag them).
+    /// at the last [`Self::corners`], and every one looked at since (their `watched` flags).
     faces: Vec<u32>,
     edges: Vec<u32>,
-    watched_faces: Vec<bool>,
-    /// [`Self::moved`]'s marks of the faces and edges it has looked at in this call (`stamp`),
-    /// and its buffers of those faces and their normals.
-    face_stamps: Vec<u32>,
+    /// [`Self::moved`]'s mark of the faces and edges it has looked at in this call (their
+    /// `stamp`), and its buffers of those faces and their normals.
     stamp: u32,
     touched: Vec<u32>,
     touched_normals: Vec<Vec3A>,
@@ -296,52 +320,51 @@ struct FoldState<'a> {
 
 impl<'a> FoldState<'a> {
     /// Every face and edge looked at.
-    fn new(
-        positions: &[[f32; 3]],
-        triangles: &'a [[u32; 3]],
-        topology: &'a Topology,
-        folds: &'a mut FoldEdges,
-    ) -> Self {
-        face_normals(positions, triangles, &mut folds.normals);
-        let (normals, m0) = (&folds.normals, &folds.m0_normals);
-        let turned: Vec<bool> = normals
-            .par_iter()
-            .zip(m0.par_iter())
+    fn new(positions: &[[f32; 3]], topology: &'a Topology, folds: &'a mut FoldEdges) -> Self {
+        let FoldEdges {
+            edges,
+            faces,
+            m0_normals,
+            normals,
+            ..
+        } = folds;
+        normals.resize(faces.len(), Vec3A::ZERO);
+        faces
+            .par_iter_mut()
+            .zip(normals.par_iter_mut())
+            .zip(m0_normals.par_iter())
             .with_min_len(super::PARALLEL_GRAIN)
-            .map(|(n, m)| n.dot(*m) < 0.0)
-            .collect();
-        folds
-            .edges
+            .for_each(|((face, normal), m0_normal)| {
+                *normal = area_normal(positions, face.corners);
+                face.turned = normal.dot(*m0_normal) < 0.0;
+                face.watched = face.turned;
+                face.stamp = 0;
+            });
+        let normals: &[Vec3A] = normals;
+        edges
             .par_iter_mut()
             .with_min_len(super::PARALLEL_GRAIN)
             .for_each(|edge| {
                 let [_, _, f, g] = edge.ends;
-                edge.folded = !edge.reference && normals[f as usize].dot(normals[g as usize]) < 0.0;
+                let (n, m) = (normals[f as usize], normals[g as usize]);
+                edge.folded = !edge.reference && n.dot(m) < 0.0;
                 edge.watched = edge.folded;
                 edge.stamp = 0;
             });
-        let faces: Vec<u32> = (0..turned.len() as u32)
-            .filter(|&f| turned[f as usize])
+        let faces: Vec<u32> = (0..folds.faces.len() as u32)
+            .filter(|&f| folds.faces[f as usize].turned)
             .collect();
         let edges: Vec<u32> = (0..folds.edges.len() as u32)
             .filter(|&e| folds.edges[e as usize].folded)
             .collect();
-        let mut watched_faces = vec![false; turned.len()];
-        for &f in &faces {
-            watched_faces[f as usize] = true;
-        }
         Self {
-            triangles,
             topology,
             folds,
-            turned,
             faces,
             edges,
-            face_stamps: vec![0; watched_faces.len()],
             stamp: 0,
             touched: Vec::new(),
             touched_normals: Vec::new(),
-            watched_faces,
         }
     }
 
@@ -350,7 +373,9 @@ impl<'a> FoldState<'a> {
     fn faces_around(&mut self, vertices: &[u32], faces: &mut Vec<u32>) {
         self.stamp = self.stamp.wrapping_add(1);
         if self.stamp == 0 {
-            self.face_stamps.fill(0);
+            for face in &mut self.folds.faces {
+                face.stamp = 0;
+            }
             for edge in &mut self.folds.edges {
                 edge.stamp = 0;
             }
@@ -360,8 +385,9 @@ impl<'a> FoldState<'a> {
         faces.clear();
         for &v in vertices {
             for &f in self.topology.faces_of(v) {
-                if self.face_stamps[f as usize] != stamp {
-                    self.face_stamps[f as usize] = stamp;
+                let face = &mut self.folds.faces[f as usize];
+                if face.stamp != stamp {
+                    face.stamp = stamp;
                     faces.push(f);
                 }
             }
@@ -374,23 +400,24 @@ impl<'a> FoldState<'a> {
         let mut faces = std::mem::take(&mut self.touched);
         self.faces_around(moved, &mut faces);
         let stamp = self.stamp;
-        let triangles = self.triangles;
         let mut normals = std::mem::take(&mut self.touched_normals);
+        let records = &self.folds.faces;
         faces
             .par_iter()
             .with_min_len(super::PARALLEL_GRAIN)
-            .map(|&f| face_normal(positions, triangles, f))
+            .map(|&f| area_normal(positions, records[f as usize].corners))
             .collect_into_vec(&mut normals);
         for (&f, &n) in faces.iter().zip(&normals) {
             self.folds.normals[f as usize] = n;
-            self.turned[f as usize] = n.dot(self.folds.m0_normals[f as usize]) < 0.0;
-            if !self.watched_faces[f as usize] {
-                self.watched_faces[f as usize] = true;
+            let face = &mut self.folds.faces[f as usize];
+            face.turned = n.dot(self.folds.m0_normals[f as usize]) < 0.0;
+            if !face.watched {
+                face.watched = true;
                 self.faces.push(f);
             }
         }
         for &f in &faces {
-            for e in self.folds.face_edges[f as usize] {
+            for e in self.folds.faces[f as usize].edges {
                 if e == NONE {
                     continue;
                 }
@@ -401,7 +428,8 @@ impl<'a> FoldState<'a> {
                 edge.stamp = stamp;
                 let [_, _, f, g] = edge.ends;
                 let normals = &self.folds.normals;
-                edge.folded = !edge.reference && normals[f as usize].dot(normals[g as usize]) < 0.0;
+                let (n, m) = (normals[f as usize], normals[g as usize]);
+                edge.folded = !edge.reference && n.dot(m) < 0.0;
                 if !edge.watched {
                     edge.watched = true;
                     self.edges.push(e);
@@ -418,14 +446,14 @@ impl<'a> FoldState<'a> {
     /// watches them then), so that the repeated calls of a run cost what is still folded.
     fn corners(&mut self) -> Vec<u32> {
         let mut corners = Vec::new();
-        let (turned, watched_faces) = (&self.turned, &mut self.watched_faces);
+        let records = &mut self.folds.faces;
         self.faces.retain(|&f| {
-            let keep = turned[f as usize];
-            watched_faces[f as usize] = keep;
-            keep
+            let face = &mut records[f as usize];
+            face.watched = face.turned;
+            face.turned
         });
         for &f in &self.faces {
-            corners.extend(self.triangles[f as usize]);
+            corners.extend(records[f as usize].corners);
         }
         let edges = &mut self.folds.edges;
         self.edges.retain(|&e| {
@@ -436,7 +464,7 @@ impl<'a> FoldState<'a> {
         for &e in &self.edges {
             let [a, b, f, g] = self.folds.edges[e as usize].ends;
             let third = |face: u32| {
-                let t = self.triangles[face as usize];
+                let t = self.folds.faces[face as usize].corners;
                 t[0] ^ t[1] ^ t[2] ^ a ^ b
             };
             corners.extend([a, b, third(f), third(g)]);
@@ -908,7 +936,7 @@ pub(super) fn unfold(positions: &mut [[f32; 3]], level: &Level, folds: &mut Fold
         }
     };
     restore(positions, &mut volume, &[]);
-    let mut state = FoldState::new(positions, &mesh.triangles, topology, folds);
+    let mut state = FoldState::new(positions, topology, folds);
     if state.faces.is_empty() && state.edges.is_empty() {
         drop(state);
         folds.volume = volume;
@@ -1021,7 +1049,7 @@ pub(super) fn unfold(positions: &mut [[f32; 3]], level: &Level, folds: &mut Fold
             // counted with them.
             break;
         }
-        let mut state = FoldState::new(positions, &mesh.triangles, topology, folds);
+        let mut state = FoldState::new(positions, topology, folds);
         if state.faces.is_empty() && state.edges.is_empty() {
             undone = true;
             break;
@@ -1034,7 +1062,7 @@ pub(super) fn unfold(positions: &mut [[f32; 3]], level: &Level, folds: &mut Fold
     let left = if undone {
         0
     } else {
-        let state = FoldState::new(positions, &mesh.triangles, topology, folds);
+        let state = FoldState::new(positions, topology, folds);
         state.faces.len() + state.edges.len()
     };
     Unfolded {
