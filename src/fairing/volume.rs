@@ -130,27 +130,17 @@ impl VolumeKeeper {
             .map(|(faces, owners)| {
                 let mut sums = vec![[0.0; 4]; parts];
                 for (t, &part) in faces.iter().zip(owners) {
-                    let apex = apexes[part as usize];
-                    let [a, b, c] = t.map(|v| point(v) - apex);
-                    let bc = b.cross(c);
-                    let sum = &mut sums[part as usize];
-                    sum[0] += f64::from(a.dot(bc));
-                    let Some((normals, moves)) = normals else {
-                        continue;
-                    };
-                    let [na, nb, nc] = t.map(|v| {
-                        let v = v as usize;
-                        if moves(v) {
-                            normals[v]
-                        } else {
-                            Vec3A::ZERO
+                    let [a, b, c] = t.map(|v| point(v) - apexes[part as usize]);
+                    let terms = match normals {
+                        None => [a.dot(b.cross(c)), 0.0, 0.0, 0.0],
+                        Some((normals, moves)) => {
+                            face_cubic([a, b, c], t.map(|v| moving_normal(normals, moves, v)))
                         }
-                    });
-                    let mixed = nb.cross(c) + b.cross(nc);
-                    let nbc = nb.cross(nc);
-                    sum[1] += f64::from(na.dot(bc) + a.dot(mixed));
-                    sum[2] += f64::from(na.dot(mixed) + a.dot(nbc));
-                    sum[3] += f64::from(na.dot(nbc));
+                    };
+                    let sum = &mut sums[part as usize];
+                    for k in 0..4 {
+                        sum[k] += f64::from(terms[k]);
+                    }
                 }
                 sums
             })
@@ -195,6 +185,18 @@ impl VolumeKeeper {
         topology: &Topology,
         held: impl Fn(usize) -> bool + Sync,
     ) -> (f64, Offsets) {
+        let (largest, offsets, _) = self.restore_parts(mesh, topology, held);
+        (largest, offsets)
+    }
+
+    /// [`Self::restore_with_normals`], also giving back each part's cubic as it was before the
+    /// offsets (about the positions given).
+    fn restore_parts(
+        &self,
+        mesh: &mut TriMesh,
+        topology: &Topology,
+        held: impl Fn(usize) -> bool + Sync,
+    ) -> (f64, Offsets, Vec<[f64; 4]>) {
         let moves = |v: usize| self.movable[v] && !held(v);
         let positions = &mesh.positions;
         let point = |v: u32| Vec3A::from_array(positions[v as usize]);
@@ -239,7 +241,104 @@ impl VolumeKeeper {
         };
         self.offset(&mut mesh.positions, &offsets, held);
         let largest = offsets.distances.iter().fold(0.0f64, |m, d| m.max(d.abs()));
-        (largest, offsets)
+        (largest, offsets, cubic)
+    }
+
+    /// [`Self::restore`], keeping what [`Self::restore_again`] needs to make the correction again
+    /// after part of the mesh moved. `held` is given per vertex (missing entries: false).
+    pub fn restore_to_redo(
+        &self,
+        mesh: &mut TriMesh,
+        topology: &Topology,
+        held: &[bool],
+    ) -> (f64, Redo) {
+        let is_held = |v: usize| held.get(v).copied().unwrap_or(false);
+        let (largest, offsets, cubic) = self.restore_parts(mesh, topology, is_held);
+        let cubic = cubic
+            .into_iter()
+            .zip(&offsets.distances)
+            .map(|(c, &distance)| shifted(c, distance))
+            .collect();
+        let redo = Redo {
+            normals: offsets.normals,
+            cubic,
+            positions: mesh.positions.clone(),
+            held: (0..mesh.positions.len()).map(is_held).collect(),
+        };
+        (largest, redo)
+    }
+
+    /// The correction of [`Self::restore_to_redo`] made again on `positions`, the same mesh after
+    /// some vertices moved or became `held` (per vertex; missing entries: false): every part's
+    /// volume is brought back to its target along the first correction's normals, as the first
+    /// correction did, but only the faces around the vertices that changed are read (their terms
+    /// of the cubic taken out as they were and put in as they are), not the whole mesh; the
+    /// offset itself is one pass over the vertices. The normals are those of the first
+    /// correction's state, not recomputed: an offset is a small fraction of an edge length, and
+    /// the cubic's root makes the volume exact along whichever normals it is taken.
+    pub fn restore_again(
+        &self,
+        redo: &mut Redo,
+        positions: &mut [[f32; 3]],
+        topology: &Topology,
+        triangles: &[[u32; 3]],
+        held: &[bool],
+    ) -> f64 {
+        let is_held = |v: usize| held.get(v).copied().unwrap_or(false);
+        let mut faces: Vec<u32> = (0..positions.len())
+            .filter(|&v| positions[v] != redo.positions[v] || is_held(v) != redo.held[v])
+            .flat_map(|v| topology.faces_of(v as u32).iter().copied())
+            .collect();
+        faces.sort_unstable();
+        faces.dedup();
+        let parts = self.parts();
+        let mut change = vec![[0.0f64; 4]; parts];
+        let normals = &redo.normals;
+        let was_moving = |v: usize| self.movable[v] && !redo.held[v];
+        let moves = |v: usize| self.movable[v] && !is_held(v);
+        for &f in &faces {
+            let part = self.face_part[f as usize] as usize;
+            let apex = self.apex[part].as_vec3a();
+            let t = triangles[f as usize];
+            let terms = |points: &[[f32; 3]], moving: &MovesFlag<'_>| {
+                face_cubic(
+                    t.map(|v| Vec3A::from_array(points[v as usize]) - apex),
+                    t.map(|v| moving_normal(normals, moving, v)),
+                )
+            };
+            let (before, now) = (
+                terms(&redo.positions, &was_moving),
+                terms(positions, &moves),
+            );
+            for k in 0..4 {
+                change[part][k] += (f64::from(now[k]) - f64::from(before[k])) / 6.0;
+            }
+        }
+        let distances: Vec<f64> = redo
+            .cubic
+            .iter_mut()
+            .zip(&change)
+            .zip(&self.target)
+            .map(|((c, change), &target)| {
+                for k in 0..4 {
+                    c[k] += change[k];
+                }
+                let distance = offset_for(c, target);
+                *c = shifted(*c, distance);
+                distance
+            })
+            .collect();
+        let offsets = Offsets {
+            normals: std::mem::take(&mut redo.normals),
+            distances,
+        };
+        self.offset(positions, &offsets, is_held);
+        redo.normals = offsets.normals;
+        redo.positions.copy_from_slice(positions);
+        for (v, was) in redo.held.iter_mut().enumerate() {
+            *was = is_held(v);
+        }
+        offsets.distances.iter().fold(0.0f64, |m, d| m.max(d.abs()))
     }
 
     /// Moves `positions` (the mesh's, or another state of the same connectivity) by `offsets`:
@@ -266,6 +365,55 @@ impl VolumeKeeper {
                 }
             });
     }
+}
+
+/// A face's four terms of [`VolumeKeeper::volume_cubics`] (six times its share of c0..c3): its
+/// corners relative to the apex, and their normals (zero for a vertex that does not move).
+#[inline]
+fn face_cubic([a, b, c]: [Vec3A; 3], [na, nb, nc]: [Vec3A; 3]) -> [f32; 4] {
+    let bc = b.cross(c);
+    let mixed = nb.cross(c) + b.cross(nc);
+    let nbc = nb.cross(nc);
+    [
+        a.dot(bc),
+        na.dot(bc) + a.dot(mixed),
+        na.dot(mixed) + a.dot(nbc),
+        na.dot(nbc),
+    ]
+}
+
+/// Vertex `v`'s normal in the cubic: its entry of `normals` where it moves, zero where it stays.
+#[inline]
+fn moving_normal(normals: &[Vec3A], moves: &MovesFlag<'_>, v: u32) -> Vec3A {
+    if moves(v as usize) {
+        normals[v as usize]
+    } else {
+        Vec3A::ZERO
+    }
+}
+
+/// The cubic `c` of a volume in δ, taken about the state `distance` further along the normals:
+/// the coefficients of t in c(distance + t).
+fn shifted(c: [f64; 4], distance: f64) -> [f64; 4] {
+    let d = distance;
+    [
+        c[0] + d * (c[1] + d * (c[2] + d * c[3])),
+        c[1] + d * (2.0 * c[2] + d * 3.0 * c[3]),
+        c[2] + d * 3.0 * c[3],
+        c[3],
+    ]
+}
+
+/// A volume correction kept so that it can be made again after part of the mesh moved
+/// ([`VolumeKeeper::restore_to_redo`], [`VolumeKeeper::restore_again`]): the normals of the first
+/// correction, each part's volume as a cubic along them about the positions the last correction
+/// left, those positions and the vertices it held.
+#[derive(Clone, Debug)]
+pub struct Redo {
+    normals: Vec<Vec3A>,
+    cubic: Vec<[f64; 4]>,
+    positions: Vec<[f32; 3]>,
+    held: Vec<bool>,
 }
 
 /// What one volume correction applied ([`VolumeKeeper::restore_with_normals`]).
@@ -345,6 +493,44 @@ mod tests {
         );
         // The second cube did not change, so it did not move.
         assert_eq!(&mesh.positions[offset as usize..], &second[..]);
+    }
+
+    #[test]
+    fn a_correction_made_again_after_a_dent_gives_the_volume_back_and_holds_what_it_is_told() {
+        let mut mesh = shapes::cuboid([1.0, 1.0, 1.0], 0.1);
+        let topology = Topology::build(&mesh);
+        let keeper = VolumeKeeper::new(&mesh, &topology, &[]);
+        let before = signed_volume(&mesh);
+        let relative = |mesh: &TriMesh| ((signed_volume(mesh) - before) / before).abs();
+        for p in &mut mesh.positions {
+            *p = p.map(|c| 0.5 + (c - 0.5) * 0.99);
+        }
+        let (_, mut redo) = keeper.restore_to_redo(&mut mesh, &topology, &[]);
+        assert!(relative(&mesh) < 1e-6, "{}", relative(&mesh));
+        // A dent: the vertices of the top face pressed in by a tenth (3 % of the volume, far
+        // more than what the unfolding moves), and a few others held where they are.
+        let top: Vec<usize> = (0..mesh.positions.len())
+            .filter(|&v| mesh.positions[v][2] > 0.99)
+            .collect();
+        assert!(top.len() > 10, "{}", top.len());
+        for &v in &top {
+            mesh.positions[v][2] -= 0.1;
+        }
+        assert!(relative(&mesh) > 1e-2);
+        let held: Vec<bool> = (0..mesh.positions.len()).map(|v| v % 7 == 0).collect();
+        let dented = mesh.positions.clone();
+        let triangles = mesh.triangles.clone();
+        let distance =
+            keeper.restore_again(&mut redo, &mut mesh.positions, &topology, &triangles, &held);
+        assert!(distance > 0.0);
+        assert!(relative(&mesh) < 1e-6, "{}", relative(&mesh));
+        for v in (0..held.len()).filter(|&v| held[v]) {
+            assert_eq!(mesh.positions[v], dented[v], "held vertex {v} moved");
+        }
+        // Made again with nothing changed, it moves nothing.
+        let corrected = mesh.positions.clone();
+        keeper.restore_again(&mut redo, &mut mesh.positions, &topology, &triangles, &held);
+        assert_eq!(mesh.positions, corrected);
     }
 
     #[test]
