@@ -240,32 +240,25 @@ impl VolumeKeeper {
                 .collect(),
         };
         self.offset(&mut mesh.positions, &offsets, held);
-        let largest = offsets.distances.iter().fold(0.0f64, |m, d| m.max(d.abs()));
-        (largest, offsets, cubic)
+        (offsets.largest(), offsets, cubic)
     }
 
     /// [`Self::restore`], keeping what [`Self::restore_again`] needs to make the correction again
     /// after part of the mesh moved. `held` is given per vertex (missing entries: false).
-    pub fn restore_to_redo(
-        &self,
-        mesh: &mut TriMesh,
-        topology: &Topology,
-        held: &[bool],
-    ) -> (f64, Redo) {
+    pub fn restore_to_redo(&self, mesh: &mut TriMesh, topology: &Topology, held: &[bool]) -> Redo {
         let is_held = |v: usize| held.get(v).copied().unwrap_or(false);
-        let (largest, offsets, cubic) = self.restore_parts(mesh, topology, is_held);
+        let (_, offsets, cubic) = self.restore_parts(mesh, topology, is_held);
         let cubic = cubic
             .into_iter()
             .zip(&offsets.distances)
             .map(|(c, &distance)| shifted(c, distance))
             .collect();
-        let redo = Redo {
+        Redo {
             normals: offsets.normals,
             cubic,
             positions: mesh.positions.clone(),
             held: (0..mesh.positions.len()).map(is_held).collect(),
-        };
-        (largest, redo)
+        }
     }
 
     /// The correction of [`Self::restore_to_redo`] made again on `positions`, the same mesh after
@@ -333,12 +326,13 @@ impl VolumeKeeper {
             distances,
         };
         self.offset(positions, &offsets, is_held);
+        let largest = offsets.largest();
         redo.normals = offsets.normals;
         redo.positions.copy_from_slice(positions);
         for (v, was) in redo.held.iter_mut().enumerate() {
             *was = is_held(v);
         }
-        offsets.distances.iter().fold(0.0f64, |m, d| m.max(d.abs()))
+        largest
     }
 
     /// Moves `positions` (the mesh's, or another state of the same connectivity) by `offsets`:
@@ -429,6 +423,13 @@ pub struct Offsets {
     pub distances: Vec<f64>,
 }
 
+impl Offsets {
+    /// The largest distance applied, in either direction.
+    fn largest(&self) -> f64 {
+        self.distances.iter().fold(0.0f64, |m, d| m.max(d.abs()))
+    }
+}
+
 /// The root nearest zero of c0 + c1 δ + c2 δ² + c3 δ³ = `target` (Newton's method from zero;
 /// the slope at zero, c1, is about the part's movable area, so the first step is the linearised
 /// offset ΔV / A). Zero where the part has no movable area or the steps do not settle.
@@ -505,7 +506,7 @@ mod tests {
         for p in &mut mesh.positions {
             *p = p.map(|c| 0.5 + (c - 0.5) * 0.99);
         }
-        let (_, mut redo) = keeper.restore_to_redo(&mut mesh, &topology, &[]);
+        let mut redo = keeper.restore_to_redo(&mut mesh, &topology, &[]);
         assert!(relative(&mesh) < 1e-6, "{}", relative(&mesh));
         // A dent: the vertices of the top face pressed in by a tenth (3 % of the volume, far
         // more than what the unfolding moves), and a few others held where they are.

@@ -935,7 +935,7 @@ pub(super) fn unfold(positions: &mut [[f32; 3]], level: &Level, folds: &mut Fold
     if let Some((keeper, result)) = &mut volume {
         result.positions.clear();
         result.positions.extend_from_slice(positions);
-        redo = Some(keeper.restore_to_redo(result, topology, &[]).1);
+        redo = Some(keeper.restore_to_redo(result, topology, &[]));
         positions.copy_from_slice(&result.positions);
     }
     let restore_again = |positions: &mut [[f32; 3]], redo: &mut Option<Redo>, held: &[bool]| {
