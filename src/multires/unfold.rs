@@ -45,11 +45,16 @@
 //! neighbours, they go back in turn, and the result becomes a patchwork of the smooth result
 //! and M0 with seams between them (a third of the mesh at M0), far worse to look at than the
 //! specks it undoes. So when steps 4 and 5 have put back more than [`PUT_BACK_BUDGET`] of the
-//! vertices from farther than [`PUT_BACK_FAR`] edge lengths, steps 3-5 are taken back whole:
-//! the result is what steps 1 and 2 left, and the faces and edges still turned or folded are
-//! counted ([`Unfolded::left`]) for the caller to say so. Within the budget (every level of
-//! the quality set's meshes), no result has a face turned or an edge folded that M0 does not
-//! have.
+//! vertices from farther than [`PUT_BACK_FAR`] edge lengths, steps 3-5 are taken back where
+//! they went over: what they moved is cut into parts (connected through M0's edges), a part
+//! with nothing left turned or folded keeps what they did (the cheapest first, as long as the
+//! vertices they put back from far fit the budget together), and the rest is what steps 1 and
+//! 2 left. The cascade is mostly in one place: the noisy 1.2M-face bunny from level 20 of 29
+//! kept eleven small parts, leaving 12 faces and edges of the one cascade over 56k vertices
+//! where taking everything back left 200 (from level 24: 243 against 416). What is still turned
+//! or folded is counted ([`Unfolded::left`]) for the caller to say so. Within the budget (every
+//! level of the quality set's meshes), no result has a face turned or an edge folded that M0
+//! does not have.
 //!
 //! The faces and edges are looked at once whole (a pass over the faces and one over the edges);
 //! after that only those around the vertices that moved, so that a run pays for its folds, not
@@ -131,7 +136,7 @@ pub const PUT_BACK_FAR: f32 = 4.0;
 /// Beyond it the putting back has become a cascade (each corner put back from far away folds
 /// its neighbours, which go back in turn), and the result a patchwork of the smooth result and
 /// M0 with seams between them, worse to look at than the specks it undoes: steps 3-5 are then
-/// taken back whole, and the folds they were undoing are left (and counted). A 150k-face noisy
+/// taken back where they went over, and the folds there are left (and counted). A 150k-face noisy
 /// bunny put back 0.24 % of its vertices from that far from level 20 of 24, and 19 % from
 /// level 22; the tests' noisy box and elephant 0.14 % and none.
 pub const PUT_BACK_BUDGET: f32 = 0.02;
@@ -799,10 +804,10 @@ fn distance_from_m0(positions: &[[f32; 3]], mesh: &TriMesh, topology: &Topology,
     m0(v).distance(Vec3A::from_array(positions[v as usize])) / length.max(f32::MIN_POSITIVE)
 }
 
-/// Steps 3-5 of the module docs, for what `state` finds turned or folded. Where they would put
-/// more than `budget` vertices back from farther than [`PUT_BACK_FAR`], they are taken back
-/// whole (the vertices `back` too): the result is what steps 1 and 2 left, and false is
-/// returned. True when they undid everything within the budget.
+/// Steps 3-5 of the module docs, for what `state` finds turned or folded. Where they put more
+/// than `budget` vertices back from farther than [`PUT_BACK_FAR`], what they did is kept only
+/// in the parts that fit ([`keep_what_fits`]); the others are taken back to what steps 1 and 2
+/// left. True when nothing is left turned or folded.
 fn undo_what_is_left(
     positions: &mut [[f32; 3]],
     mesh: &TriMesh,
@@ -816,8 +821,9 @@ fn undo_what_is_left(
     }
     let before = positions.to_vec();
     let back_before = back.to_vec();
-    let mut far = 0;
-    let mut undone = 'steps: {
+    // The vertices put back from farther than PUT_BACK_FAR.
+    let mut far = Vec::new();
+    let undone = 'steps: {
         smooth_displacement(positions, mesh, topology, state, back, &DISPLACEMENT_RINGS);
         for _ in 0..RAMP_ROUNDS {
             let still: Vec<u32> = state
@@ -828,37 +834,111 @@ fn undo_what_is_left(
             if still.is_empty() {
                 break;
             }
-            far += put_at_m0(positions, mesh, state, back, &still);
-            if far > budget {
+            put_at_m0(positions, mesh, state, back, &still, &mut far);
+            if far.len() > budget {
                 break 'steps false;
             }
             smooth_displacement(positions, mesh, topology, state, back, &DISPLACEMENT_RINGS);
         }
-        put_back(positions, mesh, state, back, budget - far)
+        put_back(positions, mesh, state, back, budget, &mut far)
     };
-    if !undone {
-        let changed: Vec<u32> = (0..positions.len() as u32)
-            .filter(|&v| positions[v as usize] != before[v as usize])
-            .collect();
-        positions.copy_from_slice(&before);
-        back.copy_from_slice(&back_before);
-        state.moved(positions, &changed);
-        undone = state.corners().is_empty();
+    if undone {
+        return true;
     }
-    undone
+    let before = Before {
+        positions: &before,
+        back: &back_before,
+    };
+    keep_what_fits(positions, topology, state, back, before, &far, budget)
+}
+
+/// What steps 1 and 2 left, for [`keep_what_fits`] to take back to.
+#[derive(Clone, Copy)]
+struct Before<'a> {
+    positions: &'a [[f32; 3]],
+    back: &'a [bool],
+}
+
+/// Steps 3-5 went over the budget: most of the time in one place, where putting corners back
+/// cascaded, while elsewhere they undid a few folds near M0 (the 1.2M-face bunny from level 20
+/// of 29: eleven small places, no vertex put back from far, and one cascade over 56k vertices).
+/// So what they moved is cut into parts (connected through M0's edges): a part with nothing
+/// turned or folded left at its vertices keeps what they did, the parts with the fewest
+/// vertices put back from far (`far`) first, as long as those fit `budget` together; the others
+/// are taken back to `before` (their `back` marks too). True when nothing is left turned or
+/// folded.
+fn keep_what_fits(
+    positions: &mut [[f32; 3]],
+    topology: &Topology,
+    state: &mut FoldState,
+    back: &mut [bool],
+    before: Before,
+    far: &[u32],
+    budget: usize,
+) -> bool {
+    let count = positions.len();
+    let changed = |v: u32| positions[v as usize] != before.positions[v as usize];
+    let mut is_far = vec![false; count];
+    for &v in far {
+        is_far[v as usize] = true;
+    }
+    let mut is_corner = vec![false; count];
+    for v in state.corners() {
+        is_corner[v as usize] = true;
+    }
+    // Each part: whether something is left at it, its vertices put back from far, its vertices.
+    let mut parts: Vec<(bool, usize, Vec<u32>)> = Vec::new();
+    let mut seen = vec![false; count];
+    for v in 0..count as u32 {
+        if seen[v as usize] || !changed(v) {
+            continue;
+        }
+        seen[v as usize] = true;
+        let mut members = vec![v];
+        let mut next = 0;
+        while let Some(&u) = members.get(next) {
+            next += 1;
+            for &w in topology.neighbors(u) {
+                if !seen[w as usize] && changed(w) {
+                    seen[w as usize] = true;
+                    members.push(w);
+                }
+            }
+        }
+        let folded = members.iter().any(|&u| is_corner[u as usize]);
+        let far = members.iter().filter(|&&u| is_far[u as usize]).count();
+        parts.push((folded, far, members));
+    }
+    // Stable: parts that cost the same keep the order of their lowest vertex.
+    parts.sort_by_key(|&(folded, far, _)| (folded, far));
+    let mut spent = 0;
+    let mut taken_back = Vec::new();
+    for (folded, far, members) in parts {
+        if !folded && spent + far <= budget {
+            spent += far;
+            continue;
+        }
+        for &u in &members {
+            positions[u as usize] = before.positions[u as usize];
+            back[u as usize] = before.back[u as usize];
+        }
+        taken_back.extend(members);
+    }
+    state.moved(positions, &taken_back);
+    state.corners().is_empty()
 }
 
 /// Puts the corners of what `state` finds turned or folded back where M0 has them, until
-/// nothing is (marking them in `back`; true), or until more than `budget` of them lay farther
-/// than [`PUT_BACK_FAR`] from M0 (false).
+/// nothing is (marking them in `back`; true), or until more than `budget` vertices lay farther
+/// than [`PUT_BACK_FAR`] from M0 when put back, counting those `far` holds already (false).
 fn put_back(
     positions: &mut [[f32; 3]],
     mesh: &TriMesh,
     state: &mut FoldState,
     back: &mut [bool],
     budget: usize,
+    far: &mut Vec<u32>,
 ) -> bool {
-    let mut far = 0;
     loop {
         let still: Vec<u32> = state
             .corners()
@@ -868,32 +948,31 @@ fn put_back(
         if still.is_empty() {
             return true;
         }
-        far += put_at_m0(positions, mesh, state, back, &still);
-        if far > budget {
+        put_at_m0(positions, mesh, state, back, &still, far);
+        if far.len() > budget {
             return false;
         }
     }
 }
 
-/// Puts `vertices` where M0 has them, marks them in `back` and tells `state` they moved.
-/// Returns how many of them lay farther than [`PUT_BACK_FAR`] from M0.
+/// Puts `vertices` where M0 has them, marks them in `back` and tells `state` they moved. Those
+/// that lay farther than [`PUT_BACK_FAR`] from M0 join `far`.
 fn put_at_m0(
     positions: &mut [[f32; 3]],
     mesh: &TriMesh,
     state: &mut FoldState,
     back: &mut [bool],
     vertices: &[u32],
-) -> usize {
-    let mut far = 0;
+    far: &mut Vec<u32>,
+) {
     for &v in vertices {
         if distance_from_m0(positions, mesh, state.topology, v) > PUT_BACK_FAR {
-            far += 1;
+            far.push(v);
         }
         positions[v as usize] = mesh.positions[v as usize];
         back[v as usize] = true;
     }
     state.moved(positions, vertices);
-    far
 }
 
 /// What [`unfold`] did.
@@ -902,8 +981,8 @@ pub(super) struct Unfolded {
     /// How many vertices moved.
     pub(super) moved: usize,
     /// How many faces it left turned against M0 and edges folded where M0 is not: none, but
-    /// where undoing them would have put more than [`PUT_BACK_BUDGET`] of the vertices back
-    /// from far from M0.
+    /// in the places where undoing them went over [`PUT_BACK_BUDGET`] (it would have put more
+    /// of the vertices back from far from M0).
     pub(super) left: usize,
 }
 
@@ -1104,6 +1183,49 @@ mod tests {
             .collect()
     }
 
+    /// Edges of `edges` folded beyond 90° with `positions` that `reference` does not fold.
+    fn new_folds(
+        positions: &[[f32; 3]],
+        mesh: &TriMesh,
+        edges: &[[u32; 4]],
+        reference: &[bool],
+    ) -> usize {
+        folded(positions, mesh, edges)
+            .iter()
+            .zip(reference)
+            .filter(|(&now, &was)| now && !was)
+            .count()
+    }
+
+    /// A flat grid of `n` by `n` squares of side `side`, its topology, its edges between two
+    /// faces and their fold flags (none folded).
+    fn flat_grid(n: usize, side: f32) -> (TriMesh, Topology, Vec<[u32; 4]>, Vec<bool>) {
+        let mut mesh = grid(n);
+        for p in &mut mesh.positions {
+            *p = p.map(|x| x * side);
+        }
+        let topology = Topology::build(&mesh);
+        let edges = two_face_edges(&mesh.triangles);
+        let reference = folded(&mesh.positions, &mesh, &edges);
+        (mesh, topology, edges, reference)
+    }
+
+    /// [`unfold`] on `mesh` with no crease and `budget`, `edges` folding nothing on `mesh`.
+    fn unfold_with_budget(
+        positions: &mut [[f32; 3]],
+        mesh: &TriMesh,
+        topology: &Topology,
+        edges: &[[u32; 4]],
+        budget: f32,
+    ) -> Unfolded {
+        let level = Level {
+            put_back_budget: budget,
+            ..level(mesh, topology)
+        };
+        let reference = vec![false; edges.len()];
+        unfold(positions, &level, &mut fold_edges(mesh, edges, &reference))
+    }
+
     fn level<'a>(mesh: &'a TriMesh, topology: &'a Topology) -> Level<'a> {
         Level {
             mesh,
@@ -1270,15 +1392,8 @@ mod tests {
         // displacement's smoothing, so only putting it back where M0 has it undoes them. The
         // budget counts only what goes back from farther than PUT_BACK_FAR edge lengths (not
         // model units: the side is not 1).
-        let n = 12;
-        let side = 0.25;
-        let mut mesh = grid(n);
-        for p in &mut mesh.positions {
-            *p = p.map(|x| x * side);
-        }
-        let topology = Topology::build(&mesh);
-        let edges = two_face_edges(&mesh.triangles);
-        let reference = folded(&mesh.positions, &mesh, &edges);
+        let (n, side) = (12, 0.25);
+        let (mesh, topology, edges, reference) = flat_grid(n, side);
         let v = n / 2;
         let turned = |positions: &[[f32; 3]]| {
             let result = TriMesh::new(positions.to_vec(), mesh.triangles.clone());
@@ -1291,15 +1406,7 @@ mod tests {
             positions[v][1] += rows * side;
             assert!(turned(&positions) > 0, "the push turns faces");
             let pushed = positions[v];
-            let level = Level {
-                put_back_budget: budget,
-                ..level(&mesh, &topology)
-            };
-            let done = unfold(
-                &mut positions,
-                &level,
-                &mut fold_edges(&mesh, &edges, &reference),
-            );
+            let done = unfold_with_budget(&mut positions, &mesh, &topology, &edges, budget);
             (positions, pushed, done)
         };
         // Pushed six rows (six edge lengths): within the budget (the whole mesh may go back), it
@@ -1313,11 +1420,7 @@ mod tests {
         let (positions, pushed, done) = run(6.0, 0.0);
         assert_eq!(positions[v], pushed);
         let left_turned = turned(&positions);
-        let left_folded = folded(&positions, &mesh, &edges)
-            .iter()
-            .zip(&reference)
-            .filter(|(&now, &was)| now && !was)
-            .count();
+        let left_folded = new_folds(&positions, &mesh, &edges, &reference);
         assert!(left_turned > 0);
         assert_eq!(done.left, left_turned + left_folded);
         // Pushed two rows, nearer than PUT_BACK_FAR: it goes back even with no budget.
@@ -1325,6 +1428,54 @@ mod tests {
         assert_eq!(positions[v], mesh.positions[v]);
         assert_eq!(turned(&positions), 0);
         assert_eq!(done.left, 0);
+    }
+
+    #[test]
+    fn over_budget_only_the_place_that_went_over_is_taken_back() {
+        // Two boundary vertices of a flat grid of squares of side 0.25 pushed into it, at
+        // opposite sides: one six rows deep (putting it back counts against the budget), one two
+        // rows (it does not). With no budget the last steps go over it at the deep push, and
+        // what they did there is taken back; at the shallow push, 38 rows away, it is kept: the
+        // faces left turned and the edges left folded all lie in the half of the deep push.
+        let (n, side) = (40, 0.25);
+        let (mesh, topology, edges, reference) = flat_grid(n, side);
+        let (deep, shallow) = (n / 2, n * (n + 1) + n / 2);
+        // Faces turned against M0, by half of the grid: [the deep push's, the shallow one's].
+        let turned = |positions: &[[f32; 3]]| {
+            let result = TriMesh::new(positions.to_vec(), mesh.triangles.clone());
+            let mut halves = [0; 2];
+            for (t, corners) in mesh.triangles.iter().enumerate() {
+                if result.face_normal(t).dot(mesh.face_normal(t)) < 0.0 {
+                    let y = corners
+                        .iter()
+                        .map(|&v| mesh.positions[v as usize][1])
+                        .sum::<f32>();
+                    halves[usize::from(y / 3.0 > 0.5 * n as f32 * side)] += 1;
+                }
+            }
+            halves
+        };
+        let run = |budget: f32| {
+            let mut positions = mesh.positions.clone();
+            positions[deep][1] += 6.0 * side;
+            positions[shallow][1] -= 2.0 * side;
+            let pushed = turned(&positions);
+            assert!(
+                pushed[0] > 0 && pushed[1] > 0,
+                "both pushes turn faces: {pushed:?}"
+            );
+            let done = unfold_with_budget(&mut positions, &mesh, &topology, &edges, budget);
+            (positions, done)
+        };
+        let (positions, done) = run(1.0);
+        assert_eq!(turned(&positions), [0, 0]);
+        assert_eq!(done.left, 0);
+        let (positions, done) = run(0.0);
+        let [at_deep, at_shallow] = turned(&positions);
+        assert!(at_deep > 0, "the deep push is left turned");
+        assert_eq!(at_shallow, 0, "the shallow push is undone");
+        let left_folded = new_folds(&positions, &mesh, &edges, &reference);
+        assert_eq!(done.left, at_deep + left_folded);
     }
 
     #[test]
