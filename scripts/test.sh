@@ -10,5 +10,8 @@ if [ -z "${XDG_RUNTIME_DIR:-}" ] || [ ! -d "$XDG_RUNTIME_DIR" ]; then
   chmod 700 "$XDG_RUNTIME_DIR"
   export XDG_RUNTIME_DIR
 fi
+# The web page's dependencies (wasm32) too: tests/architecture.rs reads `cargo tree --offline`
+# for that target as well, and a build for this machine downloads only its own.
+cargo fetch --locked --target wasm32-unknown-unknown
 cargo test --all-targets "$@"
 
