@@ -63,15 +63,19 @@ fn main() {
     let args: Vec<String> = std::env::args().skip(1).collect();
     let path = args.first().map_or("big", String::as_str);
     let sigma: f64 = args.get(1).and_then(|a| a.parse().ok()).unwrap_or(0.3);
+    // The repository's bunny wherever the example is run from.
+    let bunny = concat!(env!("CARGO_MANIFEST_DIR"), "/assets/bunny00.obj");
+    let load = |path: &str| match fairmesh::io::load(std::path::Path::new(path)) {
+        Ok(loaded) => loaded.mesh,
+        Err(error) => {
+            eprintln!("{error}");
+            std::process::exit(1);
+        }
+    };
     let clean = if path == "big" {
-        let bunny = fairmesh::io::load(std::path::Path::new("assets/bunny00.obj"))
-            .expect("assets/bunny00.obj")
-            .mesh;
-        fairmesh::mesh::subdivide_loop(&fairmesh::mesh::subdivide_loop(&bunny))
+        fairmesh::mesh::subdivide_loop(&fairmesh::mesh::subdivide_loop(&load(bunny)))
     } else {
-        fairmesh::io::load(std::path::Path::new(path))
-            .unwrap_or_else(|e| panic!("{path}: {e}"))
-            .mesh
+        load(path)
     };
     let mut noisy = clean.clone();
     if sigma > 0.0 {
