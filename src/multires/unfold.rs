@@ -53,10 +53,10 @@
 //! kept eleven small parts, leaving 12 faces and edges of the one cascade over 56k vertices
 //! where taking everything back left 200 (from level 24: 243 against 416). Around what is then
 //! left, the widest relaxation ([`LAST_REACH`], 64 rings and 80 sweeps) spreads the squeezed
-//! triangles out, the means run again, and steps 3-5 once more (the same bunny from level 20 /
-//! 22 / 24: 0 / 3 / 27 left). What is still turned or folded is counted ([`Unfolded::left`]) for
-//! the caller to say so. Within the budget (every level of the quality set's meshes), no result
-//! has a face turned or an edge folded that M0 does not have.
+//! triangles out, the means run again, and steps 3-5 once more (its figures there). What is
+//! still turned or folded is counted ([`Unfolded::left`]) for the caller to say so. Within the
+//! budget (every level of the quality set's meshes), no result has a face turned or an edge
+//! folded that M0 does not have.
 //!
 //! The faces and edges are looked at once whole (a pass over the faces and one over the edges);
 //! after that only those around the vertices that moved, so that a run pays for its folds, not
@@ -871,13 +871,11 @@ struct Before<'a> {
 }
 
 /// Steps 3-5 went over the budget: most of the time in one place, where putting corners back
-/// cascaded, while elsewhere they undid a few folds near M0 (the 1.2M-face bunny from level 20
-/// of 29: eleven small places, no vertex put back from far, and one cascade over 56k vertices).
-/// So what they moved is cut into parts (connected through M0's edges): a part with nothing
-/// turned or folded left at its vertices keeps what they did, the parts with the fewest
-/// vertices put back from far (`far`) first, as long as those fit `budget` together; the others
-/// are taken back to `before` (their `back` marks too). True when nothing is left turned or
-/// folded.
+/// cascaded, while elsewhere they undid a few folds near M0 (the module docs' figures). So what
+/// they moved is cut into parts (connected through M0's edges): a part with nothing turned or
+/// folded left at its vertices keeps what they did, the parts with the fewest vertices put back
+/// from far (`far`) first, as long as those fit `budget` together; the others are taken back to
+/// `before` (their `back` marks too). True when nothing is left turned or folded.
 fn keep_what_fits(
     positions: &mut [[f32; 3]],
     topology: &Topology,
