@@ -5,7 +5,8 @@
 # the toolbar's Input mesh and Faired buttons in turn and the Start level slider's track at two
 # places, ROUNDS times each. For every click it prints the time until the frame log's next
 # "image of the 3D view arrived" line (a drawn image, or a held mesh's kept image), the log
-# polled every 10 ms; for a level change, the next one after "a fairing result arrived". First
+# polled every 10 ms; for a level change, the next one after "a fairing result arrived" or "a kept
+# result arrived" (a level seen before, or faired ahead while the slider rested). First
 # it prints the log's own time of the first faired image (load to first faired image).
 # Needs Xvfb and xdotool.
 #
@@ -63,7 +64,7 @@ for round in $(seq "$rounds"); do
   for x in $slider_a $slider_b; do
     from=$(($(wc -l <"$log") + 1)) start=$(now)
     click "$x" $slider_y
-    echo "round $round, level change: $(wait_image "$start" "$from" 'a fairing result arrived') s"
+    echo "round $round, level change: $(wait_image "$start" "$from" 'a fairing result arrived\|a kept result arrived') s"
     sleep 4
   done
 done

@@ -132,6 +132,69 @@ fn level_view_during_a_fairing_abandons_it_and_the_faired_view_brings_it_back() 
     assert!(against_document.is_some());
 }
 
+/// The results of the levels next to the one the slider rests on are made ahead of time, and
+/// a level shown once is kept: moving the slider to one shows its result, measured, in the frame
+/// that takes the move (a fairing's result comes back in a later frame at the earliest). A
+/// changed setting drops what was kept: the same level then shows a result of its own.
+#[test]
+fn levels_next_to_the_slider_show_at_once_and_a_changed_setting_fairs_them_again() {
+    let mut harness = harness_for(bunny());
+    let middle = editor_common::at_middle_level(&mut harness);
+    let kept_around = |harness: &mut egui_kittest::Harness<'_, fairmesh_editor::app::App>| {
+        let deadline = Instant::now() + Duration::from_secs(300);
+        loop {
+            harness.step();
+            let status = harness.state().status();
+            // The level on screen and two either side (and the ones shown before).
+            if status.kept_results >= 5 && !status.fairing_ahead {
+                return;
+            }
+            assert!(Instant::now() < deadline, "not faired ahead: {status:?}");
+            std::thread::sleep(Duration::from_millis(10));
+        }
+    };
+    let set_level = |harness: &mut egui_kittest::Harness<'_, fairmesh_editor::app::App>,
+                     level: usize| {
+        harness
+            .state_mut()
+            .push_command(fairmesh_editor::app::Command::SetLevel(level));
+        harness.step();
+        harness.state().status()
+    };
+    kept_around(&mut harness);
+    let at_middle = harness.state().status();
+    let mut coarser = Vec::new();
+    for level in [middle + 1, middle + 2, middle, middle - 1] {
+        let status = set_level(&mut harness, level);
+        assert_eq!(status.faired_level, Some(level), "shown in the same frame");
+        assert!(status.faired_serial > at_middle.faired_serial);
+        assert!(!status.measuring);
+        assert!(harness.state().faired_measures().0.is_some(), "measured");
+        coarser.push(status.rms_displacement);
+    }
+    // Back at the middle level: the very result shown first.
+    assert_eq!(coarser[2], at_middle.rms_displacement);
+    assert_ne!(coarser[0], at_middle.rms_displacement);
+
+    // Another setting: nothing kept is shown for it.
+    settle(&mut harness);
+    harness.get_by_label("Fair M0 too").click();
+    harness.step();
+    assert_eq!(
+        harness.state().status().faired_level,
+        Some(middle - 1),
+        "the old result stays until the new one comes"
+    );
+    settle(&mut harness);
+    let refaired = harness.state().status();
+    assert_eq!(refaired.faired_level, Some(middle - 1));
+    assert_ne!(refaired.rms_displacement, coarser[3]);
+    kept_around(&mut harness);
+    let status = set_level(&mut harness, middle);
+    assert_eq!(status.faired_level, Some(middle));
+    assert_ne!(status.rms_displacement, at_middle.rms_displacement);
+}
+
 /// A result's measuring stops when the view moves on (here to the level mesh, which brings no
 /// new result) and is done again once things rest: the numbers end up being that result's.
 #[test]

@@ -9,7 +9,8 @@ use std::sync::{Arc, Mutex};
 use fairmesh::multires::MultiresWorkspace;
 
 use super::generation::{Generation, GenerationId};
-use super::jobs::SharedProgress;
+use super::jobs::{JobCounter, SharedProgress};
+use super::kept_results::KeptResults;
 use super::state::HierarchyKey;
 use super::tasks::measure::MeasureRequest;
 
@@ -31,6 +32,14 @@ pub(in crate::app) struct InFlight {
     /// View generation of the newest fairing asked for.
     pub(in crate::app) fair_view: GenerationId,
     pub(in crate::app) workspace: Arc<Mutex<MultiresWorkspace>>,
+    /// Faired results by start level, for the slider to show again at once.
+    pub(in crate::app) kept: KeptResults,
+    /// A level is being faired ahead ([`crate::app::App::fair_ahead`]).
+    pub(in crate::app) ahead_in_flight: bool,
+    /// The jobs fairing ahead, counted apart from [`super::workers::Workers::jobs`]: nobody
+    /// waits for them, so the editor is settled while they run.
+    #[cfg_attr(target_arch = "wasm32", allow(dead_code))]
+    pub(in crate::app) ahead_jobs: JobCounter,
     /// The faired result to measure next; see [`super::tasks::measure::MEASURE_DELAY`].
     pub(in crate::app) measure_wanted: Option<MeasureRequest>,
     pub(in crate::app) measures_stopped: u64,
@@ -49,6 +58,7 @@ impl InFlight {
         self.applied_view = GenerationId::default();
         self.applied_level_view = GenerationId::default();
         self.fair_in_flight = false;
+        self.kept.clear();
     }
 
     /// Cancels whatever runs for the document (its load, its changes, its hierarchy): each job

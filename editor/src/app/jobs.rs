@@ -44,6 +44,8 @@ pub enum JobKind {
     /// Setting up the hierarchy's levels for fairing, while nothing else waits.
     LevelSetUp,
     Fair,
+    /// Fairing a level next to the one on screen while the slider rests.
+    FairAhead,
     LevelMesh,
     Measure,
     Export,
@@ -61,6 +63,7 @@ impl JobKind {
             JobKind::Hierarchy => "building the hierarchy",
             JobKind::LevelSetUp => "setting up the levels",
             JobKind::Fair => "fairing",
+            JobKind::FairAhead => "fairing the next levels ahead",
             JobKind::LevelMesh => "making the level's mesh",
             JobKind::Measure => "measuring the result",
             JobKind::Export => "exporting",
@@ -362,6 +365,14 @@ pub enum JobResult {
         /// `None`: cancelled or failed.
         result: Option<Faired>,
     },
+    /// A level faired ahead ([`crate::app::kept_results`]), under `key`.
+    #[cfg_attr(target_arch = "wasm32", allow(dead_code))]
+    FairedAhead {
+        key: crate::app::kept_results::ResultKey,
+        level: usize,
+        /// `None`: stopped (the slider moved, a setting changed).
+        result: Option<Faired>,
+    },
     LevelMesh {
         document: GenerationId,
         view: GenerationId,
@@ -445,6 +456,7 @@ impl JobResult {
             JobResult::Loaded { .. } => "a loaded file",
             JobResult::Hierarchy { .. } => "the hierarchy",
             JobResult::Faired { .. } => "a fairing result",
+            JobResult::FairedAhead { .. } => "a level faired ahead",
             JobResult::LevelMesh { .. } => "a level mesh",
             JobResult::Measured { .. } => "measures",
             JobResult::MeasureStopped { .. } => "a stopped measure",

@@ -57,6 +57,7 @@ pub mod history;
 mod in_flight;
 mod input;
 pub mod jobs;
+mod kept_results;
 mod launch;
 mod mesh_panel;
 mod numbers_panel;

@@ -49,6 +49,9 @@ impl App {
                 level,
                 result,
             } => self.on_faired(document, view, level, result),
+            JobResult::FairedAhead { key, level, result } => {
+                self.on_faired_ahead(key, level, result)
+            }
             JobResult::Measured {
                 document,
                 serial,
@@ -109,6 +112,7 @@ impl App {
         match kind {
             JobKind::Load => self.work.loading = None,
             JobKind::Fair => self.work.fair_in_flight = false,
+            JobKind::FairAhead => self.work.ahead_in_flight = false,
             JobKind::Hierarchy => {
                 if let Some(document) = &mut self.document {
                     if matches!(document.hierarchy, HierarchyState::Building) {

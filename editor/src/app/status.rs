@@ -33,6 +33,10 @@ pub struct AppStatus {
     pub message: Option<String>,
     /// Sharp edges the current hierarchy keeps (0 without "Keep sharp edges").
     pub sharp_edges_kept: usize,
+    /// Faired results kept by start level, to be shown again at once.
+    pub kept_results: usize,
+    /// A level next to the one on screen is being faired ahead.
+    pub fairing_ahead: bool,
     /// What the main view shows.
     pub view: ViewStatus,
 }
@@ -167,6 +171,8 @@ impl App {
                 HierarchyState::Ready { hierarchy, .. } => hierarchy.crease_edge_count(),
                 _ => 0,
             }),
+            kept_results: self.work.kept.len(),
+            fairing_ahead: self.work.ahead_in_flight,
             view: ViewStatus {
                 shown_vertices: self.view.shown_counts.0,
                 shown_faces: self.view.shown_counts.1,

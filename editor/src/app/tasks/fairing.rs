@@ -8,6 +8,7 @@ use web_time::Instant;
 use crate::app::compute::FairJob;
 use crate::app::generation::GenerationId;
 use crate::app::jobs::{Faired, JobKind, JobResult};
+use crate::app::kept_results::{KeptResult, ResultKey};
 use crate::app::state::{FairedResult, HierarchyState, ViewMode};
 use crate::app::tasks::measure::MeasureRequest;
 use crate::app::App;
@@ -32,7 +33,9 @@ impl App {
             // An applied result is shown as it is until a setting changes.
             ViewMode::Faired | ViewMode::Original if applied => {}
             ViewMode::Faired | ViewMode::Original => {
-                self.request_fairing(hierarchy, document_generation, level, view)
+                if !self.show_kept(document_generation, level, view) {
+                    self.request_fairing(hierarchy, document_generation, level, view)
+                }
             }
         }
     }
@@ -156,7 +159,8 @@ impl App {
             });
     }
 
-    /// A fairing finished: its result goes on screen unless a newer one is there.
+    /// A fairing finished: its result goes on screen unless a newer one is there, and is kept
+    /// for its level ([`crate::app::kept_results`]).
     pub(in crate::app) fn on_faired(
         &mut self,
         document: GenerationId,
@@ -169,6 +173,29 @@ impl App {
         if view >= self.work.fair_view {
             self.work.fair_in_flight = false;
         }
+        let Some(faired) = result else {
+            return;
+        };
+        let kept = KeptResult::of(faired);
+        // Asked for under the settings of now (nothing changed since): kept for its level.
+        let same_document = self.document.as_ref().map(|d| d.generation) == Some(document);
+        if same_document && self.work.view_generation.is_current(view) {
+            if let Some(key) = self.result_key() {
+                self.work.kept.keep(key, level, kept.clone());
+            }
+        }
+        self.show_faired(document, view, level, kept);
+    }
+
+    /// Puts `kept`, the result from `level`, on screen unless a newer one is there, with its
+    /// measures when it has them (else they are asked for).
+    fn show_faired(
+        &mut self,
+        document: GenerationId,
+        view: GenerationId,
+        level: usize,
+        kept: KeptResult,
+    ) {
         let Some(current) = self.document.as_mut().filter(|d| d.generation == document) else {
             return;
         };
@@ -176,33 +203,177 @@ impl App {
         if view <= self.work.applied_view {
             return;
         }
-        if let Some(faired) = result {
-            self.work.applied_view = view;
-            self.work.next_serial += 1;
-            // The previous result's measures stay on screen until this one's arrive.
-            let previous = current.faired.take();
-            let positions = Arc::new(faired.positions);
-            current.faired = Some(FairedResult {
-                positions: positions.clone(),
-                level,
-                method: faired.method,
-                volume_change: faired.volume_change,
-                rms_displacement: faired.rms_displacement,
-                folds_left: faired.folds_left,
-                elapsed: faired.elapsed,
-                serial: self.work.next_serial,
-                against_document: previous.as_ref().and_then(|p| p.against_document.clone()),
-                against_clean: previous.and_then(|p| p.against_clean),
-                measure_time: Duration::ZERO,
-                measures_pending: true,
-            });
-            self.work.measure_wanted = Some(MeasureRequest {
-                document,
-                serial: self.work.next_serial,
-                positions,
-                arrived: Instant::now(),
-            });
+        self.work.applied_view = view;
+        self.work.next_serial += 1;
+        // The previous result's measures stay on screen until this one's arrive.
+        let previous = current.faired.take();
+        let (against_document, against_clean, measure_time, measures_pending) = match kept.measures
+        {
+            Some((against_document, against_clean, time)) => {
+                (against_document, against_clean, time, false)
+            }
+            None => (
+                previous.as_ref().and_then(|p| p.against_document.clone()),
+                previous.and_then(|p| p.against_clean),
+                Duration::ZERO,
+                true,
+            ),
+        };
+        current.faired = Some(FairedResult {
+            positions: kept.positions.clone(),
+            level,
+            method: kept.method,
+            volume_change: kept.volume_change,
+            rms_displacement: kept.rms_displacement,
+            folds_left: kept.folds_left,
+            elapsed: kept.elapsed,
+            serial: self.work.next_serial,
+            against_document,
+            against_clean,
+            measure_time,
+            measures_pending,
+        });
+        self.work.measure_wanted = measures_pending.then(|| MeasureRequest {
+            document,
+            serial: self.work.next_serial,
+            positions: kept.positions,
+            arrived: Instant::now(),
+        });
+        if !measures_pending {
+            self.fair_ahead();
         }
+    }
+
+    /// Everything besides the level that the document's faired result depends on now; `None`
+    /// without a hierarchy.
+    pub(in crate::app) fn result_key(&self) -> Option<ResultKey> {
+        let document = self.document.as_ref()?;
+        let HierarchyState::Ready {
+            hierarchy, denoise, ..
+        } = &document.hierarchy
+        else {
+            return None;
+        };
+        Some(ResultKey {
+            document: document.generation,
+            hierarchy: Arc::downgrade(hierarchy),
+            original: Arc::downgrade(&document.original),
+            denoised: denoise.is_some(),
+            mask: document.mask.clone(),
+            fairing: self.settings.fairing.key(),
+        })
+    }
+
+    /// Shows the result kept for `level`, if there is one: true when it did (then no fairing
+    /// is needed, and one still running for an older slider value stops, its view passed).
+    fn show_kept(&mut self, document: GenerationId, level: usize, view: GenerationId) -> bool {
+        let Some(key) = self.result_key() else {
+            return false;
+        };
+        let Some(kept) = self.work.kept.take_out(&key, level) else {
+            return false;
+        };
+        self.work.fair_view = view;
+        self.work.fair_in_flight = false;
+        let on_screen = self.document.as_ref().and_then(|d| d.faired.as_ref());
+        if on_screen.is_some_and(|f| Arc::ptr_eq(&f.positions, &kept.positions)) {
+            // Already on screen (back from the level mesh, say): nothing to upload again.
+            self.work.applied_view = view;
+            return true;
+        }
+        self.frame_stats.log_arrival("a kept result");
+        self.show_faired(document, view, level, kept);
+        true
+    }
+
+    /// While the slider rests (nothing faired or measured for the view any more), fairs the
+    /// nearest level next to it that has no kept result, on the compute worker behind anything
+    /// else it has to do ([`crate::app::kept_results::AHEAD_REACH`]); each result that comes
+    /// back asks for the next. A slider move, a changed setting or another document stops it at
+    /// its next level. Not in a page: its fairings run in the engine's worker, one at a time.
+    pub(in crate::app) fn fair_ahead(&mut self) {
+        #[cfg(not(target_arch = "wasm32"))]
+        {
+            if self.work.ahead_in_flight
+                || self.work.fair_in_flight
+                || self.work.measure_wanted.is_some()
+                || self.work.applied_view != self.work.view_generation.current()
+            {
+                return;
+            }
+            let Some(document) = &self.document else {
+                return;
+            };
+            let HierarchyState::Ready { hierarchy, .. } = &document.hierarchy else {
+                return;
+            };
+            if document.applied || self.settings.view.view_mode == ViewMode::Level {
+                return;
+            }
+            let hierarchy = hierarchy.clone();
+            let (document_id, top) = (document.generation, hierarchy.level_count() - 1);
+            let Some(key) = self.result_key() else {
+                return;
+            };
+            let missing = self.work.kept.missing_near(&key, document.level, top);
+            let Some(&level) = missing.first() else {
+                return;
+            };
+            if !self.work.kept.room_for(document.original.vertex_count()) {
+                return;
+            }
+            let Some(job) = self.fair_job(hierarchy, level) else {
+                return;
+            };
+            let view = self.work.view_generation.current();
+            let document_generation = self.work.document_generation.clone();
+            let view_generation = self.work.view_generation.clone();
+            let workspace = self.work.workspace.clone();
+            // Not counted as work in flight: nobody waits for it, and it stops for anything.
+            let (tx, ctx, ticket) = (
+                self.workers.results_tx.clone(),
+                self.ctx.clone(),
+                self.work.ahead_jobs.start(),
+            );
+            self.work.ahead_in_flight = true;
+            self.workers
+                .compute
+                .submit_idle(JobKind::FairAhead, move || {
+                    let current = || {
+                        document_generation.is_current(document_id)
+                            && view_generation.is_current(view)
+                    };
+                    let result = if current() {
+                        job.run(&workspace, |_| current())
+                    } else {
+                        None
+                    };
+                    let message = JobResult::FairedAhead { key, level, result };
+                    Self::send_result(&tx, &ctx, message, ticket);
+                });
+        }
+    }
+
+    /// A level faired ahead came back: kept, if nothing it depends on changed meanwhile, and
+    /// the next one asked for.
+    #[cfg_attr(target_arch = "wasm32", allow(dead_code))]
+    pub(in crate::app) fn on_faired_ahead(
+        &mut self,
+        key: ResultKey,
+        level: usize,
+        result: Option<Faired>,
+    ) {
+        self.work.ahead_in_flight = false;
+        let Some(faired) = result else {
+            return;
+        };
+        if self.result_key().as_ref() != Some(&key) {
+            return;
+        }
+        self.work
+            .kept
+            .keep_ahead(key, level, KeptResult::of(faired));
+        self.fair_ahead();
     }
 
     /// A level mesh for the level view arrived.

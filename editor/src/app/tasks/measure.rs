@@ -162,10 +162,19 @@ impl App {
         else {
             return;
         };
+        self.work.kept.add_measures(
+            &faired.positions,
+            (
+                against_document.clone(),
+                against_clean.clone(),
+                measure_time,
+            ),
+        );
         faired.against_document = against_document;
         faired.against_clean = against_clean;
         faired.measure_time = measure_time;
         faired.measures_pending = false;
+        self.fair_ahead();
     }
 
     /// A measuring stopped because the view moved on: measured again later if still shown.
