@@ -877,6 +877,10 @@ fn fairing_controls_explain_themselves_and_say_why_they_are_off() {
     }
     harness.get_by_label_contains("Result: Laplacian, whole mesh");
     assert!(harness.query_by_label_contains("from M").is_none());
+    // Its result is the same at every level: kept once, nothing faired ahead.
+    let status = harness.state().status();
+    assert!(!status.fairing_ahead);
+    assert_eq!(status.kept_results, 1);
 }
 
 /// A file opens at start level 0 (`fair`'s result: all the detail kept), and at the level last

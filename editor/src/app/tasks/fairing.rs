@@ -307,7 +307,11 @@ impl App {
             let HierarchyState::Ready { hierarchy, .. } = &document.hierarchy else {
                 return;
             };
-            if document.applied || self.settings.view.view_mode == ViewMode::Level {
+            // A baseline smooths the whole mesh whatever the level: nothing to fair ahead.
+            if document.applied
+                || self.settings.view.view_mode == ViewMode::Level
+                || self.settings.fairing.baseline_options().is_some()
+            {
                 return;
             }
             let hierarchy = hierarchy.clone();
