@@ -365,7 +365,7 @@ pub enum JobResult {
         /// `None`: cancelled or failed.
         result: Option<Faired>,
     },
-    /// A level faired ahead ([`crate::app::kept_results`]), under `key`.
+    /// A level faired ahead (see `kept_results.rs`), under `key`.
     #[cfg_attr(target_arch = "wasm32", allow(dead_code))]
     FairedAhead {
         key: crate::app::kept_results::ResultKey,
