@@ -18,7 +18,6 @@ use fairmesh::hierarchy::Hierarchy;
 use fairmesh::TriMesh;
 
 use super::generation::GenerationId;
-use super::jobs::Faired;
 use super::state::{FairingKey, Measures};
 
 /// How many levels either side of the one on screen are faired ahead while the slider rests.
@@ -72,19 +71,6 @@ pub(in crate::app) struct KeptResult {
 }
 
 impl KeptResult {
-    /// A fairing's result, not measured yet.
-    pub(in crate::app) fn of(faired: Faired) -> Self {
-        KeptResult {
-            positions: Arc::new(faired.positions),
-            method: faired.method,
-            volume_change: faired.volume_change,
-            rms_displacement: faired.rms_displacement,
-            folds_left: faired.folds_left,
-            elapsed: faired.elapsed,
-            measures: None,
-        }
-    }
-
     /// Memory it holds: its positions and its measures' distances.
     fn bytes(&self) -> usize {
         let distances = |m: &Option<Measures>| m.as_ref().map_or(0, |m| m.vertex_distances.len());

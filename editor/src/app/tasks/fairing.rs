@@ -176,7 +176,7 @@ impl App {
         let Some(faired) = result else {
             return;
         };
-        let kept = KeptResult::of(faired);
+        let kept = kept_result(faired);
         // Asked for under the settings of now (nothing changed since): kept for its level.
         let same_document = self.document.as_ref().map(|d| d.generation) == Some(document);
         if same_document && self.work.view_generation.is_current(view) {
@@ -374,9 +374,7 @@ impl App {
         if self.result_key().as_ref() != Some(&key) {
             return;
         }
-        self.work
-            .kept
-            .keep_ahead(key, level, KeptResult::of(faired));
+        self.work.kept.keep_ahead(key, level, kept_result(faired));
         self.fair_ahead();
     }
 
@@ -396,5 +394,18 @@ impl App {
         }
         self.work.applied_level_view = view;
         current.level_mesh = Some((level, mesh));
+    }
+}
+
+/// A fairing's result as the editor keeps it, not measured yet.
+fn kept_result(faired: Faired) -> KeptResult {
+    KeptResult {
+        positions: Arc::new(faired.positions),
+        method: faired.method,
+        volume_change: faired.volume_change,
+        rms_displacement: faired.rms_displacement,
+        folds_left: faired.folds_left,
+        elapsed: faired.elapsed,
+        measures: None,
     }
 }
