@@ -34,13 +34,13 @@ pub(in crate::app) const KEPT_AT_LEAST: usize = 3;
 /// Everything besides the start level that a faired result depends on. The hierarchy and the
 /// document's mesh are named by their allocations, held weakly: a key keeps neither alive (a
 /// hierarchy built anew frees the old one), and while it exists no other can take the address.
+/// Whether the noise was removed first comes with the hierarchy (built on the denoised mesh).
 #[derive(Clone)]
 pub struct ResultKey {
     pub(in crate::app) document: GenerationId,
     pub(in crate::app) hierarchy: Weak<Hierarchy>,
     /// The document's mesh (noise and Apply replace it).
     pub(in crate::app) original: Weak<TriMesh>,
-    pub(in crate::app) denoised: bool,
     pub(in crate::app) mask: Option<Mask>,
     pub(in crate::app) fairing: FairingKey,
 }
@@ -50,7 +50,6 @@ impl PartialEq for ResultKey {
         self.document == other.document
             && Weak::ptr_eq(&self.hierarchy, &other.hierarchy)
             && Weak::ptr_eq(&self.original, &other.original)
-            && self.denoised == other.denoised
             && self.mask == other.mask
             && self.fairing == other.fairing
     }
@@ -162,8 +161,9 @@ impl KeptResults {
         level: usize,
         top: usize,
     ) -> Vec<usize> {
-        let kept =
-            |l: usize| self.key.as_ref() == Some(key) && self.results.iter().any(|(k, _)| *k == l);
+        // Compared once: the key holds the painted mask, one weight per vertex.
+        let same_key = self.key.as_ref() == Some(key);
+        let kept = |l: usize| same_key && self.results.iter().any(|(k, _)| *k == l);
         (1..=AHEAD_REACH)
             .flat_map(|d| {
                 [
@@ -198,7 +198,6 @@ mod tests {
             document: GenerationId::default(),
             hierarchy: Arc::downgrade(hierarchy),
             original: Arc::downgrade(original),
-            denoised: false,
             mask: None,
             fairing: FairingSettings::default().key(),
         }

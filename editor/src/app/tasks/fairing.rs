@@ -248,17 +248,13 @@ impl App {
     /// without a hierarchy.
     pub(in crate::app) fn result_key(&self) -> Option<ResultKey> {
         let document = self.document.as_ref()?;
-        let HierarchyState::Ready {
-            hierarchy, denoise, ..
-        } = &document.hierarchy
-        else {
+        let HierarchyState::Ready { hierarchy, .. } = &document.hierarchy else {
             return None;
         };
         Some(ResultKey {
             document: document.generation,
             hierarchy: Arc::downgrade(hierarchy),
             original: Arc::downgrade(&document.original),
-            denoised: denoise.is_some(),
             mask: document.mask.clone(),
             fairing: self.settings.fairing.key(),
         })
